@@ -1,0 +1,71 @@
+use std::fmt;
+use std::str::FromStr;
+
+/// A shading model. The numeric value ([`BrdfId::index`]) is what the G-buffer stores and what the
+/// GLSL `BRDF_*` constants (generated from [`BrdfId::ALL`] by the shader build) switch on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BrdfId {
+    /// `rho / pi`: the diffuse default.
+    Lambert,
+    /// Lambert diffuse plus the normalized Blinn-Phong lobe `(n + 8) / (8 pi) * max(N.H, 0)^n`.
+    BlinnPhong,
+}
+
+impl BrdfId {
+    /// Every BRDF, in index order.
+    pub const ALL: [BrdfId; 2] = [BrdfId::Lambert, BrdfId::BlinnPhong];
+
+    /// The stable numeric id used by the G-buffer and the shaders.
+    pub const fn index(self) -> u32 {
+        self as u32
+    }
+
+    /// The snake_case name used on the command line, in glTF extras and in CSV files.
+    pub const fn name(self) -> &'static str {
+        match self {
+            BrdfId::Lambert => "lambert",
+            BrdfId::BlinnPhong => "blinn_phong",
+        }
+    }
+
+    /// The name of the GLSL constant holding [`BrdfId::index`].
+    pub fn glsl_constant(self) -> String {
+        format!("BRDF_{}", self.name().to_uppercase())
+    }
+}
+
+impl fmt::Display for BrdfId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A BRDF name that histencil does not know.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown BRDF `{0}` (known: lambert, blinn_phong)")]
+pub struct UnknownBrdf(pub String);
+
+impl FromStr for BrdfId {
+    type Err = UnknownBrdf;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        BrdfId::ALL
+            .into_iter()
+            .find(|b| b.name() == s)
+            .ok_or_else(|| UnknownBrdf(s.to_owned()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_indices_are_dense() {
+        for (i, b) in BrdfId::ALL.into_iter().enumerate() {
+            assert_eq!(b.index() as usize, i);
+            assert_eq!(b.name().parse::<BrdfId>().unwrap(), b);
+        }
+        assert_eq!(BrdfId::BlinnPhong.glsl_constant(), "BRDF_BLINN_PHONG");
+        assert!("phong".parse::<BrdfId>().is_err());
+    }
+}

@@ -1,0 +1,306 @@
+//! The embedded scenes: a procedural room and its variants. Deterministic: the same name always
+//! gives the same scene (a fixed-seed generator, no system randomness).
+
+use crate::{Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape};
+use glam::{Mat4, Quat, Vec3};
+
+/// `(name, description)` of every embedded scene.
+pub const EMBEDDED: [(&str, &str); 3] = [
+    (
+        "default",
+        "procedural room: 2 BRDFs, 36 point lights from tiny to huge, 3 spots, 1 directional",
+    ),
+    (
+        "inside",
+        "the default room with the camera inside a huge point light's volume",
+    ),
+    (
+        "near-far",
+        "the default room with light volumes crossing the near and the far plane",
+    ),
+];
+
+pub fn embedded_names() -> impl Iterator<Item = &'static str> {
+    EMBEDDED.iter().map(|(n, _)| *n)
+}
+
+/// The embedded scene called `name`.
+pub fn embedded(name: &str) -> Result<Scene, SceneError> {
+    let description = EMBEDDED
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, d)| d.to_string())
+        .ok_or_else(|| SceneError::UnknownScene {
+            name: name.to_owned(),
+            known: embedded_names().collect::<Vec<_>>().join(", "),
+        })?;
+    let mut scene = room(name, description);
+    match name {
+        "inside" => {
+            scene.camera.eye = Vec3::new(1.5, 2.2, 5.0);
+            scene.lights.push(Light::point(
+                Vec3::new(2.5, 2.5, 4.0),
+                6.0,
+                Vec3::new(2.0, 1.6, 1.2),
+            ));
+        }
+        "near-far" => {
+            scene.camera.near = 0.5;
+            scene.camera.far = 15.0;
+            // Crosses the near plane while the eye stays outside it.
+            let forward = (scene.camera.target - scene.camera.eye).normalize();
+            scene.lights.push(Light::point(
+                scene.camera.eye + forward * 0.9 + Vec3::new(0.3, -0.2, 0.0),
+                0.7,
+                Vec3::new(0.3, 0.6, 1.0),
+            ));
+            // Crosses the far plane over the back of the room.
+            scene.lights.push(Light::point(
+                scene.camera.eye + forward * 14.5,
+                4.0,
+                Vec3::new(6.0, 3.0, 1.5),
+            ));
+        }
+        _ => {}
+    }
+    Ok(scene)
+}
+
+/// A tiny deterministic generator (SplitMix64), so scenes never depend on a crate's RNG stream.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next_f32(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.next_f32()
+    }
+}
+
+fn object(name: &str, shape: Shape, transform: Mat4, material: Material) -> Object {
+    Object {
+        name: name.to_owned(),
+        shape,
+        transform,
+        material,
+    }
+}
+
+fn slab(name: &str, center: Vec3, half: Vec3, material: Material) -> Object {
+    object(
+        name,
+        Shape::Box,
+        Mat4::from_scale_rotation_translation(half, Quat::IDENTITY, center),
+        material,
+    )
+}
+
+fn room(name: &str, description: String) -> Scene {
+    let wall = Material::lambert(Vec3::new(0.75, 0.72, 0.68));
+    let floor = Material::blinn_phong(Vec3::new(0.5, 0.45, 0.4), 0.25, 24.0);
+    let mut objects = vec![
+        slab(
+            "floor",
+            Vec3::new(0.0, -0.1, 0.0),
+            Vec3::new(8.0, 0.1, 10.0),
+            floor,
+        ),
+        slab(
+            "wall-back",
+            Vec3::new(0.0, 3.0, -10.1),
+            Vec3::new(8.0, 3.0, 0.1),
+            wall,
+        ),
+        slab(
+            "wall-left",
+            Vec3::new(-8.1, 3.0, 0.0),
+            Vec3::new(0.1, 3.0, 10.0),
+            wall,
+        ),
+        slab(
+            "wall-right",
+            Vec3::new(8.1, 3.0, 0.0),
+            Vec3::new(0.1, 3.0, 10.0),
+            wall,
+        ),
+    ];
+    let mut rng = SplitMix(0x6869_7374_656e_6369);
+    for i in 0..6 {
+        let x = -5.0 + 2.0 * i as f32;
+        let z = -3.0 - (i % 2) as f32 * 2.5;
+        let r = 0.6 + 0.1 * (i % 3) as f32;
+        let albedo = Vec3::new(
+            rng.range(0.2, 0.9),
+            rng.range(0.2, 0.9),
+            rng.range(0.2, 0.9),
+        );
+        let material = if i % 2 == 0 {
+            Material::blinn_phong(albedo, 0.6, [16.0, 64.0, 256.0][i / 2])
+        } else {
+            Material::lambert(albedo)
+        };
+        let t = Mat4::from_scale_rotation_translation(
+            Vec3::splat(r),
+            Quat::IDENTITY,
+            Vec3::new(x, r, z),
+        );
+        objects.push(object(&format!("sphere-{i}"), Shape::Sphere, t, material));
+    }
+    for i in 0..4 {
+        let x = -4.5 + 3.0 * i as f32;
+        let h = 0.4 + 0.3 * i as f32;
+        let rot = Quat::from_rotation_y(0.4 * i as f32 + 0.2);
+        let albedo = Vec3::new(
+            rng.range(0.3, 0.9),
+            rng.range(0.3, 0.9),
+            rng.range(0.3, 0.9),
+        );
+        let material = if i % 2 == 0 {
+            Material::lambert(albedo)
+        } else {
+            Material::blinn_phong(albedo, 0.4, 32.0)
+        };
+        let t = Mat4::from_scale_rotation_translation(
+            Vec3::new(0.5, h, 0.5),
+            rot,
+            Vec3::new(x, h, 1.0),
+        );
+        objects.push(object(&format!("box-{i}"), Shape::Box, t, material));
+    }
+
+    let mut lights = Vec::new();
+    // 36 point lights on a jittered grid; radii from tiny (0.25) to huge (12).
+    for i in 0..36 {
+        let gx = (i % 6) as f32;
+        let gz = (i / 6) as f32;
+        let radius = 0.25 * 48f32.powf(rng.next_f32().powi(2));
+        let position = Vec3::new(
+            -6.5 + 2.6 * gx + rng.range(-0.5, 0.5),
+            rng.range(0.2, 4.5),
+            -9.0 + 3.0 * gz + rng.range(-0.5, 0.5),
+        );
+        let hue = Vec3::new(
+            rng.range(0.3, 1.0),
+            rng.range(0.3, 1.0),
+            rng.range(0.3, 1.0),
+        );
+        // Brightness grows with the radius so huge lights stay visible without blowing out.
+        let color = hue * (0.6 + 0.25 * radius);
+        lights.push(Light::point(position, radius, color));
+    }
+    for (i, (pos, target)) in [
+        (Vec3::new(-5.0, 5.5, 2.0), Vec3::new(-4.0, 0.0, -1.0)),
+        (Vec3::new(0.0, 5.8, -2.0), Vec3::new(0.5, 0.0, -4.0)),
+        (Vec3::new(5.0, 5.0, 3.0), Vec3::new(3.0, 0.0, 1.0)),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        lights.push(Light {
+            kind: LightKind::Spot {
+                direction: target - pos,
+                inner_angle: (15.0 + 5.0 * i as f32).to_radians(),
+                outer_angle: (25.0 + 8.0 * i as f32).to_radians(),
+            },
+            position: pos,
+            radius: 9.0,
+            color: Vec3::new(3.0, 2.6, 2.0),
+        });
+    }
+    lights.push(Light {
+        kind: LightKind::Directional {
+            direction: Vec3::new(0.3, -1.0, -0.4),
+        },
+        position: Vec3::ZERO,
+        radius: 0.0,
+        color: Vec3::new(0.08, 0.09, 0.12),
+    });
+
+    Scene {
+        name: name.to_owned(),
+        description,
+        camera: Camera {
+            eye: Vec3::new(0.0, 3.2, 9.0),
+            target: Vec3::new(0.0, 1.0, -3.0),
+            up: Vec3::Y,
+            fov_y_radians: 60f32.to_radians(),
+            near: 0.1,
+            far: 40.0,
+        },
+        objects,
+        lights,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_embedded_scene_is_valid_and_deterministic() {
+        for name in embedded_names() {
+            let a = embedded(name).unwrap();
+            a.validate().unwrap();
+            let b = embedded(name).unwrap();
+            assert_eq!(format!("{a:?}"), format!("{b:?}"));
+            let points = a
+                .lights
+                .iter()
+                .filter(|l| l.kind == LightKind::Point)
+                .count();
+            assert!(points >= 32, "{name}: {points} point lights");
+        }
+    }
+
+    #[test]
+    fn default_scene_has_tiny_and_huge_lights() {
+        let s = embedded("default").unwrap();
+        let radii: Vec<f32> = s
+            .lights
+            .iter()
+            .filter(|l| l.is_local())
+            .map(|l| l.radius)
+            .collect();
+        let min = radii.iter().cloned().fold(f32::INFINITY, f32::min);
+        let max = radii.iter().cloned().fold(0.0, f32::max);
+        assert!(min < 0.5 && max > 6.0, "radii {min}..{max}");
+    }
+
+    #[test]
+    fn variants_put_the_camera_where_they_say() {
+        let s = embedded("inside").unwrap();
+        let eye = s.camera.eye;
+        assert!(s
+            .lights
+            .iter()
+            .any(|l| l.is_local() && (l.position - eye).length() < l.radius));
+
+        let s = embedded("near-far").unwrap();
+        let c = s.camera;
+        let fwd = (c.target - c.eye).normalize();
+        let crosses = |plane: f32| {
+            s.lights.iter().any(|l| {
+                let d = (l.position - c.eye).dot(fwd);
+                l.is_local()
+                    && (d - plane).abs() < l.radius
+                    && (l.position - c.eye).length() > l.radius
+            })
+        };
+        assert!(crosses(c.near), "no light crosses the near plane");
+        assert!(crosses(c.far), "no light crosses the far plane");
+    }
+
+    #[test]
+    fn unknown_scene_is_a_clear_error() {
+        let err = embedded("kitchen").unwrap_err();
+        assert!(err.to_string().contains("unknown scene `kitchen`"));
+        assert!(err.to_string().contains("default"));
+    }
+}

@@ -1,0 +1,212 @@
+//! Procedural meshes: object shapes and light volumes. Triangles wind counter-clockwise seen from
+//! outside; light volumes *circumscribe* the region they bound, so rasterising them never misses a
+//! lit pixel (the light shader's falloff is exactly zero outside the true region).
+
+use std::f32::consts::{PI, TAU};
+
+/// A vertex: object-space position and normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+}
+
+/// An indexed triangle list.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    fn push_triangle_fan_quad(&mut self, corners: [[f32; 3]; 4], normal: [f32; 3]) {
+        let base = self.vertices.len() as u32;
+        for position in corners {
+            self.vertices.push(Vertex { position, normal });
+        }
+        self.indices
+            .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+
+    /// Each triangle's plane distance from `center` (positive when `center` is on the inner side).
+    pub fn face_distances(&self, center: glam::Vec3) -> impl Iterator<Item = f32> + '_ {
+        self.indices.chunks_exact(3).map(move |t| {
+            let p = |i: u32| glam::Vec3::from(self.vertices[i as usize].position);
+            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+            let n = (b - a).cross(c - a).normalize();
+            n.dot(a - center)
+        })
+    }
+}
+
+/// The cube `[-1, 1]^3` with flat normals.
+pub fn unit_box() -> Mesh {
+    let mut m = Mesh::default();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut normal = [0.0; 3];
+            normal[axis] = sign;
+            let corner = |a: f32, b: f32| {
+                let mut p = [0.0; 3];
+                p[axis] = sign;
+                p[u] = a;
+                p[v] = b;
+                p
+            };
+            let quad = [
+                corner(-1., -1.),
+                corner(1., -1.),
+                corner(1., 1.),
+                corner(-1., 1.),
+            ];
+            // (u, v, axis) is right-handed, so this quad faces +axis; reverse it for -axis.
+            let quad = if sign > 0.0 {
+                quad
+            } else {
+                [quad[0], quad[3], quad[2], quad[1]]
+            };
+            m.push_triangle_fan_quad(quad, normal);
+        }
+    }
+    m
+}
+
+/// A UV sphere of radius 1 with smooth normals: `segments` around, `rings` from pole to pole.
+pub fn uv_sphere(segments: u32, rings: u32) -> Mesh {
+    let mut m = Mesh::default();
+    for r in 0..=rings {
+        let theta = PI * r as f32 / rings as f32;
+        for s in 0..=segments {
+            let phi = TAU * s as f32 / segments as f32;
+            let p = [
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            ];
+            m.vertices.push(Vertex {
+                position: p,
+                normal: p,
+            });
+        }
+    }
+    let row = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let (a, b) = (r * row + s, (r + 1) * row + s);
+            if r != 0 {
+                m.indices.extend_from_slice(&[a, b, a + 1]);
+            }
+            if r != rings - 1 {
+                m.indices.extend_from_slice(&[a + 1, b, b + 1]);
+            }
+        }
+    }
+    m
+}
+
+/// A point-light volume: a UV sphere scaled so every face lies outside the unit sphere.
+pub fn light_sphere(segments: u32, rings: u32) -> Mesh {
+    let mut m = uv_sphere(segments, rings);
+    let inradius = m
+        .face_distances(glam::Vec3::ZERO)
+        .fold(f32::INFINITY, f32::min);
+    // A hair of margin so float rounding in the vertex shader cannot cut into the sphere.
+    let scale = 1.0001 / inradius;
+    for v in &mut m.vertices {
+        v.position = v.position.map(|c| c * scale);
+    }
+    m
+}
+
+/// A spot-light volume: apex at the origin, axis +Z, closed by a cap at `z = 1` whose polygon
+/// circumscribes the unit circle. The renderer scales x, y by `range * tan(outer)` and z by range.
+pub fn light_cone(sides: u32) -> Mesh {
+    let mut m = Mesh::default();
+    let r = 1.0001 / (PI / sides as f32).cos();
+    let ring = |i: u32| {
+        let a = TAU * i as f32 / sides as f32;
+        [r * a.cos(), r * a.sin(), 1.0001]
+    };
+    m.vertices.push(Vertex {
+        position: [0.0; 3],
+        normal: [0.0, 0.0, -1.0],
+    });
+    let cap_center = m.vertices.len() as u32;
+    m.vertices.push(Vertex {
+        position: [0.0, 0.0, 1.0001],
+        normal: [0.0, 0.0, 1.0],
+    });
+    for i in 0..sides {
+        m.vertices.push(Vertex {
+            position: ring(i),
+            normal: [0.0, 0.0, 1.0],
+        });
+    }
+    for i in 0..sides {
+        let a = 2 + i;
+        let b = 2 + (i + 1) % sides;
+        // Side: apex, then the ring counter-clockwise seen from outside.
+        m.indices.extend_from_slice(&[0, b, a]);
+        // Cap, seen from +Z.
+        m.indices.extend_from_slice(&[cap_center, a, b]);
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_outward(m: &Mesh, name: &str) {
+        let inside = if name == "light cone" {
+            glam::Vec3::new(0.0, 0.0, 0.5)
+        } else {
+            glam::Vec3::ZERO
+        };
+        for (i, d) in m.face_distances(inside).enumerate() {
+            assert!(
+                d > 0.0,
+                "{name}: face {i} faces inward (plane distance {d})"
+            );
+        }
+    }
+
+    #[test]
+    fn meshes_wind_outward() {
+        assert_outward(&unit_box(), "box");
+        assert_outward(&light_sphere(16, 8), "light sphere");
+        assert_outward(&light_cone(12), "light cone");
+        // UV sphere faces all face away from the centre too.
+        assert_outward(&uv_sphere(16, 8), "uv sphere");
+    }
+
+    #[test]
+    fn light_sphere_circumscribes_the_unit_sphere() {
+        let m = light_sphere(12, 6);
+        let min = m
+            .face_distances(glam::Vec3::ZERO)
+            .fold(f32::INFINITY, f32::min);
+        assert!(min >= 1.0, "inradius {min}");
+        assert!(min < 1.01);
+    }
+
+    #[test]
+    fn light_cone_circumscribes_the_unit_disc_at_z1() {
+        let m = light_cone(10);
+        // Cap faces sit at z = 1.0001 and the side planes pass outside radius z at height z.
+        for t in m.indices.chunks_exact(3) {
+            let p = |i: u32| glam::Vec3::from(m.vertices[i as usize].position);
+            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+            let n = (b - a).cross(c - a).normalize();
+            if n.z.abs() > 0.99 {
+                continue;
+            }
+            // The point on the cone surface at height 1 in this face's direction lies inside.
+            let dir = glam::Vec3::new(n.x, n.y, 0.0).normalize();
+            let on_cone = glam::Vec3::new(dir.x, dir.y, 1.0);
+            assert!(n.dot(on_cone - a) <= 1e-5, "cone face cuts the unit cone");
+        }
+    }
+}

@@ -1,0 +1,277 @@
+use glam::{Mat4, Vec3};
+use histencil_brdf::BrdfId;
+
+/// A scene: a camera, opaque objects and lights. Plain data; [`Scene::validate`] says whether a
+/// renderer can take it.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub description: String,
+    pub camera: Camera,
+    pub objects: Vec<Object>,
+    pub lights: Vec<Light>,
+}
+
+/// A perspective camera. The aspect ratio comes from the render target.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub fov_y_radians: f32,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl Camera {
+    pub fn view(&self) -> Mat4 {
+        glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up)
+    }
+
+    /// Vulkan clip space: depth 0 at `near`, 1 at `far`, y down.
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        glam::camera::rh::proj::vulkan::perspective(self.fov_y_radians, aspect, self.near, self.far)
+    }
+
+    /// Distance from the eye to a corner of the near plane: a sphere farther than this plus its
+    /// radius from the eye cannot touch the near plane.
+    pub fn near_corner_distance(&self, aspect: f32) -> f32 {
+        let ty = (self.fov_y_radians * 0.5).tan();
+        let tx = ty * aspect;
+        self.near * (1.0 + tx * tx + ty * ty).sqrt()
+    }
+}
+
+/// The shape of an object, in object space.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Shape {
+    /// The cube `[-1, 1]^3`.
+    Box,
+    /// The unit sphere.
+    Sphere,
+}
+
+/// An opaque object.
+#[derive(Clone, Debug)]
+pub struct Object {
+    pub name: String,
+    pub shape: Shape,
+    pub transform: Mat4,
+    pub material: Material,
+}
+
+/// Surface parameters. Which of them a BRDF reads is documented in `histencil-brdf`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    pub brdf: BrdfId,
+    /// Diffuse albedo, linear RGB in `[0, 1]`.
+    pub albedo: Vec3,
+    /// Specular intensity (Blinn-Phong lobe weight).
+    pub specular: f32,
+    /// Blinn-Phong exponent.
+    pub exponent: f32,
+}
+
+impl Material {
+    pub fn lambert(albedo: Vec3) -> Self {
+        Self {
+            brdf: BrdfId::Lambert,
+            albedo,
+            specular: 0.0,
+            exponent: 1.0,
+        }
+    }
+
+    pub fn blinn_phong(albedo: Vec3, specular: f32, exponent: f32) -> Self {
+        Self {
+            brdf: BrdfId::BlinnPhong,
+            albedo,
+            specular,
+            exponent,
+        }
+    }
+}
+
+/// The kind of a light and its kind-specific parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Omnidirectional; its volume is a sphere of the light's radius.
+    Point,
+    /// A cone along `direction`; full intensity inside `inner_angle`, zero outside `outer_angle`
+    /// (half-angles, radians, `outer_angle` below 80 degrees so the cone volume stays a cone).
+    Spot {
+        direction: Vec3,
+        inner_angle: f32,
+        outer_angle: f32,
+    },
+    /// Infinitely far, lighting along `direction`; drawn as a full-screen pass.
+    Directional { direction: Vec3 },
+}
+
+/// A light. `color` is linear RGB radiance scale (intensity folded in).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    pub kind: LightKind,
+    pub position: Vec3,
+    /// Range: the light's contribution is exactly zero at and beyond this distance.
+    pub radius: f32,
+    pub color: Vec3,
+}
+
+impl Light {
+    pub fn point(position: Vec3, radius: f32, color: Vec3) -> Self {
+        Self {
+            kind: LightKind::Point,
+            position,
+            radius,
+            color,
+        }
+    }
+
+    /// True when the light has a bounded volume (point, spot).
+    pub fn is_local(&self) -> bool {
+        !matches!(self.kind, LightKind::Directional { .. })
+    }
+}
+
+/// A scene that a renderer cannot take, or a name that is not a scene.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    #[error("unknown scene `{name}` (embedded scenes: {known})")]
+    UnknownScene { name: String, known: String },
+    #[error("light {index}: {problem}")]
+    BadLight { index: usize, problem: String },
+    #[error("object {index} (`{name}`): {problem}")]
+    BadObject {
+        index: usize,
+        name: String,
+        problem: String,
+    },
+    #[error("camera: {0}")]
+    BadCamera(String),
+}
+
+fn finite3(v: Vec3) -> bool {
+    v.is_finite()
+}
+
+impl Scene {
+    /// Checks everything a renderer relies on: finite numbers, positive light ranges, spot angles,
+    /// a sane camera. Returns the first problem found.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let c = &self.camera;
+        let camera_ok = finite3(c.eye)
+            && finite3(c.target)
+            && finite3(c.up)
+            && c.fov_y_radians > 0.0
+            && c.fov_y_radians < 3.0
+            && c.near > 0.0
+            && c.far > c.near
+            && c.far.is_finite()
+            && (c.target - c.eye).length() > 0.0
+            && (c.target - c.eye).cross(c.up).length() > 0.0;
+        if !camera_ok {
+            return Err(SceneError::BadCamera(format!(
+                "needs finite eye/target/up (not parallel), 0 < fov < 3 rad, 0 < near < far: {c:?}"
+            )));
+        }
+        for (index, l) in self.lights.iter().enumerate() {
+            let bad = |problem: &str| SceneError::BadLight {
+                index,
+                problem: problem.to_owned(),
+            };
+            if !finite3(l.position) || !finite3(l.color) || !l.radius.is_finite() {
+                return Err(bad(
+                    "position, colour and radius must be finite (no NaN or Inf)",
+                ));
+            }
+            if l.color.min_element() < 0.0 {
+                return Err(bad("colour must not be negative"));
+            }
+            match l.kind {
+                LightKind::Point => {}
+                LightKind::Spot {
+                    direction,
+                    inner_angle,
+                    outer_angle,
+                } => {
+                    if !finite3(direction) || direction.length() == 0.0 {
+                        return Err(bad("spot direction must be a finite non-zero vector"));
+                    }
+                    let max = 80f32.to_radians();
+                    if !(inner_angle >= 0.0 && inner_angle < outer_angle && outer_angle <= max) {
+                        return Err(bad("spot angles need 0 <= inner < outer <= 80 degrees"));
+                    }
+                }
+                LightKind::Directional { direction } => {
+                    if !finite3(direction) || direction.length() == 0.0 {
+                        return Err(bad(
+                            "directional direction must be a finite non-zero vector",
+                        ));
+                    }
+                }
+            }
+            if l.is_local() && l.radius <= 0.0 {
+                return Err(bad(
+                    "radius must be positive (zero-size lights light nothing)",
+                ));
+            }
+        }
+        for (index, o) in self.objects.iter().enumerate() {
+            let m = &o.material;
+            let problem = if !o.transform.is_finite() || o.transform.determinant() == 0.0 {
+                Some("transform must be finite and invertible")
+            } else if !finite3(m.albedo) || m.albedo.min_element() < 0.0 {
+                Some("albedo must be finite and non-negative")
+            } else if !(m.specular.is_finite() && m.specular >= 0.0) {
+                Some("specular must be finite and non-negative")
+            } else if !(m.exponent.is_finite() && m.exponent >= 0.0) {
+                Some("exponent must be finite and non-negative")
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                return Err(SceneError::BadObject {
+                    index,
+                    name: o.name.clone(),
+                    problem: problem.to_owned(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The distinct BRDFs the objects use, sorted by id. Their position in this list is their
+    /// stencil slot.
+    pub fn brdfs_in_use(&self) -> Vec<BrdfId> {
+        let mut v: Vec<BrdfId> = self.objects.iter().map(|o| o.material.brdf).collect();
+        v.sort();
+        v.dedup();
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nan_and_zero_size_lights_are_rejected() {
+        let mut s = crate::embedded("default").unwrap();
+        s.lights[0].radius = 0.0;
+        assert!(matches!(
+            s.validate(),
+            Err(SceneError::BadLight { index: 0, .. })
+        ));
+        s.lights[0].radius = 1.0;
+        s.lights[1].position.x = f32::NAN;
+        let err = s.validate().unwrap_err();
+        assert!(err.to_string().contains("light 1"), "{err}");
+    }
+
+    #[test]
+    fn brdfs_in_use_are_sorted_and_distinct() {
+        let s = crate::embedded("default").unwrap();
+        assert_eq!(s.brdfs_in_use(), vec![BrdfId::Lambert, BrdfId::BlinnPhong]);
+    }
+}
