@@ -1,1 +1,115 @@
+//! Helpers for histencil's end-to-end GPU tests: a validated context, rendering, and image
+//! comparison that writes `-actual`, `-expected` and `-difference` PNGs when a check fails.
 
+use histencil_scene::Scene;
+use histencil_vk::{Context, ContextDesc, Frame, Readback, Renderer, Technique};
+use image::RgbaImage;
+use std::path::PathBuf;
+
+/// Where failing comparisons write their images.
+pub fn output_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/test-output");
+    std::fs::create_dir_all(&dir).expect("create target/test-output");
+    dir
+}
+
+/// Runs `body` with a validated context, then drops the context (the validation layer reports
+/// leaked objects at device destruction) and fails on any validation message.
+pub fn with_validated_context<T>(body: impl FnOnce(&Context) -> T) -> T {
+    let ctx = Context::new(ContextDesc::validated()).expect("a Vulkan 1.3 device with validation");
+    let log = ctx.validation_log();
+    let result = body(&ctx);
+    drop(ctx);
+    log.assert_clean();
+    result
+}
+
+/// Renders one frame of `scene`.
+pub fn render(
+    ctx: &Context,
+    scene: &Scene,
+    technique: Technique,
+    size: u32,
+    readback: Readback,
+) -> Frame {
+    let mut renderer = Renderer::new(ctx, scene.clone(), size, size).expect("renderer");
+    renderer.render(technique, readback).expect("frame")
+}
+
+/// Per-channel absolute differences of two 8-bit images.
+#[derive(Debug, Clone, Copy)]
+pub struct ImageDiff {
+    pub max: u8,
+    pub mean: f64,
+    pub pixels_differing: usize,
+}
+
+pub fn diff(a: &RgbaImage, b: &RgbaImage) -> ImageDiff {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let mut max = 0u8;
+    let mut sum = 0u64;
+    let mut pixels_differing = 0;
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        let d =
+            pa.0.iter()
+                .zip(pb.0)
+                .map(|(x, y)| x.abs_diff(y))
+                .max()
+                .unwrap();
+        pixels_differing += usize::from(d > 0);
+        max = max.max(d);
+        sum +=
+            pa.0.iter()
+                .zip(pb.0)
+                .map(|(x, y)| u64::from(x.abs_diff(y)))
+                .sum::<u64>();
+    }
+    ImageDiff {
+        max,
+        mean: sum as f64 / (a.len() as f64),
+        pixels_differing,
+    }
+}
+
+/// Asserts `actual` is within `tolerance` (per channel, 8-bit steps) of `expected`; on failure
+/// writes `name-actual.png`, `name-expected.png` and `name-difference.png` (differences x 32).
+pub fn assert_close(
+    name: &str,
+    actual: &RgbaImage,
+    expected: &RgbaImage,
+    tolerance: u8,
+) -> ImageDiff {
+    let d = diff(actual, expected);
+    if d.max > tolerance {
+        let dir = output_dir();
+        actual.save(dir.join(format!("{name}-actual.png"))).unwrap();
+        expected
+            .save(dir.join(format!("{name}-expected.png")))
+            .unwrap();
+        let difference = RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
+            let (a, e) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
+            let c = |i: usize| a.0[i].abs_diff(e.0[i]).saturating_mul(32);
+            image::Rgba([c(0), c(1), c(2), 255])
+        });
+        difference
+            .save(dir.join(format!("{name}-difference.png")))
+            .unwrap();
+        panic!(
+            "{name}: max difference {} > {tolerance} (mean {:.4}, {} pixels differ); images in {}",
+            d.max,
+            d.mean,
+            d.pixels_differing,
+            dir.display()
+        );
+    }
+    d
+}
+
+/// Fraction of pixels with any non-zero colour channel: guards against "both images black".
+pub fn lit_fraction(image: &RgbaImage) -> f64 {
+    let lit = image
+        .pixels()
+        .filter(|p| p.0[..3].iter().any(|c| *c > 0))
+        .count();
+    lit as f64 / (image.width() * image.height()) as f64
+}

@@ -20,6 +20,11 @@ impl BrdfId {
         self as u32
     }
 
+    /// The BRDF with numeric id `index`, if any.
+    pub fn from_index(index: u32) -> Option<BrdfId> {
+        BrdfId::ALL.into_iter().find(|b| b.index() == index)
+    }
+
     /// The snake_case name used on the command line, in glTF extras and in CSV files.
     pub const fn name(self) -> &'static str {
         match self {

@@ -1,1 +1,171 @@
-fn main() {}
+//! `histencil`: render embedded scenes with the deferred renderer or the forward reference.
+
+use anyhow::{bail, Context as _, Result};
+use clap::{Parser, Subcommand};
+use histencil_vk::{Context, ContextDesc, Readback, Renderer, Technique};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "histencil",
+    version,
+    about = "Multi-BRDF deferred rendering with hierarchical stencil"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to PNG (and optionally EXR and a stencil dump).
+    Render(RenderArgs),
+    /// List the embedded scenes: name, BRDFs in use, lights, alpha entities, description.
+    Scenes,
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// An embedded scene (see `histencil scenes`).
+    #[arg(long, default_value = "default")]
+    scene: String,
+    /// deferred | forward
+    #[arg(long, default_value = "deferred")]
+    technique: Technique,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Tonemapped PNG output.
+    #[arg(long, default_value = "out/render.png")]
+    out: PathBuf,
+    /// Linear HDR output (OpenEXR).
+    #[arg(long)]
+    hdr: Option<PathBuf>,
+    /// The raw stencil byte of every pixel after lighting, as an 8-bit grey PNG.
+    #[arg(long)]
+    dump_stencil: Option<PathBuf>,
+    /// Frames to time after the written one; the median is printed.
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Enable the Khronos validation layer (with synchronisation validation); any message makes
+    /// the run fail.
+    #[arg(long)]
+    validate: bool,
+}
+
+/// Fails early, with the path in the message, when an output cannot be written.
+fn check_writable(path: &Path) -> Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create directory {}", dir.display()))?;
+    if path.is_dir() {
+        bail!("{} is a directory", path.display());
+    }
+    std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
+
+fn render(args: &RenderArgs) -> Result<()> {
+    let scene = histencil_scene::embedded(&args.scene)?;
+    for path in [
+        Some(&args.out),
+        args.hdr.as_ref(),
+        args.dump_stencil.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        check_writable(path)?;
+    }
+    let ctx = Context::new(ContextDesc {
+        validation: args.validate,
+        device_filter: None,
+    })?;
+    let log = ctx.validation_log();
+    {
+        let mut renderer = Renderer::new(&ctx, scene, args.width, args.height)?;
+        let frame = renderer.render(
+            args.technique,
+            Readback {
+                ldr: true,
+                hdr: args.hdr.is_some(),
+                stencil: args.dump_stencil.is_some(),
+                brdf_ids: false,
+            },
+        )?;
+        let images = frame.images;
+        histencil_vk::save_png(images.ldr.as_ref().expect("requested"), &args.out)?;
+        println!("wrote {}", args.out.display());
+        if let (Some(path), Some(hdr)) = (&args.hdr, &images.hdr) {
+            histencil_vk::save_exr(hdr, path)?;
+            println!("wrote {}", path.display());
+        }
+        if let (Some(path), Some(stencil)) = (&args.dump_stencil, &images.stencil) {
+            histencil_vk::save_png(stencil, path)?;
+            println!("wrote {}", path.display());
+        }
+        let timings = renderer.measure(args.technique, args.frames)?;
+        let passes: Vec<String> = timings
+            .passes
+            .iter()
+            .map(|(n, ms)| format!("{n} {ms:.2} ms"))
+            .collect();
+        println!(
+            "frame time {:.2} ms ({}; median of {} frames at {}x{}, {:?}, device: {})",
+            timings.total_ms(),
+            passes.join(", "),
+            args.frames.max(1),
+            args.width,
+            args.height,
+            args.technique,
+            ctx.device_name()
+        );
+    }
+    drop(ctx);
+    let problems = log.problems();
+    if !problems.is_empty() {
+        for p in &problems {
+            eprintln!("{p}");
+        }
+        bail!("{} validation message(s)", problems.len());
+    }
+    Ok(())
+}
+
+fn scenes() {
+    for (name, description) in histencil_scene::EMBEDDED {
+        let scene = histencil_scene::embedded(name).expect("embedded scenes exist");
+        println!(
+            "{name}\t{}\t{}\t0\t{description}",
+            scene.brdfs_in_use().len(),
+            scene.lights.len()
+        );
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Render(args) => render(args),
+        Command::Scenes => {
+            scenes();
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("histencil: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

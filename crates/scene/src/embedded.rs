@@ -191,8 +191,8 @@ fn room(name: &str, description: String) -> Scene {
             rng.range(0.3, 1.0),
             rng.range(0.3, 1.0),
         );
-        // Brightness grows with the radius so huge lights stay visible without blowing out.
-        let color = hue * (0.6 + 0.25 * radius);
+        // Brightness grows with the radius (falloff is ~1/d^2) so huge lights stay visible.
+        let color = hue * (0.4 + 0.3 * radius * radius);
         lights.push(Light::point(position, radius, color));
     }
     for (i, (pos, target)) in [
@@ -211,7 +211,7 @@ fn room(name: &str, description: String) -> Scene {
             },
             position: pos,
             radius: 9.0,
-            color: Vec3::new(3.0, 2.6, 2.0),
+            color: Vec3::new(14.0, 12.0, 9.0),
         });
     }
     lights.push(Light {

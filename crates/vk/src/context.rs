@@ -1,0 +1,336 @@
+//! The Vulkan context: instance, device, queue, memory allocator, validation log and the naming /
+//! labelling helpers every other module uses.
+
+use crate::debug::{messenger_callback, ValidationLog};
+use crate::error::{Error, Result, VkCall};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::{CStr, CString};
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// How to build a [`Context`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextDesc {
+    /// Enable the Khronos validation layer with synchronisation validation.
+    pub validation: bool,
+    /// Pick the first device whose name contains this (case-insensitive). `None` reads the
+    /// `HISTENCIL_DEVICE` environment variable; without it, a discrete GPU is preferred.
+    pub device_filter: Option<String>,
+}
+
+impl ContextDesc {
+    /// Validation on, device from `HISTENCIL_DEVICE` or the default choice: what tests use.
+    pub fn validated() -> Self {
+        Self {
+            validation: true,
+            device_filter: None,
+        }
+    }
+}
+
+/// One Vulkan device and what hangs off it. Dropping it waits for the device, frees the allocator,
+/// destroys the device (the validation layer reports leaked objects then) and the instance.
+pub struct Context {
+    _entry: ash::Entry,
+    pub(crate) instance: ash::Instance,
+    pub(crate) device: ash::Device,
+    pub(crate) queue: vk::Queue,
+    pub(crate) queue_family: u32,
+    pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    debug_device: Option<ash::ext::debug_utils::Device>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    validation: Arc<ValidationLog>,
+    device_name: String,
+    pub(crate) depth_stencil_format: vk::Format,
+    pub(crate) timestamp_period_ns: f64,
+    pub(crate) max_image_dimension: u32,
+}
+
+fn pick_depth_stencil_format(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+) -> Option<vk::Format> {
+    let needed =
+        vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+    [
+        vk::Format::D32_SFLOAT_S8_UINT,
+        vk::Format::D24_UNORM_S8_UINT,
+    ]
+    .into_iter()
+    .find(|&f| {
+        let props = unsafe { instance.get_physical_device_format_properties(pd, f) };
+        props.optimal_tiling_features.contains(needed)
+    })
+}
+
+impl Context {
+    pub fn new(desc: ContextDesc) -> Result<Self> {
+        // SAFETY: loading the system Vulkan loader; nothing else runs inside it yet.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loading(e.to_string()))?;
+        let available_exts = unsafe { entry.enumerate_instance_extension_properties(None) }
+            .call("vkEnumerateInstanceExtensionProperties")?;
+        let has_ext = |name: &CStr| {
+            available_exts
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(name))
+        };
+        let debug_utils = has_ext(ash::ext::debug_utils::NAME) || desc.validation;
+        if desc.validation {
+            let layers = unsafe { entry.enumerate_instance_layer_properties() }
+                .call("vkEnumerateInstanceLayerProperties")?;
+            if !layers
+                .iter()
+                .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+            {
+                return Err(Error::Loading(
+                    "validation requested but VK_LAYER_KHRONOS_validation is not installed \
+                     (tools/setup installs vulkan-validationlayers)"
+                        .into(),
+                ));
+            }
+        }
+
+        let app_name = c"histencil";
+        let app_info = vk::ApplicationInfo::default()
+            .application_name(app_name)
+            .engine_name(app_name)
+            .api_version(vk::API_VERSION_1_3);
+        let mut extensions = Vec::new();
+        if debug_utils {
+            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+        let mut layers = Vec::new();
+        let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut validation_features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+        if desc.validation {
+            layers.push(VALIDATION_LAYER.as_ptr());
+            extensions.push(ash::ext::validation_features::NAME.as_ptr());
+        }
+        let validation = Arc::new(ValidationLog::default());
+        let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(messenger_callback))
+            .user_data(Arc::as_ptr(&validation) as *mut std::ffi::c_void);
+        // Chained into instance creation too, so messages from vkCreateInstance are caught.
+        let mut messenger_for_create = messenger_info;
+        let mut instance_info = vk::InstanceCreateInfo::default()
+            .application_info(&app_info)
+            .enabled_extension_names(&extensions)
+            .enabled_layer_names(&layers);
+        if desc.validation {
+            instance_info = instance_info
+                .push_next(&mut validation_features)
+                .push_next(&mut messenger_for_create);
+        }
+        let instance =
+            unsafe { entry.create_instance(&instance_info, None) }.call("vkCreateInstance")?;
+
+        let (debug_instance, messenger) = if debug_utils {
+            let di = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            // A fresh copy: messenger_for_create's pNext was rewritten by push_next.
+            let messenger = if desc.validation {
+                unsafe { di.create_debug_utils_messenger(&messenger_info, None) }
+                    .call("vkCreateDebugUtilsMessengerEXT")?
+            } else {
+                vk::DebugUtilsMessengerEXT::null()
+            };
+            (Some(di), messenger)
+        } else {
+            (None, vk::DebugUtilsMessengerEXT::null())
+        };
+
+        let filter = desc.device_filter.clone().or_else(|| {
+            std::env::var("HISTENCIL_DEVICE")
+                .ok()
+                .filter(|s| !s.is_empty())
+        });
+        let chosen = Self::pick_physical_device(&instance, filter.as_deref());
+        let (physical_device, queue_family, device_name) = match chosen {
+            Ok(c) => c,
+            Err(e) => {
+                unsafe {
+                    if let Some(di) = &debug_instance {
+                        di.destroy_debug_utils_messenger(messenger, None);
+                    }
+                    instance.destroy_instance(None);
+                }
+                return Err(e);
+            }
+        };
+        let props = unsafe { instance.get_physical_device_properties(physical_device) };
+        let depth_stencil_format = pick_depth_stencil_format(&instance, physical_device)
+            .ok_or_else(|| Error::NoDevice("no D32_SFLOAT_S8_UINT or D24_UNORM_S8_UINT".into()))?;
+
+        let priorities = [1.0];
+        let queue_infos = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let features = vk::PhysicalDeviceFeatures::default().depth_clamp(true);
+        let mut features13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true);
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_infos)
+            .enabled_features(&features)
+            .push_next(&mut features13);
+        let device = unsafe { instance.create_device(physical_device, &device_info, None) }
+            .call("vkCreateDevice")?;
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let debug_device =
+            debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| Error::Allocation {
+            name: "allocator".into(),
+            message: e.to_string(),
+        })?;
+
+        let ctx = Self {
+            _entry: entry,
+            instance,
+            device,
+            queue,
+            queue_family,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            debug_instance,
+            debug_device,
+            messenger,
+            validation,
+            device_name,
+            depth_stencil_format,
+            timestamp_period_ns: f64::from(props.limits.timestamp_period),
+            max_image_dimension: props.limits.max_image_dimension2_d,
+        };
+        ctx.name(ctx.device.handle(), "histencil-device");
+        ctx.name(ctx.queue, "graphics-queue");
+        Ok(ctx)
+    }
+
+    fn pick_physical_device(
+        instance: &ash::Instance,
+        filter: Option<&str>,
+    ) -> Result<(vk::PhysicalDevice, u32, String)> {
+        let devices =
+            unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
+        let mut candidates = Vec::new();
+        let mut seen = Vec::new();
+        for pd in devices {
+            let props = unsafe { instance.get_physical_device_properties(pd) };
+            let name = props
+                .device_name_as_c_str()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            seen.push(name.clone());
+            if props.api_version < vk::API_VERSION_1_3 {
+                continue;
+            }
+            let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+            let Some(family) = families.iter().position(|f| {
+                f.queue_flags.contains(vk::QueueFlags::GRAPHICS) && f.timestamp_valid_bits > 0
+            }) else {
+                continue;
+            };
+            if let Some(f) = filter {
+                if !name.to_lowercase().contains(&f.to_lowercase()) {
+                    continue;
+                }
+            }
+            let rank = match props.device_type {
+                vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+                vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+                vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+                _ => 3,
+            };
+            candidates.push((rank, pd, family as u32, name));
+        }
+        candidates.sort_by_key(|c| c.0);
+        candidates
+            .into_iter()
+            .next()
+            .map(|(_, pd, family, name)| (pd, family, name))
+            .ok_or_else(|| {
+                Error::NoDevice(format!(
+                    "{}devices seen: [{}]",
+                    filter
+                        .map(|f| format!("none matches HISTENCIL_DEVICE=`{f}`; "))
+                        .unwrap_or_default(),
+                    seen.join(", ")
+                ))
+            })
+    }
+
+    /// The name of the device in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
+    pub fn device_name(&self) -> &str {
+        &self.device_name
+    }
+
+    /// The validation message log; keep a clone to check it after the context is dropped
+    /// (leak reports arrive while the device is destroyed).
+    pub fn validation_log(&self) -> Arc<ValidationLog> {
+        self.validation.clone()
+    }
+
+    /// Names a Vulkan object for validation messages and captures.
+    pub(crate) fn name<H: vk::Handle>(&self, handle: H, name: &str) {
+        if let Some(dd) = &self.debug_device {
+            let name = CString::new(name).expect("object names contain no NUL");
+            let info = vk::DebugUtilsObjectNameInfoEXT::default()
+                .object_handle(handle)
+                .object_name(&name);
+            // Naming is best effort: a failure here changes nothing the renderer does.
+            let _ = unsafe { dd.set_debug_utils_object_name(&info) };
+        }
+    }
+
+    /// Opens a debug label region on a command buffer; pair with [`Context::end_label`].
+    pub(crate) fn begin_label(&self, cmd: vk::CommandBuffer, label: &str) {
+        if let Some(dd) = &self.debug_device {
+            let name = CString::new(label).expect("labels contain no NUL");
+            let info = vk::DebugUtilsLabelEXT::default().label_name(&name);
+            unsafe { dd.cmd_begin_debug_utils_label(cmd, &info) };
+        }
+    }
+
+    pub(crate) fn end_label(&self, cmd: vk::CommandBuffer) {
+        if let Some(dd) = &self.debug_device {
+            unsafe { dd.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            // The allocator frees its memory blocks; it must go before the device.
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_device(None);
+            if let Some(di) = &self.debug_instance {
+                if self.messenger != vk::DebugUtilsMessengerEXT::null() {
+                    di.destroy_debug_utils_messenger(self.messenger, None);
+                }
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}

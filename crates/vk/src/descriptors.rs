@@ -1,0 +1,251 @@
+//! Descriptor set layouts as data, the pipeline layouts built from them, and the sets of a frame.
+//! The tables here are what the reflection test holds every shader module against.
+
+use crate::context::Context;
+use crate::error::{Result, VkCall};
+use crate::gpu_types::PUSH_CONSTANT_BYTES;
+use ash::vk;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    UniformBuffer,
+    StorageBuffer,
+    SampledImage,
+}
+
+impl BindingKind {
+    fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
+        }
+    }
+}
+
+/// One binding of a set: its number, what it holds, and the GLSL name that declares it.
+#[derive(Clone, Copy, Debug)]
+pub struct BindingDesc {
+    pub binding: u32,
+    pub kind: BindingKind,
+    pub glsl_name: &'static str,
+}
+
+const fn binding(binding: u32, kind: BindingKind, glsl_name: &'static str) -> BindingDesc {
+    BindingDesc {
+        binding,
+        kind,
+        glsl_name,
+    }
+}
+
+/// Set 0 of every pipeline (include/frame.glsl).
+pub const FRAME_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::UniformBuffer, "frame"),
+    binding(1, BindingKind::StorageBuffer, "lights"),
+];
+/// Set 1 of the deferred light pipelines (include/gbuffer.glsl).
+pub const GBUFFER_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::SampledImage, "gbuffer_albedo"),
+    binding(1, BindingKind::SampledImage, "gbuffer_normal_depth"),
+    binding(2, BindingKind::SampledImage, "gbuffer_material"),
+];
+/// Set 1 of the tonemap pipeline (tonemap.frag).
+pub const TONEMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "hdr")];
+
+/// The pipeline layouts: which sets, in order.
+pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET];
+pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET];
+pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
+
+/// Every shader module and the pipeline layout it is used with.
+pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
+    ("mesh.vert", MESH_LAYOUT),
+    ("gbuffer.frag", MESH_LAYOUT),
+    ("forward.frag", MESH_LAYOUT),
+    ("light_volume.vert", LIGHTING_LAYOUT),
+    ("deferred_light.frag", LIGHTING_LAYOUT),
+    ("fullscreen.vert", LIGHTING_LAYOUT),
+    ("tonemap.frag", TONEMAP_LAYOUT),
+];
+
+fn create_set_layout(
+    ctx: &Context,
+    name: &str,
+    set: &[BindingDesc],
+) -> Result<vk::DescriptorSetLayout> {
+    let bindings: Vec<_> = set
+        .iter()
+        .map(|b| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(b.binding)
+                .descriptor_type(b.kind.descriptor_type())
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+        })
+        .collect();
+    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+    let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
+        .call("vkCreateDescriptorSetLayout")?;
+    ctx.name(layout, name);
+    Ok(layout)
+}
+
+/// The frame's set layouts, pipeline layouts, pool and sets.
+pub struct Descriptors {
+    pub frame_layout: vk::DescriptorSetLayout,
+    pub gbuffer_layout: vk::DescriptorSetLayout,
+    pub tonemap_layout: vk::DescriptorSetLayout,
+    pub mesh_pipeline_layout: vk::PipelineLayout,
+    pub lighting_pipeline_layout: vk::PipelineLayout,
+    pub tonemap_pipeline_layout: vk::PipelineLayout,
+    pool: vk::DescriptorPool,
+    pub frame_set: vk::DescriptorSet,
+    pub gbuffer_set: vk::DescriptorSet,
+    pub tonemap_set: vk::DescriptorSet,
+}
+
+fn create_pipeline_layout(
+    ctx: &Context,
+    name: &str,
+    sets: &[vk::DescriptorSetLayout],
+) -> Result<vk::PipelineLayout> {
+    let ranges = [vk::PushConstantRange::default()
+        .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+        .size(PUSH_CONSTANT_BYTES)];
+    let info = vk::PipelineLayoutCreateInfo::default()
+        .set_layouts(sets)
+        .push_constant_ranges(&ranges);
+    let layout =
+        unsafe { ctx.device.create_pipeline_layout(&info, None) }.call("vkCreatePipelineLayout")?;
+    ctx.name(layout, name);
+    Ok(layout)
+}
+
+/// What the sets point at.
+pub struct DescriptorTargets {
+    pub frame_uniforms: vk::Buffer,
+    pub lights: vk::Buffer,
+    pub gbuffer_views: [vk::ImageView; 3],
+    pub hdr_view: vk::ImageView,
+}
+
+impl Descriptors {
+    pub fn new(ctx: &Context, targets: &DescriptorTargets) -> Result<Self> {
+        let frame_layout = create_set_layout(ctx, "frame-set-layout", FRAME_SET)?;
+        let gbuffer_layout = create_set_layout(ctx, "gbuffer-set-layout", GBUFFER_SET)?;
+        let tonemap_layout = create_set_layout(ctx, "tonemap-set-layout", TONEMAP_SET)?;
+        let mesh_pipeline_layout =
+            create_pipeline_layout(ctx, "mesh-pipeline-layout", &[frame_layout])?;
+        let lighting_pipeline_layout = create_pipeline_layout(
+            ctx,
+            "lighting-pipeline-layout",
+            &[frame_layout, gbuffer_layout],
+        )?;
+        let tonemap_pipeline_layout = create_pipeline_layout(
+            ctx,
+            "tonemap-pipeline-layout",
+            &[frame_layout, tonemap_layout],
+        )?;
+
+        let sizes = [
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::UNIFORM_BUFFER)
+                .descriptor_count(1),
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(1),
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::SAMPLED_IMAGE)
+                .descriptor_count(4),
+        ];
+        let pool_info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(3)
+            .pool_sizes(&sizes);
+        let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
+            .call("vkCreateDescriptorPool")?;
+        ctx.name(pool, "frame-descriptor-pool");
+        let layouts = [frame_layout, gbuffer_layout, tonemap_layout];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(pool)
+            .set_layouts(&layouts);
+        let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+            .call("vkAllocateDescriptorSets")?;
+        for (set, name) in sets.iter().zip(["frame-set", "gbuffer-set", "tonemap-set"]) {
+            ctx.name(*set, name);
+        }
+        let d = Self {
+            frame_layout,
+            gbuffer_layout,
+            tonemap_layout,
+            mesh_pipeline_layout,
+            lighting_pipeline_layout,
+            tonemap_pipeline_layout,
+            pool,
+            frame_set: sets[0],
+            gbuffer_set: sets[1],
+            tonemap_set: sets[2],
+        };
+        d.write(ctx, targets);
+        Ok(d)
+    }
+
+    fn write(&self, ctx: &Context, t: &DescriptorTargets) {
+        let ubo = [vk::DescriptorBufferInfo::default()
+            .buffer(t.frame_uniforms)
+            .range(vk::WHOLE_SIZE)];
+        let ssbo = [vk::DescriptorBufferInfo::default()
+            .buffer(t.lights)
+            .range(vk::WHOLE_SIZE)];
+        let image = |view| {
+            [vk::DescriptorImageInfo::default()
+                .image_view(view)
+                .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
+        };
+        let gbuffer: Vec<_> = t.gbuffer_views.iter().map(|v| image(*v)).collect();
+        let hdr = image(t.hdr_view);
+        let mut writes = vec![
+            vk::WriteDescriptorSet::default()
+                .dst_set(self.frame_set)
+                .dst_binding(0)
+                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+                .buffer_info(&ubo),
+            vk::WriteDescriptorSet::default()
+                .dst_set(self.frame_set)
+                .dst_binding(1)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .buffer_info(&ssbo),
+            vk::WriteDescriptorSet::default()
+                .dst_set(self.tonemap_set)
+                .dst_binding(0)
+                .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                .image_info(&hdr),
+        ];
+        for (i, info) in gbuffer.iter().enumerate() {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.gbuffer_set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                    .image_info(info),
+            );
+        }
+        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            for l in [
+                self.mesh_pipeline_layout,
+                self.lighting_pipeline_layout,
+                self.tonemap_pipeline_layout,
+            ] {
+                ctx.device.destroy_pipeline_layout(l, None);
+            }
+            for l in [self.frame_layout, self.gbuffer_layout, self.tonemap_layout] {
+                ctx.device.destroy_descriptor_set_layout(l, None);
+            }
+        }
+    }
+}

@@ -1,0 +1,42 @@
+use ash::vk;
+
+/// What can go wrong in the renderer that a caller cannot prevent by calling it correctly.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("cannot load the Vulkan library: {0}")]
+    Loading(String),
+    #[error("no suitable Vulkan 1.3 device: {0}")]
+    NoDevice(String),
+    #[error("Vulkan call `{call}` failed: {result}")]
+    Vulkan {
+        call: &'static str,
+        result: vk::Result,
+    },
+    #[error("GPU memory allocation `{name}` failed: {message}")]
+    Allocation { name: String, message: String },
+    #[error("bad resolution {width}x{height}: {reason}")]
+    BadResolution {
+        width: u32,
+        height: u32,
+        reason: String,
+    },
+    #[error(transparent)]
+    Scene(#[from] histencil_scene::SceneError),
+    #[error("stencil layout: {0}")]
+    Layout(#[from] histencil_model::LayoutError),
+    #[error("cannot write `{path}`: {message}")]
+    Output { path: String, message: String },
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Attaches the call name to a raw `vk::Result`.
+pub(crate) trait VkCall<T> {
+    fn call(self, call: &'static str) -> Result<T>;
+}
+
+impl<T> VkCall<T> for Result<T, vk::Result> {
+    fn call(self, call: &'static str) -> Result<T> {
+        self.map_err(|result| Error::Vulkan { call, result })
+    }
+}

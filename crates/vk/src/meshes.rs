@@ -1,0 +1,116 @@
+//! The scene's meshes on the GPU: object shapes and the two light-volume meshes.
+
+use crate::context::Context;
+use crate::error::Result;
+use crate::resources::Buffer;
+use ash::vk;
+use histencil_scene::{light_cone, light_sphere, unit_box, uv_sphere, Mesh, Shape};
+
+pub struct GpuMesh {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub index_count: u32,
+}
+
+impl GpuMesh {
+    fn new(ctx: &Context, name: &str, mesh: &Mesh) -> Result<Self> {
+        let vertex_bytes: Vec<u8> = mesh
+            .vertices
+            .iter()
+            .flat_map(|v| {
+                v.position
+                    .iter()
+                    .chain(&v.normal)
+                    .flat_map(|f| f.to_ne_bytes())
+            })
+            .collect();
+        let index_bytes: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
+        Ok(Self {
+            vertices: Buffer::with_data(
+                ctx,
+                &format!("{name}-vertices"),
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+                &vertex_bytes,
+            )?,
+            indices: Buffer::with_data(
+                ctx,
+                &format!("{name}-indices"),
+                vk::BufferUsageFlags::INDEX_BUFFER,
+                &index_bytes,
+            )?,
+            index_count: mesh.indices.len() as u32,
+        })
+    }
+
+    /// Binds and draws the whole mesh.
+    pub(crate) fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe {
+            ctx.device
+                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.handle], &[0]);
+            ctx.device
+                .cmd_bind_index_buffer(cmd, self.indices.handle, 0, vk::IndexType::UINT32);
+            ctx.device
+                .cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.vertices.destroy(ctx);
+        self.indices.destroy(ctx);
+    }
+}
+
+/// Light-volume tessellation: enough that the circumscribed mesh stays close to the sphere / cone.
+pub const SPHERE_SEGMENTS: u32 = 24;
+pub const SPHERE_RINGS: u32 = 12;
+pub const CONE_SIDES: u32 = 24;
+
+pub struct Meshes {
+    pub unit_box: GpuMesh,
+    pub sphere: GpuMesh,
+    pub light_sphere: GpuMesh,
+    pub light_cone: GpuMesh,
+    /// Distance from the centre to the farthest vertex of the unit light sphere mesh.
+    pub light_sphere_bound: f32,
+    /// `(farthest radial, axial)` extent of the unit light cone mesh.
+    pub light_cone_bound: (f32, f32),
+}
+
+impl Meshes {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let sphere_volume = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
+        let cone_volume = light_cone(CONE_SIDES);
+        let far = |m: &Mesh, f: fn([f32; 3]) -> f32| {
+            m.vertices.iter().map(|v| f(v.position)).fold(0.0, f32::max)
+        };
+        Ok(Self {
+            unit_box: GpuMesh::new(ctx, "box-mesh", &unit_box())?,
+            sphere: GpuMesh::new(ctx, "sphere-mesh", &uv_sphere(48, 24))?,
+            light_sphere_bound: far(&sphere_volume, |p| glam::Vec3::from(p).length()),
+            light_cone_bound: (
+                far(&cone_volume, |p| glam::Vec2::new(p[0], p[1]).length()),
+                far(&cone_volume, |p| p[2]),
+            ),
+            light_sphere: GpuMesh::new(ctx, "light-sphere-mesh", &sphere_volume)?,
+            light_cone: GpuMesh::new(ctx, "light-cone-mesh", &cone_volume)?,
+        })
+    }
+
+    pub fn shape(&self, shape: Shape) -> &GpuMesh {
+        match shape {
+            Shape::Box => &self.unit_box,
+            Shape::Sphere => &self.sphere,
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for m in [
+            &mut self.unit_box,
+            &mut self.sphere,
+            &mut self.light_sphere,
+            &mut self.light_cone,
+        ] {
+            m.destroy(ctx);
+        }
+    }
+}

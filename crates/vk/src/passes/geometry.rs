@@ -1,0 +1,144 @@
+//! The mesh passes: the G-buffer pass (surface attributes, BRDF id into the stencil BRDF bits) and
+//! the forward reference (every object lit by every light, per pixel).
+
+use super::{
+    begin_rendering, color_attachment, depth_stencil_attachment, Load, CLEAR_BLACK,
+    CLEAR_DEPTH_STENCIL,
+};
+use crate::access::{transition, ImageAccess};
+use crate::context::Context;
+use crate::gpu_types::DrawPush;
+use crate::meshes::Meshes;
+use crate::state::{DrawState, StencilState};
+use crate::targets::Targets;
+use ash::vk;
+use histencil_model::StencilLayout;
+use histencil_scene::Scene;
+
+pub struct GeometryPass<'a> {
+    pub ctx: &'a Context,
+    pub cmd: vk::CommandBuffer,
+    pub scene: &'a Scene,
+    pub meshes: &'a Meshes,
+    pub pipeline: vk::Pipeline,
+    pub pipeline_layout: vk::PipelineLayout,
+    pub frame_set: vk::DescriptorSet,
+    pub extent: vk::Extent2D,
+}
+
+/// The stencil state with which the G-buffer pass writes `slot` (a BRDF's index among those in
+/// use) into the BRDF bits and nothing else. `None` with one BRDF: no BRDF bits exist.
+pub fn gbuffer_stencil(layout: &StencilLayout, slot: u32) -> Option<StencilState> {
+    layout
+        .has_brdf_bits()
+        .then(|| StencilState::replace(layout.brdf_reference(slot), layout.brdf_mask()))
+}
+
+impl GeometryPass<'_> {
+    fn draw_objects(&self, state_of: impl Fn(usize) -> DrawState) {
+        let d = &self.ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                self.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline_layout,
+                0,
+                &[self.frame_set],
+                &[],
+            );
+        }
+        for (i, object) in self.scene.objects.iter().enumerate() {
+            state_of(i).apply(self.ctx, self.cmd);
+            let push = DrawPush::new(object.transform, &object.material);
+            unsafe {
+                d.cmd_push_constants(
+                    self.cmd,
+                    self.pipeline_layout,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+            }
+            self.meshes.shape(object.shape).draw(self.ctx, self.cmd);
+        }
+    }
+
+    /// Writes the G-buffer and each draw's BRDF slot into the stencil BRDF bits.
+    pub fn record_gbuffer(&self, targets: &mut Targets, layout: &StencilLayout, slots: &[u32]) {
+        let (ctx, cmd) = (self.ctx, self.cmd);
+        ctx.begin_label(cmd, "gbuffer");
+        for image in targets.gbuffer.iter_mut() {
+            transition(ctx, cmd, image, ImageAccess::ColorAttachment, true);
+        }
+        transition(
+            ctx,
+            cmd,
+            &mut targets.depth_stencil,
+            ImageAccess::DepthStencilAttachment,
+            true,
+        );
+        // The material target's w (BRDF id) is cleared to -1: "no geometry here".
+        let no_brdf = vk::ClearValue {
+            color: vk::ClearColorValue {
+                float32: [0.0, 0.0, 0.0, -1.0],
+            },
+        };
+        let clears = [CLEAR_BLACK, CLEAR_BLACK, no_brdf];
+        let colors: Vec<_> = targets
+            .gbuffer
+            .iter()
+            .zip(clears)
+            .map(|(i, clear)| color_attachment(i, Load::Clear(clear)))
+            .collect();
+        let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Clear(CLEAR_DEPTH_STENCIL));
+        begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
+        self.draw_objects(|i| match gbuffer_stencil(layout, slots[i]) {
+            Some(s) => DrawState::OPAQUE.with_stencil(s),
+            None => DrawState::OPAQUE,
+        });
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+        ctx.end_label(cmd);
+    }
+
+    /// The forward reference: lit HDR colour straight from the meshes.
+    pub fn record_forward(&self, targets: &mut Targets) {
+        let (ctx, cmd) = (self.ctx, self.cmd);
+        ctx.begin_label(cmd, "forward");
+        transition(
+            ctx,
+            cmd,
+            &mut targets.hdr,
+            ImageAccess::ColorAttachment,
+            true,
+        );
+        transition(
+            ctx,
+            cmd,
+            &mut targets.depth_stencil,
+            ImageAccess::DepthStencilAttachment,
+            true,
+        );
+        let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
+        let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Clear(CLEAR_DEPTH_STENCIL));
+        begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
+        self.draw_objects(|_| DrawState::OPAQUE);
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+        ctx.end_label(cmd);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gbuffer_writes_only_brdf_bits() {
+        let layout = StencilLayout::new(3, 0).unwrap();
+        let s = gbuffer_stencil(&layout, 2).unwrap();
+        assert_eq!(s.write_mask, 0x06);
+        assert_eq!(s.reference, 0x04);
+        assert_eq!(s.compare, vk::CompareOp::ALWAYS);
+        assert!(gbuffer_stencil(&StencilLayout::new(1, 0).unwrap(), 0).is_none());
+    }
+}

@@ -1,0 +1,91 @@
+//! One file per pass. Each pass takes its inputs as one small struct and records into a command
+//! buffer inside its own debug label.
+
+pub mod geometry;
+pub mod lighting;
+pub mod tonemap;
+
+use crate::context::Context;
+use crate::resources::Image;
+use ash::vk;
+
+/// How a pass treats an attachment at the start of rendering.
+#[derive(Clone, Copy)]
+pub(crate) enum Load {
+    Clear(vk::ClearValue),
+    Keep,
+}
+
+pub(crate) fn color_attachment(image: &Image, load: Load) -> vk::RenderingAttachmentInfo<'static> {
+    attachment(image, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, load)
+}
+
+pub(crate) fn depth_stencil_attachment(
+    image: &Image,
+    load: Load,
+) -> vk::RenderingAttachmentInfo<'static> {
+    attachment(
+        image,
+        vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+        load,
+    )
+}
+
+fn attachment(
+    image: &Image,
+    layout: vk::ImageLayout,
+    load: Load,
+) -> vk::RenderingAttachmentInfo<'static> {
+    let (op, clear) = match load {
+        Load::Clear(v) => (vk::AttachmentLoadOp::CLEAR, v),
+        Load::Keep => (vk::AttachmentLoadOp::LOAD, vk::ClearValue::default()),
+    };
+    vk::RenderingAttachmentInfo::default()
+        .image_view(image.view)
+        .image_layout(layout)
+        .load_op(op)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(clear)
+}
+
+pub(crate) const CLEAR_BLACK: vk::ClearValue = vk::ClearValue {
+    color: vk::ClearColorValue { float32: [0.0; 4] },
+};
+
+pub(crate) const CLEAR_DEPTH_STENCIL: vk::ClearValue = vk::ClearValue {
+    depth_stencil: vk::ClearDepthStencilValue {
+        depth: 1.0,
+        stencil: 0,
+    },
+};
+
+/// Begins dynamic rendering over the whole `extent` and sets viewport and scissor.
+pub(crate) fn begin_rendering(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    extent: vk::Extent2D,
+    colors: &[vk::RenderingAttachmentInfo],
+    depth_stencil: Option<&vk::RenderingAttachmentInfo>,
+) {
+    let area = vk::Rect2D::default().extent(extent);
+    let mut info = vk::RenderingInfo::default()
+        .render_area(area)
+        .layer_count(1)
+        .color_attachments(colors);
+    if let Some(ds) = depth_stencil {
+        info = info.depth_attachment(ds).stencil_attachment(ds);
+    }
+    let viewport = vk::Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: extent.width as f32,
+        height: extent.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    unsafe {
+        ctx.device.cmd_begin_rendering(cmd, &info);
+        ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+        ctx.device.cmd_set_scissor(cmd, 0, &[area]);
+    }
+}

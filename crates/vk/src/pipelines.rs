@@ -1,0 +1,310 @@
+//! Graphics pipelines. Everything that changes between the talk's light passes (cull mode, depth
+//! and stencil state) is dynamic state set per draw from a [`crate::state::DrawState`]; pipelines
+//! differ only in shaders, attachments, blending and colour writes.
+
+use crate::context::Context;
+use crate::error::{Result, VkCall};
+use crate::shaders;
+use ash::vk;
+use std::io::Cursor;
+
+/// Which vertex attributes a pipeline reads from binding 0 (`scene::Vertex`, 24 bytes).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum VertexInput {
+    /// No vertex buffer (full-screen triangle).
+    None,
+    /// Position only (light volumes).
+    Position,
+    /// Position and normal (meshes).
+    PositionNormal,
+}
+
+/// A graphics pipeline's fixed parts.
+pub struct PipelineDesc<'a> {
+    pub name: &'a str,
+    pub vertex: (&'a str, &'a [u8]),
+    pub fragment: Option<(&'a str, &'a [u8])>,
+    pub layout: vk::PipelineLayout,
+    pub vertex_input: VertexInput,
+    pub color_formats: &'a [vk::Format],
+    pub color_writes: bool,
+    pub additive_blend: bool,
+    pub depth_stencil_format: vk::Format,
+    /// Clamp depth instead of clipping at near/far: light volumes crossing the far plane keep
+    /// their back faces (at depth 1) so the stencil/depth tests still see them.
+    pub depth_clamp: bool,
+}
+
+fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<vk::ShaderModule> {
+    let words = ash::util::read_spv(&mut Cursor::new(spirv)).expect("build.rs wrote valid SPIR-V");
+    let info = vk::ShaderModuleCreateInfo::default().code(&words);
+    let module =
+        unsafe { ctx.device.create_shader_module(&info, None) }.call("vkCreateShaderModule")?;
+    ctx.name(module, name);
+    Ok(module)
+}
+
+pub const DYNAMIC_STATES: [vk::DynamicState; 11] = [
+    vk::DynamicState::VIEWPORT,
+    vk::DynamicState::SCISSOR,
+    vk::DynamicState::CULL_MODE,
+    vk::DynamicState::DEPTH_TEST_ENABLE,
+    vk::DynamicState::DEPTH_WRITE_ENABLE,
+    vk::DynamicState::DEPTH_COMPARE_OP,
+    vk::DynamicState::STENCIL_TEST_ENABLE,
+    vk::DynamicState::STENCIL_OP,
+    vk::DynamicState::STENCIL_COMPARE_MASK,
+    vk::DynamicState::STENCIL_WRITE_MASK,
+    vk::DynamicState::STENCIL_REFERENCE,
+];
+
+pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipeline> {
+    let vertex_module = create_module(ctx, desc.vertex.0, desc.vertex.1)?;
+    let fragment_module = match desc.fragment {
+        Some((name, spirv)) => match create_module(ctx, name, spirv) {
+            Ok(m) => Some(m),
+            Err(e) => {
+                unsafe { ctx.device.destroy_shader_module(vertex_module, None) };
+                return Err(e);
+            }
+        },
+        None => None,
+    };
+    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::VERTEX)
+        .module(vertex_module)
+        .name(c"main")];
+    if let Some(m) = fragment_module {
+        stages.push(
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(m)
+                .name(c"main"),
+        );
+    }
+    let vertex_bindings = [vk::VertexInputBindingDescription::default()
+        .binding(0)
+        .stride(std::mem::size_of::<histencil_scene::Vertex>() as u32)
+        .input_rate(vk::VertexInputRate::VERTEX)];
+    let attributes = [
+        vk::VertexInputAttributeDescription::default()
+            .location(0)
+            .binding(0)
+            .format(vk::Format::R32G32B32_SFLOAT)
+            .offset(0),
+        vk::VertexInputAttributeDescription::default()
+            .location(1)
+            .binding(0)
+            .format(vk::Format::R32G32B32_SFLOAT)
+            .offset(12),
+    ];
+    let (bindings, attributes): (&[_], &[_]) = match desc.vertex_input {
+        VertexInput::None => (&[], &[]),
+        VertexInput::Position => (&vertex_bindings, &attributes[..1]),
+        VertexInput::PositionNormal => (&vertex_bindings, &attributes),
+    };
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+        .vertex_binding_descriptions(bindings)
+        .vertex_attribute_descriptions(attributes);
+    let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+        .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .depth_clamp_enable(desc.depth_clamp)
+        .polygon_mode(vk::PolygonMode::FILL)
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let depth_stencil = vk::PipelineDepthStencilStateCreateInfo::default();
+    let write_mask = if desc.color_writes {
+        vk::ColorComponentFlags::RGBA
+    } else {
+        vk::ColorComponentFlags::empty()
+    };
+    let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
+        .blend_enable(desc.additive_blend)
+        .src_color_blend_factor(vk::BlendFactor::ONE)
+        .dst_color_blend_factor(vk::BlendFactor::ONE)
+        .color_blend_op(vk::BlendOp::ADD)
+        .src_alpha_blend_factor(vk::BlendFactor::ONE)
+        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+        .alpha_blend_op(vk::BlendOp::ADD)
+        .color_write_mask(write_mask);
+    let blend_attachments = vec![blend_attachment; desc.color_formats.len()];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&DYNAMIC_STATES);
+    let has_depth = desc.depth_stencil_format != vk::Format::UNDEFINED;
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(desc.color_formats)
+        .depth_attachment_format(desc.depth_stencil_format)
+        .stencil_attachment_format(desc.depth_stencil_format);
+    let mut info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&input_assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(desc.layout)
+        .push_next(&mut rendering);
+    if has_depth {
+        info = info.depth_stencil_state(&depth_stencil);
+    }
+    let result = unsafe {
+        ctx.device
+            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+    };
+    unsafe {
+        ctx.device.destroy_shader_module(vertex_module, None);
+        if let Some(m) = fragment_module {
+            ctx.device.destroy_shader_module(m, None);
+        }
+    }
+    let pipeline = result
+        .map_err(|(_, e)| e)
+        .call("vkCreateGraphicsPipelines")?[0];
+    ctx.name(pipeline, desc.name);
+    Ok(pipeline)
+}
+
+/// The renderer's pipelines.
+pub struct Pipelines {
+    pub gbuffer: vk::Pipeline,
+    pub forward: vk::Pipeline,
+    /// Light volume, no colour: the talk's setup (mark) and cleanup passes.
+    pub light_stencil: vk::Pipeline,
+    /// Light volume with the deferred light shader, additive.
+    pub light_volume: vk::Pipeline,
+    /// Full-screen deferred light shader (directional lights).
+    pub light_fullscreen: vk::Pipeline,
+    pub tonemap: vk::Pipeline,
+}
+
+/// Formats the pipelines render to.
+pub struct TargetFormats {
+    pub gbuffer: [vk::Format; 3],
+    pub hdr: vk::Format,
+    pub ldr: vk::Format,
+    pub depth_stencil: vk::Format,
+}
+
+pub struct PipelineLayouts {
+    pub mesh: vk::PipelineLayout,
+    pub lighting: vk::PipelineLayout,
+    pub tonemap: vk::PipelineLayout,
+}
+
+impl Pipelines {
+    pub fn new(ctx: &Context, layouts: &PipelineLayouts, formats: &TargetFormats) -> Result<Self> {
+        let mesh_vert = ("mesh.vert", shaders::MESH_VERT);
+        let volume_vert = ("light_volume.vert", shaders::LIGHT_VOLUME_VERT);
+        let fullscreen_vert = ("fullscreen.vert", shaders::FULLSCREEN_VERT);
+        let light_frag = Some(("deferred_light.frag", shaders::DEFERRED_LIGHT_FRAG));
+        let hdr = [formats.hdr];
+        let base = PipelineDesc {
+            name: "",
+            vertex: mesh_vert,
+            fragment: None,
+            layout: layouts.lighting,
+            vertex_input: VertexInput::Position,
+            color_formats: &hdr,
+            color_writes: true,
+            additive_blend: false,
+            depth_stencil_format: formats.depth_stencil,
+            depth_clamp: false,
+        };
+        let gbuffer = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "gbuffer-pipeline",
+                fragment: Some(("gbuffer.frag", shaders::GBUFFER_FRAG)),
+                layout: layouts.mesh,
+                vertex_input: VertexInput::PositionNormal,
+                color_formats: &formats.gbuffer,
+                ..base
+            },
+        )?;
+        let forward = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "forward-pipeline",
+                fragment: Some(("forward.frag", shaders::FORWARD_FRAG)),
+                layout: layouts.mesh,
+                vertex_input: VertexInput::PositionNormal,
+                ..base
+            },
+        )?;
+        let light_stencil = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "light-stencil-pipeline",
+                vertex: volume_vert,
+                color_writes: false,
+                depth_clamp: true,
+                ..base
+            },
+        )?;
+        let light_volume = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "light-volume-pipeline",
+                vertex: volume_vert,
+                fragment: light_frag,
+                additive_blend: true,
+                depth_clamp: true,
+                ..base
+            },
+        )?;
+        let light_fullscreen = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "light-fullscreen-pipeline",
+                vertex: fullscreen_vert,
+                fragment: light_frag,
+                vertex_input: VertexInput::None,
+                additive_blend: true,
+                ..base
+            },
+        )?;
+        let ldr = [formats.ldr];
+        let tonemap = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "tonemap-pipeline",
+                vertex: fullscreen_vert,
+                fragment: Some(("tonemap.frag", shaders::TONEMAP_FRAG)),
+                layout: layouts.tonemap,
+                vertex_input: VertexInput::None,
+                color_formats: &ldr,
+                depth_stencil_format: vk::Format::UNDEFINED,
+                ..base
+            },
+        )?;
+        Ok(Self {
+            gbuffer,
+            forward,
+            light_stencil,
+            light_volume,
+            light_fullscreen,
+            tonemap,
+        })
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for p in [
+            self.gbuffer,
+            self.forward,
+            self.light_stencil,
+            self.light_volume,
+            self.light_fullscreen,
+            self.tonemap,
+        ] {
+            unsafe { ctx.device.destroy_pipeline(p, None) };
+        }
+    }
+}

@@ -1,0 +1,196 @@
+//! Copying the frame's images back to the host: tonemapped colour, HDR colour and the raw stencil.
+
+use crate::access::{transition, ImageAccess};
+use crate::context::Context;
+use crate::error::Result;
+use crate::resources::{Buffer, Image};
+use crate::targets::Targets;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use histencil_brdf::BrdfId;
+use image::{GrayImage, Rgba32FImage, RgbaImage};
+
+/// Which images a frame copies back.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Readback {
+    pub ldr: bool,
+    pub hdr: bool,
+    pub stencil: bool,
+    /// The BRDF id the G-buffer stored per pixel (deferred only).
+    pub brdf_ids: bool,
+}
+
+impl Readback {
+    pub const NONE: Self = Self {
+        ldr: false,
+        hdr: false,
+        stencil: false,
+        brdf_ids: false,
+    };
+    pub const ALL: Self = Self {
+        ldr: true,
+        hdr: true,
+        stencil: true,
+        brdf_ids: true,
+    };
+}
+
+/// The images a frame copied back.
+#[derive(Default)]
+pub struct FrameImages {
+    /// Tonemapped, sRGB-encoded colour.
+    pub ldr: Option<RgbaImage>,
+    /// Linear HDR colour (the lighting result before tonemapping).
+    pub hdr: Option<Rgba32FImage>,
+    /// The raw stencil byte of every pixel after the lighting pass.
+    pub stencil: Option<GrayImage>,
+    /// Per pixel (row-major), the BRDF the G-buffer pass stored; `None` where nothing was drawn.
+    pub brdf_ids: Option<Vec<Option<BrdfId>>>,
+}
+
+pub(crate) struct ReadbackBuffers {
+    extent: vk::Extent2D,
+    ldr: Buffer,
+    hdr: Buffer,
+    stencil: Buffer,
+    material: Buffer,
+}
+
+impl ReadbackBuffers {
+    pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
+        let pixels = u64::from(extent.width) * u64::from(extent.height);
+        let buffer = |name, bytes_per_pixel| {
+            Buffer::new(
+                ctx,
+                name,
+                pixels * bytes_per_pixel,
+                vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuToCpu,
+            )
+        };
+        Ok(Self {
+            extent,
+            ldr: buffer("ldr-readback", 4)?,
+            hdr: buffer("hdr-readback", 8)?,
+            stencil: buffer("stencil-readback", 1)?,
+            material: buffer("gbuffer-material-readback", 8)?,
+        })
+    }
+
+    fn copy(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        image: &mut Image,
+        aspect: vk::ImageAspectFlags,
+        buffer: &Buffer,
+    ) {
+        transition(ctx, cmd, image, ImageAccess::TransferSource, false);
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(aspect)
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: self.extent.width,
+                height: self.extent.height,
+                depth: 1,
+            });
+        unsafe {
+            ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                image.handle,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buffer.handle,
+                &[region],
+            )
+        };
+    }
+
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        targets: &mut Targets,
+        what: Readback,
+    ) {
+        if what == Readback::NONE {
+            return;
+        }
+        ctx.begin_label(cmd, "readback");
+        let color = vk::ImageAspectFlags::COLOR;
+        if what.ldr {
+            self.copy(ctx, cmd, &mut targets.ldr, color, &self.ldr);
+        }
+        if what.hdr {
+            self.copy(ctx, cmd, &mut targets.hdr, color, &self.hdr);
+        }
+        if what.stencil {
+            self.copy(
+                ctx,
+                cmd,
+                &mut targets.depth_stencil,
+                vk::ImageAspectFlags::STENCIL,
+                &self.stencil,
+            );
+        }
+        if what.brdf_ids {
+            self.copy(ctx, cmd, &mut targets.gbuffer[2], color, &self.material);
+        }
+        // Make the copies visible to the host reads after the fence.
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::COPY)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+            .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+        unsafe {
+            ctx.device.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().memory_barriers(&barrier),
+            )
+        };
+        ctx.end_label(cmd);
+    }
+
+    pub fn read(&self, what: Readback) -> Result<FrameImages> {
+        let (w, h) = (self.extent.width, self.extent.height);
+        let mut images = FrameImages::default();
+        if what.ldr {
+            images.ldr = RgbaImage::from_raw(w, h, self.ldr.read().to_vec());
+        }
+        if what.hdr {
+            let floats: Vec<f32> = self
+                .hdr
+                .read()
+                .chunks_exact(2)
+                .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
+                .collect();
+            images.hdr = Rgba32FImage::from_raw(w, h, floats);
+        }
+        if what.stencil {
+            images.stencil = GrayImage::from_raw(w, h, self.stencil.read().to_vec());
+        }
+        if what.brdf_ids {
+            // gbuffer-material is RGBA16F with the BRDF id in w, cleared to -1 (no geometry).
+            let ids = self
+                .material
+                .read()
+                .chunks_exact(8)
+                .map(|texel| {
+                    let id = half::f16::from_le_bytes([texel[6], texel[7]]).to_f32();
+                    (id >= 0.0).then(|| BrdfId::from_index(id as u32)).flatten()
+                })
+                .collect();
+            images.brdf_ids = Some(ids);
+        }
+        Ok(images)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.ldr.destroy(ctx);
+        self.hdr.destroy(ctx);
+        self.stencil.destroy(ctx);
+        self.material.destroy(ctx);
+    }
+}

@@ -1,0 +1,222 @@
+//! Buffers and images with their gpu-allocator memory, both named after the resource. They are
+//! destroyed explicitly with the context (`destroy`), never by `Drop`, so teardown order stays in
+//! the owner's hands.
+
+use crate::access::ImageAccess;
+use crate::context::Context;
+use crate::error::{Error, Result, VkCall};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+fn allocate(
+    ctx: &Context,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> Result<Allocation> {
+    ctx.allocator
+        .lock()
+        .unwrap()
+        .allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        })
+        .map_err(|e| Error::Allocation {
+            name: name.to_owned(),
+            message: e.to_string(),
+        })
+}
+
+fn free(ctx: &Context, allocation: Allocation) {
+    // Freeing only fails for allocations this allocator did not make: a bug, not a runtime state.
+    ctx.allocator
+        .lock()
+        .unwrap()
+        .free(allocation)
+        .expect("freeing a gpu-allocator allocation");
+}
+
+/// A buffer and its memory.
+pub struct Buffer {
+    pub handle: vk::Buffer,
+    pub size: vk::DeviceSize,
+    allocation: Option<Allocation>,
+}
+
+impl Buffer {
+    /// Creates a named buffer. `location` decides host visibility: uploads use `CpuToGpu`
+    /// (written once, read by the GPU), readbacks `GpuToCpu`.
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        size: vk::DeviceSize,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Self> {
+        let info = vk::BufferCreateInfo::default()
+            .size(size.max(4))
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let handle = unsafe { ctx.device.create_buffer(&info, None) }.call("vkCreateBuffer")?;
+        ctx.name(handle, name);
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(handle) };
+        let allocation = match allocate(ctx, name, requirements, location, true) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_buffer(handle, None) };
+                return Err(e);
+            }
+        };
+        unsafe {
+            ctx.device
+                .bind_buffer_memory(handle, allocation.memory(), allocation.offset())
+        }
+        .call("vkBindBufferMemory")?;
+        Ok(Self {
+            handle,
+            size,
+            allocation: Some(allocation),
+        })
+    }
+
+    /// A host-visible buffer filled with `bytes`.
+    pub fn with_data(
+        ctx: &Context,
+        name: &str,
+        usage: vk::BufferUsageFlags,
+        bytes: &[u8],
+    ) -> Result<Self> {
+        let mut b = Self::new(
+            ctx,
+            name,
+            bytes.len() as u64,
+            usage,
+            MemoryLocation::CpuToGpu,
+        )?;
+        b.write(bytes);
+        Ok(b)
+    }
+
+    /// Copies `bytes` to the start of a host-visible buffer.
+    ///
+    /// # Panics
+    /// If the buffer is not host visible or `bytes` is longer than it: caller bugs.
+    pub fn write(&mut self, bytes: &[u8]) {
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .expect("buffer is host visible");
+        slice[..bytes.len()].copy_from_slice(bytes);
+    }
+
+    /// The contents of a host-visible buffer.
+    pub fn read(&self) -> &[u8] {
+        let slice = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .expect("buffer is host visible");
+        &slice[..self.size as usize]
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe { ctx.device.destroy_buffer(self.handle, None) };
+        if let Some(a) = self.allocation.take() {
+            free(ctx, a);
+        }
+    }
+}
+
+/// A 2D image, its memory, one view over all its aspects' sampling aspect, and its last access
+/// (from which the next barrier is derived).
+pub struct Image {
+    pub handle: vk::Image,
+    pub view: vk::ImageView,
+    pub format: vk::Format,
+    pub extent: vk::Extent2D,
+    pub aspect: vk::ImageAspectFlags,
+    pub(crate) last_access: ImageAccess,
+    allocation: Option<Allocation>,
+}
+
+impl Image {
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+    ) -> Result<Self> {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        let handle = unsafe { ctx.device.create_image(&info, None) }.call("vkCreateImage")?;
+        ctx.name(handle, name);
+        let requirements = unsafe { ctx.device.get_image_memory_requirements(handle) };
+        let allocation = match allocate(ctx, name, requirements, MemoryLocation::GpuOnly, false) {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { ctx.device.destroy_image(handle, None) };
+                return Err(e);
+            }
+        };
+        unsafe {
+            ctx.device
+                .bind_image_memory(handle, allocation.memory(), allocation.offset())
+        }
+        .call("vkBindImageMemory")?;
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(handle)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(subresource_range(aspect));
+        let view =
+            unsafe { ctx.device.create_image_view(&view_info, None) }.call("vkCreateImageView")?;
+        ctx.name(view, &format!("{name}-view"));
+        Ok(Self {
+            handle,
+            view,
+            format,
+            extent,
+            aspect,
+            last_access: ImageAccess::Nothing,
+            allocation: Some(allocation),
+        })
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_image_view(self.view, None);
+            ctx.device.destroy_image(self.handle, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            free(ctx, a);
+        }
+    }
+}
+
+pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange::default()
+        .aspect_mask(aspect)
+        .level_count(1)
+        .layer_count(1)
+}

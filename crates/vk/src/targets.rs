@@ -1,0 +1,91 @@
+//! The frame's render targets, named after their role (the names show up in validation messages
+//! and captures).
+
+use crate::context::Context;
+use crate::error::{Error, Result};
+use crate::resources::Image;
+use ash::vk;
+
+pub const GBUFFER_FORMATS: [vk::Format; 3] = [
+    vk::Format::R16G16B16A16_SFLOAT, // gbuffer-albedo
+    vk::Format::R32G32B32A32_SFLOAT, // gbuffer-normal-depth
+    vk::Format::R16G16B16A16_SFLOAT, // gbuffer-material
+];
+pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+
+pub struct Targets {
+    pub gbuffer: [Image; 3],
+    pub depth_stencil: Image,
+    pub hdr: Image,
+    pub ldr: Image,
+}
+
+/// Checks a requested resolution against the device.
+pub fn check_extent(ctx: &Context, width: u32, height: u32) -> Result<vk::Extent2D> {
+    let bad = |reason: String| Error::BadResolution {
+        width,
+        height,
+        reason,
+    };
+    if width == 0 || height == 0 {
+        return Err(bad("width and height must be at least 1".into()));
+    }
+    let max = ctx.max_image_dimension;
+    if width > max || height > max {
+        return Err(bad(format!(
+            "this device allows at most {max} pixels per side"
+        )));
+    }
+    Ok(vk::Extent2D { width, height })
+}
+
+impl Targets {
+    pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
+        use vk::ImageUsageFlags as U;
+        let color = vk::ImageAspectFlags::COLOR;
+        let gbuffer_usage = U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC;
+        let names = ["gbuffer-albedo", "gbuffer-normal-depth", "gbuffer-material"];
+        let mut gbuffer = Vec::new();
+        for (name, format) in names.into_iter().zip(GBUFFER_FORMATS) {
+            gbuffer.push(Image::new(ctx, name, format, extent, gbuffer_usage, color)?);
+        }
+        let gbuffer: [Image; 3] = gbuffer.try_into().ok().expect("three G-buffer targets");
+        Ok(Self {
+            gbuffer,
+            depth_stencil: Image::new(
+                ctx,
+                "depth-stencil",
+                ctx.depth_stencil_format,
+                extent,
+                U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
+                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+            )?,
+            hdr: Image::new(
+                ctx,
+                "hdr-color",
+                HDR_FORMAT,
+                extent,
+                U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC,
+                color,
+            )?,
+            ldr: Image::new(
+                ctx,
+                "ldr-color",
+                LDR_FORMAT,
+                extent,
+                U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
+                color,
+            )?,
+        })
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for image in self.gbuffer.iter_mut() {
+            image.destroy(ctx);
+        }
+        self.depth_stencil.destroy(ctx);
+        self.hdr.destroy(ctx);
+        self.ldr.destroy(ctx);
+    }
+}

@@ -1,0 +1,20 @@
+#version 460
+// Forward reference: every fragment evaluates its own BRDF for every light, with the same light
+// code as the deferred pass. Ground truth for every error figure.
+#include "light.glsl"
+#include "draw.glsl"
+
+layout(location = 0) in vec3 in_world_position;
+layout(location = 1) in vec3 in_world_normal;
+layout(location = 2) in float in_linear_depth;
+
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Surface s = surface_from_draw(in_world_position, in_world_normal);
+    vec3 sum = vec3(0.0);
+    for (uint i = 0; i < frame.counts.x; ++i) {
+        sum += shade_light(lights[i], s);
+    }
+    out_color = vec4(sum, 0.0);
+}

@@ -1,0 +1,25 @@
+// Per-draw push constants of the mesh passes (G-buffer, forward).
+// Rust mirror: crates/vk/src/gpu_types.rs (DrawPush).
+#ifndef DRAW_GLSL
+#define DRAW_GLSL
+
+#include "surface.glsl"
+
+layout(push_constant) uniform Draw {
+    mat4 model;
+    vec4 albedo_specular; // rgb albedo, a specular
+    vec4 params;          // x exponent, y z reserved, w BRDF id
+} draw;
+
+Surface surface_from_draw(vec3 world_position, vec3 world_normal) {
+    Surface s;
+    s.position = world_position;
+    s.normal = normalize(world_normal);
+    s.albedo = draw.albedo_specular.rgb;
+    s.specular = draw.albedo_specular.a;
+    s.params = vec4(draw.params.xyz, 0.0);
+    s.brdf = uint(draw.params.w);
+    return s;
+}
+
+#endif

@@ -1,0 +1,39 @@
+// G-buffer layout, written by gbuffer.frag and read by the deferred light shaders (set 1).
+//   albedo:       RGBA16F  rgb albedo, a specular
+//   normal_depth: RGBA32F  xyz world normal, w linear view depth (0 = no geometry)
+//   material:     RGBA16F  xyz BRDF parameters, w BRDF id
+// Float formats keep the deferred path within 1/255 of the forward reference; the error compact
+// encodings would add is the [brdf] issue's measurement.
+#ifndef GBUFFER_GLSL
+#define GBUFFER_GLSL
+
+#include "frame.glsl"
+#include "surface.glsl"
+
+#extension GL_EXT_samplerless_texture_functions : require
+
+// Sampled images read with texelFetch: no sampler, no filtering, exactly one texel.
+layout(set = 1, binding = 0) uniform texture2D gbuffer_albedo;
+layout(set = 1, binding = 1) uniform texture2D gbuffer_normal_depth;
+layout(set = 1, binding = 2) uniform texture2D gbuffer_material;
+
+// Reads the surface under pixel `frag_coord` (gl_FragCoord.xy: the pixel centre). Returns false
+// where no geometry was drawn.
+bool gbuffer_load(vec2 frag_coord, out Surface s) {
+    ivec2 px = ivec2(frag_coord);
+    vec4 normal_depth = texelFetch(gbuffer_normal_depth, px, 0);
+    float linear_depth = normal_depth.w;
+    vec4 albedo = texelFetch(gbuffer_albedo, px, 0);
+    vec4 material = texelFetch(gbuffer_material, px, 0);
+    vec2 ndc = frag_coord * frame.viewport.zw * 2.0 - 1.0;
+    vec3 view_position = vec3(ndc.x * frame.projection.x, -ndc.y * frame.projection.y, -1.0) * linear_depth;
+    s.position = (frame.inv_view * vec4(view_position, 1.0)).xyz;
+    s.normal = normal_depth.xyz;
+    s.albedo = albedo.rgb;
+    s.specular = albedo.a;
+    s.params = vec4(material.xyz, 0.0);
+    s.brdf = uint(material.w);
+    return linear_depth > 0.0;
+}
+
+#endif

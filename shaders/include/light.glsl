@@ -1,0 +1,63 @@
+// Light code shared by the deferred light shaders and the forward reference: what arrives from a
+// light at a point, and how a surface's BRDF turns it into outgoing radiance.
+#ifndef LIGHT_GLSL
+#define LIGHT_GLSL
+
+#include "frame.glsl"
+#include "brdf.glsl"
+#include "surface.glsl"
+
+// Windowed inverse square: exactly zero at d >= range, so a volume that circumscribes the range
+// sphere never misses light and rasterising more than the sphere adds nothing.
+float range_falloff(float d, float range) {
+    float x = d / range;
+    float x2 = x * x;
+    float window = clamp(1.0 - x2 * x2, 0.0, 1.0);
+    return window * window / max(d * d, 1e-4);
+}
+
+// Radiance scale arriving at P from the light, and the unit direction L towards it.
+vec3 light_incident(Light light, vec3 P, out vec3 L) {
+    uint kind = uint(light.color_kind.w);
+    if (kind == LIGHT_DIRECTIONAL) {
+        L = -light.direction.xyz;
+        return light.color_kind.rgb;
+    }
+    vec3 to_light = light.position_radius.xyz - P;
+    float d = length(to_light);
+    float range = light.position_radius.w;
+    if (d >= range || d <= 0.0) {
+        L = vec3(0.0, 0.0, 1.0);
+        return vec3(0.0);
+    }
+    L = to_light / d;
+    float a = range_falloff(d, range);
+    if (kind == LIGHT_SPOT) {
+        a *= smoothstep(light.spot.x, light.spot.y, dot(-L, light.direction.xyz));
+    }
+    return light.color_kind.rgb * a;
+}
+
+// Outgoing radiance towards V for unit light of direction L, by the surface's own BRDF.
+vec3 evaluate_brdf(Surface s, vec3 V, vec3 L) {
+    vec3 diffuse = s.albedo * brdf_lambert(1.0, s.normal, L);
+    switch (s.brdf) {
+    case BRDF_BLINN_PHONG:
+        return diffuse + s.specular * brdf_blinn_phong(s.params.x, s.normal, V, L);
+    default: // BRDF_LAMBERT
+        return diffuse;
+    }
+}
+
+// One light's contribution to one surface point seen from the camera.
+vec3 shade_light(Light light, Surface s) {
+    vec3 L;
+    vec3 incident = light_incident(light, s.position, L);
+    if (all(equal(incident, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    vec3 V = normalize(frame.eye.xyz - s.position);
+    return incident * evaluate_brdf(s, V, L);
+}
+
+#endif

@@ -1,0 +1,27 @@
+#version 460
+// Places a unit light-volume mesh (circumscribed sphere, or cone along +Z) on a light.
+#include "frame.glsl"
+
+layout(push_constant) uniform LightDraw {
+    uint light_index;
+} light_draw;
+
+layout(location = 0) in vec3 in_position;
+
+void main() {
+    Light light = lights[light_draw.light_index];
+    vec3 center = light.position_radius.xyz;
+    float range = light.position_radius.w;
+    vec3 world;
+    if (uint(light.color_kind.w) == LIGHT_SPOT) {
+        vec3 d = light.direction.xyz;
+        vec3 helper = abs(d.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+        vec3 x = normalize(cross(helper, d));
+        vec3 y = cross(d, x);
+        float r = range * light.spot.z;
+        world = center + x * (in_position.x * r) + y * (in_position.y * r) + d * (in_position.z * range);
+    } else {
+        world = center + in_position * range;
+    }
+    gl_Position = frame.view_proj * vec4(world, 1.0);
+}
