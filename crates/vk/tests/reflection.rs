@@ -1,0 +1,58 @@
+//! Every descriptor binding reflected from the SPIR-V (by naga) matches the Rust-side layout the
+//! module is used with: same set, binding, kind, and GLSL name.
+
+use histencil_vk::descriptors::{BindingKind, SHADER_LAYOUTS};
+use histencil_vk::shaders;
+
+fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, String)> {
+    let module = naga::front::spv::parse_u8_slice(spirv, &naga::front::spv::Options::default())
+        .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    module
+        .global_variables
+        .iter()
+        .filter_map(|(_, var)| {
+            let binding = var.binding.as_ref()?;
+            let kind = match var.space {
+                naga::AddressSpace::Uniform => BindingKind::UniformBuffer,
+                naga::AddressSpace::Storage { .. } => BindingKind::StorageBuffer,
+                naga::AddressSpace::Handle => match module.types[var.ty].inner {
+                    naga::TypeInner::Image { .. } => BindingKind::SampledImage,
+                    ref other => panic!("{name}: unexpected handle type {other:?}"),
+                },
+                other => panic!("{name}: unexpected address space {other:?}"),
+            };
+            Some((binding.group, binding.binding, kind, var.name.clone().unwrap_or_default()))
+        })
+        .collect()
+}
+
+#[test]
+fn every_module_has_a_layout_and_every_layout_a_module() {
+    for (name, _) in shaders::ALL {
+        assert!(SHADER_LAYOUTS.iter().any(|(n, _)| n == name), "{name} has no declared layout");
+    }
+    for (name, _) in SHADER_LAYOUTS {
+        assert!(shaders::ALL.iter().any(|(n, _)| n == name), "{name} is declared but not built");
+    }
+}
+
+#[test]
+fn reflected_bindings_match_rust_layouts() {
+    let mut checked = 0;
+    for (name, spirv) in shaders::ALL {
+        let layout = SHADER_LAYOUTS.iter().find(|(n, _)| n == name).unwrap().1;
+        for (set, binding, kind, glsl_name) in reflected_bindings(name, spirv) {
+            let declared = layout
+                .get(set as usize)
+                .and_then(|s| s.iter().find(|b| b.binding == binding))
+                .unwrap_or_else(|| panic!("{name}: set {set} binding {binding} is not in the Rust layout"));
+            assert_eq!(declared.kind, kind, "{name}: set {set} binding {binding}");
+            // Anonymous blocks (`buffer Lights { ... };`) have no variable name in SPIR-V.
+            if !glsl_name.is_empty() {
+                assert_eq!(declared.glsl_name, glsl_name, "{name}: set {set} binding {binding}");
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 10, "only {checked} bindings reflected: is reflection working?");
+}
