@@ -163,7 +163,13 @@ fn main() -> ExitCode {
         Err(e) => {
             // One line: clap's first line names the problem; its "try --help" tail is noise.
             let text = e.to_string();
-            eprintln!("histencil: {}", text.lines().next().unwrap_or("bad arguments").trim_start_matches("error: "));
+            eprintln!(
+                "histencil: {}",
+                text.lines()
+                    .next()
+                    .unwrap_or("bad arguments")
+                    .trim_start_matches("error: ")
+            );
             return ExitCode::from(2);
         }
     };

@@ -19,18 +19,36 @@ fn assert_one_line_error(args: &[&str], needle: &str) {
     assert!(!ok, "{args:?} succeeded");
     assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "{args:?}: {stderr}");
-    assert!(stderr.contains(needle), "{args:?}: expected `{needle}` in {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: expected `{needle}` in {stderr}"
+    );
 }
 
 #[test]
 fn bad_arguments_are_one_line_errors() {
     let out = std::env::temp_dir().join("histencil-cli-test.png");
     let out = out.to_str().unwrap();
-    assert_one_line_error(&["render", "--scene", "kitchen", "--out", out], "unknown scene `kitchen`");
-    assert_one_line_error(&["render", "--width", "0", "--height", "8", "--out", out], "bad resolution 0x8");
-    assert_one_line_error(&["render", "--width", "99999", "--height", "8", "--out", out], "bad resolution 99999x8");
-    assert_one_line_error(&["render", "--out", "/proc/histencil/x.png"], "/proc/histencil");
-    assert_one_line_error(&["render", "--technique", "magic", "--out", out], "unknown technique");
+    assert_one_line_error(
+        &["render", "--scene", "kitchen", "--out", out],
+        "unknown scene `kitchen`",
+    );
+    assert_one_line_error(
+        &["render", "--width", "0", "--height", "8", "--out", out],
+        "bad resolution 0x8",
+    );
+    assert_one_line_error(
+        &["render", "--width", "99999", "--height", "8", "--out", out],
+        "bad resolution 99999x8",
+    );
+    assert_one_line_error(
+        &["render", "--out", "/proc/histencil/x.png"],
+        "/proc/histencil",
+    );
+    assert_one_line_error(
+        &["render", "--technique", "magic", "--out", out],
+        "unknown technique",
+    );
 }
 
 #[test]
@@ -59,8 +77,14 @@ fn renders_and_dumps_stencil_under_validation() {
     assert!(stdout.contains("frame time"), "{stdout}");
     let stencil = image::open(&stencil).unwrap().into_luma8();
     assert_eq!(stencil.dimensions(), (64, 48));
-    assert!(stencil.pixels().all(|p| p.0[0] & 1 == 0), "culling bit left set");
-    assert!(stencil.pixels().any(|p| p.0[0] != 0), "no BRDF bits written");
+    assert!(
+        stencil.pixels().all(|p| p.0[0] & 1 == 0),
+        "culling bit left set"
+    );
+    assert!(
+        stencil.pixels().any(|p| p.0[0] != 0),
+        "no BRDF bits written"
+    );
     let hdr = image::open(&exr).unwrap().into_rgba32f();
     assert!(hdr.pixels().all(|p| p.0.iter().all(|c| c.is_finite())));
 }

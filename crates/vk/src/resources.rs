@@ -220,3 +220,34 @@ pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubres
         .level_count(1)
         .layer_count(1)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::context::ContextDesc;
+
+    /// The leak check the end-to-end tests rely on can fail: a buffer left alive at teardown is
+    /// reported by the validation layer's object tracker.
+    #[test]
+    fn leaked_buffer_is_reported_at_teardown() {
+        let ctx = Context::new(ContextDesc::validated()).unwrap();
+        let log = ctx.validation_log();
+        let buffer = Buffer::new(
+            &ctx,
+            "deliberately-leaked",
+            64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )
+        .unwrap();
+        std::mem::forget(buffer);
+        drop(ctx);
+        let problems = log.problems();
+        assert!(
+            problems
+                .iter()
+                .any(|p| p.contains("deliberately-leaked") || p.contains("VkBuffer")),
+            "no leak report: {problems:?}"
+        );
+    }
+}

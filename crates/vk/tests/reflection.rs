@@ -21,7 +21,12 @@ fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, S
                 },
                 other => panic!("{name}: unexpected address space {other:?}"),
             };
-            Some((binding.group, binding.binding, kind, var.name.clone().unwrap_or_default()))
+            Some((
+                binding.group,
+                binding.binding,
+                kind,
+                var.name.clone().unwrap_or_default(),
+            ))
         })
         .collect()
 }
@@ -29,10 +34,16 @@ fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, S
 #[test]
 fn every_module_has_a_layout_and_every_layout_a_module() {
     for (name, _) in shaders::ALL {
-        assert!(SHADER_LAYOUTS.iter().any(|(n, _)| n == name), "{name} has no declared layout");
+        assert!(
+            SHADER_LAYOUTS.iter().any(|(n, _)| n == name),
+            "{name} has no declared layout"
+        );
     }
     for (name, _) in SHADER_LAYOUTS {
-        assert!(shaders::ALL.iter().any(|(n, _)| n == name), "{name} is declared but not built");
+        assert!(
+            shaders::ALL.iter().any(|(n, _)| n == name),
+            "{name} is declared but not built"
+        );
     }
 }
 
@@ -45,14 +56,22 @@ fn reflected_bindings_match_rust_layouts() {
             let declared = layout
                 .get(set as usize)
                 .and_then(|s| s.iter().find(|b| b.binding == binding))
-                .unwrap_or_else(|| panic!("{name}: set {set} binding {binding} is not in the Rust layout"));
+                .unwrap_or_else(|| {
+                    panic!("{name}: set {set} binding {binding} is not in the Rust layout")
+                });
             assert_eq!(declared.kind, kind, "{name}: set {set} binding {binding}");
             // Anonymous blocks (`buffer Lights { ... };`) have no variable name in SPIR-V.
             if !glsl_name.is_empty() {
-                assert_eq!(declared.glsl_name, glsl_name, "{name}: set {set} binding {binding}");
+                assert_eq!(
+                    declared.glsl_name, glsl_name,
+                    "{name}: set {set} binding {binding}"
+                );
             }
             checked += 1;
         }
     }
-    assert!(checked >= 10, "only {checked} bindings reflected: is reflection working?");
+    assert!(
+        checked >= 10,
+        "only {checked} bindings reflected: is reflection working?"
+    );
 }
