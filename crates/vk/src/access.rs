@@ -50,21 +50,27 @@ pub fn access_info(
     }
 }
 
-/// Records the barrier that takes `image` from its last access to `next`. With `discard`, the
-/// old contents are not needed (the layout goes from UNDEFINED).
+/// Whether a transition keeps an image's contents.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Contents {
+    /// The next access overwrites everything: the layout goes from UNDEFINED.
+    Discard,
+    Keep,
+}
+
+/// Records the barrier that takes `image` from its last access to `next`.
 pub(crate) fn transition(
     ctx: &Context,
     cmd: vk::CommandBuffer,
     image: &mut Image,
     next: ImageAccess,
-    discard: bool,
+    contents: Contents,
 ) {
     let (old_layout, src_stage, src_access) = access_info(image.last_access);
     let (new_layout, dst_stage, dst_access) = access_info(next);
-    let old_layout = if discard {
-        vk::ImageLayout::UNDEFINED
-    } else {
-        old_layout
+    let old_layout = match contents {
+        Contents::Discard => vk::ImageLayout::UNDEFINED,
+        Contents::Keep => old_layout,
     };
     let barrier = vk::ImageMemoryBarrier2::default()
         .src_stage_mask(src_stage)

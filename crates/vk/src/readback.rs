@@ -1,6 +1,6 @@
 //! Copying the frame's images back to the host: tonemapped colour, HDR colour and the raw stencil.
 
-use crate::access::{transition, ImageAccess};
+use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::error::Result;
 use crate::resources::{Buffer, Image};
@@ -85,7 +85,7 @@ impl ReadbackBuffers {
         aspect: vk::ImageAspectFlags,
         buffer: &Buffer,
     ) {
-        transition(ctx, cmd, image, ImageAccess::TransferSource, false);
+        transition(ctx, cmd, image, ImageAccess::TransferSource, Contents::Keep);
         let region = vk::BufferImageCopy::default()
             .image_subresource(
                 vk::ImageSubresourceLayers::default()

@@ -5,7 +5,7 @@ use super::{
     begin_rendering, color_attachment, depth_stencil_attachment, Load, CLEAR_BLACK,
     CLEAR_DEPTH_STENCIL,
 };
-use crate::access::{transition, ImageAccess};
+use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::gpu_types::DrawPush;
 use crate::meshes::Meshes;
@@ -69,14 +69,20 @@ impl GeometryPass<'_> {
         let (ctx, cmd) = (self.ctx, self.cmd);
         ctx.begin_label(cmd, "gbuffer");
         for image in targets.gbuffer.iter_mut() {
-            transition(ctx, cmd, image, ImageAccess::ColorAttachment, true);
+            transition(
+                ctx,
+                cmd,
+                image,
+                ImageAccess::ColorAttachment,
+                Contents::Discard,
+            );
         }
         transition(
             ctx,
             cmd,
             &mut targets.depth_stencil,
             ImageAccess::DepthStencilAttachment,
-            true,
+            Contents::Discard,
         );
         // The material target's w (BRDF id) is cleared to -1: "no geometry here".
         let no_brdf = vk::ClearValue {
@@ -110,14 +116,14 @@ impl GeometryPass<'_> {
             cmd,
             &mut targets.hdr,
             ImageAccess::ColorAttachment,
-            true,
+            Contents::Discard,
         );
         transition(
             ctx,
             cmd,
             &mut targets.depth_stencil,
             ImageAccess::DepthStencilAttachment,
-            true,
+            Contents::Discard,
         );
         let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
         let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Clear(CLEAR_DEPTH_STENCIL));

@@ -17,7 +17,7 @@
 //! over-coverage adds nothing: the stencil and depth tests are culling, never correctness.
 
 use super::{begin_rendering, color_attachment, depth_stencil_attachment, Load, CLEAR_BLACK};
-use crate::access::{transition, ImageAccess};
+use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::meshes::Meshes;
 use crate::pipelines::Pipelines;
@@ -171,21 +171,27 @@ impl LightingPass<'_> {
         let d = &ctx.device;
         ctx.begin_label(cmd, "lighting");
         for image in targets.gbuffer.iter_mut() {
-            transition(ctx, cmd, image, ImageAccess::FragmentSampled, false);
+            transition(
+                ctx,
+                cmd,
+                image,
+                ImageAccess::FragmentSampled,
+                Contents::Keep,
+            );
         }
         transition(
             ctx,
             cmd,
             &mut targets.hdr,
             ImageAccess::ColorAttachment,
-            true,
+            Contents::Discard,
         );
         transition(
             ctx,
             cmd,
             &mut targets.depth_stencil,
             ImageAccess::DepthStencilAttachment,
-            false,
+            Contents::Keep,
         );
         let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
         let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Keep);

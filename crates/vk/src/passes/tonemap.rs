@@ -1,7 +1,7 @@
 //! HDR -> 8-bit display colour.
 
 use super::{begin_rendering, color_attachment, Load, CLEAR_BLACK};
-use crate::access::{transition, ImageAccess};
+use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::state::DrawState;
 use crate::targets::Targets;
@@ -25,14 +25,14 @@ impl TonemapPass<'_> {
             cmd,
             &mut targets.hdr,
             ImageAccess::FragmentSampled,
-            false,
+            Contents::Keep,
         );
         transition(
             ctx,
             cmd,
             &mut targets.ldr,
             ImageAccess::ColorAttachment,
-            true,
+            Contents::Discard,
         );
         begin_rendering(
             ctx,
