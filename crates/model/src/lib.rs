@@ -20,6 +20,45 @@
 //! With 8 BRDFs in use: `culling_mask = 0x01`, `brdf_mask = 0x0E`, `brdf_shift = 1`, preserved
 //! `0xF0`. The layout here is derived from the number of BRDFs a scene uses, never hard-coded.
 
-mod layout;
+//!
+//! # What this crate decides
+//! - [`StencilLayout`]: where the bits sit, derived from the BRDF count;
+//! - [`plan_light`] / [`FramePlan`]: the ordered passes of every light with their full
+//!   [`PassState`], for a [`PlatformBackend`] described as data ([`PlatformCaps`]);
+//! - [`insert_flushes`]: when the hi-stencil surface must be flushed ([`FlushPolicy`]);
+//! - [`Simulator`]: runs a plan on a software depth + stencil buffer with hi-stencil tiles
+//!   ([`TileSurface`]); the oracle for the GPU;
+//! - [`CostModel`]: stencil, branching or single-BRDF per light.
+//!
+//! # Platforms
+//! The 360's hi-stencil compares all 8 bits: engine data in the preserved bits makes tiles fail
+//! that should pass, so the 360-like backend zeroes those bits as it goes (setup and cleanup
+//! write `!brdf_mask`), optionally saving and restoring them. The PS3's hi-stencil has a read
+//! mask and leaves them alone. Native Vulkan has per-pixel compare masks and nothing to emulate.
 
+mod backend;
+mod chooser;
+mod footprint;
+mod frame;
+mod layout;
+mod plan;
+mod sim;
+mod state;
+mod synthetic;
+mod tiles;
+
+pub use backend::{Native, PlatformBackend, PlatformCaps, Ps3Like, X360Like};
+pub use chooser::{CostModel, TalkFigures};
+pub use footprint::{Footprint, Span};
+pub use frame::{insert_flushes, write_test_dependencies, FlushPolicy, FramePlan, Step};
 pub use layout::{LayoutError, StencilLayout};
+pub use plan::{
+    plan_light, Geometry, LightCase, LightRequest, LightTechnique, Pass, PassKind, PlanError,
+    Shader,
+};
+pub use sim::{LightShading, SimResult, Simulator, SoftTarget, NOT_SHADED};
+pub use state::{
+    CompareOp, CullMode, DepthState, FaceStencil, HiStencilState, PassState, StencilOp,
+};
+pub use synthetic::{SyntheticDesc, SyntheticFrame};
+pub use tiles::{TileStats, TileSurface};

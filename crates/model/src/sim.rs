@@ -1,0 +1,223 @@
+//! The CPU simulator: executes a [`FramePlan`] on a software depth + stencil buffer, with the
+//! hi-stencil emulation of [`TileSurface`], and records which pass shaded which pixel.
+//! It is the oracle for the GPU implementation: the same plan, the same state values.
+
+use crate::footprint::Footprint;
+use crate::frame::{FramePlan, Step};
+use crate::layout::StencilLayout;
+use crate::plan::{Geometry, Pass, PassKind, Shader};
+use crate::state::CullMode;
+use crate::tiles::{TileStats, TileSurface};
+
+/// Depth and stencil of the frame after the G-buffer pass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SoftTarget {
+    pub width: u32,
+    pub height: u32,
+    /// Surface depth per pixel; 1 where there is no surface.
+    pub depth: Vec<f32>,
+    pub stencil: Vec<u8>,
+}
+
+impl SoftTarget {
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        (y * self.width + x) as usize
+    }
+}
+
+/// Marks a pixel of [`LightShading::brdf`] that no pass shaded.
+pub const NOT_SHADED: u8 = u8::MAX;
+
+/// Per pixel of one light's footprint rectangle: how often and how it was shaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightShading {
+    /// Times a light shader ran on the pixel (should be 0 or 1).
+    pub count: Vec<u8>,
+    /// The BRDF slot it was shaded with (the pixel's own slot for branching), or [`NOT_SHADED`].
+    pub brdf: Vec<u8>,
+    /// Index into the plan's steps of the last pass that shaded it.
+    pub step: Vec<u32>,
+}
+
+impl LightShading {
+    fn new(footprint: &Footprint) -> Self {
+        let n = (footprint.width * footprint.height) as usize;
+        Self {
+            count: vec![0; n],
+            brdf: vec![NOT_SHADED; n],
+            step: vec![u32::MAX; n],
+        }
+    }
+}
+
+/// What a run produced besides the final stencil (left in the target).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimResult {
+    pub lights: Vec<LightShading>,
+    /// Per light: the culling bit was still set after its last pass. Only the light's footprint
+    /// rectangle is checked: passes write nowhere else, so if every earlier light left the
+    /// frame clean, the whole frame is clean exactly when this rectangle is.
+    pub culling_bit_left: Vec<bool>,
+    pub stats: TileStats,
+}
+
+/// Runs plans for one stencil layout and tile size.
+#[derive(Clone, Copy, Debug)]
+pub struct Simulator {
+    pub layout: StencilLayout,
+    pub tile_size: u32,
+}
+
+impl Simulator {
+    /// Executes `plan` on `target`; `footprints[i]` is the coverage of light `i`.
+    ///
+    /// # Panics
+    /// If a step names a light without a footprint, or a footprint exceeds the target: caller
+    /// bugs, not data errors.
+    pub fn run(
+        &self,
+        target: &mut SoftTarget,
+        plan: &FramePlan,
+        footprints: &[Footprint],
+    ) -> SimResult {
+        let mut run = Run {
+            layout: self.layout,
+            tiles: TileSurface::new(target.width, target.height, self.tile_size),
+            stats: TileStats::default(),
+            tile_stamp: Vec::new(),
+            touched: Vec::new(),
+            target,
+        };
+        run.tile_stamp = vec![u32::MAX; run.tiles.tile_count()];
+        let mut lights: Vec<LightShading> = footprints.iter().map(LightShading::new).collect();
+        let mut culling_bit_left = vec![false; footprints.len()];
+        let mut saved = Vec::new();
+        let mut current: Option<usize> = None;
+        for (index, step) in plan.steps.iter().enumerate() {
+            if let Step::Pass { light, .. } = step {
+                if let Some(previous) = current.filter(|c| c != light) {
+                    culling_bit_left[previous] = run.culling_bit_set(&footprints[previous]);
+                }
+                current = Some(*light);
+            }
+            match step {
+                Step::Pass { light, pass } => {
+                    run.pass(index as u32, pass, &footprints[*light], &mut lights[*light])
+                }
+                Step::FlushHiStencil => {
+                    run.tiles.flush();
+                    run.stats.flushes += 1;
+                }
+                Step::SavePreserved { mask } => {
+                    saved = run.target.stencil.iter().map(|s| s & mask).collect();
+                }
+                Step::RestorePreserved { mask } => {
+                    for (s, kept) in run.target.stencil.iter_mut().zip(&saved) {
+                        *s = (*s & !mask) | kept;
+                    }
+                }
+            }
+        }
+        if let Some(previous) = current {
+            culling_bit_left[previous] = run.culling_bit_set(&footprints[previous]);
+        }
+        SimResult {
+            lights,
+            culling_bit_left,
+            stats: run.stats,
+        }
+    }
+}
+
+struct Run<'a> {
+    layout: StencilLayout,
+    target: &'a mut SoftTarget,
+    tiles: TileSurface,
+    stats: TileStats,
+    /// The step that last touched each tile, so each draw counts a tile once.
+    tile_stamp: Vec<u32>,
+    touched: Vec<usize>,
+}
+
+impl Run<'_> {
+    fn culling_bit_set(&self, footprint: &Footprint) -> bool {
+        let culling = self.layout.culling_mask();
+        (footprint.y0..footprint.y0 + footprint.height).any(|y| {
+            (footprint.x0..footprint.x0 + footprint.width)
+                .any(|x| self.target.stencil[self.target.index(x, y)] & culling != 0)
+        })
+    }
+
+    fn pass(&mut self, step: u32, pass: &Pass, footprint: &Footprint, shading: &mut LightShading) {
+        let state = &pass.state;
+        let front_facing = match (pass.geometry, state.cull) {
+            (Geometry::FullScreen, _) | (Geometry::Volume, CullMode::Back) => true,
+            (Geometry::Volume, CullMode::Front) => false,
+            (Geometry::Volume, CullMode::None) => {
+                panic!("a volume pass must cull one face set: {}", pass.label())
+            }
+        };
+        let face = state.stencil_for(front_facing);
+        let hi_test = state.tests_hi_stencil();
+        let hi_write = state.hi_stencil.filter(|h| h.write);
+        self.touched.clear();
+        for y in footprint.y0..footprint.y0 + footprint.height {
+            for x in footprint.x0..footprint.x0 + footprint.width {
+                let Some(span) = footprint.span(x, y) else {
+                    continue;
+                };
+                let fragment_depth = match pass.geometry {
+                    Geometry::FullScreen => 1.0,
+                    Geometry::Volume if front_facing => match span.front {
+                        Some(front) => front,
+                        None => continue,
+                    },
+                    Geometry::Volume => span.back,
+                };
+                let tile = self.tiles.tile_of(x, y);
+                if self.tile_stamp[tile] != step {
+                    self.tile_stamp[tile] = step;
+                    self.touched.push(tile);
+                    if hi_test {
+                        self.stats.tiles_tested += 1;
+                        self.stats.tiles_culled += u64::from(!self.tiles.passes(tile));
+                    }
+                }
+                if hi_test && !self.tiles.passes(tile) {
+                    continue;
+                }
+                let i = self.target.index(x, y);
+                let stencil = self.target.stencil[i];
+                let stencil_passed = face.is_none_or(|f| f.test(stencil));
+                let depth_passed =
+                    stencil_passed && state.depth.passes(fragment_depth, self.target.depth[i]);
+                if let Some(f) = face {
+                    self.target.stencil[i] = f.update(stencil, stencil_passed, depth_passed);
+                }
+                if depth_passed && state.color_write {
+                    let local =
+                        ((y - footprint.y0) * footprint.width + (x - footprint.x0)) as usize;
+                    shading.count[local] = shading.count[local].saturating_add(1);
+                    shading.brdf[local] = match pass.kind {
+                        PassKind::Shade(Shader::Brdf(slot)) => slot as u8,
+                        _ => self.layout.brdf_slot(stencil) as u8,
+                    };
+                    shading.step[local] = step;
+                    self.stats.fragments_shaded += 1;
+                }
+            }
+        }
+        if let Some(hi) = hi_write {
+            self.tiles.begin_write();
+            let (width, height) = (self.target.width, self.target.height);
+            for &tile in &self.touched {
+                let (x0, y0, x1, y1) = self.tiles.tile_pixels(tile, width, height);
+                let may_pass = (y0..y1).any(|y| {
+                    (x0..x1)
+                        .any(|x| hi.compare_passes(self.target.stencil[(y * width + x) as usize]))
+                });
+                self.tiles.write(tile, may_pass);
+            }
+        }
+    }
+}
