@@ -1,16 +1,33 @@
-//! BRDF maths for histencil: one definition, spelled twice (here in Rust, and in GLSL under
-//! `shaders/include/brdf.glsl`), held together by tests.
+//! BRDF maths for histencil: one definition, spelled twice (here in Rust, generic over f32 and
+//! f64, and in GLSL under `shaders/include/brdf/`), held together by tests.
 //!
 //! # Convention
 //! Every function returns `f_r * cos(theta_L)`: the reflected radiance for a directional light of
-//! unit irradiance perpendicular to the light. So Lambert is `rho / pi * max(N.L, 0)`. All vectors
-//! point away from the surface and need not be normalized. For surface BRDFs, `N.L <= 0` or
-//! `N.V < 0` gives 0.
+//! unit irradiance perpendicular to the light. So Lambert is `rho / pi * max(N.L, 0)`.
+//! - All vectors point away from the surface and need not be normalized; denormal-scale and huge
+//!   inputs are rescaled before normalising. A zero (or non-finite) vector gives 0.
+//! - Surface BRDFs (Lambert, Blinn-Phong, Oren-Nayar, GGX): `N.L <= 0` or `N.V < 0` gives 0;
+//!   `N.V == 0` with `N.L > 0` gives the finite limit.
+//! - Kajiya-Kay ignores N and is not gated; a zero tangent gives 0.
+//! - Penner skin is not gated (light wraps past the terminator) and ignores V.
+//! - GGX clamps alpha to [`GGX_MIN_ALPHA`]; `pow(0, 0)` is 1 everywhere (GLSL leaves it undefined,
+//!   so the GLSL guards it).
 //!
-//! The spine implements Lambert and normalized Blinn-Phong; the `[brdf]` issue extends [`BrdfId`]
-//! with Oren-Nayar, GGX, Kajiya-Kay and pre-integrated skin.
+//! # Models
+//! [`lambert`], normalized [`blinn_phong`], [`oren_nayar_full`] (1994, with inter-reflection),
+//! [`oren_nayar_qualitative`], [`ggx`] (Cook-Torrance: GGX D, Smith height-correlated visibility,
+//! Schlick Fresnel), [`kajiya_kay`] and Penner's pre-integrated skin [`penner_skin`]. [`Brdf`]
+//! holds a model with its parameters and evaluates it as the f64 reference or the f32 spelling.
+//!
+//! [`BrdfId`] is the renderer's list of shading models stored in the G-buffer and stencil.
 
+pub mod cases;
 mod id;
-pub mod reference;
+mod model;
+mod models;
+mod vector;
 
 pub use id::{BrdfId, UnknownBrdf};
+pub use model::{Brdf, BrdfError, MODEL_NAMES};
+pub use models::*;
+pub use vector::{normalize, Real, V3};

@@ -1,0 +1,11 @@
+//! The BRDF models, each written once, generic over `f32` / `f64` ([`crate::Real`]).
+
+mod fibre;
+mod skin;
+mod surface;
+
+pub use fibre::kajiya_kay;
+pub use skin::{penner_skin, skin_diffusion, REFERENCE_PANELS, SHIPPING_PANELS, SKIN_PROFILE};
+pub use surface::{
+    blinn_phong, ggx, lambert, oren_nayar_full, oren_nayar_qualitative, GGX_MIN_ALPHA,
+};

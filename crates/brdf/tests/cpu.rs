@@ -1,0 +1,197 @@
+//! The f32 spelling against the f64 reference on ordinary and hard cases; physical sanity of
+//! the reference itself (white furnace, reciprocity, limits).
+
+use histencil_brdf::cases::{hard_cases, ordinary_cases, ordinary_error, relative_error, Case};
+use histencil_brdf::{skin_diffusion, Brdf, REFERENCE_PANELS, SHIPPING_PANELS};
+use std::f64::consts::PI;
+
+/// Worst error per model over `cases`, with the case that produced it.
+fn worst(cases: &[Case], error: fn(f64, f64) -> f64) -> Vec<(&'static str, f64, String)> {
+    let mut out: Vec<(&'static str, f64, String)> = vec![];
+    for case in cases {
+        let reference = case.brdf.reference(case.dirs);
+        let shipping = case.brdf.shipping(case.dirs_f32());
+        for k in 0..3 {
+            assert!(
+                reference[k].is_finite(),
+                "reference not finite: {}",
+                case.label
+            );
+            let e = error(f64::from(shipping[k]), reference[k]);
+            match out.iter_mut().find(|(m, ..)| *m == case.brdf.name()) {
+                Some(entry) if e > entry.1 => *entry = (entry.0, e, case.label.clone()),
+                Some(_) => {}
+                None => out.push((case.brdf.name(), e, case.label.clone())),
+            }
+        }
+    }
+    for (model, e, label) in &out {
+        println!("{model:24} worst {e:.3e}  ({label})");
+    }
+    out
+}
+
+#[test]
+fn f32_matches_f64_on_ordinary_cases() {
+    for (model, e, label) in worst(&ordinary_cases(), ordinary_error) {
+        assert!(e <= 1e-3, "{model}: {e:e} at {label}");
+    }
+}
+
+#[test]
+fn f32_is_finite_and_close_on_hard_cases() {
+    for (model, e, label) in worst(&hard_cases(), relative_error) {
+        assert!(e <= 1e-2, "{model}: {e:e} at {label}");
+    }
+}
+
+/// Directional albedo `int f cos dL` over the hemisphere, midpoint rule in (theta, phi).
+fn albedo(brdf: &Brdf, theta_v: f64) -> f64 {
+    let (nt, np) = (768, 256);
+    let n = [0.0, 0.0, 1.0];
+    let t = [1.0, 0.0, 0.0];
+    let v = [theta_v.sin(), 0.0, theta_v.cos()];
+    let (dt, dp) = (PI / 2.0 / nt as f64, 2.0 * PI / np as f64);
+    let mut sum = 0.0;
+    for i in 0..nt {
+        let theta = (i as f64 + 0.5) * dt;
+        for j in 0..np {
+            let phi = (j as f64 + 0.5) * dp;
+            let l = [
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ];
+            sum += brdf.reference([n, t, v, l])[0] * theta.sin() * dt * dp;
+        }
+    }
+    sum
+}
+
+#[test]
+fn white_furnace_energy_conserving_models_reflect_at_most_everything() {
+    let mut models = vec![Brdf::Lambert { rho: 1.0 }];
+    for alpha in [0.1, 0.3, 0.6, 1.0] {
+        models.push(Brdf::Ggx {
+            alpha,
+            f0: 1.0,
+            f90: 1.0,
+        });
+    }
+    for brdf in &models {
+        for theta_v in [0.0, 0.5, 1.0, 1.4] {
+            let a = albedo(brdf, theta_v);
+            println!("{brdf:?} theta_v {theta_v}: albedo {a:.5}");
+            assert!(a <= 1.0 + 1e-3, "{brdf:?} at theta_v {theta_v}: albedo {a}");
+        }
+    }
+    let lambert: f64 = albedo(&Brdf::Lambert { rho: 0.7 }, 0.8);
+    assert!((lambert - 0.7).abs() < 1e-4, "Lambert albedo {lambert}");
+}
+
+/// Models that are not energy conserving by construction, held to their measured bound
+/// (measured max + ~0.3%): normalized Blinn-Phong's (n + 8) / (8 pi) approximates the exact
+/// normalisation and reflects up to 6.7% too much at low exponents (max 1.0669); Oren-Nayar
+/// gains up to 1.4% (qualitative, 1.0143) and 3.6% (full, with inter-reflection, 1.0357) at
+/// grazing view with rho = 1.
+#[test]
+fn white_furnace_approximate_models_stay_within_their_measured_bounds() {
+    let mut models = vec![];
+    for exponent in [1.0, 4.0, 16.0, 128.0, 1024.0] {
+        models.push((Brdf::BlinnPhong { exponent }, BOUND_BLINN_PHONG));
+    }
+    for sigma in [0.2, 0.5, 1.0] {
+        models.push((
+            Brdf::OrenNayarQualitative { rho: 1.0, sigma },
+            BOUND_ON_QUALITATIVE,
+        ));
+        models.push((Brdf::OrenNayarFull { rho: 1.0, sigma }, BOUND_ON_FULL));
+    }
+    for (brdf, bound) in &models {
+        for theta_v in [0.0, 0.5, 1.0, 1.4, 1.55] {
+            let a = albedo(brdf, theta_v);
+            println!("{brdf:?} theta_v {theta_v}: albedo {a:.5}");
+            assert!(
+                a <= *bound,
+                "{brdf:?} at theta_v {theta_v}: albedo {a} > {bound}"
+            );
+        }
+    }
+}
+
+const BOUND_ON_QUALITATIVE: f64 = 1.017;
+const BOUND_ON_FULL: f64 = 1.039;
+const BOUND_BLINN_PHONG: f64 = 1.07;
+
+#[test]
+fn reciprocal_models_are_reciprocal() {
+    let models = [
+        Brdf::Lambert { rho: 0.5 },
+        Brdf::BlinnPhong { exponent: 40.0 },
+        Brdf::OrenNayarFull {
+            rho: 0.8,
+            sigma: 0.5,
+        },
+        Brdf::OrenNayarQualitative {
+            rho: 0.8,
+            sigma: 0.5,
+        },
+        Brdf::Ggx {
+            alpha: 0.2,
+            f0: 0.04,
+            f90: 1.0,
+        },
+    ];
+    let n = [0.0, 0.0, 1.0];
+    let t = [1.0, 0.0, 0.0];
+    for brdf in models {
+        for (theta_a, theta_b, phi) in [(0.3f64, 1.1f64, 0.7f64), (1.4, 0.2, 2.5), (0.9, 0.9, 3.1)]
+        {
+            let a = [theta_a.sin(), 0.0, f64::cos(theta_a)];
+            let b = [
+                f64::sin(theta_b) * f64::cos(phi),
+                f64::sin(theta_b) * f64::sin(phi),
+                f64::cos(theta_b),
+            ];
+            // The functions return f * cos(theta_L): divide it out.
+            let f_ab = brdf.reference([n, t, a, b])[0] / b[2];
+            let f_ba = brdf.reference([n, t, b, a])[0] / a[2];
+            assert!(
+                (f_ab - f_ba).abs() <= 1e-12 * f_ab.abs().max(1.0),
+                "{brdf:?}: {f_ab} vs {f_ba}"
+            );
+        }
+    }
+}
+
+#[test]
+fn skin_limits_and_convergence() {
+    // Flat skin is Lambert.
+    for theta in [0.0f64, 0.7, 1.5, 2.0] {
+        let d = skin_diffusion(theta, 0.0, REFERENCE_PANELS);
+        assert!(d
+            .iter()
+            .all(|x: &f64| (x - f64::cos(theta).max(0.0)).abs() < 1e-9));
+    }
+    // A tiny ball diffuses light all around the ring: 1 / pi everywhere.
+    for theta in [0.0f64, 1.5, 3.0] {
+        let d = skin_diffusion(theta, 1e6, REFERENCE_PANELS);
+        assert!(d.iter().all(|x| (x - 1.0 / PI).abs() < 1e-4), "{d:?}");
+    }
+    // Curvature wraps light past the terminator, red furthest.
+    let d = skin_diffusion(PI / 2.0 + 0.2, 1.0, REFERENCE_PANELS);
+    assert!(d[0] > d[1] && d[1] > 0.0, "{d:?}");
+    // The shipping panel count is within 1e-5 of the reference.
+    for curvature in [0.01f64, 0.1, 0.5, 2.0, 10.0] {
+        for theta in [0.0, 0.5, 1.4, 1.6, 2.5, 3.1] {
+            let a = skin_diffusion(theta, curvature, SHIPPING_PANELS);
+            let b = skin_diffusion(theta, curvature, REFERENCE_PANELS);
+            for k in 0..3 {
+                assert!(
+                    (a[k] - b[k]).abs() < 1e-5,
+                    "{theta} {curvature}: {a:?} vs {b:?}"
+                );
+            }
+        }
+    }
+}
