@@ -14,6 +14,45 @@ fn generated_glsl() -> String {
     for brdf in histencil_brdf::BrdfId::ALL {
         writeln!(s, "#define {} {}u", brdf.glsl_constant(), brdf.index()).unwrap();
     }
+    for (i, name) in histencil_brdf::MODEL_NAMES.iter().enumerate() {
+        writeln!(s, "#define BRDF_MODEL_{} {i}u", name.to_uppercase()).unwrap();
+    }
+    writeln!(
+        s,
+        "#define GGX_MIN_ALPHA {:e}",
+        histencil_brdf::GGX_MIN_ALPHA
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "#define SKIN_PANELS {}u",
+        histencil_brdf::SHIPPING_PANELS
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "#define SKIN_FLAT_LIMIT {:e}",
+        histencil_brdf::SKIN_FLAT_LIMIT
+    )
+    .unwrap();
+    let profile = histencil_brdf::SKIN_PROFILE;
+    let variances: Vec<String> = profile.iter().map(|(v, _)| format!("{v:?}")).collect();
+    let weights: Vec<String> = profile
+        .iter()
+        .map(|(_, w)| format!("vec3({:?}, {:?}, {:?})", w[0], w[1], w[2]))
+        .collect();
+    writeln!(
+        s,
+        "const float SKIN_VARIANCE[6] = float[6]({});",
+        variances.join(", ")
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "const vec3 SKIN_WEIGHT[6] = vec3[6]({});",
+        weights.join(", ")
+    )
+    .unwrap();
     for (name, value) in LIGHT_KINDS {
         writeln!(s, "#define {name} {value}u").unwrap();
     }

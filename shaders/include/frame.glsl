@@ -4,8 +4,7 @@
 #define FRAME_GLSL
 
 #include "generated.glsl"
-
-const float PI = 3.14159265358979323846;
+#include "brdf/common.glsl"
 
 layout(set = 0, binding = 0, std140) uniform Frame {
     mat4 view;

@@ -4,7 +4,7 @@
 #define LIGHT_GLSL
 
 #include "frame.glsl"
-#include "brdf.glsl"
+#include "brdf/surface.glsl"
 #include "surface.glsl"
 
 // Windowed inverse square: exactly zero at d >= range, so a volume that circumscribes the range

@@ -52,11 +52,17 @@ pub const GBUFFER_SET: &[BindingDesc] = &[
 ];
 /// Set 1 of the tonemap pipeline (tonemap.frag).
 pub const TONEMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "hdr")];
+/// The BRDF evaluator's cases (read) and results (written); see `brdf_eval.rs`.
+pub const BRDF_EVAL_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, "cases"),
+    binding(1, BindingKind::StorageBuffer, "results"),
+];
 
 /// The pipeline layouts: which sets, in order.
 pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET];
 pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET];
 pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
+pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
 
 /// Every shader module and the pipeline layout it is used with.
 pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
@@ -67,6 +73,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("deferred_light.frag", LIGHTING_LAYOUT),
     ("fullscreen.vert", LIGHTING_LAYOUT),
     ("tonemap.frag", TONEMAP_LAYOUT),
+    ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
 ];
 
 fn create_set_layout(

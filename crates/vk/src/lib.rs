@@ -10,6 +10,7 @@
 //! validation layer with synchronisation validation, and any message fails them.
 
 pub mod access;
+mod brdf_eval;
 mod context;
 mod debug;
 pub mod descriptors;
@@ -32,6 +33,7 @@ pub mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
 
+pub use brdf_eval::BrdfEvaluator;
 pub use context::{Context, ContextDesc};
 pub use debug::ValidationLog;
 pub use error::{Error, Result};

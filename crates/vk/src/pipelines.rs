@@ -35,7 +35,7 @@ pub struct PipelineDesc<'a> {
     pub depth_clamp: bool,
 }
 
-fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<vk::ShaderModule> {
+pub(crate) fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<vk::ShaderModule> {
     let words = ash::util::read_spv(&mut Cursor::new(spirv)).expect("build.rs wrote valid SPIR-V");
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
     let module =

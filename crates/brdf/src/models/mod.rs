@@ -5,7 +5,10 @@ mod skin;
 mod surface;
 
 pub use fibre::kajiya_kay;
-pub use skin::{penner_skin, skin_diffusion, REFERENCE_PANELS, SHIPPING_PANELS, SKIN_PROFILE};
+pub use skin::{
+    penner_skin, skin_diffusion, FLAT_LIMIT as SKIN_FLAT_LIMIT, REFERENCE_PANELS, SHIPPING_PANELS,
+    SKIN_PROFILE,
+};
 pub use surface::{
     blinn_phong, ggx, lambert, oren_nayar_full, oren_nayar_qualitative, GGX_MIN_ALPHA,
 };

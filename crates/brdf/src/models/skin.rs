@@ -29,7 +29,7 @@ pub const REFERENCE_PANELS: u32 = 256;
 pub const SHIPPING_PANELS: u32 = 32;
 
 /// Half-widths below this (radians) use the flat limit: the error is `O(width^2)`.
-const FLAT_LIMIT: f64 = 1e-4;
+pub const FLAT_LIMIT: f64 = 1e-4;
 
 /// Composite Simpson over `[a, b]` with `panels` (even) panels.
 fn simpson<R: Real>(a: R, b: R, panels: u32, f: impl Fn(R) -> R) -> R {

@@ -1,0 +1,271 @@
+//! Evaluates BRDF cases on the GPU with the GLSL spelling (`shaders/brdf_eval.comp`), so the
+//! shipping shader code can be held to the f64 reference. One dispatch per call.
+
+use crate::context::Context;
+use crate::descriptors::{BindingKind, BRDF_EVAL_SET};
+use crate::error::{Result, VkCall};
+use crate::pipelines::create_module;
+use crate::resources::Buffer;
+use crate::shaders;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use histencil_brdf::{Brdf, V3};
+
+/// std430 mirror of `BrdfCase` in `shaders/brdf_eval.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuBrdfCase {
+    model: [u32; 4],
+    params: [f32; 4],
+    n: [f32; 4],
+    t: [f32; 4],
+    v: [f32; 4],
+    l: [f32; 4],
+}
+
+const WORKGROUP: u32 = 64;
+
+fn pad(d: V3<f32>) -> [f32; 4] {
+    [d[0], d[1], d[2], 0.0]
+}
+
+/// The compute pipeline and its layouts; buffers are made per call.
+pub struct BrdfEvaluator {
+    set_layout: vk::DescriptorSetLayout,
+    pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+}
+
+impl BrdfEvaluator {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let d = &ctx.device;
+        let bindings: Vec<_> = BRDF_EVAL_SET
+            .iter()
+            .map(|b| {
+                debug_assert_eq!(b.kind, BindingKind::StorageBuffer);
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b.binding)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            })
+            .collect();
+        let set_layout = unsafe {
+            d.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                None,
+            )
+        }
+        .call("vkCreateDescriptorSetLayout")?;
+        ctx.name(set_layout, "brdf-eval-set-layout");
+        let ranges = [vk::PushConstantRange::default()
+            .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            .size(4)];
+        let set_layouts = [set_layout];
+        let pipeline_layout = unsafe {
+            d.create_pipeline_layout(
+                &vk::PipelineLayoutCreateInfo::default()
+                    .set_layouts(&set_layouts)
+                    .push_constant_ranges(&ranges),
+                None,
+            )
+        }
+        .call("vkCreatePipelineLayout")?;
+        ctx.name(pipeline_layout, "brdf-eval-pipeline-layout");
+        let module = create_module(ctx, "brdf-eval-comp", shaders::BRDF_EVAL_COMP)?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main");
+        let info = [vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(pipeline_layout)];
+        let created = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
+        unsafe { d.destroy_shader_module(module, None) };
+        let pipeline = created
+            .map_err(|(_, e)| e)
+            .call("vkCreateComputePipelines")?[0];
+        ctx.name(pipeline, "brdf-eval-pipeline");
+        Ok(Self {
+            set_layout,
+            pipeline_layout,
+            pipeline,
+        })
+    }
+
+    /// `f_r * cos(theta_L)` of each case, RGB (scalar models repeat their value).
+    pub fn evaluate(&self, ctx: &Context, cases: &[(Brdf, [V3<f32>; 4])]) -> Result<Vec<[f32; 3]>> {
+        if cases.is_empty() {
+            return Ok(Vec::new());
+        }
+        let gpu: Vec<GpuBrdfCase> = cases
+            .iter()
+            .map(|(brdf, [n, t, v, l])| GpuBrdfCase {
+                model: [brdf.model_index(), 0, 0, 0],
+                params: brdf.packed_params().map(|p| p as f32),
+                n: pad(*n),
+                t: pad(*t),
+                v: pad(*v),
+                l: pad(*l),
+            })
+            .collect();
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let mut input =
+            Buffer::with_data(ctx, "brdf-eval-cases", storage, bytemuck::cast_slice(&gpu))?;
+        let mut output = match Buffer::new(
+            ctx,
+            "brdf-eval-results",
+            (cases.len() * 16) as u64,
+            storage,
+            MemoryLocation::GpuToCpu,
+        ) {
+            Ok(b) => b,
+            Err(e) => {
+                input.destroy(ctx);
+                return Err(e);
+            }
+        };
+        let result = self.dispatch(ctx, &input, &output, cases.len() as u32);
+        let values = result.map(|()| {
+            bytemuck::cast_slice::<u8, f32>(output.read())
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect()
+        });
+        input.destroy(ctx);
+        output.destroy(ctx);
+        values
+    }
+
+    fn dispatch(&self, ctx: &Context, input: &Buffer, output: &Buffer, count: u32) -> Result<()> {
+        let d = &ctx.device;
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::STORAGE_BUFFER)
+            .descriptor_count(2)];
+        let pool = unsafe {
+            d.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(1)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }
+        .call("vkCreateDescriptorPool")?;
+        ctx.name(pool, "brdf-eval-descriptor-pool");
+        let command_pool = unsafe {
+            d.create_command_pool(
+                &vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family),
+                None,
+            )
+        };
+        let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) };
+        let recorded = (|| -> Result<()> {
+            let command_pool = command_pool.call("vkCreateCommandPool")?;
+            ctx.name(command_pool, "brdf-eval-command-pool");
+            let fence = fence.call("vkCreateFence")?;
+            ctx.name(fence, "brdf-eval-fence");
+            let layouts = [self.set_layout];
+            let set = unsafe {
+                d.allocate_descriptor_sets(
+                    &vk::DescriptorSetAllocateInfo::default()
+                        .descriptor_pool(pool)
+                        .set_layouts(&layouts),
+                )
+            }
+            .call("vkAllocateDescriptorSets")?[0];
+            ctx.name(set, "brdf-eval-set");
+            let infos = [input, output].map(|b| {
+                [vk::DescriptorBufferInfo::default()
+                    .buffer(b.handle)
+                    .range(vk::WHOLE_SIZE)]
+            });
+            let writes: Vec<_> = infos
+                .iter()
+                .enumerate()
+                .map(|(i, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(i as u32)
+                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                        .buffer_info(info)
+                })
+                .collect();
+            unsafe { d.update_descriptor_sets(&writes, &[]) };
+            let cmd = unsafe {
+                d.allocate_command_buffers(
+                    &vk::CommandBufferAllocateInfo::default()
+                        .command_pool(command_pool)
+                        .command_buffer_count(1),
+                )
+            }
+            .call("vkAllocateCommandBuffers")?[0];
+            ctx.name(cmd, "brdf-eval-commands");
+            unsafe {
+                d.begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .call("vkBeginCommandBuffer")?;
+                ctx.begin_label(cmd, "brdf-eval");
+                // Host writes to the case buffer are visible at submit; only the result needs
+                // a barrier, towards the host read after the fence.
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    self.pipeline_layout,
+                    0,
+                    &[set],
+                    &[],
+                );
+                d.cmd_push_constants(
+                    cmd,
+                    self.pipeline_layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    &count.to_le_bytes(),
+                );
+                d.cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1);
+                let barrier = [vk::MemoryBarrier2::default()
+                    .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+                    .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+                    .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                    .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+                d.cmd_pipeline_barrier2(
+                    cmd,
+                    &vk::DependencyInfo::default().memory_barriers(&barrier),
+                );
+                ctx.end_label(cmd);
+                d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
+                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+                d.queue_submit2(ctx.queue, &[submit], fence)
+                    .call("vkQueueSubmit2")?;
+                d.wait_for_fences(&[fence], true, u64::MAX)
+                    .call("vkWaitForFences")?;
+            }
+            Ok(())
+        })();
+        unsafe {
+            if let Ok(fence) = fence {
+                d.destroy_fence(fence, None);
+            }
+            if let Ok(command_pool) = command_pool {
+                d.destroy_command_pool(command_pool, None);
+            }
+            d.destroy_descriptor_pool(pool, None);
+        }
+        recorded
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device
+                .destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}

@@ -1,0 +1,38 @@
+#version 460
+// Evaluates BRDF cases with the GLSL spelling, for the comparison against the f64 reference
+// (histencil brdf-eval --device gpu, and crates/vk/tests/brdf_gpu.rs).
+// Rust mirror of the structs: crates/vk/src/brdf_eval.rs (GpuBrdfCase).
+
+#include "brdf/eval.glsl"
+
+layout(local_size_x = 64) in;
+
+struct BrdfCase {
+    uvec4 model;
+    vec4 params;
+    vec4 n;
+    vec4 t;
+    vec4 v;
+    vec4 l;
+};
+
+layout(set = 0, binding = 0, std430) readonly buffer Cases {
+    BrdfCase cases[];
+};
+
+layout(set = 0, binding = 1, std430) writeonly buffer Results {
+    vec4 results[];
+};
+
+layout(push_constant) uniform Push {
+    uint count;
+} push;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= push.count) {
+        return;
+    }
+    BrdfCase c = cases[i];
+    results[i] = vec4(brdf_eval(c.model.x, c.params, c.n.xyz, c.t.xyz, c.v.xyz, c.l.xyz), 0.0);
+}
