@@ -6,6 +6,8 @@ use histencil_vk::{Context, ContextDesc, Readback, Renderer, Technique};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod brdf_eval;
+
 #[derive(Parser)]
 #[command(
     name = "histencil",
@@ -23,6 +25,29 @@ enum Command {
     Render(RenderArgs),
     /// List the embedded scenes: name, BRDFs in use, lights, alpha entities, description.
     Scenes,
+    /// Evaluate BRDF cases from a CSV file (id,brdf,params,N,T,V,L) into `id,value`.
+    BrdfEval(BrdfEvalArgs),
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Device {
+    /// The f64 reference.
+    Cpu,
+    /// The GLSL spelling, in a compute shader.
+    Gpu,
+}
+
+#[derive(clap::Args)]
+struct BrdfEvalArgs {
+    #[arg(long)]
+    cases: PathBuf,
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long, value_enum, default_value = "cpu")]
+    device: Device,
+    /// With `--device gpu`: run under the validation layer; any message fails the run.
+    #[arg(long)]
+    validate: bool,
 }
 
 #[derive(clap::Args)]
@@ -141,6 +166,29 @@ fn render(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
+    let input = std::fs::File::open(&args.cases)
+        .with_context(|| format!("cannot read {}", args.cases.display()))?;
+    let (rows, errors) =
+        brdf_eval::parse_cases(input).with_context(|| format!("in {}", args.cases.display()))?;
+    for e in &errors {
+        eprintln!("histencil: {}: {e}", args.cases.display());
+    }
+    let (values, as_f32) = match args.device {
+        Device::Cpu => (brdf_eval::evaluate_cpu(&rows), false),
+        Device::Gpu => (brdf_eval::evaluate_gpu(&rows, args.validate)?, true),
+    };
+    check_writable(&args.out)?;
+    let out = std::fs::File::create(&args.out)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    brdf_eval::write_results(std::io::BufWriter::new(out), &rows, &values, as_f32)?;
+    println!("wrote {} ({} rows)", args.out.display(), rows.len());
+    if !errors.is_empty() {
+        bail!("{} row(s) could not be evaluated", errors.len());
+    }
+    Ok(())
+}
+
 fn scenes() {
     for (name, description) in histencil_scene::EMBEDDED {
         let scene = histencil_scene::embedded(name).expect("embedded scenes exist");
@@ -179,6 +227,7 @@ fn main() -> ExitCode {
             scenes();
             Ok(())
         }
+        Command::BrdfEval(args) => brdf_eval(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -99,3 +99,59 @@ fn scenes_lists_every_embedded_scene() {
         assert_eq!(line.split('\t').count(), 5, "{line}");
     }
 }
+
+#[test]
+fn brdf_eval_agrees_between_cpu_and_gpu_and_reports_bad_rows() {
+    let dir = std::env::temp_dir().join(format!("histencil-brdf-eval-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = dir.join("cases.csv");
+    std::fs::write(
+        &cases,
+        "id,brdf,params,N,T,V,L\n\
+         a,ggx,\"{\"\"alpha\"\": 0.2}\",0;0;1,,0.2;0.1;1,-0.3;0;1\n\
+         b,penner_skin,\"{\"\"rho\"\": 0.9, \"\"radius_mm\"\": 3}\",0;0;1,,,1;0;0.05\n\
+         c,lambert,\"{\"\"albedo\"\": 1}\",0;0;1,,,0;0;1\n",
+    )
+    .unwrap();
+    let mut outputs = vec![];
+    for device in ["cpu", "gpu"] {
+        let out = dir.join(format!("{device}.csv"));
+        let args = [
+            "brdf-eval",
+            "--cases",
+            cases.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--device",
+            device,
+            "--validate",
+        ];
+        let (ok, _, stderr) = histencil(&args);
+        assert!(!ok, "a bad row makes the run fail");
+        assert!(
+            stderr.contains("row 3 (id `c`): lambert: unknown parameter `albedo`"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        outputs.push(std::fs::read_to_string(out).unwrap());
+    }
+    let values = |text: &str| -> Vec<f64> {
+        text.lines()
+            .skip(1)
+            .flat_map(|l| {
+                l.split(',')
+                    .nth(1)
+                    .unwrap()
+                    .split(';')
+                    .map(|v| v.parse().unwrap())
+                    .collect::<Vec<f64>>()
+            })
+            .collect()
+    };
+    let (cpu, gpu) = (values(&outputs[0]), values(&outputs[1]));
+    assert_eq!(cpu.len(), 4, "one GGX value and three skin channels");
+    for (c, g) in cpu.iter().zip(&gpu) {
+        assert!((c - g).abs() <= 1e-3 * c.abs(), "cpu {c} vs gpu {g}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
