@@ -2,7 +2,7 @@
 //! shipping shader code can be held to the f64 reference. One dispatch per call.
 
 use crate::context::Context;
-use crate::descriptors::{BindingKind, BRDF_EVAL_SET};
+use crate::descriptors::{create_pipeline_layout, create_set_layout, BRDF_EVAL_SET};
 use crate::error::{Result, VkCall};
 use crate::pipelines::create_module;
 use crate::resources::Buffer;
@@ -39,42 +39,14 @@ pub struct BrdfEvaluator {
 impl BrdfEvaluator {
     pub fn new(ctx: &Context) -> Result<Self> {
         let d = &ctx.device;
-        let bindings: Vec<_> = BRDF_EVAL_SET
-            .iter()
-            .map(|b| {
-                debug_assert_eq!(b.kind, BindingKind::StorageBuffer);
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b.binding)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        let set_layout = unsafe {
-            d.create_descriptor_set_layout(
-                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
-                None,
-            )
-        }
-        .call("vkCreateDescriptorSetLayout")?;
-        ctx.name(set_layout, "brdf-eval-set-layout");
-        let ranges = [vk::PushConstantRange::default()
-            .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            .size(4)];
-        let set_layouts = [set_layout];
-        let pipeline_layout = unsafe {
-            d.create_pipeline_layout(
-                &vk::PipelineLayoutCreateInfo::default()
-                    .set_layouts(&set_layouts)
-                    .push_constant_ranges(&ranges),
-                None,
-            )
-        }
-        .call("vkCreatePipelineLayout")?;
-        ctx.name(pipeline_layout, "brdf-eval-pipeline-layout");
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let set_layout = create_set_layout(ctx, "brdf-eval-set-layout", BRDF_EVAL_SET, compute)?;
+        // Push constants: the case count.
+        let pipeline_layout =
+            create_pipeline_layout(ctx, "brdf-eval-pipeline-layout", &[set_layout], compute, 4)?;
         let module = create_module(ctx, "brdf-eval-comp", shaders::BRDF_EVAL_COMP)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::COMPUTE)
+            .stage(compute)
             .module(module)
             .name(c"main");
         let info = [vk::ComputePipelineCreateInfo::default()

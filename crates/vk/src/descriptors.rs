@@ -76,10 +76,17 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
 ];
 
-fn create_set_layout(
+/// The stages of the graphics passes: every binding and push constant is visible to both.
+const GRAPHICS_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
+    vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw(),
+);
+
+/// A named set layout with every binding of `set` visible to `stages`.
+pub(crate) fn create_set_layout(
     ctx: &Context,
     name: &str,
     set: &[BindingDesc],
+    stages: vk::ShaderStageFlags,
 ) -> Result<vk::DescriptorSetLayout> {
     let bindings: Vec<_> = set
         .iter()
@@ -88,7 +95,7 @@ fn create_set_layout(
                 .binding(b.binding)
                 .descriptor_type(b.kind.descriptor_type())
                 .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+                .stage_flags(stages)
         })
         .collect();
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
@@ -112,14 +119,17 @@ pub struct Descriptors {
     pub tonemap_set: vk::DescriptorSet,
 }
 
-fn create_pipeline_layout(
+/// A named pipeline layout: `sets` in order, and `push_constant_bytes` visible to `stages`.
+pub(crate) fn create_pipeline_layout(
     ctx: &Context,
     name: &str,
     sets: &[vk::DescriptorSetLayout],
+    stages: vk::ShaderStageFlags,
+    push_constant_bytes: u32,
 ) -> Result<vk::PipelineLayout> {
     let ranges = [vk::PushConstantRange::default()
-        .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
-        .size(PUSH_CONSTANT_BYTES)];
+        .stage_flags(stages)
+        .size(push_constant_bytes)];
     let info = vk::PipelineLayoutCreateInfo::default()
         .set_layouts(sets)
         .push_constant_ranges(&ranges);
@@ -139,21 +149,18 @@ pub struct DescriptorTargets {
 
 impl Descriptors {
     pub fn new(ctx: &Context, targets: &DescriptorTargets) -> Result<Self> {
-        let frame_layout = create_set_layout(ctx, "frame-set-layout", FRAME_SET)?;
-        let gbuffer_layout = create_set_layout(ctx, "gbuffer-set-layout", GBUFFER_SET)?;
-        let tonemap_layout = create_set_layout(ctx, "tonemap-set-layout", TONEMAP_SET)?;
-        let mesh_pipeline_layout =
-            create_pipeline_layout(ctx, "mesh-pipeline-layout", &[frame_layout])?;
-        let lighting_pipeline_layout = create_pipeline_layout(
-            ctx,
-            "lighting-pipeline-layout",
-            &[frame_layout, gbuffer_layout],
-        )?;
-        let tonemap_pipeline_layout = create_pipeline_layout(
-            ctx,
-            "tonemap-pipeline-layout",
-            &[frame_layout, tonemap_layout],
-        )?;
+        let set_layout = |name, set| create_set_layout(ctx, name, set, GRAPHICS_STAGES);
+        let frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
+        let gbuffer_layout = set_layout("gbuffer-set-layout", GBUFFER_SET)?;
+        let tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
+        let pipeline_layout = |name, sets: &[vk::DescriptorSetLayout]| {
+            create_pipeline_layout(ctx, name, sets, GRAPHICS_STAGES, PUSH_CONSTANT_BYTES)
+        };
+        let mesh_pipeline_layout = pipeline_layout("mesh-pipeline-layout", &[frame_layout])?;
+        let lighting_pipeline_layout =
+            pipeline_layout("lighting-pipeline-layout", &[frame_layout, gbuffer_layout])?;
+        let tonemap_pipeline_layout =
+            pipeline_layout("tonemap-pipeline-layout", &[frame_layout, tonemap_layout])?;
 
         let sizes = [
             vk::DescriptorPoolSize::default()
