@@ -211,3 +211,40 @@ pub fn ordinary_error(actual: f64, reference: f64) -> f64 {
         abs / reference.abs()
     }
 }
+
+/// The worst error of each model over `cases`: `(model, error, label of the case)`. `actual[i]`
+/// is case `i` as evaluated by the spelling under test, against the f64 reference; skin
+/// compares its three channels, scalar models their one value. Prints one line per model,
+/// prefixed by `spelling`, for the report.
+///
+/// # Panics
+/// If the f64 reference itself is not finite: that is a bug in the reference.
+pub fn worst_per_model(
+    spelling: &str,
+    cases: &[Case],
+    actual: &[[f64; 3]],
+    error: fn(f64, f64) -> f64,
+) -> Vec<(&'static str, f64, String)> {
+    let mut out: Vec<(&'static str, f64, String)> = vec![];
+    for (case, value) in cases.iter().zip(actual) {
+        let reference = case.brdf.reference(case.dirs);
+        let channels = if case.brdf.is_rgb() { 3 } else { 1 };
+        for k in 0..channels {
+            assert!(
+                reference[k].is_finite(),
+                "reference not finite: {}",
+                case.label
+            );
+            let e = error(value[k], reference[k]);
+            match out.iter_mut().find(|(m, ..)| *m == case.brdf.name()) {
+                Some(entry) if e > entry.1 => *entry = (entry.0, e, case.label.clone()),
+                Some(_) => {}
+                None => out.push((case.brdf.name(), e, case.label.clone())),
+            }
+        }
+    }
+    for (model, e, label) in &out {
+        println!("{spelling} {model:24} worst {e:.3e}  ({label})");
+    }
+    out
+}

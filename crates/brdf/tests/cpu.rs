@@ -1,48 +1,36 @@
 //! The f32 spelling against the f64 reference on ordinary and hard cases; physical sanity of
 //! the reference itself (white furnace, reciprocity, limits).
 
-use histencil_brdf::cases::{hard_cases, ordinary_cases, ordinary_error, relative_error, Case};
+use histencil_brdf::cases::{
+    hard_cases, ordinary_cases, ordinary_error, relative_error, worst_per_model, Case,
+};
 use histencil_brdf::{skin_diffusion, Brdf, REFERENCE_PANELS, SHIPPING_PANELS};
 use std::f64::consts::PI;
 
-/// Worst error per model over `cases`, with the case that produced it.
-fn worst(cases: &[Case], error: fn(f64, f64) -> f64) -> Vec<(&'static str, f64, String)> {
-    let mut out: Vec<(&'static str, f64, String)> = vec![];
-    for case in cases {
-        let reference = case.brdf.reference(case.dirs);
-        let shipping = case.brdf.shipping(case.dirs_f32());
-        for k in 0..3 {
-            assert!(
-                reference[k].is_finite(),
-                "reference not finite: {}",
-                case.label
-            );
-            let e = error(f64::from(shipping[k]), reference[k]);
-            match out.iter_mut().find(|(m, ..)| *m == case.brdf.name()) {
-                Some(entry) if e > entry.1 => *entry = (entry.0, e, case.label.clone()),
-                Some(_) => {}
-                None => out.push((case.brdf.name(), e, case.label.clone())),
-            }
-        }
-    }
-    for (model, e, label) in &out {
-        println!("{model:24} worst {e:.3e}  ({label})");
-    }
-    out
+/// Every case evaluated by the f32 spelling.
+fn in_f32(cases: &[Case]) -> Vec<[f64; 3]> {
+    cases
+        .iter()
+        .map(|c| c.brdf.shipping(c.dirs_f32()).map(f64::from))
+        .collect()
 }
 
 #[test]
 fn f32_matches_f64_on_ordinary_cases() {
+    let cases = ordinary_cases();
+    let values = in_f32(&cases);
     // Printed for the report: plain relative error, before the near-zero absolute allowance.
-    worst(&ordinary_cases(), relative_error);
-    for (model, e, label) in worst(&ordinary_cases(), ordinary_error) {
+    worst_per_model("f32", &cases, &values, relative_error);
+    for (model, e, label) in worst_per_model("f32", &cases, &values, ordinary_error) {
         assert!(e <= 1e-3, "{model}: {e:e} at {label}");
     }
 }
 
 #[test]
 fn f32_is_finite_and_close_on_hard_cases() {
-    for (model, e, label) in worst(&hard_cases(), relative_error) {
+    let cases = hard_cases();
+    let values = in_f32(&cases);
+    for (model, e, label) in worst_per_model("f32", &cases, &values, relative_error) {
         assert!(e <= 1e-2, "{model}: {e:e} at {label}");
     }
 }
