@@ -167,32 +167,16 @@ pub fn evaluate_cpu(rows: &[Row]) -> Vec<[f64; 3]> {
     rows.iter().map(|r| r.brdf.reference(r.dirs)).collect()
 }
 
-/// The GLSL spelling of every row, on the chosen device.
-pub fn evaluate_gpu(rows: &[Row], validate: bool) -> Result<Vec<[f64; 3]>> {
-    let desc = if validate {
-        histencil_vk::ContextDesc::validated()
-    } else {
-        histencil_vk::ContextDesc::default()
-    };
-    let ctx = histencil_vk::Context::new(desc)?;
-    let log = ctx.validation_log();
-    let values = {
-        let mut evaluator = histencil_vk::BrdfEvaluator::new(&ctx)?;
-        let input: Vec<_> = rows
-            .iter()
-            .map(|r| (r.brdf, r.dirs.map(|d| d.map(|x| x as f32))))
-            .collect();
-        let values = evaluator.evaluate(&ctx, &input);
-        evaluator.destroy(&ctx);
-        values?
-    };
-    // Leaks are reported when the device goes away: check the log after.
-    drop(ctx);
-    let problems = log.problems();
-    if !problems.is_empty() {
-        bail!("validation messages:\n{}", problems.join("\n"));
-    }
-    Ok(values.into_iter().map(|v| v.map(f64::from)).collect())
+/// The GLSL spelling of every row, on `ctx`'s device.
+pub fn evaluate_gpu(ctx: &histencil_vk::Context, rows: &[Row]) -> Result<Vec<[f64; 3]>> {
+    let mut evaluator = histencil_vk::BrdfEvaluator::new(ctx)?;
+    let input: Vec<_> = rows
+        .iter()
+        .map(|r| (r.brdf, r.dirs.map(|d| d.map(|x| x as f32))))
+        .collect();
+    let values = evaluator.evaluate(ctx, &input);
+    evaluator.destroy(ctx);
+    Ok(values?.into_iter().map(|v| v.map(f64::from)).collect())
 }
 
 #[cfg(test)]

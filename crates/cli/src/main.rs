@@ -111,13 +111,8 @@ fn render(args: &RenderArgs) -> Result<()> {
     {
         check_writable(path)?;
     }
-    let ctx = Context::new(ContextDesc {
-        validation: args.validate,
-        device_filter: None,
-    })?;
-    let log = ctx.validation_log();
-    {
-        let mut renderer = Renderer::new(&ctx, scene, args.width, args.height)?;
+    on_device(args.validate, |ctx| {
+        let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
         let frame = renderer.render(
             args.technique,
             Readback {
@@ -154,7 +149,19 @@ fn render(args: &RenderArgs) -> Result<()> {
             args.technique,
             ctx.device_name()
         );
-    }
+        Ok(())
+    })
+}
+
+/// Runs `body` on a device, then drops the context and fails on any validation message (with
+/// `validate`): leaked objects are only reported when the device goes away.
+fn on_device<T>(validate: bool, body: impl FnOnce(&Context) -> Result<T>) -> Result<T> {
+    let ctx = Context::new(ContextDesc {
+        validation: validate,
+        device_filter: None,
+    })?;
+    let log = ctx.validation_log();
+    let value = body(&ctx)?;
     drop(ctx);
     let problems = log.problems();
     if !problems.is_empty() {
@@ -163,7 +170,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         }
         bail!("{} validation message(s)", problems.len());
     }
-    Ok(())
+    Ok(value)
 }
 
 fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
@@ -176,7 +183,10 @@ fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
     }
     let (values, as_f32) = match args.device {
         Device::Cpu => (brdf_eval::evaluate_cpu(&rows), false),
-        Device::Gpu => (brdf_eval::evaluate_gpu(&rows, args.validate)?, true),
+        Device::Gpu => (
+            on_device(args.validate, |ctx| brdf_eval::evaluate_gpu(ctx, &rows))?,
+            true,
+        ),
     };
     check_writable(&args.out)?;
     let out = std::fs::File::create(&args.out)
