@@ -80,15 +80,15 @@ impl Simulator {
         plan: &FramePlan,
         footprints: &[Footprint],
     ) -> SimResult {
+        let tiles = TileSurface::new(target.width, target.height, self.tile_size);
         let mut run = Run {
             layout: self.layout,
-            tiles: TileSurface::new(target.width, target.height, self.tile_size),
+            tile_stamp: vec![u32::MAX; tiles.tile_count()],
+            tiles,
             stats: TileStats::default(),
-            tile_stamp: Vec::new(),
             touched: Vec::new(),
             target,
         };
-        run.tile_stamp = vec![u32::MAX; run.tiles.tile_count()];
         let mut lights: Vec<LightShading> = footprints.iter().map(LightShading::new).collect();
         let mut culling_bit_left = vec![false; footprints.len()];
         let mut saved = Vec::new();
