@@ -87,6 +87,26 @@ pub fn extreme_brdfs() -> Vec<Brdf> {
     out
 }
 
+/// The `i`-th point of the Halton sequence in `base` (a prime), in (0, 1): the low-discrepancy
+/// samples the fixed direction sets are built from.
+pub fn halton(i: usize, base: usize) -> f64 {
+    let (mut f, mut r, mut i) = (1.0, 0.0, i + 1);
+    while i > 0 {
+        f /= base as f64;
+        r += f * (i % base) as f64;
+        i /= base;
+    }
+    r
+}
+
+/// The unit vector with height `z` in [-1, 1] at azimuth `s` turns: uniform on the sphere for
+/// uniform `z` and `s`.
+pub fn sphere_point(z: f64, s: f64) -> V3<f64> {
+    let phi = std::f64::consts::TAU * s;
+    let radius = (1.0 - z * z).max(0.0).sqrt();
+    [radius * phi.cos(), radius * phi.sin(), z]
+}
+
 fn unit(theta: f64, phi: f64) -> V3<f64> {
     [
         theta.sin() * phi.cos(),

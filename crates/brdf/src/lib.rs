@@ -19,10 +19,15 @@
 //! Schlick Fresnel), [`kajiya_kay`] and Penner's pre-integrated skin [`penner_skin`]. [`Brdf`]
 //! holds a model with its parameters and evaluates it as the f64 reference or the f32 spelling.
 //!
+//! [`lut`] bakes the talk's look-up tables and measures their error against resolution;
+//! [`encoding`] measures what G-buffer quantisation adds.
+//!
 //! [`BrdfId`] is the renderer's list of shading models stored in the G-buffer and stencil.
 
 pub mod cases;
+pub mod encoding;
 mod id;
+pub mod lut;
 mod model;
 mod models;
 mod vector;

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod brdf_eval;
+mod brdf_report;
 
 #[derive(Parser)]
 #[command(
@@ -27,6 +28,19 @@ enum Command {
     Scenes,
     /// Evaluate BRDF cases from a CSV file (id,brdf,params,N,T,V,L) into `id,value`.
     BrdfEval(BrdfEvalArgs),
+    /// Print the error of the BRDF look-up tables against resolution and the error the G-buffer
+    /// encodings add (markdown), both against the f64 reference.
+    BrdfReport(BrdfReportArgs),
+}
+
+#[derive(clap::Args)]
+struct BrdfReportArgs {
+    /// Table resolutions (grid points per axis), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "8,16,32,64")]
+    lut_res: Vec<u32>,
+    /// Size of the fixed direction sets.
+    #[arg(long, default_value_t = 4096)]
+    directions: usize,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -199,6 +213,24 @@ fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
     Ok(())
 }
 
+fn brdf_report(args: &BrdfReportArgs) -> Result<()> {
+    if args.directions == 0 {
+        bail!("--directions must be at least 1");
+    }
+    println!("## LUT error against resolution\n");
+    println!(
+        "Absolute error of `f_r cos` over {} fixed directions (f64 reference).\n",
+        args.directions
+    );
+    println!(
+        "{}",
+        brdf_report::lut_table(&args.lut_res, args.directions)?
+    );
+    println!("## G-buffer encoding error\n");
+    println!("{}", brdf_report::encoding_table(args.directions));
+    Ok(())
+}
+
 fn scenes() {
     for (name, description) in histencil_scene::EMBEDDED {
         let scene = histencil_scene::embedded(name).expect("embedded scenes exist");
@@ -238,6 +270,7 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::BrdfEval(args) => brdf_eval(args),
+        Command::BrdfReport(args) => brdf_report(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -49,6 +49,19 @@ fn bad_arguments_are_one_line_errors() {
         &["render", "--technique", "magic", "--out", out],
         "unknown technique",
     );
+    assert_one_line_error(&["brdf-report", "--lut-res", "1"], "LUT resolution 1");
+    assert_one_line_error(&["brdf-report", "--directions", "0"], "--directions");
+}
+
+#[test]
+fn brdf_report_prints_both_tables() {
+    let (ok, stdout, stderr) =
+        histencil(&["brdf-report", "--lut-res", "4,8", "--directions", "64"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("| material | peak | res 4: max / mean | res 8: max / mean |"));
+    assert!(stdout.contains("| penner_skin (0.9, 1.5) |"));
+    assert!(stdout.contains("f32 normal, f16 params (histencil)"));
+    assert!(stdout.contains("| worst normal error (degrees) |"));
 }
 
 #[test]

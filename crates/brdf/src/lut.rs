@@ -1,0 +1,386 @@
+//! BRDF look-up tables: the talk's alternative to multi-pass stencil and branching. A table
+//! holds `f_r * cos(theta_L)` of one material, sampled on a regular grid over the model's
+//! geometric axes and looked up with multilinear interpolation.
+//!
+//! # Parameterisation
+//! The axes are angles (not cosines): the specular lobes are as wide in angle at grazing as at
+//! normal incidence, so a uniform angle grid spends its samples evenly. Grid point `i` of `res`
+//! sits at `u = i / (res - 1)` on every axis, so both ends of each range are sampled exactly.
+//!
+//! | model | axes | size |
+//! |---|---|---|
+//! | lambert | `N.L` in [0, 1] (exact: Lambert is linear in it) | `res` |
+//! | blinn_phong, oren_nayar_*, ggx | `theta_L`, `theta_V` in [0, pi/2], `phi` (azimuth between L and V about N) in [0, pi] | `res^3` |
+//! | kajiya_kay | angles `T^L`, `T^V` in [0, pi] | `res^2` |
+//! | penner_skin | `theta` (N to L) in [0, pi], curvature as `k / (k + 1)` with `k` in 1/mm | `res^2`, RGB |
+//!
+//! Every parameter is fixed at bake time except the skin's curvature, which varies per pixel and
+//! is therefore an axis: the "limited control over parameters" the talk warns about is real, a
+//! material with another roughness needs another table. The three angles are the complete
+//! geometry of an isotropic BRDF, so the only error is the grid's; the report
+//! ([`LutAccuracy::measure`]) states it against resolution.
+
+use crate::cases::{halton, sphere_point};
+use crate::model::Brdf;
+use crate::vector::{cross, dot, normalize, scale, sub, V3};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// The geometric axes a table is sampled over (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LutAxes {
+    /// `N.L`.
+    CosLight,
+    /// `theta_L`, `theta_V`, `phi`.
+    Isotropic,
+    /// The angles between T and L, and between T and V.
+    Fibre,
+    /// `theta` between N and L, and the warped curvature.
+    SkinCurvature,
+}
+
+/// Skin curvature (1/mm) stored at the far end of the curvature axis: 1/k^2 from the ring
+/// average, far below the f32 resolution of the table.
+const SKIN_CURVATURE_AT_END: f64 = 1e6;
+
+impl LutAxes {
+    pub fn of(brdf: &Brdf) -> Self {
+        match brdf {
+            Brdf::Lambert { .. } => LutAxes::CosLight,
+            Brdf::BlinnPhong { .. }
+            | Brdf::OrenNayarFull { .. }
+            | Brdf::OrenNayarQualitative { .. }
+            | Brdf::Ggx { .. } => LutAxes::Isotropic,
+            Brdf::KajiyaKay { .. } => LutAxes::Fibre,
+            Brdf::PennerSkin { .. } => LutAxes::SkinCurvature,
+        }
+    }
+
+    pub fn dimensions(self) -> usize {
+        match self {
+            LutAxes::CosLight => 1,
+            LutAxes::Fibre | LutAxes::SkinCurvature => 2,
+            LutAxes::Isotropic => 3,
+        }
+    }
+
+    /// The table coordinates (each in [0, 1]) of a shading point, or `None` where the model
+    /// gives 0 without looking anything up (zero vectors; `N.L <= 0` or `N.V < 0` for the
+    /// surface models, as their gate says). `curvature_per_mm` is only read by skin.
+    pub fn coordinates(
+        self,
+        [n, t, v, l]: [V3<f64>; 4],
+        curvature_per_mm: f64,
+    ) -> Option<[f64; 3]> {
+        let angle = |a: V3<f64>, b: V3<f64>| {
+            let x = cross(a, b);
+            dot(x, x).sqrt().atan2(dot(a, b))
+        };
+        match self {
+            LutAxes::CosLight => {
+                let (n, l) = (normalize(n)?, normalize(l)?);
+                let cos = dot(n, l).min(1.0);
+                (cos > 0.0).then_some([cos, 0.0, 0.0])
+            }
+            LutAxes::Isotropic => {
+                let (n, v, l) = (normalize(n)?, normalize(v)?, normalize(l)?);
+                if dot(n, l) <= 0.0 || dot(n, v) < 0.0 {
+                    return None;
+                }
+                let in_plane = |d: V3<f64>| normalize(sub(d, scale(n, dot(n, d))));
+                let phi = match (in_plane(l), in_plane(v)) {
+                    (Some(lp), Some(vp)) => angle(lp, vp),
+                    // Along the normal the azimuth is undefined and the BRDF does not depend
+                    // on it.
+                    _ => 0.0,
+                };
+                Some([angle(n, l) / FRAC_PI_2, angle(n, v) / FRAC_PI_2, phi / PI])
+            }
+            LutAxes::Fibre => {
+                let (t, v, l) = (normalize(t)?, normalize(v)?, normalize(l)?);
+                Some([angle(t, l) / PI, angle(t, v) / PI, 0.0])
+            }
+            LutAxes::SkinCurvature => {
+                let (n, l) = (normalize(n)?, normalize(l)?);
+                let k = curvature_per_mm.max(0.0);
+                Some([angle(n, l) / PI, k / (k + 1.0), 0.0])
+            }
+        }
+    }
+
+    /// Directions `[N, T, V, L]` at table coordinates `u`, and the skin curvature there.
+    fn directions(self, u: [f64; 3]) -> ([V3<f64>; 4], f64) {
+        let n = [0.0, 0.0, 1.0];
+        let x = [1.0, 0.0, 0.0];
+        let polar = |theta: f64, phi: f64| {
+            [
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ]
+        };
+        match self {
+            LutAxes::CosLight => {
+                let l = [(1.0 - u[0] * u[0]).max(0.0).sqrt(), 0.0, u[0]];
+                ([n, x, n, l], 0.0)
+            }
+            LutAxes::Isotropic => {
+                let l = polar(u[0] * FRAC_PI_2, 0.0);
+                let v = polar(u[1] * FRAC_PI_2, u[2] * PI);
+                ([n, x, v, l], 0.0)
+            }
+            LutAxes::Fibre => {
+                // T along +Z; L and V at their angles to it.
+                let l = polar(u[0] * PI, 0.0);
+                let v = polar(u[1] * PI, FRAC_PI_2);
+                ([x, n, v, l], 0.0)
+            }
+            LutAxes::SkinCurvature => {
+                let l = polar(u[0] * PI, 0.0);
+                let k = if u[1] >= 1.0 {
+                    SKIN_CURVATURE_AT_END
+                } else {
+                    u[1] / (1.0 - u[1])
+                };
+                ([n, x, n, l], k)
+            }
+        }
+    }
+}
+
+/// Why a table could not be built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LutError {
+    #[error("LUT resolution {0} is out of range (2..={max})", max = Lut::MAX_RESOLUTION)]
+    Resolution(u32),
+}
+
+/// A baked table for one material.
+#[derive(Clone, Debug)]
+pub struct Lut {
+    pub brdf: Brdf,
+    pub axes: LutAxes,
+    /// Grid points per axis.
+    pub resolution: u32,
+    /// `f_r * cos` at the grid points, RGB, first axis fastest.
+    pub values: Vec<[f32; 3]>,
+}
+
+impl Lut {
+    /// 512 points per axis is 512 MiB of RGB f32 for a 3D table: beyond anything useful.
+    pub const MAX_RESOLUTION: u32 = 512;
+
+    /// Samples `brdf` (its f64 reference) at `resolution` points per axis.
+    pub fn bake(brdf: Brdf, resolution: u32) -> Result<Self, LutError> {
+        if !(2..=Self::MAX_RESOLUTION).contains(&resolution) {
+            return Err(LutError::Resolution(resolution));
+        }
+        let axes = LutAxes::of(&brdf);
+        let dims = axes.dimensions();
+        let r = resolution as usize;
+        let count = r.pow(dims as u32);
+        let step = 1.0 / f64::from(resolution - 1);
+        let values = (0..count)
+            .map(|index| {
+                let mut u = [0.0; 3];
+                let mut rest = index;
+                for axis in u.iter_mut().take(dims) {
+                    *axis = (rest % r) as f64 * step;
+                    rest /= r;
+                }
+                let (dirs, curvature) = axes.directions(u);
+                let at = match brdf {
+                    Brdf::PennerSkin { rho, .. } => Brdf::PennerSkin {
+                        rho,
+                        curvature_per_mm: curvature,
+                    },
+                    other => other,
+                };
+                at.reference(dirs).map(|x| x as f32)
+            })
+            .collect();
+        Ok(Self {
+            brdf,
+            axes,
+            resolution,
+            values,
+        })
+    }
+
+    /// The table's value at a shading point: multilinear interpolation between grid points,
+    /// in f32 as a shader does it. Gated points give 0.
+    pub fn lookup(&self, dirs: [V3<f64>; 4]) -> [f32; 3] {
+        let curvature = match self.brdf {
+            Brdf::PennerSkin {
+                curvature_per_mm, ..
+            } => curvature_per_mm,
+            _ => 0.0,
+        };
+        let Some(u) = self.axes.coordinates(dirs, curvature) else {
+            return [0.0; 3];
+        };
+        let dims = self.axes.dimensions();
+        let r = self.resolution as usize;
+        let last = (self.resolution - 1) as f32;
+        // Per axis: the lower grid index and the weight of the upper one.
+        let mut base = [0usize; 3];
+        let mut frac = [0f32; 3];
+        for a in 0..dims {
+            let x = (u[a] as f32).clamp(0.0, 1.0) * last;
+            let i = (x.floor() as usize).min(r - 2);
+            base[a] = i;
+            frac[a] = x - i as f32;
+        }
+        let mut out = [0f32; 3];
+        for corner in 0..(1usize << dims) {
+            let mut weight = 1f32;
+            let mut index = 0usize;
+            let mut stride = 1usize;
+            for a in 0..dims {
+                let upper = (corner >> a) & 1;
+                weight *= if upper == 1 { frac[a] } else { 1.0 - frac[a] };
+                index += (base[a] + upper) * stride;
+                stride *= r;
+            }
+            for (o, v) in out.iter_mut().zip(self.values[index]) {
+                *o += weight * v;
+            }
+        }
+        out
+    }
+
+    /// Bytes of the table as RGB f32.
+    pub fn size_bytes(&self) -> usize {
+        self.values.len() * std::mem::size_of::<[f32; 3]>()
+    }
+}
+
+/// The fixed direction set the tables are judged on: `count` Halton points, L and V uniform over
+/// the upper hemisphere (L over the whole sphere for skin, which wraps), N = +Z, T = +X.
+pub fn report_directions(count: usize) -> Vec<[V3<f64>; 4]> {
+    (0..count)
+        .map(|i| {
+            let l = sphere_point(2.0 * halton(i, 2) - 1.0, halton(i, 3));
+            let v = sphere_point(halton(i, 5), halton(i, 7));
+            [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], v, l]
+        })
+        .collect()
+}
+
+/// A table's error against the f64 reference over [`report_directions`], in the units of the
+/// BRDF's value (`f_r * cos`), worst channel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LutAccuracy {
+    pub max_abs: f64,
+    pub mean_abs: f64,
+    /// The largest reference value over the set: the scale the errors are read against.
+    pub peak: f64,
+}
+
+impl LutAccuracy {
+    pub fn measure(lut: &Lut, directions: &[[V3<f64>; 4]]) -> Self {
+        let (mut max_abs, mut sum, mut peak) = (0f64, 0f64, 0f64);
+        for dirs in directions {
+            let reference = lut.brdf.reference(*dirs);
+            let table = lut.lookup(*dirs);
+            let error = (0..3)
+                .map(|k| (f64::from(table[k]) - reference[k]).abs())
+                .fold(0.0, f64::max);
+            max_abs = max_abs.max(error);
+            sum += error;
+            peak = reference.into_iter().fold(peak, f64::max);
+        }
+        Self {
+            max_abs,
+            mean_abs: sum / directions.len().max(1) as f64,
+            peak,
+        }
+    }
+}
+
+/// The materials the LUT report covers: one or two per model, spanning sharp and broad lobes.
+pub fn report_materials() -> Vec<Brdf> {
+    vec![
+        Brdf::Lambert { rho: 0.9 },
+        Brdf::BlinnPhong { exponent: 16.0 },
+        Brdf::BlinnPhong { exponent: 200.0 },
+        Brdf::OrenNayarFull {
+            rho: 0.9,
+            sigma: 0.35,
+        },
+        Brdf::OrenNayarQualitative {
+            rho: 0.9,
+            sigma: 0.35,
+        },
+        Brdf::Ggx {
+            alpha: 0.3,
+            f0: 0.04,
+            f90: 1.0,
+        },
+        Brdf::Ggx {
+            alpha: 0.05,
+            f0: 0.04,
+            f90: 1.0,
+        },
+        Brdf::KajiyaKay {
+            kd: 0.4,
+            ks: 0.6,
+            p: 30.0,
+        },
+        Brdf::PennerSkin {
+            rho: 0.9,
+            curvature_per_mm: 0.3,
+        },
+        Brdf::PennerSkin {
+            rho: 0.9,
+            curvature_per_mm: 1.5,
+        },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_points_are_reproduced_exactly() {
+        let brdf = Brdf::Ggx {
+            alpha: 0.3,
+            f0: 0.04,
+            f90: 1.0,
+        };
+        let lut = Lut::bake(brdf, 5).unwrap();
+        let (dirs, _) = lut.axes.directions([0.25, 0.5, 0.75]);
+        let reference = brdf.reference(dirs)[0];
+        assert!((f64::from(lut.lookup(dirs)[0]) - reference).abs() < 1e-6 * reference.max(1.0));
+    }
+
+    #[test]
+    fn lambert_is_exact_and_gated() {
+        let lut = Lut::bake(Brdf::Lambert { rho: 0.5 }, 2).unwrap();
+        let error = LutAccuracy::measure(&lut, &report_directions(256));
+        assert!(error.max_abs < 1e-7, "{error:?}");
+    }
+
+    #[test]
+    fn resolution_is_checked() {
+        let brdf = Brdf::Lambert { rho: 1.0 };
+        assert_eq!(Lut::bake(brdf, 1).unwrap_err(), LutError::Resolution(1));
+        assert!(Lut::bake(brdf, 513).is_err());
+    }
+
+    #[test]
+    fn coordinates_cover_the_unit_cube() {
+        for dirs in report_directions(512) {
+            for axes in [
+                LutAxes::Isotropic,
+                LutAxes::Fibre,
+                LutAxes::SkinCurvature,
+                LutAxes::CosLight,
+            ] {
+                if let Some(u) = axes.coordinates(dirs, 3.0) {
+                    assert!(u.iter().all(|x| (0.0..=1.0).contains(x)), "{axes:?} {u:?}");
+                }
+            }
+        }
+    }
+}
