@@ -1,7 +1,12 @@
 #version 460
-// Deferred light shader: one light, every BRDF (branching on the G-buffer's BRDF id).
+// Deferred light shader for one light. SHADED_BRDF picks the BRDF at pipeline creation: a
+// BRDF_* id gives the talk's per-BRDF shader (the stencil test guarantees the pixel's BRDF), and
+// BRANCH_ON_GBUFFER gives the uber shader that branches on the G-buffer's id.
 #include "light.glsl"
 #include "gbuffer.glsl"
+
+const uint BRANCH_ON_GBUFFER = 0xFFFFFFFFu;
+layout(constant_id = 0) const uint SHADED_BRDF = BRANCH_ON_GBUFFER;
 
 layout(push_constant) uniform LightDraw {
     uint light_index;
@@ -15,5 +20,16 @@ void main() {
         out_color = vec4(0.0);
         return;
     }
-    out_color = vec4(shade_light(lights[light_draw.light_index], s), 0.0);
+    // A switch on the constant itself: a comparison would become OpSpecConstantOp, which naga
+    // cannot read. The driver folds the switch when it specialises the pipeline.
+    uint model;
+    switch (SHADED_BRDF) {
+    case BRANCH_ON_GBUFFER:
+        model = s.brdf;
+        break;
+    default:
+        model = SHADED_BRDF;
+        break;
+    }
+    out_color = vec4(shade_light_with(lights[light_draw.light_index], s, model), 0.0);
 }

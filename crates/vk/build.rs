@@ -14,9 +14,6 @@ fn generated_glsl() -> String {
     for brdf in histencil_brdf::BrdfId::ALL {
         writeln!(s, "#define {} {}u", brdf.glsl_constant(), brdf.index()).unwrap();
     }
-    for (i, name) in histencil_brdf::MODEL_NAMES.iter().enumerate() {
-        writeln!(s, "#define BRDF_MODEL_{} {i}u", name.to_uppercase()).unwrap();
-    }
     writeln!(
         s,
         "#define GGX_MIN_ALPHA {:e}",

@@ -7,16 +7,15 @@
 
 layout(push_constant) uniform Draw {
     mat4 model;
-    vec4 albedo_specular; // rgb albedo, a specular
-    vec4 params;          // x exponent, y z reserved, w BRDF id
+    vec4 tint;   // rgb tint
+    vec4 params; // xyz the BRDF's packed parameters (histencil_brdf::Brdf::packed_params), w id
 } draw;
 
 Surface surface_from_draw(vec3 world_position, vec3 world_normal) {
     Surface s;
     s.position = world_position;
     s.normal = normalize(world_normal);
-    s.albedo = draw.albedo_specular.rgb;
-    s.specular = draw.albedo_specular.a;
+    s.tint = draw.tint.rgb;
     s.params = vec4(draw.params.xyz, 0.0);
     s.brdf = uint(draw.params.w);
     return s;

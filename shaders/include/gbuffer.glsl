@@ -1,9 +1,10 @@
 // G-buffer layout, written by gbuffer.frag and read by the deferred light shaders (set 1).
-//   albedo:       RGBA16F  rgb albedo, a specular
+//   albedo:       RGBA16F  rgb tint
 //   normal_depth: RGBA32F  xyz world normal, w linear view depth (0 = no geometry)
-//   material:     RGBA16F  xyz BRDF parameters, w BRDF id
-// Float formats keep the deferred path within 1/255 of the forward reference; the error compact
-// encodings would add is the [brdf] issue's measurement.
+//   material:     RGBA32F  xyz BRDF parameters, w BRDF id
+// Float formats keep the deferred path within 1/255 of the forward reference: parameters are
+// stored exactly as the forward pass reads them. What compact encodings would add is measured by
+// `histencil brdf-report` (histencil_brdf::encoding).
 #ifndef GBUFFER_GLSL
 #define GBUFFER_GLSL
 
@@ -29,8 +30,7 @@ bool gbuffer_load(vec2 frag_coord, out Surface s) {
     vec3 view_position = vec3(ndc.x * frame.projection.x, -ndc.y * frame.projection.y, -1.0) * linear_depth;
     s.position = (frame.inv_view * vec4(view_position, 1.0)).xyz;
     s.normal = normal_depth.xyz;
-    s.albedo = albedo.rgb;
-    s.specular = albedo.a;
+    s.tint = albedo.rgb;
     s.params = vec4(material.xyz, 0.0);
     s.brdf = uint(material.w);
     return linear_depth > 0.0;

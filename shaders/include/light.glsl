@@ -4,7 +4,7 @@
 #define LIGHT_GLSL
 
 #include "frame.glsl"
-#include "brdf/surface.glsl"
+#include "brdf/eval.glsl"
 #include "surface.glsl"
 
 // Windowed inverse square: exactly zero at d >= range, so a volume that circumscribes the range
@@ -38,26 +38,33 @@ vec3 light_incident(Light light, vec3 P, out vec3 L) {
     return light.color_kind.rgb * a;
 }
 
-// Outgoing radiance towards V for unit light of direction L, by the surface's own BRDF.
-vec3 evaluate_brdf(Surface s, vec3 V, vec3 L) {
-    vec3 diffuse = s.albedo * brdf_lambert(1.0, s.normal, L);
-    switch (s.brdf) {
-    case BRDF_BLINN_PHONG:
-        return diffuse + s.specular * brdf_blinn_phong(s.params.x, s.normal, V, L);
-    default: // BRDF_LAMBERT
-        return diffuse;
-    }
+// Kajiya-Kay's fibre direction: world +Y projected onto the surface ("combed downwards"). A
+// function of the normal only, so the G-buffer needs no tangent and deferred and forward agree
+// bit for bit; zero where the normal is vertical, which the BRDF maps to 0.
+vec3 fibre_tangent(vec3 N) {
+    return vec3(0.0, 1.0, 0.0) - N * N.y;
 }
 
-// One light's contribution to one surface point seen from the camera.
-vec3 shade_light(Light light, Surface s) {
+// Outgoing radiance towards V for unit light of direction L, by BRDF model `model` with the
+// surface's parameters.
+vec3 evaluate_brdf(Surface s, uint model, vec3 V, vec3 L) {
+    return s.tint * brdf_eval(model, s.params, s.normal, fibre_tangent(s.normal), V, L);
+}
+
+// One light's contribution to one surface point seen from the camera, by BRDF `model` (the
+// surface's own, or a shader's specialised one).
+vec3 shade_light_with(Light light, Surface s, uint model) {
     vec3 L;
     vec3 incident = light_incident(light, s.position, L);
     if (all(equal(incident, vec3(0.0)))) {
         return vec3(0.0);
     }
     vec3 V = normalize(frame.eye.xyz - s.position);
-    return incident * evaluate_brdf(s, V, L);
+    return incident * evaluate_brdf(s, model, V, L);
+}
+
+vec3 shade_light(Light light, Surface s) {
+    return shade_light_with(light, s, s.brdf);
 }
 
 #endif

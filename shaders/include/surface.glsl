@@ -6,9 +6,8 @@
 struct Surface {
     vec3 position; // world space
     vec3 normal;   // world space, normalized
-    vec3 albedo;   // diffuse albedo
-    float specular;
-    vec4 params;   // x: Blinn-Phong exponent; y, z: reserved for other BRDFs
+    vec3 tint;     // multiplies the BRDF's value
+    vec4 params;   // the BRDF's packed parameters (histencil_brdf::Brdf::packed_params)
     uint brdf;     // BRDF_* id
 };
 

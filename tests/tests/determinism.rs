@@ -15,7 +15,7 @@ fn png_bytes(technique: Technique, run: u32) -> Vec<u8> {
 
 #[test]
 fn two_runs_give_identical_pngs() {
-    for technique in [Technique::Deferred, Technique::Forward] {
+    for technique in [Technique::DEFERRED, Technique::Forward] {
         let a = png_bytes(technique, 0);
         let b = png_bytes(technique, 1);
         assert!(a == b, "{technique:?}: two runs differ");

@@ -7,13 +7,31 @@ use std::str::FromStr;
 pub enum BrdfId {
     /// `rho / pi`: the diffuse default.
     Lambert,
-    /// Lambert diffuse plus the normalized Blinn-Phong lobe `(n + 8) / (8 pi) * max(N.H, 0)^n`.
+    /// The normalized Blinn-Phong lobe `(n + 8) / (8 pi) * max(N.H, 0)^n`.
     BlinnPhong,
+    /// Oren-Nayar 1994 with the inter-reflection term.
+    OrenNayarFull,
+    /// Oren-Nayar's qualitative model.
+    OrenNayarQualitative,
+    /// Cook-Torrance with GGX D, Smith height-correlated visibility and Schlick Fresnel.
+    Ggx,
+    /// Kajiya-Kay fibres.
+    KajiyaKay,
+    /// Penner's pre-integrated skin.
+    PennerSkin,
 }
 
 impl BrdfId {
     /// Every BRDF, in index order.
-    pub const ALL: [BrdfId; 2] = [BrdfId::Lambert, BrdfId::BlinnPhong];
+    pub const ALL: [BrdfId; 7] = [
+        BrdfId::Lambert,
+        BrdfId::BlinnPhong,
+        BrdfId::OrenNayarFull,
+        BrdfId::OrenNayarQualitative,
+        BrdfId::Ggx,
+        BrdfId::KajiyaKay,
+        BrdfId::PennerSkin,
+    ];
 
     /// The stable numeric id used by the G-buffer and the shaders.
     pub const fn index(self) -> u32 {
@@ -30,6 +48,11 @@ impl BrdfId {
         match self {
             BrdfId::Lambert => "lambert",
             BrdfId::BlinnPhong => "blinn_phong",
+            BrdfId::OrenNayarFull => "oren_nayar_full",
+            BrdfId::OrenNayarQualitative => "oren_nayar_qualitative",
+            BrdfId::Ggx => "ggx",
+            BrdfId::KajiyaKay => "kajiya_kay",
+            BrdfId::PennerSkin => "penner_skin",
         }
     }
 
@@ -47,7 +70,7 @@ impl fmt::Display for BrdfId {
 
 /// A BRDF name that histencil does not know.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown BRDF `{0}` (known: lambert, blinn_phong)")]
+#[error("unknown BRDF `{0}` (known: {names})", names = crate::MODEL_NAMES.join(", "))]
 pub struct UnknownBrdf(pub String);
 
 impl FromStr for BrdfId {

@@ -1,6 +1,7 @@
 //! A BRDF with its parameters: parsed from a name and a JSON object, evaluated in f64 or f32,
 //! and packed for the GLSL spelling (`shaders/include/brdf/eval.glsl`).
 
+use crate::id::BrdfId;
 use crate::models;
 use crate::vector::{c, Real, V3};
 use serde_json::{Map, Value};
@@ -39,16 +40,16 @@ pub enum Brdf {
     },
 }
 
-/// Names accepted by [`Brdf::parse`], in GPU id order.
-pub const MODEL_NAMES: [&str; 7] = [
-    "lambert",
-    "blinn_phong",
-    "oren_nayar_full",
-    "oren_nayar_qualitative",
-    "ggx",
-    "kajiya_kay",
-    "penner_skin",
-];
+/// Names accepted by [`Brdf::parse`], in id order ([`BrdfId::ALL`]).
+pub const MODEL_NAMES: [&str; 7] = {
+    let mut names = [""; 7];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = BrdfId::ALL[i].name();
+        i += 1;
+    }
+    names
+};
 
 /// Why a BRDF description was refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -241,17 +242,22 @@ impl Brdf {
         })
     }
 
+    /// The model, without its parameters: what the stencil and the G-buffer store.
+    pub fn id(&self) -> BrdfId {
+        match self {
+            Brdf::Lambert { .. } => BrdfId::Lambert,
+            Brdf::BlinnPhong { .. } => BrdfId::BlinnPhong,
+            Brdf::OrenNayarFull { .. } => BrdfId::OrenNayarFull,
+            Brdf::OrenNayarQualitative { .. } => BrdfId::OrenNayarQualitative,
+            Brdf::Ggx { .. } => BrdfId::Ggx,
+            Brdf::KajiyaKay { .. } => BrdfId::KajiyaKay,
+            Brdf::PennerSkin { .. } => BrdfId::PennerSkin,
+        }
+    }
+
     /// The model's index in [`MODEL_NAMES`]: the id the GLSL evaluator switches on.
     pub fn model_index(&self) -> u32 {
-        match self {
-            Brdf::Lambert { .. } => 0,
-            Brdf::BlinnPhong { .. } => 1,
-            Brdf::OrenNayarFull { .. } => 2,
-            Brdf::OrenNayarQualitative { .. } => 3,
-            Brdf::Ggx { .. } => 4,
-            Brdf::KajiyaKay { .. } => 5,
-            Brdf::PennerSkin { .. } => 6,
-        }
+        self.id().index()
     }
 
     pub fn name(&self) -> &'static str {

@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use histencil_vk::{Context, ContextDesc, Readback, Renderer, Technique};
+use histencil_vk::{Backend, Context, ContextDesc, FlushPolicy, Readback, Renderer, Technique};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -69,9 +69,21 @@ struct RenderArgs {
     /// An embedded scene (see `histencil scenes`).
     #[arg(long, default_value = "default")]
     scene: String,
-    /// deferred | forward
-    #[arg(long, default_value = "deferred")]
-    technique: Technique,
+    /// How lights are applied: `stencil` (the talk's one pass per BRDF, masked by stencil),
+    /// `branching` (one uber shader), `deferred` (branching on the native backend), `forward`
+    /// (the reference).
+    #[arg(long, value_enum, default_value = "deferred")]
+    technique: TechniqueArg,
+    /// Platform behaviour of the stencil plan: x360 (no hi-stencil read mask, zeroes preserved
+    /// bits), x360-no-zeroing (shows the talk's failure), ps3 (read mask), native (no hi-stencil).
+    #[arg(long, value_enum, default_value = "native")]
+    backend: BackendArg,
+    /// When hi-stencil is flushed.
+    #[arg(long, value_enum, default_value = "auto")]
+    flush: FlushArg,
+    /// The engine's bits written into the preserved stencil bits by the G-buffer pass, e.g. 0xA0.
+    #[arg(long, value_parser = parse_byte, default_value = "0")]
+    preserved_pattern: u8,
     #[arg(long, default_value_t = 1280)]
     width: u32,
     #[arg(long, default_value_t = 720)]
@@ -92,6 +104,64 @@ struct RenderArgs {
     /// the run fail.
     #[arg(long)]
     validate: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum TechniqueArg {
+    Stencil,
+    Branching,
+    Deferred,
+    Forward,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum BackendArg {
+    X360,
+    X360NoZeroing,
+    Ps3,
+    Native,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FlushArg {
+    Auto,
+    Always,
+    Never,
+}
+
+impl RenderArgs {
+    fn technique(&self) -> Technique {
+        let backend = match self.backend {
+            BackendArg::X360 => Backend::X360 {
+                zero_preserved: true,
+            },
+            BackendArg::X360NoZeroing => Backend::X360 {
+                zero_preserved: false,
+            },
+            BackendArg::Ps3 => Backend::Ps3,
+            BackendArg::Native => Backend::Native,
+        };
+        let flush = match self.flush {
+            FlushArg::Auto => FlushPolicy::Auto,
+            FlushArg::Always => FlushPolicy::Always,
+            FlushArg::Never => FlushPolicy::Never,
+        };
+        match self.technique {
+            TechniqueArg::Stencil => Technique::Stencil { backend, flush },
+            TechniqueArg::Branching => Technique::Branching { backend, flush },
+            TechniqueArg::Deferred => Technique::DEFERRED,
+            TechniqueArg::Forward => Technique::Forward,
+        }
+    }
+}
+
+/// A byte as decimal or `0x` hexadecimal.
+fn parse_byte(text: &str) -> Result<u8, String> {
+    let parsed = match text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
+        Some(hex) => u8::from_str_radix(hex, 16),
+        None => text.parse(),
+    };
+    parsed.map_err(|_| format!("`{text}` is not a byte (0-255 or 0x00-0xFF)"))
 }
 
 /// Fails early, with the path in the message, when an output cannot be written.
@@ -126,9 +196,11 @@ fn render(args: &RenderArgs) -> Result<()> {
         check_writable(path)?;
     }
     on_device(args.validate, |ctx| {
+        let technique = args.technique();
         let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
+        renderer.set_preserved_pattern(args.preserved_pattern);
         let frame = renderer.render(
-            args.technique,
+            technique,
             Readback {
                 ldr: true,
                 hdr: args.hdr.is_some(),
@@ -147,7 +219,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             histencil_vk::save_png(stencil, path)?;
             println!("wrote {}", path.display());
         }
-        let timings = renderer.measure(args.technique, args.frames)?;
+        let timings = renderer.measure(technique, args.frames)?;
         let passes: Vec<String> = timings
             .passes
             .iter()
@@ -160,7 +232,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             args.frames.max(1),
             args.width,
             args.height,
-            args.technique,
+            technique,
             ctx.device_name()
         );
         Ok(())

@@ -47,7 +47,7 @@ fn bad_arguments_are_one_line_errors() {
     );
     assert_one_line_error(
         &["render", "--technique", "magic", "--out", out],
-        "unknown technique",
+        "invalid value 'magic'",
     );
     assert_one_line_error(&["brdf-report", "--lut-res", "1"], "LUT resolution 1");
     assert_one_line_error(&["brdf-report", "--directions", "0"], "--directions");

@@ -3,12 +3,59 @@
 
 use crate::{Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape};
 use glam::{Mat4, Quat, Vec3};
+use histencil_brdf::{Brdf, BrdfId};
+
+/// The room's material of model `id`; `variant` varies its parameters between objects.
+fn material(id: BrdfId, variant: usize, tint: Vec3) -> Material {
+    let brdf = match id {
+        BrdfId::Lambert => Brdf::Lambert { rho: 1.0 },
+        BrdfId::BlinnPhong => Brdf::BlinnPhong {
+            exponent: [16.0, 64.0, 256.0][variant % 3],
+        },
+        BrdfId::OrenNayarFull => Brdf::OrenNayarFull {
+            rho: 0.9,
+            sigma: [0.3, 0.6][variant % 2],
+        },
+        BrdfId::OrenNayarQualitative => Brdf::OrenNayarQualitative {
+            rho: 0.9,
+            sigma: [0.3, 0.6][variant % 2],
+        },
+        BrdfId::Ggx => Brdf::Ggx {
+            alpha: [0.15, 0.4][variant % 2],
+            f0: [0.04, 0.6][variant % 2],
+            f90: 1.0,
+        },
+        BrdfId::KajiyaKay => Brdf::KajiyaKay {
+            kd: 0.35,
+            ks: 0.5,
+            p: 40.0,
+        },
+        BrdfId::PennerSkin => Brdf::PennerSkin {
+            rho: 0.85,
+            curvature_per_mm: [0.3, 1.0][variant % 2],
+        },
+    };
+    Material::new(brdf, tint)
+}
 
 /// `(name, description)` of every embedded scene.
-pub const EMBEDDED: [(&str, &str); 3] = [
+pub const EMBEDDED: [(&str, &str); 6] = [
     (
         "default",
         "procedural room: 2 BRDFs, 36 point lights from tiny to huge, 3 spots, 1 directional",
+    ),
+    (
+        "brdfs-1",
+        "the default room with Lambert only: the plain deferred path, no BRDF passes",
+    ),
+    (
+        "brdfs-3",
+        "the default room with Lambert, Oren-Nayar (full) and GGX",
+    ),
+    (
+        "brdfs-6",
+        "the default room with all six BRDFs: Lambert, Blinn-Phong, Oren-Nayar, GGX, \
+         Kajiya-Kay, Penner skin",
     ),
     (
         "inside",
@@ -34,7 +81,20 @@ pub fn embedded(name: &str) -> Result<Scene, SceneError> {
             name: name.to_owned(),
             known: embedded_names().collect::<Vec<_>>().join(", "),
         })?;
-    let mut scene = room(name, description);
+    let models: &[BrdfId] = match name {
+        "brdfs-1" => &[BrdfId::Lambert],
+        "brdfs-3" => &[BrdfId::Lambert, BrdfId::OrenNayarFull, BrdfId::Ggx],
+        "brdfs-6" => &[
+            BrdfId::Lambert,
+            BrdfId::BlinnPhong,
+            BrdfId::OrenNayarFull,
+            BrdfId::Ggx,
+            BrdfId::KajiyaKay,
+            BrdfId::PennerSkin,
+        ],
+        _ => &[BrdfId::Lambert, BrdfId::BlinnPhong],
+    };
+    let mut scene = room(name, description, models);
     match name {
         "inside" => {
             scene.camera.eye = Vec3::new(1.5, 2.2, 5.0);
@@ -102,9 +162,11 @@ fn slab(name: &str, center: Vec3, half: Vec3, material: Material) -> Object {
     )
 }
 
-fn room(name: &str, description: String) -> Scene {
-    let wall = Material::lambert(Vec3::new(0.75, 0.72, 0.68));
-    let floor = Material::blinn_phong(Vec3::new(0.5, 0.45, 0.4), 0.25, 24.0);
+/// The procedural room; objects take the models of `models` in turn (walls and floor the first,
+/// the others in turn), so every model in the list is in use.
+fn room(name: &str, description: String, models: &[BrdfId]) -> Scene {
+    let wall = material(models[0], 0, Vec3::new(0.75, 0.72, 0.68));
+    let floor = material(models[0], 1, Vec3::new(0.5, 0.45, 0.4));
     let mut objects = vec![
         slab(
             "floor",
@@ -141,11 +203,7 @@ fn room(name: &str, description: String) -> Scene {
             rng.range(0.2, 0.9),
             rng.range(0.2, 0.9),
         );
-        let material = if i % 2 == 0 {
-            Material::blinn_phong(albedo, 0.6, [16.0, 64.0, 256.0][i / 2])
-        } else {
-            Material::lambert(albedo)
-        };
+        let material = material(models[(i + 1) % models.len()], i / 2, albedo);
         let t = Mat4::from_scale_rotation_translation(
             Vec3::splat(r),
             Quat::IDENTITY,
@@ -162,11 +220,7 @@ fn room(name: &str, description: String) -> Scene {
             rng.range(0.3, 0.9),
             rng.range(0.3, 0.9),
         );
-        let material = if i % 2 == 0 {
-            Material::lambert(albedo)
-        } else {
-            Material::blinn_phong(albedo, 0.4, 32.0)
-        };
+        let material = material(models[i % models.len()], i, albedo);
         let t = Mat4::from_scale_rotation_translation(
             Vec3::new(0.5, h, 0.5),
             rot,
@@ -295,6 +349,22 @@ mod tests {
         };
         assert!(crosses(c.near), "no light crosses the near plane");
         assert!(crosses(c.far), "no light crosses the far plane");
+    }
+
+    #[test]
+    fn brdf_scenes_use_what_their_names_say() {
+        for (name, count) in [
+            ("default", 2),
+            ("brdfs-1", 1),
+            ("brdfs-3", 3),
+            ("brdfs-6", 6),
+        ] {
+            assert_eq!(
+                embedded(name).unwrap().brdfs_in_use().len(),
+                count,
+                "{name}"
+            );
+        }
     }
 
     #[test]

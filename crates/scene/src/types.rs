@@ -1,5 +1,5 @@
 use glam::{Mat4, Vec3};
-use histencil_brdf::BrdfId;
+use histencil_brdf::{Brdf, BrdfId};
 
 /// A scene: a camera, opaque objects and lights. Plain data; [`Scene::validate`] says whether a
 /// renderer can take it.
@@ -60,35 +60,44 @@ pub struct Object {
     pub material: Material,
 }
 
-/// Surface parameters. Which of them a BRDF reads is documented in `histencil-brdf`.
+impl Object {
+    /// The world-space axis-aligned box containing the object: the transformed corners of the
+    /// unit cube (which contains the unit sphere too).
+    pub fn world_bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for corner in 0..8 {
+            let unit = Vec3::new(
+                if corner & 1 == 0 { -1.0 } else { 1.0 },
+                if corner & 2 == 0 { -1.0 } else { 1.0 },
+                if corner & 4 == 0 { -1.0 } else { 1.0 },
+            );
+            let p = self.transform.transform_point3(unit);
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        (lo, hi)
+    }
+}
+
+/// A surface: a BRDF model with its parameters (as `histencil-brdf` defines them) and a tint.
+/// The outgoing radiance is `tint * brdf(N, T, V, L) * incident`; Kajiya-Kay's fibre tangent is
+/// the world +Y axis projected onto the surface (see `shaders/include/light.glsl`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
-    pub brdf: BrdfId,
-    /// Diffuse albedo, linear RGB in `[0, 1]`.
-    pub albedo: Vec3,
-    /// Specular intensity (Blinn-Phong lobe weight).
-    pub specular: f32,
-    /// Blinn-Phong exponent.
-    pub exponent: f32,
+    pub brdf: Brdf,
+    /// Linear RGB multiplier in `[0, 1]` per channel: the surface's colour.
+    pub tint: Vec3,
 }
 
 impl Material {
-    pub fn lambert(albedo: Vec3) -> Self {
-        Self {
-            brdf: BrdfId::Lambert,
-            albedo,
-            specular: 0.0,
-            exponent: 1.0,
-        }
+    pub fn new(brdf: Brdf, tint: Vec3) -> Self {
+        Self { brdf, tint }
     }
 
-    pub fn blinn_phong(albedo: Vec3, specular: f32, exponent: f32) -> Self {
-        Self {
-            brdf: BrdfId::BlinnPhong,
-            albedo,
-            specular,
-            exponent,
-        }
+    /// A Lambertian surface of diffuse albedo `albedo`.
+    pub fn lambert(albedo: Vec3) -> Self {
+        Self::new(Brdf::Lambert { rho: 1.0 }, albedo)
     }
 }
 
@@ -221,12 +230,15 @@ impl Scene {
             let m = &o.material;
             let problem = if !o.transform.is_finite() || o.transform.determinant() == 0.0 {
                 Some("transform must be finite and invertible")
-            } else if !finite3(m.albedo) || m.albedo.min_element() < 0.0 {
-                Some("albedo must be finite and non-negative")
-            } else if !(m.specular.is_finite() && m.specular >= 0.0) {
-                Some("specular must be finite and non-negative")
-            } else if !(m.exponent.is_finite() && m.exponent >= 0.0) {
-                Some("exponent must be finite and non-negative")
+            } else if !finite3(m.tint) || m.tint.min_element() < 0.0 {
+                Some("tint must be finite and non-negative")
+            } else if !m
+                .brdf
+                .packed_params()
+                .iter()
+                .all(|p| p.is_finite() && *p >= 0.0)
+            {
+                Some("BRDF parameters must be finite and non-negative")
             } else {
                 None
             };
@@ -244,7 +256,26 @@ impl Scene {
     /// The distinct BRDFs the objects use, sorted by id. Their position in this list is their
     /// stencil slot.
     pub fn brdfs_in_use(&self) -> Vec<BrdfId> {
-        let mut v: Vec<BrdfId> = self.objects.iter().map(|o| o.material.brdf).collect();
+        let mut v: Vec<BrdfId> = self.objects.iter().map(|o| o.material.brdf.id()).collect();
+        v.sort();
+        v.dedup();
+        v
+    }
+
+    /// The BRDFs of the objects that `light` can reach (world bounds against its range sphere;
+    /// every BRDF in use for a directional light), sorted by id. A light volume is drawn once per
+    /// BRDF in this list, so a BRDF the light cannot touch costs nothing.
+    pub fn brdfs_lit_by(&self, light: &Light) -> Vec<BrdfId> {
+        let mut v: Vec<BrdfId> = self
+            .objects
+            .iter()
+            .filter(|o| {
+                let (lo, hi) = o.world_bounds();
+                let nearest = light.position.clamp(lo, hi);
+                !light.is_local() || nearest.distance(light.position) < light.radius
+            })
+            .map(|o| o.material.brdf.id())
+            .collect();
         v.sort();
         v.dedup();
         v
@@ -273,5 +304,20 @@ mod tests {
     fn brdfs_in_use_are_sorted_and_distinct() {
         let s = crate::embedded("default").unwrap();
         assert_eq!(s.brdfs_in_use(), vec![BrdfId::Lambert, BrdfId::BlinnPhong]);
+    }
+
+    #[test]
+    fn lights_touch_only_the_brdfs_in_their_range() {
+        let s = crate::embedded("brdfs-6").unwrap();
+        let far_away = Light::point(Vec3::new(0.0, 100.0, 0.0), 1.0, Vec3::ONE);
+        assert!(s.brdfs_lit_by(&far_away).is_empty());
+        // Over the first sphere, small: only that sphere's BRDF (and nothing else nearby).
+        let sphere = &s.objects[4];
+        let (lo, hi) = sphere.world_bounds();
+        let top = Vec3::new((lo.x + hi.x) * 0.5, hi.y + 0.5, (lo.z + hi.z) * 0.5);
+        let close = Light::point(top, 0.6, Vec3::ONE);
+        assert_eq!(s.brdfs_lit_by(&close), vec![sphere.material.brdf.id()]);
+        let sun = s.lights.iter().find(|l| !l.is_local()).unwrap();
+        assert_eq!(s.brdfs_lit_by(sun), s.brdfs_in_use());
     }
 }

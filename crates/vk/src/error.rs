@@ -24,6 +24,10 @@ pub enum Error {
     Scene(#[from] histencil_scene::SceneError),
     #[error("stencil layout: {0}")]
     Layout(#[from] histencil_model::LayoutError),
+    #[error("lighting plan: {0}")]
+    Plan(#[from] histencil_model::PlanError),
+    #[error("not supported yet: {0}")]
+    Unsupported(&'static str),
     #[error("cannot write `{path}`: {message}")]
     Output { path: String, message: String },
 }

@@ -98,16 +98,22 @@ impl GpuLight {
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct DrawPush {
     pub model: [[f32; 4]; 4],
-    pub albedo_specular: [f32; 4],
+    pub tint: [f32; 4],
     pub params: [f32; 4],
 }
 
 impl DrawPush {
     pub fn new(model: Mat4, material: &Material) -> Self {
+        let p = material.brdf.packed_params();
         Self {
             model: model.to_cols_array_2d(),
-            albedo_specular: material.albedo.extend(material.specular).to_array(),
-            params: [material.exponent, 0.0, 0.0, material.brdf.index() as f32],
+            tint: material.tint.extend(0.0).to_array(),
+            params: [
+                p[0] as f32,
+                p[1] as f32,
+                p[2] as f32,
+                material.brdf.model_index() as f32,
+            ],
         }
     }
 }

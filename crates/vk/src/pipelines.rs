@@ -33,6 +33,8 @@ pub struct PipelineDesc<'a> {
     /// Clamp depth instead of clipping at near/far: light volumes crossing the far plane keep
     /// their back faces (at depth 1) so the stencil/depth tests still see them.
     pub depth_clamp: bool,
+    /// The fragment shader's specialisation constant 0, if any.
+    pub specialization: Option<u32>,
 }
 
 pub(crate) fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<vk::ShaderModule> {
@@ -74,13 +76,25 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
         .stage(vk::ShaderStageFlags::VERTEX)
         .module(vertex_module)
         .name(c"main")];
+    let constant_bytes = desc.specialization.map(u32::to_ne_bytes);
+    let entries = [vk::SpecializationMapEntry::default()
+        .constant_id(0)
+        .offset(0)
+        .size(4)];
+    let specialization = constant_bytes.as_ref().map(|bytes| {
+        vk::SpecializationInfo::default()
+            .map_entries(&entries)
+            .data(bytes)
+    });
     if let Some(m) = fragment_module {
-        stages.push(
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(m)
-                .name(c"main"),
-        );
+        let mut stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(m)
+            .name(c"main");
+        if let Some(info) = specialization.as_ref() {
+            stage = stage.specialization_info(info);
+        }
+        stages.push(stage);
     }
     let vertex_bindings = [vk::VertexInputBindingDescription::default()
         .binding(0)
@@ -172,16 +186,10 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     Ok(pipeline)
 }
 
-/// The renderer's pipelines.
+/// The renderer's fixed pipelines (light pipelines are created per plan: `passes::lighting`).
 pub struct Pipelines {
     pub gbuffer: vk::Pipeline,
     pub forward: vk::Pipeline,
-    /// Light volume, no colour: the talk's setup (mark) and cleanup passes.
-    pub light_stencil: vk::Pipeline,
-    /// Light volume with the deferred light shader, additive.
-    pub light_volume: vk::Pipeline,
-    /// Full-screen deferred light shader (directional lights).
-    pub light_fullscreen: vk::Pipeline,
     pub tonemap: vk::Pipeline,
 }
 
@@ -202,9 +210,7 @@ pub struct PipelineLayouts {
 impl Pipelines {
     pub fn new(ctx: &Context, layouts: &PipelineLayouts, formats: &TargetFormats) -> Result<Self> {
         let mesh_vert = ("mesh.vert", shaders::MESH_VERT);
-        let volume_vert = ("light_volume.vert", shaders::LIGHT_VOLUME_VERT);
         let fullscreen_vert = ("fullscreen.vert", shaders::FULLSCREEN_VERT);
-        let light_frag = Some(("deferred_light.frag", shaders::DEFERRED_LIGHT_FRAG));
         let hdr = [formats.hdr];
         let base = PipelineDesc {
             name: "",
@@ -217,6 +223,7 @@ impl Pipelines {
             additive_blend: false,
             depth_stencil_format: formats.depth_stencil,
             depth_clamp: false,
+            specialization: None,
         };
         let gbuffer = create_pipeline(
             ctx,
@@ -239,38 +246,6 @@ impl Pipelines {
                 ..base
             },
         )?;
-        let light_stencil = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "light-stencil-pipeline",
-                vertex: volume_vert,
-                color_writes: false,
-                depth_clamp: true,
-                ..base
-            },
-        )?;
-        let light_volume = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "light-volume-pipeline",
-                vertex: volume_vert,
-                fragment: light_frag,
-                additive_blend: true,
-                depth_clamp: true,
-                ..base
-            },
-        )?;
-        let light_fullscreen = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "light-fullscreen-pipeline",
-                vertex: fullscreen_vert,
-                fragment: light_frag,
-                vertex_input: VertexInput::None,
-                additive_blend: true,
-                ..base
-            },
-        )?;
         let ldr = [formats.ldr];
         let tonemap = create_pipeline(
             ctx,
@@ -288,22 +263,12 @@ impl Pipelines {
         Ok(Self {
             gbuffer,
             forward,
-            light_stencil,
-            light_volume,
-            light_fullscreen,
             tonemap,
         })
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for p in [
-            self.gbuffer,
-            self.forward,
-            self.light_stencil,
-            self.light_volume,
-            self.light_fullscreen,
-            self.tonemap,
-        ] {
+        for p in [self.gbuffer, self.forward, self.tonemap] {
             unsafe { ctx.device.destroy_pipeline(p, None) };
         }
     }

@@ -73,7 +73,7 @@ impl ReadbackBuffers {
             ldr: buffer("ldr-readback", 4)?,
             hdr: buffer("hdr-readback", 8)?,
             stencil: buffer("stencil-readback", 1)?,
-            material: buffer("gbuffer-material-readback", 8)?,
+            material: buffer("gbuffer-material-readback", 16)?,
         })
     }
 
@@ -172,13 +172,13 @@ impl ReadbackBuffers {
             images.stencil = GrayImage::from_raw(w, h, self.stencil.read().to_vec());
         }
         if what.brdf_ids {
-            // gbuffer-material is RGBA16F with the BRDF id in w, cleared to -1 (no geometry).
+            // gbuffer-material is RGBA32F with the BRDF id in w, cleared to -1 (no geometry).
             let ids = self
                 .material
                 .read()
-                .chunks_exact(8)
+                .chunks_exact(16)
                 .map(|texel| {
-                    let id = half::f16::from_le_bytes([texel[6], texel[7]]).to_f32();
+                    let id = f32::from_le_bytes([texel[12], texel[13], texel[14], texel[15]]);
                     (id >= 0.0).then(|| BrdfId::from_index(id as u32)).flatten()
                 })
                 .collect();

@@ -7,6 +7,7 @@ use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::meshes::Meshes;
 use crate::passes::geometry::GeometryPass;
 use crate::passes::lighting::LightingPass;
+use crate::passes::lighting::{classify, mesh_bound, prepare_pipelines, LightPipelines};
 use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::{FrameImages, Readback, ReadbackBuffers};
@@ -15,28 +16,71 @@ use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FOR
 use crate::timing::{FrameTimings, Timestamps};
 use ash::vk;
 use histencil_brdf::BrdfId;
-use histencil_model::StencilLayout;
+use histencil_model::{
+    FlushPolicy, FramePlan, LightRequest, LightTechnique, Native, PlatformBackend, Ps3Like,
+    StencilLayout, X360Like,
+};
 use histencil_scene::Scene;
+
+/// The platform whose stencil and hi-stencil behaviour the lighting plan follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// 360-like: hi-stencil without a read mask. `zero_preserved` zeroes the engine's preserved
+    /// bits as lights draw (the talk's fix); without it, hi-stencil fails on preserved bits.
+    X360 { zero_preserved: bool },
+    /// PS3-like: hi-stencil with a read mask; preserved bits survive.
+    Ps3,
+    /// Plain Vulkan: no hi-stencil.
+    Native,
+}
+
+impl Backend {
+    pub fn platform(self) -> Box<dyn PlatformBackend> {
+        match self {
+            Backend::X360 { zero_preserved } => Box::new(X360Like {
+                zero_preserved,
+                save_restore: false,
+            }),
+            Backend::Ps3 => Box::new(Ps3Like),
+            Backend::Native => Box::new(Native),
+        }
+    }
+}
 
 /// How the frame is lit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Technique {
-    /// G-buffer, then light volumes with stencil depth culling; the light shader branches on the
-    /// G-buffer's BRDF id.
-    Deferred,
     /// The forward reference: every object lit by every light per pixel.
     Forward,
+    /// The talk's technique: each light volume drawn once per BRDF it touches, masked by the
+    /// BRDF id in the stencil, with one shader per BRDF.
+    Stencil {
+        backend: Backend,
+        flush: FlushPolicy,
+    },
+    /// One uber light shader branching on the G-buffer's BRDF id; one draw per light.
+    Branching {
+        backend: Backend,
+        flush: FlushPolicy,
+    },
 }
 
-impl std::str::FromStr for Technique {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "deferred" => Ok(Technique::Deferred),
-            "forward" => Ok(Technique::Forward),
-            _ => Err(format!(
-                "unknown technique `{s}` (known: deferred, forward)"
-            )),
+impl Technique {
+    /// Plain deferred shading: branching, no hi-stencil.
+    pub const DEFERRED: Technique = Technique::Branching {
+        backend: Backend::Native,
+        flush: FlushPolicy::Auto,
+    };
+
+    fn light_technique(self) -> Option<(LightTechnique, Backend, FlushPolicy)> {
+        match self {
+            Technique::Forward => None,
+            Technique::Stencil { backend, flush } => {
+                Some((LightTechnique::Stencil, backend, flush))
+            }
+            Technique::Branching { backend, flush } => {
+                Some((LightTechnique::Branching, backend, flush))
+            }
         }
     }
 }
@@ -52,8 +96,13 @@ pub struct Renderer<'c> {
     ctx: &'c Context,
     scene: Scene,
     stencil_layout: StencilLayout,
-    /// Each object's BRDF slot (index among the BRDFs in use).
+    /// The BRDFs in use; a BRDF's index here is its stencil slot.
+    brdfs: Vec<BrdfId>,
+    /// Each object's BRDF slot.
     object_slots: Vec<u32>,
+    /// Written into the preserved stencil bits by the G-buffer pass (the engine's own bits).
+    preserved_pattern: u8,
+    light_pipelines: LightPipelines,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -78,7 +127,12 @@ impl<'c> Renderer<'c> {
         let object_slots = scene
             .objects
             .iter()
-            .map(|o| brdfs.iter().position(|b| *b == o.material.brdf).unwrap() as u32)
+            .map(|o| {
+                brdfs
+                    .iter()
+                    .position(|b| *b == o.material.brdf.id())
+                    .expect("brdfs_in_use lists every object's BRDF") as u32
+            })
             .collect();
 
         let targets = Targets::new(ctx, extent)?;
@@ -124,6 +178,11 @@ impl<'c> Renderer<'c> {
                 depth_stencil: ctx.depth_stencil_format,
             },
         )?;
+        let light_pipelines = LightPipelines::new(
+            descriptors.lighting_pipeline_layout,
+            HDR_FORMAT,
+            ctx.depth_stencil_format,
+        );
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -149,7 +208,10 @@ impl<'c> Renderer<'c> {
             ctx,
             scene,
             stencil_layout,
+            brdfs,
             object_slots,
+            preserved_pattern: 0,
+            light_pipelines,
             extent,
             targets,
             meshes,
@@ -169,29 +231,84 @@ impl<'c> Renderer<'c> {
         &self.stencil_layout
     }
 
-    /// The stencil value each object's G-buffer draw writes (before any engine bits).
+    /// The BRDFs in use, in stencil slot order.
+    pub fn brdfs(&self) -> &[BrdfId] {
+        &self.brdfs
+    }
+
+    /// Sets the engine's bits that the G-buffer pass writes into the preserved stencil bits
+    /// (only the bits of [`StencilLayout::preserved_mask`] are kept).
+    pub fn set_preserved_pattern(&mut self, pattern: u8) {
+        self.preserved_pattern = pattern;
+    }
+
+    /// The stencil value each object's G-buffer draw writes, preserved pattern included.
     pub fn object_stencil_values(&self) -> Vec<u8> {
-        let l = &self.stencil_layout;
         self.object_slots
             .iter()
             .map(|s| {
-                if l.has_brdf_bits() {
-                    l.brdf_reference(*s)
-                } else {
-                    0
-                }
+                crate::passes::geometry::gbuffer_stencil(
+                    &self.stencil_layout,
+                    *s,
+                    self.preserved_pattern,
+                )
+                .map_or(0, |f| f.reference)
             })
             .collect()
+    }
+
+    /// Light pipelines created so far.
+    pub fn light_pipeline_count(&self) -> usize {
+        self.light_pipelines.count()
+    }
+
+    /// The lighting plan of a frame: each light that touches an object, classified against the
+    /// camera, with the BRDF slots it touches. Also returns the scene index of each planned
+    /// light.
+    pub fn plan(&self, technique: Technique) -> Result<(FramePlan, Vec<u32>)> {
+        let Some((light_technique, backend, flush)) = technique.light_technique() else {
+            return Ok((FramePlan { steps: vec![] }, vec![]));
+        };
+        let aspect = self.extent.width as f32 / self.extent.height as f32;
+        let mut requests = Vec::new();
+        let mut indices = Vec::new();
+        for (index, light) in self.scene.lights.iter().enumerate() {
+            let affected: Vec<u32> = self
+                .scene
+                .brdfs_lit_by(light)
+                .into_iter()
+                .map(|id| self.brdfs.iter().position(|b| *b == id).expect("in use") as u32)
+                .collect();
+            if affected.is_empty() {
+                continue;
+            }
+            let bound = mesh_bound(light, &self.meshes);
+            requests.push(LightRequest {
+                case: classify(light, bound, &self.scene.camera, aspect),
+                affected,
+                technique: light_technique,
+            });
+            indices.push(index as u32);
+        }
+        let plan = FramePlan::build(
+            &self.stencil_layout,
+            backend.platform().as_ref(),
+            &requests,
+            flush,
+        )?;
+        Ok((plan, indices))
     }
 
     /// Renders one frame and waits for it. `readback` says which images to copy back.
     pub fn render(&mut self, technique: Technique, readback: Readback) -> Result<Frame> {
         // Only the deferred path has a G-buffer to read BRDF ids from.
         let readback = Readback {
-            brdf_ids: readback.brdf_ids && technique == Technique::Deferred,
+            brdf_ids: readback.brdf_ids && technique != Technique::Forward,
             ..readback
         };
         let ctx = self.ctx;
+        let (plan, light_indices) = self.plan(technique)?;
+        prepare_pipelines(ctx, &mut self.light_pipelines, &plan, &self.brdfs)?;
         let cmd = self.cmd;
         unsafe {
             ctx.device
@@ -210,39 +327,41 @@ impl<'c> Renderer<'c> {
             scene: &self.scene,
             meshes: &self.meshes,
             pipeline: match technique {
-                Technique::Deferred => self.pipelines.gbuffer,
                 Technique::Forward => self.pipelines.forward,
+                _ => self.pipelines.gbuffer,
             },
             pipeline_layout: self.descriptors.mesh_pipeline_layout,
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
         };
         match technique {
-            Technique::Deferred => {
+            Technique::Forward => {
+                geometry.record_forward(&mut self.targets);
+                self.timestamps.mark(ctx, cmd, "forward");
+            }
+            _ => {
                 geometry.record_gbuffer(
                     &mut self.targets,
                     &self.stencil_layout,
                     &self.object_slots,
+                    self.preserved_pattern,
                 );
                 self.timestamps.mark(ctx, cmd, "gbuffer");
                 LightingPass {
                     ctx,
                     cmd,
+                    plan: &plan,
+                    light_indices: &light_indices,
                     lights: &self.scene.lights,
-                    camera: &self.scene.camera,
+                    brdfs: &self.brdfs,
                     meshes: &self.meshes,
-                    pipelines: &self.pipelines,
+                    pipelines: &self.light_pipelines,
                     pipeline_layout: self.descriptors.lighting_pipeline_layout,
                     sets: [self.descriptors.frame_set, self.descriptors.gbuffer_set],
-                    layout: &self.stencil_layout,
                     extent: self.extent,
                 }
-                .record(&mut self.targets);
+                .record(&mut self.targets)?;
                 self.timestamps.mark(ctx, cmd, "lighting");
-            }
-            Technique::Forward => {
-                geometry.record_forward(&mut self.targets);
-                self.timestamps.mark(ctx, cmd, "forward");
             }
         }
         TonemapPass {
@@ -298,6 +417,7 @@ impl Drop for Renderer<'_> {
         self.timestamps.destroy(ctx);
         self.readback.destroy(ctx);
         self.pipelines.destroy(ctx);
+        self.light_pipelines.destroy(ctx);
         self.descriptors.destroy(ctx);
         self.lights.destroy(ctx);
         self.frame_uniforms.destroy(ctx);

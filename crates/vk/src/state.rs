@@ -1,100 +1,107 @@
-//! Per-draw depth / stencil / cull state as plain data, and its one translation to Vulkan dynamic
-//! state. The light passes of the talk are written as constants of this type in
-//! `passes/lighting.rs`, so the state of every pass can be read (and tested) without a GPU.
+//! The one translation from histencil-model's pass state (plain data, also executed by the CPU
+//! simulator) to Vulkan dynamic state. Every draw of every pass goes through [`apply`], so what
+//! the GPU does and what the model simulates cannot drift apart.
+//!
+//! Hi-stencil state is not Vulkan state: the GPU tile surface that emulates it is recorded by
+//! the lighting pass, not here.
 
 use crate::context::Context;
 use ash::vk;
+use histencil_model::{CompareOp, CullMode, DepthState, FaceStencil, PassState, StencilOp};
 
-/// Stencil test and update for both faces.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StencilState {
-    pub compare: vk::CompareOp,
-    pub compare_mask: u8,
-    pub write_mask: u8,
-    pub reference: u8,
-    pub pass: vk::StencilOp,
-    pub fail: vk::StencilOp,
-    pub depth_fail: vk::StencilOp,
-}
-
-impl StencilState {
-    /// Writes `reference` into the bits of `write_mask` wherever the depth test passes.
-    pub const fn replace(reference: u8, write_mask: u8) -> Self {
-        Self {
-            compare: vk::CompareOp::ALWAYS,
-            compare_mask: 0xFF,
-            write_mask,
-            reference,
-            pass: vk::StencilOp::REPLACE,
-            fail: vk::StencilOp::KEEP,
-            depth_fail: vk::StencilOp::KEEP,
-        }
-    }
-
-    /// Passes where `stencil & compare_mask == reference`; writes nothing.
-    pub const fn test_equal(reference: u8, compare_mask: u8) -> Self {
-        Self {
-            compare: vk::CompareOp::EQUAL,
-            compare_mask,
-            write_mask: 0,
-            reference,
-            pass: vk::StencilOp::KEEP,
-            fail: vk::StencilOp::KEEP,
-            depth_fail: vk::StencilOp::KEEP,
-        }
+pub fn compare_op(op: CompareOp) -> vk::CompareOp {
+    match op {
+        CompareOp::Never => vk::CompareOp::NEVER,
+        CompareOp::Less => vk::CompareOp::LESS,
+        CompareOp::Equal => vk::CompareOp::EQUAL,
+        CompareOp::LessOrEqual => vk::CompareOp::LESS_OR_EQUAL,
+        CompareOp::Greater => vk::CompareOp::GREATER,
+        CompareOp::NotEqual => vk::CompareOp::NOT_EQUAL,
+        CompareOp::GreaterOrEqual => vk::CompareOp::GREATER_OR_EQUAL,
+        CompareOp::Always => vk::CompareOp::ALWAYS,
     }
 }
 
-/// Everything a draw sets as dynamic state, besides viewport and scissor.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DrawState {
-    pub cull: vk::CullModeFlags,
-    /// `None` disables the depth test.
-    pub depth_compare: Option<vk::CompareOp>,
-    pub depth_write: bool,
-    /// `None` disables the stencil test.
-    pub stencil: Option<StencilState>,
+pub fn stencil_op(op: StencilOp) -> vk::StencilOp {
+    match op {
+        StencilOp::Keep => vk::StencilOp::KEEP,
+        StencilOp::Zero => vk::StencilOp::ZERO,
+        StencilOp::Replace => vk::StencilOp::REPLACE,
+        StencilOp::IncrementAndClamp => vk::StencilOp::INCREMENT_AND_CLAMP,
+    }
 }
 
-impl DrawState {
-    /// Opaque geometry: back-face culling, depth LESS with writes.
-    pub const OPAQUE: Self = Self {
-        cull: vk::CullModeFlags::BACK,
-        depth_compare: Some(vk::CompareOp::LESS),
-        depth_write: true,
-        stencil: None,
-    };
-
-    /// No depth or stencil at all (tonemap).
-    pub const FULLSCREEN: Self = Self {
-        cull: vk::CullModeFlags::NONE,
-        depth_compare: None,
-        depth_write: false,
-        stencil: None,
-    };
-
-    pub fn with_stencil(self, stencil: StencilState) -> Self {
-        Self {
-            stencil: Some(stencil),
-            ..self
-        }
+pub fn cull_mode(cull: CullMode) -> vk::CullModeFlags {
+    match cull {
+        CullMode::None => vk::CullModeFlags::NONE,
+        CullMode::Front => vk::CullModeFlags::FRONT,
+        CullMode::Back => vk::CullModeFlags::BACK,
     }
+}
 
-    /// Records this state into `cmd`.
-    pub(crate) fn apply(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        let d = &ctx.device;
-        let face = vk::StencilFaceFlags::FRONT_AND_BACK;
-        let s = self.stencil.unwrap_or(StencilState::test_equal(0, 0));
-        unsafe {
-            d.cmd_set_cull_mode(cmd, self.cull);
-            d.cmd_set_depth_test_enable(cmd, self.depth_compare.is_some());
-            d.cmd_set_depth_compare_op(cmd, self.depth_compare.unwrap_or(vk::CompareOp::ALWAYS));
-            d.cmd_set_depth_write_enable(cmd, self.depth_write);
-            d.cmd_set_stencil_test_enable(cmd, self.stencil.is_some());
-            d.cmd_set_stencil_op(cmd, face, s.fail, s.pass, s.depth_fail, s.compare);
-            d.cmd_set_stencil_compare_mask(cmd, face, u32::from(s.compare_mask));
-            d.cmd_set_stencil_write_mask(cmd, face, u32::from(s.write_mask));
-            d.cmd_set_stencil_reference(cmd, face, u32::from(s.reference));
+/// Opaque geometry: back faces culled, depth LESS with writes, no stencil.
+pub const OPAQUE: PassState = PassState {
+    cull: CullMode::Back,
+    depth: DepthState {
+        compare: Some(CompareOp::Less),
+        write: true,
+    },
+    front: None,
+    back: None,
+    color_write: true,
+    hi_stencil: None,
+};
+
+/// A full-screen pass with no depth or stencil (tonemap).
+pub const FULLSCREEN: PassState = PassState {
+    cull: CullMode::None,
+    depth: DepthState::OFF,
+    front: None,
+    back: None,
+    color_write: true,
+    hi_stencil: None,
+};
+
+/// `state` with `face` on both faces.
+pub fn with_stencil(state: PassState, face: FaceStencil) -> PassState {
+    PassState {
+        front: Some(face),
+        back: Some(face),
+        ..state
+    }
+}
+
+/// Records `state` into `cmd` as dynamic state. A face without stencil state passes and keeps
+/// (the stencil test is one switch for both faces in Vulkan). Colour writes are pipeline state:
+/// the caller binds a pipeline that matches `state.color_write`.
+pub(crate) fn apply(ctx: &Context, cmd: vk::CommandBuffer, state: &PassState) {
+    let d = &ctx.device;
+    let enabled = state.front.is_some() || state.back.is_some();
+    unsafe {
+        d.cmd_set_cull_mode(cmd, cull_mode(state.cull));
+        d.cmd_set_depth_test_enable(cmd, state.depth.compare.is_some());
+        d.cmd_set_depth_compare_op(
+            cmd,
+            compare_op(state.depth.compare.unwrap_or(CompareOp::Always)),
+        );
+        d.cmd_set_depth_write_enable(cmd, state.depth.write);
+        d.cmd_set_stencil_test_enable(cmd, enabled);
+        for (flags, face) in [
+            (vk::StencilFaceFlags::FRONT, state.front),
+            (vk::StencilFaceFlags::BACK, state.back),
+        ] {
+            let s = face.unwrap_or(FaceStencil::DISABLED);
+            d.cmd_set_stencil_op(
+                cmd,
+                flags,
+                stencil_op(s.fail),
+                stencil_op(s.pass),
+                stencil_op(s.depth_fail),
+                compare_op(s.compare),
+            );
+            d.cmd_set_stencil_compare_mask(cmd, flags, u32::from(s.compare_mask));
+            d.cmd_set_stencil_write_mask(cmd, flags, u32::from(s.write_mask));
+            d.cmd_set_stencil_reference(cmd, flags, u32::from(s.reference));
         }
     }
 }

@@ -9,7 +9,7 @@ use ash::vk;
 pub const GBUFFER_FORMATS: [vk::Format; 3] = [
     vk::Format::R16G16B16A16_SFLOAT, // gbuffer-albedo
     vk::Format::R32G32B32A32_SFLOAT, // gbuffer-normal-depth
-    vk::Format::R16G16B16A16_SFLOAT, // gbuffer-material
+    vk::Format::R32G32B32A32_SFLOAT, // gbuffer-material
 ];
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;

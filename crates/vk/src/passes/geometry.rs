@@ -9,10 +9,10 @@ use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::gpu_types::DrawPush;
 use crate::meshes::Meshes;
-use crate::state::{DrawState, StencilState};
+use crate::state::{apply, with_stencil, OPAQUE};
 use crate::targets::Targets;
 use ash::vk;
-use histencil_model::StencilLayout;
+use histencil_model::{CompareOp, FaceStencil, PassState, StencilLayout, StencilOp};
 use histencil_scene::Scene;
 
 pub struct GeometryPass<'a> {
@@ -27,15 +27,33 @@ pub struct GeometryPass<'a> {
 }
 
 /// The stencil state with which the G-buffer pass writes `slot` (a BRDF's index among those in
-/// use) into the BRDF bits and nothing else. `None` with one BRDF: no BRDF bits exist.
-pub fn gbuffer_stencil(layout: &StencilLayout, slot: u32) -> Option<StencilState> {
-    layout
-        .has_brdf_bits()
-        .then(|| StencilState::replace(layout.brdf_reference(slot), layout.brdf_mask()))
+/// use) into the BRDF bits and the engine's `preserved_pattern` into the preserved bits; the
+/// culling bit stays 0. `None` when there is nothing to write (one BRDF, no pattern): the clear
+/// already left 0.
+pub fn gbuffer_stencil(
+    layout: &StencilLayout,
+    slot: u32,
+    preserved_pattern: u8,
+) -> Option<FaceStencil> {
+    let brdf = if layout.has_brdf_bits() {
+        layout.brdf_reference(slot)
+    } else {
+        0
+    };
+    let value = brdf | (preserved_pattern & layout.preserved_mask());
+    (layout.has_brdf_bits() || value != 0).then_some(FaceStencil {
+        compare: CompareOp::Always,
+        compare_mask: 0,
+        write_mask: !layout.culling_mask(),
+        reference: value,
+        pass: StencilOp::Replace,
+        fail: StencilOp::Keep,
+        depth_fail: StencilOp::Keep,
+    })
 }
 
 impl GeometryPass<'_> {
-    fn draw_objects(&self, state_of: impl Fn(usize) -> DrawState) {
+    fn draw_objects(&self, state_of: impl Fn(usize) -> PassState) {
         let d = &self.ctx.device;
         unsafe {
             d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
@@ -49,7 +67,7 @@ impl GeometryPass<'_> {
             );
         }
         for (i, object) in self.scene.objects.iter().enumerate() {
-            state_of(i).apply(self.ctx, self.cmd);
+            apply(self.ctx, self.cmd, &state_of(i));
             let push = DrawPush::new(object.transform, &object.material);
             unsafe {
                 d.cmd_push_constants(
@@ -65,7 +83,13 @@ impl GeometryPass<'_> {
     }
 
     /// Writes the G-buffer and each draw's BRDF slot into the stencil BRDF bits.
-    pub fn record_gbuffer(&self, targets: &mut Targets, layout: &StencilLayout, slots: &[u32]) {
+    pub fn record_gbuffer(
+        &self,
+        targets: &mut Targets,
+        layout: &StencilLayout,
+        slots: &[u32],
+        preserved_pattern: u8,
+    ) {
         let (ctx, cmd) = (self.ctx, self.cmd);
         ctx.begin_label(cmd, "gbuffer");
         for image in targets.gbuffer.iter_mut() {
@@ -99,10 +123,12 @@ impl GeometryPass<'_> {
             .collect();
         let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Clear(CLEAR_DEPTH_STENCIL));
         begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
-        self.draw_objects(|i| match gbuffer_stencil(layout, slots[i]) {
-            Some(s) => DrawState::OPAQUE.with_stencil(s),
-            None => DrawState::OPAQUE,
-        });
+        self.draw_objects(
+            |i| match gbuffer_stencil(layout, slots[i], preserved_pattern) {
+                Some(s) => with_stencil(OPAQUE, s),
+                None => OPAQUE,
+            },
+        );
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }
@@ -128,7 +154,7 @@ impl GeometryPass<'_> {
         let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
         let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Clear(CLEAR_DEPTH_STENCIL));
         begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
-        self.draw_objects(|_| DrawState::OPAQUE);
+        self.draw_objects(|_| OPAQUE);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }
@@ -141,10 +167,17 @@ mod tests {
     #[test]
     fn gbuffer_writes_only_brdf_bits() {
         let layout = StencilLayout::new(3, 0).unwrap();
-        let s = gbuffer_stencil(&layout, 2).unwrap();
-        assert_eq!(s.write_mask, 0x06);
+        let s = gbuffer_stencil(&layout, 2, 0).unwrap();
+        assert_eq!(s.write_mask, 0xFE);
         assert_eq!(s.reference, 0x04);
-        assert_eq!(s.compare, vk::CompareOp::ALWAYS);
-        assert!(gbuffer_stencil(&StencilLayout::new(1, 0).unwrap(), 0).is_none());
+        assert_eq!(s.compare, CompareOp::Always);
+        // The pattern lands in the preserved bits only, never in the culling or BRDF bits.
+        assert_eq!(
+            gbuffer_stencil(&layout, 1, 0xFF).unwrap().reference,
+            0xF8 | 0x02
+        );
+        let single = StencilLayout::new(1, 0).unwrap();
+        assert!(gbuffer_stencil(&single, 0, 0).is_none());
+        assert_eq!(gbuffer_stencil(&single, 0, 0xA1).unwrap().reference, 0xA0);
     }
 }

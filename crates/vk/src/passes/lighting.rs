@@ -1,172 +1,209 @@
-//! The deferred lighting pass with the talk's stencil depth culling of light volumes.
+//! The deferred lighting pass, driven by histencil-model's frame plan: every light's passes
+//! (setup, per-BRDF mask and shade, cleanup, as `plan_light` derives them for the platform
+//! backend), with the state of each draw translated by [`crate::state::apply`].
 //!
-//! Viewer outside a volume (the talk's case), three draws per light:
-//! 1. *setup*: back faces, depth LESS: where the volume's back face is in front of the surface the
-//!    surface lies behind the volume, so the culling bit is set; no colour.
-//! 2. *shade*: front faces, depth LESS, stencil "culling bit clear": the light shader runs exactly
-//!    on surfaces between the front and back faces.
-//! 3. *cleanup*: back faces, no depth test: the culling bit goes back to 0 wherever the volume
-//!    projects (a superset of where setup set it).
+//! This module only decides how each light is classified and which BRDFs it touches, and records
+//! the plan; the stencil logic lives in the model, where the CPU simulator checks it.
 //!
-//! Viewer inside the volume, or the volume touching the near plane (front faces clipped): one
-//! draw of the back faces with depth GREATER (surface in front of the exit point) and no stencil.
-//! Volumes crossing the far plane need no special case: the volume pipelines clamp depth, so back
-//! faces beyond the far plane sit at depth 1, behind every surface.
-//!
-//! Volumes circumscribe the light's range and the falloff is exactly zero outside it, so any
-//! over-coverage adds nothing: the stencil and depth tests are culling, never correctness.
+//! Hi-stencil steps (the tile surface written by mask passes and its flushes) are recorded as
+//! labelled no-ops for now: the per-pixel stencil test alone is exact, so images are correct,
+//! and the tile emulation only adds culling statistics.
 
 use super::{begin_rendering, color_attachment, depth_stencil_attachment, Load, CLEAR_BLACK};
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
+use crate::error::{Error, Result};
 use crate::meshes::Meshes;
-use crate::pipelines::Pipelines;
-use crate::state::{DrawState, StencilState};
+use crate::pipelines::{create_pipeline, PipelineDesc, VertexInput};
+use crate::shaders;
+use crate::state::apply;
 use crate::targets::Targets;
 use ash::vk;
-use glam::Vec3;
-use histencil_model::StencilLayout;
+use histencil_brdf::BrdfId;
+use histencil_model::{FramePlan, Geometry, LightCase, PassKind, Shader, Step};
 use histencil_scene::{Camera, Light, LightKind};
+use std::collections::HashMap;
 
-/// How a light is drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum VolumeCase {
-    /// The talk's three passes.
-    Outside,
-    /// Back faces with depth GREATER.
-    Inside,
-    /// Directional: a full-screen triangle at the far plane, depth GREATER.
-    FullScreen,
-}
-
-/// A sphere containing the light's volume mesh.
-pub fn volume_bound(
-    light: &Light,
-    meshes_sphere_bound: f32,
-    cone_bound: (f32, f32),
-) -> (Vec3, f32) {
+/// The radius of a sphere containing `light`'s volume mesh, as a multiple of its range.
+pub fn mesh_bound(light: &Light, meshes: &Meshes) -> f32 {
     match light.kind {
-        LightKind::Point => (light.position, light.radius * meshes_sphere_bound),
         LightKind::Spot { outer_angle, .. } => {
-            let radial = cone_bound.0 * outer_angle.tan();
-            (
-                light.position,
-                light.radius * (radial * radial + cone_bound.1 * cone_bound.1).sqrt(),
-            )
+            let (radial, axial) = meshes.light_cone_bound;
+            let radial = radial * outer_angle.tan();
+            (radial * radial + axial * axial).sqrt()
         }
-        LightKind::Directional { .. } => (Vec3::ZERO, f32::INFINITY),
+        _ => meshes.light_sphere_bound,
     }
 }
 
-/// Chooses the passes for a light. Conservative: a volume whose bounding sphere could touch the
-/// near plane (or contain the eye) is drawn as [`VolumeCase::Inside`].
-pub fn classify(light: &Light, bound: (Vec3, f32), camera: &Camera, aspect: f32) -> VolumeCase {
+/// How a light is drawn (see `histencil_model::LightCase`). Conservative where it cannot be
+/// sure: [`LightCase::CrossesNear`]'s plan is correct for any volume, the others are faster
+/// special cases taken only when they certainly apply.
+pub fn classify(light: &Light, mesh_bound: f32, camera: &Camera, aspect: f32) -> LightCase {
     if !light.is_local() {
-        return VolumeCase::FullScreen;
+        return LightCase::FullScreen;
     }
-    let (center, radius) = bound;
-    if (center - camera.eye).length() <= radius + camera.near_corner_distance(aspect) {
-        VolumeCase::Inside
-    } else {
-        VolumeCase::Outside
+    let near = camera.near_corner_distance(aspect);
+    let distance = (light.position - camera.eye).length();
+    let viewer_inside_sphere = distance + near < light.radius;
+    match light.kind {
+        // The sphere mesh contains the range sphere: eye and near plane are inside the mesh.
+        LightKind::Point if viewer_inside_sphere => LightCase::ViewerInside,
+        _ if distance <= light.radius * mesh_bound + near => LightCase::CrossesNear,
+        _ => LightCase::Outside,
     }
 }
 
-/// Which pipeline a light draw uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LightPipeline {
-    /// Volume mesh, no colour writes.
-    Stencil,
-    /// Volume mesh, light shader.
-    Volume,
-    /// Full-screen triangle, light shader.
-    FullScreen,
+/// The shader of a light pipeline: none (stencil and hi-stencil only), one BRDF, or the
+/// branching uber shader.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LightShader {
+    None,
+    Brdf(BrdfId),
+    Branching,
 }
 
-/// One draw of a light: a label, a pipeline and its full state.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LightDraw {
-    pub label: &'static str,
-    pub pipeline: LightPipeline,
-    pub state: DrawState,
+/// Light pipelines, created the first time a plan needs them: a scene pays only for the BRDFs it
+/// uses, and a technique only for its own shaders.
+pub struct LightPipelines {
+    layout: vk::PipelineLayout,
+    hdr_format: vk::Format,
+    depth_stencil_format: vk::Format,
+    pipelines: HashMap<(Geometry, LightShader), vk::Pipeline>,
 }
 
-const NO_DEPTH_WRITE: bool = false;
+/// `SHADED_BRDF` of `deferred_light.frag` for the branching shader.
+const BRANCH_ON_GBUFFER: u32 = u32::MAX;
 
-/// The ordered draws of a light. Pure: the stencil logic of the pass lives here.
-pub fn light_draws(case: VolumeCase, layout: &StencilLayout) -> Vec<LightDraw> {
-    let culling = layout.culling_mask();
-    match case {
-        VolumeCase::Outside => vec![
-            LightDraw {
-                label: "setup",
-                pipeline: LightPipeline::Stencil,
-                state: DrawState {
-                    cull: vk::CullModeFlags::FRONT,
-                    depth_compare: Some(vk::CompareOp::LESS),
-                    depth_write: NO_DEPTH_WRITE,
-                    stencil: Some(StencilState::replace(culling, culling)),
-                },
-            },
-            LightDraw {
-                label: "shade",
-                pipeline: LightPipeline::Volume,
-                state: DrawState {
-                    cull: vk::CullModeFlags::BACK,
-                    depth_compare: Some(vk::CompareOp::LESS),
-                    depth_write: NO_DEPTH_WRITE,
-                    stencil: Some(StencilState::test_equal(0, culling)),
-                },
-            },
-            LightDraw {
-                label: "cleanup",
-                pipeline: LightPipeline::Stencil,
-                state: DrawState {
-                    cull: vk::CullModeFlags::FRONT,
-                    depth_compare: None,
-                    depth_write: NO_DEPTH_WRITE,
-                    stencil: Some(StencilState::replace(0, culling)),
-                },
-            },
-        ],
-        VolumeCase::Inside => vec![LightDraw {
-            label: "shade-inside",
-            pipeline: LightPipeline::Volume,
-            state: DrawState {
-                cull: vk::CullModeFlags::FRONT,
-                depth_compare: Some(vk::CompareOp::GREATER),
-                depth_write: NO_DEPTH_WRITE,
-                stencil: None,
-            },
-        }],
-        VolumeCase::FullScreen => vec![LightDraw {
-            label: "shade-fullscreen",
-            pipeline: LightPipeline::FullScreen,
-            state: DrawState {
-                cull: vk::CullModeFlags::NONE,
-                depth_compare: Some(vk::CompareOp::GREATER),
-                depth_write: NO_DEPTH_WRITE,
-                stencil: None,
-            },
-        }],
+impl LightPipelines {
+    pub fn new(
+        layout: vk::PipelineLayout,
+        hdr_format: vk::Format,
+        depth_stencil_format: vk::Format,
+    ) -> Self {
+        Self {
+            layout,
+            hdr_format,
+            depth_stencil_format,
+            pipelines: HashMap::new(),
+        }
     }
+
+    /// Creates the pipeline for `key` unless it exists.
+    pub fn prepare(&mut self, ctx: &Context, key: (Geometry, LightShader)) -> Result<()> {
+        if self.pipelines.contains_key(&key) {
+            return Ok(());
+        }
+        let (geometry, shader) = key;
+        let (vertex, vertex_input) = match geometry {
+            Geometry::Volume => (
+                ("light_volume.vert", shaders::LIGHT_VOLUME_VERT),
+                VertexInput::Position,
+            ),
+            Geometry::FullScreen => (
+                ("fullscreen.vert", shaders::FULLSCREEN_VERT),
+                VertexInput::None,
+            ),
+        };
+        let specialization = match shader {
+            LightShader::None => None,
+            LightShader::Brdf(id) => Some(id.index()),
+            LightShader::Branching => Some(BRANCH_ON_GBUFFER),
+        };
+        let shader_name = match shader {
+            LightShader::None => "stencil".to_owned(),
+            LightShader::Brdf(id) => id.name().to_owned(),
+            LightShader::Branching => "branching".to_owned(),
+        };
+        let geometry_name = match geometry {
+            Geometry::Volume => "volume",
+            Geometry::FullScreen => "fullscreen",
+        };
+        let hdr = [self.hdr_format];
+        let pipeline = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: &format!("light-{geometry_name}-{shader_name}-pipeline"),
+                vertex,
+                fragment: specialization
+                    .map(|_| ("deferred_light.frag", shaders::DEFERRED_LIGHT_FRAG)),
+                layout: self.layout,
+                vertex_input,
+                color_formats: &hdr,
+                color_writes: shader != LightShader::None,
+                additive_blend: shader != LightShader::None,
+                depth_stencil_format: self.depth_stencil_format,
+                // Back faces beyond the far plane clamp to depth 1, behind every surface.
+                depth_clamp: geometry == Geometry::Volume,
+                specialization,
+            },
+        )?;
+        self.pipelines.insert(key, pipeline);
+        Ok(())
+    }
+
+    fn get(&self, key: (Geometry, LightShader)) -> vk::Pipeline {
+        self.pipelines[&key]
+    }
+
+    /// How many pipelines exist: what the scene and the techniques used so far cost.
+    pub fn count(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for (_, p) in self.pipelines.drain() {
+            unsafe { ctx.device.destroy_pipeline(p, None) };
+        }
+    }
+}
+
+/// The pipeline key of a planned pass. `brdfs` maps stencil slots to BRDFs.
+pub fn pipeline_key(
+    kind: PassKind,
+    geometry: Geometry,
+    brdfs: &[BrdfId],
+) -> (Geometry, LightShader) {
+    let shader = match kind {
+        PassKind::Shade(Shader::Brdf(slot)) => LightShader::Brdf(brdfs[slot as usize]),
+        PassKind::Shade(Shader::Branching) => LightShader::Branching,
+        PassKind::ZeroPreserved | PassKind::Setup | PassKind::Mask(_) | PassKind::Cleanup => {
+            LightShader::None
+        }
+    };
+    (geometry, shader)
+}
+
+/// Creates every pipeline `plan` uses.
+pub fn prepare_pipelines(
+    ctx: &Context,
+    pipelines: &mut LightPipelines,
+    plan: &FramePlan,
+    brdfs: &[BrdfId],
+) -> Result<()> {
+    for pass in plan.passes() {
+        pipelines.prepare(ctx, pipeline_key(pass.kind, pass.geometry, brdfs))?;
+    }
+    Ok(())
 }
 
 pub struct LightingPass<'a> {
     pub ctx: &'a Context,
     pub cmd: vk::CommandBuffer,
+    pub plan: &'a FramePlan,
+    /// The scene light each planned light index stands for.
+    pub light_indices: &'a [u32],
     pub lights: &'a [Light],
-    pub camera: &'a Camera,
+    pub brdfs: &'a [BrdfId],
     pub meshes: &'a Meshes,
-    pub pipelines: &'a Pipelines,
+    pub pipelines: &'a LightPipelines,
     pub pipeline_layout: vk::PipelineLayout,
     pub sets: [vk::DescriptorSet; 2],
-    pub layout: &'a StencilLayout,
     pub extent: vk::Extent2D,
 }
 
 impl LightingPass<'_> {
-    pub fn record(&self, targets: &mut Targets) {
+    pub fn record(&self, targets: &mut Targets) -> Result<()> {
         let (ctx, cmd) = (self.ctx, self.cmd);
         let d = &ctx.device;
         ctx.begin_label(cmd, "lighting");
@@ -206,126 +243,121 @@ impl LightingPass<'_> {
                 &[],
             );
         }
-        let aspect = self.extent.width as f32 / self.extent.height as f32;
-        for (index, light) in self.lights.iter().enumerate() {
-            let bound = volume_bound(
-                light,
-                self.meshes.light_sphere_bound,
-                self.meshes.light_cone_bound,
-            );
-            let case = classify(light, bound, self.camera, aspect);
-            let mesh = match light.kind {
-                LightKind::Spot { .. } => &self.meshes.light_cone,
-                _ => &self.meshes.light_sphere,
-            };
-            ctx.begin_label(cmd, &format!("light-{index}-{case:?}"));
-            let index = index as u32;
-            unsafe {
-                d.cmd_push_constants(
-                    cmd,
-                    self.pipeline_layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    &index.to_ne_bytes(),
-                );
-            }
-            for draw in light_draws(case, self.layout) {
-                ctx.begin_label(cmd, draw.label);
-                let pipeline = match draw.pipeline {
-                    LightPipeline::Stencil => self.pipelines.light_stencil,
-                    LightPipeline::Volume => self.pipelines.light_volume,
-                    LightPipeline::FullScreen => self.pipelines.light_fullscreen,
-                };
-                unsafe { d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline) };
-                draw.state.apply(ctx, cmd);
-                match draw.pipeline {
-                    LightPipeline::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
-                    _ => mesh.draw(ctx, cmd),
+        let mut current_light = None;
+        for step in &self.plan.steps {
+            match step {
+                Step::Pass { light, pass } => {
+                    if current_light != Some(*light) {
+                        if current_light.is_some() {
+                            ctx.end_label(cmd);
+                        }
+                        current_light = Some(*light);
+                        self.begin_light(*light);
+                    }
+                    let scene_light = self.light_indices[*light] as usize;
+                    ctx.begin_label(cmd, &pass.label());
+                    let key = pipeline_key(pass.kind, pass.geometry, self.brdfs);
+                    unsafe {
+                        d.cmd_bind_pipeline(
+                            cmd,
+                            vk::PipelineBindPoint::GRAPHICS,
+                            self.pipelines.get(key),
+                        )
+                    };
+                    apply(ctx, cmd, &pass.state);
+                    match pass.geometry {
+                        Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
+                        Geometry::Volume => match self.lights[scene_light].kind {
+                            LightKind::Spot { .. } => self.meshes.light_cone.draw(ctx, cmd),
+                            _ => self.meshes.light_sphere.draw(ctx, cmd),
+                        },
+                    }
+                    ctx.end_label(cmd);
                 }
-                ctx.end_label(cmd);
+                Step::FlushHiStencil => {
+                    ctx.begin_label(cmd, "flush-hi-stencil");
+                    ctx.end_label(cmd);
+                }
+                Step::SavePreserved { .. } | Step::RestorePreserved { .. } => {
+                    return Err(Error::Unsupported(
+                        "saving and restoring preserved stencil bits on the GPU",
+                    ));
+                }
             }
+        }
+        if current_light.is_some() {
             ctx.end_label(cmd);
         }
         unsafe { d.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
+        Ok(())
+    }
+
+    /// Opens the label of planned light `light` and pushes its scene index.
+    fn begin_light(&self, light: usize) {
+        let (ctx, cmd) = (self.ctx, self.cmd);
+        let index = self.light_indices[light];
+        ctx.begin_label(cmd, &format!("light-{index}"));
+        unsafe {
+            ctx.device.cmd_push_constants(
+                cmd,
+                self.pipeline_layout,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                &index.to_ne_bytes(),
+            );
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn layout() -> StencilLayout {
-        StencilLayout::new(2, 0).unwrap()
-    }
-
-    #[test]
-    fn outside_passes_touch_only_the_culling_bit() {
-        let draws = light_draws(VolumeCase::Outside, &layout());
-        assert_eq!(
-            draws.iter().map(|d| d.label).collect::<Vec<_>>(),
-            ["setup", "shade", "cleanup"]
-        );
-        for d in &draws {
-            let s = d.state.stencil.unwrap();
-            assert_eq!(
-                s.write_mask & !0x01,
-                0,
-                "{} writes more than the culling bit",
-                d.label
-            );
-            assert!(!d.state.depth_write);
-        }
-        assert_eq!(
-            draws[0].state.cull,
-            vk::CullModeFlags::FRONT,
-            "setup draws back faces"
-        );
-        assert_eq!(
-            draws[1].state.cull,
-            vk::CullModeFlags::BACK,
-            "shade draws front faces"
-        );
-        assert_eq!(draws[1].state.stencil.unwrap().compare_mask, 0x01);
-        assert_eq!(
-            draws[2].state.stencil.unwrap().reference,
-            0,
-            "cleanup clears the bit"
-        );
-        assert_eq!(
-            draws[2].state.depth_compare, None,
-            "cleanup clears wherever setup could mark"
-        );
-    }
-
-    #[test]
-    fn inside_and_fullscreen_do_not_touch_stencil() {
-        for case in [VolumeCase::Inside, VolumeCase::FullScreen] {
-            for d in light_draws(case, &layout()) {
-                assert_eq!(d.state.stencil, None);
-                assert_eq!(d.state.depth_compare, Some(vk::CompareOp::GREATER));
-            }
-        }
-    }
+    use glam::Vec3;
 
     #[test]
     fn classification_is_conservative_near_the_eye() {
         let scene = histencil_scene::embedded("default").unwrap();
         let camera = scene.camera;
+        let bound = 1.01;
         let mut light = Light::point(camera.eye + Vec3::new(0.0, 0.0, -5.0), 1.0, Vec3::ONE);
+        assert_eq!(classify(&light, bound, &camera, 1.0), LightCase::Outside);
+        light.radius = 4.95;
         assert_eq!(
-            classify(&light, (light.position, 1.01), &camera, 1.0),
-            VolumeCase::Outside
+            classify(&light, bound, &camera, 1.0),
+            LightCase::CrossesNear
         );
-        light.radius = 5.0;
+        light.radius = 5.05;
+        // Eye inside the range sphere, but the near plane may poke out of it.
         assert_eq!(
-            classify(&light, (light.position, 5.05), &camera, 1.0),
-            VolumeCase::Inside
+            classify(&light, bound, &camera, 1.0),
+            LightCase::CrossesNear
         );
-        // Eye outside by less than the near-plane corner distance: still drawn as inside.
+        light.radius = 5.5;
         assert_eq!(
-            classify(&light, (light.position, 4.95), &camera, 1.0),
-            VolumeCase::Inside
+            classify(&light, bound, &camera, 1.0),
+            LightCase::ViewerInside
+        );
+        light.kind = LightKind::Directional {
+            direction: Vec3::NEG_Y,
+        };
+        assert_eq!(classify(&light, bound, &camera, 1.0), LightCase::FullScreen);
+    }
+
+    #[test]
+    fn passes_map_to_the_shaders_of_their_brdfs() {
+        let brdfs = [BrdfId::Lambert, BrdfId::Ggx];
+        assert_eq!(
+            pipeline_key(PassKind::Shade(Shader::Brdf(1)), Geometry::Volume, &brdfs),
+            (Geometry::Volume, LightShader::Brdf(BrdfId::Ggx))
+        );
+        assert_eq!(
+            pipeline_key(
+                PassKind::Mask(Shader::Brdf(1)),
+                Geometry::FullScreen,
+                &brdfs
+            ),
+            (Geometry::FullScreen, LightShader::None)
         );
     }
 }

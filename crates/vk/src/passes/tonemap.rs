@@ -3,7 +3,7 @@
 use super::{begin_rendering, color_attachment, Load, CLEAR_BLACK};
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
-use crate::state::DrawState;
+use crate::state::{apply, FULLSCREEN};
 use crate::targets::Targets;
 use ash::vk;
 
@@ -52,7 +52,7 @@ impl TonemapPass<'_> {
                 &self.sets,
                 &[],
             );
-            DrawState::FULLSCREEN.apply(ctx, cmd);
+            apply(ctx, cmd, &FULLSCREEN);
             ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
             ctx.device.cmd_end_rendering(cmd);
         }
