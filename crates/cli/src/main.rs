@@ -81,6 +81,10 @@ struct RenderArgs {
     /// When hi-stencil is flushed.
     #[arg(long, value_enum, default_value = "auto")]
     flush: FlushArg,
+    /// Time every lighting step and print the talk's pass groups (setup, mask and shade per BRDF,
+    /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
+    #[arg(long)]
+    timings: bool,
     /// The engine's bits written into the preserved stencil bits by the G-buffer pass, e.g. 0xA0.
     #[arg(long, value_parser = parse_byte, default_value = "0")]
     preserved_pattern: u8,
@@ -155,6 +159,24 @@ impl RenderArgs {
     }
 }
 
+/// The lighting breakdown as lines: each pass group, then the five most expensive lights.
+fn describe_breakdown(lighting: &histencil_vk::LightingBreakdown) -> String {
+    let mut out = String::from("lighting by pass group (median):\n");
+    for (group, ms) in &lighting.groups {
+        out += &format!("  {group:24} {ms:8.3} ms\n");
+    }
+    let mut lights = lighting.per_light.clone();
+    lights.sort_by(|a, b| b.1.total_cmp(&a.1));
+    out += &format!(
+        "most expensive of {} lights drawn:\n",
+        lighting.per_light.len()
+    );
+    for (light, ms) in lights.iter().take(5) {
+        out += &format!("  light {light:<18} {ms:8.3} ms\n");
+    }
+    out
+}
+
 /// A byte as decimal or `0x` hexadecimal.
 fn parse_byte(text: &str) -> Result<u8, String> {
     let parsed = match text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
@@ -219,6 +241,7 @@ fn render(args: &RenderArgs) -> Result<()> {
             histencil_vk::save_png(stencil, path)?;
             println!("wrote {}", path.display());
         }
+        renderer.set_pass_timing(args.timings);
         let timings = renderer.measure(technique, args.frames)?;
         let passes: Vec<String> = timings
             .passes
@@ -235,6 +258,9 @@ fn render(args: &RenderArgs) -> Result<()> {
             technique,
             ctx.device_name()
         );
+        if let Some(lighting) = &timings.lighting {
+            print!("{}", describe_breakdown(lighting));
+        }
         Ok(())
     })
 }

@@ -50,6 +50,14 @@ fn bad_arguments_are_one_line_errors() {
         "invalid value 'magic'",
     );
     assert_one_line_error(&["brdf-report", "--lut-res", "1"], "LUT resolution 1");
+    assert_one_line_error(
+        &["render", "--preserved-pattern", "0x1FF", "--out", out],
+        "not a byte",
+    );
+    assert_one_line_error(
+        &["render", "--backend", "wii", "--out", out],
+        "invalid value 'wii'",
+    );
     assert_one_line_error(&["brdf-report", "--directions", "0"], "--directions");
 }
 
@@ -85,9 +93,20 @@ fn renders_and_dumps_stencil_under_validation() {
         exr.to_str().unwrap(),
         "--dump-stencil",
         stencil.to_str().unwrap(),
+        "--scene",
+        "brdfs-6",
+        "--technique",
+        "stencil",
+        "--backend",
+        "ps3",
+        "--preserved-pattern",
+        "0xA0",
+        "--timings",
     ]);
     assert!(ok, "{stdout}\n{stderr}");
     assert!(stdout.contains("frame time"), "{stdout}");
+    assert!(stdout.contains("lighting by pass group"), "{stdout}");
+    assert!(stdout.contains("shade-kajiya_kay"), "{stdout}");
     let stencil = image::open(&stencil).unwrap().into_luma8();
     assert_eq!(stencil.dimensions(), (64, 48));
     assert!(
@@ -95,8 +114,16 @@ fn renders_and_dumps_stencil_under_validation() {
         "culling bit left set"
     );
     assert!(
-        stencil.pixels().any(|p| p.0[0] != 0),
+        stencil.pixels().any(|p| p.0[0] & 0x0E != 0),
         "no BRDF bits written"
+    );
+    // Six BRDFs take bits 1-3; the PS3-like backend keeps the engine's 0xA0 wherever the
+    // G-buffer drew.
+    assert!(
+        stencil
+            .pixels()
+            .all(|p| p.0[0] & 0xF0 == 0xA0 || p.0[0] == 0),
+        "preserved pattern changed"
     );
     let hdr = image::open(&exr).unwrap().into_rgba32f();
     assert!(hdr.pixels().all(|p| p.0.iter().all(|c| c.is_finite())));

@@ -41,4 +41,4 @@ pub use histencil_model::FlushPolicy;
 pub use output::{save_exr, save_png};
 pub use readback::{FrameImages, Readback};
 pub use renderer::{Backend, Frame, Renderer, Technique};
-pub use timing::{median_of_sorted, FrameTimings};
+pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown};

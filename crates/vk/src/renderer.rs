@@ -13,7 +13,7 @@ use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::{FrameImages, Readback, ReadbackBuffers};
 use crate::resources::Buffer;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
-use crate::timing::{FrameTimings, Timestamps};
+use crate::timing::{FrameTimings, StepTimer, Timestamps};
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
@@ -103,6 +103,9 @@ pub struct Renderer<'c> {
     /// Written into the preserved stencil bits by the G-buffer pass (the engine's own bits).
     preserved_pattern: u8,
     light_pipelines: LightPipelines,
+    /// Per-step lighting timestamps, when asked for.
+    pass_timing: bool,
+    step_timer: Option<StepTimer>,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -212,6 +215,8 @@ impl<'c> Renderer<'c> {
             object_slots,
             preserved_pattern: 0,
             light_pipelines,
+            pass_timing: false,
+            step_timer: None,
             extent,
             targets,
             meshes,
@@ -255,6 +260,12 @@ impl<'c> Renderer<'c> {
                 .map_or(0, |f| f.reference)
             })
             .collect()
+    }
+
+    /// With `on`, frames time every lighting step and report the talk's pass groups
+    /// ([`FrameTimings::lighting`]). Off by default: timestamps between draws can serialise them.
+    pub fn set_pass_timing(&mut self, on: bool) {
+        self.pass_timing = on;
     }
 
     /// Light pipelines created so far.
@@ -309,6 +320,20 @@ impl<'c> Renderer<'c> {
         let ctx = self.ctx;
         let (plan, light_indices) = self.plan(technique)?;
         prepare_pipelines(ctx, &mut self.light_pipelines, &plan, &self.brdfs)?;
+        let time_steps = self.pass_timing && technique != Technique::Forward;
+        if time_steps {
+            let needed = plan.steps.len() as u32 + 1;
+            if self
+                .step_timer
+                .as_ref()
+                .is_none_or(|t| t.capacity() < needed)
+            {
+                if let Some(mut old) = self.step_timer.take() {
+                    old.destroy(ctx);
+                }
+                self.step_timer = Some(StepTimer::new(ctx, needed.next_power_of_two())?);
+            }
+        }
         let cmd = self.cmd;
         unsafe {
             ctx.device
@@ -360,7 +385,10 @@ impl<'c> Renderer<'c> {
                     sets: [self.descriptors.frame_set, self.descriptors.gbuffer_set],
                     extent: self.extent,
                 }
-                .record(&mut self.targets)?;
+                .record(
+                    &mut self.targets,
+                    self.step_timer.as_mut().filter(|_| time_steps),
+                )?;
                 self.timestamps.mark(ctx, cmd, "lighting");
             }
         }
@@ -391,7 +419,10 @@ impl<'c> Renderer<'c> {
                 .reset_fences(&[self.fence])
                 .call("vkResetFences")?;
         }
-        let timings = self.timestamps.read(ctx)?;
+        let mut timings = self.timestamps.read(ctx)?;
+        if let Some(timer) = self.step_timer.as_ref().filter(|_| time_steps) {
+            timings.lighting = Some(timer.read(ctx)?);
+        }
         let images = self.readback.read(readback)?;
         Ok(Frame { timings, images })
     }
@@ -415,6 +446,9 @@ impl Drop for Renderer<'_> {
             ctx.device.destroy_command_pool(self.command_pool, None);
         }
         self.timestamps.destroy(ctx);
+        if let Some(t) = self.step_timer.as_mut() {
+            t.destroy(ctx);
+        }
         self.readback.destroy(ctx);
         self.pipelines.destroy(ctx);
         self.light_pipelines.destroy(ctx);

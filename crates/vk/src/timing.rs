@@ -10,6 +10,64 @@ const MAX_MARKS: u32 = 16;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameTimings {
     pub passes: Vec<(&'static str, f64)>,
+    /// The lighting pass broken down by the talk's pass groups, when asked for
+    /// (`Renderer::set_pass_timing`).
+    pub lighting: Option<LightingBreakdown>,
+}
+
+/// Lighting time by pass group (`setup`, `mask-<brdf>`, `shade-<brdf>`, `cleanup`,
+/// `zero-preserved`, `flush`), totalled over lights in first-seen order, and per light.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LightingBreakdown {
+    pub groups: Vec<(String, f64)>,
+    /// `(scene light index, ms)`.
+    pub per_light: Vec<(u32, f64)>,
+}
+
+impl LightingBreakdown {
+    /// Totals per-step durations: `steps[i] = (group, light, ms)`.
+    pub fn from_steps(steps: &[(String, Option<u32>, f64)]) -> Self {
+        let mut out = Self::default();
+        for (group, light, ms) in steps {
+            match out.groups.iter_mut().find(|(g, _)| g == group) {
+                Some(entry) => entry.1 += ms,
+                None => out.groups.push((group.clone(), *ms)),
+            }
+            if let Some(light) = light {
+                match out.per_light.iter_mut().find(|(l, _)| l == light) {
+                    Some(entry) => entry.1 += ms,
+                    None => out.per_light.push((*light, *ms)),
+                }
+            }
+        }
+        out
+    }
+
+    pub fn group_ms(&self, group: &str) -> Option<f64> {
+        self.groups.iter().find(|g| g.0 == group).map(|g| g.1)
+    }
+
+    /// The median of each entry over frames of the same plan.
+    fn median(frames: &[&LightingBreakdown]) -> LightingBreakdown {
+        fn median_of<K: Clone + PartialEq>(lists: Vec<&Vec<(K, f64)>>) -> Vec<(K, f64)> {
+            let first = lists[0];
+            first
+                .iter()
+                .map(|(key, _)| {
+                    let mut v: Vec<f64> = lists
+                        .iter()
+                        .filter_map(|l| l.iter().find(|(k, _)| k == key).map(|e| e.1))
+                        .collect();
+                    v.sort_by(f64::total_cmp);
+                    (key.clone(), median_of_sorted(&v))
+                })
+                .collect()
+        }
+        LightingBreakdown {
+            groups: median_of(frames.iter().map(|f| &f.groups).collect()),
+            per_light: median_of(frames.iter().map(|f| &f.per_light).collect()),
+        }
+    }
 }
 
 impl FrameTimings {
@@ -36,7 +94,11 @@ impl FrameTimings {
                 (*name, median_of_sorted(&v))
             })
             .collect();
-        FrameTimings { passes }
+        let breakdowns: Vec<&LightingBreakdown> =
+            frames.iter().filter_map(|f| f.lighting.as_ref()).collect();
+        let lighting =
+            (breakdowns.len() == frames.len()).then(|| LightingBreakdown::median(&breakdowns));
+        FrameTimings { passes, lighting }
     }
 }
 
@@ -49,6 +111,39 @@ pub fn median_of_sorted(v: &[f64]) -> f64 {
     }
 }
 
+fn timestamp_pool(ctx: &Context, name: &str, count: u32) -> Result<vk::QueryPool> {
+    let info = vk::QueryPoolCreateInfo::default()
+        .query_type(vk::QueryType::TIMESTAMP)
+        .query_count(count);
+    let pool = unsafe { ctx.device.create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
+    ctx.name(pool, name);
+    Ok(pool)
+}
+
+/// A timestamp after all previous work, into query `index`.
+fn write_timestamp(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, index: u32) {
+    unsafe {
+        ctx.device
+            .cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, index)
+    };
+}
+
+/// The first `count` timestamps of `pool`, waiting for them.
+fn read_ticks(ctx: &Context, pool: vk::QueryPool, count: usize) -> Result<Vec<u64>> {
+    let mut ticks = vec![0u64; count];
+    unsafe {
+        ctx.device
+            .get_query_pool_results(
+                pool,
+                0,
+                &mut ticks,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+            .call("vkGetQueryPoolResults")?;
+    }
+    Ok(ticks)
+}
+
 pub(crate) struct Timestamps {
     pool: vk::QueryPool,
     names: Vec<&'static str>,
@@ -56,12 +151,7 @@ pub(crate) struct Timestamps {
 
 impl Timestamps {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let info = vk::QueryPoolCreateInfo::default()
-            .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(MAX_MARKS);
-        let pool =
-            unsafe { ctx.device.create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
-        ctx.name(pool, "frame-timestamps");
+        let pool = timestamp_pool(ctx, "frame-timestamps", MAX_MARKS)?;
         Ok(Self {
             pool,
             names: Vec::new(),
@@ -84,34 +174,94 @@ impl Timestamps {
             index < MAX_MARKS,
             "more timestamp marks than the pool holds"
         );
-        unsafe {
-            ctx.device.cmd_write_timestamp2(
-                cmd,
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                self.pool,
-                index,
-            )
-        };
+        write_timestamp(ctx, cmd, self.pool, index);
         self.names.push(name);
     }
 
     pub fn read(&self, ctx: &Context) -> Result<FrameTimings> {
-        let mut ticks = vec![0u64; self.names.len()];
-        unsafe {
-            ctx.device
-                .get_query_pool_results(
-                    self.pool,
-                    0,
-                    &mut ticks,
-                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-                )
-                .call("vkGetQueryPoolResults")?;
-        }
+        let ticks = read_ticks(ctx, self.pool, self.names.len())?;
         let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * ctx.timestamp_period_ns * 1e-6;
         let passes = (1..ticks.len())
             .map(|i| (self.names[i], ms(ticks[i - 1], ticks[i])))
             .collect();
-        Ok(FrameTimings { passes })
+        Ok(FrameTimings {
+            passes,
+            lighting: None,
+        })
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+    }
+}
+
+/// A timestamp after every step of the lighting plan, for the per-group breakdown. Opt-in: on
+/// some drivers a timestamp between draws serialises them, so the breakdown costs time.
+pub(crate) struct StepTimer {
+    pool: vk::QueryPool,
+    capacity: u32,
+    /// `(group, light)` of each timed step, in order.
+    steps: Vec<(String, Option<u32>)>,
+}
+
+impl StepTimer {
+    pub fn new(ctx: &Context, capacity: u32) -> Result<Self> {
+        let pool = timestamp_pool(ctx, "lighting-step-timestamps", capacity)?;
+        Ok(Self {
+            pool,
+            capacity,
+            steps: Vec::new(),
+        })
+    }
+
+    /// Steps (plus one start mark) this timer can hold.
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// Resets the queries: outside any rendering, as Vulkan requires.
+    pub fn reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        self.steps.clear();
+        unsafe {
+            ctx.device
+                .cmd_reset_query_pool(cmd, self.pool, 0, self.capacity)
+        };
+    }
+
+    /// The mark the first step is timed from.
+    pub fn start(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        write_timestamp(ctx, cmd, self.pool, 0);
+    }
+
+    /// Marks the end of a step of `group`, drawn for scene light `light`.
+    pub fn mark(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        group: String,
+        light: Option<u32>,
+    ) {
+        let index = self.steps.len() as u32 + 1;
+        assert!(
+            index < self.capacity,
+            "more lighting steps than the timer holds"
+        );
+        write_timestamp(ctx, cmd, self.pool, index);
+        self.steps.push((group, light));
+    }
+
+    pub fn read(&self, ctx: &Context) -> Result<LightingBreakdown> {
+        let ticks = read_ticks(ctx, self.pool, self.steps.len() + 1)?;
+        let steps: Vec<(String, Option<u32>, f64)> = self
+            .steps
+            .iter()
+            .zip(ticks.windows(2))
+            .map(|((group, light), t)| {
+                let ms = t[1].saturating_sub(t[0]) as f64 * ctx.timestamp_period_ns * 1e-6;
+                (group.clone(), *light, ms)
+            })
+            .collect();
+        Ok(LightingBreakdown::from_steps(&steps))
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -127,10 +277,24 @@ mod tests {
     fn median_per_pass() {
         let f = |a, b| FrameTimings {
             passes: vec![("gbuffer", a), ("lighting", b)],
+            lighting: None,
         };
         let m = FrameTimings::median(&[f(1.0, 9.0), f(3.0, 1.0), f(2.0, 5.0)]);
         assert_eq!(m, f(2.0, 5.0));
         assert_eq!(m.total_ms(), 7.0);
         assert_eq!(median_of_sorted(&[1.0, 2.0, 3.0, 4.0]), 2.5);
+    }
+
+    #[test]
+    fn breakdown_totals_groups_and_lights() {
+        let b = LightingBreakdown::from_steps(&[
+            ("setup".into(), Some(3), 1.0),
+            ("shade-ggx".into(), Some(3), 2.0),
+            ("setup".into(), Some(5), 0.5),
+            ("flush".into(), None, 0.25),
+        ]);
+        assert_eq!(b.group_ms("setup"), Some(1.5));
+        assert_eq!(b.groups.len(), 3);
+        assert_eq!(b.per_light, vec![(3, 3.0), (5, 0.5)]);
     }
 }

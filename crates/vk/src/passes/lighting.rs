@@ -18,6 +18,7 @@ use crate::pipelines::{create_pipeline, PipelineDesc, VertexInput};
 use crate::shaders;
 use crate::state::apply;
 use crate::targets::Targets;
+use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{FramePlan, Geometry, LightCase, PassKind, Shader, Step};
@@ -174,6 +175,22 @@ pub fn pipeline_key(
     (geometry, shader)
 }
 
+/// The talk's pass group of a planned pass, for timings: `setup`, `mask-<brdf>`, `shade-<brdf>`
+/// (`-branching` for the uber shader), `cleanup`, `zero-preserved`.
+pub fn pass_group(kind: PassKind, brdfs: &[BrdfId]) -> String {
+    let shader = |s: Shader| match s {
+        Shader::Brdf(slot) => brdfs[slot as usize].name(),
+        Shader::Branching => "branching",
+    };
+    match kind {
+        PassKind::ZeroPreserved => "zero-preserved".into(),
+        PassKind::Setup => "setup".into(),
+        PassKind::Mask(s) => format!("mask-{}", shader(s)),
+        PassKind::Shade(s) => format!("shade-{}", shader(s)),
+        PassKind::Cleanup => "cleanup".into(),
+    }
+}
+
 /// Creates every pipeline `plan` uses.
 pub fn prepare_pipelines(
     ctx: &Context,
@@ -203,7 +220,12 @@ pub struct LightingPass<'a> {
 }
 
 impl LightingPass<'_> {
-    pub fn record(&self, targets: &mut Targets) -> Result<()> {
+    /// Records the plan; with `timer`, a timestamp after every step.
+    pub(crate) fn record(
+        &self,
+        targets: &mut Targets,
+        mut timer: Option<&mut StepTimer>,
+    ) -> Result<()> {
         let (ctx, cmd) = (self.ctx, self.cmd);
         let d = &ctx.device;
         ctx.begin_label(cmd, "lighting");
@@ -230,6 +252,9 @@ impl LightingPass<'_> {
             ImageAccess::DepthStencilAttachment,
             Contents::Keep,
         );
+        if let Some(t) = timer.as_deref_mut() {
+            t.reset(ctx, cmd);
+        }
         let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
         let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Keep);
         begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
@@ -242,6 +267,9 @@ impl LightingPass<'_> {
                 &self.sets,
                 &[],
             );
+        }
+        if let Some(t) = timer.as_deref_mut() {
+            t.start(ctx, cmd);
         }
         let mut current_light = None;
         for step in &self.plan.steps {
@@ -273,10 +301,17 @@ impl LightingPass<'_> {
                         },
                     }
                     ctx.end_label(cmd);
+                    if let Some(t) = timer.as_deref_mut() {
+                        let group = pass_group(pass.kind, self.brdfs);
+                        t.mark(ctx, cmd, group, Some(scene_light as u32));
+                    }
                 }
                 Step::FlushHiStencil => {
                     ctx.begin_label(cmd, "flush-hi-stencil");
                     ctx.end_label(cmd);
+                    if let Some(t) = timer.as_deref_mut() {
+                        t.mark(ctx, cmd, "flush".into(), None);
+                    }
                 }
                 Step::SavePreserved { .. } | Step::RestorePreserved { .. } => {
                     return Err(Error::Unsupported(

@@ -1,0 +1,98 @@
+//! The lighting breakdown by the talk's pass groups, and "only what the scene needs" in the plans:
+//! a one-BRDF scene gets the plain deferred passes, and a light draws only for the BRDFs it
+//! touches.
+
+use histencil_model::PassKind;
+use histencil_tests::with_validated_context;
+use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+
+const STENCIL: Technique = Technique::Stencil {
+    backend: Backend::Native,
+    flush: FlushPolicy::Auto,
+};
+
+#[test]
+fn pass_groups_are_timed_per_brdf() {
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
+    with_validated_context(|ctx| {
+        let mut renderer = Renderer::new(ctx, scene, 96, 96).expect("renderer");
+        renderer.set_pass_timing(true);
+        let timings = renderer
+            .render(STENCIL, Readback::NONE)
+            .expect("frame")
+            .timings;
+        let lighting = timings.lighting.expect("breakdown asked for");
+        for group in [
+            "setup",
+            "shade-lambert",
+            "shade-oren_nayar_full",
+            "shade-ggx",
+            "cleanup",
+        ] {
+            let ms = lighting
+                .group_ms(group)
+                .unwrap_or_else(|| panic!("no {group}: {lighting:?}"));
+            assert!(ms.is_finite() && ms >= 0.0, "{group}: {ms}");
+        }
+        assert!(lighting.group_ms("shade-branching").is_none());
+        let (plan, lights) = renderer.plan(STENCIL).unwrap();
+        assert_eq!(lighting.per_light.len(), lights.len());
+        assert_eq!(
+            plan.passes().count(),
+            plan.steps.len(),
+            "native has no flushes"
+        );
+
+        let branching = renderer
+            .render(Technique::DEFERRED, Readback::NONE)
+            .expect("frame")
+            .timings
+            .lighting
+            .unwrap();
+        assert!(branching.group_ms("shade-branching").is_some());
+        assert!(branching.group_ms("shade-ggx").is_none());
+
+        renderer.set_pass_timing(false);
+        let plain = renderer
+            .render(STENCIL, Readback::NONE)
+            .expect("frame")
+            .timings;
+        assert!(plain.lighting.is_none());
+    });
+}
+
+#[test]
+fn one_brdf_scene_runs_the_plain_deferred_passes() {
+    let scene = histencil_scene::embedded("brdfs-1").unwrap();
+    with_validated_context(|ctx| {
+        let renderer = Renderer::new(ctx, scene, 64, 64).expect("renderer");
+        let (stencil, _) = renderer.plan(STENCIL).unwrap();
+        let (deferred, _) = renderer.plan(Technique::DEFERRED).unwrap();
+        let kinds =
+            |p: &histencil_model::FramePlan| p.passes().map(|p| p.kind).collect::<Vec<PassKind>>();
+        assert!(!kinds(&stencil)
+            .iter()
+            .any(|k| matches!(k, PassKind::Mask(_))));
+        assert_eq!(kinds(&stencil).len(), kinds(&deferred).len());
+    });
+}
+
+#[test]
+fn lights_draw_once_per_brdf_they_touch() {
+    let scene = histencil_scene::embedded("brdfs-6").unwrap();
+    with_validated_context(|ctx| {
+        let renderer = Renderer::new(ctx, scene.clone(), 64, 64).expect("renderer");
+        let (plan, lights) = renderer.plan(STENCIL).unwrap();
+        for (planned, &index) in lights.iter().enumerate() {
+            let touched = scene.brdfs_lit_by(&scene.lights[index as usize]).len();
+            let shades = plan
+                .steps
+                .iter()
+                .filter(|s| matches!(s, histencil_model::Step::Pass { light, pass } if *light == planned && matches!(pass.kind, PassKind::Shade(_))))
+                .count();
+            assert_eq!(shades, touched, "light {index}");
+        }
+        // Lights out of every object's reach are not drawn at all.
+        assert!(lights.len() <= scene.lights.len());
+    });
+}
