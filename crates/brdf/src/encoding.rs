@@ -12,7 +12,7 @@
 
 use crate::cases::{halton, sphere_point};
 use crate::model::Brdf;
-use crate::vector::{cross, dot, normalize, V3};
+use crate::vector::{angle_between, cross, normalize, V3};
 use half::f16;
 
 /// How the G-buffer stores the normal.
@@ -217,8 +217,7 @@ impl EncodingError {
             sum += error;
             peak = reference.into_iter().fold(peak, f64::max);
             if let (Some(a), Some(b)) = (normalize(n), normalize(n_stored)) {
-                let x = cross(a, b);
-                max_angle = max_angle.max(dot(x, x).sqrt().atan2(dot(a, b)).to_degrees());
+                max_angle = max_angle.max(angle_between(a, b).to_degrees());
             }
         }
         Self {

@@ -22,7 +22,7 @@
 
 use crate::cases::{halton, sphere_point};
 use crate::model::Brdf;
-use crate::vector::{cross, dot, normalize, scale, sub, V3};
+use crate::vector::{angle_between, dot, normalize, scale, sub, V3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The geometric axes a table is sampled over (see the module doc).
@@ -71,10 +71,6 @@ impl LutAxes {
         [n, t, v, l]: [V3<f64>; 4],
         curvature_per_mm: f64,
     ) -> Option<[f64; 3]> {
-        let angle = |a: V3<f64>, b: V3<f64>| {
-            let x = cross(a, b);
-            dot(x, x).sqrt().atan2(dot(a, b))
-        };
         match self {
             LutAxes::CosLight => {
                 let (n, l) = (normalize(n)?, normalize(l)?);
@@ -88,21 +84,25 @@ impl LutAxes {
                 }
                 let in_plane = |d: V3<f64>| normalize(sub(d, scale(n, dot(n, d))));
                 let phi = match (in_plane(l), in_plane(v)) {
-                    (Some(lp), Some(vp)) => angle(lp, vp),
+                    (Some(lp), Some(vp)) => angle_between(lp, vp),
                     // Along the normal the azimuth is undefined and the BRDF does not depend
                     // on it.
                     _ => 0.0,
                 };
-                Some([angle(n, l) / FRAC_PI_2, angle(n, v) / FRAC_PI_2, phi / PI])
+                Some([
+                    angle_between(n, l) / FRAC_PI_2,
+                    angle_between(n, v) / FRAC_PI_2,
+                    phi / PI,
+                ])
             }
             LutAxes::Fibre => {
                 let (t, v, l) = (normalize(t)?, normalize(v)?, normalize(l)?);
-                Some([angle(t, l) / PI, angle(t, v) / PI, 0.0])
+                Some([angle_between(t, l) / PI, angle_between(t, v) / PI, 0.0])
             }
             LutAxes::SkinCurvature => {
                 let (n, l) = (normalize(n)?, normalize(l)?);
                 let k = curvature_per_mm.max(0.0);
-                Some([angle(n, l) / PI, k / (k + 1.0), 0.0])
+                Some([angle_between(n, l) / PI, k / (k + 1.0), 0.0])
             }
         }
     }

@@ -54,6 +54,13 @@ pub fn normalize<R: Real>(a: V3<R>) -> Option<V3<R>> {
     Some(scale(a, len.recip()))
 }
 
+/// The angle between two vectors, from `atan2(|a x b|, a . b)`: accurate near 0 and pi, where
+/// `acos` of the dot product is not.
+pub(crate) fn angle_between<R: Real>(a: V3<R>, b: V3<R>) -> R {
+    let x = cross(a, b);
+    dot(x, x).sqrt().atan2(dot(a, b))
+}
+
 /// `sin` of the angle between unit vectors, from their cosine, never NaN.
 pub(crate) fn sin_from_cos<R: Real>(cos: R) -> R {
     (R::one() - cos * cos).max(R::zero()).sqrt()

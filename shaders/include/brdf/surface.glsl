@@ -45,10 +45,9 @@ float brdf_blinn_phong(float exponent, vec3 N, vec3 V, vec3 L) {
 struct OrenNayarAngles {
     float sin_alpha;
     float alpha;
-    float sin_beta;
-    float cos_beta;
     float beta;
     float cos_phi;
+    float cos_i_tan_beta; // cos(theta_i) tan(beta), as a bounded ratio
 };
 
 OrenNayarAngles brdf_oren_nayar_angles(BrdfLit s) {
@@ -61,10 +60,13 @@ OrenNayarAngles brdf_oren_nayar_angles(BrdfLit s) {
     if (brdf_normalize(s.l - s.n * s.n_dot_l, lp) && brdf_normalize(s.v - s.n * s.n_dot_v, vp)) {
         cos_phi = clamp(dot(lp, vp), -1.0, 1.0);
     }
+    // The larger angle has the smaller cosine; cos(beta) >= cos(theta_i) keeps the ratio finite.
     if (theta_i >= theta_r) {
-        return OrenNayarAngles(sin_i, theta_i, sin_r, s.n_dot_v, theta_r, cos_phi);
+        float cos_i_tan_beta = s.n_dot_l * sin_r / max(s.n_dot_v, s.n_dot_l);
+        return OrenNayarAngles(sin_i, theta_i, theta_r, cos_phi, cos_i_tan_beta);
     }
-    return OrenNayarAngles(sin_r, theta_r, sin_i, s.n_dot_l, theta_i, cos_phi);
+    float cos_i_tan_beta = s.n_dot_l * sin_i / s.n_dot_l;
+    return OrenNayarAngles(sin_r, theta_r, theta_i, cos_phi, cos_i_tan_beta);
 }
 
 float brdf_oren_nayar_full(float rho, float sigma, vec3 N, vec3 V, vec3 L) {
@@ -82,11 +84,10 @@ float brdf_oren_nayar_full(float rho, float sigma, vec3 N, vec3 V, vec3 L) {
         : c2_base * (a.sin_alpha - two_beta_over_pi * two_beta_over_pi * two_beta_over_pi);
     float k = 4.0 * a.alpha * a.beta / (PI * PI);
     float c3 = 0.125 * s2 / (s2 + 0.09) * k * k;
-    float cos_i_tan_beta = s.n_dot_l * a.sin_beta / max(a.cos_beta, s.n_dot_l);
     float half_angle = (a.alpha + a.beta) * 0.5;
     float cos_i_tan_half = s.n_dot_l * sin(half_angle) / max(cos(half_angle), 1.17549435e-38);
     float direct = rho * INV_PI
-        * (c1 * s.n_dot_l + a.cos_phi * c2 * cos_i_tan_beta
+        * (c1 * s.n_dot_l + a.cos_phi * c2 * a.cos_i_tan_beta
             + (1.0 - abs(a.cos_phi)) * c3 * cos_i_tan_half);
     float interreflection = 0.17 * rho * rho * INV_PI * s.n_dot_l * s2 / (s2 + 0.13)
         * (1.0 - a.cos_phi * two_beta_over_pi * two_beta_over_pi);
@@ -102,9 +103,8 @@ float brdf_oren_nayar_qualitative(float rho, float sigma, vec3 N, vec3 V, vec3 L
     float s2 = sigma * sigma;
     float big_a = 1.0 - 0.5 * s2 / (s2 + 0.33);
     float big_b = 0.45 * s2 / (s2 + 0.09);
-    float cos_i_tan_beta = s.n_dot_l * a.sin_beta / max(a.cos_beta, s.n_dot_l);
     return rho * INV_PI
-        * (big_a * s.n_dot_l + big_b * max(a.cos_phi, 0.0) * a.sin_alpha * cos_i_tan_beta);
+        * (big_a * s.n_dot_l + big_b * max(a.cos_phi, 0.0) * a.sin_alpha * a.cos_i_tan_beta);
 }
 
 float brdf_ggx(float alpha, float f0, float f90, vec3 N, vec3 V, vec3 L) {

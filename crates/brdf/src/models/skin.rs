@@ -11,7 +11,7 @@
 //! a few dozen samples reach 1e-6. Curvature 0 (flat) is Lambert; huge curvature tends to the
 //! ring average `1 / pi`.
 
-use crate::vector::{c, cross, dot, normalize, Real, V3};
+use crate::vector::{angle_between, c, normalize, Real, V3};
 
 /// Variances (mm^2) and RGB weights of the six Gaussians of d'Eon and Luebke's skin profile.
 pub const SKIN_PROFILE: [(f64, [f64; 3]); 6] = [
@@ -102,7 +102,6 @@ pub fn penner_skin<R: Real>(
     let (Some(n), Some(l)) = (normalize(n), normalize(l)) else {
         return [R::zero(); 3];
     };
-    let x = cross(n, l);
-    let theta = dot(x, x).sqrt().atan2(dot(n, l));
+    let theta = angle_between(n, l);
     skin_diffusion(theta, curvature_per_mm, panels).map(|d| rho * R::FRAC_1_PI() * d)
 }

@@ -52,15 +52,15 @@ pub fn blinn_phong<R: Real>(exponent: R, n: V3<R>, v: V3<R>, l: V3<R>) -> R {
     (exponent + c(8.0)) / (c::<R>(8.0) * R::PI()) * pow_safe(n_dot_h, exponent) * s.n_dot_l
 }
 
-/// The angles of Oren-Nayar: `sin` and `cos` of `alpha = max(theta_i, theta_r)` and
-/// `beta = min(...)`, and `cos(phi_i - phi_r)` (0 when either direction is the normal).
+/// The angles of Oren-Nayar: `alpha = max(theta_i, theta_r)` and its sine, `beta = min(...)`,
+/// `cos(phi_i - phi_r)` (0 when either direction is the normal), and `cos(theta_i) tan(beta)`
+/// formed as a ratio with `cos(beta) >= cos(theta_i)`, so grazing angles stay finite.
 struct OrenNayarAngles<R: Real> {
     sin_alpha: R,
     alpha: R,
-    sin_beta: R,
-    cos_beta: R,
     beta: R,
     cos_phi: R,
+    cos_i_tan_beta: R,
 }
 
 fn oren_nayar_angles<R: Real>(s: &Lit<R>) -> OrenNayarAngles<R> {
@@ -77,26 +77,23 @@ fn oren_nayar_angles<R: Real>(s: &Lit<R>) -> OrenNayarAngles<R> {
         OrenNayarAngles {
             sin_alpha: sin_i,
             alpha: theta_i,
-            sin_beta: sin_r,
-            cos_beta: s.n_dot_v,
             beta: theta_r,
             cos_phi,
+            cos_i_tan_beta: s.n_dot_l * sin_r / s.n_dot_v.max(s.n_dot_l),
         }
     } else {
         OrenNayarAngles {
             sin_alpha: sin_r,
             alpha: theta_r,
-            sin_beta: sin_i,
-            cos_beta: s.n_dot_l,
             beta: theta_i,
             cos_phi,
+            cos_i_tan_beta: s.n_dot_l * sin_i / s.n_dot_l,
         }
     }
 }
 
 /// Oren-Nayar 1994, the full model with the inter-reflection term (their eq. 30 and 39).
-/// `sigma` is the slope deviation in radians. `cos(theta_i) tan(beta)` is formed as a ratio with
-/// `cos(beta) >= cos(theta_i)`, so grazing angles stay finite.
+/// `sigma` is the slope deviation in radians.
 pub fn oren_nayar_full<R: Real>(rho: R, sigma: R, n: V3<R>, v: V3<R>, l: V3<R>) -> R {
     let Some(s) = lit(n, v, l) else {
         return R::zero();
@@ -114,14 +111,13 @@ pub fn oren_nayar_full<R: Real>(rho: R, sigma: R, n: V3<R>, v: V3<R>, l: V3<R>) 
     };
     let c3 =
         c::<R>(0.125) * s2 / (s2 + c(0.09)) * (c::<R>(4.0) * a.alpha * a.beta / (pi * pi)).powi(2);
-    let cos_i_tan_beta = s.n_dot_l * a.sin_beta / a.cos_beta.max(s.n_dot_l);
     let half = (a.alpha + a.beta) * c(0.5);
     // half < pi/2 unless both angles are grazing, which the gate excludes.
     let cos_i_tan_half = s.n_dot_l * half.sin() / half.cos().max(R::min_positive_value());
     let direct = rho
         * R::FRAC_1_PI()
         * (c1 * s.n_dot_l
-            + a.cos_phi * c2 * cos_i_tan_beta
+            + a.cos_phi * c2 * a.cos_i_tan_beta
             + (R::one() - a.cos_phi.abs()) * c3 * cos_i_tan_half);
     let interreflection = c::<R>(0.17) * rho * rho * R::FRAC_1_PI() * s.n_dot_l * s2
         / (s2 + c(0.13))
@@ -138,9 +134,8 @@ pub fn oren_nayar_qualitative<R: Real>(rho: R, sigma: R, n: V3<R>, v: V3<R>, l: 
     let s2 = sigma * sigma;
     let big_a = R::one() - c::<R>(0.5) * s2 / (s2 + c(0.33));
     let big_b = c::<R>(0.45) * s2 / (s2 + c(0.09));
-    let cos_i_tan_beta = s.n_dot_l * a.sin_beta / a.cos_beta.max(s.n_dot_l);
     rho * R::FRAC_1_PI()
-        * (big_a * s.n_dot_l + big_b * a.cos_phi.max(R::zero()) * a.sin_alpha * cos_i_tan_beta)
+        * (big_a * s.n_dot_l + big_b * a.cos_phi.max(R::zero()) * a.sin_alpha * a.cos_i_tan_beta)
 }
 
 /// The smallest GGX alpha evaluated: a perfect mirror has no finite BRDF, and below this the
