@@ -71,12 +71,7 @@ fn culling_bit_clear_brdf_bits_intact_and_preserved_bits_as_the_backend_says() {
                         Some(brdf) => {
                             let slot = brdfs.iter().position(|b| b == brdf).unwrap() as u32;
                             seen_slots.insert(slot);
-                            let bits = if layout.has_brdf_bits() {
-                                layout.brdf_reference(slot)
-                            } else {
-                                0
-                            };
-                            (bits, PATTERN & preserved)
+                            (layout.brdf_reference(slot), PATTERN & preserved)
                         }
                         None => (0, 0),
                     };

@@ -256,30 +256,27 @@ impl Scene {
     /// The distinct BRDFs the objects use, sorted by id. Their position in this list is their
     /// stencil slot.
     pub fn brdfs_in_use(&self) -> Vec<BrdfId> {
-        let mut v: Vec<BrdfId> = self.objects.iter().map(|o| o.material.brdf.id()).collect();
-        v.sort();
-        v.dedup();
-        v
+        distinct_brdfs(self.objects.iter())
     }
 
     /// The BRDFs of the objects that `light` can reach (world bounds against its range sphere;
     /// every BRDF in use for a directional light), sorted by id. A light volume is drawn once per
     /// BRDF in this list, so a BRDF the light cannot touch costs nothing.
     pub fn brdfs_lit_by(&self, light: &Light) -> Vec<BrdfId> {
-        let mut v: Vec<BrdfId> = self
-            .objects
-            .iter()
-            .filter(|o| {
-                let (lo, hi) = o.world_bounds();
-                let nearest = light.position.clamp(lo, hi);
-                !light.is_local() || nearest.distance(light.position) < light.radius
-            })
-            .map(|o| o.material.brdf.id())
-            .collect();
-        v.sort();
-        v.dedup();
-        v
+        distinct_brdfs(self.objects.iter().filter(|o| {
+            let (lo, hi) = o.world_bounds();
+            let nearest = light.position.clamp(lo, hi);
+            !light.is_local() || nearest.distance(light.position) < light.radius
+        }))
     }
+}
+
+/// The distinct BRDFs of `objects`, sorted by id.
+fn distinct_brdfs<'a>(objects: impl Iterator<Item = &'a Object>) -> Vec<BrdfId> {
+    let mut v: Vec<BrdfId> = objects.map(|o| o.material.brdf.id()).collect();
+    v.sort();
+    v.dedup();
+    v
 }
 
 #[cfg(test)]

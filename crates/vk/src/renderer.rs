@@ -85,6 +85,14 @@ impl Technique {
     }
 }
 
+/// The stencil slot of BRDF `id`: its index among the BRDFs in use.
+fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
+    brdfs
+        .iter()
+        .position(|b| *b == id)
+        .expect("brdfs_in_use lists every object's BRDF") as u32
+}
+
 /// A rendered frame: its GPU timings and the images asked for.
 pub struct Frame {
     pub timings: FrameTimings,
@@ -130,12 +138,7 @@ impl<'c> Renderer<'c> {
         let object_slots = scene
             .objects
             .iter()
-            .map(|o| {
-                brdfs
-                    .iter()
-                    .position(|b| *b == o.material.brdf.id())
-                    .expect("brdfs_in_use lists every object's BRDF") as u32
-            })
+            .map(|o| slot_of(&brdfs, o.material.brdf.id()))
             .collect();
 
         let targets = Targets::new(ctx, extent)?;
@@ -288,7 +291,7 @@ impl<'c> Renderer<'c> {
                 .scene
                 .brdfs_lit_by(light)
                 .into_iter()
-                .map(|id| self.brdfs.iter().position(|b| *b == id).expect("in use") as u32)
+                .map(|id| slot_of(&self.brdfs, id))
                 .collect();
             if affected.is_empty() {
                 continue;

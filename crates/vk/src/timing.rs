@@ -29,15 +29,9 @@ impl LightingBreakdown {
     pub fn from_steps(steps: &[(String, Option<u32>, f64)]) -> Self {
         let mut out = Self::default();
         for (group, light, ms) in steps {
-            match out.groups.iter_mut().find(|(g, _)| g == group) {
-                Some(entry) => entry.1 += ms,
-                None => out.groups.push((group.clone(), *ms)),
-            }
+            add_to(&mut out.groups, group, *ms);
             if let Some(light) = light {
-                match out.per_light.iter_mut().find(|(l, _)| l == light) {
-                    Some(entry) => entry.1 += ms,
-                    None => out.per_light.push((*light, *ms)),
-                }
+                add_to(&mut out.per_light, light, *ms);
             }
         }
         out
@@ -45,28 +39,6 @@ impl LightingBreakdown {
 
     pub fn group_ms(&self, group: &str) -> Option<f64> {
         self.groups.iter().find(|g| g.0 == group).map(|g| g.1)
-    }
-
-    /// The median of each entry over frames of the same plan.
-    fn median(frames: &[&LightingBreakdown]) -> LightingBreakdown {
-        fn median_of<K: Clone + PartialEq>(lists: Vec<&Vec<(K, f64)>>) -> Vec<(K, f64)> {
-            let first = lists[0];
-            first
-                .iter()
-                .map(|(key, _)| {
-                    let mut v: Vec<f64> = lists
-                        .iter()
-                        .filter_map(|l| l.iter().find(|(k, _)| k == key).map(|e| e.1))
-                        .collect();
-                    v.sort_by(f64::total_cmp);
-                    (key.clone(), median_of_sorted(&v))
-                })
-                .collect()
-        }
-        LightingBreakdown {
-            groups: median_of(frames.iter().map(|f| &f.groups).collect()),
-            per_light: median_of(frames.iter().map(|f| &f.per_light).collect()),
-        }
     }
 }
 
@@ -84,22 +56,43 @@ impl FrameTimings {
         let Some(first) = frames.first() else {
             return FrameTimings::default();
         };
-        let passes = first
-            .passes
-            .iter()
-            .enumerate()
-            .map(|(i, (name, _))| {
-                let mut v: Vec<f64> = frames.iter().map(|f| f.passes[i].1).collect();
-                v.sort_by(f64::total_cmp);
-                (*name, median_of_sorted(&v))
-            })
-            .collect();
+        let passes = median_per_key(&first.passes, frames.iter().map(|f| &f.passes));
         let breakdowns: Vec<&LightingBreakdown> =
             frames.iter().filter_map(|f| f.lighting.as_ref()).collect();
-        let lighting =
-            (breakdowns.len() == frames.len()).then(|| LightingBreakdown::median(&breakdowns));
+        let lighting = (breakdowns.len() == frames.len()).then(|| LightingBreakdown {
+            groups: median_per_key(&breakdowns[0].groups, breakdowns.iter().map(|b| &b.groups)),
+            per_light: median_per_key(
+                &breakdowns[0].per_light,
+                breakdowns.iter().map(|b| &b.per_light),
+            ),
+        });
         FrameTimings { passes, lighting }
     }
+}
+
+/// Adds `ms` to `key`'s total, appending the key the first time it is seen.
+fn add_to<K: Clone + PartialEq>(totals: &mut Vec<(K, f64)>, key: &K, ms: f64) {
+    match totals.iter_mut().find(|(k, _)| k == key) {
+        Some(entry) => entry.1 += ms,
+        None => totals.push((key.clone(), ms)),
+    }
+}
+
+/// For each key of `keys` (in its order), the median of its values over `lists`.
+fn median_per_key<'a, K: Clone + PartialEq + 'a>(
+    keys: &[(K, f64)],
+    lists: impl Iterator<Item = &'a Vec<(K, f64)>> + Clone,
+) -> Vec<(K, f64)> {
+    keys.iter()
+        .map(|(key, _)| {
+            let mut v: Vec<f64> = lists
+                .clone()
+                .filter_map(|l| l.iter().find(|(k, _)| k == key).map(|e| e.1))
+                .collect();
+            v.sort_by(f64::total_cmp);
+            (key.clone(), median_of_sorted(&v))
+        })
+        .collect()
 }
 
 /// The median of sorted values (mean of the middle two for even counts).

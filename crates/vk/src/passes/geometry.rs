@@ -2,8 +2,8 @@
 //! the forward reference (every object lit by every light, per pixel).
 
 use super::{
-    begin_rendering, color_attachment, depth_stencil_attachment, Load, CLEAR_BLACK,
-    CLEAR_DEPTH_STENCIL,
+    begin_hdr_rendering, begin_rendering, color_attachment, depth_stencil_attachment, Load,
+    CLEAR_BLACK, CLEAR_DEPTH_STENCIL,
 };
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
@@ -35,12 +35,8 @@ pub fn gbuffer_stencil(
     slot: u32,
     preserved_pattern: u8,
 ) -> Option<FaceStencil> {
-    let brdf = if layout.has_brdf_bits() {
-        layout.brdf_reference(slot)
-    } else {
-        0
-    };
-    let value = brdf | (preserved_pattern & layout.preserved_mask());
+    // With one BRDF there are no BRDF bits and slot 0's reference is 0.
+    let value = layout.brdf_reference(slot) | (preserved_pattern & layout.preserved_mask());
     (layout.has_brdf_bits() || value != 0).then_some(FaceStencil {
         compare: CompareOp::Always,
         compare_mask: 0,
@@ -137,23 +133,13 @@ impl GeometryPass<'_> {
     pub fn record_forward(&self, targets: &mut Targets) {
         let (ctx, cmd) = (self.ctx, self.cmd);
         ctx.begin_label(cmd, "forward");
-        transition(
+        begin_hdr_rendering(
             ctx,
             cmd,
-            &mut targets.hdr,
-            ImageAccess::ColorAttachment,
-            Contents::Discard,
+            targets,
+            self.extent,
+            Load::Clear(CLEAR_DEPTH_STENCIL),
         );
-        transition(
-            ctx,
-            cmd,
-            &mut targets.depth_stencil,
-            ImageAccess::DepthStencilAttachment,
-            Contents::Discard,
-        );
-        let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
-        let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Clear(CLEAR_DEPTH_STENCIL));
-        begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
         self.draw_objects(|_| OPAQUE);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);

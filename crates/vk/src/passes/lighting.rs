@@ -9,7 +9,7 @@
 //! labelled no-ops for now: the per-pixel stencil test alone is exact, so images are correct,
 //! and the tile emulation only adds culling statistics.
 
-use super::{begin_rendering, color_attachment, depth_stencil_attachment, Load, CLEAR_BLACK};
+use super::{begin_hdr_rendering, Load};
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::error::{Error, Result};
@@ -238,26 +238,10 @@ impl LightingPass<'_> {
                 Contents::Keep,
             );
         }
-        transition(
-            ctx,
-            cmd,
-            &mut targets.hdr,
-            ImageAccess::ColorAttachment,
-            Contents::Discard,
-        );
-        transition(
-            ctx,
-            cmd,
-            &mut targets.depth_stencil,
-            ImageAccess::DepthStencilAttachment,
-            Contents::Keep,
-        );
         if let Some(t) = timer.as_deref_mut() {
             t.reset(ctx, cmd);
         }
-        let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
-        let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Keep);
-        begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
+        begin_hdr_rendering(ctx, cmd, targets, self.extent, Load::Keep);
         unsafe {
             d.cmd_bind_descriptor_sets(
                 cmd,

@@ -5,8 +5,10 @@ pub mod geometry;
 pub mod lighting;
 pub mod tonemap;
 
+use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::resources::Image;
+use crate::targets::Targets;
 use ash::vk;
 
 /// How a pass treats an attachment at the start of rendering.
@@ -88,4 +90,36 @@ pub(crate) fn begin_rendering(
         ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
         ctx.device.cmd_set_scissor(cmd, 0, &[area]);
     }
+}
+
+/// Begins rendering into the HDR target, cleared to black, with the depth-stencil target loaded
+/// as `depth` says (cleared for the forward pass, kept from the G-buffer pass for lighting).
+pub(crate) fn begin_hdr_rendering(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    targets: &mut Targets,
+    extent: vk::Extent2D,
+    depth: Load,
+) {
+    transition(
+        ctx,
+        cmd,
+        &mut targets.hdr,
+        ImageAccess::ColorAttachment,
+        Contents::Discard,
+    );
+    let depth_contents = match depth {
+        Load::Clear(_) => Contents::Discard,
+        Load::Keep => Contents::Keep,
+    };
+    transition(
+        ctx,
+        cmd,
+        &mut targets.depth_stencil,
+        ImageAccess::DepthStencilAttachment,
+        depth_contents,
+    );
+    let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
+    let ds = depth_stencil_attachment(&targets.depth_stencil, depth);
+    begin_rendering(ctx, cmd, extent, &colors, Some(&ds));
 }
