@@ -1,10 +1,7 @@
 #version 460
 // Places a unit light-volume mesh (circumscribed sphere, or cone along +Z) on a light.
 #include "frame.glsl"
-
-layout(push_constant) uniform LightDraw {
-    uint light_index;
-} light_draw;
+#include "light_draw.glsl"
 
 layout(location = 0) in vec3 in_position;
 

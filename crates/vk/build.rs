@@ -50,9 +50,10 @@ fn generated_glsl() -> String {
         weights.join(", ")
     )
     .unwrap();
-    for (name, value) in LIGHT_KINDS {
+    for (name, value) in LIGHT_KINDS.into_iter().chain(LIGHT_DRAW_FLAGS) {
         writeln!(s, "#define {name} {value}u").unwrap();
     }
+    writeln!(s, "#define HI_STENCIL_TILE {HI_STENCIL_TILE}u").unwrap();
     s + "#endif\n"
 }
 

@@ -2,7 +2,7 @@
 //! bits hold exactly what the G-buffer pass wrote for the surface there, and the engine's
 //! preserved pattern survives on the PS3-like and native backends. The 360-like backend zeroes
 //! preserved bits where lights draw (the talk's price for its missing read mask) and never
-//! changes them otherwise.
+//! changes them otherwise; with save / restore they survive there too.
 
 use histencil_tests::with_validated_context;
 use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
@@ -41,6 +41,17 @@ fn culling_bit_clear_brdf_bits_intact_and_preserved_bits_as_the_backend_says() {
             Technique::Stencil {
                 backend: Backend::X360 {
                     zero_preserved: true,
+                    save_restore: false,
+                },
+                flush,
+            },
+        ),
+        (
+            "stencil-x360-save-restore",
+            Technique::Stencil {
+                backend: Backend::X360 {
+                    zero_preserved: true,
+                    save_restore: true,
                 },
                 flush,
             },

@@ -75,7 +75,8 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "deferred")]
     technique: TechniqueArg,
     /// Platform behaviour of the stencil plan: x360 (no hi-stencil read mask, zeroes preserved
-    /// bits), x360-no-zeroing (shows the talk's failure), ps3 (read mask), native (no hi-stencil).
+    /// bits), x360-no-zeroing (shows the talk's failure), x360-save-restore (zeroes, then writes
+    /// the bits back after lighting), ps3 (read mask), native (no hi-stencil).
     #[arg(long, value_enum, default_value = "native")]
     backend: BackendArg,
     /// When hi-stencil is flushed.
@@ -122,6 +123,7 @@ enum TechniqueArg {
 enum BackendArg {
     X360,
     X360NoZeroing,
+    X360SaveRestore,
     Ps3,
     Native,
 }
@@ -138,9 +140,15 @@ impl RenderArgs {
         let backend = match self.backend {
             BackendArg::X360 => Backend::X360 {
                 zero_preserved: true,
+                save_restore: false,
             },
             BackendArg::X360NoZeroing => Backend::X360 {
                 zero_preserved: false,
+                save_restore: false,
+            },
+            BackendArg::X360SaveRestore => Backend::X360 {
+                zero_preserved: true,
+                save_restore: true,
             },
             BackendArg::Ps3 => Backend::Ps3,
             BackendArg::Native => Backend::Native,

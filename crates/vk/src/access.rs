@@ -89,6 +89,22 @@ pub(crate) fn transition(
     image.last_access = next;
 }
 
+/// A global memory barrier: every write recorded before is visible to every access after.
+///
+/// The hi-stencil emulation and split light passes hand buffers and attachments between
+/// fragment shaders, attachments, copies and compute many times a frame; one broad barrier
+/// between those phases is simpler to get right than a precise one per hand-over, and costs the
+/// same on a driver that serialises them anyway.
+pub(crate) fn memory_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+        .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+        .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
+    let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

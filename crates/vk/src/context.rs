@@ -178,7 +178,11 @@ impl Context {
         let queue_infos = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let features = vk::PhysicalDeviceFeatures::default().depth_clamp(true);
+        // Fragment stores and atomics: the hi-stencil emulation marks and counts tiles from fragment
+        // shaders (every desktop driver and lavapipe have it).
+        let features = vk::PhysicalDeviceFeatures::default()
+            .depth_clamp(true)
+            .fragment_stores_and_atomics(true);
         let mut features13 = vk::PhysicalDeviceVulkan13Features::default()
             .dynamic_rendering(true)
             .synchronization2(true);

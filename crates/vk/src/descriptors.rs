@@ -50,6 +50,20 @@ pub const GBUFFER_SET: &[BindingDesc] = &[
     binding(1, BindingKind::SampledImage, "gbuffer_normal_depth"),
     binding(2, BindingKind::SampledImage, "gbuffer_material"),
 ];
+/// Set 2 of the light pipelines: the hi-stencil emulation (include/hi_stencil.glsl).
+pub const HI_STENCIL_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, "hi_stats"),
+    binding(3, BindingKind::StorageBuffer, ""),
+];
+/// The tile update's stencil copy (read), covered stamps (read) and pending surface (written);
+/// see `hi_stencil.rs`.
+pub const HI_STENCIL_UPDATE_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, ""),
+];
 /// Set 1 of the tonemap pipeline (tonemap.frag).
 pub const TONEMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "hdr")];
 /// The BRDF evaluator's cases (read) and results (written); see `brdf_eval.rs`.
@@ -60,9 +74,10 @@ pub const BRDF_EVAL_SET: &[BindingDesc] = &[
 
 /// The pipeline layouts: which sets, in order.
 pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET];
-pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET];
+pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET];
 pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
 pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
+pub const HI_STENCIL_UPDATE_LAYOUT: &[&[BindingDesc]] = &[HI_STENCIL_UPDATE_SET];
 
 /// Every shader module and the pipeline layout it is used with.
 pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
@@ -71,6 +86,10 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("forward.frag", MESH_LAYOUT),
     ("light_volume.vert", LIGHTING_LAYOUT),
     ("deferred_light.frag", LIGHTING_LAYOUT),
+    ("hi_stencil_touch.frag", LIGHTING_LAYOUT),
+    ("hi_stencil_count.frag", LIGHTING_LAYOUT),
+    ("restore_preserved.frag", LIGHTING_LAYOUT),
+    ("hi_stencil_update.comp", HI_STENCIL_UPDATE_LAYOUT),
     ("fullscreen.vert", LIGHTING_LAYOUT),
     ("tonemap.frag", TONEMAP_LAYOUT),
     ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
@@ -109,6 +128,7 @@ pub(crate) fn create_set_layout(
 pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
     pub gbuffer_layout: vk::DescriptorSetLayout,
+    pub hi_stencil_layout: vk::DescriptorSetLayout,
     pub tonemap_layout: vk::DescriptorSetLayout,
     pub mesh_pipeline_layout: vk::PipelineLayout,
     pub lighting_pipeline_layout: vk::PipelineLayout,
@@ -116,6 +136,7 @@ pub struct Descriptors {
     pool: vk::DescriptorPool,
     pub frame_set: vk::DescriptorSet,
     pub gbuffer_set: vk::DescriptorSet,
+    pub hi_stencil_set: vk::DescriptorSet,
     pub tonemap_set: vk::DescriptorSet,
 }
 
@@ -144,6 +165,8 @@ pub struct DescriptorTargets {
     pub frame_uniforms: vk::Buffer,
     pub lights: vk::Buffer,
     pub gbuffer_views: [vk::ImageView; 3],
+    /// Bindings 0..=3 of [`HI_STENCIL_SET`], in order.
+    pub hi_stencil: [vk::Buffer; 4],
     pub hdr_view: vk::ImageView,
 }
 
@@ -152,13 +175,16 @@ impl Descriptors {
         let set_layout = |name, set| create_set_layout(ctx, name, set, GRAPHICS_STAGES);
         let frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
         let gbuffer_layout = set_layout("gbuffer-set-layout", GBUFFER_SET)?;
+        let hi_stencil_layout = set_layout("hi-stencil-set-layout", HI_STENCIL_SET)?;
         let tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
         let pipeline_layout = |name, sets: &[vk::DescriptorSetLayout]| {
             create_pipeline_layout(ctx, name, sets, GRAPHICS_STAGES, PUSH_CONSTANT_BYTES)
         };
         let mesh_pipeline_layout = pipeline_layout("mesh-pipeline-layout", &[frame_layout])?;
-        let lighting_pipeline_layout =
-            pipeline_layout("lighting-pipeline-layout", &[frame_layout, gbuffer_layout])?;
+        let lighting_pipeline_layout = pipeline_layout(
+            "lighting-pipeline-layout",
+            &[frame_layout, gbuffer_layout, hi_stencil_layout],
+        )?;
         let tonemap_pipeline_layout =
             pipeline_layout("tonemap-pipeline-layout", &[frame_layout, tonemap_layout])?;
 
@@ -168,29 +194,36 @@ impl Descriptors {
                 .descriptor_count(1),
             vk::DescriptorPoolSize::default()
                 .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1),
+                .descriptor_count(1 + HI_STENCIL_SET.len() as u32),
             vk::DescriptorPoolSize::default()
                 .ty(vk::DescriptorType::SAMPLED_IMAGE)
                 .descriptor_count(4),
         ];
         let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(3)
+            .max_sets(4)
             .pool_sizes(&sizes);
         let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
             .call("vkCreateDescriptorPool")?;
         ctx.name(pool, "frame-descriptor-pool");
-        let layouts = [frame_layout, gbuffer_layout, tonemap_layout];
+        let layouts = [
+            frame_layout,
+            gbuffer_layout,
+            hi_stencil_layout,
+            tonemap_layout,
+        ];
         let alloc = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(pool)
             .set_layouts(&layouts);
         let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .call("vkAllocateDescriptorSets")?;
-        for (set, name) in sets.iter().zip(["frame-set", "gbuffer-set", "tonemap-set"]) {
+        let names = ["frame-set", "gbuffer-set", "hi-stencil-set", "tonemap-set"];
+        for (set, name) in sets.iter().zip(names) {
             ctx.name(*set, name);
         }
         let d = Self {
             frame_layout,
             gbuffer_layout,
+            hi_stencil_layout,
             tonemap_layout,
             mesh_pipeline_layout,
             lighting_pipeline_layout,
@@ -198,7 +231,8 @@ impl Descriptors {
             pool,
             frame_set: sets[0],
             gbuffer_set: sets[1],
-            tonemap_set: sets[2],
+            hi_stencil_set: sets[2],
+            tonemap_set: sets[3],
         };
         d.write(ctx, targets);
         Ok(d)
@@ -216,6 +250,15 @@ impl Descriptors {
                 .image_view(view)
                 .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
         };
+        let hi_stencil: Vec<_> = t
+            .hi_stencil
+            .iter()
+            .map(|b| {
+                [vk::DescriptorBufferInfo::default()
+                    .buffer(*b)
+                    .range(vk::WHOLE_SIZE)]
+            })
+            .collect();
         let gbuffer: Vec<_> = t.gbuffer_views.iter().map(|v| image(*v)).collect();
         let hdr = image(t.hdr_view);
         let mut writes = vec![
@@ -244,6 +287,15 @@ impl Descriptors {
                     .image_info(info),
             );
         }
+        for (i, info) in hi_stencil.iter().enumerate() {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.hi_stencil_set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .buffer_info(info),
+            );
+        }
         unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
     }
 
@@ -257,7 +309,12 @@ impl Descriptors {
             ] {
                 ctx.device.destroy_pipeline_layout(l, None);
             }
-            for l in [self.frame_layout, self.gbuffer_layout, self.tonemap_layout] {
+            for l in [
+                self.frame_layout,
+                self.gbuffer_layout,
+                self.hi_stencil_layout,
+                self.tonemap_layout,
+            ] {
                 ctx.device.destroy_descriptor_set_layout(l, None);
             }
         }

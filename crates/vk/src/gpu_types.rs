@@ -118,6 +118,19 @@ impl DrawPush {
     }
 }
 
+/// Push constants of the light passes (include/light_draw.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightDrawPush {
+    pub light_index: u32,
+    /// Unique per draw of a frame: the hi-stencil emulation marks covered tiles with it.
+    pub stamp: u32,
+    /// `LIGHT_DRAW_*` bits (`shader_consts::LIGHT_DRAW_FLAGS`).
+    pub flags: u32,
+    /// The stencil bit a restore draw writes.
+    pub bit: u32,
+}
+
 /// Bytes of push-constant space every pipeline layout declares (the largest block, `Draw`).
 pub const PUSH_CONSTANT_BYTES: u32 = std::mem::size_of::<DrawPush>() as u32;
 

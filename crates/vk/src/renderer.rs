@@ -4,10 +4,11 @@ use crate::context::Context;
 use crate::descriptors::{DescriptorTargets, Descriptors};
 use crate::error::{Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::hi_stencil::HiStencilSurface;
 use crate::meshes::Meshes;
 use crate::passes::geometry::GeometryPass;
-use crate::passes::lighting::LightingPass;
-use crate::passes::lighting::{classify, mesh_bound, prepare_pipelines, LightPipelines};
+use crate::passes::light_pipelines::{prepare_pipelines, LightPipelines};
+use crate::passes::lighting::{classify, mesh_bound, LightingPass};
 use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::{FrameImages, Readback, ReadbackBuffers};
@@ -18,7 +19,7 @@ use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
     FlushPolicy, FramePlan, LightRequest, LightTechnique, Native, PlatformBackend, Ps3Like,
-    StencilLayout, X360Like,
+    StencilLayout, TileStats, X360Like,
 };
 use histencil_scene::Scene;
 
@@ -27,7 +28,11 @@ use histencil_scene::Scene;
 pub enum Backend {
     /// 360-like: hi-stencil without a read mask. `zero_preserved` zeroes the engine's preserved
     /// bits as lights draw (the talk's fix); without it, hi-stencil fails on preserved bits.
-    X360 { zero_preserved: bool },
+    /// `save_restore` (with zeroing) copies them aside before lighting and writes them back after.
+    X360 {
+        zero_preserved: bool,
+        save_restore: bool,
+    },
     /// PS3-like: hi-stencil with a read mask; preserved bits survive.
     Ps3,
     /// Plain Vulkan: no hi-stencil.
@@ -37,9 +42,12 @@ pub enum Backend {
 impl Backend {
     pub fn platform(self) -> Box<dyn PlatformBackend> {
         match self {
-            Backend::X360 { zero_preserved } => Box::new(X360Like {
+            Backend::X360 {
                 zero_preserved,
-                save_restore: false,
+                save_restore,
+            } => Box::new(X360Like {
+                zero_preserved,
+                save_restore,
             }),
             Backend::Ps3 => Box::new(Ps3Like),
             Backend::Native => Box::new(Native),
@@ -93,10 +101,12 @@ fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
         .expect("brdfs_in_use lists every object's BRDF") as u32
 }
 
-/// A rendered frame: its GPU timings and the images asked for.
+/// A rendered frame: its GPU timings, the images asked for, and the hi-stencil statistics when
+/// [`Renderer::set_tile_stats`] is on (deferred techniques only).
 pub struct Frame {
     pub timings: FrameTimings,
     pub images: FrameImages,
+    pub tile_stats: Option<TileStats>,
 }
 
 /// A scene ready to render at one resolution.
@@ -114,6 +124,9 @@ pub struct Renderer<'c> {
     /// Per-step lighting timestamps, when asked for.
     pass_timing: bool,
     step_timer: Option<StepTimer>,
+    /// Count hi-stencil tile and fragment statistics, when asked for.
+    tile_stats: bool,
+    hi_stencil: HiStencilSurface,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -143,6 +156,7 @@ impl<'c> Renderer<'c> {
 
         let targets = Targets::new(ctx, extent)?;
         let meshes = Meshes::new(ctx)?;
+        let hi_stencil = HiStencilSurface::new(ctx, extent)?;
         let uniforms = FrameUniforms::new(&scene.camera, width, height, scene.lights.len() as u32);
         let frame_uniforms = Buffer::with_data(
             ctx,
@@ -167,6 +181,7 @@ impl<'c> Renderer<'c> {
                     targets.gbuffer[1].view,
                     targets.gbuffer[2].view,
                 ],
+                hi_stencil: hi_stencil.light_set_buffers(),
                 hdr_view: targets.hdr.view,
             },
         )?;
@@ -220,6 +235,8 @@ impl<'c> Renderer<'c> {
             light_pipelines,
             pass_timing: false,
             step_timer: None,
+            tile_stats: false,
+            hi_stencil,
             extent,
             targets,
             meshes,
@@ -269,6 +286,13 @@ impl<'c> Renderer<'c> {
     /// ([`FrameTimings::lighting`]). Off by default: timestamps between draws can serialise them.
     pub fn set_pass_timing(&mut self, on: bool) {
         self.pass_timing = on;
+    }
+
+    /// With `on`, deferred frames count hi-stencil statistics ([`Frame::tile_stats`]): tiles
+    /// tested and culled, fragments shaded, flushes. Off by default: counting adds a draw per
+    /// hi-stencil test and an atomic per shaded fragment.
+    pub fn set_tile_stats(&mut self, on: bool) {
+        self.tile_stats = on;
     }
 
     /// Light pipelines created so far.
@@ -322,7 +346,14 @@ impl<'c> Renderer<'c> {
         };
         let ctx = self.ctx;
         let (plan, light_indices) = self.plan(technique)?;
-        prepare_pipelines(ctx, &mut self.light_pipelines, &plan, &self.brdfs)?;
+        let count_stats = self.tile_stats && technique != Technique::Forward;
+        prepare_pipelines(
+            ctx,
+            &mut self.light_pipelines,
+            &plan,
+            &self.brdfs,
+            count_stats,
+        )?;
         let time_steps = self.pass_timing && technique != Technique::Forward;
         if time_steps {
             let needed = plan.steps.len() as u32 + 1;
@@ -385,11 +416,17 @@ impl<'c> Renderer<'c> {
                     meshes: &self.meshes,
                     pipelines: &self.light_pipelines,
                     pipeline_layout: self.descriptors.lighting_pipeline_layout,
-                    sets: [self.descriptors.frame_set, self.descriptors.gbuffer_set],
+                    sets: [
+                        self.descriptors.frame_set,
+                        self.descriptors.gbuffer_set,
+                        self.descriptors.hi_stencil_set,
+                    ],
                     extent: self.extent,
+                    count_stats,
                 }
                 .record(
                     &mut self.targets,
+                    &mut self.hi_stencil,
                     self.step_timer.as_mut().filter(|_| time_steps),
                 )?;
                 self.timestamps.mark(ctx, cmd, "lighting");
@@ -427,7 +464,15 @@ impl<'c> Renderer<'c> {
             timings.lighting = Some(timer.read(ctx)?);
         }
         let images = self.readback.read(readback)?;
-        Ok(Frame { timings, images })
+        let tile_stats = count_stats.then(|| TileStats {
+            flushes: plan.flushes() as u64,
+            ..self.hi_stencil.read_stats()
+        });
+        Ok(Frame {
+            timings,
+            images,
+            tile_stats,
+        })
     }
 
     /// Renders `frames` frames without readback and returns the median of each timing.
@@ -456,6 +501,7 @@ impl Drop for Renderer<'_> {
         self.pipelines.destroy(ctx);
         self.light_pipelines.destroy(ctx);
         self.descriptors.destroy(ctx);
+        self.hi_stencil.destroy(ctx);
         self.lights.destroy(ctx);
         self.frame_uniforms.destroy(ctx);
         self.meshes.destroy(ctx);

@@ -7,3 +7,20 @@ pub const LIGHT_KINDS: [(&str, u32); 3] = [
     ("LIGHT_SPOT", 1),
     ("LIGHT_DIRECTIONAL", 2),
 ];
+
+/// Side of a hi-stencil tile in pixels (GLSL `HI_STENCIL_TILE`): one flag of the emulated coarse
+/// surface covers this many pixels squared, like the 8x8 granularity of console hi-stencil.
+pub const HI_STENCIL_TILE: u32 = 8;
+
+/// `LightDraw.flags` bit: reject fragments in tiles the active hi-stencil surface marks failing.
+pub const LIGHT_DRAW_HI_STENCIL_TEST: u32 = 1;
+/// `LightDraw.flags` bit: count shaded fragments into the tile statistics.
+pub const LIGHT_DRAW_COUNT: u32 = 2;
+
+/// GLSL `LIGHT_DRAW_*` bits of `LightDraw.flags` (include/light_draw.glsl). Read by build.rs;
+/// the library uses the constants above.
+#[allow(dead_code)]
+pub const LIGHT_DRAW_FLAGS: [(&str, u32); 2] = [
+    ("LIGHT_DRAW_HI_STENCIL_TEST", LIGHT_DRAW_HI_STENCIL_TEST),
+    ("LIGHT_DRAW_COUNT", LIGHT_DRAW_COUNT),
+];

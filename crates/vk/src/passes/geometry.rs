@@ -138,6 +138,7 @@ impl GeometryPass<'_> {
             cmd,
             targets,
             self.extent,
+            Load::Clear(CLEAR_BLACK),
             Load::Clear(CLEAR_DEPTH_STENCIL),
         );
         self.draw_objects(|_| OPAQUE);

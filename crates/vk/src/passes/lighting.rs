@@ -5,25 +5,29 @@
 //! This module only decides how each light is classified and which BRDFs it touches, and records
 //! the plan; the stencil logic lives in the model, where the CPU simulator checks it.
 //!
-//! Hi-stencil steps (the tile surface written by mask passes and its flushes) are recorded as
-//! labelled no-ops for now: the per-pixel stencil test alone is exact, so images are correct,
-//! and the tile emulation only adds culling statistics.
+//! On backends with hi-stencil, the plan's hi-stencil writes, tests and flushes run on the GPU
+//! tile surface of [`crate::hi_stencil`], so its failures (stale tiles without a flush, preserved
+//! bits on 360-like hardware without zeroing) show in the image as they would on the console.
 
-use super::{begin_hdr_rendering, Load};
-use crate::access::{transition, Contents, ImageAccess};
+use super::light_pipelines::{pipeline_key, LightPipelineKey, LightPipelines, LightShader};
+use super::{begin_hdr_rendering, Load, CLEAR_BLACK};
+use crate::access::{memory_barrier, transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::error::{Error, Result};
+use crate::gpu_types::LightDrawPush;
+use crate::hi_stencil::HiStencilSurface;
 use crate::meshes::Meshes;
-use crate::pipelines::{create_pipeline, PipelineDesc, VertexInput};
-use crate::shaders;
-use crate::state::apply;
+use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
+use crate::state::{apply, FULLSCREEN};
 use crate::targets::Targets;
 use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
-use histencil_model::{FramePlan, Geometry, LightCase, PassKind, Shader, Step};
+use histencil_model::{
+    CompareOp, DepthState, FaceStencil, FramePlan, Geometry, LightCase, Pass, PassKind, PassState,
+    Shader, StencilOp, Step,
+};
 use histencil_scene::{Camera, Light, LightKind};
-use std::collections::HashMap;
 
 /// The radius of a sphere containing `light`'s volume mesh, as a multiple of its range.
 pub fn mesh_bound(light: &Light, meshes: &Meshes) -> f32 {
@@ -55,126 +59,6 @@ pub fn classify(light: &Light, mesh_bound: f32, camera: &Camera, aspect: f32) ->
     }
 }
 
-/// The shader of a light pipeline: none (stencil and hi-stencil only), one BRDF, or the
-/// branching uber shader.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum LightShader {
-    None,
-    Brdf(BrdfId),
-    Branching,
-}
-
-/// Light pipelines, created the first time a plan needs them: a scene pays only for the BRDFs it
-/// uses, and a technique only for its own shaders.
-pub struct LightPipelines {
-    layout: vk::PipelineLayout,
-    hdr_format: vk::Format,
-    depth_stencil_format: vk::Format,
-    pipelines: HashMap<(Geometry, LightShader), vk::Pipeline>,
-}
-
-/// `SHADED_BRDF` of `deferred_light.frag` for the branching shader.
-const BRANCH_ON_GBUFFER: u32 = u32::MAX;
-
-impl LightPipelines {
-    pub fn new(
-        layout: vk::PipelineLayout,
-        hdr_format: vk::Format,
-        depth_stencil_format: vk::Format,
-    ) -> Self {
-        Self {
-            layout,
-            hdr_format,
-            depth_stencil_format,
-            pipelines: HashMap::new(),
-        }
-    }
-
-    /// Creates the pipeline for `key` unless it exists.
-    pub fn prepare(&mut self, ctx: &Context, key: (Geometry, LightShader)) -> Result<()> {
-        if self.pipelines.contains_key(&key) {
-            return Ok(());
-        }
-        let (geometry, shader) = key;
-        let (vertex, vertex_input) = match geometry {
-            Geometry::Volume => (
-                ("light_volume.vert", shaders::LIGHT_VOLUME_VERT),
-                VertexInput::Position,
-            ),
-            Geometry::FullScreen => (
-                ("fullscreen.vert", shaders::FULLSCREEN_VERT),
-                VertexInput::None,
-            ),
-        };
-        let specialization = match shader {
-            LightShader::None => None,
-            LightShader::Brdf(id) => Some(id.index()),
-            LightShader::Branching => Some(BRANCH_ON_GBUFFER),
-        };
-        let shader_name = match shader {
-            LightShader::None => "stencil".to_owned(),
-            LightShader::Brdf(id) => id.name().to_owned(),
-            LightShader::Branching => "branching".to_owned(),
-        };
-        let geometry_name = match geometry {
-            Geometry::Volume => "volume",
-            Geometry::FullScreen => "fullscreen",
-        };
-        let hdr = [self.hdr_format];
-        let pipeline = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: &format!("light-{geometry_name}-{shader_name}-pipeline"),
-                vertex,
-                fragment: specialization
-                    .map(|_| ("deferred_light.frag", shaders::DEFERRED_LIGHT_FRAG)),
-                layout: self.layout,
-                vertex_input,
-                color_formats: &hdr,
-                color_writes: shader != LightShader::None,
-                additive_blend: shader != LightShader::None,
-                depth_stencil_format: self.depth_stencil_format,
-                // Back faces beyond the far plane clamp to depth 1, behind every surface.
-                depth_clamp: geometry == Geometry::Volume,
-                specialization,
-            },
-        )?;
-        self.pipelines.insert(key, pipeline);
-        Ok(())
-    }
-
-    fn get(&self, key: (Geometry, LightShader)) -> vk::Pipeline {
-        self.pipelines[&key]
-    }
-
-    /// How many pipelines exist: what the scene and the techniques used so far cost.
-    pub fn count(&self) -> usize {
-        self.pipelines.len()
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        for (_, p) in self.pipelines.drain() {
-            unsafe { ctx.device.destroy_pipeline(p, None) };
-        }
-    }
-}
-
-/// The pipeline key of a planned pass. `brdfs` maps stencil slots to BRDFs.
-pub fn pipeline_key(
-    kind: PassKind,
-    geometry: Geometry,
-    brdfs: &[BrdfId],
-) -> (Geometry, LightShader) {
-    let shader = match kind {
-        PassKind::Shade(Shader::Brdf(slot)) => LightShader::Brdf(brdfs[slot as usize]),
-        PassKind::Shade(Shader::Branching) => LightShader::Branching,
-        PassKind::ZeroPreserved | PassKind::Setup | PassKind::Mask(_) | PassKind::Cleanup => {
-            LightShader::None
-        }
-    };
-    (geometry, shader)
-}
-
 /// The talk's pass group of a planned pass, for timings: `setup`, `mask-<brdf>`, `shade-<brdf>`
 /// (`-branching` for the uber shader), `cleanup`, `zero-preserved`.
 pub fn pass_group(kind: PassKind, brdfs: &[BrdfId]) -> String {
@@ -191,19 +75,6 @@ pub fn pass_group(kind: PassKind, brdfs: &[BrdfId]) -> String {
     }
 }
 
-/// Creates every pipeline `plan` uses.
-pub fn prepare_pipelines(
-    ctx: &Context,
-    pipelines: &mut LightPipelines,
-    plan: &FramePlan,
-    brdfs: &[BrdfId],
-) -> Result<()> {
-    for pass in plan.passes() {
-        pipelines.prepare(ctx, pipeline_key(pass.kind, pass.geometry, brdfs))?;
-    }
-    Ok(())
-}
-
 pub struct LightingPass<'a> {
     pub ctx: &'a Context,
     pub cmd: vk::CommandBuffer,
@@ -215,8 +86,54 @@ pub struct LightingPass<'a> {
     pub meshes: &'a Meshes,
     pub pipelines: &'a LightPipelines,
     pub pipeline_layout: vk::PipelineLayout,
-    pub sets: [vk::DescriptorSet; 2],
+    /// Frame, G-buffer and hi-stencil sets.
+    pub sets: [vk::DescriptorSet; 3],
     pub extent: vk::Extent2D,
+    /// Count tile and fragment statistics (extra draws and atomics).
+    pub count_stats: bool,
+}
+
+/// Whether the HDR and depth-stencil attachments are bound. Hi-stencil writes, flushes and the
+/// preserved-bit copy happen outside rendering, so the lighting pass is split around them.
+struct Rendering {
+    open: bool,
+    /// The HDR target was cleared by the first opening.
+    cleared: bool,
+}
+
+impl Rendering {
+    fn open(&mut self, pass: &LightingPass, targets: &mut Targets) {
+        if self.open {
+            return;
+        }
+        let hdr = if self.cleared {
+            Load::Keep
+        } else {
+            Load::Clear(CLEAR_BLACK)
+        };
+        begin_hdr_rendering(pass.ctx, pass.cmd, targets, pass.extent, hdr, Load::Keep);
+        self.open = true;
+        self.cleared = true;
+    }
+
+    fn close(&mut self, pass: &LightingPass) {
+        if self.open {
+            unsafe { pass.ctx.device.cmd_end_rendering(pass.cmd) };
+            self.open = false;
+        }
+    }
+
+    /// Ends rendering and makes every write so far visible: draws that share the statistics
+    /// buffer cannot be ordered inside one dynamic rendering instance.
+    fn split(&mut self, pass: &LightingPass) {
+        self.close(pass);
+        memory_barrier(pass.ctx, pass.cmd);
+    }
+}
+
+/// A stamp per draw that is unique in the frame and never 0 (the cleared `touched` value).
+fn stamp(step: usize, count_draw: bool) -> u32 {
+    2 * step as u32 + 1 + u32::from(count_draw)
 }
 
 impl LightingPass<'_> {
@@ -224,6 +141,7 @@ impl LightingPass<'_> {
     pub(crate) fn record(
         &self,
         targets: &mut Targets,
+        hi_stencil: &mut HiStencilSurface,
         mut timer: Option<&mut StepTimer>,
     ) -> Result<()> {
         let (ctx, cmd) = (self.ctx, self.cmd);
@@ -241,7 +159,7 @@ impl LightingPass<'_> {
         if let Some(t) = timer.as_deref_mut() {
             t.reset(ctx, cmd);
         }
-        begin_hdr_rendering(ctx, cmd, targets, self.extent, Load::Keep);
+        hi_stencil.record_reset(ctx, cmd);
         unsafe {
             d.cmd_bind_descriptor_sets(
                 cmd,
@@ -252,11 +170,16 @@ impl LightingPass<'_> {
                 &[],
             );
         }
+        let mut rendering = Rendering {
+            open: false,
+            cleared: false,
+        };
+        rendering.open(self, targets);
         if let Some(t) = timer.as_deref_mut() {
             t.start(ctx, cmd);
         }
         let mut current_light = None;
-        for step in &self.plan.steps {
+        for (index, step) in self.plan.steps.iter().enumerate() {
             match step {
                 Step::Pass { light, pass } => {
                     if current_light != Some(*light) {
@@ -264,67 +187,201 @@ impl LightingPass<'_> {
                             ctx.end_label(cmd);
                         }
                         current_light = Some(*light);
-                        self.begin_light(*light);
+                        ctx.begin_label(cmd, &format!("light-{}", self.light_indices[*light]));
                     }
-                    let scene_light = self.light_indices[*light] as usize;
+                    let scene_light = self.light_indices[*light];
                     ctx.begin_label(cmd, &pass.label());
-                    let key = pipeline_key(pass.kind, pass.geometry, self.brdfs);
-                    unsafe {
-                        d.cmd_bind_pipeline(
-                            cmd,
-                            vk::PipelineBindPoint::GRAPHICS,
-                            self.pipelines.get(key),
-                        )
-                    };
-                    apply(ctx, cmd, &pass.state);
-                    match pass.geometry {
-                        Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
-                        Geometry::Volume => match self.lights[scene_light].kind {
-                            LightKind::Spot { .. } => self.meshes.light_cone.draw(ctx, cmd),
-                            _ => self.meshes.light_sphere.draw(ctx, cmd),
-                        },
-                    }
+                    self.record_pass(
+                        targets,
+                        hi_stencil,
+                        &mut rendering,
+                        index,
+                        pass,
+                        scene_light,
+                    )?;
                     ctx.end_label(cmd);
                     if let Some(t) = timer.as_deref_mut() {
                         let group = pass_group(pass.kind, self.brdfs);
-                        t.mark(ctx, cmd, group, Some(scene_light as u32));
+                        t.mark(ctx, cmd, group, Some(scene_light));
                     }
                 }
                 Step::FlushHiStencil => {
                     ctx.begin_label(cmd, "flush-hi-stencil");
+                    rendering.close(self);
+                    hi_stencil.record_flush(ctx, cmd);
                     ctx.end_label(cmd);
                     if let Some(t) = timer.as_deref_mut() {
                         t.mark(ctx, cmd, "flush".into(), None);
                     }
                 }
-                Step::SavePreserved { .. } | Step::RestorePreserved { .. } => {
-                    return Err(Error::Unsupported(
-                        "saving and restoring preserved stencil bits on the GPU",
-                    ));
+                Step::SavePreserved { .. } => {
+                    ctx.begin_label(cmd, "save-preserved");
+                    rendering.close(self);
+                    hi_stencil.record_save(ctx, cmd, &mut targets.depth_stencil);
+                    ctx.end_label(cmd);
+                    if let Some(t) = timer.as_deref_mut() {
+                        t.mark(ctx, cmd, "save-preserved".into(), None);
+                    }
+                }
+                Step::RestorePreserved { mask } => {
+                    if current_light.take().is_some() {
+                        ctx.end_label(cmd);
+                    }
+                    ctx.begin_label(cmd, "restore-preserved");
+                    rendering.open(self, targets);
+                    self.record_restore(*mask);
+                    ctx.end_label(cmd);
+                    if let Some(t) = timer.as_deref_mut() {
+                        t.mark(ctx, cmd, "restore-preserved".into(), None);
+                    }
                 }
             }
         }
         if current_light.is_some() {
             ctx.end_label(cmd);
         }
-        unsafe { d.cmd_end_rendering(cmd) };
+        rendering.close(self);
+        if self.count_stats {
+            hi_stencil.record_stats_readable(ctx, cmd);
+        }
         ctx.end_label(cmd);
         Ok(())
     }
 
-    /// Opens the label of planned light `light` and pushes its scene index.
-    fn begin_light(&self, light: usize) {
+    /// One planned pass: the statistics draw of a hi-stencil test, the pass's own draw, and the
+    /// tile update of a hi-stencil write.
+    fn record_pass(
+        &self,
+        targets: &mut Targets,
+        hi_stencil: &mut HiStencilSurface,
+        rendering: &mut Rendering,
+        step: usize,
+        pass: &Pass,
+        scene_light: u32,
+    ) -> Result<()> {
+        let state = &pass.state;
+        if state.tests_hi_stencil() && state.writes_stencil() {
+            // The light shader rejects tiles after early depth / stencil tests, which would
+            // already have written stencil: the emulation would diverge from the model.
+            return Err(Error::Unsupported(
+                "a hi-stencil test in a pass that writes stencil",
+            ));
+        }
+        let shades = matches!(pass.kind, PassKind::Shade(_));
+        let mut flags = 0;
+        if state.tests_hi_stencil() {
+            flags |= LIGHT_DRAW_HI_STENCIL_TEST;
+            if self.count_stats {
+                rendering.split(self);
+                rendering.open(self, targets);
+                let count = PassState {
+                    depth: DepthState::OFF,
+                    front: None,
+                    back: None,
+                    color_write: false,
+                    hi_stencil: None,
+                    ..*state
+                };
+                let key = (pass.geometry, LightShader::CountTiles);
+                let push = LightDrawPush {
+                    light_index: scene_light,
+                    stamp: stamp(step, true),
+                    ..Default::default()
+                };
+                self.draw(key, &count, pass.geometry, push);
+            }
+        }
+        if shades && self.count_stats {
+            flags |= LIGHT_DRAW_COUNT;
+            rendering.split(self);
+        }
+        rendering.open(self, targets);
+        let push = LightDrawPush {
+            light_index: scene_light,
+            stamp: stamp(step, false),
+            flags,
+            bit: 0,
+        };
+        self.draw(pipeline_key(pass, self.brdfs), state, pass.geometry, push);
+        if let Some(hi) = state.hi_stencil.filter(|h| h.write) {
+            rendering.close(self);
+            memory_barrier(self.ctx, self.cmd);
+            hi_stencil.record_update(
+                self.ctx,
+                self.cmd,
+                &mut targets.depth_stencil,
+                &hi,
+                push.stamp,
+            );
+        }
+        Ok(())
+    }
+
+    /// Writes the saved preserved bits of `mask` back: one pass zeroes them, then one pass per
+    /// bit sets it where the saved copy had it (stencil references are per draw, not per pixel).
+    fn record_restore(&self, mask: u8) {
+        let write = |write_mask: u8, reference: u8| FaceStencil {
+            compare: CompareOp::Always,
+            compare_mask: 0,
+            write_mask,
+            reference,
+            pass: StencilOp::Replace,
+            fail: StencilOp::Keep,
+            depth_fail: StencilOp::Keep,
+        };
+        let state = |face: FaceStencil| PassState {
+            front: Some(face),
+            back: Some(face),
+            color_write: false,
+            ..FULLSCREEN
+        };
+        let zero = (Geometry::FullScreen, LightShader::StencilOnly);
+        self.draw(
+            zero,
+            &state(write(mask, 0)),
+            Geometry::FullScreen,
+            LightDrawPush::default(),
+        );
+        for bit in (0..8).map(|b| 1u8 << b).filter(|b| mask & b != 0) {
+            let push = LightDrawPush {
+                bit: u32::from(bit),
+                ..Default::default()
+            };
+            let key = (Geometry::FullScreen, LightShader::RestoreBit);
+            self.draw(key, &state(write(bit, bit)), Geometry::FullScreen, push);
+        }
+    }
+
+    fn draw(
+        &self,
+        key: LightPipelineKey,
+        state: &PassState,
+        geometry: Geometry,
+        push: LightDrawPush,
+    ) {
         let (ctx, cmd) = (self.ctx, self.cmd);
-        let index = self.light_indices[light];
-        ctx.begin_label(cmd, &format!("light-{index}"));
+        let d = &ctx.device;
         unsafe {
-            ctx.device.cmd_push_constants(
+            d.cmd_bind_pipeline(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipelines.get(key),
+            );
+            d.cmd_push_constants(
                 cmd,
                 self.pipeline_layout,
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                 0,
-                &index.to_ne_bytes(),
+                bytemuck::bytes_of(&push),
             );
+        }
+        apply(ctx, cmd, state);
+        match geometry {
+            Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
+            Geometry::Volume => match self.lights[push.light_index as usize].kind {
+                LightKind::Spot { .. } => self.meshes.light_cone.draw(ctx, cmd),
+                _ => self.meshes.light_sphere.draw(ctx, cmd),
+            },
         }
     }
 }
@@ -361,22 +418,5 @@ mod tests {
             direction: Vec3::NEG_Y,
         };
         assert_eq!(classify(&light, bound, &camera, 1.0), LightCase::FullScreen);
-    }
-
-    #[test]
-    fn passes_map_to_the_shaders_of_their_brdfs() {
-        let brdfs = [BrdfId::Lambert, BrdfId::Ggx];
-        assert_eq!(
-            pipeline_key(PassKind::Shade(Shader::Brdf(1)), Geometry::Volume, &brdfs),
-            (Geometry::Volume, LightShader::Brdf(BrdfId::Ggx))
-        );
-        assert_eq!(
-            pipeline_key(
-                PassKind::Mask(Shader::Brdf(1)),
-                Geometry::FullScreen,
-                &brdfs
-            ),
-            (Geometry::FullScreen, LightShader::None)
-        );
     }
 }

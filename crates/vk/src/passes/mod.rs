@@ -2,6 +2,7 @@
 //! buffer inside its own debug label.
 
 pub mod geometry;
+pub mod light_pipelines;
 pub mod lighting;
 pub mod tonemap;
 
@@ -92,26 +93,29 @@ pub(crate) fn begin_rendering(
     }
 }
 
-/// Begins rendering into the HDR target, cleared to black, with the depth-stencil target loaded
-/// as `depth` says (cleared for the forward pass, kept from the G-buffer pass for lighting).
+/// Begins rendering into the HDR target and the depth-stencil target, each cleared or kept as
+/// `hdr` and `depth` say (the forward pass clears both; lighting keeps the G-buffer's depth and
+/// clears HDR once, keeping both when a split pass resumes).
 pub(crate) fn begin_hdr_rendering(
     ctx: &Context,
     cmd: vk::CommandBuffer,
     targets: &mut Targets,
     extent: vk::Extent2D,
+    hdr: Load,
     depth: Load,
 ) {
+    let contents = |load| match load {
+        Load::Clear(_) => Contents::Discard,
+        Load::Keep => Contents::Keep,
+    };
     transition(
         ctx,
         cmd,
         &mut targets.hdr,
         ImageAccess::ColorAttachment,
-        Contents::Discard,
+        contents(hdr),
     );
-    let depth_contents = match depth {
-        Load::Clear(_) => Contents::Discard,
-        Load::Keep => Contents::Keep,
-    };
+    let depth_contents = contents(depth);
     transition(
         ctx,
         cmd,
@@ -119,7 +123,7 @@ pub(crate) fn begin_hdr_rendering(
         ImageAccess::DepthStencilAttachment,
         depth_contents,
     );
-    let colors = [color_attachment(&targets.hdr, Load::Clear(CLEAR_BLACK))];
+    let colors = [color_attachment(&targets.hdr, hdr)];
     let ds = depth_stencil_attachment(&targets.depth_stencil, depth);
     begin_rendering(ctx, cmd, extent, &colors, Some(&ds));
 }

@@ -1,0 +1,391 @@
+//! Console hi-stencil, emulated on the GPU exactly as `histencil_model::TileSurface` specifies,
+//! so the CPU simulator is an oracle for it.
+//!
+//! The coarse surface is one word per [`HI_STENCIL_TILE`]-pixel tile, in two buffers: `pending`
+//! (what write-enabled draws evaluated) and `active` (what testing draws see). A hi-stencil
+//! write is a *split pass*: the draw marks the tiles it rasterises (`hi_stencil_touch.frag`),
+//! rendering ends, the stencil is copied out and `hi_stencil_update.comp` re-evaluates the
+//! marked tiles into `pending`. A flush, or the next write while one is unflushed (the latest
+//! point hardware could retire it), copies `pending` to `active`. Testing draws reject
+//! fragments of failing tiles in the light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
+//!
+//! Statistics are optional because counting needs extra draws and atomics: with them on, each
+//! testing draw is preceded by `hi_stencil_count.frag` over the same geometry, and light shaders
+//! count the fragments they shade.
+
+use crate::access::{memory_barrier, transition, Contents, ImageAccess};
+use crate::context::Context;
+use crate::descriptors::{create_pipeline_layout, create_set_layout, HI_STENCIL_UPDATE_SET};
+use crate::error::{Result, VkCall};
+use crate::pipelines::create_module;
+use crate::resources::{Buffer, Image};
+use crate::shader_consts::HI_STENCIL_TILE;
+use crate::shaders;
+use crate::state::compare_op;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use histencil_model::{HiStencilState, TileStats};
+
+/// Push constants of `hi_stencil_update.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct UpdatePush {
+    stamp: u32,
+    compare: u32,
+    reference: u32,
+    read_mask: u32,
+    width: u32,
+    height: u32,
+    tiles_x: u32,
+}
+
+/// Words of the statistics buffer (`HiStencilStats` in include/hi_stencil.glsl).
+const STATS_WORDS: usize = 4;
+
+/// The tile surface, its scratch buffers and the update pipeline.
+pub struct HiStencilSurface {
+    extent: vk::Extent2D,
+    tiles_x: u32,
+    tiles_y: u32,
+    active: Buffer,
+    pending: Buffer,
+    touched: Buffer,
+    stats: Buffer,
+    stencil_copy: Buffer,
+    saved: Buffer,
+    set_layout: vk::DescriptorSetLayout,
+    pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+    /// A write since the last flush has not become active yet (see the module doc).
+    unflushed: bool,
+}
+
+/// Bytes of a buffer holding one stencil byte per pixel, rounded up to whole words.
+fn stencil_bytes(extent: vk::Extent2D) -> u64 {
+    (u64::from(extent.width) * u64::from(extent.height)).next_multiple_of(4)
+}
+
+impl HiStencilSurface {
+    pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
+        let tiles_x = extent.width.div_ceil(HI_STENCIL_TILE);
+        let tiles_y = extent.height.div_ceil(HI_STENCIL_TILE);
+        let tile_bytes = u64::from(tiles_x * tiles_y) * 4;
+        use vk::BufferUsageFlags as U;
+        let gpu = |name, size, usage| Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly);
+        let storage = U::STORAGE_BUFFER | U::TRANSFER_DST;
+        let mut made: Vec<Buffer> = Vec::new();
+        let result = (|| -> Result<()> {
+            made.push(gpu("hi-stencil-active", tile_bytes, storage)?);
+            made.push(gpu(
+                "hi-stencil-pending",
+                tile_bytes,
+                storage | U::TRANSFER_SRC,
+            )?);
+            made.push(gpu("hi-stencil-touched", tile_bytes, storage)?);
+            made.push(Buffer::new(
+                ctx,
+                "hi-stencil-stats",
+                (STATS_WORDS * 4) as u64,
+                storage,
+                MemoryLocation::GpuToCpu,
+            )?);
+            made.push(gpu("stencil-copy", stencil_bytes(extent), storage)?);
+            made.push(gpu("saved-stencil", stencil_bytes(extent), storage)?);
+            Ok(())
+        })();
+        if let Err(e) = result {
+            for mut b in made {
+                b.destroy(ctx);
+            }
+            return Err(e);
+        }
+        let mut buffers = made.into_iter();
+        let mut next = || buffers.next().expect("six buffers were made");
+        let (active, pending, touched, stats, stencil_copy, saved) =
+            (next(), next(), next(), next(), next(), next());
+
+        let d = &ctx.device;
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let set_layout = create_set_layout(
+            ctx,
+            "hi-stencil-update-set-layout",
+            HI_STENCIL_UPDATE_SET,
+            compute,
+        )?;
+        let pipeline_layout = create_pipeline_layout(
+            ctx,
+            "hi-stencil-update-pipeline-layout",
+            &[set_layout],
+            compute,
+            std::mem::size_of::<UpdatePush>() as u32,
+        )?;
+        let module = create_module(
+            ctx,
+            "hi-stencil-update-comp",
+            shaders::HI_STENCIL_UPDATE_COMP,
+        )?;
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(compute)
+            .module(module)
+            .name(c"main");
+        let info = [vk::ComputePipelineCreateInfo::default()
+            .stage(stage)
+            .layout(pipeline_layout)];
+        let created = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
+        unsafe { d.destroy_shader_module(module, None) };
+        let pipeline = created
+            .map_err(|(_, e)| e)
+            .call("vkCreateComputePipelines")?[0];
+        ctx.name(pipeline, "hi-stencil-update-pipeline");
+
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::STORAGE_BUFFER)
+            .descriptor_count(HI_STENCIL_UPDATE_SET.len() as u32)];
+        let pool = unsafe {
+            d.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(1)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }
+        .call("vkCreateDescriptorPool")?;
+        ctx.name(pool, "hi-stencil-update-descriptor-pool");
+        let layouts = [set_layout];
+        let set = unsafe {
+            d.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        }
+        .call("vkAllocateDescriptorSets")?[0];
+        ctx.name(set, "hi-stencil-update-set");
+        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = [&stencil_copy, &touched, &pending]
+            .iter()
+            .map(|b| {
+                [vk::DescriptorBufferInfo::default()
+                    .buffer(b.handle)
+                    .range(vk::WHOLE_SIZE)]
+            })
+            .collect();
+        let writes: Vec<_> = infos
+            .iter()
+            .enumerate()
+            .map(|(i, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .buffer_info(info)
+            })
+            .collect();
+        unsafe { d.update_descriptor_sets(&writes, &[]) };
+        Ok(Self {
+            extent,
+            tiles_x,
+            tiles_y,
+            active,
+            pending,
+            touched,
+            stats,
+            stencil_copy,
+            saved,
+            set_layout,
+            pipeline_layout,
+            pipeline,
+            pool,
+            set,
+            unflushed: false,
+        })
+    }
+
+    /// The buffers of set 2 of the light pipelines (`HI_STENCIL_SET`), in binding order.
+    pub fn light_set_buffers(&self) -> [vk::Buffer; 4] {
+        [
+            self.active.handle,
+            self.touched.handle,
+            self.stats.handle,
+            self.saved.handle,
+        ]
+    }
+
+    /// Outside rendering, before lighting: every tile passes, no tile is marked, statistics zero.
+    pub fn record_reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        let d = &ctx.device;
+        unsafe {
+            d.cmd_fill_buffer(cmd, self.active.handle, 0, vk::WHOLE_SIZE, 1);
+            d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
+            d.cmd_fill_buffer(cmd, self.touched.handle, 0, vk::WHOLE_SIZE, 0);
+            d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
+        }
+        memory_barrier(ctx, cmd);
+        self.unflushed = false;
+    }
+
+    /// Outside rendering: pending state becomes active.
+    pub fn record_flush(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        // Light shaders may still be reading the active surface.
+        memory_barrier(ctx, cmd);
+        let region = [vk::BufferCopy::default().size(self.pending.size)];
+        unsafe {
+            ctx.device
+                .cmd_copy_buffer(cmd, self.pending.handle, self.active.handle, &region)
+        };
+        memory_barrier(ctx, cmd);
+        self.unflushed = false;
+    }
+
+    /// Outside rendering, after a draw with stamp `stamp` marked its tiles: retires an
+    /// unflushed earlier write, then evaluates `hi` on the marked tiles into pending state.
+    pub fn record_update(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        depth_stencil: &mut Image,
+        hi: &HiStencilState,
+        stamp: u32,
+    ) {
+        if self.unflushed {
+            self.record_flush(ctx, cmd);
+        }
+        self.copy_stencil(ctx, cmd, depth_stencil, CopyTo::Scratch);
+        let push = UpdatePush {
+            stamp,
+            compare: compare_op(hi.compare).as_raw() as u32,
+            reference: u32::from(hi.reference),
+            read_mask: u32::from(hi.read_mask.unwrap_or(0xFF)),
+            width: self.extent.width,
+            height: self.extent.height,
+            tiles_x: self.tiles_x,
+        };
+        let d = &ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.pipeline_layout,
+                0,
+                &[self.set],
+                &[],
+            );
+            d.cmd_push_constants(
+                cmd,
+                self.pipeline_layout,
+                vk::ShaderStageFlags::COMPUTE,
+                0,
+                bytemuck::bytes_of(&push),
+            );
+            d.cmd_dispatch(cmd, self.tiles_x, self.tiles_y, 1);
+        }
+        memory_barrier(ctx, cmd);
+        self.unflushed = true;
+    }
+
+    /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
+    pub fn record_save(&self, ctx: &Context, cmd: vk::CommandBuffer, depth_stencil: &mut Image) {
+        self.copy_stencil(ctx, cmd, depth_stencil, CopyTo::Saved);
+    }
+
+    fn copy_stencil(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        depth_stencil: &mut Image,
+        to: CopyTo,
+    ) {
+        let buffer = match to {
+            CopyTo::Scratch => &self.stencil_copy,
+            CopyTo::Saved => &self.saved,
+        };
+        transition(
+            ctx,
+            cmd,
+            depth_stencil,
+            ImageAccess::TransferSource,
+            Contents::Keep,
+        );
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(vk::ImageAspectFlags::STENCIL)
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: self.extent.width,
+                height: self.extent.height,
+                depth: 1,
+            })];
+        unsafe {
+            ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                depth_stencil.handle,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buffer.handle,
+                &region,
+            )
+        };
+        transition(
+            ctx,
+            cmd,
+            depth_stencil,
+            ImageAccess::DepthStencilAttachment,
+            Contents::Keep,
+        );
+        memory_barrier(ctx, cmd);
+    }
+
+    /// Makes the statistics visible to the host; record after the last lighting draw.
+    pub fn record_stats_readable(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
+            .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+            .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+        let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+    }
+
+    /// The statistics of the last frame that counted; `flushes` is the caller's to fill in.
+    pub fn read_stats(&self) -> TileStats {
+        let words: &[u32] = bytemuck::cast_slice(self.stats.read());
+        TileStats {
+            tiles_tested: u64::from(words[0]),
+            tiles_culled: u64::from(words[1]),
+            fragments_shaded: u64::from(words[2]),
+            flushes: 0,
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device
+                .destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+        }
+        for b in [
+            &mut self.active,
+            &mut self.pending,
+            &mut self.touched,
+            &mut self.stats,
+            &mut self.stencil_copy,
+            &mut self.saved,
+        ] {
+            b.destroy(ctx);
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+enum CopyTo {
+    /// For the tile update.
+    Scratch,
+    /// For restoring preserved bits after lighting.
+    Saved,
+}

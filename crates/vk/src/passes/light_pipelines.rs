@@ -1,0 +1,222 @@
+//! The pipelines of the lighting pass, created the first time a plan needs them: a scene pays
+//! only for the BRDFs it uses, and a technique only for its own shaders.
+
+use crate::context::Context;
+use crate::error::Result;
+use crate::pipelines::{create_pipeline, PipelineDesc, VertexInput};
+use crate::shaders;
+use ash::vk;
+use histencil_brdf::BrdfId;
+use histencil_model::{FramePlan, Geometry, Pass, PassKind, Shader, Step};
+use std::collections::HashMap;
+
+/// The fragment stage of a light pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LightShader {
+    /// No fragment shader: stencil and depth only.
+    StencilOnly,
+    /// Marks the hi-stencil tiles the draw covers (`hi_stencil_touch.frag`).
+    TouchTiles,
+    /// Counts tiles a hi-stencil test covers and rejects (`hi_stencil_count.frag`).
+    CountTiles,
+    /// Writes one saved preserved stencil bit back (`restore_preserved.frag`).
+    RestoreBit,
+    /// The light shader of one BRDF.
+    Brdf(BrdfId),
+    /// The uber light shader branching on the G-buffer's BRDF id.
+    Branching,
+}
+
+/// A light pipeline: what it rasterises and its fragment stage.
+pub type LightPipelineKey = (Geometry, LightShader);
+
+/// `SHADED_BRDF` of `deferred_light.frag` for the branching shader.
+const BRANCH_ON_GBUFFER: u32 = u32::MAX;
+
+pub struct LightPipelines {
+    layout: vk::PipelineLayout,
+    hdr_format: vk::Format,
+    depth_stencil_format: vk::Format,
+    pipelines: HashMap<LightPipelineKey, vk::Pipeline>,
+}
+
+impl LightPipelines {
+    pub fn new(
+        layout: vk::PipelineLayout,
+        hdr_format: vk::Format,
+        depth_stencil_format: vk::Format,
+    ) -> Self {
+        Self {
+            layout,
+            hdr_format,
+            depth_stencil_format,
+            pipelines: HashMap::new(),
+        }
+    }
+
+    /// Creates the pipeline for `key` unless it exists.
+    pub fn prepare(&mut self, ctx: &Context, key: LightPipelineKey) -> Result<()> {
+        if self.pipelines.contains_key(&key) {
+            return Ok(());
+        }
+        let (geometry, shader) = key;
+        let (vertex, vertex_input) = match geometry {
+            Geometry::Volume => (
+                ("light_volume.vert", shaders::LIGHT_VOLUME_VERT),
+                VertexInput::Position,
+            ),
+            Geometry::FullScreen => (
+                ("fullscreen.vert", shaders::FULLSCREEN_VERT),
+                VertexInput::None,
+            ),
+        };
+        let light = ("deferred_light.frag", shaders::DEFERRED_LIGHT_FRAG);
+        let (fragment, specialization, shader_name) = match shader {
+            LightShader::StencilOnly => (None, None, "stencil"),
+            LightShader::TouchTiles => (
+                Some(("hi_stencil_touch.frag", shaders::HI_STENCIL_TOUCH_FRAG)),
+                None,
+                "touch-tiles",
+            ),
+            LightShader::CountTiles => (
+                Some(("hi_stencil_count.frag", shaders::HI_STENCIL_COUNT_FRAG)),
+                None,
+                "count-tiles",
+            ),
+            LightShader::RestoreBit => (
+                Some(("restore_preserved.frag", shaders::RESTORE_PRESERVED_FRAG)),
+                None,
+                "restore-bit",
+            ),
+            LightShader::Brdf(id) => (Some(light), Some(id.index()), id.name()),
+            LightShader::Branching => (Some(light), Some(BRANCH_ON_GBUFFER), "branching"),
+        };
+        let shades = specialization.is_some();
+        let geometry_name = match geometry {
+            Geometry::Volume => "volume",
+            Geometry::FullScreen => "fullscreen",
+        };
+        let hdr = [self.hdr_format];
+        let pipeline = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: &format!("light-{geometry_name}-{shader_name}-pipeline"),
+                vertex,
+                fragment,
+                layout: self.layout,
+                vertex_input,
+                color_formats: &hdr,
+                color_writes: shades,
+                additive_blend: shades,
+                depth_stencil_format: self.depth_stencil_format,
+                // Back faces beyond the far plane clamp to depth 1, behind every surface.
+                depth_clamp: geometry == Geometry::Volume,
+                specialization,
+            },
+        )?;
+        self.pipelines.insert(key, pipeline);
+        Ok(())
+    }
+
+    pub(crate) fn get(&self, key: LightPipelineKey) -> vk::Pipeline {
+        self.pipelines[&key]
+    }
+
+    /// How many pipelines exist: what the scene and the techniques used so far cost.
+    pub fn count(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for (_, p) in self.pipelines.drain() {
+            unsafe { ctx.device.destroy_pipeline(p, None) };
+        }
+    }
+}
+
+/// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs.
+pub fn pipeline_key(pass: &Pass, brdfs: &[BrdfId]) -> LightPipelineKey {
+    let shader = match pass.kind {
+        PassKind::Shade(Shader::Brdf(slot)) => LightShader::Brdf(brdfs[slot as usize]),
+        PassKind::Shade(Shader::Branching) => LightShader::Branching,
+        _ if pass.state.writes_hi_stencil() => LightShader::TouchTiles,
+        _ => LightShader::StencilOnly,
+    };
+    (pass.geometry, shader)
+}
+
+/// Every pipeline a plan uses; `count_tiles` adds the statistics draws of hi-stencil tests.
+pub fn plan_pipelines(
+    plan: &FramePlan,
+    brdfs: &[BrdfId],
+    count_tiles: bool,
+) -> Vec<LightPipelineKey> {
+    let mut keys = Vec::new();
+    for step in &plan.steps {
+        match step {
+            Step::Pass { pass, .. } => {
+                keys.push(pipeline_key(pass, brdfs));
+                if count_tiles && pass.state.tests_hi_stencil() {
+                    keys.push((pass.geometry, LightShader::CountTiles));
+                }
+            }
+            Step::RestorePreserved { .. } => {
+                keys.push((Geometry::FullScreen, LightShader::StencilOnly));
+                keys.push((Geometry::FullScreen, LightShader::RestoreBit));
+            }
+            Step::FlushHiStencil | Step::SavePreserved { .. } => {}
+        }
+    }
+    keys.sort_unstable_by_key(|k| format!("{k:?}"));
+    keys.dedup();
+    keys
+}
+
+/// Creates every pipeline `plan` uses.
+pub fn prepare_pipelines(
+    ctx: &Context,
+    pipelines: &mut LightPipelines,
+    plan: &FramePlan,
+    brdfs: &[BrdfId],
+    count_tiles: bool,
+) -> Result<()> {
+    for key in plan_pipelines(plan, brdfs, count_tiles) {
+        pipelines.prepare(ctx, key)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use histencil_model::{
+        FlushPolicy, LightCase, LightRequest, LightTechnique, StencilLayout, X360Like,
+    };
+
+    #[test]
+    fn passes_map_to_the_shaders_of_their_brdfs() {
+        let brdfs = [BrdfId::Lambert, BrdfId::Ggx];
+        let layout = StencilLayout::new(2, 0).unwrap();
+        let request = LightRequest {
+            case: LightCase::Outside,
+            affected: vec![0, 1],
+            technique: LightTechnique::Stencil,
+        };
+        let plan =
+            FramePlan::build(&layout, &X360Like::default(), &[request], FlushPolicy::Auto).unwrap();
+        let keys = plan_pipelines(&plan, &brdfs, false);
+        let shaders: Vec<LightShader> = keys.iter().map(|k| k.1).collect();
+        for expected in [
+            LightShader::StencilOnly,
+            LightShader::TouchTiles,
+            LightShader::Brdf(BrdfId::Lambert),
+            LightShader::Brdf(BrdfId::Ggx),
+        ] {
+            assert!(shaders.contains(&expected), "{expected:?} in {shaders:?}");
+        }
+        assert!(!shaders.contains(&LightShader::CountTiles));
+        assert!(plan_pipelines(&plan, &brdfs, true)
+            .iter()
+            .any(|k| k.1 == LightShader::CountTiles));
+    }
+}
