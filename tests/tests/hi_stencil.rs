@@ -7,6 +7,7 @@
 //!
 //! "Exact" below means within 1/255 of the forward reference, like every deferred technique.
 
+use histencil_model::Simulator;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
 use image::RgbaImage;
@@ -102,6 +103,55 @@ fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
                     diff(&always, &auto).pixels_differing,
                     0,
                     "{label}: flush always differs from auto"
+                );
+            }
+        });
+    }
+}
+
+/// The GPU frame does what the CPU simulator predicts from the GPU's own inputs (G-buffer depth
+/// and stencil, rasterised light footprints, the plan): the same stencil after lighting, so the
+/// 360-like backend zeroes preserved bits exactly where the model says, and the same tile
+/// statistics, so tiles are marked, flushed and culled exactly as the model says.
+#[test]
+fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
+    let cases = [
+        ("ps3", Backend::Ps3, FlushPolicy::Auto),
+        ("x360", x360(true, false), FlushPolicy::Auto),
+        ("x360-no-zeroing", x360(false, false), FlushPolicy::Auto),
+        ("x360-save-restore", x360(true, true), FlushPolicy::Auto),
+        ("ps3-flush-never", Backend::Ps3, FlushPolicy::Never),
+        ("x360-flush-always", x360(true, false), FlushPolicy::Always),
+    ];
+    for name in ["default", "brdfs-3", "near-far", "inside"] {
+        let scene = histencil_scene::embedded(name).unwrap();
+        with_validated_context(|ctx| {
+            let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
+            renderer.set_preserved_pattern(PATTERN);
+            renderer.set_tile_stats(true);
+            for (label, backend, flush) in cases {
+                let technique = stencil(backend, flush);
+                let inputs = renderer.simulator_inputs(technique).expect("inputs");
+                let simulator = Simulator {
+                    layout: inputs.layout,
+                    tile_size: inputs.tile_size,
+                };
+                let mut predicted = inputs.target.clone();
+                let sim = simulator.run(&mut predicted, &inputs.plan, &inputs.footprints);
+                let frame = renderer.render(technique, Readback::ALL).expect("frame");
+                let stats = frame.tile_stats.expect("statistics were asked for");
+                println!("{name} {label}: {stats:?}");
+                assert!(stats.tiles_tested > 0, "{name} {label}: nothing tested");
+                assert_eq!(stats, sim.stats, "{name} {label}: tile statistics");
+                let stencil = frame.images.stencil.unwrap().into_raw();
+                let wrong = stencil
+                    .iter()
+                    .zip(&predicted.stencil)
+                    .filter(|(a, b)| a != b)
+                    .count();
+                assert_eq!(
+                    wrong, 0,
+                    "{name} {label}: stencil differs at {wrong} pixels"
                 );
             }
         });

@@ -86,6 +86,10 @@ struct RenderArgs {
     /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
     #[arg(long)]
     timings: bool,
+    /// Count the written frame's hi-stencil statistics (tiles tested and culled, fragments
+    /// shaded, flushes) and check them against the CPU simulator run on the GPU's own inputs.
+    #[arg(long)]
+    stats: bool,
     /// The engine's bits written into the preserved stencil bits by the G-buffer pass, e.g. 0xA0.
     #[arg(long, value_parser = parse_byte, default_value = "0")]
     preserved_pattern: u8,
@@ -229,6 +233,9 @@ fn render(args: &RenderArgs) -> Result<()> {
         let technique = args.technique();
         let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
         renderer.set_preserved_pattern(args.preserved_pattern);
+        if args.stats {
+            print_stats(&mut renderer, technique)?;
+        }
         let frame = renderer.render(
             technique,
             Readback {
@@ -271,6 +278,42 @@ fn render(args: &RenderArgs) -> Result<()> {
         }
         Ok(())
     })
+}
+
+/// Prints the GPU's hi-stencil statistics of one frame next to the simulator's prediction.
+fn print_stats(renderer: &mut Renderer, technique: Technique) -> Result<()> {
+    if technique == Technique::Forward {
+        bail!("--stats needs a deferred technique: the forward reference has no lighting passes");
+    }
+    let inputs = renderer.simulator_inputs(technique)?;
+    let simulator = histencil_model::Simulator {
+        layout: inputs.layout,
+        tile_size: inputs.tile_size,
+    };
+    let mut target = inputs.target.clone();
+    let predicted = simulator
+        .run(&mut target, &inputs.plan, &inputs.footprints)
+        .stats;
+    renderer.set_tile_stats(true);
+    let frame = renderer.render(technique, Readback::NONE);
+    renderer.set_tile_stats(false);
+    let gpu = frame?.tile_stats.expect("statistics were asked for");
+    println!(
+        "hi-stencil ({}x{}-pixel tiles): {} tiles tested, {} culled, {} fragments shaded, {} flushes; \
+         simulator {}",
+        inputs.tile_size,
+        inputs.tile_size,
+        gpu.tiles_tested,
+        gpu.tiles_culled,
+        gpu.fragments_shaded,
+        gpu.flushes,
+        if gpu == predicted {
+            "agrees".to_owned()
+        } else {
+            format!("predicts {predicted:?}")
+        }
+    );
+    Ok(())
 }
 
 /// Runs `body` on a device, then drops the context and fails on any validation message (with

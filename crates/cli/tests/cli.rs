@@ -59,6 +59,10 @@ fn bad_arguments_are_one_line_errors() {
         "invalid value 'wii'",
     );
     assert_one_line_error(&["brdf-report", "--directions", "0"], "--directions");
+    assert_one_line_error(
+        &["render", "--technique", "forward", "--stats", "--out", out],
+        "--stats needs a deferred technique",
+    );
 }
 
 #[test]
@@ -102,9 +106,11 @@ fn renders_and_dumps_stencil_under_validation() {
         "--preserved-pattern",
         "0xA0",
         "--timings",
+        "--stats",
     ]);
     assert!(ok, "{stdout}\n{stderr}");
     assert!(stdout.contains("frame time"), "{stdout}");
+    assert!(stdout.contains("simulator agrees"), "{stdout}");
     assert!(stdout.contains("lighting by pass group"), "{stdout}");
     assert!(stdout.contains("shade-kajiya_kay"), "{stdout}");
     let stencil = image::open(&stencil).unwrap().into_luma8();

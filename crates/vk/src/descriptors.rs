@@ -89,6 +89,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("hi_stencil_touch.frag", LIGHTING_LAYOUT),
     ("hi_stencil_count.frag", LIGHTING_LAYOUT),
     ("restore_preserved.frag", LIGHTING_LAYOUT),
+    ("footprint.frag", LIGHTING_LAYOUT),
     ("hi_stencil_update.comp", HI_STENCIL_UPDATE_LAYOUT),
     ("fullscreen.vert", LIGHTING_LAYOUT),
     ("tonemap.frag", TONEMAP_LAYOUT),

@@ -18,6 +18,7 @@ use crate::context::Context;
 use crate::descriptors::{create_pipeline_layout, create_set_layout, HI_STENCIL_UPDATE_SET};
 use crate::error::{Result, VkCall};
 use crate::pipelines::create_module;
+use crate::readback::copy_image_to_buffer;
 use crate::resources::{Buffer, Image};
 use crate::shader_consts::HI_STENCIL_TILE;
 use crate::shaders;
@@ -301,33 +302,13 @@ impl HiStencilSurface {
             CopyTo::Scratch => &self.stencil_copy,
             CopyTo::Saved => &self.saved,
         };
-        transition(
+        copy_image_to_buffer(
             ctx,
             cmd,
             depth_stencil,
-            ImageAccess::TransferSource,
-            Contents::Keep,
+            vk::ImageAspectFlags::STENCIL,
+            buffer,
         );
-        let region = [vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(vk::ImageAspectFlags::STENCIL)
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: self.extent.width,
-                height: self.extent.height,
-                depth: 1,
-            })];
-        unsafe {
-            ctx.device.cmd_copy_image_to_buffer(
-                cmd,
-                depth_stencil.handle,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                buffer.handle,
-                &region,
-            )
-        };
         transition(
             ctx,
             cmd,

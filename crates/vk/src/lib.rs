@@ -11,6 +11,7 @@
 
 pub mod access;
 mod brdf_eval;
+mod capture;
 mod context;
 mod debug;
 pub mod descriptors;
@@ -35,6 +36,7 @@ pub mod shaders {
 }
 
 pub use brdf_eval::BrdfEvaluator;
+pub use capture::SimulatorInputs;
 pub use context::{Context, ContextDesc};
 pub use debug::ValidationLog;
 pub use error::{Error, Result};

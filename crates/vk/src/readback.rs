@@ -6,7 +6,6 @@ use crate::error::Result;
 use crate::resources::{Buffer, Image};
 use crate::targets::Targets;
 use ash::vk;
-use gpu_allocator::MemoryLocation;
 use histencil_brdf::BrdfId;
 use image::{GrayImage, Rgba32FImage, RgbaImage};
 
@@ -48,6 +47,52 @@ pub struct FrameImages {
     pub brdf_ids: Option<Vec<Option<BrdfId>>>,
 }
 
+/// Copies one aspect of the whole of `image` into `buffer`, tightly packed.
+pub(crate) fn copy_image_to_buffer(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: &mut Image,
+    aspect: vk::ImageAspectFlags,
+    buffer: &Buffer,
+) {
+    transition(ctx, cmd, image, ImageAccess::TransferSource, Contents::Keep);
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(aspect)
+                .layer_count(1),
+        )
+        .image_extent(vk::Extent3D {
+            width: image.extent.width,
+            height: image.extent.height,
+            depth: 1,
+        });
+    unsafe {
+        ctx.device.cmd_copy_image_to_buffer(
+            cmd,
+            image.handle,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            buffer.handle,
+            &[region],
+        )
+    };
+}
+
+/// Makes every copy so far visible to host reads after the fence.
+pub(crate) fn host_readable(ctx: &Context, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::COPY)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    unsafe {
+        ctx.device.cmd_pipeline_barrier2(
+            cmd,
+            &vk::DependencyInfo::default().memory_barriers(&barrier),
+        )
+    };
+}
+
 pub(crate) struct ReadbackBuffers {
     extent: vk::Extent2D,
     ldr: Buffer,
@@ -59,15 +104,7 @@ pub(crate) struct ReadbackBuffers {
 impl ReadbackBuffers {
     pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
-        let buffer = |name, bytes_per_pixel| {
-            Buffer::new(
-                ctx,
-                name,
-                pixels * bytes_per_pixel,
-                vk::BufferUsageFlags::TRANSFER_DST,
-                MemoryLocation::GpuToCpu,
-            )
-        };
+        let buffer = |name, bytes_per_pixel| Buffer::readback(ctx, name, pixels * bytes_per_pixel);
         Ok(Self {
             extent,
             ldr: buffer("ldr-readback", 4)?,
@@ -75,37 +112,6 @@ impl ReadbackBuffers {
             stencil: buffer("stencil-readback", 1)?,
             material: buffer("gbuffer-material-readback", 16)?,
         })
-    }
-
-    fn copy(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        image: &mut Image,
-        aspect: vk::ImageAspectFlags,
-        buffer: &Buffer,
-    ) {
-        transition(ctx, cmd, image, ImageAccess::TransferSource, Contents::Keep);
-        let region = vk::BufferImageCopy::default()
-            .image_subresource(
-                vk::ImageSubresourceLayers::default()
-                    .aspect_mask(aspect)
-                    .layer_count(1),
-            )
-            .image_extent(vk::Extent3D {
-                width: self.extent.width,
-                height: self.extent.height,
-                depth: 1,
-            });
-        unsafe {
-            ctx.device.cmd_copy_image_to_buffer(
-                cmd,
-                image.handle,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                buffer.handle,
-                &[region],
-            )
-        };
     }
 
     pub fn record(
@@ -121,13 +127,13 @@ impl ReadbackBuffers {
         ctx.begin_label(cmd, "readback");
         let color = vk::ImageAspectFlags::COLOR;
         if what.ldr {
-            self.copy(ctx, cmd, &mut targets.ldr, color, &self.ldr);
+            copy_image_to_buffer(ctx, cmd, &mut targets.ldr, color, &self.ldr);
         }
         if what.hdr {
-            self.copy(ctx, cmd, &mut targets.hdr, color, &self.hdr);
+            copy_image_to_buffer(ctx, cmd, &mut targets.hdr, color, &self.hdr);
         }
         if what.stencil {
-            self.copy(
+            copy_image_to_buffer(
                 ctx,
                 cmd,
                 &mut targets.depth_stencil,
@@ -136,20 +142,9 @@ impl ReadbackBuffers {
             );
         }
         if what.brdf_ids {
-            self.copy(ctx, cmd, &mut targets.gbuffer[2], color, &self.material);
+            copy_image_to_buffer(ctx, cmd, &mut targets.gbuffer[2], color, &self.material);
         }
-        // Make the copies visible to the host reads after the fence.
-        let barrier = [vk::MemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::COPY)
-            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-            .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-        unsafe {
-            ctx.device.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().memory_barriers(&barrier),
-            )
-        };
+        host_readable(ctx, cmd);
         ctx.end_label(cmd);
     }
 

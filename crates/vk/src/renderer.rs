@@ -1,5 +1,6 @@
 //! The renderer: owns a scene's GPU resources and records / submits whole frames.
 
+use crate::capture::{is_full_screen, FootprintCapture, SimulatorInputs};
 use crate::context::Context;
 use crate::descriptors::{DescriptorTargets, Descriptors};
 use crate::error::{Result, VkCall};
@@ -11,15 +12,18 @@ use crate::passes::light_pipelines::{prepare_pipelines, LightPipelines};
 use crate::passes::lighting::{classify, mesh_bound, LightingPass};
 use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
-use crate::readback::{FrameImages, Readback, ReadbackBuffers};
+use crate::readback::{
+    copy_image_to_buffer, host_readable, FrameImages, Readback, ReadbackBuffers,
+};
 use crate::resources::Buffer;
+use crate::shader_consts::HI_STENCIL_TILE;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
 use crate::timing::{FrameTimings, StepTimer, Timestamps};
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
-    FlushPolicy, FramePlan, LightRequest, LightTechnique, Native, PlatformBackend, Ps3Like,
-    StencilLayout, TileStats, X360Like,
+    FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native, PlatformBackend,
+    Ps3Like, SoftTarget, StencilLayout, TileStats, X360Like,
 };
 use histencil_scene::Scene;
 
@@ -368,43 +372,15 @@ impl<'c> Renderer<'c> {
                 self.step_timer = Some(StepTimer::new(ctx, needed.next_power_of_two())?);
             }
         }
-        let cmd = self.cmd;
-        unsafe {
-            ctx.device
-                .reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
-                .call("vkResetCommandBuffer")?;
-            let begin = vk::CommandBufferBeginInfo::default()
-                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-            ctx.device
-                .begin_command_buffer(cmd, &begin)
-                .call("vkBeginCommandBuffer")?;
-        }
+        let cmd = self.begin_commands()?;
         self.timestamps.begin_frame(ctx, cmd);
-        let geometry = GeometryPass {
-            ctx,
-            cmd,
-            scene: &self.scene,
-            meshes: &self.meshes,
-            pipeline: match technique {
-                Technique::Forward => self.pipelines.forward,
-                _ => self.pipelines.gbuffer,
-            },
-            pipeline_layout: self.descriptors.mesh_pipeline_layout,
-            frame_set: self.descriptors.frame_set,
-            extent: self.extent,
-        };
         match technique {
             Technique::Forward => {
-                geometry.record_forward(&mut self.targets);
+                self.record_geometry(true);
                 self.timestamps.mark(ctx, cmd, "forward");
             }
             _ => {
-                geometry.record_gbuffer(
-                    &mut self.targets,
-                    &self.stencil_layout,
-                    &self.object_slots,
-                    self.preserved_pattern,
-                );
+                self.record_geometry(false);
                 self.timestamps.mark(ctx, cmd, "gbuffer");
                 LightingPass {
                     ctx,
@@ -443,6 +419,40 @@ impl<'c> Renderer<'c> {
         .record(&mut self.targets);
         self.timestamps.mark(ctx, cmd, "tonemap");
         self.readback.record(ctx, cmd, &mut self.targets, readback);
+        self.submit_and_wait()?;
+        let mut timings = self.timestamps.read(ctx)?;
+        if let Some(timer) = self.step_timer.as_ref().filter(|_| time_steps) {
+            timings.lighting = Some(timer.read(ctx)?);
+        }
+        let images = self.readback.read(readback)?;
+        let tile_stats = count_stats.then(|| TileStats {
+            flushes: plan.flushes() as u64,
+            ..self.hi_stencil.read_stats()
+        });
+        Ok(Frame {
+            timings,
+            images,
+            tile_stats,
+        })
+    }
+
+    /// Resets and begins the frame's command buffer.
+    fn begin_commands(&self) -> Result<vk::CommandBuffer> {
+        let (d, cmd) = (&self.ctx.device, self.cmd);
+        unsafe {
+            d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
+                .call("vkResetCommandBuffer")?;
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            d.begin_command_buffer(cmd, &begin)
+                .call("vkBeginCommandBuffer")?;
+        }
+        Ok(cmd)
+    }
+
+    /// Ends, submits and waits for the frame's command buffer.
+    fn submit_and_wait(&self) -> Result<()> {
+        let (ctx, cmd) = (self.ctx, self.cmd);
         unsafe {
             ctx.device
                 .end_command_buffer(cmd)
@@ -459,20 +469,107 @@ impl<'c> Renderer<'c> {
                 .reset_fences(&[self.fence])
                 .call("vkResetFences")?;
         }
-        let mut timings = self.timestamps.read(ctx)?;
-        if let Some(timer) = self.step_timer.as_ref().filter(|_| time_steps) {
-            timings.lighting = Some(timer.read(ctx)?);
+        Ok(())
+    }
+
+    /// Records the forward pass or the G-buffer pass.
+    fn record_geometry(&mut self, forward: bool) {
+        let geometry = GeometryPass {
+            ctx: self.ctx,
+            cmd: self.cmd,
+            scene: &self.scene,
+            meshes: &self.meshes,
+            pipeline: if forward {
+                self.pipelines.forward
+            } else {
+                self.pipelines.gbuffer
+            },
+            pipeline_layout: self.descriptors.mesh_pipeline_layout,
+            frame_set: self.descriptors.frame_set,
+            extent: self.extent,
+        };
+        if forward {
+            geometry.record_forward(&mut self.targets);
+        } else {
+            geometry.record_gbuffer(
+                &mut self.targets,
+                &self.stencil_layout,
+                &self.object_slots,
+                self.preserved_pattern,
+            );
         }
-        let images = self.readback.read(readback)?;
-        let tile_stats = count_stats.then(|| TileStats {
-            flushes: plan.flushes() as u64,
-            ..self.hi_stencil.read_stats()
-        });
-        Ok(Frame {
-            timings,
-            images,
-            tile_stats,
-        })
+    }
+
+    /// The CPU simulator's inputs for `technique`'s frame, captured from the GPU: the G-buffer
+    /// pass's depth and stencil, the plan, and each planned light's footprint as rasterised.
+    /// `histencil_model::Simulator` run on them predicts the stencil and the hi-stencil
+    /// statistics ([`Frame::tile_stats`]) the GPU frame produces.
+    ///
+    /// # Errors
+    /// [`crate::Error::Unsupported`] without a 32-bit float depth buffer (the simulator compares
+    /// f32 depths), besides the errors of [`Renderer::plan`] and of Vulkan calls.
+    pub fn simulator_inputs(&mut self, technique: Technique) -> Result<SimulatorInputs> {
+        let ctx = self.ctx;
+        let (plan, light_indices) = self.plan(technique)?;
+        let mut capture =
+            FootprintCapture::new(ctx, self.descriptors.lighting_pipeline_layout, self.extent)?;
+        let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
+        let mut depth = Buffer::readback(ctx, "depth-readback", pixels * 4)?;
+        let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
+        let result = (|| {
+            let cmd = self.begin_commands()?;
+            self.record_geometry(false);
+            let image = &mut self.targets.depth_stencil;
+            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
+            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
+            host_readable(ctx, cmd);
+            self.submit_and_wait()?;
+            let target = SoftTarget {
+                width: self.extent.width,
+                height: self.extent.height,
+                depth: bytemuck::cast_slice(depth.read()).to_vec(),
+                stencil: stencil.read().to_vec(),
+            };
+            let mut footprints = Vec::new();
+            for (planned, &index) in light_indices.iter().enumerate() {
+                if is_full_screen(&plan, planned) {
+                    footprints.push(Footprint::full_screen(target.width, target.height));
+                    continue;
+                }
+                let cmd = self.begin_commands()?;
+                unsafe {
+                    ctx.device.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        self.descriptors.lighting_pipeline_layout,
+                        0,
+                        &[self.descriptors.frame_set],
+                        &[],
+                    );
+                }
+                let light = &self.scene.lights[index as usize];
+                capture.record(
+                    ctx,
+                    cmd,
+                    self.descriptors.lighting_pipeline_layout,
+                    &self.meshes,
+                    (index, light),
+                );
+                self.submit_and_wait()?;
+                footprints.push(capture.footprint()?);
+            }
+            Ok(SimulatorInputs {
+                layout: self.stencil_layout,
+                tile_size: HI_STENCIL_TILE,
+                target,
+                plan,
+                footprints,
+            })
+        })();
+        capture.destroy(ctx);
+        depth.destroy(ctx);
+        stencil.destroy(ctx);
+        result
     }
 
     /// Renders `frames` frames without readback and returns the median of each timing.

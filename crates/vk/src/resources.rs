@@ -84,6 +84,17 @@ impl Buffer {
         })
     }
 
+    /// A host-readable buffer that copies write into.
+    pub fn readback(ctx: &Context, name: &str, size: vk::DeviceSize) -> Result<Self> {
+        Self::new(
+            ctx,
+            name,
+            size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )
+    }
+
     /// A host-visible buffer filled with `bytes`.
     pub fn with_data(
         ctx: &Context,

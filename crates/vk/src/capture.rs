@@ -1,0 +1,209 @@
+//! The CPU simulator's inputs, captured from the GPU: the depth and stencil the G-buffer pass
+//! left, and each planned light's footprint as the rasteriser produced it (the depth of its
+//! front and back faces per pixel, drawn with the light pipelines' vertex shader and depth
+//! clamp). Running `histencil_model::Simulator` on them predicts the GPU frame exactly: its
+//! final stencil and its hi-stencil statistics (`tests/tests/hi_stencil.rs` holds it to that).
+
+use crate::access::{transition, Contents, ImageAccess};
+use crate::context::Context;
+use crate::error::{Error, Result};
+use crate::gpu_types::LightDrawPush;
+use crate::meshes::Meshes;
+use crate::passes::{begin_rendering, color_attachment, Load};
+use crate::pipelines::{create_pipeline, PipelineDesc, VertexInput};
+use crate::readback::{copy_image_to_buffer, host_readable};
+use crate::resources::{Buffer, Image};
+use crate::shaders;
+use crate::state::apply;
+use ash::vk;
+use histencil_model::{
+    CullMode, DepthState, Footprint, FramePlan, Geometry, PassState, SoftTarget, Span,
+    StencilLayout, Step,
+};
+use histencil_scene::{Light, LightKind};
+
+/// Everything `histencil_model::Simulator` needs to predict a frame.
+#[derive(Clone, Debug)]
+pub struct SimulatorInputs {
+    pub layout: StencilLayout,
+    pub tile_size: u32,
+    /// Depth and stencil after the G-buffer pass.
+    pub target: SoftTarget,
+    pub plan: FramePlan,
+    /// Per planned light (the plan's light indices).
+    pub footprints: Vec<Footprint>,
+}
+
+/// "No face here" in the captured depth images.
+const NO_FACE: f32 = -1.0;
+const DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+
+/// The capture pipeline, its two depth images (front faces, back faces) and their readbacks.
+pub(crate) struct FootprintCapture {
+    extent: vk::Extent2D,
+    pipeline: vk::Pipeline,
+    faces: [Image; 2],
+    readback: [Buffer; 2],
+}
+
+impl FootprintCapture {
+    pub fn new(ctx: &Context, layout: vk::PipelineLayout, extent: vk::Extent2D) -> Result<Self> {
+        if ctx.depth_stencil_format != vk::Format::D32_SFLOAT_S8_UINT {
+            return Err(Error::Unsupported(
+                "simulator inputs need a 32-bit float depth buffer (D32_SFLOAT_S8_UINT)",
+            ));
+        }
+        let formats = [DEPTH_FORMAT];
+        let pipeline = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "footprint-capture-pipeline",
+                vertex: ("light_volume.vert", shaders::LIGHT_VOLUME_VERT),
+                fragment: Some(("footprint.frag", shaders::FOOTPRINT_FRAG)),
+                layout,
+                vertex_input: VertexInput::Position,
+                color_formats: &formats,
+                color_writes: true,
+                additive_blend: false,
+                depth_stencil_format: vk::Format::UNDEFINED,
+                depth_clamp: true,
+                specialization: None,
+            },
+        )?;
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+        let color = vk::ImageAspectFlags::COLOR;
+        let image = |name| Image::new(ctx, name, DEPTH_FORMAT, extent, usage, color);
+        let bytes = u64::from(extent.width) * u64::from(extent.height) * 4;
+        let buffer = |name| Buffer::readback(ctx, name, bytes);
+        Ok(Self {
+            extent,
+            pipeline,
+            faces: [image("footprint-front")?, image("footprint-back")?],
+            readback: [
+                buffer("footprint-front-readback")?,
+                buffer("footprint-back-readback")?,
+            ],
+        })
+    }
+
+    /// Records the front and back face depths of scene light `light` and their copies. The
+    /// frame descriptor set must be bound.
+    pub fn record(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        pipeline_layout: vk::PipelineLayout,
+        meshes: &Meshes,
+        light: (u32, &Light),
+    ) {
+        ctx.begin_label(cmd, &format!("capture-footprint-{}", light.0));
+        for (face, cull) in [CullMode::Back, CullMode::Front].into_iter().enumerate() {
+            let image = &mut self.faces[face];
+            transition(
+                ctx,
+                cmd,
+                image,
+                ImageAccess::ColorAttachment,
+                Contents::Discard,
+            );
+            let clear = vk::ClearValue {
+                color: vk::ClearColorValue {
+                    float32: [NO_FACE; 4],
+                },
+            };
+            let colors = [color_attachment(image, Load::Clear(clear))];
+            begin_rendering(ctx, cmd, self.extent, &colors, None);
+            let push = LightDrawPush {
+                light_index: light.0,
+                ..Default::default()
+            };
+            unsafe {
+                ctx.device
+                    .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+                ctx.device.cmd_push_constants(
+                    cmd,
+                    pipeline_layout,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+            }
+            apply(
+                ctx,
+                cmd,
+                &PassState {
+                    cull,
+                    depth: DepthState::OFF,
+                    front: None,
+                    back: None,
+                    color_write: true,
+                    hi_stencil: None,
+                },
+            );
+            match light.1.kind {
+                LightKind::Spot { .. } => meshes.light_cone.draw(ctx, cmd),
+                _ => meshes.light_sphere.draw(ctx, cmd),
+            }
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+            copy_image_to_buffer(
+                ctx,
+                cmd,
+                image,
+                vk::ImageAspectFlags::COLOR,
+                &self.readback[face],
+            );
+        }
+        host_readable(ctx, cmd);
+        ctx.end_label(cmd);
+    }
+
+    /// The footprint of the last recorded light, once the commands have completed.
+    pub fn footprint(&self) -> Result<Footprint> {
+        let [front, back] = &self.readback;
+        let front: &[f32] = bytemuck::cast_slice(front.read());
+        let back: &[f32] = bytemuck::cast_slice(back.read());
+        let width = self.extent.width;
+        let mut bounds: Option<(u32, u32, u32, u32)> = None;
+        for (i, (&f, &b)) in front.iter().zip(back).enumerate() {
+            if b == NO_FACE && f != NO_FACE {
+                return Err(Error::Unsupported(
+                    "a light volume whose front face covers a pixel its back face does not",
+                ));
+            }
+            if b != NO_FACE {
+                let (x, y) = (i as u32 % width, i as u32 / width);
+                bounds = Some(match bounds {
+                    None => (x, y, x, y),
+                    Some((x0, y0, x1, y1)) => (x0.min(x), y0.min(y), x1.max(x), y1.max(y)),
+                });
+            }
+        }
+        let rect = bounds.map_or((0, 0, 0, 0), |(x0, y0, x1, y1)| {
+            (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
+        });
+        Ok(Footprint::from_fn(rect, |x, y| {
+            let i = (y * width + x) as usize;
+            (back[i] != NO_FACE).then(|| Span {
+                front: (front[i] != NO_FACE).then_some(front[i]),
+                back: back[i],
+            })
+        }))
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe { ctx.device.destroy_pipeline(self.pipeline, None) };
+        for image in &mut self.faces {
+            image.destroy(ctx);
+        }
+        for buffer in &mut self.readback {
+            buffer.destroy(ctx);
+        }
+    }
+}
+
+/// Whether planned light `light` is drawn full screen (a light without a volume).
+pub(crate) fn is_full_screen(plan: &FramePlan, light: usize) -> bool {
+    plan.steps.iter().any(|s| {
+        matches!(s, Step::Pass { light: l, pass } if *l == light && pass.geometry == Geometry::FullScreen)
+    })
+}
