@@ -9,7 +9,7 @@
 //! order. So the sums round identically. The test asserts it.
 
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, CostModel, FlushPolicy, Readback, Renderer, Technique};
 
 const SIZE: u32 = 160;
 const TOLERANCE: u8 = 1;
@@ -27,6 +27,13 @@ fn techniques() -> Vec<(&'static str, Technique)> {
                 zero_preserved: true,
                 save_restore: false,
             }),
+        ),
+        (
+            "adaptive-ps3",
+            Technique::Adaptive {
+                backend: Backend::Ps3,
+                flush,
+            },
         ),
         (
             "branching-x360",
@@ -83,11 +90,12 @@ fn check(scene_name: &str) {
                 "{scene_name}: {label} is not bit-identical to branching"
             );
         }
-        // Only the BRDFs in use get shaders: per BRDF a volume and (for the directional light)
-        // a full-screen pipeline, plus branching, stencil-only and hi-stencil tile-marking ones.
+        // Only the BRDFs in use get shaders: per BRDF and geometry (volume, and full screen for
+        // the directional light) one pipeline with and one without the hi-stencil emulation's
+        // tile work, plus branching, stencil-only and tile-marking ones.
         let brdfs = renderer.brdfs().len();
         assert!(
-            renderer.light_pipeline_count() <= 2 * (brdfs + 3),
+            renderer.light_pipeline_count() <= 2 * (2 * brdfs + 3),
             "{scene_name}: {} light pipelines for {brdfs} BRDFs",
             renderer.light_pipeline_count()
         );
@@ -122,4 +130,39 @@ fn camera_inside_a_light_volume() {
 #[test]
 fn volumes_crossing_near_and_far_planes() {
     check("near-far");
+}
+
+/// Adaptive follows its cost model: costs that make stencil free plan exactly the stencil
+/// technique, costs that make branching free plan exactly branching.
+#[test]
+fn adaptive_chooses_what_the_cost_model_says() {
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
+    with_validated_context(|ctx| {
+        let mut renderer = Renderer::new(ctx, scene, SIZE, SIZE).expect("renderer");
+        let (backend, flush) = (Backend::Ps3, FlushPolicy::Auto);
+        let plan = |renderer: &Renderer, technique| renderer.plan(technique).expect("plan").0;
+        let adaptive = Technique::Adaptive { backend, flush };
+        let free_stencil = CostModel {
+            pass_overhead_ms: 0.0,
+            stencil_per_brdf_ms: 0.0,
+            branch_tax_per_brdf_ms: 1.0,
+            shade_ms: 1.0,
+        };
+        renderer.set_cost_model(Some(free_stencil));
+        assert_eq!(
+            plan(&renderer, adaptive),
+            plan(&renderer, Technique::Stencil { backend, flush })
+        );
+        let free_branching = CostModel {
+            pass_overhead_ms: 1.0,
+            stencil_per_brdf_ms: 1.0,
+            branch_tax_per_brdf_ms: 0.0,
+            shade_ms: 1.0,
+        };
+        renderer.set_cost_model(Some(free_branching));
+        assert_eq!(
+            plan(&renderer, adaptive),
+            plan(&renderer, Technique::Branching { backend, flush })
+        );
+    });
 }

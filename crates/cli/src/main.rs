@@ -70,8 +70,9 @@ struct RenderArgs {
     #[arg(long, default_value = "default")]
     scene: String,
     /// How lights are applied: `stencil` (the talk's one pass per BRDF, masked by stencil),
-    /// `branching` (one uber shader), `deferred` (branching on the native backend), `forward`
-    /// (the reference).
+    /// `branching` (one uber shader), `adaptive` (stencil or branching per light, by the cost
+    /// model fitted to the talk's figures), `deferred` (branching on the native backend),
+    /// `forward` (the reference).
     #[arg(long, value_enum, default_value = "deferred")]
     technique: TechniqueArg,
     /// Platform behaviour of the stencil plan: x360 (no hi-stencil read mask, zeroes preserved
@@ -119,6 +120,7 @@ struct RenderArgs {
 enum TechniqueArg {
     Stencil,
     Branching,
+    Adaptive,
     Deferred,
     Forward,
 }
@@ -165,6 +167,7 @@ impl RenderArgs {
         match self.technique {
             TechniqueArg::Stencil => Technique::Stencil { backend, flush },
             TechniqueArg::Branching => Technique::Branching { backend, flush },
+            TechniqueArg::Adaptive => Technique::Adaptive { backend, flush },
             TechniqueArg::Deferred => Technique::DEFERRED,
             TechniqueArg::Forward => Technique::Forward,
         }

@@ -67,7 +67,7 @@ impl FootprintCapture {
                 additive_blend: false,
                 depth_stencil_format: vk::Format::UNDEFINED,
                 depth_clamp: true,
-                specialization: None,
+                specialization: &[],
             },
         )?;
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;

@@ -40,7 +40,7 @@ pub use capture::SimulatorInputs;
 pub use context::{Context, ContextDesc};
 pub use debug::ValidationLog;
 pub use error::{Error, Result};
-pub use histencil_model::{FlushPolicy, TileStats};
+pub use histencil_model::{CostModel, FlushPolicy, TileStats};
 pub use output::{save_exr, save_png};
 pub use readback::{FrameImages, Readback};
 pub use renderer::{Backend, Frame, Renderer, Technique};

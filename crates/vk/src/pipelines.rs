@@ -33,8 +33,9 @@ pub struct PipelineDesc<'a> {
     /// Clamp depth instead of clipping at near/far: light volumes crossing the far plane keep
     /// their back faces (at depth 1) so the stencil/depth tests still see them.
     pub depth_clamp: bool,
-    /// The fragment shader's specialisation constant 0, if any.
-    pub specialization: Option<u32>,
+    /// The fragment shader's specialisation constants, ids 0, 1, ... in order (32-bit each;
+    /// booleans as 0 / 1).
+    pub specialization: &'a [u32],
 }
 
 pub(crate) fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<vk::ShaderModule> {
@@ -76,15 +77,23 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
         .stage(vk::ShaderStageFlags::VERTEX)
         .module(vertex_module)
         .name(c"main")];
-    let constant_bytes = desc.specialization.map(u32::to_ne_bytes);
-    let entries = [vk::SpecializationMapEntry::default()
-        .constant_id(0)
-        .offset(0)
-        .size(4)];
-    let specialization = constant_bytes.as_ref().map(|bytes| {
+    let entries: Vec<vk::SpecializationMapEntry> = (0..desc.specialization.len() as u32)
+        .map(|id| {
+            vk::SpecializationMapEntry::default()
+                .constant_id(id)
+                .offset(4 * id)
+                .size(4)
+        })
+        .collect();
+    let constant_bytes: Vec<u8> = desc
+        .specialization
+        .iter()
+        .flat_map(|c| c.to_ne_bytes())
+        .collect();
+    let specialization = (!entries.is_empty()).then(|| {
         vk::SpecializationInfo::default()
             .map_entries(&entries)
-            .data(bytes)
+            .data(&constant_bytes)
     });
     if let Some(m) = fragment_module {
         let mut stage = vk::PipelineShaderStageCreateInfo::default()
@@ -223,7 +232,7 @@ impl Pipelines {
             additive_blend: false,
             depth_stencil_format: formats.depth_stencil,
             depth_clamp: false,
-            specialization: None,
+            specialization: &[],
         };
         let gbuffer = create_pipeline(
             ctx,

@@ -9,7 +9,7 @@ use crate::hi_stencil::HiStencilSurface;
 use crate::meshes::Meshes;
 use crate::passes::geometry::GeometryPass;
 use crate::passes::light_pipelines::{prepare_pipelines, LightPipelines};
-use crate::passes::lighting::{classify, mesh_bound, LightingPass};
+use crate::passes::lighting::{classify, mesh_bound, screen_coverage, LightingPass};
 use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::{
@@ -22,8 +22,8 @@ use crate::timing::{FrameTimings, StepTimer, Timestamps};
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
-    FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native, PlatformBackend,
-    Ps3Like, SoftTarget, StencilLayout, TileStats, X360Like,
+    CostModel, FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native,
+    PlatformBackend, Ps3Like, SoftTarget, StencilLayout, TalkFigures, TileStats, X360Like,
 };
 use histencil_scene::Scene;
 
@@ -75,6 +75,12 @@ pub enum Technique {
         backend: Backend,
         flush: FlushPolicy,
     },
+    /// Stencil or branching per light, whichever the renderer's [`CostModel`] predicts cheaper
+    /// for the light's screen coverage and BRDF count (the talk's "tiny lights? try branching").
+    Adaptive {
+        backend: Backend,
+        flush: FlushPolicy,
+    },
 }
 
 impl Technique {
@@ -93,9 +99,16 @@ impl Technique {
             Technique::Branching { backend, flush } => {
                 Some((LightTechnique::Branching, backend, flush))
             }
+            // Refined per light by the cost model; stencil is the talk's default.
+            Technique::Adaptive { backend, flush } => {
+                Some((LightTechnique::Stencil, backend, flush))
+            }
         }
     }
 }
+
+/// The talk gives no fixed cost per draw; the default cost model assumes this one.
+const ASSUMED_DRAW_OVERHEAD_MS: f64 = 0.005;
 
 /// The stencil slot of BRDF `id`: its index among the BRDFs in use.
 fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
@@ -128,6 +141,8 @@ pub struct Renderer<'c> {
     /// Per-step lighting timestamps, when asked for.
     pass_timing: bool,
     step_timer: Option<StepTimer>,
+    /// The adaptive technique's costs; `None`: fitted to the talk's figures for the backend.
+    cost_model: Option<CostModel>,
     /// Count hi-stencil tile and fragment statistics, when asked for.
     tile_stats: bool,
     hi_stencil: HiStencilSurface,
@@ -240,6 +255,7 @@ impl<'c> Renderer<'c> {
             pass_timing: false,
             step_timer: None,
             tile_stats: false,
+            cost_model: None,
             hi_stencil,
             extent,
             targets,
@@ -299,6 +315,24 @@ impl<'c> Renderer<'c> {
         self.tile_stats = on;
     }
 
+    /// The costs [`Technique::Adaptive`] chooses with, e.g. calibrated on this device. Without
+    /// them it uses the talk's measurements fitted by [`CostModel::from_talk`] (360 figures for
+    /// the 360-like backend, PS3 figures otherwise) with an assumed 5 us per extra draw.
+    pub fn set_cost_model(&mut self, costs: Option<CostModel>) {
+        self.cost_model = costs;
+    }
+
+    /// The costs the adaptive technique uses with `backend`.
+    pub fn cost_model(&self, backend: Backend) -> CostModel {
+        self.cost_model.unwrap_or_else(|| {
+            let figures = match backend {
+                Backend::X360 { .. } => TalkFigures::X360,
+                Backend::Ps3 | Backend::Native => TalkFigures::PS3,
+            };
+            CostModel::from_talk(&figures, ASSUMED_DRAW_OVERHEAD_MS)
+        })
+    }
+
     /// Light pipelines created so far.
     pub fn light_pipeline_count(&self) -> usize {
         self.light_pipelines.count()
@@ -325,10 +359,19 @@ impl<'c> Renderer<'c> {
                 continue;
             }
             let bound = mesh_bound(light, &self.meshes);
+            let case = classify(light, bound, &self.scene.camera, aspect);
+            let chosen = match technique {
+                Technique::Adaptive { .. } => {
+                    let coverage = screen_coverage(light, bound, &self.scene.camera, aspect, case);
+                    self.cost_model(backend)
+                        .choose(coverage, affected.len() as u32)
+                }
+                _ => light_technique,
+            };
             requests.push(LightRequest {
-                case: classify(light, bound, &self.scene.camera, aspect),
+                case,
                 affected,
-                technique: light_technique,
+                technique: chosen,
             });
             indices.push(index as u32);
         }

@@ -22,9 +22,18 @@ pub enum LightShader {
     /// Writes one saved preserved stencil bit back (`restore_preserved.frag`).
     RestoreBit,
     /// The light shader of one BRDF.
-    Brdf(BrdfId),
+    Brdf { id: BrdfId, tiles: TileWork },
     /// The uber light shader branching on the G-buffer's BRDF id.
-    Branching,
+    Branching { tiles: TileWork },
+}
+
+/// Whether a light shader carries the hi-stencil emulation's work: rejecting failing tiles and
+/// counting shaded fragments. Without it the code is specialised away, so the native path does
+/// not pay for shader memory writes (llvmpipe is about 20 % slower with them compiled in).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TileWork {
+    None,
+    TestAndCount,
 }
 
 /// A light pipeline: what it rasterises and its fragment stage.
@@ -72,24 +81,35 @@ impl LightPipelines {
         };
         let light = ("deferred_light.frag", shaders::DEFERRED_LIGHT_FRAG);
         let (fragment, specialization, shader_name) = match shader {
-            LightShader::StencilOnly => (None, None, "stencil"),
+            LightShader::StencilOnly => (None, None, "stencil".to_owned()),
             LightShader::TouchTiles => (
                 Some(("hi_stencil_touch.frag", shaders::HI_STENCIL_TOUCH_FRAG)),
                 None,
-                "touch-tiles",
+                "touch-tiles".to_owned(),
             ),
             LightShader::CountTiles => (
                 Some(("hi_stencil_count.frag", shaders::HI_STENCIL_COUNT_FRAG)),
                 None,
-                "count-tiles",
+                "count-tiles".to_owned(),
             ),
             LightShader::RestoreBit => (
                 Some(("restore_preserved.frag", shaders::RESTORE_PRESERVED_FRAG)),
                 None,
-                "restore-bit",
+                "restore-bit".to_owned(),
             ),
-            LightShader::Brdf(id) => (Some(light), Some(id.index()), id.name()),
-            LightShader::Branching => (Some(light), Some(BRANCH_ON_GBUFFER), "branching"),
+            LightShader::Brdf { id, tiles } => (
+                Some(light),
+                Some([id.index(), u32::from(tiles == TileWork::TestAndCount)]),
+                format!("{}{}", id.name(), tiles.suffix()),
+            ),
+            LightShader::Branching { tiles } => (
+                Some(light),
+                Some([
+                    BRANCH_ON_GBUFFER,
+                    u32::from(tiles == TileWork::TestAndCount),
+                ]),
+                format!("branching{}", tiles.suffix()),
+            ),
         };
         let shades = specialization.is_some();
         let geometry_name = match geometry {
@@ -111,7 +131,7 @@ impl LightPipelines {
                 depth_stencil_format: self.depth_stencil_format,
                 // Back faces beyond the far plane clamp to depth 1, behind every surface.
                 depth_clamp: geometry == Geometry::Volume,
-                specialization,
+                specialization: specialization.as_ref().map_or(&[], |c| c.as_slice()),
             },
         )?;
         self.pipelines.insert(key, pipeline);
@@ -134,11 +154,29 @@ impl LightPipelines {
     }
 }
 
-/// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs.
-pub fn pipeline_key(pass: &Pass, brdfs: &[BrdfId]) -> LightPipelineKey {
+impl TileWork {
+    fn suffix(self) -> &'static str {
+        match self {
+            TileWork::None => "",
+            TileWork::TestAndCount => "-tiles",
+        }
+    }
+}
+
+/// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs; with `count_stats`
+/// every light shader counts its fragments.
+pub fn pipeline_key(pass: &Pass, brdfs: &[BrdfId], count_stats: bool) -> LightPipelineKey {
+    let tiles = if count_stats || pass.state.tests_hi_stencil() {
+        TileWork::TestAndCount
+    } else {
+        TileWork::None
+    };
     let shader = match pass.kind {
-        PassKind::Shade(Shader::Brdf(slot)) => LightShader::Brdf(brdfs[slot as usize]),
-        PassKind::Shade(Shader::Branching) => LightShader::Branching,
+        PassKind::Shade(Shader::Brdf(slot)) => LightShader::Brdf {
+            id: brdfs[slot as usize],
+            tiles,
+        },
+        PassKind::Shade(Shader::Branching) => LightShader::Branching { tiles },
         _ if pass.state.writes_hi_stencil() => LightShader::TouchTiles,
         _ => LightShader::StencilOnly,
     };
@@ -155,7 +193,7 @@ pub fn plan_pipelines(
     for step in &plan.steps {
         match step {
             Step::Pass { pass, .. } => {
-                keys.push(pipeline_key(pass, brdfs));
+                keys.push(pipeline_key(pass, brdfs, count_tiles));
                 if count_tiles && pass.state.tests_hi_stencil() {
                     keys.push((pass.geometry, LightShader::CountTiles));
                 }
@@ -206,11 +244,18 @@ mod tests {
             FramePlan::build(&layout, &X360Like::default(), &[request], FlushPolicy::Auto).unwrap();
         let keys = plan_pipelines(&plan, &brdfs, false);
         let shaders: Vec<LightShader> = keys.iter().map(|k| k.1).collect();
+        let tiles = TileWork::TestAndCount;
         for expected in [
             LightShader::StencilOnly,
             LightShader::TouchTiles,
-            LightShader::Brdf(BrdfId::Lambert),
-            LightShader::Brdf(BrdfId::Ggx),
+            LightShader::Brdf {
+                id: BrdfId::Lambert,
+                tiles,
+            },
+            LightShader::Brdf {
+                id: BrdfId::Ggx,
+                tiles,
+            },
         ] {
             assert!(shaders.contains(&expected), "{expected:?} in {shaders:?}");
         }

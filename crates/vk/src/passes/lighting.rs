@@ -75,6 +75,29 @@ pub fn pass_group(kind: PassKind, brdfs: &[BrdfId]) -> String {
     }
 }
 
+/// The fraction of the screen a light covers, for the technique chooser: the projected disc of
+/// the sphere around its volume mesh for lights outside it, 1 for lights that reach the near
+/// plane or have no volume. An estimate (a sphere's projection is an ellipse off-axis), which is
+/// all a cost model linear in coverage can use.
+pub fn screen_coverage(
+    light: &Light,
+    mesh_bound: f32,
+    camera: &Camera,
+    aspect: f32,
+    case: LightCase,
+) -> f64 {
+    if case != LightCase::Outside {
+        return 1.0;
+    }
+    let distance = f64::from((light.position - camera.eye).length());
+    let radius = f64::from(light.radius * mesh_bound);
+    let sin = (radius / distance).min(1.0);
+    let tan = sin / (1.0 - sin * sin).sqrt().max(1e-9);
+    // In units of half the screen height; the screen is 2 * aspect by 2 of them.
+    let disc_radius = tan / f64::from((camera.fov_y_radians * 0.5).tan());
+    (std::f64::consts::PI * disc_radius * disc_radius / (4.0 * f64::from(aspect))).min(1.0)
+}
+
 pub struct LightingPass<'a> {
     pub ctx: &'a Context,
     pub cmd: vk::CommandBuffer,
@@ -302,7 +325,8 @@ impl LightingPass<'_> {
             flags,
             bit: 0,
         };
-        self.draw(pipeline_key(pass, self.brdfs), state, pass.geometry, push);
+        let key = pipeline_key(pass, self.brdfs, self.count_stats);
+        self.draw(key, state, pass.geometry, push);
         if let Some(hi) = state.hi_stencil.filter(|h| h.write) {
             rendering.close(self);
             memory_barrier(self.ctx, self.cmd);
@@ -418,5 +442,19 @@ mod tests {
             direction: Vec3::NEG_Y,
         };
         assert_eq!(classify(&light, bound, &camera, 1.0), LightCase::FullScreen);
+    }
+
+    #[test]
+    fn coverage_falls_with_distance_and_is_full_near_the_eye() {
+        let scene = histencil_scene::embedded("default").unwrap();
+        let camera = scene.camera;
+        let forward = (camera.target - camera.eye).normalize();
+        let light = |d: f32| Light::point(camera.eye + forward * d, 1.0, Vec3::ONE);
+        let near = screen_coverage(&light(3.0), 1.0, &camera, 1.0, LightCase::Outside);
+        let far = screen_coverage(&light(30.0), 1.0, &camera, 1.0, LightCase::Outside);
+        assert!(far < near && far > 0.0, "{near} {far}");
+        assert!(near <= 1.0);
+        let inside = screen_coverage(&light(0.5), 1.0, &camera, 1.0, LightCase::CrossesNear);
+        assert_eq!(inside, 1.0);
     }
 }
