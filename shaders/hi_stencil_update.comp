@@ -3,6 +3,7 @@
 // this draw's) may pass when any of its pixels passes the hi-stencil compare on the stencil the
 // draw left: `(stencil & read_mask) OP reference`, as histencil_model::HiStencilState says.
 #include "generated.glsl"
+#include "stencil_bytes.glsl"
 
 layout(local_size_x = HI_STENCIL_TILE, local_size_y = HI_STENCIL_TILE) in;
 
@@ -55,7 +56,7 @@ void main() {
     uvec2 px = gl_GlobalInvocationID.xy;
     if (px.x < update.width && px.y < update.height) {
         uint index = px.y * update.width + px.x;
-        uint stencil = (stencil_copy[index >> 2] >> ((index & 3u) * 8u)) & 0xFFu;
+        uint stencil = stencil_byte(stencil_copy[index >> 2], index);
         if (compare_passes(update.compare, stencil & update.read_mask, update.reference)) {
             atomicOr(any_pixel_passes, 1u);
         }

@@ -5,6 +5,7 @@
 #define HI_STENCIL_GLSL
 
 #include "frame.glsl"
+#include "stencil_bytes.glsl"
 
 // Non-zero where the active surface lets fragments through.
 layout(set = 2, binding = 0, std430) readonly buffer HiStencilActive {
@@ -30,11 +31,6 @@ uint hi_stencil_tile() {
     uint tiles_x = (uint(frame.viewport.x) + HI_STENCIL_TILE - 1u) / HI_STENCIL_TILE;
     uvec2 tile = uvec2(gl_FragCoord.xy) / HI_STENCIL_TILE;
     return tile.y * tiles_x + tile.x;
-}
-
-// The byte of pixel `index` in a buffer of tightly packed stencil bytes.
-uint stencil_byte(uint word, uint index) {
-    return (word >> ((index & 3u) * 8u)) & 0xFFu;
 }
 
 #endif

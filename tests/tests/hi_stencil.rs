@@ -7,7 +7,6 @@
 //!
 //! "Exact" below means within 1/255 of the forward reference, like every deferred technique.
 
-use histencil_model::Simulator;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
 use image::RgbaImage;
@@ -132,12 +131,7 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
             for (label, backend, flush) in cases {
                 let technique = stencil(backend, flush);
                 let inputs = renderer.simulator_inputs(technique).expect("inputs");
-                let simulator = Simulator {
-                    layout: inputs.layout,
-                    tile_size: inputs.tile_size,
-                };
-                let mut predicted = inputs.target.clone();
-                let sim = simulator.run(&mut predicted, &inputs.plan, &inputs.footprints);
+                let (sim, predicted) = inputs.predict();
                 let frame = renderer.render(technique, Readback::ALL).expect("frame");
                 let stats = frame.tile_stats.expect("statistics were asked for");
                 println!("{name} {label}: {stats:?}");

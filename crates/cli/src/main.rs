@@ -289,14 +289,7 @@ fn print_stats(renderer: &mut Renderer, technique: Technique) -> Result<()> {
         bail!("--stats needs a deferred technique: the forward reference has no lighting passes");
     }
     let inputs = renderer.simulator_inputs(technique)?;
-    let simulator = histencil_model::Simulator {
-        layout: inputs.layout,
-        tile_size: inputs.tile_size,
-    };
-    let mut target = inputs.target.clone();
-    let predicted = simulator
-        .run(&mut target, &inputs.plan, &inputs.footprints)
-        .stats;
+    let predicted = inputs.predict().0.stats;
     renderer.set_tile_stats(true);
     let frame = renderer.render(technique, Readback::NONE);
     renderer.set_tile_stats(false);

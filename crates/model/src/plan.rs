@@ -189,24 +189,6 @@ fn stencil_pass(
     }
 }
 
-/// Writes `reference` (pass) and `depth_fail_op` into the bits of `write_mask`.
-fn write_face(
-    write_mask: u8,
-    reference: u8,
-    pass: StencilOp,
-    depth_fail: StencilOp,
-) -> FaceStencil {
-    FaceStencil {
-        compare: CompareOp::Always,
-        compare_mask: 0,
-        write_mask,
-        reference,
-        pass,
-        fail: StencilOp::Keep,
-        depth_fail,
-    }
-}
-
 /// Checks the request and returns its sorted slots and the technique it really needs.
 fn normalise(
     layout: &StencilLayout,
@@ -276,7 +258,7 @@ pub fn plan_light(
             geometry,
             cull,
             DepthState::OFF,
-            write_face(scratch_mask, 0, StencilOp::Zero, StencilOp::Zero),
+            FaceStencil::writing(scratch_mask, 0, StencilOp::Zero, StencilOp::Zero),
         ));
     }
     if let Some((setup_cull, marks_culled)) = culling_faces {
@@ -296,7 +278,7 @@ pub fn plan_light(
             Geometry::Volume,
             setup_cull,
             DepthState::test(marks_culled),
-            write_face(write_mask, culling, StencilOp::Replace, unmarked),
+            FaceStencil::writing(write_mask, culling, StencilOp::Replace, unmarked),
         ));
     }
     // Hi-stencil may only be written by a pass that rasterises the shade pass's pixels, or
@@ -373,7 +355,7 @@ pub fn plan_light(
             Geometry::Volume,
             setup_cull,
             DepthState::OFF,
-            write_face(scratch_mask, 0, StencilOp::Zero, StencilOp::Zero),
+            FaceStencil::writing(scratch_mask, 0, StencilOp::Zero, StencilOp::Zero),
         ));
     }
     Ok(passes)

@@ -80,6 +80,25 @@ impl FaceStencil {
         depth_fail: StencilOp::Keep,
     };
 
+    /// Passes everywhere and writes `pass` where the depth test passes and `depth_fail` where it
+    /// fails, into the bits of `write_mask` (`Replace` writes `reference`).
+    pub const fn writing(
+        write_mask: u8,
+        reference: u8,
+        pass: StencilOp,
+        depth_fail: StencilOp,
+    ) -> Self {
+        Self {
+            compare: CompareOp::Always,
+            compare_mask: 0,
+            write_mask,
+            reference,
+            pass,
+            fail: StencilOp::Keep,
+            depth_fail,
+        }
+    }
+
     /// Vulkan's stencil test: `(reference & mask) OP (stencil & mask)`.
     pub fn test(&self, stencil: u8) -> bool {
         self.compare.test(

@@ -2,9 +2,12 @@
 //! shipping shader code can be held to the f64 reference. One dispatch per call.
 
 use crate::context::Context;
-use crate::descriptors::{create_pipeline_layout, create_set_layout, BRDF_EVAL_SET};
+use crate::descriptors::{
+    create_pipeline_layout, create_set_layout, create_storage_buffer_set, BRDF_EVAL_SET,
+};
 use crate::error::{Result, VkCall};
-use crate::pipelines::create_module;
+use crate::pipelines::create_compute_pipeline;
+use crate::readback::host_readable;
 use crate::resources::Buffer;
 use crate::shaders;
 use ash::vk;
@@ -38,26 +41,17 @@ pub struct BrdfEvaluator {
 
 impl BrdfEvaluator {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let d = &ctx.device;
         let compute = vk::ShaderStageFlags::COMPUTE;
         let set_layout = create_set_layout(ctx, "brdf-eval-set-layout", BRDF_EVAL_SET, compute)?;
         // Push constants: the case count.
         let pipeline_layout =
             create_pipeline_layout(ctx, "brdf-eval-pipeline-layout", &[set_layout], compute, 4)?;
-        let module = create_module(ctx, "brdf-eval-comp", shaders::BRDF_EVAL_COMP)?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(compute)
-            .module(module)
-            .name(c"main");
-        let info = [vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(pipeline_layout)];
-        let created = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
-        unsafe { d.destroy_shader_module(module, None) };
-        let pipeline = created
-            .map_err(|(_, e)| e)
-            .call("vkCreateComputePipelines")?[0];
-        ctx.name(pipeline, "brdf-eval-pipeline");
+        let pipeline = create_compute_pipeline(
+            ctx,
+            "brdf-eval-pipeline",
+            ("brdf-eval-comp", shaders::BRDF_EVAL_COMP),
+            pipeline_layout,
+        )?;
         Ok(Self {
             set_layout,
             pipeline_layout,
@@ -111,19 +105,12 @@ impl BrdfEvaluator {
 
     fn dispatch(&self, ctx: &Context, input: &Buffer, output: &Buffer, count: u32) -> Result<()> {
         let d = &ctx.device;
-        let sizes = [vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::STORAGE_BUFFER)
-            .descriptor_count(2)];
-        let pool = unsafe {
-            d.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(1)
-                    .pool_sizes(&sizes),
-                None,
-            )
-        }
-        .call("vkCreateDescriptorPool")?;
-        ctx.name(pool, "brdf-eval-descriptor-pool");
+        let (pool, set) = create_storage_buffer_set(
+            ctx,
+            "brdf-eval",
+            self.set_layout,
+            &[input.handle, output.handle],
+        )?;
         let command_pool = unsafe {
             d.create_command_pool(
                 &vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family),
@@ -136,33 +123,6 @@ impl BrdfEvaluator {
             ctx.name(command_pool, "brdf-eval-command-pool");
             let fence = fence.call("vkCreateFence")?;
             ctx.name(fence, "brdf-eval-fence");
-            let layouts = [self.set_layout];
-            let set = unsafe {
-                d.allocate_descriptor_sets(
-                    &vk::DescriptorSetAllocateInfo::default()
-                        .descriptor_pool(pool)
-                        .set_layouts(&layouts),
-                )
-            }
-            .call("vkAllocateDescriptorSets")?[0];
-            ctx.name(set, "brdf-eval-set");
-            let infos = [input, output].map(|b| {
-                [vk::DescriptorBufferInfo::default()
-                    .buffer(b.handle)
-                    .range(vk::WHOLE_SIZE)]
-            });
-            let writes: Vec<_> = infos
-                .iter()
-                .enumerate()
-                .map(|(i, info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(i as u32)
-                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                        .buffer_info(info)
-                })
-                .collect();
-            unsafe { d.update_descriptor_sets(&writes, &[]) };
             let cmd = unsafe {
                 d.allocate_command_buffers(
                     &vk::CommandBufferAllocateInfo::default()
@@ -199,15 +159,7 @@ impl BrdfEvaluator {
                     &count.to_le_bytes(),
                 );
                 d.cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1);
-                let barrier = [vk::MemoryBarrier2::default()
-                    .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
-                    .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
-                    .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                    .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-                d.cmd_pipeline_barrier2(
-                    cmd,
-                    &vk::DependencyInfo::default().memory_barriers(&barrier),
-                );
+                host_readable(ctx, cmd, vk::PipelineStageFlags2::COMPUTE_SHADER);
                 ctx.end_label(cmd);
                 d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
                 let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];

@@ -17,8 +17,8 @@ use crate::shaders;
 use crate::state::apply;
 use ash::vk;
 use histencil_model::{
-    CullMode, DepthState, Footprint, FramePlan, Geometry, PassState, SoftTarget, Span,
-    StencilLayout, Step,
+    CullMode, DepthState, Footprint, FramePlan, Geometry, PassState, SimResult, Simulator,
+    SoftTarget, Span, StencilLayout, Step,
 };
 use histencil_scene::{Light, LightKind};
 
@@ -32,6 +32,19 @@ pub struct SimulatorInputs {
     pub plan: FramePlan,
     /// Per planned light (the plan's light indices).
     pub footprints: Vec<Footprint>,
+}
+
+impl SimulatorInputs {
+    /// Runs the simulator: what the GPU frame's lighting will do, and the stencil it leaves.
+    pub fn predict(&self) -> (SimResult, SoftTarget) {
+        let simulator = Simulator {
+            layout: self.layout,
+            tile_size: self.tile_size,
+        };
+        let mut target = self.target.clone();
+        let result = simulator.run(&mut target, &self.plan, &self.footprints);
+        (result, target)
+    }
 }
 
 /// "No face here" in the captured depth images.
@@ -153,7 +166,7 @@ impl FootprintCapture {
                 &self.readback[face],
             );
         }
-        host_readable(ctx, cmd);
+        host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
         ctx.end_label(cmd);
     }
 

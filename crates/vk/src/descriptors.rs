@@ -125,6 +125,73 @@ pub(crate) fn create_set_layout(
     Ok(layout)
 }
 
+/// A pool holding one set of `layout` whose bindings 0, 1, ... are the storage buffers
+/// `buffers`, named `{name}-descriptor-pool` and `{name}-set`. The caller destroys the pool.
+pub(crate) fn create_storage_buffer_set(
+    ctx: &Context,
+    name: &str,
+    layout: vk::DescriptorSetLayout,
+    buffers: &[vk::Buffer],
+) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
+    let d = &ctx.device;
+    let sizes = [vk::DescriptorPoolSize::default()
+        .ty(vk::DescriptorType::STORAGE_BUFFER)
+        .descriptor_count(buffers.len() as u32)];
+    let pool = unsafe {
+        d.create_descriptor_pool(
+            &vk::DescriptorPoolCreateInfo::default()
+                .max_sets(1)
+                .pool_sizes(&sizes),
+            None,
+        )
+    }
+    .call("vkCreateDescriptorPool")?;
+    ctx.name(pool, &format!("{name}-descriptor-pool"));
+    let layouts = [layout];
+    let allocated = unsafe {
+        d.allocate_descriptor_sets(
+            &vk::DescriptorSetAllocateInfo::default()
+                .descriptor_pool(pool)
+                .set_layouts(&layouts),
+        )
+    }
+    .call("vkAllocateDescriptorSets");
+    let set = match allocated {
+        Ok(sets) => sets[0],
+        Err(e) => {
+            unsafe { d.destroy_descriptor_pool(pool, None) };
+            return Err(e);
+        }
+    };
+    ctx.name(set, &format!("{name}-set"));
+    write_storage_buffers(ctx, set, buffers);
+    Ok((pool, set))
+}
+
+/// Points bindings 0, 1, ... of `set` at the storage buffers `buffers`.
+fn write_storage_buffers(ctx: &Context, set: vk::DescriptorSet, buffers: &[vk::Buffer]) {
+    let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+        .iter()
+        .map(|b| {
+            [vk::DescriptorBufferInfo::default()
+                .buffer(*b)
+                .range(vk::WHOLE_SIZE)]
+        })
+        .collect();
+    let writes: Vec<_> = infos
+        .iter()
+        .enumerate()
+        .map(|(i, info)| {
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(i as u32)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .buffer_info(info)
+        })
+        .collect();
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+}
+
 /// The frame's set layouts, pipeline layouts, pool and sets.
 pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
@@ -251,15 +318,6 @@ impl Descriptors {
                 .image_view(view)
                 .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
         };
-        let hi_stencil: Vec<_> = t
-            .hi_stencil
-            .iter()
-            .map(|b| {
-                [vk::DescriptorBufferInfo::default()
-                    .buffer(*b)
-                    .range(vk::WHOLE_SIZE)]
-            })
-            .collect();
         let gbuffer: Vec<_> = t.gbuffer_views.iter().map(|v| image(*v)).collect();
         let hdr = image(t.hdr_view);
         let mut writes = vec![
@@ -288,16 +346,8 @@ impl Descriptors {
                     .image_info(info),
             );
         }
-        for (i, info) in hi_stencil.iter().enumerate() {
-            writes.push(
-                vk::WriteDescriptorSet::default()
-                    .dst_set(self.hi_stencil_set)
-                    .dst_binding(i as u32)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .buffer_info(info),
-            );
-        }
         unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        write_storage_buffers(ctx, self.hi_stencil_set, &t.hi_stencil);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

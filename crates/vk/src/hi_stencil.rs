@@ -15,10 +15,12 @@
 
 use crate::access::{memory_barrier, transition, Contents, ImageAccess};
 use crate::context::Context;
-use crate::descriptors::{create_pipeline_layout, create_set_layout, HI_STENCIL_UPDATE_SET};
-use crate::error::{Result, VkCall};
-use crate::pipelines::create_module;
-use crate::readback::copy_image_to_buffer;
+use crate::descriptors::{
+    create_pipeline_layout, create_set_layout, create_storage_buffer_set, HI_STENCIL_UPDATE_SET,
+};
+use crate::error::Result;
+use crate::pipelines::create_compute_pipeline;
+use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::{Buffer, Image};
 use crate::shader_consts::HI_STENCIL_TILE;
 use crate::shaders;
@@ -107,7 +109,6 @@ impl HiStencilSurface {
         let (active, pending, touched, stats, stencil_copy, saved) =
             (next(), next(), next(), next(), next(), next());
 
-        let d = &ctx.device;
         let compute = vk::ShaderStageFlags::COMPUTE;
         let set_layout = create_set_layout(
             ctx,
@@ -122,68 +123,18 @@ impl HiStencilSurface {
             compute,
             std::mem::size_of::<UpdatePush>() as u32,
         )?;
-        let module = create_module(
+        let pipeline = create_compute_pipeline(
             ctx,
-            "hi-stencil-update-comp",
-            shaders::HI_STENCIL_UPDATE_COMP,
+            "hi-stencil-update-pipeline",
+            ("hi-stencil-update-comp", shaders::HI_STENCIL_UPDATE_COMP),
+            pipeline_layout,
         )?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(compute)
-            .module(module)
-            .name(c"main");
-        let info = [vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(pipeline_layout)];
-        let created = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
-        unsafe { d.destroy_shader_module(module, None) };
-        let pipeline = created
-            .map_err(|(_, e)| e)
-            .call("vkCreateComputePipelines")?[0];
-        ctx.name(pipeline, "hi-stencil-update-pipeline");
-
-        let sizes = [vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::STORAGE_BUFFER)
-            .descriptor_count(HI_STENCIL_UPDATE_SET.len() as u32)];
-        let pool = unsafe {
-            d.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(1)
-                    .pool_sizes(&sizes),
-                None,
-            )
-        }
-        .call("vkCreateDescriptorPool")?;
-        ctx.name(pool, "hi-stencil-update-descriptor-pool");
-        let layouts = [set_layout];
-        let set = unsafe {
-            d.allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
-                    .set_layouts(&layouts),
-            )
-        }
-        .call("vkAllocateDescriptorSets")?[0];
-        ctx.name(set, "hi-stencil-update-set");
-        let infos: Vec<[vk::DescriptorBufferInfo; 1]> = [&stencil_copy, &touched, &pending]
-            .iter()
-            .map(|b| {
-                [vk::DescriptorBufferInfo::default()
-                    .buffer(b.handle)
-                    .range(vk::WHOLE_SIZE)]
-            })
-            .collect();
-        let writes: Vec<_> = infos
-            .iter()
-            .enumerate()
-            .map(|(i, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(i as u32)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .buffer_info(info)
-            })
-            .collect();
-        unsafe { d.update_descriptor_sets(&writes, &[]) };
+        let (pool, set) = create_storage_buffer_set(
+            ctx,
+            "hi-stencil-update",
+            set_layout,
+            &[stencil_copy.handle, touched.handle, pending.handle],
+        )?;
         Ok(Self {
             extent,
             tiles_x,
@@ -321,13 +272,7 @@ impl HiStencilSurface {
 
     /// Makes the statistics visible to the host; record after the last lighting draw.
     pub fn record_stats_readable(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        let barrier = [vk::MemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
-            .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-            .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-        let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
-        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+        host_readable(ctx, cmd, vk::PipelineStageFlags2::FRAGMENT_SHADER);
     }
 
     /// The statistics of the last frame that counted; `flushes` is the caller's to fill in.

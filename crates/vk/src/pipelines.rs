@@ -47,6 +47,33 @@ pub(crate) fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<v
     Ok(module)
 }
 
+/// A named compute pipeline running `module` (name, SPIR-V) with `layout`.
+pub(crate) fn create_compute_pipeline(
+    ctx: &Context,
+    name: &str,
+    module: (&str, &[u8]),
+    layout: vk::PipelineLayout,
+) -> Result<vk::Pipeline> {
+    let shader = create_module(ctx, module.0, module.1)?;
+    let stage = vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::COMPUTE)
+        .module(shader)
+        .name(c"main");
+    let info = [vk::ComputePipelineCreateInfo::default()
+        .stage(stage)
+        .layout(layout)];
+    let created = unsafe {
+        ctx.device
+            .create_compute_pipelines(vk::PipelineCache::null(), &info, None)
+    };
+    unsafe { ctx.device.destroy_shader_module(shader, None) };
+    let pipeline = created
+        .map_err(|(_, e)| e)
+        .call("vkCreateComputePipelines")?[0];
+    ctx.name(pipeline, name);
+    Ok(pipeline)
+}
+
 pub const DYNAMIC_STATES: [vk::DynamicState; 11] = [
     vk::DynamicState::VIEWPORT,
     vk::DynamicState::SCISSOR,

@@ -78,11 +78,17 @@ pub(crate) fn copy_image_to_buffer(
     };
 }
 
-/// Makes every copy so far visible to host reads after the fence.
-pub(crate) fn host_readable(ctx: &Context, cmd: vk::CommandBuffer) {
+/// Makes the writes of `stage` so far (copies, or shader storage writes) visible to host reads
+/// after the fence.
+pub(crate) fn host_readable(ctx: &Context, cmd: vk::CommandBuffer, stage: vk::PipelineStageFlags2) {
+    let writes = if stage == vk::PipelineStageFlags2::COPY {
+        vk::AccessFlags2::TRANSFER_WRITE
+    } else {
+        vk::AccessFlags2::SHADER_STORAGE_WRITE
+    };
     let barrier = [vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::COPY)
-        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .src_stage_mask(stage)
+        .src_access_mask(writes)
         .dst_stage_mask(vk::PipelineStageFlags2::HOST)
         .dst_access_mask(vk::AccessFlags2::HOST_READ)];
     unsafe {
@@ -144,7 +150,7 @@ impl ReadbackBuffers {
         if what.brdf_ids {
             copy_image_to_buffer(ctx, cmd, &mut targets.gbuffer[2], color, &self.material);
         }
-        host_readable(ctx, cmd);
+        host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
         ctx.end_label(cmd);
     }
 

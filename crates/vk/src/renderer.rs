@@ -565,7 +565,7 @@ impl<'c> Renderer<'c> {
             let image = &mut self.targets.depth_stencil;
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
-            host_readable(ctx, cmd);
+            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
             self.submit_and_wait()?;
             let target = SoftTarget {
                 width: self.extent.width,

@@ -12,7 +12,7 @@ use crate::meshes::Meshes;
 use crate::state::{apply, with_stencil, OPAQUE};
 use crate::targets::Targets;
 use ash::vk;
-use histencil_model::{CompareOp, FaceStencil, PassState, StencilLayout, StencilOp};
+use histencil_model::{FaceStencil, PassState, StencilLayout, StencilOp};
 use histencil_scene::Scene;
 
 pub struct GeometryPass<'a> {
@@ -37,15 +37,12 @@ pub fn gbuffer_stencil(
 ) -> Option<FaceStencil> {
     // With one BRDF there are no BRDF bits and slot 0's reference is 0.
     let value = layout.brdf_reference(slot) | (preserved_pattern & layout.preserved_mask());
-    (layout.has_brdf_bits() || value != 0).then_some(FaceStencil {
-        compare: CompareOp::Always,
-        compare_mask: 0,
-        write_mask: !layout.culling_mask(),
-        reference: value,
-        pass: StencilOp::Replace,
-        fail: StencilOp::Keep,
-        depth_fail: StencilOp::Keep,
-    })
+    (layout.has_brdf_bits() || value != 0).then_some(FaceStencil::writing(
+        !layout.culling_mask(),
+        value,
+        StencilOp::Replace,
+        StencilOp::Keep,
+    ))
 }
 
 impl GeometryPass<'_> {
@@ -150,6 +147,7 @@ impl GeometryPass<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use histencil_model::CompareOp;
 
     #[test]
     fn gbuffer_writes_only_brdf_bits() {

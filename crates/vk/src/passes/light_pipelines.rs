@@ -183,30 +183,33 @@ pub fn pipeline_key(pass: &Pass, brdfs: &[BrdfId], count_stats: bool) -> LightPi
     (pass.geometry, shader)
 }
 
-/// Every pipeline a plan uses; `count_tiles` adds the statistics draws of hi-stencil tests.
+/// Every pipeline a plan uses, each once, in first-use order; `count_tiles` adds the statistics draws of hi-stencil tests.
 pub fn plan_pipelines(
     plan: &FramePlan,
     brdfs: &[BrdfId],
     count_tiles: bool,
 ) -> Vec<LightPipelineKey> {
     let mut keys = Vec::new();
+    let mut add = |key| {
+        if !keys.contains(&key) {
+            keys.push(key);
+        }
+    };
     for step in &plan.steps {
         match step {
             Step::Pass { pass, .. } => {
-                keys.push(pipeline_key(pass, brdfs, count_tiles));
+                add(pipeline_key(pass, brdfs, count_tiles));
                 if count_tiles && pass.state.tests_hi_stencil() {
-                    keys.push((pass.geometry, LightShader::CountTiles));
+                    add((pass.geometry, LightShader::CountTiles));
                 }
             }
             Step::RestorePreserved { .. } => {
-                keys.push((Geometry::FullScreen, LightShader::StencilOnly));
-                keys.push((Geometry::FullScreen, LightShader::RestoreBit));
+                add((Geometry::FullScreen, LightShader::StencilOnly));
+                add((Geometry::FullScreen, LightShader::RestoreBit));
             }
             Step::FlushHiStencil | Step::SavePreserved { .. } => {}
         }
     }
-    keys.sort_unstable_by_key(|k| format!("{k:?}"));
-    keys.dedup();
     keys
 }
 

@@ -24,8 +24,8 @@ use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
-    CompareOp, DepthState, FaceStencil, FramePlan, Geometry, LightCase, Pass, PassKind, PassState,
-    Shader, StencilOp, Step,
+    DepthState, FaceStencil, FramePlan, Geometry, LightCase, Pass, PassKind, PassState, Shader,
+    StencilOp, Step,
 };
 use histencil_scene::{Camera, Light, LightKind};
 
@@ -328,8 +328,7 @@ impl LightingPass<'_> {
         let key = pipeline_key(pass, self.brdfs, self.count_stats);
         self.draw(key, state, pass.geometry, push);
         if let Some(hi) = state.hi_stencil.filter(|h| h.write) {
-            rendering.close(self);
-            memory_barrier(self.ctx, self.cmd);
+            rendering.split(self);
             hi_stencil.record_update(
                 self.ctx,
                 self.cmd,
@@ -344,14 +343,8 @@ impl LightingPass<'_> {
     /// Writes the saved preserved bits of `mask` back: one pass zeroes them, then one pass per
     /// bit sets it where the saved copy had it (stencil references are per draw, not per pixel).
     fn record_restore(&self, mask: u8) {
-        let write = |write_mask: u8, reference: u8| FaceStencil {
-            compare: CompareOp::Always,
-            compare_mask: 0,
-            write_mask,
-            reference,
-            pass: StencilOp::Replace,
-            fail: StencilOp::Keep,
-            depth_fail: StencilOp::Keep,
+        let write = |write_mask: u8, reference: u8| {
+            FaceStencil::writing(write_mask, reference, StencilOp::Replace, StencilOp::Keep)
         };
         let state = |face: FaceStencil| PassState {
             front: Some(face),
