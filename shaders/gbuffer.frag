@@ -13,7 +13,7 @@ layout(location = 2) out vec4 out_material;
 
 void main() {
     Surface s = surface_from_draw(in_world_position, in_world_normal);
-    out_albedo = vec4(s.tint, 0.0);
+    out_albedo = vec4(s.tint, draw.tint.w);
     out_normal_depth = vec4(s.normal, in_linear_depth);
     out_material = vec4(s.params.xyz, float(s.brdf));
 }

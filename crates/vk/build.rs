@@ -54,6 +54,9 @@ fn generated_glsl() -> String {
         writeln!(s, "#define {name} {value}u").unwrap();
     }
     writeln!(s, "#define HI_STENCIL_TILE {HI_STENCIL_TILE}u").unwrap();
+    for axes in histencil_brdf::lut::LutAxes::ALL {
+        writeln!(s, "#define {} {}u", axes.glsl_constant(), axes.index()).unwrap();
+    }
     s + "#endif\n"
 }
 

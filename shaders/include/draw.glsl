@@ -7,7 +7,7 @@
 
 layout(push_constant) uniform Draw {
     mat4 model;
-    vec4 tint;   // rgb tint
+    vec4 tint;   // rgb tint, w material index (the LUT technique's table)
     vec4 params; // xyz the BRDF's packed parameters (histencil_brdf::Brdf::packed_params), w id
 } draw;
 

@@ -1,5 +1,6 @@
 // G-buffer layout, written by gbuffer.frag and read by the deferred light shaders (set 1).
-//   albedo:       RGBA16F  rgb tint
+//   albedo:       RGBA16F  rgb tint, a material index (the LUT technique's table; integers are
+//                          exact in f16 up to 2048)
 //   normal_depth: RGBA32F  xyz world normal, w linear view depth (0 = no geometry)
 //   material:     RGBA32F  xyz BRDF parameters, w BRDF id
 // Float formats keep the deferred path within 1/255 of the forward reference: parameters are
@@ -34,6 +35,11 @@ bool gbuffer_load(vec2 frag_coord, out Surface s) {
     s.params = vec4(material.xyz, 0.0);
     s.brdf = uint(material.w);
     return linear_depth > 0.0;
+}
+
+// The material index of the surface under pixel `frag_coord`.
+uint gbuffer_material_index(vec2 frag_coord) {
+    return uint(texelFetch(gbuffer_albedo, ivec2(frag_coord), 0).a);
 }
 
 #endif

@@ -114,13 +114,31 @@ fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
 /// statistics, so tiles are marked, flushed and culled exactly as the model says.
 #[test]
 fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
+    let auto = FlushPolicy::Auto;
     let cases = [
-        ("ps3", Backend::Ps3, FlushPolicy::Auto),
-        ("x360", x360(true, false), FlushPolicy::Auto),
-        ("x360-no-zeroing", x360(false, false), FlushPolicy::Auto),
-        ("x360-save-restore", x360(true, true), FlushPolicy::Auto),
-        ("ps3-flush-never", Backend::Ps3, FlushPolicy::Never),
-        ("x360-flush-always", x360(true, false), FlushPolicy::Always),
+        ("ps3", stencil(Backend::Ps3, auto)),
+        ("x360", stencil(x360(true, false), auto)),
+        ("x360-no-zeroing", stencil(x360(false, false), auto)),
+        ("x360-save-restore", stencil(x360(true, true), auto)),
+        ("ps3-flush-never", stencil(Backend::Ps3, FlushPolicy::Never)),
+        (
+            "x360-flush-always",
+            stencil(x360(true, false), FlushPolicy::Always),
+        ),
+        (
+            "branching-ps3",
+            Technique::Branching {
+                backend: Backend::Ps3,
+                flush: auto,
+            },
+        ),
+        (
+            "lut-ps3",
+            Technique::Lut {
+                backend: Backend::Ps3,
+                flush: auto,
+            },
+        ),
     ];
     for name in ["default", "brdfs-3", "near-far", "inside"] {
         let scene = histencil_scene::embedded(name).unwrap();
@@ -128,8 +146,7 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
             renderer.set_preserved_pattern(PATTERN);
             renderer.set_tile_stats(true);
-            for (label, backend, flush) in cases {
-                let technique = stencil(backend, flush);
+            for (label, technique) in cases {
                 let inputs = renderer.simulator_inputs(technique).expect("inputs");
                 let (sim, predicted) = inputs.predict();
                 let frame = renderer.render(technique, Readback::ALL).expect("frame");

@@ -43,6 +43,29 @@ pub enum LutAxes {
 const SKIN_CURVATURE_AT_END: f64 = 1e6;
 
 impl LutAxes {
+    /// Every parameterisation, in [`LutAxes::index`] order.
+    pub const ALL: [LutAxes; 4] = [
+        LutAxes::CosLight,
+        LutAxes::Isotropic,
+        LutAxes::Fibre,
+        LutAxes::SkinCurvature,
+    ];
+
+    /// The code the GPU tables store (GLSL `LUT_AXES_*`, generated from [`LutAxes::ALL`]).
+    pub fn index(self) -> u32 {
+        self as u32
+    }
+
+    /// The name of the GLSL constant holding [`LutAxes::index`].
+    pub fn glsl_constant(self) -> &'static str {
+        match self {
+            LutAxes::CosLight => "LUT_AXES_COS_LIGHT",
+            LutAxes::Isotropic => "LUT_AXES_ISOTROPIC",
+            LutAxes::Fibre => "LUT_AXES_FIBRE",
+            LutAxes::SkinCurvature => "LUT_AXES_SKIN_CURVATURE",
+        }
+    }
+
     pub fn of(brdf: &Brdf) -> Self {
         match brdf {
             Brdf::Lambert { .. } => LutAxes::CosLight,
@@ -209,13 +232,7 @@ impl Lut {
     /// The table's value at a shading point: multilinear interpolation between grid points,
     /// in f32 as a shader does it. Gated points give 0.
     pub fn lookup(&self, dirs: [V3<f64>; 4]) -> [f32; 3] {
-        let curvature = match self.brdf {
-            Brdf::PennerSkin {
-                curvature_per_mm, ..
-            } => curvature_per_mm,
-            _ => 0.0,
-        };
-        let Some(u) = self.axes.coordinates(dirs, curvature) else {
+        let Some(u) = self.axes.coordinates(dirs, self.curvature_per_mm()) else {
             return [0.0; 3];
         };
         let dims = self.axes.dimensions();
@@ -246,6 +263,17 @@ impl Lut {
             }
         }
         out
+    }
+
+    /// The skin curvature the table is looked up at (0 for the other models): the material's
+    /// own, since curvature is an axis of the skin table.
+    pub fn curvature_per_mm(&self) -> f64 {
+        match self.brdf {
+            Brdf::PennerSkin {
+                curvature_per_mm, ..
+            } => curvature_per_mm,
+            _ => 0.0,
+        }
     }
 
     /// Bytes of the table as RGB f32.
@@ -359,6 +387,13 @@ mod tests {
         let lut = Lut::bake(Brdf::Lambert { rho: 0.5 }, 2).unwrap();
         let error = LutAccuracy::measure(&lut, &report_directions(256));
         assert!(error.max_abs < 1e-7, "{error:?}");
+    }
+
+    #[test]
+    fn axes_codes_follow_all() {
+        for (i, axes) in LutAxes::ALL.into_iter().enumerate() {
+            assert_eq!(axes.index() as usize, i);
+        }
     }
 
     #[test]

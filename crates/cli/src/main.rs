@@ -71,8 +71,9 @@ struct RenderArgs {
     scene: String,
     /// How lights are applied: `stencil` (the talk's one pass per BRDF, masked by stencil),
     /// `branching` (one uber shader), `adaptive` (stencil or branching per light, by the cost
-    /// model fitted to the talk's figures), `deferred` (branching on the native backend),
-    /// `forward` (the reference).
+    /// model fitted to the talk's figures), `lut` (one pass per light, every BRDF from its
+    /// material's look-up table), `deferred` (branching on the native backend), `forward` (the
+    /// reference).
     #[arg(long, value_enum, default_value = "deferred")]
     technique: TechniqueArg,
     /// Platform behaviour of the stencil plan: x360 (no hi-stencil read mask, zeroes preserved
@@ -83,6 +84,10 @@ struct RenderArgs {
     /// When hi-stencil is flushed.
     #[arg(long, value_enum, default_value = "auto")]
     flush: FlushArg,
+    /// With `--technique lut`: grid points per axis of every BRDF table (2..=512; a 3D table
+    /// takes 12 * N^3 bytes).
+    #[arg(long, default_value_t = histencil_vk::DEFAULT_LUT_RESOLUTION)]
+    lut_resolution: u32,
     /// Time every lighting step and print the talk's pass groups (setup, mask and shade per BRDF,
     /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
     #[arg(long)]
@@ -121,6 +126,7 @@ enum TechniqueArg {
     Stencil,
     Branching,
     Adaptive,
+    Lut,
     Deferred,
     Forward,
 }
@@ -168,6 +174,7 @@ impl RenderArgs {
             TechniqueArg::Stencil => Technique::Stencil { backend, flush },
             TechniqueArg::Branching => Technique::Branching { backend, flush },
             TechniqueArg::Adaptive => Technique::Adaptive { backend, flush },
+            TechniqueArg::Lut => Technique::Lut { backend, flush },
             TechniqueArg::Deferred => Technique::DEFERRED,
             TechniqueArg::Forward => Technique::Forward,
         }
@@ -236,6 +243,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         let technique = args.technique();
         let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
         renderer.set_preserved_pattern(args.preserved_pattern);
+        renderer.set_lut_resolution(args.lut_resolution)?;
         if args.stats {
             print_stats(&mut renderer, technique)?;
         }

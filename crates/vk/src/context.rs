@@ -48,6 +48,7 @@ pub struct Context {
     pub(crate) depth_stencil_format: vk::Format,
     pub(crate) timestamp_period_ns: f64,
     pub(crate) max_image_dimension: u32,
+    pub(crate) max_storage_buffer_range: u32,
 }
 
 fn pick_depth_stencil_format(
@@ -224,6 +225,7 @@ impl Context {
             depth_stencil_format,
             timestamp_period_ns: f64::from(props.limits.timestamp_period),
             max_image_dimension: props.limits.max_image_dimension2_d,
+            max_storage_buffer_range: props.limits.max_storage_buffer_range,
         };
         ctx.name(ctx.device.handle(), "histencil-device");
         ctx.name(ctx.queue, "graphics-queue");

@@ -72,12 +72,27 @@ pub const BRDF_EVAL_SET: &[BindingDesc] = &[
     binding(1, BindingKind::StorageBuffer, "results"),
 ];
 
+/// Set 3 of the light pipelines: the LUT technique's tables (include/lut.glsl), bound only by
+/// the LUT light shader.
+pub const LUT_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+];
+/// The table lookup evaluator's cases, results and tables; see `lut.rs`.
+pub const LUT_EVAL_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, ""),
+    binding(3, BindingKind::StorageBuffer, ""),
+];
+
 /// The pipeline layouts: which sets, in order.
 pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET];
-pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET];
+pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET, LUT_SET];
 pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
 pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
 pub const HI_STENCIL_UPDATE_LAYOUT: &[&[BindingDesc]] = &[HI_STENCIL_UPDATE_SET];
+pub const LUT_EVAL_LAYOUT: &[&[BindingDesc]] = &[LUT_EVAL_SET];
 
 /// Every shader module and the pipeline layout it is used with.
 pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
@@ -86,6 +101,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("forward.frag", MESH_LAYOUT),
     ("light_volume.vert", LIGHTING_LAYOUT),
     ("deferred_light.frag", LIGHTING_LAYOUT),
+    ("lut_light.frag", LIGHTING_LAYOUT),
     ("hi_stencil_touch.frag", LIGHTING_LAYOUT),
     ("hi_stencil_count.frag", LIGHTING_LAYOUT),
     ("restore_preserved.frag", LIGHTING_LAYOUT),
@@ -94,6 +110,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("fullscreen.vert", LIGHTING_LAYOUT),
     ("tonemap.frag", TONEMAP_LAYOUT),
     ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
+    ("lut_eval.comp", LUT_EVAL_LAYOUT),
 ];
 
 /// The stages of the graphics passes: every binding and push constant is visible to both.
@@ -169,7 +186,7 @@ pub(crate) fn create_storage_buffer_set(
 }
 
 /// Points bindings 0, 1, ... of `set` at the storage buffers `buffers`.
-fn write_storage_buffers(ctx: &Context, set: vk::DescriptorSet, buffers: &[vk::Buffer]) {
+pub(crate) fn write_storage_buffers(ctx: &Context, set: vk::DescriptorSet, buffers: &[vk::Buffer]) {
     let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
         .iter()
         .map(|b| {
@@ -197,6 +214,7 @@ pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
     pub gbuffer_layout: vk::DescriptorSetLayout,
     pub hi_stencil_layout: vk::DescriptorSetLayout,
+    pub lut_layout: vk::DescriptorSetLayout,
     pub tonemap_layout: vk::DescriptorSetLayout,
     pub mesh_pipeline_layout: vk::PipelineLayout,
     pub lighting_pipeline_layout: vk::PipelineLayout,
@@ -205,6 +223,8 @@ pub struct Descriptors {
     pub frame_set: vk::DescriptorSet,
     pub gbuffer_set: vk::DescriptorSet,
     pub hi_stencil_set: vk::DescriptorSet,
+    /// Written when the LUT technique first needs its tables.
+    pub lut_set: vk::DescriptorSet,
     pub tonemap_set: vk::DescriptorSet,
 }
 
@@ -244,6 +264,7 @@ impl Descriptors {
         let frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
         let gbuffer_layout = set_layout("gbuffer-set-layout", GBUFFER_SET)?;
         let hi_stencil_layout = set_layout("hi-stencil-set-layout", HI_STENCIL_SET)?;
+        let lut_layout = set_layout("lut-set-layout", LUT_SET)?;
         let tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
         let pipeline_layout = |name, sets: &[vk::DescriptorSetLayout]| {
             create_pipeline_layout(ctx, name, sets, GRAPHICS_STAGES, PUSH_CONSTANT_BYTES)
@@ -251,7 +272,7 @@ impl Descriptors {
         let mesh_pipeline_layout = pipeline_layout("mesh-pipeline-layout", &[frame_layout])?;
         let lighting_pipeline_layout = pipeline_layout(
             "lighting-pipeline-layout",
-            &[frame_layout, gbuffer_layout, hi_stencil_layout],
+            &[frame_layout, gbuffer_layout, hi_stencil_layout, lut_layout],
         )?;
         let tonemap_pipeline_layout =
             pipeline_layout("tonemap-pipeline-layout", &[frame_layout, tonemap_layout])?;
@@ -262,13 +283,13 @@ impl Descriptors {
                 .descriptor_count(1),
             vk::DescriptorPoolSize::default()
                 .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1 + HI_STENCIL_SET.len() as u32),
+                .descriptor_count(1 + (HI_STENCIL_SET.len() + LUT_SET.len()) as u32),
             vk::DescriptorPoolSize::default()
                 .ty(vk::DescriptorType::SAMPLED_IMAGE)
                 .descriptor_count(4),
         ];
         let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(4)
+            .max_sets(5)
             .pool_sizes(&sizes);
         let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
             .call("vkCreateDescriptorPool")?;
@@ -277,6 +298,7 @@ impl Descriptors {
             frame_layout,
             gbuffer_layout,
             hi_stencil_layout,
+            lut_layout,
             tonemap_layout,
         ];
         let alloc = vk::DescriptorSetAllocateInfo::default()
@@ -284,7 +306,13 @@ impl Descriptors {
             .set_layouts(&layouts);
         let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .call("vkAllocateDescriptorSets")?;
-        let names = ["frame-set", "gbuffer-set", "hi-stencil-set", "tonemap-set"];
+        let names = [
+            "frame-set",
+            "gbuffer-set",
+            "hi-stencil-set",
+            "lut-set",
+            "tonemap-set",
+        ];
         for (set, name) in sets.iter().zip(names) {
             ctx.name(*set, name);
         }
@@ -292,6 +320,7 @@ impl Descriptors {
             frame_layout,
             gbuffer_layout,
             hi_stencil_layout,
+            lut_layout,
             tonemap_layout,
             mesh_pipeline_layout,
             lighting_pipeline_layout,
@@ -300,7 +329,8 @@ impl Descriptors {
             frame_set: sets[0],
             gbuffer_set: sets[1],
             hi_stencil_set: sets[2],
-            tonemap_set: sets[3],
+            lut_set: sets[3],
+            tonemap_set: sets[4],
         };
         d.write(ctx, targets);
         Ok(d)
@@ -364,6 +394,7 @@ impl Descriptors {
                 self.frame_layout,
                 self.gbuffer_layout,
                 self.hi_stencil_layout,
+                self.lut_layout,
                 self.tonemap_layout,
             ] {
                 ctx.device.destroy_descriptor_set_layout(l, None);

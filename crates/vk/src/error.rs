@@ -26,6 +26,15 @@ pub enum Error {
     Layout(#[from] histencil_model::LayoutError),
     #[error("lighting plan: {0}")]
     Plan(#[from] histencil_model::PlanError),
+    #[error("BRDF table: {0}")]
+    Lut(#[from] histencil_brdf::lut::LutError),
+    #[error(
+        "the BRDF tables need {bytes} bytes, more than this device's storage-buffer range of \
+         {limit} bytes: lower the LUT resolution"
+    )]
+    LutTooLarge { bytes: u64, limit: u64 },
+    #[error("{count} distinct materials; the G-buffer indexes at most {max}")]
+    TooManyMaterials { count: usize, max: usize },
     #[error("not supported yet: {0}")]
     Unsupported(&'static str),
     #[error("cannot write `{path}`: {message}")]

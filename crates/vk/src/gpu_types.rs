@@ -103,11 +103,13 @@ pub struct DrawPush {
 }
 
 impl DrawPush {
-    pub fn new(model: Mat4, material: &Material) -> Self {
+    /// `material_index` is the material's LUT table (the G-buffer stores it for the LUT
+    /// technique).
+    pub fn new(model: Mat4, material: &Material, material_index: u32) -> Self {
         let p = material.brdf.packed_params();
         Self {
             model: model.to_cols_array_2d(),
-            tint: material.tint.extend(0.0).to_array(),
+            tint: material.tint.extend(material_index as f32).to_array(),
             params: [
                 p[0] as f32,
                 p[1] as f32,

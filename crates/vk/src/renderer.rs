@@ -2,13 +2,15 @@
 
 use crate::capture::{is_full_screen, FootprintCapture, SimulatorInputs};
 use crate::context::Context;
+use crate::descriptors::write_storage_buffers;
 use crate::descriptors::{DescriptorTargets, Descriptors};
 use crate::error::{Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::hi_stencil::HiStencilSurface;
+use crate::lut::LutTables;
 use crate::meshes::Meshes;
 use crate::passes::geometry::GeometryPass;
-use crate::passes::light_pipelines::{prepare_pipelines, LightPipelines};
+use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
 use crate::passes::lighting::{classify, mesh_bound, screen_coverage, LightingPass};
 use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
@@ -20,7 +22,8 @@ use crate::shader_consts::HI_STENCIL_TILE;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
 use crate::timing::{FrameTimings, StepTimer, Timestamps};
 use ash::vk;
-use histencil_brdf::BrdfId;
+use histencil_brdf::lut::{Lut, LutError};
+use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
     CostModel, FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native,
     PlatformBackend, Ps3Like, SoftTarget, StencilLayout, TalkFigures, TileStats, X360Like,
@@ -81,6 +84,13 @@ pub enum Technique {
         backend: Backend,
         flush: FlushPolicy,
     },
+    /// The talk's third option: one draw per light, as branching, with every BRDF read from its
+    /// material's look-up table ([`Renderer::set_lut_resolution`]) instead of its formula.
+    /// Approximate: its error against forward falls with the table resolution.
+    Lut {
+        backend: Backend,
+        flush: FlushPolicy,
+    },
 }
 
 impl Technique {
@@ -103,8 +113,47 @@ impl Technique {
             Technique::Adaptive { backend, flush } => {
                 Some((LightTechnique::Stencil, backend, flush))
             }
+            // Planned as branching: one draw per light, whatever the pixel's BRDF.
+            Technique::Lut { backend, flush } => Some((LightTechnique::Branching, backend, flush)),
         }
     }
+
+    fn brdf_source(self) -> BrdfSource {
+        match self {
+            Technique::Lut { .. } => BrdfSource::Table,
+            _ => BrdfSource::Formula,
+        }
+    }
+}
+
+/// The LUT technique's table resolution until [`Renderer::set_lut_resolution`] says otherwise:
+/// the `brdf-report` tables put the broad lobes within about 1e-3 of their formula at 32
+/// points per axis (the sharp ones need more, see the README), at 384 KiB per 3D table.
+pub const DEFAULT_LUT_RESOLUTION: u32 = 32;
+
+/// The most materials the G-buffer can index: integers are exact in its f16 alpha up to here.
+const MAX_MATERIALS: usize = 2048;
+
+/// The distinct BRDF materials of `scene` in first-use order (the LUT technique's tables) and
+/// each object's index among them.
+fn distinct_materials(scene: &Scene) -> (Vec<Brdf>, Vec<u32>) {
+    let mut materials: Vec<Brdf> = Vec::new();
+    let indices = scene
+        .objects
+        .iter()
+        .map(|o| {
+            let brdf = o.material.brdf;
+            let index = materials
+                .iter()
+                .position(|m| *m == brdf)
+                .unwrap_or_else(|| {
+                    materials.push(brdf);
+                    materials.len() - 1
+                });
+            index as u32
+        })
+        .collect();
+    (materials, indices)
 }
 
 /// The talk gives no fixed cost per draw; the default cost model assumes this one.
@@ -135,6 +184,12 @@ pub struct Renderer<'c> {
     brdfs: Vec<BrdfId>,
     /// Each object's BRDF slot.
     object_slots: Vec<u32>,
+    /// The distinct BRDF materials (one LUT table each) and each object's index among them.
+    materials: Vec<Brdf>,
+    object_materials: Vec<u32>,
+    lut_resolution: u32,
+    /// Baked when the LUT technique first renders at `lut_resolution`.
+    lut_tables: Option<LutTables>,
     /// Written into the preserved stencil bits by the G-buffer pass (the engine's own bits).
     preserved_pattern: u8,
     light_pipelines: LightPipelines,
@@ -172,6 +227,7 @@ impl<'c> Renderer<'c> {
             .iter()
             .map(|o| slot_of(&brdfs, o.material.brdf.id()))
             .collect();
+        let (materials, object_materials) = distinct_materials(&scene);
 
         let targets = Targets::new(ctx, extent)?;
         let meshes = Meshes::new(ctx)?;
@@ -250,6 +306,10 @@ impl<'c> Renderer<'c> {
             stencil_layout,
             brdfs,
             object_slots,
+            materials,
+            object_materials,
+            lut_resolution: DEFAULT_LUT_RESOLUTION,
+            lut_tables: None,
             preserved_pattern: 0,
             light_pipelines,
             pass_timing: false,
@@ -333,6 +393,49 @@ impl<'c> Renderer<'c> {
         })
     }
 
+    /// Sets the LUT technique's table resolution (grid points per axis); the tables are baked
+    /// again on the next LUT frame.
+    ///
+    /// # Errors
+    /// [`crate::Error::Lut`] outside `2..=`[`Lut::MAX_RESOLUTION`].
+    pub fn set_lut_resolution(&mut self, resolution: u32) -> Result<()> {
+        if !(2..=Lut::MAX_RESOLUTION).contains(&resolution) {
+            return Err(LutError::Resolution(resolution).into());
+        }
+        if resolution != self.lut_resolution {
+            if let Some(mut old) = self.lut_tables.take() {
+                old.destroy(self.ctx);
+            }
+            self.lut_resolution = resolution;
+        }
+        Ok(())
+    }
+
+    pub fn lut_resolution(&self) -> u32 {
+        self.lut_resolution
+    }
+
+    /// The LUT technique's tables at the current resolution, baked and uploaded on first use
+    /// (by table index: the scene's distinct BRDF materials in first-use order).
+    ///
+    /// # Errors
+    /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
+    /// [`LutTables::new`].
+    pub fn lut_tables(&mut self) -> Result<&LutTables> {
+        if self.lut_tables.is_none() {
+            if self.materials.len() > MAX_MATERIALS {
+                return Err(crate::Error::TooManyMaterials {
+                    count: self.materials.len(),
+                    max: MAX_MATERIALS,
+                });
+            }
+            let tables = LutTables::new(self.ctx, &self.materials, self.lut_resolution)?;
+            write_storage_buffers(self.ctx, self.descriptors.lut_set, &tables.buffers());
+            self.lut_tables = Some(tables);
+        }
+        Ok(self.lut_tables.as_ref().expect("baked above"))
+    }
+
     /// Light pipelines created so far.
     pub fn light_pipeline_count(&self) -> usize {
         self.light_pipelines.count()
@@ -394,12 +497,17 @@ impl<'c> Renderer<'c> {
         let ctx = self.ctx;
         let (plan, light_indices) = self.plan(technique)?;
         let count_stats = self.tile_stats && technique != Technique::Forward;
+        let brdf_source = technique.brdf_source();
+        if brdf_source == BrdfSource::Table {
+            self.lut_tables()?;
+        }
         prepare_pipelines(
             ctx,
             &mut self.light_pipelines,
             &plan,
             &self.brdfs,
             count_stats,
+            brdf_source,
         )?;
         let time_steps = self.pass_timing && technique != Technique::Forward;
         if time_steps {
@@ -415,6 +523,12 @@ impl<'c> Renderer<'c> {
                 self.step_timer = Some(StepTimer::new(ctx, needed.next_power_of_two())?);
             }
         }
+        let light_sets = [
+            self.descriptors.frame_set,
+            self.descriptors.gbuffer_set,
+            self.descriptors.hi_stencil_set,
+            self.descriptors.lut_set,
+        ];
         let cmd = self.begin_commands()?;
         self.timestamps.begin_frame(ctx, cmd);
         match technique {
@@ -435,11 +549,13 @@ impl<'c> Renderer<'c> {
                     meshes: &self.meshes,
                     pipelines: &self.light_pipelines,
                     pipeline_layout: self.descriptors.lighting_pipeline_layout,
-                    sets: [
-                        self.descriptors.frame_set,
-                        self.descriptors.gbuffer_set,
-                        self.descriptors.hi_stencil_set,
-                    ],
+                    // The LUT set is written only once tables exist.
+                    sets: &light_sets[..if brdf_source == BrdfSource::Table {
+                        4
+                    } else {
+                        3
+                    }],
+                    brdf_source,
                     extent: self.extent,
                     count_stats,
                 }
@@ -530,6 +646,7 @@ impl<'c> Renderer<'c> {
             pipeline_layout: self.descriptors.mesh_pipeline_layout,
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
+            material_indices: &self.object_materials,
         };
         if forward {
             geometry.record_forward(&mut self.targets);
@@ -640,6 +757,9 @@ impl Drop for Renderer<'_> {
         self.readback.destroy(ctx);
         self.pipelines.destroy(ctx);
         self.light_pipelines.destroy(ctx);
+        if let Some(t) = self.lut_tables.as_mut() {
+            t.destroy(ctx);
+        }
         self.descriptors.destroy(ctx);
         self.hi_stencil.destroy(ctx);
         self.lights.destroy(ctx);

@@ -24,6 +24,8 @@ pub struct GeometryPass<'a> {
     pub pipeline_layout: vk::PipelineLayout,
     pub frame_set: vk::DescriptorSet,
     pub extent: vk::Extent2D,
+    /// Each object's material index (its LUT table), stored in the G-buffer.
+    pub material_indices: &'a [u32],
 }
 
 /// The stencil state with which the G-buffer pass writes `slot` (a BRDF's index among those in
@@ -61,7 +63,7 @@ impl GeometryPass<'_> {
         }
         for (i, object) in self.scene.objects.iter().enumerate() {
             apply(self.ctx, self.cmd, &state_of(i));
-            let push = DrawPush::new(object.transform, &object.material);
+            let push = DrawPush::new(object.transform, &object.material, self.material_indices[i]);
             unsafe {
                 d.cmd_push_constants(
                     self.cmd,

@@ -25,6 +25,18 @@ pub enum LightShader {
     Brdf { id: BrdfId, tiles: TileWork },
     /// The uber light shader branching on the G-buffer's BRDF id.
     Branching { tiles: TileWork },
+    /// The LUT technique's light shader: every BRDF from its material's table.
+    Lut { tiles: TileWork },
+}
+
+/// Where shade passes get a BRDF's value from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BrdfSource {
+    /// The BRDF's formula (`include/brdf`): the stencil, branching and adaptive techniques.
+    Formula,
+    /// The material's look-up table (`include/lut.glsl`): the LUT technique, whatever pass the
+    /// plan shades with.
+    Table,
 }
 
 /// Whether a light shader carries the hi-stencil emulation's work: rejecting failing tiles and
@@ -110,6 +122,16 @@ impl LightPipelines {
                 ]),
                 format!("branching{}", tiles.suffix()),
             ),
+            // Constant 0 is unused by the LUT shader; both are given so every light shader
+            // specialises the same way.
+            LightShader::Lut { tiles } => (
+                Some(("lut_light.frag", shaders::LUT_LIGHT_FRAG)),
+                Some([
+                    BRANCH_ON_GBUFFER,
+                    u32::from(tiles == TileWork::TestAndCount),
+                ]),
+                format!("lut{}", tiles.suffix()),
+            ),
         };
         let shades = specialization.is_some();
         let geometry_name = match geometry {
@@ -165,13 +187,19 @@ impl TileWork {
 
 /// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs; with `count_stats`
 /// every light shader counts its fragments.
-pub fn pipeline_key(pass: &Pass, brdfs: &[BrdfId], count_stats: bool) -> LightPipelineKey {
+pub fn pipeline_key(
+    pass: &Pass,
+    brdfs: &[BrdfId],
+    count_stats: bool,
+    source: BrdfSource,
+) -> LightPipelineKey {
     let tiles = if count_stats || pass.state.tests_hi_stencil() {
         TileWork::TestAndCount
     } else {
         TileWork::None
     };
     let shader = match pass.kind {
+        PassKind::Shade(_) if source == BrdfSource::Table => LightShader::Lut { tiles },
         PassKind::Shade(Shader::Brdf(slot)) => LightShader::Brdf {
             id: brdfs[slot as usize],
             tiles,
@@ -188,6 +216,7 @@ pub fn plan_pipelines(
     plan: &FramePlan,
     brdfs: &[BrdfId],
     count_tiles: bool,
+    source: BrdfSource,
 ) -> Vec<LightPipelineKey> {
     let mut keys = Vec::new();
     let mut add = |key| {
@@ -198,7 +227,7 @@ pub fn plan_pipelines(
     for step in &plan.steps {
         match step {
             Step::Pass { pass, .. } => {
-                add(pipeline_key(pass, brdfs, count_tiles));
+                add(pipeline_key(pass, brdfs, count_tiles, source));
                 if count_tiles && pass.state.tests_hi_stencil() {
                     add((pass.geometry, LightShader::CountTiles));
                 }
@@ -220,8 +249,9 @@ pub fn prepare_pipelines(
     plan: &FramePlan,
     brdfs: &[BrdfId],
     count_tiles: bool,
+    source: BrdfSource,
 ) -> Result<()> {
-    for key in plan_pipelines(plan, brdfs, count_tiles) {
+    for key in plan_pipelines(plan, brdfs, count_tiles, source) {
         pipelines.prepare(ctx, key)?;
     }
     Ok(())
@@ -245,7 +275,7 @@ mod tests {
         };
         let plan =
             FramePlan::build(&layout, &X360Like::default(), &[request], FlushPolicy::Auto).unwrap();
-        let keys = plan_pipelines(&plan, &brdfs, false);
+        let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula);
         let shaders: Vec<LightShader> = keys.iter().map(|k| k.1).collect();
         let tiles = TileWork::TestAndCount;
         for expected in [
@@ -263,8 +293,14 @@ mod tests {
             assert!(shaders.contains(&expected), "{expected:?} in {shaders:?}");
         }
         assert!(!shaders.contains(&LightShader::CountTiles));
-        assert!(plan_pipelines(&plan, &brdfs, true)
+        assert!(plan_pipelines(&plan, &brdfs, true, BrdfSource::Formula)
             .iter()
             .any(|k| k.1 == LightShader::CountTiles));
+        let table = plan_pipelines(&plan, &brdfs, false, BrdfSource::Table);
+        assert!(table.iter().any(|k| matches!(k.1, LightShader::Lut { .. })));
+        assert!(!table.iter().any(|k| matches!(
+            k.1,
+            LightShader::Brdf { .. } | LightShader::Branching { .. }
+        )));
     }
 }

@@ -9,7 +9,9 @@
 //! tile surface of [`crate::hi_stencil`], so its failures (stale tiles without a flush, preserved
 //! bits on 360-like hardware without zeroing) show in the image as they would on the console.
 
-use super::light_pipelines::{pipeline_key, LightPipelineKey, LightPipelines, LightShader};
+use super::light_pipelines::{
+    pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
+};
 use super::{begin_hdr_rendering, Load, CLEAR_BLACK};
 use crate::access::{memory_barrier, transition, Contents, ImageAccess};
 use crate::context::Context;
@@ -60,9 +62,10 @@ pub fn classify(light: &Light, mesh_bound: f32, camera: &Camera, aspect: f32) ->
 }
 
 /// The talk's pass group of a planned pass, for timings: `setup`, `mask-<brdf>`, `shade-<brdf>`
-/// (`-branching` for the uber shader), `cleanup`, `zero-preserved`.
-pub fn pass_group(kind: PassKind, brdfs: &[BrdfId]) -> String {
+/// (`-branching` for the uber shader, `-lut` for the table shader), `cleanup`, `zero-preserved`.
+pub fn pass_group(kind: PassKind, brdfs: &[BrdfId], source: BrdfSource) -> String {
     let shader = |s: Shader| match s {
+        _ if source == BrdfSource::Table => "lut",
         Shader::Brdf(slot) => brdfs[slot as usize].name(),
         Shader::Branching => "branching",
     };
@@ -109,8 +112,9 @@ pub struct LightingPass<'a> {
     pub meshes: &'a Meshes,
     pub pipelines: &'a LightPipelines,
     pub pipeline_layout: vk::PipelineLayout,
-    /// Frame, G-buffer and hi-stencil sets.
-    pub sets: [vk::DescriptorSet; 3],
+    /// Frame, G-buffer and hi-stencil sets, and the LUT set when shading from tables.
+    pub sets: &'a [vk::DescriptorSet],
+    pub brdf_source: BrdfSource,
     pub extent: vk::Extent2D,
     /// Count tile and fragment statistics (extra draws and atomics).
     pub count_stats: bool,
@@ -189,7 +193,7 @@ impl LightingPass<'_> {
                 vk::PipelineBindPoint::GRAPHICS,
                 self.pipeline_layout,
                 0,
-                &self.sets,
+                self.sets,
                 &[],
             );
         }
@@ -224,7 +228,7 @@ impl LightingPass<'_> {
                     )?;
                     ctx.end_label(cmd);
                     if let Some(t) = timer.as_deref_mut() {
-                        let group = pass_group(pass.kind, self.brdfs);
+                        let group = pass_group(pass.kind, self.brdfs, self.brdf_source);
                         t.mark(ctx, cmd, group, Some(scene_light));
                     }
                 }
@@ -325,7 +329,7 @@ impl LightingPass<'_> {
             flags,
             bit: 0,
         };
-        let key = pipeline_key(pass, self.brdfs, self.count_stats);
+        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source);
         self.draw(key, state, pass.geometry, push);
         if let Some(hi) = state.hi_stencil.filter(|h| h.write) {
             rendering.split(self);

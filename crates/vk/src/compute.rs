@@ -1,0 +1,195 @@
+//! Compute kernels run once and waited for: the test-facing evaluators (GLSL BRDFs, GLSL table
+//! lookups) that hold the shader code to its Rust reference, case by case.
+
+use crate::context::Context;
+use crate::descriptors::{
+    create_pipeline_layout, create_set_layout, create_storage_buffer_set, BindingDesc,
+};
+use crate::error::{Result, VkCall};
+use crate::pipelines::create_compute_pipeline;
+use crate::readback::host_readable;
+use crate::resources::Buffer;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// Invocations per workgroup of every case kernel (`local_size_x` in the shaders).
+const WORKGROUP: u32 = 64;
+
+/// A compute pipeline over one set of storage buffers, with the case count as its only push
+/// constant: binding 0 holds the cases, binding 1 receives one `vec4` per case, and any further
+/// bindings are the caller's read-only data.
+pub(crate) struct CaseKernel {
+    name: &'static str,
+    set_layout: vk::DescriptorSetLayout,
+    pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+}
+
+impl CaseKernel {
+    pub fn new(
+        ctx: &Context,
+        name: &'static str,
+        set: &[BindingDesc],
+        module: (&str, &[u8]),
+    ) -> Result<Self> {
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let set_layout = create_set_layout(ctx, &format!("{name}-set-layout"), set, compute)?;
+        let pipeline_layout = match create_pipeline_layout(
+            ctx,
+            &format!("{name}-pipeline-layout"),
+            &[set_layout],
+            compute,
+            4,
+        ) {
+            Ok(l) => l,
+            Err(e) => {
+                unsafe { ctx.device.destroy_descriptor_set_layout(set_layout, None) };
+                return Err(e);
+            }
+        };
+        let mut kernel = Self {
+            name,
+            set_layout,
+            pipeline_layout,
+            pipeline: vk::Pipeline::null(),
+        };
+        match create_compute_pipeline(ctx, &format!("{name}-pipeline"), module, pipeline_layout) {
+            Ok(p) => kernel.pipeline = p,
+            Err(e) => {
+                kernel.destroy(ctx);
+                return Err(e);
+            }
+        }
+        Ok(kernel)
+    }
+
+    /// Runs the kernel over `count` cases laid out in `cases` (std430), with `extra` as
+    /// bindings 2, 3, ..., and returns the first three components of each result.
+    pub fn run(
+        &self,
+        ctx: &Context,
+        cases: &[u8],
+        count: u32,
+        extra: &[vk::Buffer],
+    ) -> Result<Vec<[f32; 3]>> {
+        if count == 0 {
+            return Ok(Vec::new());
+        }
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let mut input = Buffer::with_data(ctx, &format!("{}-cases", self.name), storage, cases)?;
+        let mut output = match Buffer::new(
+            ctx,
+            &format!("{}-results", self.name),
+            u64::from(count) * 16,
+            storage,
+            MemoryLocation::GpuToCpu,
+        ) {
+            Ok(b) => b,
+            Err(e) => {
+                input.destroy(ctx);
+                return Err(e);
+            }
+        };
+        let mut buffers = vec![input.handle, output.handle];
+        buffers.extend_from_slice(extra);
+        let values = self.dispatch(ctx, &buffers, count).map(|()| {
+            bytemuck::cast_slice::<u8, f32>(output.read())
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect()
+        });
+        input.destroy(ctx);
+        output.destroy(ctx);
+        values
+    }
+
+    fn dispatch(&self, ctx: &Context, buffers: &[vk::Buffer], count: u32) -> Result<()> {
+        let d = &ctx.device;
+        let (pool, set) = create_storage_buffer_set(ctx, self.name, self.set_layout, buffers)?;
+        let command_pool = unsafe {
+            d.create_command_pool(
+                &vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family),
+                None,
+            )
+        };
+        let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) };
+        let recorded = (|| -> Result<()> {
+            let command_pool = command_pool.call("vkCreateCommandPool")?;
+            ctx.name(command_pool, &format!("{}-command-pool", self.name));
+            let fence = fence.call("vkCreateFence")?;
+            ctx.name(fence, &format!("{}-fence", self.name));
+            let cmd = unsafe {
+                d.allocate_command_buffers(
+                    &vk::CommandBufferAllocateInfo::default()
+                        .command_pool(command_pool)
+                        .command_buffer_count(1),
+                )
+            }
+            .call("vkAllocateCommandBuffers")?[0];
+            ctx.name(cmd, &format!("{}-commands", self.name));
+            unsafe {
+                d.begin_command_buffer(
+                    cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .call("vkBeginCommandBuffer")?;
+                ctx.begin_label(cmd, self.name);
+                // Host writes to the inputs are visible at submit; only the results need a
+                // barrier, towards the host read after the fence.
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    self.pipeline_layout,
+                    0,
+                    &[set],
+                    &[],
+                );
+                d.cmd_push_constants(
+                    cmd,
+                    self.pipeline_layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    &count.to_le_bytes(),
+                );
+                d.cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1);
+                host_readable(ctx, cmd, vk::PipelineStageFlags2::COMPUTE_SHADER);
+                ctx.end_label(cmd);
+                d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
+                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+                d.queue_submit2(ctx.queue, &[submit], fence)
+                    .call("vkQueueSubmit2")?;
+                d.wait_for_fences(&[fence], true, u64::MAX)
+                    .call("vkWaitForFences")?;
+            }
+            Ok(())
+        })();
+        unsafe {
+            if let Ok(fence) = fence {
+                d.destroy_fence(fence, None);
+            }
+            if let Ok(command_pool) = command_pool {
+                d.destroy_command_pool(command_pool, None);
+            }
+            d.destroy_descriptor_pool(pool, None);
+        }
+        recorded
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device
+                .destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// A direction padded to a std430 `vec4`.
+pub(crate) fn pad(d: [f32; 3]) -> [f32; 4] {
+    [d[0], d[1], d[2], 0.0]
+}

@@ -1,0 +1,181 @@
+//! The LUT technique's tables on the GPU: every material's [`Lut`] baked by histencil-brdf,
+//! in one storage buffer of values with a header per table (`shaders/include/lut.glsl`), and an
+//! evaluator that runs the GLSL lookup on chosen directions so it can be held to
+//! [`Lut::lookup`].
+
+use crate::compute::{pad, CaseKernel};
+use crate::context::Context;
+use crate::descriptors::LUT_EVAL_SET;
+use crate::error::{Error, Result};
+use crate::resources::Buffer;
+use crate::shaders;
+use ash::vk;
+use histencil_brdf::lut::Lut;
+use histencil_brdf::{Brdf, V3};
+
+/// std430 mirror of `LutTable` in `shaders/include/lut.glsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuLutTable {
+    axes: u32,
+    resolution: u32,
+    /// First grid point in the values buffer, in RGB triples.
+    offset: u32,
+    curvature: f32,
+}
+
+/// One table per material, baked at one resolution and uploaded.
+pub struct LutTables {
+    luts: Vec<Lut>,
+    resolution: u32,
+    headers: Buffer,
+    values: Buffer,
+}
+
+impl LutTables {
+    /// Bakes a table of `resolution` points per axis for each of `materials` (a material's
+    /// index here is its table index) and uploads them.
+    ///
+    /// # Errors
+    /// [`Error::Lut`] for a resolution histencil-brdf refuses, [`Error::LutTooLarge`] when the
+    /// values exceed the device's storage-buffer range, and allocation errors.
+    pub fn new(ctx: &Context, materials: &[Brdf], resolution: u32) -> Result<Self> {
+        let luts = materials
+            .iter()
+            .map(|b| Lut::bake(*b, resolution))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut headers = Vec::with_capacity(luts.len());
+        let mut values: Vec<f32> = Vec::new();
+        for lut in &luts {
+            headers.push(GpuLutTable {
+                axes: lut.axes.index(),
+                resolution,
+                offset: (values.len() / 3) as u32,
+                curvature: lut.curvature_per_mm() as f32,
+            });
+            values.extend(lut.values.iter().flatten());
+        }
+        let bytes = (values.len() * 4) as u64;
+        let limit = u64::from(ctx.max_storage_buffer_range);
+        if bytes > limit {
+            return Err(Error::LutTooLarge { bytes, limit });
+        }
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let mut headers =
+            Buffer::with_data(ctx, "lut-headers", storage, bytemuck::cast_slice(&headers))?;
+        let values =
+            match Buffer::with_data(ctx, "lut-values", storage, bytemuck::cast_slice(&values)) {
+                Ok(b) => b,
+                Err(e) => {
+                    headers.destroy(ctx);
+                    return Err(e);
+                }
+            };
+        Ok(Self {
+            luts,
+            resolution,
+            headers,
+            values,
+        })
+    }
+
+    /// The baked tables, by table index: what the GPU looks up.
+    pub fn luts(&self) -> &[Lut] {
+        &self.luts
+    }
+
+    pub fn resolution(&self) -> u32 {
+        self.resolution
+    }
+
+    /// GPU memory the values take.
+    pub fn size_bytes(&self) -> usize {
+        self.luts.iter().map(Lut::size_bytes).sum()
+    }
+
+    /// The headers and the values: bindings `LUT_BINDING` and `LUT_BINDING + 1` of lut.glsl.
+    pub(crate) fn buffers(&self) -> [vk::Buffer; 2] {
+        [self.headers.handle, self.values.handle]
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.headers.destroy(ctx);
+        self.values.destroy(ctx);
+    }
+}
+
+/// std430 mirror of `LutCase` in `shaders/lut_eval.comp`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuLutCase {
+    table: [u32; 4],
+    unused: [f32; 4],
+    n: [f32; 4],
+    t: [f32; 4],
+    v: [f32; 4],
+    l: [f32; 4],
+}
+
+/// Runs `lut_lookup` of lut.glsl, the code the LUT light shader shades with, on chosen cases.
+pub struct LutEvaluator {
+    kernel: CaseKernel,
+}
+
+impl LutEvaluator {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let kernel = CaseKernel::new(
+            ctx,
+            "lut-eval",
+            LUT_EVAL_SET,
+            ("lut-eval-comp", shaders::LUT_EVAL_COMP),
+        )?;
+        Ok(Self { kernel })
+    }
+
+    /// Table `index`'s value at directions `[N, T, V, L]`, per case, RGB.
+    ///
+    /// # Panics
+    /// If a case names a table `tables` does not have: a caller bug.
+    pub fn evaluate(
+        &self,
+        ctx: &Context,
+        tables: &LutTables,
+        cases: &[(u32, [V3<f32>; 4])],
+    ) -> Result<Vec<[f32; 3]>> {
+        let gpu: Vec<GpuLutCase> = cases
+            .iter()
+            .map(|(table, [n, t, v, l])| {
+                assert!((*table as usize) < tables.luts.len(), "no table {table}");
+                GpuLutCase {
+                    table: [*table, 0, 0, 0],
+                    unused: [0.0; 4],
+                    n: pad(*n),
+                    t: pad(*t),
+                    v: pad(*v),
+                    l: pad(*l),
+                }
+            })
+            .collect();
+        self.kernel.run(
+            ctx,
+            bytemuck::cast_slice(&gpu),
+            gpu.len() as u32,
+            &tables.buffers(),
+        )
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.kernel.destroy(ctx);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_matches_the_glsl_struct() {
+        assert_eq!(std::mem::size_of::<GpuLutTable>(), 16);
+        assert_eq!(std::mem::size_of::<GpuLutCase>(), 96);
+    }
+}

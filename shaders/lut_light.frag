@@ -1,0 +1,35 @@
+#version 460
+// Deferred light shader of the LUT technique: one draw per light, every BRDF through its
+// material's table (include/lut.glsl) instead of its formula. The light, the G-buffer and the
+// hi-stencil work are the branching shader's; only `f_r * cos` comes from the table, indexed by
+// the material index the G-buffer stores in albedo alpha.
+#include "light.glsl"
+#include "gbuffer.glsl"
+#include "light_tiles.glsl"
+#define LUT_SET 3
+#define LUT_BINDING 0
+#include "lut.glsl"
+
+layout(early_fragment_tests) in;
+
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    if (light_tile_culled()) {
+        discard;
+    }
+    Surface s;
+    if (!gbuffer_load(gl_FragCoord.xy, s)) {
+        out_color = vec4(0.0);
+        return;
+    }
+    vec3 L;
+    vec3 incident = light_incident(lights[light_draw.light_index], s.position, L);
+    if (all(equal(incident, vec3(0.0)))) {
+        out_color = vec4(0.0);
+        return;
+    }
+    vec3 V = normalize(frame.eye.xyz - s.position);
+    vec3 f = lut_lookup(gbuffer_material_index(gl_FragCoord.xy), s.normal, fibre_tangent(s.normal), V, L);
+    out_color = vec4(incident * (s.tint * f), 0.0);
+}
