@@ -1,0 +1,19 @@
+//! histencil-alpha: the talk's second technique, as far as it can be decided without a GPU.
+//!
+//! Alpha objects and particle systems cannot be lit by the deferred pass (they are not in the
+//! G-buffer). The talk lights them on the GPU every frame instead: each entity owns a region of
+//! one shared atlas holding its light probes (baked positions for objects; interpolated
+//! positions for particle systems), every light that reaches the entity is rendered into that
+//! region with the deferred pass's light code, and the alpha pass samples the result.
+//!
+//! # What this crate decides
+//! - [`Atlas`]: where each entity's region sits, allocated and freed as entities come and go
+//!   (a shelf allocator, etagere), with a guard band against filtering across regions and a
+//!   documented downgrade when the atlas is full;
+//! - [`side_for_coverage`]: how many texels an entity gets from its size on screen.
+
+mod atlas;
+mod sizing;
+
+pub use atlas::{Allocation, Atlas, AtlasError, Region, RegionId};
+pub use sizing::{side_for_coverage, MAX_SIDE, MIN_SIDE, PIXELS_PER_TEXEL};
