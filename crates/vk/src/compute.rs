@@ -1,5 +1,7 @@
-//! Compute kernels run once and waited for: the test-facing evaluators (GLSL BRDFs, GLSL table
-//! lookups) that hold the shader code to its Rust reference, case by case.
+//! Compute pipelines over one set of storage buffers ([`ComputePipeline`]: the hi-stencil tile
+//! update, the evaluators), and kernels run once and waited for ([`CaseKernel`]: the test-facing
+//! evaluators of GLSL BRDFs and table lookups that hold the shader code to its Rust reference,
+//! case by case).
 
 use crate::context::Context;
 use crate::descriptors::{
@@ -15,14 +17,83 @@ use gpu_allocator::MemoryLocation;
 /// Invocations per workgroup of every case kernel (`local_size_x` in the shaders).
 const WORKGROUP: u32 = 64;
 
-/// A compute pipeline over one set of storage buffers, with the case count as its only push
-/// constant: binding 0 holds the cases, binding 1 receives one `vec4` per case, and any further
-/// bindings are the caller's read-only data.
+/// A compute pipeline whose only set (set 0) is a [`BindingDesc`] table of storage buffers, with
+/// `push_bytes` of push constants; named `{name}-set-layout`, `{name}-pipeline-layout` and
+/// `{name}-pipeline`.
+pub(crate) struct ComputePipeline {
+    pub set_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+}
+
+impl ComputePipeline {
+    /// Creates the three objects; on failure, destroys those already made.
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        set: &[BindingDesc],
+        module: (&str, &[u8]),
+        push_bytes: u32,
+    ) -> Result<Self> {
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let set_layout = create_set_layout(ctx, &format!("{name}-set-layout"), set, compute)?;
+        let mut made = Self {
+            set_layout,
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+        };
+        let layout_name = format!("{name}-pipeline-layout");
+        let result = create_pipeline_layout(ctx, &layout_name, &[set_layout], compute, push_bytes)
+            .and_then(|layout| {
+                made.layout = layout;
+                create_compute_pipeline(ctx, &format!("{name}-pipeline"), module, layout)
+            });
+        match result {
+            Ok(pipeline) => {
+                made.pipeline = pipeline;
+                Ok(made)
+            }
+            Err(e) => {
+                made.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// Binds the pipeline and `set` as set 0, and pushes `push` at offset 0.
+    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, set: vk::DescriptorSet, push: &[u8]) {
+        let d = &ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.layout,
+                0,
+                &[set],
+                &[],
+            );
+            d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+        }
+    }
+
+    /// Destroys what exists (null handles are ignored by Vulkan).
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// A [`ComputePipeline`] with the case count as its only push constant: binding 0 holds the
+/// cases, binding 1 receives one `vec4` per case, and any further bindings are the caller's
+/// read-only data.
 pub(crate) struct CaseKernel {
     name: &'static str,
-    set_layout: vk::DescriptorSetLayout,
-    pipeline_layout: vk::PipelineLayout,
-    pipeline: vk::Pipeline,
+    compute: ComputePipeline,
 }
 
 impl CaseKernel {
@@ -32,35 +103,8 @@ impl CaseKernel {
         set: &[BindingDesc],
         module: (&str, &[u8]),
     ) -> Result<Self> {
-        let compute = vk::ShaderStageFlags::COMPUTE;
-        let set_layout = create_set_layout(ctx, &format!("{name}-set-layout"), set, compute)?;
-        let pipeline_layout = match create_pipeline_layout(
-            ctx,
-            &format!("{name}-pipeline-layout"),
-            &[set_layout],
-            compute,
-            4,
-        ) {
-            Ok(l) => l,
-            Err(e) => {
-                unsafe { ctx.device.destroy_descriptor_set_layout(set_layout, None) };
-                return Err(e);
-            }
-        };
-        let mut kernel = Self {
-            name,
-            set_layout,
-            pipeline_layout,
-            pipeline: vk::Pipeline::null(),
-        };
-        match create_compute_pipeline(ctx, &format!("{name}-pipeline"), module, pipeline_layout) {
-            Ok(p) => kernel.pipeline = p,
-            Err(e) => {
-                kernel.destroy(ctx);
-                return Err(e);
-            }
-        }
-        Ok(kernel)
+        let compute = ComputePipeline::new(ctx, name, set, module, 4)?;
+        Ok(Self { name, compute })
     }
 
     /// Runs the kernel over `count` cases laid out in `cases` (std430), with `extra` as
@@ -105,7 +149,8 @@ impl CaseKernel {
 
     fn dispatch(&self, ctx: &Context, buffers: &[vk::Buffer], count: u32) -> Result<()> {
         let d = &ctx.device;
-        let (pool, set) = create_storage_buffer_set(ctx, self.name, self.set_layout, buffers)?;
+        let (pool, set) =
+            create_storage_buffer_set(ctx, self.name, self.compute.set_layout, buffers)?;
         let command_pool = unsafe {
             d.create_command_pool(
                 &vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family),
@@ -137,22 +182,7 @@ impl CaseKernel {
                 ctx.begin_label(cmd, self.name);
                 // Host writes to the inputs are visible at submit; only the results need a
                 // barrier, towards the host read after the fence.
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::COMPUTE,
-                    self.pipeline_layout,
-                    0,
-                    &[set],
-                    &[],
-                );
-                d.cmd_push_constants(
-                    cmd,
-                    self.pipeline_layout,
-                    vk::ShaderStageFlags::COMPUTE,
-                    0,
-                    &count.to_le_bytes(),
-                );
+                self.compute.bind(ctx, cmd, set, &count.to_le_bytes());
                 d.cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1);
                 host_readable(ctx, cmd, vk::PipelineStageFlags2::COMPUTE_SHADER);
                 ctx.end_label(cmd);
@@ -179,13 +209,7 @@ impl CaseKernel {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device
-                .destroy_pipeline_layout(self.pipeline_layout, None);
-            ctx.device
-                .destroy_descriptor_set_layout(self.set_layout, None);
-        }
+        self.compute.destroy(ctx);
     }
 }
 

@@ -14,12 +14,10 @@
 //! count the fragments they shade.
 
 use crate::access::{memory_barrier, transition, Contents, ImageAccess};
+use crate::compute::ComputePipeline;
 use crate::context::Context;
-use crate::descriptors::{
-    create_pipeline_layout, create_set_layout, create_storage_buffer_set, HI_STENCIL_UPDATE_SET,
-};
+use crate::descriptors::{create_storage_buffer_set, HI_STENCIL_UPDATE_SET};
 use crate::error::Result;
-use crate::pipelines::create_compute_pipeline;
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::{Buffer, Image};
 use crate::shader_consts::HI_STENCIL_TILE;
@@ -56,9 +54,7 @@ pub struct HiStencilSurface {
     stats: Buffer,
     stencil_copy: Buffer,
     saved: Buffer,
-    set_layout: vk::DescriptorSetLayout,
-    pipeline_layout: vk::PipelineLayout,
-    pipeline: vk::Pipeline,
+    update: ComputePipeline,
     pool: vk::DescriptorPool,
     set: vk::DescriptorSet,
     /// A write since the last flush has not become active yet (see the module doc).
@@ -109,32 +105,36 @@ impl HiStencilSurface {
         let (active, pending, touched, stats, stencil_copy, saved) =
             (next(), next(), next(), next(), next(), next());
 
-        let compute = vk::ShaderStageFlags::COMPUTE;
-        let set_layout = create_set_layout(
-            ctx,
-            "hi-stencil-update-set-layout",
-            HI_STENCIL_UPDATE_SET,
-            compute,
-        )?;
-        let pipeline_layout = create_pipeline_layout(
-            ctx,
-            "hi-stencil-update-pipeline-layout",
-            &[set_layout],
-            compute,
-            std::mem::size_of::<UpdatePush>() as u32,
-        )?;
-        let pipeline = create_compute_pipeline(
-            ctx,
-            "hi-stencil-update-pipeline",
-            ("hi-stencil-update-comp", shaders::HI_STENCIL_UPDATE_COMP),
-            pipeline_layout,
-        )?;
-        let (pool, set) = create_storage_buffer_set(
+        let update = ComputePipeline::new(
             ctx,
             "hi-stencil-update",
-            set_layout,
-            &[stencil_copy.handle, touched.handle, pending.handle],
-        )?;
+            HI_STENCIL_UPDATE_SET,
+            ("hi-stencil-update-comp", shaders::HI_STENCIL_UPDATE_COMP),
+            std::mem::size_of::<UpdatePush>() as u32,
+        );
+        let made = update.and_then(|mut update| {
+            match create_storage_buffer_set(
+                ctx,
+                "hi-stencil-update",
+                update.set_layout,
+                &[stencil_copy.handle, touched.handle, pending.handle],
+            ) {
+                Ok(pool_set) => Ok((update, pool_set)),
+                Err(e) => {
+                    update.destroy(ctx);
+                    Err(e)
+                }
+            }
+        });
+        let (update, (pool, set)) = match made {
+            Ok(made) => made,
+            Err(e) => {
+                for mut b in [active, pending, touched, stats, stencil_copy, saved] {
+                    b.destroy(ctx);
+                }
+                return Err(e);
+            }
+        };
         Ok(Self {
             extent,
             tiles_x,
@@ -145,9 +145,7 @@ impl HiStencilSurface {
             stats,
             stencil_copy,
             saved,
-            set_layout,
-            pipeline_layout,
-            pipeline,
+            update,
             pool,
             set,
             unflushed: false,
@@ -213,26 +211,9 @@ impl HiStencilSurface {
             height: self.extent.height,
             tiles_x: self.tiles_x,
         };
-        let d = &ctx.device;
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                self.pipeline_layout,
-                0,
-                &[self.set],
-                &[],
-            );
-            d.cmd_push_constants(
-                cmd,
-                self.pipeline_layout,
-                vk::ShaderStageFlags::COMPUTE,
-                0,
-                bytemuck::bytes_of(&push),
-            );
-            d.cmd_dispatch(cmd, self.tiles_x, self.tiles_y, 1);
-        }
+        self.update
+            .bind(ctx, cmd, self.set, bytemuck::bytes_of(&push));
+        unsafe { ctx.device.cmd_dispatch(cmd, self.tiles_x, self.tiles_y, 1) };
         memory_barrier(ctx, cmd);
         self.unflushed = true;
     }
@@ -287,14 +268,8 @@ impl HiStencilSurface {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device
-                .destroy_pipeline_layout(self.pipeline_layout, None);
-            ctx.device
-                .destroy_descriptor_set_layout(self.set_layout, None);
-            ctx.device.destroy_descriptor_pool(self.pool, None);
-        }
+        self.update.destroy(ctx);
+        unsafe { ctx.device.destroy_descriptor_pool(self.pool, None) };
         for b in [
             &mut self.active,
             &mut self.pending,
