@@ -192,11 +192,18 @@ impl Lut {
     /// 512 points per axis is 512 MiB of RGB f32 for a 3D table: beyond anything useful.
     pub const MAX_RESOLUTION: u32 = 512;
 
+    /// `Ok` for a resolution [`Lut::bake`] accepts: 2 to [`Lut::MAX_RESOLUTION`] points per axis.
+    pub fn check_resolution(resolution: u32) -> Result<(), LutError> {
+        if (2..=Self::MAX_RESOLUTION).contains(&resolution) {
+            Ok(())
+        } else {
+            Err(LutError::Resolution(resolution))
+        }
+    }
+
     /// Samples `brdf` (its f64 reference) at `resolution` points per axis.
     pub fn bake(brdf: Brdf, resolution: u32) -> Result<Self, LutError> {
-        if !(2..=Self::MAX_RESOLUTION).contains(&resolution) {
-            return Err(LutError::Resolution(resolution));
-        }
+        Self::check_resolution(resolution)?;
         let axes = LutAxes::of(&brdf);
         let dims = axes.dimensions();
         let r = resolution as usize;

@@ -22,7 +22,7 @@ use crate::shader_consts::HI_STENCIL_TILE;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
 use crate::timing::{FrameTimings, StepTimer, Timestamps};
 use ash::vk;
-use histencil_brdf::lut::{Lut, LutError};
+use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
     CostModel, FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native,
@@ -399,9 +399,7 @@ impl<'c> Renderer<'c> {
     /// # Errors
     /// [`crate::Error::Lut`] outside `2..=`[`Lut::MAX_RESOLUTION`].
     pub fn set_lut_resolution(&mut self, resolution: u32) -> Result<()> {
-        if !(2..=Lut::MAX_RESOLUTION).contains(&resolution) {
-            return Err(LutError::Resolution(resolution).into());
-        }
+        Lut::check_resolution(resolution)?;
         if resolution != self.lut_resolution {
             if let Some(mut old) = self.lut_tables.take() {
                 old.destroy(self.ctx);
