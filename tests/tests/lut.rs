@@ -3,7 +3,7 @@
 //! `LutAccuracy`), an error that falls as the resolution rises.
 
 use glam::Vec3;
-use histencil_brdf::lut::{report_directions, report_materials, LutAccuracy};
+use histencil_brdf::lut::{report_directions, report_materials, Lut, LutAccuracy};
 use histencil_brdf::{Brdf, BrdfId, V3};
 use histencil_scene::{Light, LightKind, Scene};
 use histencil_tests::{diff, with_validated_context};
@@ -112,22 +112,21 @@ fn directionally_lit_room() -> Scene {
 }
 
 /// Per BRDF model: the largest tint channel and the largest table error (`LutAccuracy` over
-/// the report's directions) among the scene's materials of that model.
-fn per_model_bounds(scene: &Scene, resolution: u32) -> Vec<(BrdfId, f32, f64)> {
+/// the report's directions) among the scene's materials of that model, measured on `luts`, the
+/// tables the frame was lit with.
+fn per_model_bounds(scene: &Scene, luts: &[Lut]) -> Vec<(BrdfId, f32, f64)> {
     let directions = report_directions(4096);
+    let errors: Vec<(Brdf, f64)> = luts
+        .iter()
+        .map(|lut| (lut.brdf, LutAccuracy::measure(lut, &directions).max_abs))
+        .collect();
     let mut bounds: Vec<(BrdfId, f32, f64)> = Vec::new();
-    let mut measured: Vec<(Brdf, f64)> = Vec::new();
     for object in &scene.objects {
         let brdf = object.material.brdf;
-        let error = match measured.iter().find(|(b, _)| *b == brdf) {
-            Some((_, e)) => *e,
-            None => {
-                let lut = histencil_brdf::lut::Lut::bake(brdf, resolution).unwrap();
-                let e = LutAccuracy::measure(&lut, &directions).max_abs;
-                measured.push((brdf, e));
-                e
-            }
-        };
+        let (_, error) = *errors
+            .iter()
+            .find(|(b, _)| *b == brdf)
+            .expect("a table per material");
         let tint = object.material.tint.max_element();
         match bounds.iter_mut().find(|(id, ..)| *id == brdf.id()) {
             Some(b) => {
@@ -194,7 +193,7 @@ fn frame_error_stays_within_the_tables_and_falls_with_resolution() {
         for resolution in [4, 8, 16, 32, 64] {
             renderer.set_lut_resolution(resolution).unwrap();
             let frame = renderer.render(LUT, readback).unwrap();
-            let bounds = per_model_bounds(&scene, resolution);
+            let bounds = per_model_bounds(&scene, renderer.lut_tables().unwrap().luts());
             let (ratio, mean) = against_prediction(
                 frame.images.hdr.as_ref().unwrap(),
                 &forward_hdr,
