@@ -135,10 +135,6 @@ impl Atlas {
     pub fn allocate(&mut self, width: u32, height: u32) -> Result<Allocation, AtlasError> {
         self.check_request(width, height)?;
         self.try_allocate(width, height)
-            .map(|a| Allocation {
-                requested: (width, height),
-                ..a
-            })
             .ok_or_else(|| self.full(width, height))
     }
 
