@@ -10,10 +10,23 @@
 //! - [`Atlas`]: where each entity's region sits, allocated and freed as entities come and go
 //!   (a shelf allocator, etagere), with a guard band against filtering across regions and a
 //!   documented downgrade when the atlas is full;
-//! - [`side_for_coverage`]: how many texels an entity gets from its size on screen.
+//! - [`side_for_coverage`]: how many texels an entity gets from its size on screen;
+//! - [`plan_layout`]: every entity's region shape (a square for objects and billboards, a row
+//!   of slices, a grid of motes, a line of texels for ribbons) packed into an atlas sized to fit;
+//! - [`fit_frame`]: the camera-facing probe quad (and slices) around a particle system;
+//! - [`sprite_vertices`] and [`back_to_front`]: the alpha pass's geometry and blending order.
 
 mod atlas;
+mod layout;
+mod probes;
 mod sizing;
+mod sprites;
 
 pub use atlas::{Allocation, Atlas, AtlasError, Region, RegionId};
+pub use layout::{
+    bounding_sphere, dust_grid, entities, plan_layout, projected_diameter, region_shape, EntityKey,
+    EntityRegion, LayoutError, LightmapLayout, RegionShape, ATLAS_PADDING, START_ATLAS_SIDE,
+};
+pub use probes::{back_to_front, camera_axes, fit_frame, probe_point, ProbeFrame};
 pub use sizing::{side_for_coverage, MAX_SIDE, MIN_SIDE, PIXELS_PER_TEXEL};
+pub use sprites::{sprite_vertices, SpriteVertex};

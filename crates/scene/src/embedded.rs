@@ -39,7 +39,7 @@ fn material(id: BrdfId, variant: usize, tint: Vec3) -> Material {
 }
 
 /// `(name, description)` of every embedded scene.
-pub const EMBEDDED: [(&str, &str); 6] = [
+pub const EMBEDDED: [(&str, &str); 11] = [
     (
         "default",
         "procedural room: 2 BRDFs, 36 point lights from tiny to huge, 3 spots, 1 directional",
@@ -64,6 +64,26 @@ pub const EMBEDDED: [(&str, &str); 6] = [
     (
         "near-far",
         "the default room with light volumes crossing the near and the far plane",
+    ),
+    (
+        "alpha",
+        "the default room with a glass sphere and a smoke column, each next to a point light",
+    ),
+    (
+        "dust",
+        "the default room with a cloud of 600 dust motes (one lightmap texel each) around two lights",
+    ),
+    (
+        "ribbon",
+        "the default room with a helical ribbon trail (a line of lightmap texels) round a light",
+    ),
+    (
+        "volume",
+        "the default room with a thick ball of smoke lit in 8 slices, a point light inside it",
+    ),
+    (
+        "alpha-many",
+        "the default room with 8 smoke systems x 256 particles, each with a light of its own",
     ),
 ];
 
@@ -95,6 +115,7 @@ pub fn embedded(name: &str) -> Result<Scene, SceneError> {
         _ => &[BrdfId::Lambert, BrdfId::BlinnPhong],
     };
     let mut scene = room(name, description, models);
+    crate::alpha_scenes::add_alpha_entities(name, &mut scene);
     match name {
         "inside" => {
             scene.camera.eye = Vec3::new(1.5, 2.2, 5.0);
@@ -290,6 +311,8 @@ fn room(name: &str, description: String, models: &[BrdfId]) -> Scene {
         },
         objects,
         lights,
+        alpha_objects: vec![],
+        particle_systems: vec![],
     }
 }
 

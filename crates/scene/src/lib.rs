@@ -1,10 +1,16 @@
 //! histencil-scene: scenes as plain data (what a glTF importer fills), the embedded scenes, meshes
 //! and light volumes, bounds, and what a frame needs from a scene.
 
+mod alpha;
+mod alpha_scenes;
 mod embedded;
 mod mesh;
 mod types;
 
+pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICES};
+pub use alpha_scenes::{glass_sphere, smoke_volume};
 pub use embedded::{embedded, embedded_names, EMBEDDED};
-pub use mesh::{light_cone, light_sphere, unit_box, uv_sphere, Mesh, Vertex};
+pub use mesh::{
+    light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, Mesh, Vertex, BOX_UV_INSET,
+};
 pub use types::{Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape};

@@ -4,12 +4,14 @@
 
 use std::f32::consts::{PI, TAU};
 
-/// A vertex: object-space position and normal.
+/// A vertex: object-space position and normal, and its place in the shape's lightmap layout
+/// (`uv` in `[0, 1]^2`; zero on light volumes, which have no lightmap).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
+    pub uv: [f32; 2],
 }
 
 /// An indexed triangle list.
@@ -20,10 +22,19 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    fn push_triangle_fan_quad(&mut self, corners: [[f32; 3]; 4], normal: [f32; 3]) {
+    fn push_triangle_fan_quad(
+        &mut self,
+        corners: [[f32; 3]; 4],
+        normal: [f32; 3],
+        uvs: [[f32; 2]; 4],
+    ) {
         let base = self.vertices.len() as u32;
-        for position in corners {
-            self.vertices.push(Vertex { position, normal });
+        for (position, uv) in corners.into_iter().zip(uvs) {
+            self.vertices.push(Vertex {
+                position,
+                normal,
+                uv,
+            });
         }
         self.indices
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
@@ -40,8 +51,25 @@ impl Mesh {
     }
 }
 
-/// The cube `[-1, 1]^3` with flat normals.
+/// The box lightmap layout: face `f` (axis `f / 2`, `-` then `+`) owns cell `(f % 3, f / 3)` of a
+/// 3 x 2 grid, inset by this fraction of the cell on every side. The inset is a gutter that the
+/// bake fills by extending each face's plane ([`unit_box_bake`]), so bilinear filtering at a face
+/// edge reads texels of the same plane instead of a neighbouring face's or empty ones.
+pub const BOX_UV_INSET: f32 = 0.125;
+
+/// The cube `[-1, 1]^3` with flat normals, each face in its cell of the box lightmap layout.
 pub fn unit_box() -> Mesh {
+    box_faces(1.0, BOX_UV_INSET)
+}
+
+/// The box as the lightmap bake draws it: each face's plane extended to fill its whole cell,
+/// positions extrapolated linearly into the gutter, so every texel of the layout holds a probe.
+pub fn unit_box_bake() -> Mesh {
+    box_faces(1.0 / (1.0 - 2.0 * BOX_UV_INSET), 0.0)
+}
+
+/// The six faces at in-plane half-extent `extent`, mapped to their cells inset by `inset`.
+fn box_faces(extent: f32, inset: f32) -> Mesh {
     let mut m = Mesh::default();
     for axis in 0..3 {
         for sign in [-1.0f32, 1.0] {
@@ -51,23 +79,29 @@ pub fn unit_box() -> Mesh {
             let corner = |a: f32, b: f32| {
                 let mut p = [0.0; 3];
                 p[axis] = sign;
-                p[u] = a;
-                p[v] = b;
+                p[u] = a * extent;
+                p[v] = b * extent;
                 p
             };
-            let quad = [
-                corner(-1., -1.),
-                corner(1., -1.),
-                corner(1., 1.),
-                corner(-1., 1.),
-            ];
-            // (u, v, axis) is right-handed, so this quad faces +axis; reverse it for -axis.
-            let quad = if sign > 0.0 {
-                quad
-            } else {
-                [quad[0], quad[3], quad[2], quad[1]]
+            let face = axis * 2 + usize::from(sign > 0.0);
+            let cell = [(face % 3) as f32, (face / 3) as f32];
+            let uv = |a: f32, b: f32| {
+                let local = |t: f32| inset + (t + 1.0) * 0.5 * (1.0 - 2.0 * inset);
+                [(cell[0] + local(a)) / 3.0, (cell[1] + local(b)) / 2.0]
             };
-            m.push_triangle_fan_quad(quad, normal);
+            let params = [(-1., -1.), (1., -1.), (1., 1.), (-1., 1.)];
+            let quad = params.map(|(a, b)| corner(a, b));
+            let uvs = params.map(|(a, b)| uv(a, b));
+            // (u, v, axis) is right-handed, so this quad faces +axis; reverse it for -axis.
+            let (quad, uvs) = if sign > 0.0 {
+                (quad, uvs)
+            } else {
+                (
+                    [quad[0], quad[3], quad[2], quad[1]],
+                    [uvs[0], uvs[3], uvs[2], uvs[1]],
+                )
+            };
+            m.push_triangle_fan_quad(quad, normal, uvs);
         }
     }
     m
@@ -88,6 +122,7 @@ pub fn uv_sphere(segments: u32, rings: u32) -> Mesh {
             m.vertices.push(Vertex {
                 position: p,
                 normal: p,
+                uv: [s as f32 / segments as f32, r as f32 / rings as f32],
             });
         }
     }
@@ -132,16 +167,19 @@ pub fn light_cone(sides: u32) -> Mesh {
     m.vertices.push(Vertex {
         position: [0.0; 3],
         normal: [0.0, 0.0, -1.0],
+        uv: [0.0; 2],
     });
     let cap_center = m.vertices.len() as u32;
     m.vertices.push(Vertex {
         position: [0.0, 0.0, 1.0001],
         normal: [0.0, 0.0, 1.0],
+        uv: [0.0; 2],
     });
     for i in 0..sides {
         m.vertices.push(Vertex {
             position: ring(i),
             normal: [0.0, 0.0, 1.0],
+            uv: [0.0; 2],
         });
     }
     for i in 0..sides {
@@ -180,6 +218,39 @@ mod tests {
         assert_outward(&light_cone(12), "light cone");
         // UV sphere faces all face away from the centre too.
         assert_outward(&uv_sphere(16, 8), "uv sphere");
+    }
+
+    #[test]
+    fn box_faces_keep_to_their_cells_and_the_bake_fills_them() {
+        let (faces, bake) = (unit_box(), unit_box_bake());
+        for (f, (quad, baked)) in faces
+            .vertices
+            .chunks_exact(4)
+            .zip(bake.vertices.chunks_exact(4))
+            .enumerate()
+        {
+            let cell = [(f % 3) as f32 / 3.0, (f / 3) as f32 / 2.0];
+            for v in quad {
+                let local = [(v.uv[0] - cell[0]) * 3.0, (v.uv[1] - cell[1]) * 2.0];
+                for t in local {
+                    assert!(
+                        (t - BOX_UV_INSET).abs() < 1e-6 || (t - 1.0 + BOX_UV_INSET).abs() < 1e-6
+                    );
+                }
+            }
+            // The bake quad covers the whole cell, on the same plane, along the same uv axes.
+            for (v, b) in quad.iter().zip(baked) {
+                assert_eq!(v.normal, b.normal);
+                let axis = v.normal.iter().position(|n| *n != 0.0).unwrap();
+                assert_eq!(v.position[axis], b.position[axis]);
+            }
+            let span = |q: &[Vertex], i: usize| {
+                q.iter().map(|v| v.uv[i]).fold(f32::MIN, f32::max)
+                    - q.iter().map(|v| v.uv[i]).fold(f32::MAX, f32::min)
+            };
+            assert!((span(baked, 0) - 1.0 / 3.0).abs() < 1e-6);
+            assert!((span(baked, 1) - 0.5).abs() < 1e-6);
+        }
     }
 
     #[test]

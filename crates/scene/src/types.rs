@@ -1,8 +1,11 @@
+use crate::alpha::{alpha_problem, transformed_unit_cube};
+use crate::{AlphaObject, ParticleSystem};
 use glam::{Mat4, Vec3};
 use histencil_brdf::{Brdf, BrdfId};
 
-/// A scene: a camera, opaque objects and lights. Plain data; [`Scene::validate`] says whether a
-/// renderer can take it.
+/// A scene: a camera, opaque objects, lights, and alpha entities (translucent objects and particle
+/// systems, drawn after lighting). Plain data; [`Scene::validate`] says whether a renderer can take
+/// it.
 #[derive(Clone, Debug)]
 pub struct Scene {
     pub name: String,
@@ -10,6 +13,8 @@ pub struct Scene {
     pub camera: Camera,
     pub objects: Vec<Object>,
     pub lights: Vec<Light>,
+    pub alpha_objects: Vec<AlphaObject>,
+    pub particle_systems: Vec<ParticleSystem>,
 }
 
 /// A perspective camera. The aspect ratio comes from the render target.
@@ -64,19 +69,7 @@ impl Object {
     /// The world-space axis-aligned box containing the object: the transformed corners of the
     /// unit cube (which contains the unit sphere too).
     pub fn world_bounds(&self) -> (Vec3, Vec3) {
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for corner in 0..8 {
-            let unit = Vec3::new(
-                if corner & 1 == 0 { -1.0 } else { 1.0 },
-                if corner & 2 == 0 { -1.0 } else { 1.0 },
-                if corner & 4 == 0 { -1.0 } else { 1.0 },
-            );
-            let p = self.transform.transform_point3(unit);
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-        (lo, hi)
+        transformed_unit_cube(self.transform)
     }
 }
 
@@ -141,6 +134,13 @@ impl Light {
     pub fn is_local(&self) -> bool {
         !matches!(self.kind, LightKind::Directional { .. })
     }
+
+    /// Whether the light can add anything inside the box `lo..=hi`: its range sphere reaches the
+    /// box (always, for a directional light). Exact culling: the light's falloff is zero at and
+    /// beyond its range.
+    pub fn reaches_box(&self, lo: Vec3, hi: Vec3) -> bool {
+        !self.is_local() || self.position.clamp(lo, hi).distance(self.position) < self.radius
+    }
 }
 
 /// A scene that a renderer cannot take, or a name that is not a scene.
@@ -158,6 +158,35 @@ pub enum SceneError {
     },
     #[error("camera: {0}")]
     BadCamera(String),
+    #[error("{kind} {index} (`{name}`): {problem}")]
+    BadAlphaEntity {
+        /// `alpha object` or `particle system`.
+        kind: &'static str,
+        index: usize,
+        name: String,
+        problem: String,
+    },
+}
+
+/// What is wrong with a material, if anything.
+pub(crate) fn material_problem(m: &Material) -> Option<&'static str> {
+    if !finite3(m.tint) || m.tint.min_element() < 0.0 {
+        Some("tint must be finite and non-negative")
+    } else if !m
+        .brdf
+        .packed_params()
+        .iter()
+        .all(|p| p.is_finite() && *p >= 0.0)
+    {
+        Some("BRDF parameters must be finite and non-negative")
+    } else {
+        None
+    }
+}
+
+fn transform_problem(transform: &Mat4) -> Option<&'static str> {
+    (!transform.is_finite() || transform.determinant() == 0.0)
+        .then_some("transform must be finite and invertible")
 }
 
 fn finite3(v: Vec3) -> bool {
@@ -227,21 +256,7 @@ impl Scene {
             }
         }
         for (index, o) in self.objects.iter().enumerate() {
-            let m = &o.material;
-            let problem = if !o.transform.is_finite() || o.transform.determinant() == 0.0 {
-                Some("transform must be finite and invertible")
-            } else if !finite3(m.tint) || m.tint.min_element() < 0.0 {
-                Some("tint must be finite and non-negative")
-            } else if !m
-                .brdf
-                .packed_params()
-                .iter()
-                .all(|p| p.is_finite() && *p >= 0.0)
-            {
-                Some("BRDF parameters must be finite and non-negative")
-            } else {
-                None
-            };
+            let problem = transform_problem(&o.transform).or(material_problem(&o.material));
             if let Some(problem) = problem {
                 return Err(SceneError::BadObject {
                     index,
@@ -250,7 +265,29 @@ impl Scene {
                 });
             }
         }
+        let bad_alpha = |kind, index, name: &str, problem: &str| SceneError::BadAlphaEntity {
+            kind,
+            index,
+            name: name.to_owned(),
+            problem: problem.to_owned(),
+        };
+        for (index, o) in self.alpha_objects.iter().enumerate() {
+            let problem = transform_problem(&o.transform).or(alpha_problem(o.opacity, &o.material));
+            if let Some(problem) = problem {
+                return Err(bad_alpha("alpha object", index, &o.name, problem));
+            }
+        }
+        for (index, p) in self.particle_systems.iter().enumerate() {
+            if let Some(problem) = p.problem().or(alpha_problem(p.opacity, &p.material)) {
+                return Err(bad_alpha("particle system", index, &p.name, problem));
+            }
+        }
         Ok(())
+    }
+
+    /// How many alpha entities (translucent objects and particle systems) the scene has.
+    pub fn alpha_entity_count(&self) -> usize {
+        self.alpha_objects.len() + self.particle_systems.len()
     }
 
     /// The distinct BRDFs the objects use, sorted by id. Their position in this list is their
@@ -265,8 +302,7 @@ impl Scene {
     pub fn brdfs_lit_by(&self, light: &Light) -> Vec<BrdfId> {
         distinct_brdfs(self.objects.iter().filter(|o| {
             let (lo, hi) = o.world_bounds();
-            let nearest = light.position.clamp(lo, hi);
-            !light.is_local() || nearest.distance(light.position) < light.radius
+            light.reaches_box(lo, hi)
         }))
     }
 }

@@ -21,6 +21,7 @@ impl GpuMesh {
                 v.position
                     .iter()
                     .chain(&v.normal)
+                    .chain(&v.uv)
                     .flat_map(|f| f.to_ne_bytes())
             })
             .collect();

@@ -1,0 +1,298 @@
+//! Which lightmap region each alpha entity gets: its texel layout (from the talk's
+//! parameterisations) and its size (from screen coverage), packed into one atlas whose size is
+//! derived from what the scene needs.
+
+use crate::{side_for_coverage, Atlas, AtlasError, Region, MIN_SIDE};
+use glam::Vec3;
+use histencil_scene::{Camera, ParticleLayout, ParticleSystem, Scene};
+
+/// An alpha entity of a scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EntityKey {
+    /// `scene.alpha_objects[i]`
+    Object(usize),
+    /// `scene.particle_systems[i]`
+    System(usize),
+}
+
+/// How an entity's probes sit in its region: `tiles` tiles of `tile_width x tile_height` texels
+/// side by side (a slice each for sliced systems, one otherwise).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RegionShape {
+    pub tiles: u32,
+    pub tile_width: u32,
+    pub tile_height: u32,
+    /// Whether a full atlas may halve the tiles (not for dust: one texel per mote is the layout).
+    pub downgradable: bool,
+}
+
+/// An entity's place in the atlas.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EntityRegion {
+    pub entity: EntityKey,
+    /// The whole region: `shape.tiles` tiles side by side.
+    pub region: Region,
+    /// The tiles as granted (halved when the atlas was full).
+    pub shape: RegionShape,
+    pub downgraded: bool,
+}
+
+/// Every entity's region, and the atlas they were packed into.
+pub struct LightmapLayout {
+    pub atlas: Atlas,
+    pub regions: Vec<EntityRegion>,
+}
+
+/// The smallest atlas tried; it doubles until everything fits.
+pub const START_ATLAS_SIDE: u32 = 256;
+/// Texels of guard band around every region.
+pub const ATLAS_PADDING: u32 = 1;
+
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LayoutError {
+    #[error("lightmap resolution {0} is out of range (2..=4096 texels a side)")]
+    BadResolution(u32),
+    #[error("the lightmap atlas is full even at {side}x{side} texels with every region halved down to {min}: {source}", min = MIN_SIDE)]
+    AtlasFull {
+        side: u32,
+        #[source]
+        source: AtlasError,
+    },
+}
+
+/// Diameter in pixels that a sphere of `radius` at `centre` covers on a `viewport_height`-pixel
+/// tall view from `camera` (at least the near plane away).
+pub fn projected_diameter(camera: &Camera, centre: Vec3, radius: f32, viewport_height: u32) -> f32 {
+    let distance = (centre - camera.eye).length().max(camera.near);
+    let tan = (camera.fov_y_radians * 0.5).tan();
+    2.0 * radius / (2.0 * distance * tan) * viewport_height as f32
+}
+
+/// Centre and radius of a sphere containing the box `lo..hi`.
+pub fn bounding_sphere((lo, hi): (Vec3, Vec3)) -> (Vec3, f32) {
+    ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
+}
+
+/// The texel layout of `entity`: its size from screen coverage, or `forced_side` texels.
+pub fn region_shape(
+    scene: &Scene,
+    entity: EntityKey,
+    viewport_height: u32,
+    forced_side: Option<u32>,
+) -> RegionShape {
+    let side_of = |bounds| {
+        let (centre, radius) = bounding_sphere(bounds);
+        forced_side.unwrap_or_else(|| {
+            side_for_coverage(projected_diameter(
+                &scene.camera,
+                centre,
+                radius,
+                viewport_height,
+            ))
+        })
+    };
+    let square = |tiles, side| RegionShape {
+        tiles,
+        tile_width: side,
+        tile_height: side,
+        downgradable: true,
+    };
+    match entity {
+        EntityKey::Object(i) => square(1, side_of(scene.alpha_objects[i].world_bounds())),
+        EntityKey::System(i) => {
+            let system = &scene.particle_systems[i];
+            match system.layout {
+                ParticleLayout::Billboard => square(1, side_of(system.world_bounds())),
+                ParticleLayout::Slices { count } => square(count, side_of(system.world_bounds())),
+                ParticleLayout::Dust => {
+                    let (w, h) = dust_grid(system.particles.len() as u32);
+                    RegionShape {
+                        tiles: 1,
+                        tile_width: w,
+                        tile_height: h,
+                        downgradable: false,
+                    }
+                }
+                ParticleLayout::Ribbon => RegionShape {
+                    tiles: 1,
+                    tile_width: forced_side
+                        .unwrap_or_else(|| ribbon_texels(scene, system, viewport_height)),
+                    tile_height: 1,
+                    downgradable: true,
+                },
+            }
+        }
+    }
+}
+
+/// The texel grid of `motes` dust motes: as square as possible, row by row.
+pub fn dust_grid(motes: u32) -> (u32, u32) {
+    let w = (motes as f64).sqrt().ceil().max(1.0) as u32;
+    (w, motes.div_ceil(w).max(1))
+}
+
+/// Texels along a ribbon: one per [`crate::PIXELS_PER_TEXEL`] pixels of its projected length,
+/// as for a region side.
+fn ribbon_texels(scene: &Scene, system: &ParticleSystem, viewport_height: u32) -> u32 {
+    let length_px: f32 = system
+        .particles
+        .windows(2)
+        .map(|w| {
+            let mid = (w[0].position + w[1].position) * 0.5;
+            let half = (w[1].position - w[0].position).length() * 0.5;
+            projected_diameter(&scene.camera, mid, half, viewport_height)
+        })
+        .sum();
+    side_for_coverage(length_px)
+}
+
+/// Every alpha entity of `scene`, objects first.
+pub fn entities(scene: &Scene) -> impl Iterator<Item = EntityKey> {
+    (0..scene.alpha_objects.len())
+        .map(EntityKey::Object)
+        .chain((0..scene.particle_systems.len()).map(EntityKey::System))
+}
+
+/// Packs every entity's region into the smallest square atlas from [`START_ATLAS_SIDE`]
+/// (doubling) up to `max_side` that holds them all at full size. When even `max_side` does not,
+/// regions are halved where they allow it ([`Atlas::allocate_downgrading`]; the result says
+/// which were).
+///
+/// # Errors
+/// [`LayoutError::BadResolution`] for a forced side outside 2..=4096, and
+/// [`LayoutError::AtlasFull`] when the entities do not fit even halved.
+pub fn plan_layout(
+    scene: &Scene,
+    viewport_height: u32,
+    forced_side: Option<u32>,
+    max_side: u32,
+) -> Result<LightmapLayout, LayoutError> {
+    if let Some(side) = forced_side.filter(|s| !(2..=4096).contains(s)) {
+        return Err(LayoutError::BadResolution(side));
+    }
+    let shapes: Vec<(EntityKey, RegionShape)> = entities(scene)
+        .map(|e| (e, region_shape(scene, e, viewport_height, forced_side)))
+        .collect();
+    let max_side = max_side.clamp(1, Atlas::MAX_SIDE);
+    let mut side = START_ATLAS_SIDE.min(max_side);
+    loop {
+        let downgrade = side >= max_side;
+        match pack(&shapes, side, downgrade) {
+            Ok(layout) => return Ok(layout),
+            Err(source) if downgrade => return Err(LayoutError::AtlasFull { side, source }),
+            Err(_) => side = (side * 2).min(max_side),
+        }
+    }
+}
+
+fn pack(
+    shapes: &[(EntityKey, RegionShape)],
+    side: u32,
+    downgrade: bool,
+) -> Result<LightmapLayout, AtlasError> {
+    let mut atlas = Atlas::new(side, side, ATLAS_PADDING)?;
+    // Largest first: shelf packing wastes less, and the order (hence the layout) is fixed.
+    let mut order: Vec<usize> = (0..shapes.len()).collect();
+    order.sort_by_key(|&i| {
+        let s = shapes[i].1;
+        (
+            std::cmp::Reverse(s.tile_height),
+            std::cmp::Reverse(s.tiles * s.tile_width),
+            i,
+        )
+    });
+    let mut regions = vec![None; shapes.len()];
+    for i in order {
+        let (entity, shape) = shapes[i];
+        let (w, h) = (shape.tiles * shape.tile_width, shape.tile_height);
+        let allocation = if downgrade && shape.downgradable {
+            atlas.allocate_downgrading(w, h, MIN_SIDE.min(w.max(h)))?
+        } else {
+            atlas.allocate(w, h)?
+        };
+        let region = allocation.region;
+        regions[i] = Some(EntityRegion {
+            entity,
+            region,
+            shape: RegionShape {
+                tile_width: region.width / shape.tiles,
+                tile_height: region.height,
+                ..shape
+            },
+            downgraded: allocation.downgraded(),
+        });
+    }
+    Ok(LightmapLayout {
+        atlas,
+        regions: regions
+            .into_iter()
+            .map(|r| r.expect("every entity placed"))
+            .collect(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(name: &str) -> Scene {
+        histencil_scene::embedded(name).unwrap()
+    }
+
+    #[test]
+    fn every_entity_gets_a_region_and_none_overlap() {
+        for name in ["alpha", "dust", "ribbon", "volume", "alpha-many"] {
+            let s = scene(name);
+            let layout = plan_layout(&s, 720, None, 4096).unwrap();
+            assert_eq!(layout.regions.len(), s.alpha_entity_count(), "{name}");
+            for (i, a) in layout.regions.iter().enumerate() {
+                assert!(!a.downgraded);
+                for b in &layout.regions[i + 1..] {
+                    assert!(
+                        !a.region.expanded(ATLAS_PADDING).overlaps(&b.region),
+                        "{name}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn region_shapes_follow_the_layouts() {
+        let s = scene("volume");
+        let shape = region_shape(&s, EntityKey::System(0), 720, Some(32));
+        assert_eq!(
+            (shape.tiles, shape.tile_width, shape.tile_height),
+            (8, 32, 32)
+        );
+        let s = scene("dust");
+        let shape = region_shape(&s, EntityKey::System(0), 720, Some(32));
+        assert_eq!((shape.tile_width, shape.tile_height), (25, 24));
+        assert!(shape.tile_width * shape.tile_height >= 600 && !shape.downgradable);
+        let s = scene("ribbon");
+        assert_eq!(
+            region_shape(&s, EntityKey::System(0), 720, None).tile_height,
+            1
+        );
+        // Coverage: the same sphere seen on a taller viewport gets at least as many texels.
+        let s = scene("alpha");
+        let small = region_shape(&s, EntityKey::Object(0), 180, None).tile_width;
+        let large = region_shape(&s, EntityKey::Object(0), 1440, None).tile_width;
+        assert!(small < large, "{small} {large}");
+    }
+
+    #[test]
+    fn the_atlas_grows_then_downgrades_then_fails_clearly() {
+        let mut s = scene("alpha-many");
+        let grown = plan_layout(&s, 720, Some(128), 4096).unwrap();
+        assert!(grown.atlas.size().0 > START_ATLAS_SIDE);
+        let capped = plan_layout(&s, 720, Some(128), 256).unwrap();
+        assert!(capped.regions.iter().any(|r| r.downgraded));
+        s.particle_systems[0].layout = ParticleLayout::Dust;
+        s.particle_systems[0].particles = s.particle_systems[0].particles.repeat(400);
+        let err = plan_layout(&s, 720, Some(128), 256).err().expect("too many motes");
+        assert!(matches!(err, LayoutError::AtlasFull { .. }), "{err}");
+        let bad = plan_layout(&s, 720, Some(1), 256).err();
+        assert_eq!(bad, Some(LayoutError::BadResolution(1)));
+    }
+}
