@@ -50,7 +50,8 @@ fn generated_glsl() -> String {
         weights.join(", ")
     )
     .unwrap();
-    for (name, value) in LIGHT_KINDS.into_iter().chain(LIGHT_DRAW_FLAGS) {
+    let alpha = ALPHA_KINDS.into_iter().chain(ALPHA_MODES);
+    for (name, value) in LIGHT_KINDS.into_iter().chain(LIGHT_DRAW_FLAGS).chain(alpha) {
         writeln!(s, "#define {name} {value}u").unwrap();
     }
     writeln!(s, "#define HI_STENCIL_TILE {HI_STENCIL_TILE}u").unwrap();

@@ -290,7 +290,9 @@ mod tests {
         assert!(capped.regions.iter().any(|r| r.downgraded));
         s.particle_systems[0].layout = ParticleLayout::Dust;
         s.particle_systems[0].particles = s.particle_systems[0].particles.repeat(400);
-        let err = plan_layout(&s, 720, Some(128), 256).err().expect("too many motes");
+        let err = plan_layout(&s, 720, Some(128), 256)
+            .err()
+            .expect("too many motes");
         assert!(matches!(err, LayoutError::AtlasFull { .. }), "{err}");
         let bad = plan_layout(&s, 720, Some(1), 256).err();
         assert_eq!(bad, Some(LayoutError::BadResolution(1)));

@@ -2,7 +2,9 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use histencil_vk::{Backend, Context, ContextDesc, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{
+    AlphaMode, Backend, Context, ContextDesc, FlushPolicy, Readback, Renderer, Technique,
+};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -88,6 +90,15 @@ struct RenderArgs {
     /// takes 12 * N^3 bytes).
     #[arg(long, default_value_t = histencil_vk::DEFAULT_LUT_RESOLUTION)]
     lut_resolution: u32,
+    /// How translucent objects and particles are lit: `lightmap` (the talk's per-entity GPU
+    /// lightmaps), `forward` (every light per pixel: the reference), `probe` (every light at one
+    /// point per entity: the classic CPU light probe).
+    #[arg(long, value_enum, default_value = "lightmap")]
+    alpha: AlphaArg,
+    /// Lightmap side in texels for every alpha entity (2..=4096); default: from screen coverage
+    /// (8 to 128 texels).
+    #[arg(long)]
+    lightmap_resolution: Option<u32>,
     /// Time every lighting step and print the talk's pass groups (setup, mask and shade per BRDF,
     /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
     #[arg(long)]
@@ -129,6 +140,23 @@ enum TechniqueArg {
     Lut,
     Deferred,
     Forward,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum AlphaArg {
+    Lightmap,
+    Forward,
+    Probe,
+}
+
+impl AlphaArg {
+    fn mode(self) -> AlphaMode {
+        match self {
+            AlphaArg::Lightmap => AlphaMode::Lightmap,
+            AlphaArg::Forward => AlphaMode::Forward,
+            AlphaArg::Probe => AlphaMode::Probe,
+        }
+    }
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -244,6 +272,8 @@ fn render(args: &RenderArgs) -> Result<()> {
         let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
         renderer.set_preserved_pattern(args.preserved_pattern);
         renderer.set_lut_resolution(args.lut_resolution)?;
+        renderer.set_alpha_mode(args.alpha.mode());
+        renderer.set_lightmap_resolution(args.lightmap_resolution)?;
         if args.stats {
             print_stats(&mut renderer, technique)?;
         }
@@ -388,9 +418,10 @@ fn scenes() {
     for (name, description) in histencil_scene::EMBEDDED {
         let scene = histencil_scene::embedded(name).expect("embedded scenes exist");
         println!(
-            "{name}\t{}\t{}\t0\t{description}",
+            "{name}\t{}\t{}\t{}\t{description}",
             scene.brdfs_in_use().len(),
-            scene.lights.len()
+            scene.lights.len(),
+            scene.alpha_entity_count()
         );
     }
 }

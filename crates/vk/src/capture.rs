@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
 use crate::meshes::Meshes;
 use crate::passes::{begin_rendering, color_attachment, Load};
-use crate::pipelines::{create_pipeline, PipelineDesc, VertexInput};
+use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::{Buffer, Image};
 use crate::shaders;
@@ -77,7 +77,7 @@ impl FootprintCapture {
                 vertex_input: VertexInput::Position,
                 color_formats: &formats,
                 color_writes: true,
-                additive_blend: false,
+                blend: Blend::Off,
                 depth_stencil_format: vk::Format::UNDEFINED,
                 depth_clamp: true,
                 specialization: &[],

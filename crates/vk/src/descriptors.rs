@@ -86,6 +86,18 @@ pub const LUT_EVAL_SET: &[BindingDesc] = &[
     binding(3, BindingKind::StorageBuffer, ""),
 ];
 
+/// Set 1 of the alpha pipelines (include/alpha.glsl): entity records, dust and ribbon points,
+/// and the baked position and normal atlases.
+pub const ALPHA_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::SampledImage, "position_atlas"),
+    binding(3, BindingKind::SampledImage, "normal_atlas"),
+];
+/// Set 2 of the alpha pass (include/alpha_lightmap.glsl): the lightmap atlas. A set of its own
+/// because the lightmap pass renders into it.
+pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "lightmap")];
+
 /// The pipeline layouts: which sets, in order.
 pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET];
 pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET, LUT_SET];
@@ -93,6 +105,7 @@ pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
 pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
 pub const HI_STENCIL_UPDATE_LAYOUT: &[&[BindingDesc]] = &[HI_STENCIL_UPDATE_SET];
 pub const LUT_EVAL_LAYOUT: &[&[BindingDesc]] = &[LUT_EVAL_SET];
+pub const ALPHA_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET, ALPHA_LIGHTMAP_SET];
 
 /// Every shader module and the pipeline layout it is used with.
 pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
@@ -111,10 +124,17 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("tonemap.frag", TONEMAP_LAYOUT),
     ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
     ("lut_eval.comp", LUT_EVAL_LAYOUT),
+    ("alpha_bake.vert", ALPHA_LAYOUT),
+    ("alpha_bake.frag", ALPHA_LAYOUT),
+    ("lightmap.frag", ALPHA_LAYOUT),
+    ("alpha_object.vert", ALPHA_LAYOUT),
+    ("alpha_object.frag", ALPHA_LAYOUT),
+    ("particle.vert", ALPHA_LAYOUT),
+    ("particle.frag", ALPHA_LAYOUT),
 ];
 
 /// The stages of the graphics passes: every binding and push constant is visible to both.
-const GRAPHICS_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
+pub(crate) const GRAPHICS_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
     vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw(),
 );
 

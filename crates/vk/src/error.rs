@@ -33,6 +33,8 @@ pub enum Error {
          {limit} bytes: lower the LUT resolution"
     )]
     LutTooLarge { bytes: u64, limit: u64 },
+    #[error("alpha lightmaps: {0}")]
+    Lightmap(#[from] histencil_alpha::LayoutError),
     #[error("{count} distinct materials; the G-buffer indexes at most {max}")]
     TooManyMaterials { count: usize, max: usize },
     #[error("not supported yet: {0}")]

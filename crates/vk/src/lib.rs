@@ -10,6 +10,7 @@
 //! validation layer with synchronisation validation, and any message fails them.
 
 pub mod access;
+mod alpha;
 mod brdf_eval;
 mod capture;
 mod compute;
@@ -37,6 +38,7 @@ pub mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
 
+pub use alpha::AlphaMode;
 pub use brdf_eval::BrdfEvaluator;
 pub use capture::SimulatorInputs;
 pub use context::{Context, ContextDesc};

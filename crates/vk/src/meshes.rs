@@ -4,7 +4,7 @@ use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
 use ash::vk;
-use histencil_scene::{light_cone, light_sphere, unit_box, uv_sphere, Mesh, Shape};
+use histencil_scene::{light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, Mesh, Shape};
 
 pub struct GpuMesh {
     pub vertices: Buffer,
@@ -68,6 +68,8 @@ pub const CONE_SIDES: u32 = 24;
 
 pub struct Meshes {
     pub unit_box: GpuMesh,
+    /// The box as the lightmap bake draws it (`histencil_scene::unit_box_bake`).
+    pub unit_box_bake: GpuMesh,
     pub sphere: GpuMesh,
     pub light_sphere: GpuMesh,
     pub light_cone: GpuMesh,
@@ -86,6 +88,7 @@ impl Meshes {
         };
         Ok(Self {
             unit_box: GpuMesh::new(ctx, "box-mesh", &unit_box())?,
+            unit_box_bake: GpuMesh::new(ctx, "box-bake-mesh", &unit_box_bake())?,
             sphere: GpuMesh::new(ctx, "sphere-mesh", &uv_sphere(48, 24))?,
             light_sphere_bound: far(&sphere_volume, |p| glam::Vec3::from(p).length()),
             light_cone_bound: (
@@ -104,9 +107,18 @@ impl Meshes {
         }
     }
 
+    /// The mesh the lightmap bake draws for `shape` (its whole UV layout covered).
+    pub fn bake_shape(&self, shape: Shape) -> &GpuMesh {
+        match shape {
+            Shape::Box => &self.unit_box_bake,
+            Shape::Sphere => &self.sphere,
+        }
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         for m in [
             &mut self.unit_box,
+            &mut self.unit_box_bake,
             &mut self.sphere,
             &mut self.light_sphere,
             &mut self.light_cone,

@@ -8,15 +8,30 @@ use crate::shaders;
 use ash::vk;
 use std::io::Cursor;
 
-/// Which vertex attributes a pipeline reads from binding 0 (`scene::Vertex`, 24 bytes).
+/// Which vertex attributes a pipeline reads from binding 0.
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub enum VertexInput {
     /// No vertex buffer (full-screen triangle).
     None,
-    /// Position only (light volumes).
+    /// Position only (light volumes; `scene::Vertex`).
     Position,
-    /// Position and normal (meshes).
+    /// Position and normal (meshes; `scene::Vertex`).
     PositionNormal,
+    /// Position, normal and lightmap uv (alpha meshes; `scene::Vertex`).
+    PositionNormalUv,
+    /// `histencil_alpha::SpriteVertex`: position, corner, entity, param.
+    Sprite,
+}
+
+/// How a pipeline's colour output combines with the target.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Blend {
+    /// Overwrite.
+    Off,
+    /// Add (light accumulation).
+    Additive,
+    /// Premultiplied-alpha "over": `src + dst * (1 - src.a)` (translucent surfaces).
+    PremultipliedOver,
 }
 
 /// A graphics pipeline's fixed parts.
@@ -28,7 +43,7 @@ pub struct PipelineDesc<'a> {
     pub vertex_input: VertexInput,
     pub color_formats: &'a [vk::Format],
     pub color_writes: bool,
-    pub additive_blend: bool,
+    pub blend: Blend,
     pub depth_stencil_format: vk::Format,
     /// Clamp depth instead of clipping at near/far: light volumes crossing the far plane keep
     /// their back faces (at depth 1) so the stencil/depth tests still see them.
@@ -88,6 +103,51 @@ pub const DYNAMIC_STATES: [vk::DynamicState; 11] = [
     vk::DynamicState::STENCIL_REFERENCE,
 ];
 
+/// The vertex stride and attributes (locations 0, 1, ...) of `input`.
+fn vertex_attributes(input: VertexInput) -> (u32, Vec<vk::VertexInputAttributeDescription>) {
+    use vk::Format as F;
+    let (stride, formats): (usize, &[(vk::Format, u32)]) = match input {
+        VertexInput::None => (0, &[]),
+        VertexInput::Position => (
+            size_of::<histencil_scene::Vertex>(),
+            &[(F::R32G32B32_SFLOAT, 0)],
+        ),
+        VertexInput::PositionNormal => (
+            size_of::<histencil_scene::Vertex>(),
+            &[(F::R32G32B32_SFLOAT, 0), (F::R32G32B32_SFLOAT, 12)],
+        ),
+        VertexInput::PositionNormalUv => (
+            size_of::<histencil_scene::Vertex>(),
+            &[
+                (F::R32G32B32_SFLOAT, 0),
+                (F::R32G32B32_SFLOAT, 12),
+                (F::R32G32_SFLOAT, 24),
+            ],
+        ),
+        VertexInput::Sprite => (
+            size_of::<histencil_alpha::SpriteVertex>(),
+            &[
+                (F::R32G32B32_SFLOAT, 0),
+                (F::R32G32_SFLOAT, 12),
+                (F::R32_UINT, 20),
+                (F::R32_SFLOAT, 24),
+            ],
+        ),
+    };
+    let attributes = formats
+        .iter()
+        .enumerate()
+        .map(|(location, (format, offset))| {
+            vk::VertexInputAttributeDescription::default()
+                .location(location as u32)
+                .binding(0)
+                .format(*format)
+                .offset(*offset)
+        })
+        .collect();
+    (stride as u32, attributes)
+}
+
 pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipeline> {
     let vertex_module = create_module(ctx, desc.vertex.0, desc.vertex.1)?;
     let fragment_module = match desc.fragment {
@@ -132,30 +192,19 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
         }
         stages.push(stage);
     }
+    let (stride, attributes) = vertex_attributes(desc.vertex_input);
     let vertex_bindings = [vk::VertexInputBindingDescription::default()
         .binding(0)
-        .stride(std::mem::size_of::<histencil_scene::Vertex>() as u32)
+        .stride(stride)
         .input_rate(vk::VertexInputRate::VERTEX)];
-    let attributes = [
-        vk::VertexInputAttributeDescription::default()
-            .location(0)
-            .binding(0)
-            .format(vk::Format::R32G32B32_SFLOAT)
-            .offset(0),
-        vk::VertexInputAttributeDescription::default()
-            .location(1)
-            .binding(0)
-            .format(vk::Format::R32G32B32_SFLOAT)
-            .offset(12),
-    ];
-    let (bindings, attributes): (&[_], &[_]) = match desc.vertex_input {
-        VertexInput::None => (&[], &[]),
-        VertexInput::Position => (&vertex_bindings, &attributes[..1]),
-        VertexInput::PositionNormal => (&vertex_bindings, &attributes),
+    let bindings: &[_] = if attributes.is_empty() {
+        &[]
+    } else {
+        &vertex_bindings
     };
     let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
         .vertex_binding_descriptions(bindings)
-        .vertex_attribute_descriptions(attributes);
+        .vertex_attribute_descriptions(&attributes);
     let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
         .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
     let viewport = vk::PipelineViewportStateCreateInfo::default()
@@ -174,13 +223,17 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     } else {
         vk::ColorComponentFlags::empty()
     };
+    let dst_factor = match desc.blend {
+        Blend::PremultipliedOver => vk::BlendFactor::ONE_MINUS_SRC_ALPHA,
+        Blend::Off | Blend::Additive => vk::BlendFactor::ONE,
+    };
     let blend_attachment = vk::PipelineColorBlendAttachmentState::default()
-        .blend_enable(desc.additive_blend)
+        .blend_enable(desc.blend != Blend::Off)
         .src_color_blend_factor(vk::BlendFactor::ONE)
-        .dst_color_blend_factor(vk::BlendFactor::ONE)
+        .dst_color_blend_factor(dst_factor)
         .color_blend_op(vk::BlendOp::ADD)
         .src_alpha_blend_factor(vk::BlendFactor::ONE)
-        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+        .dst_alpha_blend_factor(dst_factor)
         .alpha_blend_op(vk::BlendOp::ADD)
         .color_write_mask(write_mask);
     let blend_attachments = vec![blend_attachment; desc.color_formats.len()];
@@ -256,7 +309,7 @@ impl Pipelines {
             vertex_input: VertexInput::Position,
             color_formats: &hdr,
             color_writes: true,
-            additive_blend: false,
+            blend: Blend::Off,
             depth_stencil_format: formats.depth_stencil,
             depth_clamp: false,
             specialization: &[],

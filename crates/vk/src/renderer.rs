@@ -1,5 +1,6 @@
 //! The renderer: owns a scene's GPU resources and records / submits whole frames.
 
+use crate::alpha::{AlphaLighting, AlphaMode};
 use crate::capture::{is_full_screen, FootprintCapture, SimulatorInputs};
 use crate::context::Context;
 use crate::descriptors::write_storage_buffers;
@@ -190,6 +191,12 @@ pub struct Renderer<'c> {
     lut_resolution: u32,
     /// Baked when the LUT technique first renders at `lut_resolution`.
     lut_tables: Option<LutTables>,
+    alpha_mode: AlphaMode,
+    /// Lightmap region side for every entity; `None`: from screen coverage.
+    lightmap_side: Option<u32>,
+    /// Created at the first frame of a scene with alpha entities (and again when the lightmap
+    /// resolution changes).
+    alpha: Option<AlphaLighting>,
     /// Written into the preserved stencil bits by the G-buffer pass (the engine's own bits).
     preserved_pattern: u8,
     light_pipelines: LightPipelines,
@@ -310,6 +317,9 @@ impl<'c> Renderer<'c> {
             object_materials,
             lut_resolution: DEFAULT_LUT_RESOLUTION,
             lut_tables: None,
+            alpha_mode: AlphaMode::default(),
+            lightmap_side: None,
+            alpha: None,
             preserved_pattern: 0,
             light_pipelines,
             pass_timing: false,
@@ -434,6 +444,64 @@ impl<'c> Renderer<'c> {
         Ok(self.lut_tables.as_ref().expect("baked above"))
     }
 
+    /// How the alpha pass lights translucent objects and particles (default: lightmaps).
+    pub fn set_alpha_mode(&mut self, mode: AlphaMode) {
+        self.alpha_mode = mode;
+    }
+
+    pub fn alpha_mode(&self) -> AlphaMode {
+        self.alpha_mode
+    }
+
+    /// Gives every alpha entity's lightmap `side` texels a side (a ribbon `side` texels along
+    /// it; dust keeps one texel per mote); `None` sizes them from screen coverage
+    /// (`histencil_alpha::side_for_coverage`). The atlas is laid out again on the next frame.
+    ///
+    /// # Errors
+    /// [`crate::Error::Lightmap`] for a side outside 2..=4096 (the renderer keeps its setting).
+    pub fn set_lightmap_resolution(&mut self, side: Option<u32>) -> Result<()> {
+        if let Some(s) = side.filter(|s| !(2..=4096).contains(s)) {
+            return Err(histencil_alpha::LayoutError::BadResolution(s).into());
+        }
+        if side != self.lightmap_side {
+            if let Some(mut old) = self.alpha.take() {
+                old.destroy(self.ctx);
+            }
+            self.lightmap_side = side;
+        }
+        Ok(())
+    }
+
+    /// The alpha entities' lightmap layout (atlas size, each entity's region), planned on first
+    /// use; `None` for a scene without alpha entities.
+    ///
+    /// # Errors
+    /// [`crate::Error::Lightmap`] when the entities do not fit the atlas.
+    pub fn lightmap_layout(&mut self) -> Result<Option<&histencil_alpha::LightmapLayout>> {
+        Ok(self.alpha_lighting()?.map(|a| a.layout()))
+    }
+
+    /// Lightmap draws per frame: one per (entity, light that reaches its bounds).
+    pub fn lightmap_draws(&mut self) -> Result<usize> {
+        Ok(self.alpha_lighting()?.map_or(0, |a| a.lightmap_draws()))
+    }
+
+    fn alpha_lighting(&mut self) -> Result<Option<&mut AlphaLighting>> {
+        if self.scene.alpha_entity_count() == 0 {
+            return Ok(None);
+        }
+        if self.alpha.is_none() {
+            self.alpha = Some(AlphaLighting::new(
+                self.ctx,
+                &self.scene,
+                self.extent,
+                self.lightmap_side,
+                self.descriptors.frame_layout,
+            )?);
+        }
+        Ok(self.alpha.as_mut())
+    }
+
     /// Light pipelines created so far.
     pub fn light_pipeline_count(&self) -> usize {
         self.light_pipelines.count()
@@ -499,6 +567,7 @@ impl<'c> Renderer<'c> {
         if brdf_source == BrdfSource::Table {
             self.lut_tables()?;
         }
+        self.alpha_lighting()?;
         prepare_pipelines(
             ctx,
             &mut self.light_pipelines,
@@ -564,6 +633,23 @@ impl<'c> Renderer<'c> {
                 )?;
                 self.timestamps.mark(ctx, cmd, "lighting");
             }
+        }
+        if let Some(alpha) = self.alpha.as_mut() {
+            let frame_set = self.descriptors.frame_set;
+            let (scene, meshes) = (&self.scene, &self.meshes);
+            alpha.record_lightmaps(ctx, cmd, scene, meshes, frame_set, self.alpha_mode);
+            self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
+            alpha.record_alpha(
+                ctx,
+                cmd,
+                scene,
+                meshes,
+                &mut self.targets,
+                frame_set,
+                self.alpha_mode,
+                self.extent,
+            );
+            self.timestamps.mark(ctx, cmd, "alpha");
         }
         TonemapPass {
             ctx,
@@ -757,6 +843,9 @@ impl Drop for Renderer<'_> {
         self.light_pipelines.destroy(ctx);
         if let Some(t) = self.lut_tables.as_mut() {
             t.destroy(ctx);
+        }
+        if let Some(a) = self.alpha.as_mut() {
+            a.destroy(ctx);
         }
         self.descriptors.destroy(ctx);
         self.hi_stencil.destroy(ctx);

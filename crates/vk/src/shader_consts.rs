@@ -24,3 +24,19 @@ pub const LIGHT_DRAW_FLAGS: [(&str, u32); 2] = [
     ("LIGHT_DRAW_HI_STENCIL_TEST", LIGHT_DRAW_HI_STENCIL_TEST),
     ("LIGHT_DRAW_COUNT", LIGHT_DRAW_COUNT),
 ];
+
+/// GLSL `ALPHA_*` entity kinds, in `AlphaEntity.shape.x` (include/alpha.glsl): how an entity's
+/// lightmap texels map to probe positions.
+pub const ALPHA_KINDS: [(&str, u32); 4] = [
+    ("ALPHA_OBJECT", 0),
+    ("ALPHA_SLICES", 1),
+    ("ALPHA_DUST", 2),
+    ("ALPHA_RIBBON", 3),
+];
+
+/// GLSL `ALPHA_MODE_*`, in `AlphaDraw.mode`: how the alpha pass lights a fragment.
+pub const ALPHA_MODES: [(&str, u32); 3] = [
+    ("ALPHA_MODE_LIGHTMAP", 0),
+    ("ALPHA_MODE_FORWARD", 1),
+    ("ALPHA_MODE_PROBE", 2),
+];

@@ -3,7 +3,7 @@
 
 use crate::context::Context;
 use crate::error::Result;
-use crate::pipelines::{create_pipeline, PipelineDesc, VertexInput};
+use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::shaders;
 use ash::vk;
 use histencil_brdf::BrdfId;
@@ -149,7 +149,7 @@ impl LightPipelines {
                 vertex_input,
                 color_formats: &hdr,
                 color_writes: shades,
-                additive_blend: shades,
+                blend: if shades { Blend::Additive } else { Blend::Off },
                 depth_stencil_format: self.depth_stencil_format,
                 // Back faces beyond the far plane clamp to depth 1, behind every surface.
                 depth_clamp: geometry == Geometry::Volume,

@@ -1,0 +1,165 @@
+//! The alpha passes' GPU records (include/alpha.glsl) and how a scene fills them.
+
+use crate::shader_consts::ALPHA_KINDS;
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use histencil_alpha::{fit_frame, probe_point, EntityKey, EntityRegion, ProbeFrame};
+use histencil_scene::{Material, ParticleLayout, Scene};
+
+/// `AlphaEntity` in alpha.glsl (std430).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuAlphaEntity {
+    pub model: [[f32; 4]; 4],
+    pub tint_opacity: [f32; 4],
+    pub params: [f32; 4],
+    pub region: [u32; 4],
+    pub shape: [u32; 4],
+    pub centre_radius: [f32; 4],
+    pub right_depth: [f32; 4],
+    pub up: [f32; 4],
+    pub forward: [f32; 4],
+}
+
+/// `AlphaDraw` push constants in alpha.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct AlphaDrawPush {
+    pub entity: u32,
+    pub light: u32,
+    pub mode: u32,
+    pub pad: u32,
+}
+
+fn kind_code(name: &str) -> u32 {
+    ALPHA_KINDS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .expect("known alpha kind")
+        .1
+}
+
+/// The records of every entity (in `regions` order, which is `histencil_alpha::entities`
+/// order), and the dust and ribbon points they index.
+pub fn entity_records(
+    scene: &Scene,
+    regions: &[EntityRegion],
+) -> (Vec<GpuAlphaEntity>, Vec<[f32; 4]>) {
+    let mut points: Vec<[f32; 4]> = Vec::new();
+    let records = regions
+        .iter()
+        .map(|r| {
+            let region = [
+                r.region.x,
+                r.region.y,
+                r.shape.tile_width,
+                r.shape.tile_height,
+            ];
+            let centre = probe_point(scene, r.entity);
+            match r.entity {
+                EntityKey::Object(i) => {
+                    let o = &scene.alpha_objects[i];
+                    let frame = ProbeFrame {
+                        centre,
+                        radius: 1.0,
+                        half_depth: 0.0,
+                        right: Vec3::X,
+                        up: Vec3::Y,
+                        forward: Vec3::Z,
+                    };
+                    record(
+                        o.transform,
+                        &o.material,
+                        o.opacity,
+                        region,
+                        [kind_code("ALPHA_OBJECT"), 1, 0, 0],
+                        &frame,
+                    )
+                }
+                EntityKey::System(i) => {
+                    let s = &scene.particle_systems[i];
+                    let mut frame = fit_frame(&scene.camera, s);
+                    frame.centre = centre;
+                    let first = points.len() as u32;
+                    let count = s.particles.len() as u32;
+                    let (kind, tiles) = match s.layout {
+                        ParticleLayout::Billboard => ("ALPHA_SLICES", 1),
+                        ParticleLayout::Slices { count } => ("ALPHA_SLICES", count),
+                        ParticleLayout::Dust => ("ALPHA_DUST", 1),
+                        ParticleLayout::Ribbon => ("ALPHA_RIBBON", 1),
+                    };
+                    if matches!(s.layout, ParticleLayout::Dust | ParticleLayout::Ribbon) {
+                        points.extend(
+                            s.particles
+                                .iter()
+                                .map(|p| p.position.extend(p.size).to_array()),
+                        );
+                    }
+                    let shape = [kind_code(kind), tiles, first, count];
+                    record(
+                        Mat4::IDENTITY,
+                        &s.material,
+                        s.opacity,
+                        region,
+                        shape,
+                        &frame,
+                    )
+                }
+            }
+        })
+        .collect();
+    (records, points)
+}
+
+fn record(
+    model: Mat4,
+    material: &Material,
+    opacity: f32,
+    region: [u32; 4],
+    shape: [u32; 4],
+    frame: &ProbeFrame,
+) -> GpuAlphaEntity {
+    let p = material.brdf.packed_params();
+    GpuAlphaEntity {
+        model: model.to_cols_array_2d(),
+        tint_opacity: material.tint.extend(opacity).to_array(),
+        params: [
+            p[0] as f32,
+            p[1] as f32,
+            p[2] as f32,
+            material.brdf.model_index() as f32,
+        ],
+        region,
+        shape,
+        centre_radius: frame.centre.extend(frame.radius).to_array(),
+        right_depth: frame.right.extend(frame.half_depth).to_array(),
+        up: frame.up.extend(0.0).to_array(),
+        forward: frame.forward.extend(0.0).to_array(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn records_match_the_glsl_block() {
+        assert_eq!(std::mem::size_of::<GpuAlphaEntity>(), 64 + 8 * 16);
+        assert_eq!(std::mem::size_of::<AlphaDrawPush>(), 16);
+    }
+
+    #[test]
+    fn dust_and_ribbons_index_their_points() {
+        let mut scene = histencil_scene::embedded("dust").unwrap();
+        let ribbon = histencil_scene::embedded("ribbon")
+            .unwrap()
+            .particle_systems[0]
+            .clone();
+        scene.particle_systems.push(ribbon);
+        let layout = histencil_alpha::plan_layout(&scene, 256, None, 4096).unwrap();
+        let (records, points) = entity_records(&scene, &layout.regions);
+        assert_eq!(records[0].shape[2..], [0, 600]);
+        assert_eq!(records[1].shape[2..], [600, 64]);
+        assert_eq!(points.len(), 664);
+    }
+}

@@ -1,0 +1,118 @@
+// Alpha entities (translucent objects, particle systems) and where their light probes are.
+// Rust mirrors: crates/vk/src/alpha/gpu.rs (GpuAlphaEntity, AlphaDrawPush); the probe frame is
+// histencil_alpha::ProbeFrame, the layouts histencil_alpha::plan_layout.
+#ifndef ALPHA_GLSL
+#define ALPHA_GLSL
+
+#include "light.glsl"
+
+#extension GL_EXT_samplerless_texture_functions : require
+
+struct AlphaEntity {
+    mat4 model;           // object -> world (identity for particle systems)
+    vec4 tint_opacity;    // rgb tint, w opacity
+    vec4 params;          // xyz the BRDF's packed parameters, w BRDF id
+    uvec4 region;         // xy: the region's first texel in the atlas; zw: one tile's size
+    uvec4 shape;          // x: ALPHA_* kind, y: tiles (slices), z: first point, w: point count
+    vec4 centre_radius;   // xyz: probe frame centre (the single probe's point), w: its radius
+    vec4 right_depth;     // xyz: unit right, w: half depth of the slice stack
+    vec4 up;              // xyz: unit up
+    vec4 forward;         // xyz: unit view direction
+};
+
+layout(set = 1, binding = 0, std430) readonly buffer AlphaEntities {
+    AlphaEntity entities[];
+};
+
+// Dust motes and ribbon control points: xyz position, w size.
+layout(set = 1, binding = 1, std430) readonly buffer AlphaPoints {
+    vec4 points[];
+};
+
+// Baked object-space positions (w = 1 where a surface covers the texel) and normals.
+layout(set = 1, binding = 2) uniform texture2D position_atlas;
+layout(set = 1, binding = 3) uniform texture2D normal_atlas;
+
+layout(push_constant) uniform AlphaDraw {
+    uint entity; // into `entities`
+    uint light;  // into `lights` (lightmap pass)
+    uint mode;   // ALPHA_MODE_* (alpha pass)
+    uint pad;
+} alpha_draw;
+
+// The entity's surface at world position P with world normal N.
+Surface alpha_surface(AlphaEntity e, vec3 P, vec3 N) {
+    Surface s;
+    s.position = P;
+    s.normal = N;
+    s.tint = e.tint_opacity.rgb;
+    s.params = vec4(e.params.xyz, 0.0);
+    s.brdf = uint(e.params.w);
+    return s;
+}
+
+// Particles face the viewer: their shading normal points at the eye.
+vec3 facing_normal(vec3 P) {
+    vec3 to_eye = frame.eye.xyz - P;
+    return length(to_eye) > 0.0 ? normalize(to_eye) : vec3(0.0, 0.0, 1.0);
+}
+
+// The probe at (u, v) of slice k of the entity's frame (histencil_alpha::ProbeFrame::probe).
+vec3 frame_probe(AlphaEntity e, vec2 uv, uint k) {
+    uint n = e.shape.y;
+    float half_depth = e.right_depth.w;
+    float depth = n > 1u ? -half_depth + 2.0 * half_depth * float(k) / float(n - 1u) : 0.0;
+    float r = e.centre_radius.w;
+    return e.centre_radius.xyz + e.right_depth.xyz * r * (2.0 * uv.x - 1.0)
+        - e.up.xyz * r * (2.0 * uv.y - 1.0) + e.forward.xyz * depth;
+}
+
+// `(u, v, slice)` of the probe nearest P (histencil_alpha::ProbeFrame::locate).
+vec3 frame_locate(AlphaEntity e, vec3 P) {
+    vec3 d = P - e.centre_radius.xyz;
+    float r = e.centre_radius.w;
+    uint n = e.shape.y;
+    float s = 0.0;
+    if (n > 1u) {
+        float half_depth = e.right_depth.w;
+        s = clamp((dot(d, e.forward.xyz) + half_depth) / (2.0 * half_depth) * float(n - 1u),
+                  0.0, float(n - 1u));
+    }
+    return vec3(0.5 + 0.5 * dot(d, e.right_depth.xyz) / r, 0.5 - 0.5 * dot(d, e.up.xyz) / r, s);
+}
+
+// The point at `t` in [0, 1] along a ribbon: linear between control points, evenly in index.
+vec3 ribbon_point(AlphaEntity e, float t) {
+    uint count = e.shape.w;
+    float x = clamp(t, 0.0, 1.0) * float(count - 1u);
+    uint i = min(uint(floor(x)), count - 2u);
+    vec3 a = points[e.shape.z + i].xyz;
+    vec3 b = points[e.shape.z + i + 1u].xyz;
+    return mix(a, b, x - float(i));
+}
+
+// Every light's contribution at surface s (the forward reference).
+vec3 forward_lighting(Surface s) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0; i < frame.counts.x; ++i) {
+        sum += shade_light(lights[i], s);
+    }
+    return sum;
+}
+
+// The classic single light probe: what every light delivers at one point stands for the whole
+// entity; the BRDF still sees the fragment's own normal and view direction.
+vec3 probe_lighting(Surface s, vec3 probe) {
+    vec3 sum = vec3(0.0);
+    vec3 V = normalize(frame.eye.xyz - s.position);
+    for (uint i = 0; i < frame.counts.x; ++i) {
+        vec3 L;
+        vec3 incident = light_incident(lights[i], probe, L);
+        if (any(notEqual(incident, vec3(0.0)))) {
+            sum += incident * evaluate_brdf(s, s.brdf, V, L);
+        }
+    }
+    return sum;
+}
+
+#endif

@@ -1,0 +1,43 @@
+#version 460
+// The per-frame lightmap pass: one draw per (entity, light that reaches it) over the entity's
+// region, additive. Each texel is a light probe; it is lit by the same light and BRDF code as
+// the deferred pass (include/light.glsl), with the entity's own BRDF, towards the camera.
+#include "alpha.glsl"
+
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    AlphaEntity e = entities[alpha_draw.entity];
+    ivec2 local = ivec2(gl_FragCoord.xy) - ivec2(e.region.xy);
+    uint kind = e.shape.x;
+    vec3 P;
+    vec3 N;
+    if (kind == ALPHA_OBJECT) {
+        ivec2 texel = ivec2(gl_FragCoord.xy);
+        vec4 p = texelFetch(position_atlas, texel, 0);
+        if (p.w == 0.0) {
+            out_color = vec4(0.0);
+            return;
+        }
+        P = (e.model * vec4(p.xyz, 1.0)).xyz;
+        N = normalize(transpose(inverse(mat3(e.model))) * texelFetch(normal_atlas, texel, 0).xyz);
+    } else if (kind == ALPHA_DUST) {
+        uint i = uint(local.y) * e.region.z + uint(local.x);
+        if (i >= e.shape.w) {
+            out_color = vec4(0.0);
+            return;
+        }
+        P = points[e.shape.z + i].xyz;
+        N = facing_normal(P);
+    } else if (kind == ALPHA_RIBBON) {
+        P = ribbon_point(e, (float(local.x) + 0.5) / float(e.region.z));
+        N = facing_normal(P);
+    } else {
+        uint k = uint(local.x) / e.region.z;
+        vec2 in_tile = vec2(uint(local.x) - k * e.region.z, local.y) + 0.5;
+        P = frame_probe(e, in_tile / vec2(e.region.zw), k);
+        N = facing_normal(P);
+    }
+    Surface s = alpha_surface(e, P, N);
+    out_color = vec4(shade_light(lights[alpha_draw.light], s), 0.0);
+}
