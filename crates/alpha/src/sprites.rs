@@ -1,5 +1,6 @@
-//! The alpha pass's particle geometry, built on the CPU each frame because it faces the camera:
-//! one quad per sprite (billboard, slices, dust) or a strip through a ribbon's control points.
+//! The alpha pass's particle geometry, built on the CPU for a camera because it faces it: one
+//! quad per sprite (billboard, slices, dust) or a strip through a ribbon's control points. (The
+//! renderer's camera is fixed per scene, so it builds them once; a moving camera rebuilds them.)
 
 use crate::probes::camera_axes;
 use glam::Vec3;

@@ -99,6 +99,10 @@ struct RenderArgs {
     /// (8 to 128 texels).
     #[arg(long)]
     lightmap_resolution: Option<u32>,
+    /// Also render the alpha entities forward per pixel, and the scene without them, and print
+    /// the written frame's error against the forward alpha over the pixels they cover.
+    #[arg(long)]
+    alpha_error: bool,
     /// Time every lighting step and print the talk's pass groups (setup, mask and shade per BRDF,
     /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
     #[arg(long)]
@@ -287,6 +291,14 @@ fn render(args: &RenderArgs) -> Result<()> {
             },
         )?;
         let images = frame.images;
+        if args.alpha_error {
+            print_alpha_error(
+                ctx,
+                &mut renderer,
+                technique,
+                images.ldr.as_ref().expect("requested"),
+            )?;
+        }
         histencil_vk::save_png(images.ldr.as_ref().expect("requested"), &args.out)?;
         println!("wrote {}", args.out.display());
         if let (Some(path), Some(hdr)) = (&args.hdr, &images.hdr) {
@@ -319,6 +331,40 @@ fn render(args: &RenderArgs) -> Result<()> {
         }
         Ok(())
     })
+}
+
+/// Prints `ldr`'s error against the same frame with forward-lit alpha entities, over the pixels
+/// the entities cover (where that frame differs from one without them).
+fn print_alpha_error(
+    ctx: &Context,
+    renderer: &mut Renderer,
+    technique: Technique,
+    ldr: &image::RgbaImage,
+) -> Result<()> {
+    let only_ldr = Readback {
+        ldr: true,
+        ..Readback::NONE
+    };
+    let mode = renderer.alpha_mode();
+    renderer.set_alpha_mode(AlphaMode::Forward);
+    let forward = renderer.render(technique, only_ldr);
+    renderer.set_alpha_mode(mode);
+    let forward = forward?.images.ldr.expect("requested");
+    let mut bare = renderer.scene().clone();
+    bare.alpha_objects.clear();
+    bare.particle_systems.clear();
+    let (w, h) = ldr.dimensions();
+    let background = Renderer::new(ctx, bare, w, h)?
+        .render(technique, only_ldr)?
+        .images
+        .ldr
+        .expect("requested");
+    let e = histencil_vk::masked_error(ldr, &forward, &background).expect("same sizes");
+    println!(
+        "alpha error against forward ({mode:?}): mean {:.3}/255, max {}/255 over {} pixels",
+        e.mean, e.max, e.pixels
+    );
+    Ok(())
 }
 
 /// Prints the GPU's hi-stencil statistics of one frame next to the simulator's prediction.

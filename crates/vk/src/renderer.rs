@@ -342,6 +342,11 @@ impl<'c> Renderer<'c> {
         })
     }
 
+    /// The scene being rendered.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
     pub fn stencil_layout(&self) -> &StencilLayout {
         &self.stencil_layout
     }
