@@ -14,9 +14,9 @@ void main() {
     Surface s = alpha_surface(e, in_world_position, normalize(in_world_normal));
     vec3 lit;
     if (alpha_draw.mode == ALPHA_MODE_FORWARD) {
-        lit = forward_lighting(s);
+        lit = forward_lighting(e, s);
     } else if (alpha_draw.mode == ALPHA_MODE_PROBE) {
-        lit = probe_lighting(s, e.centre_radius.xyz);
+        lit = probe_lighting(e, s);
     } else {
         lit = sample_tile(e, 0u, in_uv);
     }

@@ -21,9 +21,9 @@ void main() {
     Surface s = alpha_surface(e, P, facing_normal(P));
     vec3 lit;
     if (alpha_draw.mode == ALPHA_MODE_FORWARD) {
-        lit = forward_lighting(s);
+        lit = forward_lighting(e, s);
     } else if (alpha_draw.mode == ALPHA_MODE_PROBE) {
-        lit = probe_lighting(s, e.centre_radius.xyz);
+        lit = probe_lighting(e, s);
     } else {
         // Dust reads its mote's texel (flat: the interpolated copy may round off the index).
         lit = particle_lightmap(e, P, e.shape.x == ALPHA_DUST ? in_mote : in_param);

@@ -18,6 +18,7 @@ struct AlphaEntity {
     vec4 right_depth;     // xyz: unit right, w: half depth of the slice stack
     vec4 up;              // xyz: unit up
     vec4 forward;         // xyz: unit view direction
+    uvec4 light_range;    // x: first index into `entity_lights`, y: count
 };
 
 layout(set = 1, binding = 0, std430) readonly buffer AlphaEntities {
@@ -27,6 +28,11 @@ layout(set = 1, binding = 0, std430) readonly buffer AlphaEntities {
 // Dust motes and ribbon control points: xyz position, w size.
 layout(set = 1, binding = 1, std430) readonly buffer AlphaPoints {
     vec4 points[];
+};
+
+// Per entity, the lights whose range reaches its bounds (the only ones that can light it).
+layout(set = 1, binding = 4, std430) readonly buffer AlphaEntityLights {
+    uint entity_lights[];
 };
 
 // Baked object-space positions (w = 1 where a surface covers the texel) and normals.
@@ -91,23 +97,25 @@ vec3 ribbon_point(AlphaEntity e, float t) {
     return mix(a, b, x - float(i));
 }
 
-// Every light's contribution at surface s (the forward reference).
-vec3 forward_lighting(Surface s) {
+// Every light's contribution at surface s (the forward reference), over the entity's light
+// list: the others contribute exactly zero inside its bounds.
+vec3 forward_lighting(AlphaEntity e, Surface s) {
     vec3 sum = vec3(0.0);
-    for (uint i = 0; i < frame.counts.x; ++i) {
-        sum += shade_light(lights[i], s);
+    for (uint i = 0; i < e.light_range.y; ++i) {
+        sum += shade_light(lights[entity_lights[e.light_range.x + i]], s);
     }
     return sum;
 }
 
 // The classic single light probe: what every light delivers at one point stands for the whole
 // entity; the BRDF still sees the fragment's own normal and view direction.
-vec3 probe_lighting(Surface s, vec3 probe) {
+vec3 probe_lighting(AlphaEntity e, Surface s) {
+    vec3 probe = e.centre_radius.xyz;
     vec3 sum = vec3(0.0);
     vec3 V = normalize(frame.eye.xyz - s.position);
-    for (uint i = 0; i < frame.counts.x; ++i) {
+    for (uint i = 0; i < e.light_range.y; ++i) {
         vec3 L;
-        vec3 incident = light_incident(lights[i], probe, L);
+        vec3 incident = light_incident(lights[entity_lights[e.light_range.x + i]], probe, L);
         if (any(notEqual(incident, vec3(0.0)))) {
             sum += incident * evaluate_brdf(s, s.brdf, V, L);
         }

@@ -19,6 +19,8 @@ pub struct GpuAlphaEntity {
     pub right_depth: [f32; 4],
     pub up: [f32; 4],
     pub forward: [f32; 4],
+    /// First index into the entity light list, and count.
+    pub light_range: [u32; 4],
 }
 
 /// `AlphaDraw` push constants in alpha.glsl.
@@ -39,12 +41,31 @@ fn kind_code(name: &str) -> u32 {
         .1
 }
 
+/// Per entity (in `regions` order), the lights whose range reaches its bounds.
+pub fn entity_lights(scene: &Scene, regions: &[EntityRegion]) -> Vec<Vec<u32>> {
+    regions
+        .iter()
+        .map(|r| {
+            let (lo, hi) = match r.entity {
+                EntityKey::Object(i) => scene.alpha_objects[i].world_bounds(),
+                EntityKey::System(i) => scene.particle_systems[i].world_bounds(),
+            };
+            (0..scene.lights.len() as u32)
+                .filter(|l| scene.lights[*l as usize].reaches_box(lo, hi))
+                .collect()
+        })
+        .collect()
+}
+
 /// The records of every entity (in `regions` order, which is `histencil_alpha::entities`
-/// order), and the dust and ribbon points they index.
+/// order), the dust and ribbon points they index, and their light lists flattened (each
+/// record's `light_range` points into it).
 pub fn entity_records(
     scene: &Scene,
     regions: &[EntityRegion],
-) -> (Vec<GpuAlphaEntity>, Vec<[f32; 4]>) {
+    lights: &[Vec<u32>],
+) -> (Vec<GpuAlphaEntity>, Vec<[f32; 4]>, Vec<u32>) {
+    let mut light_list: Vec<u32> = Vec::new();
     let mut points: Vec<[f32; 4]> = Vec::new();
     let records = regions
         .iter()
@@ -107,8 +128,14 @@ pub fn entity_records(
                 }
             }
         })
+        .zip(lights)
+        .map(|(mut record, lights): (GpuAlphaEntity, &Vec<u32>)| {
+            record.light_range = [light_list.len() as u32, lights.len() as u32, 0, 0];
+            light_list.extend(lights);
+            record
+        })
         .collect();
-    (records, points)
+    (records, points, light_list)
 }
 
 fn record(
@@ -135,6 +162,7 @@ fn record(
         right_depth: frame.right.extend(frame.half_depth).to_array(),
         up: frame.up.extend(0.0).to_array(),
         forward: frame.forward.extend(0.0).to_array(),
+        light_range: [0; 4],
     }
 }
 
@@ -144,7 +172,7 @@ mod tests {
 
     #[test]
     fn records_match_the_glsl_block() {
-        assert_eq!(std::mem::size_of::<GpuAlphaEntity>(), 64 + 8 * 16);
+        assert_eq!(std::mem::size_of::<GpuAlphaEntity>(), 64 + 9 * 16);
         assert_eq!(std::mem::size_of::<AlphaDrawPush>(), 16);
     }
 
@@ -157,7 +185,10 @@ mod tests {
             .clone();
         scene.particle_systems.push(ribbon);
         let layout = histencil_alpha::plan_layout(&scene, 256, None, 4096).unwrap();
-        let (records, points) = entity_records(&scene, &layout.regions);
+        let lights = entity_lights(&scene, &layout.regions);
+        let (records, points, list) = entity_records(&scene, &layout.regions, &lights);
+        assert_eq!(list.len(), lights.iter().map(Vec::len).sum::<usize>());
+        assert_eq!(records[1].light_range[0] as usize, lights[0].len());
         assert_eq!(records[0].shape[2..], [0, 600]);
         assert_eq!(records[1].shape[2..], [600, 64]);
         assert_eq!(points.len(), 664);

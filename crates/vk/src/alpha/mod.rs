@@ -27,7 +27,7 @@ use crate::shaders;
 use crate::state::{apply, FULLSCREEN};
 use crate::targets::{Targets, HDR_FORMAT};
 use ash::vk;
-use gpu::{entity_records, AlphaDrawPush};
+use gpu::{entity_lights, entity_records, AlphaDrawPush};
 use histencil_alpha::{
     back_to_front, plan_layout, sprite_vertices, EntityKey, LightmapLayout, SpriteVertex,
 };
@@ -99,6 +99,7 @@ pub(crate) struct AlphaLighting {
     lightmap: Image,
     entities: Buffer,
     points: Buffer,
+    light_list: Buffer,
     sprites: Buffer,
     alpha_set_layout: vk::DescriptorSetLayout,
     lightmap_set_layout: vk::DescriptorSetLayout,
@@ -201,9 +202,15 @@ impl AlphaLighting {
                 .push(Image::new(ctx, name, format, extent, usage, color)?);
         }
 
-        let (records, mut points) = entity_records(scene, &layout.regions);
+        let entity_lights = entity_lights(scene, &layout.regions);
+        let (records, mut points, mut light_list) =
+            entity_records(scene, &layout.regions, &entity_lights);
+        // A storage buffer binding needs a non-empty range.
         if points.is_empty() {
-            points.push([0.0; 4]); // a storage buffer binding needs a non-empty range
+            points.push([0.0; 4]);
+        }
+        if light_list.is_empty() {
+            light_list.push(0);
         }
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         parts.buffers.push(Buffer::with_data(
@@ -217,6 +224,12 @@ impl AlphaLighting {
             "alpha-points",
             storage,
             bytemuck::cast_slice(&points),
+        )?);
+        parts.buffers.push(Buffer::with_data(
+            ctx,
+            "alpha-entity-lights",
+            storage,
+            bytemuck::cast_slice(&light_list),
         )?);
         let mut sprites: Vec<SpriteVertex> = Vec::new();
         let mut sprite_ranges = Vec::new();
@@ -235,19 +248,6 @@ impl AlphaLighting {
             vk::BufferUsageFlags::VERTEX_BUFFER,
             bytemuck::cast_slice(&sprites),
         )?);
-        let entity_lights = layout
-            .regions
-            .iter()
-            .map(|r| {
-                let (lo, hi) = match r.entity {
-                    EntityKey::Object(i) => scene.alpha_objects[i].world_bounds(),
-                    EntityKey::System(i) => scene.particle_systems[i].world_bounds(),
-                };
-                (0..scene.lights.len() as u32)
-                    .filter(|l| scene.lights[*l as usize].reaches_box(lo, hi))
-                    .collect()
-            })
-            .collect();
 
         let alpha_set_layout =
             create_set_layout(ctx, "alpha-set-layout", ALPHA_SET, GRAPHICS_STAGES)?;
@@ -324,6 +324,7 @@ impl AlphaLighting {
         let images = &parts.images;
         let buffers = [parts.buffers[0].handle, parts.buffers[1].handle];
         write_storage_buffers(ctx, alpha_set, &buffers);
+        write_storage_buffer(ctx, alpha_set, 4, parts.buffers[2].handle);
         write_sampled_image(ctx, alpha_set, 2, images[0].view);
         write_sampled_image(ctx, alpha_set, 3, images[1].view);
         write_sampled_image(ctx, lightmap_set, 0, images[2].view);
@@ -344,6 +345,7 @@ impl AlphaLighting {
             lightmap: next(),
             entities: buffers.next().expect("entities"),
             points: buffers.next().expect("points"),
+            light_list: buffers.next().expect("light list"),
             sprites: buffers.next().expect("sprites"),
             alpha_set_layout,
             lightmap_set_layout,
@@ -613,7 +615,12 @@ impl AlphaLighting {
         for image in [&mut self.positions, &mut self.normals, &mut self.lightmap] {
             image.destroy(ctx);
         }
-        for buffer in [&mut self.entities, &mut self.points, &mut self.sprites] {
+        for buffer in [
+            &mut self.entities,
+            &mut self.points,
+            &mut self.light_list,
+            &mut self.sprites,
+        ] {
             buffer.destroy(ctx);
         }
     }
@@ -645,7 +652,7 @@ fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: histencil_alpha::Region)
     }
 }
 
-/// A pool with one alpha set (two storage buffers, two sampled images) and one lightmap set.
+/// A pool with one alpha set (three storage buffers, two sampled images) and one lightmap set.
 fn create_sets(
     ctx: &Context,
     parts: &mut Parts,
@@ -654,7 +661,7 @@ fn create_sets(
     let sizes = [
         vk::DescriptorPoolSize::default()
             .ty(vk::DescriptorType::STORAGE_BUFFER)
-            .descriptor_count(2),
+            .descriptor_count(3),
         vk::DescriptorPoolSize::default()
             .ty(vk::DescriptorType::SAMPLED_IMAGE)
             .descriptor_count(3),
@@ -674,6 +681,18 @@ fn create_sets(
     ctx.name(sets[0], "alpha-set");
     ctx.name(sets[1], "alpha-lightmap-set");
     Ok((pool, sets[0], sets[1]))
+}
+
+fn write_storage_buffer(ctx: &Context, set: vk::DescriptorSet, binding: u32, buffer: vk::Buffer) {
+    let info = [vk::DescriptorBufferInfo::default()
+        .buffer(buffer)
+        .range(vk::WHOLE_SIZE)];
+    let write = vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(binding)
+        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+        .buffer_info(&info);
+    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
 }
 
 fn write_sampled_image(ctx: &Context, set: vk::DescriptorSet, binding: u32, view: vk::ImageView) {
