@@ -31,13 +31,13 @@ layout(set = 1, binding = 1, std430) readonly buffer AlphaPoints {
 };
 
 // Per entity, the lights whose range reaches its bounds (the only ones that can light it).
-layout(set = 1, binding = 4, std430) readonly buffer AlphaEntityLights {
+layout(set = 1, binding = 2, std430) readonly buffer AlphaEntityLights {
     uint entity_lights[];
 };
 
 // Baked object-space positions (w = 1 where a surface covers the texel) and normals.
-layout(set = 1, binding = 2) uniform texture2D position_atlas;
-layout(set = 1, binding = 3) uniform texture2D normal_atlas;
+layout(set = 1, binding = 3) uniform texture2D position_atlas;
+layout(set = 1, binding = 4) uniform texture2D normal_atlas;
 
 layout(push_constant) uniform AlphaDraw {
     uint entity; // into `entities`

@@ -87,13 +87,13 @@ pub const LUT_EVAL_SET: &[BindingDesc] = &[
 ];
 
 /// Set 1 of the alpha pipelines (include/alpha.glsl): entity records, dust and ribbon points,
-/// the baked position and normal atlases, and each entity's light list.
+/// each entity's light list, and the baked position and normal atlases.
 pub const ALPHA_SET: &[BindingDesc] = &[
     binding(0, BindingKind::StorageBuffer, ""),
     binding(1, BindingKind::StorageBuffer, ""),
-    binding(2, BindingKind::SampledImage, "position_atlas"),
-    binding(3, BindingKind::SampledImage, "normal_atlas"),
-    binding(4, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, ""),
+    binding(3, BindingKind::SampledImage, "position_atlas"),
+    binding(4, BindingKind::SampledImage, "normal_atlas"),
 ];
 /// Set 2 of the alpha pass (include/alpha_lightmap.glsl): the lightmap atlas. A set of its own
 /// because the lightmap pass renders into it.

@@ -212,25 +212,16 @@ impl AlphaLighting {
         if light_list.is_empty() {
             light_list.push(0);
         }
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        parts.buffers.push(Buffer::with_data(
-            ctx,
-            "alpha-entities",
-            storage,
-            bytemuck::cast_slice(&records),
-        )?);
-        parts.buffers.push(Buffer::with_data(
-            ctx,
-            "alpha-points",
-            storage,
-            bytemuck::cast_slice(&points),
-        )?);
-        parts.buffers.push(Buffer::with_data(
-            ctx,
-            "alpha-entity-lights",
-            storage,
-            bytemuck::cast_slice(&light_list),
-        )?);
+        for (name, bytes) in [
+            ("alpha-entities", bytemuck::cast_slice::<_, u8>(&records)),
+            ("alpha-points", bytemuck::cast_slice(&points)),
+            ("alpha-entity-lights", bytemuck::cast_slice(&light_list)),
+        ] {
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            parts
+                .buffers
+                .push(Buffer::with_data(ctx, name, usage, bytes)?);
+        }
         let mut sprites: Vec<SpriteVertex> = Vec::new();
         let mut sprite_ranges = Vec::new();
         let objects = scene.alpha_objects.len() as u32;
@@ -322,11 +313,10 @@ impl AlphaLighting {
         }
 
         let images = &parts.images;
-        let buffers = [parts.buffers[0].handle, parts.buffers[1].handle];
-        write_storage_buffers(ctx, alpha_set, &buffers);
-        write_storage_buffer(ctx, alpha_set, 4, parts.buffers[2].handle);
-        write_sampled_image(ctx, alpha_set, 2, images[0].view);
-        write_sampled_image(ctx, alpha_set, 3, images[1].view);
+        let storage: Vec<vk::Buffer> = parts.buffers[..3].iter().map(|b| b.handle).collect();
+        write_storage_buffers(ctx, alpha_set, &storage);
+        write_sampled_image(ctx, alpha_set, 3, images[0].view);
+        write_sampled_image(ctx, alpha_set, 4, images[1].view);
         write_sampled_image(ctx, lightmap_set, 0, images[2].view);
 
         let order = back_to_front(scene);
@@ -681,18 +671,6 @@ fn create_sets(
     ctx.name(sets[0], "alpha-set");
     ctx.name(sets[1], "alpha-lightmap-set");
     Ok((pool, sets[0], sets[1]))
-}
-
-fn write_storage_buffer(ctx: &Context, set: vk::DescriptorSet, binding: u32, buffer: vk::Buffer) {
-    let info = [vk::DescriptorBufferInfo::default()
-        .buffer(buffer)
-        .range(vk::WHOLE_SIZE)];
-    let write = vk::WriteDescriptorSet::default()
-        .dst_set(set)
-        .dst_binding(binding)
-        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-        .buffer_info(&info);
-    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
 }
 
 fn write_sampled_image(ctx: &Context, set: vk::DescriptorSet, binding: u32, view: vk::ImageView) {
