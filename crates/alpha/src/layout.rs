@@ -153,6 +153,21 @@ pub fn entities(scene: &Scene) -> impl Iterator<Item = EntityKey> {
         .chain((0..scene.particle_systems.len()).map(EntityKey::System))
 }
 
+/// The forced lightmap sides [`plan_layout`] and the renderer take.
+const FORCED_SIDES: std::ops::RangeInclusive<u32> = 2..=4096;
+
+/// Checks a forced lightmap side (2..=4096 texels).
+///
+/// # Errors
+/// [`LayoutError::BadResolution`] outside the range.
+pub fn check_forced_side(side: u32) -> Result<(), LayoutError> {
+    if FORCED_SIDES.contains(&side) {
+        Ok(())
+    } else {
+        Err(LayoutError::BadResolution(side))
+    }
+}
+
 /// Packs every entity's region into the smallest square atlas from [`START_ATLAS_SIDE`]
 /// (doubling) up to `max_side` that holds them all at full size. When even `max_side` does not,
 /// regions are halved where they allow it ([`Atlas::allocate_downgrading`]; the result says
@@ -167,8 +182,8 @@ pub fn plan_layout(
     forced_side: Option<u32>,
     max_side: u32,
 ) -> Result<LightmapLayout, LayoutError> {
-    if let Some(side) = forced_side.filter(|s| !(2..=4096).contains(s)) {
-        return Err(LayoutError::BadResolution(side));
+    if let Some(side) = forced_side {
+        check_forced_side(side)?;
     }
     let shapes: Vec<(EntityKey, RegionShape)> = entities(scene)
         .map(|e| (e, region_shape(scene, e, viewport_height, forced_side)))

@@ -465,8 +465,8 @@ impl<'c> Renderer<'c> {
     /// # Errors
     /// [`crate::Error::Lightmap`] for a side outside 2..=4096 (the renderer keeps its setting).
     pub fn set_lightmap_resolution(&mut self, side: Option<u32>) -> Result<()> {
-        if let Some(s) = side.filter(|s| !(2..=4096).contains(s)) {
-            return Err(histencil_alpha::LayoutError::BadResolution(s).into());
+        if let Some(s) = side {
+            histencil_alpha::check_forced_side(s)?;
         }
         if side != self.lightmap_side {
             if let Some(mut old) = self.alpha.take() {
