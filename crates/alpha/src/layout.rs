@@ -15,6 +15,16 @@ pub enum EntityKey {
     System(usize),
 }
 
+impl EntityKey {
+    /// The entity's world-space box in `scene`.
+    pub fn world_bounds(self, scene: &Scene) -> (Vec3, Vec3) {
+        match self {
+            EntityKey::Object(i) => scene.alpha_objects[i].world_bounds(),
+            EntityKey::System(i) => scene.particle_systems[i].world_bounds(),
+        }
+    }
+}
+
 /// How an entity's probes sit in its region: `tiles` tiles of `tile_width x tile_height` texels
 /// side by side (a slice each for sliced systems, one otherwise).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,8 +90,8 @@ pub fn region_shape(
     viewport_height: u32,
     forced_side: Option<u32>,
 ) -> RegionShape {
-    let side_of = |bounds| {
-        let (centre, radius) = bounding_sphere(bounds);
+    let side = || {
+        let (centre, radius) = bounding_sphere(entity.world_bounds(scene));
         forced_side.unwrap_or_else(|| {
             side_for_coverage(projected_diameter(
                 &scene.camera,
@@ -98,12 +108,12 @@ pub fn region_shape(
         downgradable: true,
     };
     match entity {
-        EntityKey::Object(i) => square(1, side_of(scene.alpha_objects[i].world_bounds())),
+        EntityKey::Object(_) => square(1, side()),
         EntityKey::System(i) => {
             let system = &scene.particle_systems[i];
             match system.layout {
-                ParticleLayout::Billboard => square(1, side_of(system.world_bounds())),
-                ParticleLayout::Slices { count } => square(count, side_of(system.world_bounds())),
+                ParticleLayout::Billboard => square(1, side()),
+                ParticleLayout::Slices { count } => square(count, side()),
                 ParticleLayout::Dust => {
                     let (w, h) = dust_grid(system.particles.len() as u32);
                     RegionShape {

@@ -83,7 +83,7 @@ impl ProbeFrame {
 pub fn probe_point(scene: &Scene, entity: EntityKey) -> Vec3 {
     match entity {
         EntityKey::Object(i) => scene.alpha_objects[i].transform.w_axis.truncate(),
-        EntityKey::System(i) => bounding_sphere(scene.particle_systems[i].world_bounds()).0,
+        EntityKey::System(_) => bounding_sphere(entity.world_bounds(scene)).0,
     }
 }
 
@@ -105,6 +105,8 @@ mod tests {
     fn probes_and_locate_are_inverse() {
         let scene = histencil_scene::embedded("volume").unwrap();
         let frame = fit_frame(&scene.camera, &scene.particle_systems[0]);
+        // The GPU records use the frame's centre as the system's single probe point.
+        assert_eq!(frame.centre, probe_point(&scene, EntityKey::System(0)));
         for (u, v, k) in [(0.25, 0.75, 0), (0.5, 0.5, 3), (0.9, 0.1, 7)] {
             let p = frame.probe(u, v, k, 8);
             let (lu, lv, s) = frame.locate(p, 8);

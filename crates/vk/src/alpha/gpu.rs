@@ -46,10 +46,7 @@ pub fn entity_lights(scene: &Scene, regions: &[EntityRegion]) -> Vec<Vec<u32>> {
     regions
         .iter()
         .map(|r| {
-            let (lo, hi) = match r.entity {
-                EntityKey::Object(i) => scene.alpha_objects[i].world_bounds(),
-                EntityKey::System(i) => scene.particle_systems[i].world_bounds(),
-            };
+            let (lo, hi) = r.entity.world_bounds(scene);
             (0..scene.lights.len() as u32)
                 .filter(|l| scene.lights[*l as usize].reaches_box(lo, hi))
                 .collect()
@@ -76,12 +73,11 @@ pub fn entity_records(
                 r.shape.tile_width,
                 r.shape.tile_height,
             ];
-            let centre = probe_point(scene, r.entity);
             match r.entity {
                 EntityKey::Object(i) => {
                     let o = &scene.alpha_objects[i];
                     let frame = ProbeFrame {
-                        centre,
+                        centre: probe_point(scene, r.entity),
                         radius: 1.0,
                         half_depth: 0.0,
                         right: Vec3::X,
@@ -99,15 +95,14 @@ pub fn entity_records(
                 }
                 EntityKey::System(i) => {
                     let s = &scene.particle_systems[i];
-                    let mut frame = fit_frame(&scene.camera, s);
-                    frame.centre = centre;
+                    // Centred on the system's bounds: also its single probe's point.
+                    let frame = fit_frame(&scene.camera, s);
                     let first = points.len() as u32;
                     let count = s.particles.len() as u32;
-                    let (kind, tiles) = match s.layout {
-                        ParticleLayout::Billboard => ("ALPHA_SLICES", 1),
-                        ParticleLayout::Slices { count } => ("ALPHA_SLICES", count),
-                        ParticleLayout::Dust => ("ALPHA_DUST", 1),
-                        ParticleLayout::Ribbon => ("ALPHA_RIBBON", 1),
+                    let kind = match s.layout {
+                        ParticleLayout::Billboard | ParticleLayout::Slices { .. } => "ALPHA_SLICES",
+                        ParticleLayout::Dust => "ALPHA_DUST",
+                        ParticleLayout::Ribbon => "ALPHA_RIBBON",
                     };
                     if matches!(s.layout, ParticleLayout::Dust | ParticleLayout::Ribbon) {
                         points.extend(
@@ -116,7 +111,7 @@ pub fn entity_records(
                                 .map(|p| p.position.extend(p.size).to_array()),
                         );
                     }
-                    let shape = [kind_code(kind), tiles, first, count];
+                    let shape = [kind_code(kind), r.shape.tiles, first, count];
                     record(
                         Mat4::IDENTITY,
                         &s.material,
