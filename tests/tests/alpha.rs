@@ -29,15 +29,6 @@ fn frame(ctx: &Context, scene: &Scene, mode: AlphaMode, side: Option<u32>) -> Rg
     frame.images.ldr.expect("ldr")
 }
 
-/// The scene with its alpha entities removed: what the alpha pass draws over.
-fn without_alpha(scene: &Scene) -> Scene {
-    Scene {
-        alpha_objects: vec![],
-        particle_systems: vec![],
-        ..scene.clone()
-    }
-}
-
 /// Mean and max absolute 8-bit error of `actual` against `expected` over the pixels that the
 /// alpha entities change in `expected` (against `background`).
 fn alpha_error(actual: &RgbaImage, expected: &RgbaImage, background: &RgbaImage) -> (f64, u8) {
@@ -53,7 +44,7 @@ fn alpha_error(actual: &RgbaImage, expected: &RgbaImage, background: &RgbaImage)
 /// A sphere close to the camera with a point light just off its surface: the light's falloff
 /// across the sphere is what the lightmap must follow.
 fn sphere_near_a_light() -> Scene {
-    let mut scene = without_alpha(&histencil_scene::embedded("default").unwrap());
+    let mut scene = histencil_scene::embedded("default").unwrap();
     let centre = Vec3::new(0.0, 1.8, 5.0);
     let mut sphere = glass_sphere(centre, 1.0);
     sphere.opacity = 0.8;
@@ -78,7 +69,7 @@ fn save(name: &str, image: &RgbaImage) {
 fn lightmap_error_falls_with_resolution_and_is_small_at_the_default() {
     with_validated_context(|ctx| {
         let scene = sphere_near_a_light();
-        let background = frame(ctx, &without_alpha(&scene), AlphaMode::Forward, None);
+        let background = frame(ctx, &scene.without_alpha(), AlphaMode::Forward, None);
         let forward = frame(ctx, &scene, AlphaMode::Forward, None);
         let mut errors = Vec::new();
         for side in [8, 16, 32, 64, 128] {
@@ -110,7 +101,7 @@ fn lightmap_error_falls_with_resolution_and_is_small_at_the_default() {
 /// A large translucent sphere with a point light inside it, off its centre: one probe at the
 /// centre sees the light at the wrong distance and from the wrong side for most of the surface.
 fn light_inside_a_large_sphere() -> Scene {
-    let mut scene = without_alpha(&histencil_scene::embedded("default").unwrap());
+    let mut scene = histencil_scene::embedded("default").unwrap();
     let centre = Vec3::new(0.0, 2.5, 2.0);
     let mut sphere = glass_sphere(centre, 2.5);
     sphere.material = histencil_scene::Material::lambert(Vec3::new(0.9, 0.85, 0.8));
@@ -128,7 +119,7 @@ fn light_inside_a_large_sphere() -> Scene {
 fn the_single_probe_is_worse_than_the_lightmap_with_a_light_inside() {
     with_validated_context(|ctx| {
         let scene = light_inside_a_large_sphere();
-        let background = frame(ctx, &without_alpha(&scene), AlphaMode::Forward, None);
+        let background = frame(ctx, &scene.without_alpha(), AlphaMode::Forward, None);
         let forward = frame(ctx, &scene, AlphaMode::Forward, None);
         let lightmap = frame(ctx, &scene, AlphaMode::Lightmap, None);
         let probe = frame(ctx, &scene, AlphaMode::Probe, None);
@@ -151,7 +142,7 @@ fn slices_beat_a_single_quad_on_a_thick_volume() {
         let sliced = histencil_scene::embedded("volume").unwrap();
         let mut billboard = sliced.clone();
         billboard.particle_systems[0].layout = ParticleLayout::Billboard;
-        let background = frame(ctx, &without_alpha(&sliced), AlphaMode::Forward, None);
+        let background = frame(ctx, &sliced.without_alpha(), AlphaMode::Forward, None);
         let forward = frame(ctx, &sliced, AlphaMode::Forward, None);
         let slices = frame(ctx, &sliced, AlphaMode::Lightmap, None);
         let quad = frame(ctx, &billboard, AlphaMode::Lightmap, None);
@@ -181,7 +172,7 @@ fn dust_and_ribbons_follow_the_forward_reference() {
         // get their regions from coverage.
         for (name, bound) in [("dust", 0.5), ("ribbon", 1.0), ("alpha", 6.0)] {
             let scene = histencil_scene::embedded(name).unwrap();
-            let background = frame(ctx, &without_alpha(&scene), AlphaMode::Forward, None);
+            let background = frame(ctx, &scene.without_alpha(), AlphaMode::Forward, None);
             let forward = frame(ctx, &scene, AlphaMode::Forward, None);
             let lightmap = frame(ctx, &scene, AlphaMode::Lightmap, None);
             let error = alpha_error(&lightmap, &forward, &background);

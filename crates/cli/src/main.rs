@@ -350,11 +350,8 @@ fn print_alpha_error(
     let forward = renderer.render(technique, only_ldr);
     renderer.set_alpha_mode(mode);
     let forward = forward?.images.ldr.expect("requested");
-    let mut bare = renderer.scene().clone();
-    bare.alpha_objects.clear();
-    bare.particle_systems.clear();
     let (w, h) = ldr.dimensions();
-    let background = Renderer::new(ctx, bare, w, h)?
+    let background = Renderer::new(ctx, renderer.scene().without_alpha(), w, h)?
         .render(technique, only_ldr)?
         .images
         .ldr

@@ -14,10 +14,6 @@ fn r3(i: usize) -> Vec3 {
     Vec3::new(f(0), f(1), f(2))
 }
 
-fn lambert(tint: Vec3) -> Material {
-    Material::lambert(tint)
-}
-
 /// A point inside the unit ball from a point of the unit cube (uniform in volume).
 fn in_ball(u: Vec3) -> Vec3 {
     let theta = u.x * std::f32::consts::TAU;
@@ -73,7 +69,7 @@ fn smoke_column(base: Vec3, puffs: usize) -> ParticleSystem {
         "smoke-column",
         ParticleLayout::Billboard,
         particles,
-        lambert(Vec3::splat(0.8)),
+        Material::lambert(Vec3::splat(0.8)),
     )
 }
 
@@ -89,7 +85,7 @@ fn dust_cloud(lo: Vec3, hi: Vec3, count: usize) -> ParticleSystem {
         "dust-cloud",
         ParticleLayout::Dust,
         particles,
-        lambert(Vec3::new(1.0, 0.95, 0.85)),
+        Material::lambert(Vec3::new(1.0, 0.95, 0.85)),
     );
     s.opacity = 0.9;
     s
@@ -111,7 +107,7 @@ fn ribbon_trail(axis_base: Vec3, points: usize) -> ParticleSystem {
         "ribbon-trail",
         ParticleLayout::Ribbon,
         particles,
-        lambert(Vec3::new(0.9, 0.6, 1.0)),
+        Material::lambert(Vec3::new(0.9, 0.6, 1.0)),
     );
     s.opacity = 0.8;
     s
@@ -129,7 +125,7 @@ pub fn smoke_volume(centre: Vec3, r: f32, count: usize, layout: ParticleLayout) 
         "smoke-volume",
         layout,
         particles,
-        lambert(Vec3::splat(0.85)),
+        Material::lambert(Vec3::splat(0.85)),
     );
     s.opacity = 0.25;
     s

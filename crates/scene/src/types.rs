@@ -285,6 +285,16 @@ impl Scene {
         Ok(())
     }
 
+    /// The scene without its alpha entities: what the alpha pass draws over, the background
+    /// of an alpha error figure.
+    pub fn without_alpha(&self) -> Scene {
+        Scene {
+            alpha_objects: vec![],
+            particle_systems: vec![],
+            ..self.clone()
+        }
+    }
+
     /// How many alpha entities (translucent objects and particle systems) the scene has.
     pub fn alpha_entity_count(&self) -> usize {
         self.alpha_objects.len() + self.particle_systems.len()

@@ -277,6 +277,13 @@ impl AlphaLighting {
             depth_clamp: false,
             specialization: &[],
         };
+        // The alpha pass: blended over the lit HDR frame, tested against its depth.
+        let over_the_frame = PipelineDesc {
+            color_formats: &hdr,
+            blend: Blend::PremultipliedOver,
+            depth_stencil_format: ctx.depth_stencil_format,
+            ..base
+        };
         let descs = [
             PipelineDesc { ..base },
             PipelineDesc {
@@ -292,20 +299,14 @@ impl AlphaLighting {
                 name: "alpha-object-pipeline",
                 vertex: ("alpha_object.vert", shaders::ALPHA_OBJECT_VERT),
                 fragment: Some(("alpha_object.frag", shaders::ALPHA_OBJECT_FRAG)),
-                color_formats: &hdr,
-                blend: Blend::PremultipliedOver,
-                depth_stencil_format: ctx.depth_stencil_format,
-                ..base
+                ..over_the_frame
             },
             PipelineDesc {
                 name: "alpha-particle-pipeline",
                 vertex: ("particle.vert", shaders::PARTICLE_VERT),
                 fragment: Some(("particle.frag", shaders::PARTICLE_FRAG)),
                 vertex_input: VertexInput::Sprite,
-                color_formats: &hdr,
-                blend: Blend::PremultipliedOver,
-                depth_stencil_format: ctx.depth_stencil_format,
-                ..base
+                ..over_the_frame
             },
         ];
         for desc in &descs {
