@@ -68,7 +68,7 @@ struct BrdfEvalArgs {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// An embedded scene (see `histencil scenes`).
+    /// An embedded scene (see `histencil scenes`) or a `.gltf` / `.glb` file.
     #[arg(long, default_value = "default")]
     scene: String,
     /// How lights are applied: `stencil` (the talk's one pass per BRDF, masked by stencil),
@@ -260,7 +260,7 @@ fn check_writable(path: &Path) -> Result<()> {
 }
 
 fn render(args: &RenderArgs) -> Result<()> {
-    let scene = histencil_scene::embedded(&args.scene)?;
+    let scene = histencil_scene::load_scene(&args.scene)?;
     for path in [
         Some(&args.out),
         args.hdr.as_ref(),

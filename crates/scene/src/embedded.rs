@@ -313,6 +313,7 @@ fn room(name: &str, description: String, models: &[BrdfId]) -> Scene {
         lights,
         alpha_objects: vec![],
         particle_systems: vec![],
+        meshes: vec![],
     }
 }
 

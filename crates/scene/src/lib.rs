@@ -4,12 +4,16 @@
 mod alpha;
 mod alpha_scenes;
 mod embedded;
+mod import;
 mod mesh;
 mod types;
 
 pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICES};
 pub use alpha_scenes::{glass_sphere, smoke_volume};
 pub use embedded::{embedded, embedded_names, EMBEDDED};
+pub use import::{
+    import_gltf, load_gltf, load_scene, material_from_gltf, ImportError, MaterialError,
+};
 pub use mesh::{
     light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, Mesh, Vertex, BOX_UV_INSET,
 };

@@ -1,5 +1,5 @@
 use crate::alpha::{alpha_problem, transformed_unit_cube};
-use crate::{AlphaObject, ParticleSystem};
+use crate::{AlphaObject, Mesh, ParticleSystem};
 use glam::{Mat4, Vec3};
 use histencil_brdf::{Brdf, BrdfId};
 
@@ -15,6 +15,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub alpha_objects: Vec<AlphaObject>,
     pub particle_systems: Vec<ParticleSystem>,
+    /// Imported triangle meshes, referenced by [`Shape::Mesh`]; empty for the embedded scenes.
+    pub meshes: Vec<Mesh>,
 }
 
 /// A perspective camera. The aspect ratio comes from the render target.
@@ -54,6 +56,10 @@ pub enum Shape {
     Box,
     /// The unit sphere.
     Sphere,
+    /// `Scene::meshes[i]`, an imported mesh fitted into `[-1, 1]^3` (the importer folds the
+    /// mesh's own bounds into the object's transform), so the transformed unit cube bounds it as
+    /// it bounds the built-in shapes. Its `uv` is its lightmap layout when it is an alpha object.
+    Mesh(u32),
 }
 
 /// An opaque object.
@@ -156,6 +162,8 @@ pub enum SceneError {
         name: String,
         problem: String,
     },
+    #[error("mesh {index}: {problem}")]
+    BadMesh { index: usize, problem: &'static str },
     #[error("camera: {0}")]
     BadCamera(String),
     #[error("{kind} {index} (`{name}`): {problem}")]
@@ -182,6 +190,38 @@ pub(crate) fn material_problem(m: &Material) -> Option<&'static str> {
     } else {
         None
     }
+}
+
+/// What is wrong with an imported mesh, if anything: it must be a non-empty triangle list with
+/// finite vertices inside `[-1, 1]^3` (with a little slack for rounding) and unit normals.
+fn mesh_problem(mesh: &Mesh) -> Option<&'static str> {
+    const SLACK: f32 = 1e-4;
+    if mesh.indices.is_empty() || !mesh.indices.len().is_multiple_of(3) {
+        return Some("needs a non-empty triangle list");
+    }
+    if mesh
+        .indices
+        .iter()
+        .any(|&i| i as usize >= mesh.vertices.len())
+    {
+        return Some("an index is out of range");
+    }
+    let inside = |v: &crate::Vertex| {
+        v.position
+            .iter()
+            .all(|p| p.is_finite() && p.abs() <= 1.0 + SLACK)
+    };
+    let unit = |v: &crate::Vertex| (Vec3::from(v.normal).length() - 1.0).abs() < 1e-3;
+    if !mesh.vertices.iter().all(inside) {
+        return Some("vertices must be finite and inside [-1, 1]^3");
+    }
+    if !mesh.vertices.iter().all(unit) {
+        return Some("normals must be unit length");
+    }
+    if !mesh.vertices.iter().flat_map(|v| v.uv).all(f32::is_finite) {
+        return Some("uvs must be finite");
+    }
+    None
 }
 
 fn transform_problem(transform: &Mat4) -> Option<&'static str> {
@@ -255,8 +295,16 @@ impl Scene {
                 ));
             }
         }
+        for (index, mesh) in self.meshes.iter().enumerate() {
+            if let Some(problem) = mesh_problem(mesh) {
+                return Err(SceneError::BadMesh { index, problem });
+            }
+        }
         for (index, o) in self.objects.iter().enumerate() {
-            let problem = transform_problem(&o.transform).or(material_problem(&o.material));
+            let problem = self
+                .shape_problem(o.shape)
+                .or(transform_problem(&o.transform))
+                .or(material_problem(&o.material));
             if let Some(problem) = problem {
                 return Err(SceneError::BadObject {
                     index,
@@ -272,7 +320,10 @@ impl Scene {
             problem: problem.to_owned(),
         };
         for (index, o) in self.alpha_objects.iter().enumerate() {
-            let problem = transform_problem(&o.transform).or(alpha_problem(o.opacity, &o.material));
+            let problem = self
+                .shape_problem(o.shape)
+                .or(transform_problem(&o.transform))
+                .or(alpha_problem(o.opacity, &o.material));
             if let Some(problem) = problem {
                 return Err(bad_alpha("alpha object", index, &o.name, problem));
             }
@@ -283,6 +334,13 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    fn shape_problem(&self, shape: Shape) -> Option<&'static str> {
+        match shape {
+            Shape::Mesh(i) if i as usize >= self.meshes.len() => Some("mesh index out of range"),
+            _ => None,
+        }
     }
 
     /// The scene without its alpha entities: what the alpha pass draws over, the background

@@ -77,10 +77,13 @@ pub struct Meshes {
     pub light_sphere_bound: f32,
     /// `(farthest radial, axial)` extent of the unit light cone mesh.
     pub light_cone_bound: (f32, f32),
+    /// The scene's imported meshes (`Shape::Mesh`), in `Scene::meshes` order.
+    pub imported: Vec<GpuMesh>,
 }
 
 impl Meshes {
-    pub fn new(ctx: &Context) -> Result<Self> {
+    /// The built-in shapes and light volumes, and the scene's `imported` meshes.
+    pub fn new(ctx: &Context, imported: &[Mesh]) -> Result<Self> {
         let sphere_volume = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
         let cone_volume = light_cone(CONE_SIDES);
         let far = |m: &Mesh, f: fn([f32; 3]) -> f32| {
@@ -97,6 +100,11 @@ impl Meshes {
             ),
             light_sphere: GpuMesh::new(ctx, "light-sphere-mesh", &sphere_volume)?,
             light_cone: GpuMesh::new(ctx, "light-cone-mesh", &cone_volume)?,
+            imported: imported
+                .iter()
+                .enumerate()
+                .map(|(i, m)| GpuMesh::new(ctx, &format!("imported-mesh-{i}"), m))
+                .collect::<Result<_>>()?,
         })
     }
 
@@ -104,6 +112,7 @@ impl Meshes {
         match shape {
             Shape::Box => &self.unit_box,
             Shape::Sphere => &self.sphere,
+            Shape::Mesh(i) => &self.imported[i as usize],
         }
     }
 
@@ -111,7 +120,7 @@ impl Meshes {
     pub fn bake_shape(&self, shape: Shape) -> &GpuMesh {
         match shape {
             Shape::Box => &self.unit_box_bake,
-            Shape::Sphere => &self.sphere,
+            Shape::Sphere | Shape::Mesh(_) => self.shape(shape),
         }
     }
 
@@ -122,7 +131,10 @@ impl Meshes {
             &mut self.sphere,
             &mut self.light_sphere,
             &mut self.light_cone,
-        ] {
+        ]
+        .into_iter()
+        .chain(&mut self.imported)
+        {
             m.destroy(ctx);
         }
     }

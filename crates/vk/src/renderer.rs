@@ -237,7 +237,7 @@ impl<'c> Renderer<'c> {
         let (materials, object_materials) = distinct_materials(&scene);
 
         let targets = Targets::new(ctx, extent)?;
-        let meshes = Meshes::new(ctx)?;
+        let meshes = Meshes::new(ctx, &scene.meshes)?;
         let hi_stencil = HiStencilSurface::new(ctx, extent)?;
         let uniforms = FrameUniforms::new(&scene.camera, width, height, scene.lights.len() as u32);
         let frame_uniforms = Buffer::with_data(

@@ -1,0 +1,1 @@
+//! histencil-lab

@@ -1,0 +1,451 @@
+//! glTF 2.0 scenes (`.gltf` with external or embedded buffers, or `.glb`) as histencil scenes.
+//!
+//! - **Meshes:** every triangle primitive of every node in the default scene becomes an object.
+//!   Its vertices are fitted into `[-1, 1]^3` and the fit is folded into the object's transform
+//!   ([`crate::Shape::Mesh`]). Missing normals are flat, as the glTF spec asks.
+//! - **Materials:** the BRDF comes from the material's `extras` (see [`material_from_gltf`]).
+//!   `alphaMode: BLEND` makes the primitive an [`AlphaObject`] with the base colour's alpha as its
+//!   opacity. It then needs `TEXCOORD_0` as its lightmap layout: unique and inside `[0, 1]^2`.
+//!   `MASK` is drawn opaque.
+//! - **Lights:** from `KHR_lights_punctual`. `color * intensity` is the light's radiance scale:
+//!   the renderer's falloff is the same `1/d^2` as glTF's, windowed to zero at the range. A light
+//!   without a `range` gets the distance at which `intensity / d^2` falls to 1/255. Spot cones
+//!   must stay within 80 degrees.
+//! - **Camera:** the first perspective camera met, else one framing the scene's bounds.
+//!
+//! Anything the renderer cannot take gives an [`ImportError`] naming the file's element, never a
+//! panic: truncated files, missing or short buffers, accessors past their views, unknown BRDFs.
+
+mod buffers;
+mod material;
+
+pub use material::{material_from_gltf, MaterialError};
+
+use crate::{
+    AlphaObject, Camera, Light, LightKind, Mesh, Object, Scene, SceneError, Shape, Vertex,
+};
+use glam::{Mat4, Vec3};
+use gltf::khr_lights_punctual::Kind;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Why a glTF file could not become a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum ImportError {
+    #[error("cannot read {path}: {problem}")]
+    Io { path: String, problem: String },
+    #[error("not a valid glTF file: {0}")]
+    Parse(String),
+    #[error("buffer {index}: {problem}")]
+    Buffer { index: usize, problem: String },
+    #[error("mesh {index} (`{name}`): {problem}")]
+    Mesh {
+        index: usize,
+        name: String,
+        problem: String,
+    },
+    #[error("material {index} (`{name}`): {source}")]
+    Material {
+        index: usize,
+        name: String,
+        source: MaterialError,
+    },
+    #[error("light {index} (`{name}`): {problem}")]
+    Light {
+        index: usize,
+        name: String,
+        problem: String,
+    },
+    #[error("camera {index}: {problem}")]
+    Camera { index: usize, problem: String },
+    #[error("{0}")]
+    Structure(String),
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+/// Deepest node hierarchy accepted; deeper is taken for a cycle.
+const MAX_NODE_DEPTH: usize = 64;
+
+/// An embedded scene by name, or a glTF file when `spec` ends in `.gltf` or `.glb`.
+pub fn load_scene(spec: &str) -> Result<Scene, ImportError> {
+    let lower = spec.to_ascii_lowercase();
+    if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+        load_gltf(Path::new(spec))
+    } else {
+        Ok(crate::embedded(spec)?)
+    }
+}
+
+/// Reads and imports a `.gltf` or `.glb` file; external buffers are read next to it.
+pub fn load_gltf(path: &Path) -> Result<Scene, ImportError> {
+    let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
+        path: path.display().to_string(),
+        problem: e.to_string(),
+    })?;
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut scene = import_gltf(&bytes, path.parent(), &name)?;
+    scene.description = format!("glTF {}", path.display());
+    Ok(scene)
+}
+
+/// Imports glTF or GLB bytes; relative buffer URIs are read from `base_dir`.
+pub fn import_gltf(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+) -> Result<Scene, ImportError> {
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| ImportError::Parse(e.to_string()))?;
+    let buffers = buffers::load_buffers(&gltf.document, gltf.blob, base_dir)?;
+    let mut importer = Importer {
+        buffers: &buffers,
+        scene: Scene {
+            name: name.to_owned(),
+            description: "glTF".to_owned(),
+            camera: placeholder_camera(),
+            objects: vec![],
+            lights: vec![],
+            alpha_objects: vec![],
+            particle_systems: vec![],
+            meshes: vec![],
+        },
+        mesh_slots: HashMap::new(),
+        camera: None,
+    };
+    let document = &gltf.document;
+    let root = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+        .ok_or_else(|| ImportError::Structure("the file has no scene".into()))?;
+    for node in root.nodes() {
+        importer.visit(&node, Mat4::IDENTITY, 0)?;
+    }
+    let mut scene = importer.scene;
+    scene.camera = match importer.camera {
+        Some(camera) => camera,
+        None => framing_camera(&scene),
+    };
+    scene.validate()?;
+    Ok(scene)
+}
+
+struct Importer<'a> {
+    buffers: &'a [Vec<u8>],
+    scene: Scene,
+    /// `(mesh, primitive, mirrored)` to its index in `scene.meshes`: a mesh used by several
+    /// nodes is stored once per winding.
+    mesh_slots: HashMap<(usize, usize, bool), (u32, Mat4)>,
+    camera: Option<Camera>,
+}
+
+impl Importer<'_> {
+    fn visit(&mut self, node: &gltf::Node, parent: Mat4, depth: usize) -> Result<(), ImportError> {
+        if depth > MAX_NODE_DEPTH {
+            return Err(ImportError::Structure(format!(
+                "node {} is nested deeper than {MAX_NODE_DEPTH} levels (a cycle?)",
+                node.index()
+            )));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(ImportError::Structure(format!(
+                "node {}: transform is not finite",
+                node.index()
+            )));
+        }
+        if let Some(mesh) = node.mesh() {
+            self.add_mesh(&mesh, world)?;
+        }
+        if let Some(light) = node.light() {
+            let light = import_light(&light, world)?;
+            self.scene.lights.push(light);
+        }
+        if let (None, Some(camera)) = (&self.camera, node.camera()) {
+            self.camera = Some(import_camera(&camera, world)?);
+        }
+        for child in node.children() {
+            self.visit(&child, world, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    fn add_mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), ImportError> {
+        let mesh_error = |problem: String| ImportError::Mesh {
+            index: mesh.index(),
+            name: mesh.name().unwrap_or("").to_owned(),
+            problem,
+        };
+        let mirrored = world.determinant() < 0.0;
+        for primitive in mesh.primitives() {
+            let gltf_material = primitive.material();
+            let pbr = gltf_material.pbr_metallic_roughness();
+            let material = material_from_gltf(
+                gltf_material.extras().as_ref().map(|raw| raw.get()),
+                pbr.base_color_factor(),
+                pbr.metallic_factor(),
+                pbr.roughness_factor(),
+            )
+            .map_err(|source| ImportError::Material {
+                index: gltf_material.index().unwrap_or(usize::MAX),
+                name: gltf_material.name().unwrap_or("default").to_owned(),
+                source,
+            })?;
+            let blend = gltf_material.alpha_mode() == gltf::material::AlphaMode::Blend;
+            let key = (mesh.index(), primitive.index(), mirrored);
+            let (slot, fit) = match self.mesh_slots.get(&key) {
+                Some(found) => *found,
+                None => {
+                    let (fitted, fit) = read_primitive(self.buffers, &primitive, mirrored, blend)
+                        .map_err(|p| {
+                        mesh_error(format!("primitive {}: {p}", primitive.index()))
+                    })?;
+                    let slot = (self.scene.meshes.len() as u32, fit);
+                    self.scene.meshes.push(fitted);
+                    self.mesh_slots.insert(key, slot);
+                    slot
+                }
+            };
+            let name = format!(
+                "{}#{}",
+                mesh.name()
+                    .map_or_else(|| format!("mesh{}", mesh.index()), str::to_owned),
+                primitive.index()
+            );
+            let (shape, transform) = (Shape::Mesh(slot), world * fit);
+            if blend {
+                self.scene.alpha_objects.push(AlphaObject {
+                    name,
+                    shape,
+                    transform,
+                    material,
+                    opacity: pbr.base_color_factor()[3].clamp(0.0, 1.0),
+                });
+            } else {
+                self.scene.objects.push(Object {
+                    name,
+                    shape,
+                    transform,
+                    material,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The primitive's triangles fitted into `[-1, 1]^3`, and the transform that undoes the fit.
+fn read_primitive(
+    buffers: &[Vec<u8>],
+    primitive: &gltf::Primitive,
+    mirrored: bool,
+    needs_uv: bool,
+) -> Result<(Mesh, Mat4), String> {
+    if primitive.mode() != gltf::mesh::Mode::Triangles {
+        return Err(format!(
+            "mode {:?}: only triangle lists are supported",
+            primitive.mode()
+        ));
+    }
+    let positions_accessor = primitive
+        .get(&gltf::Semantic::Positions)
+        .ok_or("has no POSITION attribute")?;
+    let checked = [
+        Some(positions_accessor),
+        primitive.get(&gltf::Semantic::Normals),
+        primitive.get(&gltf::Semantic::TexCoords(0)),
+        primitive.indices(),
+    ];
+    for accessor in checked.iter().flatten() {
+        buffers::check_accessor(accessor)?;
+    }
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .ok_or("POSITION is not a float vec3")?
+        .map(Vec3::from)
+        .collect();
+    if positions.is_empty() || !positions.iter().all(|p| p.is_finite()) {
+        return Err("POSITION must be non-empty and finite".into());
+    }
+    let mut indices: Vec<u32> = match reader.read_indices() {
+        Some(read) => read.into_u32().collect(),
+        None => (0..positions.len() as u32).collect(),
+    };
+    if !indices.len().is_multiple_of(3) || indices.is_empty() {
+        return Err(format!("{} indices do not make triangles", indices.len()));
+    }
+    if indices.iter().any(|&i| i as usize >= positions.len()) {
+        return Err("an index is out of range".into());
+    }
+    let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
+    if needs_uv && uvs.is_none() {
+        return Err("an alphaMode BLEND primitive needs TEXCOORD_0 for its lightmap".into());
+    }
+    let normals: Option<Vec<Vec3>> = reader
+        .read_normals()
+        .map(|n| n.map(|n| Vec3::from(n).normalize_or(Vec3::Y)).collect());
+    let uv_of = |i: usize| {
+        uvs.as_ref()
+            .and_then(|u| u.get(i).copied())
+            .unwrap_or_default()
+    };
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    let centre = (lo + hi) * 0.5;
+    // A flat mesh (a plane) keeps a sliver of thickness so the fit stays invertible.
+    let half = ((hi - lo) * 0.5).max(Vec3::splat(((hi - lo).max_element() * 5e-4).max(1e-6)));
+    let fit = |p: Vec3| ((p - centre) / half).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
+    // Normals transform by the inverse transpose of the fit's `1 / half` scale.
+    let fit_normal = |n: Vec3| (n * half).normalize_or(Vec3::Y);
+    let mut mesh = Mesh::default();
+    match normals {
+        Some(normals) if normals.len() == positions.len() => {
+            mesh.vertices = (0..positions.len())
+                .map(|i| vertex(fit(positions[i]), fit_normal(normals[i]), uv_of(i)))
+                .collect();
+            mesh.indices = std::mem::take(&mut indices);
+        }
+        Some(_) => return Err("NORMAL and POSITION counts differ".into()),
+        None => {
+            for t in indices.chunks_exact(3) {
+                let [a, b, c] = [0, 1, 2].map(|k| positions[t[k] as usize]);
+                let n = fit_normal((b - a).cross(c - a).normalize_or(Vec3::Y));
+                for &i in t {
+                    mesh.indices.push(mesh.vertices.len() as u32);
+                    mesh.vertices
+                        .push(vertex(fit(positions[i as usize]), n, uv_of(i as usize)));
+                }
+            }
+        }
+    }
+    if mirrored {
+        // A mirroring transform flips the winding on screen; flipping it here restores it.
+        for t in mesh.indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
+        }
+    }
+    Ok((
+        mesh,
+        Mat4::from_translation(centre) * Mat4::from_scale(half),
+    ))
+}
+
+fn vertex(position: Vec3, normal: Vec3, uv: [f32; 2]) -> Vertex {
+    Vertex {
+        position: position.to_array(),
+        normal: normal.to_array(),
+        uv,
+    }
+}
+
+fn import_light(
+    light: &gltf::khr_lights_punctual::Light,
+    world: Mat4,
+) -> Result<Light, ImportError> {
+    let bad = |problem: &str| ImportError::Light {
+        index: light.index(),
+        name: light.name().unwrap_or("").to_owned(),
+        problem: problem.to_owned(),
+    };
+    let intensity = light.intensity();
+    if !(intensity.is_finite() && intensity >= 0.0) {
+        return Err(bad("intensity must be finite and non-negative"));
+    }
+    let color = Vec3::from(light.color()) * intensity;
+    let position = world.transform_point3(Vec3::ZERO);
+    let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+    let radius = match light.range() {
+        Some(range) if range.is_finite() && range > 0.0 => range,
+        Some(_) => return Err(bad("range must be finite and positive")),
+        None => (255.0 * color.max_element()).sqrt().max(1e-3),
+    };
+    let kind = match light.kind() {
+        Kind::Point => LightKind::Point,
+        Kind::Directional => LightKind::Directional { direction },
+        Kind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } => {
+            if outer_cone_angle > 80f32.to_radians() {
+                return Err(bad(
+                    "spot outer cone angle above 80 degrees (its volume would not be a cone)",
+                ));
+            }
+            LightKind::Spot {
+                direction,
+                inner_angle: inner_cone_angle,
+                outer_angle: outer_cone_angle,
+            }
+        }
+    };
+    Ok(Light {
+        kind,
+        position,
+        radius,
+        color,
+    })
+}
+
+fn import_camera(camera: &gltf::Camera, world: Mat4) -> Result<Camera, ImportError> {
+    let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+        return Err(ImportError::Camera {
+            index: camera.index(),
+            problem: "orthographic cameras are not supported".into(),
+        });
+    };
+    let eye = world.transform_point3(Vec3::ZERO);
+    Ok(Camera {
+        eye,
+        target: eye
+            + world
+                .transform_vector3(Vec3::NEG_Z)
+                .normalize_or(Vec3::NEG_Z),
+        up: world.transform_vector3(Vec3::Y).normalize_or(Vec3::Y),
+        fov_y_radians: p.yfov(),
+        near: p.znear(),
+        // An infinite projection gets a far plane well beyond anything in a glTF scene.
+        far: p.zfar().unwrap_or(p.znear() * 1e5),
+    })
+}
+
+/// Replaced before the scene is returned.
+fn placeholder_camera() -> Camera {
+    Camera {
+        eye: Vec3::Z,
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_radians: 1.0,
+        near: 0.1,
+        far: 100.0,
+    }
+}
+
+/// A 50-degree camera looking at the centre of the objects' bounds from above and in front
+/// (+Z, +Y), far enough to see all of it.
+fn framing_camera(scene: &Scene) -> Camera {
+    let bounds = scene
+        .objects
+        .iter()
+        .map(|o| o.world_bounds())
+        .chain(scene.alpha_objects.iter().map(|o| o.world_bounds()))
+        .reduce(|(lo, hi), (l, h)| (lo.min(l), hi.max(h)));
+    let (lo, hi) = bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let fov_y_radians = 50f32.to_radians();
+    let distance = radius / (fov_y_radians * 0.5).sin();
+    Camera {
+        eye: centre + Vec3::new(0.0, 0.35, 1.0).normalize() * distance,
+        target: centre,
+        up: Vec3::Y,
+        fov_y_radians,
+        near: distance * 0.01,
+        far: distance + radius * 2.0,
+    }
+}
