@@ -7,6 +7,7 @@ use histencil_scene::{load_scene, ImportError, MaterialError, Shape};
 use histencil_tests::{assert_close, lit_fraction, output_dir, with_validated_context};
 use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
 use serde_json::{json, Value};
+use std::f32::consts::FRAC_1_SQRT_2 as H;
 use std::path::PathBuf;
 
 /// Binary data and the accessors that address it.
@@ -128,13 +129,13 @@ fn test_gltf(box_brdf: &str) -> (Value, Vec<u8>) {
              "rotation": [0.0, 0.3826834, 0.0, 0.9238795]},
             {"name": "floor", "mesh": 1, "scale": [5.0, 1.0, 5.0]},
             {"name": "pane", "mesh": 2, "translation": [1.2, 1.0, 1.2],
-             "rotation": [0.7071068, 0.0, 0.0, 0.7071068], "scale": [0.5, 1.0, 0.5]},
+             "rotation": [H, 0.0, 0.0, H], "scale": [0.5, 1.0, 0.5]},
             {"name": "warm", "extensions": {"KHR_lights_punctual": {"light": 0}},
              "translation": [1.5, 2.0, 1.0]},
             {"name": "cool", "extensions": {"KHR_lights_punctual": {"light": 1}},
              "translation": [-1.5, 1.5, 0.5]},
             {"name": "spot", "extensions": {"KHR_lights_punctual": {"light": 2}},
-             "translation": [0.0, 5.0, 0.0], "rotation": [-0.7071068, 0.0, 0.0, 0.7071068]},
+             "translation": [0.0, 5.0, 0.0], "rotation": [-H, 0.0, 0.0, H]},
             {"name": "camera", "camera": 0, "translation": [0.0, 3.0, 6.0],
              "rotation": [-0.2297529, 0.0, 0.0, 0.9732489]}
         ],
