@@ -39,7 +39,7 @@ fn material(id: BrdfId, variant: usize, tint: Vec3) -> Material {
 }
 
 /// `(name, description)` of every embedded scene.
-pub const EMBEDDED: [(&str, &str); 11] = [
+pub const EMBEDDED: [(&str, &str); 12] = [
     (
         "default",
         "procedural room: 2 BRDFs, 36 point lights from tiny to huge, 3 spots, 1 directional",
@@ -56,6 +56,11 @@ pub const EMBEDDED: [(&str, &str); 11] = [
         "brdfs-6",
         "the default room with all six BRDFs: Lambert, Blinn-Phong, Oren-Nayar, GGX, \
          Kajiya-Kay, Penner skin",
+    ),
+    (
+        "huge-lights",
+        "the room with Lambert, Blinn-Phong and Oren-Nayar under 8 huge point lights, each \
+         covering the whole screen, as in the talk's measurements",
     ),
     (
         "inside",
@@ -104,6 +109,7 @@ pub fn embedded(name: &str) -> Result<Scene, SceneError> {
     let models: &[BrdfId] = match name {
         "brdfs-1" => &[BrdfId::Lambert],
         "brdfs-3" => &[BrdfId::Lambert, BrdfId::OrenNayarFull, BrdfId::Ggx],
+        "huge-lights" => &[BrdfId::Lambert, BrdfId::BlinnPhong, BrdfId::OrenNayarFull],
         "brdfs-6" => &[
             BrdfId::Lambert,
             BrdfId::BlinnPhong,
@@ -117,6 +123,7 @@ pub fn embedded(name: &str) -> Result<Scene, SceneError> {
     let mut scene = room(name, description, models);
     crate::alpha_scenes::add_alpha_entities(name, &mut scene);
     match name {
+        "huge-lights" => scene.lights = huge_lights(),
         "inside" => {
             scene.camera.eye = Vec3::new(1.5, 2.2, 5.0);
             scene.lights.push(Light::point(
@@ -163,6 +170,22 @@ impl SplitMix {
     fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.next_f32()
     }
+}
+
+/// Eight point lights of range 40 spread over the room: the camera is inside every volume, so
+/// each covers the whole screen, and each reaches every object.
+fn huge_lights() -> Vec<Light> {
+    (0..8)
+        .map(|i| {
+            let (x, z) = ((i % 4) as f32 * 4.0 - 6.0, (i / 4) as f32 * 6.0 - 7.0);
+            let hue = [
+                Vec3::new(1.0, 0.85, 0.7),
+                Vec3::new(0.7, 0.8, 1.0),
+                Vec3::new(0.9, 1.0, 0.8),
+            ][i % 3];
+            Light::point(Vec3::new(x, 3.5, z), 40.0, hue * 10.0)
+        })
+        .collect()
 }
 
 fn object(name: &str, shape: Shape, transform: Mat4, material: Material) -> Object {
@@ -333,7 +356,9 @@ mod tests {
                 .iter()
                 .filter(|l| l.kind == LightKind::Point)
                 .count();
-            assert!(points >= 32, "{name}: {points} point lights");
+            // Every room keeps its 36 point lights, except the one built to have only huge ones.
+            let expected = if name == "huge-lights" { 8 } else { 32 };
+            assert!(points >= expected, "{name}: {points} point lights");
         }
     }
 
