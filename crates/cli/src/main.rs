@@ -10,6 +10,7 @@ use std::process::ExitCode;
 
 mod brdf_eval;
 mod brdf_report;
+mod lab;
 
 #[derive(Parser)]
 #[command(
@@ -28,6 +29,16 @@ enum Command {
     Render(RenderArgs),
     /// List the embedded scenes: name, BRDFs in use, lights, alpha entities, description.
     Scenes,
+    /// The talk's table on this device: lighting time with 1, 2, 3 BRDFs per technique and
+    /// platform backend, the per-BRDF breakdown, a light-size sweep, each next to its error
+    /// against forward; writes report.md, report.json and PNG plots.
+    Compare(lab::CompareArgs),
+    /// Speed against error for one setting (lut-res, lightmap-res, tile-size): CSV, JSON and a
+    /// Pareto plot.
+    Sweep(lab::SweepArgs),
+    /// Measure this device's per-pass overhead, branch tax and shade cost for the adaptive
+    /// technique (`--costs`).
+    Calibrate(lab::CalibrateArgs),
     /// Evaluate BRDF cases from a CSV file (id,brdf,params,N,T,V,L) into `id,value`.
     BrdfEval(BrdfEvalArgs),
     /// Print the error of the BRDF look-up tables against resolution and the error the G-buffer
@@ -103,6 +114,10 @@ struct RenderArgs {
     /// the written frame's error against the forward alpha over the pixels they cover.
     #[arg(long)]
     alpha_error: bool,
+    /// Costs from `histencil calibrate` for `--technique adaptive` (default: fitted to the talk's
+    /// figures).
+    #[arg(long)]
+    costs: Option<PathBuf>,
     /// Time every lighting step and print the talk's pass groups (setup, mask and shade per BRDF,
     /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
     #[arg(long)]
@@ -261,6 +276,11 @@ fn check_writable(path: &Path) -> Result<()> {
 
 fn render(args: &RenderArgs) -> Result<()> {
     let scene = histencil_scene::load_scene(&args.scene)?;
+    let costs = args
+        .costs
+        .as_deref()
+        .map(histencil_lab::read_costs)
+        .transpose()?;
     for path in [
         Some(&args.out),
         args.hdr.as_ref(),
@@ -275,6 +295,7 @@ fn render(args: &RenderArgs) -> Result<()> {
         let technique = args.technique();
         let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
         renderer.set_preserved_pattern(args.preserved_pattern);
+        renderer.set_cost_model(costs);
         renderer.set_lut_resolution(args.lut_resolution)?;
         renderer.set_alpha_mode(args.alpha.mode());
         renderer.set_lightmap_resolution(args.lightmap_resolution)?;
@@ -496,6 +517,9 @@ fn main() -> ExitCode {
             scenes();
             Ok(())
         }
+        Command::Compare(args) => lab::compare(args),
+        Command::Sweep(args) => lab::sweep(args),
+        Command::Calibrate(args) => lab::calibrate(args),
         Command::BrdfEval(args) => brdf_eval(args),
         Command::BrdfReport(args) => brdf_report(args),
     };

@@ -1,1 +1,53 @@
-//! histencil-lab
+//! histencil-lab: what `histencil compare`, `sweep` and `calibrate` run, as a library an engine's
+//! own tooling can call. Every speed figure comes with its error against the forward reference,
+//! measured in the same run on the same device.
+//!
+//! - [`compare`]: the talk's table (lighting time with 1, 2, 3 BRDFs per technique and platform
+//!   backend, overhead against the 1-BRDF time), the per-BRDF pass breakdown, and a light-size
+//!   sweep showing where branching overtakes stencil and whether adaptive follows the better one.
+//! - [`sweep`]: speed against error for one setting (LUT resolution, lightmap resolution,
+//!   hi-stencil tile size), with its Pareto front.
+//! - [`calibrate`]: this device's per-pass overhead, branch tax and shade cost, the
+//!   [`CostModel`](histencil_vk::CostModel) that the adaptive technique chooses with.
+
+pub mod calibrate;
+pub mod compare;
+mod image_error;
+mod measure;
+mod plot;
+pub mod sweep;
+mod variants;
+
+pub use calibrate::{calibrate, read_costs, Calibration};
+pub use compare::{run_compare, CompareReport, CompareSettings};
+pub use image_error::{image_error, ImageError};
+pub use measure::Timing;
+pub use sweep::{run_sweep, SweepParam, SweepReport};
+pub use variants::{light_size_scene, with_brdf_count};
+
+/// Why a lab run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum LabError {
+    #[error(transparent)]
+    Vulkan(#[from] histencil_vk::Error),
+    #[error(transparent)]
+    Scene(#[from] histencil_scene::SceneError),
+    #[error("cannot write {path}: {problem}")]
+    Write { path: String, problem: String },
+    #[error("cannot draw plot {path}: {problem}")]
+    Plot { path: String, problem: String },
+    #[error("cost model {path}: {problem}")]
+    Costs { path: String, problem: String },
+    #[error("{0}")]
+    Settings(String),
+}
+
+pub type Result<T, E = LabError> = std::result::Result<T, E>;
+
+/// Writes `bytes` to `path`, naming the path in the error.
+pub(crate) fn write_file(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
+    std::fs::write(path, bytes).map_err(|e| LabError::Write {
+        path: path.display().to_string(),
+        problem: e.to_string(),
+    })
+}

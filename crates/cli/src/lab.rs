@@ -1,0 +1,192 @@
+//! `compare`, `sweep` and `calibrate`: the lab's runs with a progress bar.
+
+use crate::on_device;
+use anyhow::{bail, Result};
+use histencil_lab::{CompareSettings, SweepParam};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct CompareArgs {
+    /// An embedded scene or a `.gltf` / `.glb` file; its objects' BRDFs are folded onto 1, 2
+    /// and 3 models for the table's columns.
+    #[arg(long, default_value = "huge-lights")]
+    scene: String,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Timed frames per cell (after one warm-up frame).
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Light sizes of the light-size sweep, in percent of the screen.
+    #[arg(long, value_delimiter = ',', default_value = "0.1,0.3,1,3,10,30,100")]
+    light_sizes: Vec<f64>,
+    /// Costs from `histencil calibrate` for the adaptive technique (default: fitted to the
+    /// talk's figures).
+    #[arg(long)]
+    costs: Option<PathBuf>,
+    /// Output directory: report.md, report.json and PNG plots.
+    #[arg(long, default_value = "out/compare")]
+    out: PathBuf,
+    /// Run under the validation layer; any message fails the run.
+    #[arg(long)]
+    validate: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum ParamArg {
+    LutRes,
+    LightmapRes,
+    TileSize,
+}
+
+#[derive(clap::Args)]
+pub struct SweepArgs {
+    /// The setting to sweep.
+    #[arg(long, value_enum)]
+    param: ParamArg,
+    /// Values to try (default: lut-res 8..96, lightmap-res 4..128, tile-size 2..64).
+    #[arg(long, value_delimiter = ',')]
+    values: Vec<u32>,
+    /// Scene (default: `default` for lut-res and tile-size, `alpha` for lightmap-res).
+    #[arg(long)]
+    scene: Option<String>,
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Output directory: sweep.csv, sweep.json, pareto.png.
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
+    #[arg(long)]
+    validate: bool,
+}
+
+#[derive(clap::Args)]
+pub struct CalibrateArgs {
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    #[arg(long, default_value_t = 5)]
+    frames: usize,
+    /// Where the costs go (read back by `--costs`).
+    #[arg(long, default_value = "out/costs.json")]
+    out: PathBuf,
+    #[arg(long)]
+    validate: bool,
+}
+
+/// A spinner with a message, or a bar when the number of steps is known.
+fn progress_bar(steps: Option<u64>) -> ProgressBar {
+    match steps {
+        Some(n) => ProgressBar::new(n).with_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
+                .expect("valid template"),
+        ),
+        None => ProgressBar::new_spinner().with_style(
+            ProgressStyle::with_template("{spinner} {elapsed} {msg}").expect("valid template"),
+        ),
+    }
+}
+
+pub fn compare(args: &CompareArgs) -> Result<()> {
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    if let Some(bad) = args
+        .light_sizes
+        .iter()
+        .find(|s| !(**s > 0.0 && **s <= 100.0))
+    {
+        bail!("--light-sizes: {bad} is not a percentage in (0, 100]");
+    }
+    let mut settings = CompareSettings::talk(args.width, args.height, args.frames);
+    settings.scene = histencil_scene::load_scene(&args.scene)?;
+    settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
+    settings.costs = args
+        .costs
+        .as_deref()
+        .map(histencil_lab::read_costs)
+        .transpose()?;
+    let report = on_device(args.validate, |ctx| {
+        let bar = progress_bar(None);
+        let report = histencil_lab::run_compare(ctx, &settings, &mut |what| {
+            bar.set_message(what.to_owned());
+            bar.tick();
+        });
+        bar.finish_and_clear();
+        Ok(report?)
+    })?;
+    for path in report.write(&args.out)? {
+        println!("wrote {}", path.display());
+    }
+    print!("{}", report.markdown());
+    Ok(())
+}
+
+pub fn sweep(args: &SweepArgs) -> Result<()> {
+    let param = match args.param {
+        ParamArg::LutRes => SweepParam::LutRes,
+        ParamArg::LightmapRes => SweepParam::LightmapRes,
+        ParamArg::TileSize => SweepParam::TileSize,
+    };
+    let values = if args.values.is_empty() {
+        param.default_values()
+    } else {
+        args.values.clone()
+    };
+    let scene =
+        histencil_scene::load_scene(args.scene.as_deref().unwrap_or(param.default_scene()))?;
+    let report = on_device(args.validate, |ctx| {
+        let bar = progress_bar(Some(values.len() as u64));
+        bar.set_message(format!("{} on {}", param.name(), scene.name));
+        let report = histencil_lab::run_sweep(
+            ctx,
+            scene,
+            param,
+            &values,
+            args.width,
+            args.height,
+            args.frames,
+            &mut |done, _| bar.set_position(done as u64),
+        );
+        bar.finish_and_clear();
+        Ok(report?)
+    })?;
+    for path in report.write(&args.out)? {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    let calibration = on_device(args.validate, |ctx| {
+        let bar = progress_bar(None);
+        let c = histencil_lab::calibrate(ctx, args.width, args.height, args.frames, &mut |what| {
+            bar.set_message(what.to_owned());
+            bar.tick();
+        });
+        bar.finish_and_clear();
+        Ok(c?)
+    })?;
+    crate::check_writable(&args.out)?;
+    calibration.write(&args.out)?;
+    let c = &calibration.costs;
+    println!(
+        "wrote {} ({}): pass overhead {:.4} ms, stencil {:.4} ms and branch tax {:.4} ms per extra \
+         BRDF per full-screen light, shade {:.4} ms; stencil wins above {}",
+        args.out.display(),
+        calibration.device,
+        c.pass_overhead_ms,
+        c.stencil_per_brdf_ms,
+        c.branch_tax_per_brdf_ms,
+        c.shade_ms,
+        c.crossover_coverage()
+            .map_or("never".to_owned(), |x| format!("{:.2} % of the screen", x * 100.0))
+    );
+    Ok(())
+}

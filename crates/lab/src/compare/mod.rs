@@ -1,0 +1,360 @@
+//! `histencil compare`: the talk's lighting-time table on this device, with every figure's error
+//! against the forward reference rendered in the same run.
+
+mod report;
+
+use crate::image_error::{image_error, ImageError};
+use crate::measure::{frame, time_lighting, Timing};
+use crate::variants::{light_size_scene, with_brdf_count};
+use crate::Result;
+use histencil_scene::Scene;
+use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Renderer, Technique};
+
+/// What a comparison run measures.
+#[derive(Clone, Debug)]
+pub struct CompareSettings {
+    pub scene: Scene,
+    pub width: u32,
+    pub height: u32,
+    /// Timed frames per cell, after [`crate::measure::WARM_UP_FRAMES`].
+    pub frames: usize,
+    /// The adaptive technique's costs; `None`: fitted to the talk's figures.
+    pub costs: Option<CostModel>,
+    /// BRDF counts of the table's columns (the talk's 1, 2, 3).
+    pub brdf_counts: Vec<usize>,
+    /// Screen coverages of the light-size sweep, 0..=1.
+    pub light_sizes: Vec<f64>,
+}
+
+impl CompareSettings {
+    /// The talk's set-up: `huge-lights`, 1 to 3 BRDFs, lights from 0.1 % to 100 % of the screen.
+    pub fn talk(width: u32, height: u32, frames: usize) -> Self {
+        Self {
+            scene: histencil_scene::embedded("huge-lights").expect("embedded"),
+            width,
+            height,
+            frames,
+            costs: None,
+            brdf_counts: vec![1, 2, 3],
+            light_sizes: vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0],
+        }
+    }
+}
+
+/// The table's rows: the technique and platform backend of each.
+pub fn table_rows() -> Vec<(&'static str, Technique)> {
+    let flush = FlushPolicy::Auto;
+    let x360 = Backend::X360 {
+        zero_preserved: true,
+        save_restore: false,
+    };
+    vec![
+        (
+            "branching",
+            Technique::Branching {
+                backend: Backend::Native,
+                flush,
+            },
+        ),
+        (
+            "stencil x360",
+            Technique::Stencil {
+                backend: x360,
+                flush,
+            },
+        ),
+        (
+            "stencil ps3",
+            Technique::Stencil {
+                backend: Backend::Ps3,
+                flush,
+            },
+        ),
+        (
+            "stencil native",
+            Technique::Stencil {
+                backend: Backend::Native,
+                flush,
+            },
+        ),
+        (
+            "lut",
+            Technique::Lut {
+                backend: Backend::Native,
+                flush,
+            },
+        ),
+        (
+            "adaptive",
+            Technique::Adaptive {
+                backend: Backend::Native,
+                flush,
+            },
+        ),
+    ]
+}
+
+/// One technique at one BRDF count.
+#[derive(Clone, Debug)]
+pub struct Cell {
+    pub brdfs: usize,
+    pub lighting: Timing,
+    pub error: ImageError,
+}
+
+/// One technique across the BRDF counts.
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub name: &'static str,
+    pub cells: Vec<Cell>,
+}
+
+impl Row {
+    /// `(ms, %)` of the cell at `index` over this row's first (1-BRDF) cell.
+    pub fn overhead(&self, index: usize) -> (f64, f64) {
+        let base = self.cells[0].lighting.median_ms;
+        let extra = self.cells[index].lighting.median_ms - base;
+        (
+            extra,
+            if base > 0.0 {
+                100.0 * extra / base
+            } else {
+                0.0
+            },
+        )
+    }
+
+    /// The largest error over the row's cells, per measure.
+    pub fn worst_error(&self) -> ImageError {
+        self.cells
+            .iter()
+            .fold(ImageError::default(), |w, c| ImageError {
+                max: w.max.max(c.error.max),
+                mean: w.mean.max(c.error.mean),
+                flip: w.flip.max(c.error.flip),
+            })
+    }
+}
+
+/// The lighting pass of one technique split into the talk's groups, in total milliseconds.
+#[derive(Clone, Debug)]
+pub struct Breakdown {
+    pub name: &'static str,
+    pub brdfs: usize,
+    pub lights: usize,
+    pub setup_ms: f64,
+    pub mask_ms: f64,
+    pub render_ms: f64,
+    pub cleanup_ms: f64,
+    /// Zeroing preserved bits, flushes, restores: `(group, ms)`.
+    pub other: Vec<(String, f64)>,
+}
+
+impl Breakdown {
+    /// Per light and BRDF, as the talk gives it: setup and cleanup once per light, mask and render
+    /// once per light and BRDF (every light touches every BRDF in the huge-light scene).
+    pub fn per_pass(&self) -> [f64; 4] {
+        let lights = self.lights.max(1) as f64;
+        let passes = lights * self.brdfs.max(1) as f64;
+        [
+            self.setup_ms / lights,
+            self.mask_ms / passes,
+            self.render_ms / passes,
+            self.cleanup_ms / lights,
+        ]
+    }
+}
+
+/// One light size of the sweep.
+#[derive(Clone, Debug)]
+pub struct SizePoint {
+    pub coverage: f64,
+    pub lights: usize,
+    pub branching: Timing,
+    pub stencil: Timing,
+    pub adaptive: Timing,
+    /// The worst of the three techniques' errors against forward.
+    pub error: ImageError,
+}
+
+impl SizePoint {
+    /// Adaptive's time over the better of branching and stencil (1 is ideal).
+    pub fn adaptive_over_best(&self) -> f64 {
+        let best = self.branching.median_ms.min(self.stencil.median_ms);
+        if best > 0.0 {
+            self.adaptive.median_ms / best
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Everything a comparison run measured.
+#[derive(Clone, Debug)]
+pub struct CompareReport {
+    pub device: String,
+    pub scene: String,
+    pub scene_lights: usize,
+    pub width: u32,
+    pub height: u32,
+    pub frames: usize,
+    pub rows: Vec<Row>,
+    pub breakdowns: Vec<Breakdown>,
+    pub sizes: Vec<SizePoint>,
+    /// The costs the adaptive rows used.
+    pub costs: CostModel,
+    pub costs_calibrated: bool,
+}
+
+impl CompareReport {
+    /// The smallest swept coverage from which stencil is faster than branching, interpolated
+    /// between the two sizes around the change (in log coverage); `None` if it never changes.
+    pub fn measured_crossover(&self) -> Option<f64> {
+        let gain = |p: &SizePoint| p.branching.median_ms - p.stencil.median_ms;
+        self.sizes.windows(2).find_map(|w| {
+            let (a, b) = (gain(&w[0]), gain(&w[1]));
+            (a <= 0.0 && b > 0.0).then(|| {
+                let t = -a / (b - a);
+                (w[0].coverage.ln() + t * (w[1].coverage.ln() - w[0].coverage.ln())).exp()
+            })
+        })
+    }
+}
+
+/// Runs the comparison; `progress` is told what is being measured next.
+pub fn run_compare(
+    ctx: &Context,
+    settings: &CompareSettings,
+    progress: &mut dyn FnMut(&str),
+) -> Result<CompareReport> {
+    if settings.brdf_counts.first() != Some(&1) {
+        return Err(crate::LabError::Settings(
+            "the BRDF counts must start at 1: overheads are against the 1-BRDF time".into(),
+        ));
+    }
+    let (w, h, frames) = (settings.width, settings.height, settings.frames);
+    let new_renderer = |scene: Scene| -> Result<Renderer> {
+        let mut r = Renderer::new(ctx, scene, w, h)?;
+        r.set_cost_model(settings.costs);
+        Ok(r)
+    };
+    let rows_spec = table_rows();
+    let mut rows: Vec<Row> = rows_spec
+        .iter()
+        .map(|(name, _)| Row {
+            name,
+            cells: vec![],
+        })
+        .collect();
+    let mut breakdowns = Vec::new();
+    let mut costs = None;
+    let last = *settings.brdf_counts.last().expect("not empty");
+    for &brdfs in &settings.brdf_counts {
+        let mut renderer = new_renderer(with_brdf_count(&settings.scene, brdfs))?;
+        costs.get_or_insert(renderer.cost_model(Backend::Native));
+        progress(&format!("{brdfs} BRDF(s): forward reference"));
+        let reference = frame(&mut renderer, Technique::Forward)?;
+        for (row, (name, technique)) in rows.iter_mut().zip(&rows_spec) {
+            progress(&format!("{brdfs} BRDF(s): {name}"));
+            let lighting = time_lighting(&mut renderer, *technique, frames)?;
+            let error = image_error(&frame(&mut renderer, *technique)?, &reference);
+            row.cells.push(Cell {
+                brdfs,
+                lighting,
+                error,
+            });
+        }
+        if brdfs == last {
+            for (name, technique) in rows_spec.iter().filter(|(n, _)| n.starts_with("stencil")) {
+                progress(&format!("{brdfs} BRDF(s): {name} pass breakdown"));
+                breakdowns.push(breakdown(&mut renderer, name, *technique, brdfs, frames)?);
+            }
+        }
+    }
+    let aspect = w as f32 / h as f32;
+    let mut sizes = Vec::new();
+    for &coverage in &settings.light_sizes {
+        progress(&format!("light size {:.1} %", coverage * 100.0));
+        let scene = light_size_scene(coverage, aspect);
+        let lights = scene.lights.len();
+        let mut renderer = new_renderer(scene)?;
+        let reference = frame(&mut renderer, Technique::Forward)?;
+        let mut timings = [Timing::default(); 3];
+        let mut error = ImageError::default();
+        for (i, technique) in size_techniques().into_iter().enumerate() {
+            timings[i] = time_lighting(&mut renderer, technique, frames)?;
+            let e = image_error(&frame(&mut renderer, technique)?, &reference);
+            error = ImageError {
+                max: error.max.max(e.max),
+                mean: error.mean.max(e.mean),
+                flip: error.flip.max(e.flip),
+            };
+        }
+        sizes.push(SizePoint {
+            coverage,
+            lights,
+            branching: timings[0],
+            stencil: timings[1],
+            adaptive: timings[2],
+            error,
+        });
+    }
+    Ok(CompareReport {
+        device: ctx.device_name().to_owned(),
+        scene: settings.scene.name.clone(),
+        scene_lights: settings.scene.lights.len(),
+        width: w,
+        height: h,
+        frames,
+        rows,
+        breakdowns,
+        sizes,
+        costs: costs.expect("at least one BRDF count"),
+        costs_calibrated: settings.costs.is_some(),
+    })
+}
+
+/// Branching, stencil and adaptive on the native backend: the light-size sweep's three.
+fn size_techniques() -> [Technique; 3] {
+    let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
+    [
+        Technique::Branching { backend, flush },
+        Technique::Stencil { backend, flush },
+        Technique::Adaptive { backend, flush },
+    ]
+}
+
+/// The median pass-group times of `technique` (timestamps between steps; they cost time of
+/// their own, so these are measured apart from the table's times).
+fn breakdown(
+    renderer: &mut Renderer,
+    name: &'static str,
+    technique: Technique,
+    brdfs: usize,
+    frames: usize,
+) -> Result<Breakdown> {
+    renderer.set_pass_timing(true);
+    let measured = renderer.measure(technique, frames.max(1));
+    renderer.set_pass_timing(false);
+    let lighting = measured?.lighting.unwrap_or_default();
+    let mut b = Breakdown {
+        name,
+        brdfs,
+        lights: lighting.per_light.len(),
+        setup_ms: 0.0,
+        mask_ms: 0.0,
+        render_ms: 0.0,
+        cleanup_ms: 0.0,
+        other: vec![],
+    };
+    for (group, ms) in lighting.groups {
+        match group.as_str() {
+            "setup" => b.setup_ms += ms,
+            "cleanup" => b.cleanup_ms += ms,
+            g if g.starts_with("mask-") => b.mask_ms += ms,
+            g if g.starts_with("shade-") => b.render_ms += ms,
+            _ => b.other.push((group, ms)),
+        }
+    }
+    Ok(b)
+}

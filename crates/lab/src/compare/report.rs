@@ -1,0 +1,376 @@
+//! A comparison run as `report.md` (the talk's tables beside ours), `report.json` (every cell,
+//! machine-readable) and PNG plots.
+
+use super::{Breakdown, CompareReport, Row, SizePoint};
+use crate::image_error::ImageError;
+use crate::measure::{Timing, WARM_UP_FRAMES};
+use crate::plot::{self, Axis, Series};
+use crate::{write_file, Result};
+use histencil_model::TalkFigures;
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The plots `write` draws, relative to the output directory.
+pub const PLOTS: [&str; 3] = ["lighting.png", "light-size.png", "speed-vs-error.png"];
+
+impl CompareReport {
+    /// Writes `report.md`, `report.json` and the [`PLOTS`] into `dir` (created if needed);
+    /// returns the paths written.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        std::fs::create_dir_all(dir).map_err(|e| crate::LabError::Write {
+            path: dir.display().to_string(),
+            problem: e.to_string(),
+        })?;
+        let md = dir.join("report.md");
+        write_file(&md, self.markdown().as_bytes())?;
+        let js = dir.join("report.json");
+        let text = serde_json::to_string_pretty(&self.json()).expect("JSON values serialise");
+        write_file(&js, text.as_bytes())?;
+        let plots: Vec<PathBuf> = PLOTS.iter().map(|p| dir.join(p)).collect();
+        self.plot_lighting(&plots[0])?;
+        self.plot_sizes(&plots[1])?;
+        self.plot_speed_vs_error(&plots[2])?;
+        Ok([md, js].into_iter().chain(plots).collect())
+    }
+
+    /// Every figure of the run; all numbers are finite.
+    pub fn json(&self) -> Value {
+        let c = &self.costs;
+        let mut out = json!({
+            "device": self.device,
+            "settings": {
+                "scene": self.scene,
+                "scene_lights": self.scene_lights,
+                "width": self.width,
+                "height": self.height,
+                "frames": self.frames,
+                "warm_up_frames": WARM_UP_FRAMES,
+            },
+            "rows": self.rows.iter().map(row_json).collect::<Vec<_>>(),
+            "breakdown": self.breakdowns.iter().map(breakdown_json).collect::<Vec<_>>(),
+            "light_sizes": self.sizes.iter().map(size_json).collect::<Vec<_>>(),
+            "cost_model": {
+                "calibrated": self.costs_calibrated,
+                "pass_overhead_ms": c.pass_overhead_ms,
+                "stencil_per_brdf_ms": c.stencil_per_brdf_ms,
+                "branch_tax_per_brdf_ms": c.branch_tax_per_brdf_ms,
+                "shade_ms": c.shade_ms,
+            },
+        });
+        let mut crossover = serde_json::Map::new();
+        if let Some(x) = self.measured_crossover() {
+            crossover.insert("measured_coverage".into(), json!(x));
+        }
+        if let Some(x) = self.costs.crossover_coverage() {
+            crossover.insert("model_coverage".into(), json!(x));
+        }
+        out["crossover"] = Value::Object(crossover);
+        out
+    }
+
+    pub fn markdown(&self) -> String {
+        let mut md = String::new();
+        let _ = writeln!(
+            md,
+            "# histencil compare\n\nDevice: **{}**. Scene `{}` ({} lights) at {}x{}. Lighting-pass \
+             GPU time, median of {} frames after {WARM_UP_FRAMES} warm-up (± spread, max - min). \
+             Error against the forward reference of the same scene: 8-bit max / mean, and mean \
+             FLIP.\n",
+            self.device, self.scene, self.scene_lights, self.width, self.height, self.frames
+        );
+        md += "## Lighting time against BRDF count\n\n";
+        md += "Overheads are against each row's own 1-BRDF time in this run; the error column is \
+               the worst over the BRDF counts.\n\n";
+        let counts: Vec<usize> = self.rows[0].cells.iter().map(|c| c.brdfs).collect();
+        let head: Vec<String> = counts.iter().map(|n| brdfs_label(*n)).collect();
+        let _ = writeln!(
+            md,
+            "| technique | {} | error max / mean / FLIP |\n|---|{}---|",
+            head.join(" | "),
+            "---|".repeat(counts.len())
+        );
+        for row in &self.rows {
+            let cells: Vec<String> = (0..row.cells.len()).map(|i| cell_text(row, i)).collect();
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} |",
+                row.name,
+                cells.join(" | "),
+                error_text(&row.worst_error())
+            );
+        }
+        md += "\nThe talk (Develop 2012, huge lights, ms):\n\n\
+               | platform | 1 BRDF | 2 BRDFs branching | 3 BRDFs branching | 2 BRDFs stencil | 3 BRDFs stencil |\n\
+               |---|---|---|---|---|---|\n";
+        for (name, f) in [("Xbox 360", TalkFigures::X360), ("PS3", TalkFigures::PS3)] {
+            let rel = |t: f64| {
+                format!(
+                    "{t:.2} (+{:.2} ms, +{:.0} %)",
+                    t - f.one_brdf,
+                    100.0 * (t - f.one_brdf) / f.one_brdf
+                )
+            };
+            let _ = writeln!(
+                md,
+                "| {name} | {:.2} | {} | {} | {} | {} |",
+                f.one_brdf,
+                rel(f.branching[0]),
+                rel(f.branching[1]),
+                rel(f.stencil[0]),
+                rel(f.stencil[1])
+            );
+        }
+        md += "\n## Per-BRDF breakdown of the stencil technique\n\n\
+               Pass-group timestamps at the largest BRDF count (they cost time of their own, so \
+               they are measured apart from the table). Totals in ms, then per light (setup, \
+               cleanup) and per light and BRDF (mask, render).\n\n\
+               | technique | lights x BRDFs | setup | mask | render | cleanup | other | per pass: setup / mask / render / cleanup |\n\
+               |---|---|---|---|---|---|---|---|\n";
+        for b in &self.breakdowns {
+            let per = b.per_pass();
+            let other: Vec<String> = b
+                .other
+                .iter()
+                .map(|(g, ms)| format!("{g} {ms:.3}"))
+                .collect();
+            let _ = writeln!(
+                md,
+                "| {} | {} x {} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {:.4} / {:.4} / {:.4} / {:.4} |",
+                b.name,
+                b.lights,
+                b.brdfs,
+                b.setup_ms,
+                b.mask_ms,
+                b.render_ms,
+                b.cleanup_ms,
+                if other.is_empty() { "-".to_owned() } else { other.join(", ") },
+                per[0],
+                per[1],
+                per[2],
+                per[3]
+            );
+        }
+        for (name, f) in [("Xbox 360", TalkFigures::X360), ("PS3", TalkFigures::PS3)] {
+            let _ = writeln!(
+                md,
+                "| talk: {name} | per BRDF | | | | | | {} / {} / {} / {} |",
+                f.setup, f.mask, f.render, f.cleanup
+            );
+        }
+        md += "\n## Light size: where branching overtakes stencil\n\n\
+               A striped wall in three BRDFs under lights covering the given fraction of the \
+               screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
+               screens. Native backend; the error is the worst of the three techniques.\n\n\
+               | coverage | lights | branching | stencil | adaptive | faster | adaptive / best | error max / mean / FLIP |\n\
+               |---|---|---|---|---|---|---|---|\n";
+        for p in &self.sizes {
+            let faster = if p.branching.median_ms < p.stencil.median_ms {
+                "branching"
+            } else {
+                "stencil"
+            };
+            let _ = writeln!(
+                md,
+                "| {:.1} % | {} | {} | {} | {} | {faster} | {:.2} | {} |",
+                p.coverage * 100.0,
+                p.lights,
+                time_text(&p.branching),
+                time_text(&p.stencil),
+                time_text(&p.adaptive),
+                p.adaptive_over_best(),
+                error_text(&p.error)
+            );
+        }
+        let measured = self
+            .measured_crossover()
+            .map_or("never in the swept range".to_owned(), |x| {
+                format!("{:.2} % of the screen", x * 100.0)
+            });
+        let model = self
+            .costs
+            .crossover_coverage()
+            .map_or("never".to_owned(), |x| format!("{:.2} %", x * 100.0));
+        let _ = writeln!(
+            md,
+            "\nStencil becomes faster than branching at {measured}; the adaptive technique's cost \
+             model ({}) puts the change at {model}.",
+            if self.costs_calibrated {
+                "calibrated on this device"
+            } else {
+                "fitted to the talk's figures"
+            }
+        );
+        md += "\nPlots: `lighting.png`, `light-size.png`, `speed-vs-error.png`.\n";
+        md
+    }
+
+    fn plot_lighting(&self, path: &Path) -> Result<()> {
+        let series: Vec<Series> = self
+            .rows
+            .iter()
+            .map(|r| Series {
+                name: r.name.to_owned(),
+                points: r
+                    .cells
+                    .iter()
+                    .map(|c| (c.brdfs as f64, c.lighting.median_ms))
+                    .collect(),
+            })
+            .collect();
+        plot::line_chart(
+            path,
+            &format!("Lighting time against BRDF count ({})", self.device),
+            Axis {
+                label: "BRDFs in use",
+                log: false,
+            },
+            Axis {
+                label: "lighting ms",
+                log: false,
+            },
+            &series,
+        )
+    }
+
+    fn plot_sizes(&self, path: &Path) -> Result<()> {
+        let per_light = |f: fn(&SizePoint) -> &Timing| -> Vec<(f64, f64)> {
+            self.sizes
+                .iter()
+                .map(|p| (p.coverage * 100.0, f(p).median_ms / p.lights.max(1) as f64))
+                .collect()
+        };
+        let series = [
+            Series {
+                name: "branching".into(),
+                points: per_light(|p| &p.branching),
+            },
+            Series {
+                name: "stencil".into(),
+                points: per_light(|p| &p.stencil),
+            },
+            Series {
+                name: "adaptive".into(),
+                points: per_light(|p| &p.adaptive),
+            },
+        ];
+        plot::line_chart(
+            path,
+            "Lighting time per light against light size (3 BRDFs)",
+            Axis {
+                label: "screen coverage per light, %",
+                log: true,
+            },
+            Axis {
+                label: "ms per light",
+                log: true,
+            },
+            &series,
+        )
+    }
+
+    fn plot_speed_vs_error(&self, path: &Path) -> Result<()> {
+        let points: Vec<(f64, f64, String)> = self
+            .rows
+            .iter()
+            .map(|r| {
+                let last = r.cells.last().expect("cells");
+                (last.lighting.median_ms, last.error.mean, r.name.to_owned())
+            })
+            .collect();
+        plot::pareto_chart(
+            path,
+            "Speed against error at the largest BRDF count",
+            Axis {
+                label: "lighting ms",
+                log: false,
+            },
+            Axis {
+                label: "mean error, 8-bit steps",
+                log: false,
+            },
+            &points,
+        )
+    }
+}
+
+fn brdfs_label(n: usize) -> String {
+    if n == 1 {
+        "1 BRDF".into()
+    } else {
+        format!("{n} BRDFs")
+    }
+}
+
+fn time_text(t: &Timing) -> String {
+    format!("{:.3} ms ±{:.3}", t.median_ms, t.spread_ms())
+}
+
+fn cell_text(row: &Row, i: usize) -> String {
+    let t = time_text(&row.cells[i].lighting);
+    if i == 0 {
+        return t;
+    }
+    let (ms, pct) = row.overhead(i);
+    format!("{t} ({ms:+.3} ms, {pct:+.1} %)")
+}
+
+fn error_text(e: &ImageError) -> String {
+    format!("{:.0} / {:.3} / {:.4}", e.max, e.mean, e.flip)
+}
+
+fn timing_json(t: &Timing) -> Value {
+    json!({"median_ms": t.median_ms, "min_ms": t.min_ms, "max_ms": t.max_ms, "spread_ms": t.spread_ms()})
+}
+
+fn error_json(e: &ImageError) -> Value {
+    json!({"max": e.max, "mean": e.mean, "flip": e.flip})
+}
+
+fn row_json(row: &Row) -> Value {
+    let cells: Vec<Value> = row
+        .cells
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let (ms, pct) = row.overhead(i);
+            json!({
+                "brdfs": c.brdfs,
+                "lighting": timing_json(&c.lighting),
+                "overhead_ms": ms,
+                "overhead_percent": pct,
+                "error": error_json(&c.error),
+            })
+        })
+        .collect();
+    json!({"technique": row.name, "cells": cells})
+}
+
+fn breakdown_json(b: &Breakdown) -> Value {
+    let per = b.per_pass();
+    let other: serde_json::Map<String, Value> = b
+        .other
+        .iter()
+        .map(|(g, ms)| (g.clone(), json!(ms)))
+        .collect();
+    json!({
+        "technique": b.name,
+        "brdfs": b.brdfs,
+        "lights": b.lights,
+        "total_ms": {"setup": b.setup_ms, "mask": b.mask_ms, "render": b.render_ms,
+                     "cleanup": b.cleanup_ms, "other": other},
+        "per_pass_ms": {"setup": per[0], "mask": per[1], "render": per[2], "cleanup": per[3]},
+    })
+}
+
+fn size_json(p: &SizePoint) -> Value {
+    json!({
+        "coverage": p.coverage,
+        "lights": p.lights,
+        "branching": timing_json(&p.branching),
+        "stencil": timing_json(&p.stencil),
+        "adaptive": timing_json(&p.adaptive),
+        "adaptive_over_best": p.adaptive_over_best(),
+        "error": error_json(&p.error),
+    })
+}

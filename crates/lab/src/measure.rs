@@ -1,0 +1,70 @@
+//! Timing a technique over frames, and the frame it renders.
+
+use crate::Result;
+use histencil_vk::{median_of_sorted, Readback, Renderer, Technique};
+use image::RgbaImage;
+
+/// Milliseconds of one measured quantity over frames: the median and the spread.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timing {
+    pub median_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+}
+
+impl Timing {
+    pub fn from_samples(mut samples: Vec<f64>) -> Self {
+        samples.sort_by(f64::total_cmp);
+        Self {
+            median_ms: median_of_sorted(&samples),
+            min_ms: samples.first().copied().unwrap_or(0.0),
+            max_ms: samples.last().copied().unwrap_or(0.0),
+        }
+    }
+
+    /// `max - min`.
+    pub fn spread_ms(&self) -> f64 {
+        self.max_ms - self.min_ms
+    }
+}
+
+/// Frames rendered and thrown away before timing: the first frame of a technique builds its
+/// pipelines and tables and bakes lightmap probes.
+pub const WARM_UP_FRAMES: usize = 1;
+
+/// The summed time of `passes` in each of `frames` frames after the warm-up.
+pub fn time_passes(
+    renderer: &mut Renderer,
+    technique: Technique,
+    passes: &[&str],
+    frames: usize,
+) -> Result<Timing> {
+    for _ in 0..WARM_UP_FRAMES {
+        renderer.render(technique, Readback::NONE)?;
+    }
+    let mut samples = Vec::with_capacity(frames);
+    for _ in 0..frames.max(1) {
+        let timings = renderer.render(technique, Readback::NONE)?.timings;
+        samples.push(passes.iter().filter_map(|p| timings.pass_ms(p)).sum());
+    }
+    Ok(Timing::from_samples(samples))
+}
+
+/// The lighting pass's time (the talk's figure).
+pub fn time_lighting(
+    renderer: &mut Renderer,
+    technique: Technique,
+    frames: usize,
+) -> Result<Timing> {
+    time_passes(renderer, technique, &["lighting"], frames)
+}
+
+/// The tonemapped frame.
+pub fn frame(renderer: &mut Renderer, technique: Technique) -> Result<RgbaImage> {
+    let readback = Readback {
+        ldr: true,
+        ..Readback::NONE
+    };
+    let images = renderer.render(technique, readback)?.images;
+    Ok(images.ldr.expect("the LDR frame was asked for"))
+}

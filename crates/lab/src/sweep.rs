@@ -1,0 +1,335 @@
+//! `histencil sweep`: one setting against speed and error, with its Pareto front.
+//!
+//! - `lut-res`: the LUT technique's table resolution; lighting time against error of the frame
+//!   against forward.
+//! - `lightmap-res`: the alpha entities' lightmap side; lightmap + alpha pass time against the
+//!   error over the pixels the entities cover, against forward-lit alpha.
+//! - `tile-size`: the hi-stencil tile size. The GPU emulation's tile size is a shader constant,
+//!   so this one runs the hi-stencil simulator on the GPU's own captured light footprints (the
+//!   simulator agrees with the GPU at that size, `render --stats`). Culling is exact at every
+//!   size, so there is no error to trade: the trade is tile tests (the culling surface's work)
+//!   against fragments shaded.
+
+use crate::image_error::{image_error, ImageError};
+use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
+use crate::plot::{self, Axis};
+use crate::{write_file, LabError, Result};
+use histencil_scene::Scene;
+use histencil_vk::{AlphaMode, Backend, Context, FlushPolicy, Renderer, Technique};
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The setting a sweep varies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SweepParam {
+    LutRes,
+    LightmapRes,
+    TileSize,
+}
+
+impl SweepParam {
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepParam::LutRes => "lut-res",
+            SweepParam::LightmapRes => "lightmap-res",
+            SweepParam::TileSize => "tile-size",
+        }
+    }
+
+    pub fn default_values(self) -> Vec<u32> {
+        match self {
+            SweepParam::LutRes => vec![8, 16, 32, 64, 96],
+            SweepParam::LightmapRes => vec![4, 8, 16, 32, 64, 128],
+            SweepParam::TileSize => vec![2, 4, 8, 16, 32, 64],
+        }
+    }
+
+    /// The embedded scene that exercises the setting: Blinn-Phong up to 256 for the LUT, glass and
+    /// smoke for the lightmaps, tiny to huge lights for the tiles.
+    pub fn default_scene(self) -> &'static str {
+        match self {
+            SweepParam::LutRes | SweepParam::TileSize => "default",
+            SweepParam::LightmapRes => "alpha",
+        }
+    }
+
+    /// `(speed column, error column)` names and the speed unit.
+    fn columns(self) -> (&'static str, &'static str) {
+        match self {
+            SweepParam::LutRes => ("lighting_ms", "mean error, 8-bit steps"),
+            SweepParam::LightmapRes => ("alpha_ms", "mean error over alpha pixels, 8-bit steps"),
+            SweepParam::TileSize => ("tiles_tested", "fragments shaded"),
+        }
+    }
+}
+
+/// One setting's measurements.
+#[derive(Clone, Debug)]
+pub struct SweepPoint {
+    pub setting: u32,
+    /// Milliseconds for timed settings; tile tests for `tile-size`.
+    pub speed: Timing,
+    pub error: ImageError,
+    /// Further figures: `(name, value)`.
+    pub extra: Vec<(&'static str, f64)>,
+}
+
+/// A sweep's measurements.
+#[derive(Clone, Debug)]
+pub struct SweepReport {
+    pub device: String,
+    pub param: SweepParam,
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub frames: usize,
+    pub points: Vec<SweepPoint>,
+}
+
+/// Measures `scene` at every value; `progress(done, total)` after each.
+#[allow(clippy::too_many_arguments)]
+pub fn run_sweep(
+    ctx: &Context,
+    scene: Scene,
+    param: SweepParam,
+    values: &[u32],
+    width: u32,
+    height: u32,
+    frames: usize,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<SweepReport> {
+    if values.is_empty() {
+        return Err(LabError::Settings("no values to sweep".into()));
+    }
+    if param == SweepParam::LightmapRes && scene.alpha_entity_count() == 0 {
+        return Err(LabError::Settings(format!(
+            "scene `{}` has no alpha objects or particles to light",
+            scene.name
+        )));
+    }
+    let name = scene.name.clone();
+    let background = scene.without_alpha();
+    let mut renderer = Renderer::new(ctx, scene, width, height)?;
+    let mut points = Vec::new();
+    match param {
+        SweepParam::LutRes => {
+            let reference = frame(&mut renderer, Technique::Forward)?;
+            let lut = Technique::Lut {
+                backend: Backend::Native,
+                flush: FlushPolicy::Auto,
+            };
+            for (i, &res) in values.iter().enumerate() {
+                renderer.set_lut_resolution(res)?;
+                let speed = time_lighting(&mut renderer, lut, frames)?;
+                let error = image_error(&frame(&mut renderer, lut)?, &reference);
+                let bytes = renderer.lut_tables()?.size_bytes();
+                points.push(SweepPoint {
+                    setting: res,
+                    speed,
+                    error,
+                    extra: vec![("table_bytes", bytes as f64)],
+                });
+                progress(i + 1, values.len());
+            }
+        }
+        SweepParam::LightmapRes => {
+            let technique = Technique::DEFERRED;
+            renderer.set_alpha_mode(AlphaMode::Forward);
+            let reference = frame(&mut renderer, technique)?;
+            renderer.set_alpha_mode(AlphaMode::Lightmap);
+            let mut without = Renderer::new(ctx, background, width, height)?;
+            let background = frame(&mut without, technique)?;
+            drop(without);
+            for (i, &side) in values.iter().enumerate() {
+                renderer.set_lightmap_resolution(Some(side))?;
+                let speed = time_passes(
+                    &mut renderer,
+                    technique,
+                    &["alpha-lightmaps", "alpha"],
+                    frames,
+                )?;
+                let lit = frame(&mut renderer, technique)?;
+                let masked = histencil_vk::masked_error(&lit, &reference, &background)
+                    .expect("frames of one size");
+                let whole = image_error(&lit, &reference);
+                let atlas = renderer
+                    .lightmap_layout()?
+                    .map_or(0, |layout| layout.atlas.size().0);
+                points.push(SweepPoint {
+                    setting: side,
+                    speed,
+                    error: ImageError {
+                        max: f64::from(masked.max),
+                        mean: masked.mean,
+                        flip: whole.flip,
+                    },
+                    extra: vec![
+                        ("alpha_pixels", masked.pixels as f64),
+                        ("atlas_side", f64::from(atlas)),
+                        ("lightmap_draws", renderer.lightmap_draws()? as f64),
+                    ],
+                });
+                progress(i + 1, values.len());
+            }
+        }
+        SweepParam::TileSize => {
+            let technique = Technique::Stencil {
+                backend: Backend::X360 {
+                    zero_preserved: true,
+                    save_restore: false,
+                },
+                flush: FlushPolicy::Auto,
+            };
+            let mut inputs = renderer.simulator_inputs(technique)?;
+            for (i, &tile) in values.iter().enumerate() {
+                if tile == 0 || tile > width.max(height) {
+                    return Err(LabError::Settings(format!(
+                        "tile size {tile} must be between 1 and the frame's larger side"
+                    )));
+                }
+                inputs.tile_size = tile;
+                let stats = inputs.predict().0.stats;
+                let tested = stats.tiles_tested as f64;
+                points.push(SweepPoint {
+                    setting: tile,
+                    speed: Timing {
+                        median_ms: tested,
+                        min_ms: tested,
+                        max_ms: tested,
+                    },
+                    error: ImageError {
+                        max: 0.0,
+                        mean: stats.fragments_shaded as f64,
+                        flip: 0.0,
+                    },
+                    extra: vec![
+                        ("tiles_culled", stats.tiles_culled as f64),
+                        ("fragments_shaded", stats.fragments_shaded as f64),
+                        ("flushes", stats.flushes as f64),
+                    ],
+                });
+                progress(i + 1, values.len());
+            }
+        }
+    }
+    Ok(SweepReport {
+        device: ctx.device_name().to_owned(),
+        param,
+        scene: name,
+        width,
+        height,
+        frames,
+        points,
+    })
+}
+
+impl SweepReport {
+    /// Writes `sweep.csv`, `sweep.json` and `pareto.png` into `dir`; returns their paths.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        std::fs::create_dir_all(dir).map_err(|e| LabError::Write {
+            path: dir.display().to_string(),
+            problem: e.to_string(),
+        })?;
+        let csv = dir.join("sweep.csv");
+        write_file(&csv, self.csv().as_bytes())?;
+        let js = dir.join("sweep.json");
+        let text = serde_json::to_string_pretty(&self.json()).expect("JSON values serialise");
+        write_file(&js, text.as_bytes())?;
+        let png = dir.join("pareto.png");
+        let (speed, error) = self.param.columns();
+        let points: Vec<(f64, f64, String)> = self
+            .points
+            .iter()
+            .map(|p| (p.speed.median_ms, p.error.mean, p.setting.to_string()))
+            .collect();
+        plot::pareto_chart(
+            &png,
+            &format!(
+                "{} sweep on {} ({})",
+                self.param.name(),
+                self.scene,
+                self.device
+            ),
+            Axis {
+                label: speed,
+                log: false,
+            },
+            Axis {
+                label: error,
+                log: self.param == SweepParam::TileSize,
+            },
+            &points,
+        )?;
+        Ok(vec![csv, js, png])
+    }
+
+    fn csv(&self) -> String {
+        let (speed, _) = self.param.columns();
+        let mut out = if self.param == SweepParam::TileSize {
+            "tile_size,tiles_tested".to_owned()
+        } else {
+            format!(
+                "{},{speed},{speed}_min,{speed}_max,error_max,error_mean,flip",
+                self.param.name().replace('-', "_")
+            )
+        };
+        for (name, _) in self.points.first().map_or(&[][..], |p| &p.extra[..]) {
+            let _ = write!(out, ",{name}");
+        }
+        out.push('\n');
+        for p in &self.points {
+            if self.param == SweepParam::TileSize {
+                let _ = write!(out, "{},{}", p.setting, p.speed.median_ms);
+            } else {
+                let _ = write!(
+                    out,
+                    "{},{},{},{},{},{},{}",
+                    p.setting,
+                    p.speed.median_ms,
+                    p.speed.min_ms,
+                    p.speed.max_ms,
+                    p.error.max,
+                    p.error.mean,
+                    p.error.flip
+                );
+            }
+            for (_, v) in &p.extra {
+                let _ = write!(out, ",{v}");
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    /// Every figure of the sweep; all numbers are finite.
+    pub fn json(&self) -> Value {
+        let (speed, _) = self.param.columns();
+        let points: Vec<Value> = self
+            .points
+            .iter()
+            .map(|p| {
+                let mut v = json!({ "setting": p.setting });
+                if self.param == SweepParam::TileSize {
+                    v["tiles_tested"] = json!(p.speed.median_ms);
+                } else {
+                    v[speed] = json!({"median": p.speed.median_ms, "min": p.speed.min_ms,
+                                      "max": p.speed.max_ms});
+                    v["error"] = json!({"max": p.error.max, "mean": p.error.mean,
+                                        "flip": p.error.flip});
+                }
+                for (name, value) in &p.extra {
+                    v[*name] = json!(value);
+                }
+                v
+            })
+            .collect();
+        json!({
+            "device": self.device,
+            "param": self.param.name(),
+            "settings": {"scene": self.scene, "width": self.width, "height": self.height,
+                         "frames": self.frames, "warm_up_frames": WARM_UP_FRAMES},
+            "points": points,
+        })
+    }
+}
