@@ -169,16 +169,13 @@ pub fn pareto_chart(
             front.iter().copied().map(mapped),
             RED.stroke_width(2),
         ))?;
-        for (px, py, label) in points {
-            let at = mapped((*px, *py));
-            chart.draw_series(std::iter::once(Circle::new(at, 5, BLUE.filled())))?;
-            if text {
-                chart.draw_series(std::iter::once(Text::new(
-                    label.clone(),
-                    at,
-                    (FONT, 14).into_font(),
-                )))?;
-            }
+        let at = |(px, py, _): &(f64, f64, String)| mapped((*px, *py));
+        chart.draw_series(points.iter().map(|p| Circle::new(at(p), 5, BLUE.filled())))?;
+        if text {
+            // Labels sit up and to the right of their point, clear of the marker.
+            chart.draw_series(points.iter().map(|p| {
+                EmptyElement::at(at(p)) + Text::new(p.2.clone(), (8, -18), (FONT, 14).into_font())
+            }))?;
         }
         Ok(())
     })

@@ -7,8 +7,10 @@
 //! - `tile-size`: the hi-stencil tile size. The GPU emulation's tile size is a shader constant,
 //!   so this one runs the hi-stencil simulator on the GPU's own captured light footprints (the
 //!   simulator agrees with the GPU at that size, `render --stats`). Culling is exact at every
-//!   size, so there is no error to trade: the trade is tile tests (the culling surface's work)
-//!   against fragments shaded.
+//!   size, so there is no error to trade, and the fragments shaded are the same at every size:
+//!   the trade is tile tests (the culling surface's work) against the pixels left in unculled
+//!   tiles (the per-pixel stencil test's work; an upper bound, as edge tiles are partly outside
+//!   the light's footprint).
 
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
@@ -59,7 +61,7 @@ impl SweepParam {
         match self {
             SweepParam::LutRes => ("lighting_ms", "mean error, 8-bit steps"),
             SweepParam::LightmapRes => ("alpha_ms", "mean error over alpha pixels, 8-bit steps"),
-            SweepParam::TileSize => ("tiles_tested", "fragments shaded"),
+            SweepParam::TileSize => ("tiles_tested", "pixels in unculled tiles"),
         }
     }
 }
@@ -200,7 +202,8 @@ pub fn run_sweep(
                     },
                     error: ImageError {
                         max: 0.0,
-                        mean: stats.fragments_shaded as f64,
+                        mean: ((stats.tiles_tested - stats.tiles_culled) * u64::from(tile * tile))
+                            as f64,
                         flip: 0.0,
                     },
                     extra: vec![
@@ -267,7 +270,7 @@ impl SweepReport {
     fn csv(&self) -> String {
         let (speed, _) = self.param.columns();
         let mut out = if self.param == SweepParam::TileSize {
-            "tile_size,tiles_tested".to_owned()
+            "tile_size,tiles_tested,unculled_tile_pixels".to_owned()
         } else {
             format!(
                 "{},{speed},{speed}_min,{speed}_max,error_max,error_mean,flip",
@@ -280,7 +283,7 @@ impl SweepReport {
         out.push('\n');
         for p in &self.points {
             if self.param == SweepParam::TileSize {
-                let _ = write!(out, "{},{}", p.setting, p.speed.median_ms);
+                let _ = write!(out, "{},{},{}", p.setting, p.speed.median_ms, p.error.mean);
             } else {
                 let _ = write!(
                     out,
@@ -312,6 +315,7 @@ impl SweepReport {
                 let mut v = json!({ "setting": p.setting });
                 if self.param == SweepParam::TileSize {
                     v["tiles_tested"] = json!(p.speed.median_ms);
+                    v["unculled_tile_pixels"] = json!(p.error.mean);
                 } else {
                     v[speed] = json!({"median": p.speed.median_ms, "min": p.speed.min_ms,
                                       "max": p.speed.max_ms});

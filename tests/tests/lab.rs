@@ -1,0 +1,182 @@
+//! The lab's runs end to end on lavapipe under the validation layer: `compare` at 64x64 with 2
+//! frames writes a report whose every JSON number is finite, whose markdown has the talk's
+//! columns, and whose plots are PNGs; sweeps write CSV, JSON and a Pareto PNG, and their error
+//! falls as the setting grows; calibration gives finite costs that `--costs` reads back into
+//! the adaptive technique.
+
+use histencil_lab::{calibrate, read_costs, run_compare, run_sweep, CompareSettings, SweepParam};
+use histencil_tests::{output_dir, with_validated_context};
+use histencil_vk::{Backend, Renderer};
+use serde_json::Value;
+use std::path::Path;
+
+/// Every number under `value` is finite; returns how many there are. Nulls are refused too.
+fn count_finite_numbers(value: &Value, at: &str) -> usize {
+    match value {
+        Value::Number(n) => {
+            let x = n.as_f64().unwrap_or(f64::NAN);
+            assert!(x.is_finite(), "{at} = {x}");
+            1
+        }
+        Value::Null => panic!("{at} is null"),
+        Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .map(|(i, v)| count_finite_numbers(v, &format!("{at}[{i}]")))
+            .sum(),
+        Value::Object(map) => map
+            .iter()
+            .map(|(k, v)| count_finite_numbers(v, &format!("{at}.{k}")))
+            .sum(),
+        Value::String(_) | Value::Bool(_) => 0,
+    }
+}
+
+fn assert_png(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
+        "{} is not a PNG",
+        path.display()
+    );
+    let image = image::load_from_memory(&bytes).expect("a decodable PNG");
+    assert!(image.width() > 100 && image.height() > 100);
+}
+
+fn read_json(path: &Path) -> Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).expect("valid JSON")
+}
+
+#[test]
+fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
+    let mut settings = CompareSettings::talk(64, 64, 2);
+    // Fewer light sizes than the command's seven keep the test short; each is a full run.
+    settings.light_sizes = vec![0.01, 0.1, 1.0];
+    let report = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
+    let dir = output_dir().join("compare");
+    let written = report.write(&dir).unwrap();
+    assert_eq!(written.len(), 5);
+
+    let json = read_json(&dir.join("report.json"));
+    let numbers = count_finite_numbers(&json, "report");
+    // 6 rows x 3 counts x (4 timing + 2 overhead + 3 error + 1) numbers at least.
+    assert!(numbers > 6 * 3 * 10, "{numbers} numbers");
+    let rows = json["rows"].as_array().unwrap();
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["technique"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "branching",
+            "stencil x360",
+            "stencil ps3",
+            "stencil native",
+            "lut",
+            "adaptive"
+        ]
+    );
+    for row in rows {
+        let cells = row["cells"].as_array().unwrap();
+        assert_eq!(cells.len(), 3);
+        for cell in cells {
+            assert!(cell["lighting"]["median_ms"].as_f64().unwrap() > 0.0);
+        }
+        assert_eq!(cells[0]["overhead_ms"].as_f64(), Some(0.0));
+    }
+    // The exact techniques stay within 1/255 of forward; the LUT within its stated tolerance.
+    for (row, name) in rows.iter().zip(names) {
+        let limit = if name == "lut" { 32.0 } else { 1.0 };
+        for cell in row["cells"].as_array().unwrap() {
+            let max = cell["error"]["max"].as_f64().unwrap();
+            assert!(max <= limit, "{name}: error max {max}");
+        }
+    }
+    assert_eq!(json["light_sizes"].as_array().unwrap().len(), 3);
+    assert_eq!(json["breakdown"].as_array().unwrap().len(), 3);
+    assert!(json["device"].as_str().unwrap().contains("llvmpipe") || !json["device"].is_null());
+
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for column in [
+        "| technique | 1 BRDF | 2 BRDFs | 3 BRDFs |",
+        "2 BRDFs branching",
+        "3 BRDFs stencil",
+    ] {
+        assert!(md.contains(column), "report.md lacks `{column}`");
+    }
+    for part in [
+        "setup",
+        "mask",
+        "render",
+        "cleanup",
+        "ms, +",
+        "Light size",
+        "FLIP",
+    ] {
+        assert!(md.contains(part), "report.md lacks `{part}`");
+    }
+    for plot in ["lighting.png", "light-size.png", "speed-vs-error.png"] {
+        assert_png(&dir.join(plot));
+    }
+}
+
+#[test]
+fn sweeps_write_csv_json_and_a_pareto_plot_and_error_falls() {
+    let cases = [
+        (SweepParam::LutRes, "default", vec![8, 32]),
+        (SweepParam::LightmapRes, "alpha", vec![8, 64]),
+        (SweepParam::TileSize, "default", vec![4, 16]),
+    ];
+    for (param, scene, values) in cases {
+        let scene = histencil_scene::embedded(scene).unwrap();
+        let report = with_validated_context(|ctx| {
+            run_sweep(ctx, scene, param, &values, 96, 64, 1, &mut |_, _| {}).unwrap()
+        });
+        let dir = output_dir().join(format!("sweep-{}", param.name()));
+        report.write(&dir).unwrap();
+        let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + values.len(), "{csv}");
+        let json = read_json(&dir.join("sweep.json"));
+        count_finite_numbers(&json, "sweep");
+        assert_png(&dir.join("pareto.png"));
+        let p = &report.points;
+        match param {
+            // Finer tables and lightmaps: less error.
+            SweepParam::LutRes | SweepParam::LightmapRes => {
+                assert!(p[1].error.mean < p[0].error.mean, "{}: {p:?}", param.name());
+            }
+            // Smaller tiles: more tile tests, fewer pixels left for the per-pixel test.
+            SweepParam::TileSize => {
+                assert!(p[0].speed.median_ms > p[1].speed.median_ms, "{p:?}");
+                assert!(p[0].error.mean < p[1].error.mean, "{p:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
+    let calibration = with_validated_context(|ctx| calibrate(ctx, 96, 64, 1, &mut |_| {}).unwrap());
+    let c = calibration.costs;
+    for x in [
+        c.pass_overhead_ms,
+        c.stencil_per_brdf_ms,
+        c.branch_tax_per_brdf_ms,
+        c.shade_ms,
+    ] {
+        assert!(x.is_finite() && x >= 0.0, "{c:?}");
+    }
+    assert!(c.shade_ms > 0.0, "{c:?}");
+    let path = output_dir().join("costs.json");
+    calibration.write(&path).unwrap();
+    let read = read_costs(&path).unwrap();
+    assert_eq!(read, c);
+    with_validated_context(|ctx| {
+        let scene = histencil_scene::embedded("brdfs-3").unwrap();
+        let mut renderer = Renderer::new(ctx, scene, 32, 32).unwrap();
+        assert_ne!(renderer.cost_model(Backend::Native), read);
+        renderer.set_cost_model(Some(read));
+        assert_eq!(renderer.cost_model(Backend::Native), read);
+    });
+}
