@@ -207,17 +207,32 @@ pub struct CompareReport {
 }
 
 impl CompareReport {
-    /// The smallest swept coverage from which stencil is faster than branching, interpolated
-    /// between the two sizes around the change (in log coverage); `None` if it never changes.
+    /// The coverage from which stencil stays faster than branching at every larger swept size:
+    /// interpolated (in log coverage) between the largest size where branching is still at least
+    /// as fast and the next. `None` when branching wins at the largest size; the smallest swept
+    /// coverage when stencil wins everywhere. Single points that flip within the timing noise
+    /// below a stencil-winning stretch do not move it.
     pub fn measured_crossover(&self) -> Option<f64> {
-        let gain = |p: &SizePoint| p.branching.median_ms - p.stencil.median_ms;
-        self.sizes.windows(2).find_map(|w| {
-            let (a, b) = (gain(&w[0]), gain(&w[1]));
-            (a <= 0.0 && b > 0.0).then(|| {
-                let t = -a / (b - a);
-                (w[0].coverage.ln() + t * (w[1].coverage.ln() - w[0].coverage.ln())).exp()
-            })
-        })
+        let gains: Vec<(f64, f64)> = self
+            .sizes
+            .iter()
+            .map(|p| (p.coverage, p.branching.median_ms - p.stencil.median_ms))
+            .collect();
+        stencil_wins_from(&gains)
+    }
+}
+
+/// See [`CompareReport::measured_crossover`]; `gains` are `(coverage, branching - stencil ms)`
+/// by increasing coverage.
+fn stencil_wins_from(gains: &[(f64, f64)]) -> Option<f64> {
+    match gains.iter().rposition(|g| g.1 <= 0.0) {
+        None => gains.first().map(|g| g.0),
+        Some(i) if i + 1 == gains.len() => None,
+        Some(i) => {
+            let ((ca, a), (cb, b)) = (gains[i], gains[i + 1]);
+            let t = -a / (b - a);
+            Some((ca.ln() + t * (cb.ln() - ca.ln())).exp())
+        }
     }
 }
 
@@ -357,4 +372,18 @@ fn breakdown(
         }
     }
     Ok(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stencil_wins_from;
+
+    #[test]
+    fn the_crossover_is_where_stencil_starts_to_win_for_good() {
+        assert_eq!(stencil_wins_from(&[(0.01, 1.0), (1.0, 2.0)]), Some(0.01));
+        assert_eq!(stencil_wins_from(&[(0.01, -1.0), (1.0, -2.0)]), None);
+        // Branching ahead by 1 ms at 1 %, stencil ahead by 1 ms at 100 %: halfway in log.
+        let x = stencil_wins_from(&[(0.001, 3.0), (0.01, -1.0), (1.0, 1.0)]).unwrap();
+        assert!((x - 0.1).abs() < 1e-12, "{x}");
+    }
 }

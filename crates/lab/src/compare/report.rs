@@ -193,7 +193,7 @@ impl CompareReport {
             .map_or("never".to_owned(), |x| format!("{:.2} %", x * 100.0));
         let _ = writeln!(
             md,
-            "\nStencil becomes faster than branching at {measured}; the adaptive technique's cost \
+            "\nStencil stays faster than branching from {measured}; the adaptive technique's cost \
              model ({}) puts the change at {model}.",
             if self.costs_calibrated {
                 "calibrated on this device"
