@@ -6,19 +6,29 @@ use histencil_lab::{CompareSettings, SweepParam};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
+/// What every lab run takes: the frame size, the timed frames and validation.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Timed frames per measurement (after one warm-up frame), at least 1.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..))]
+    frames: u64,
+    /// Run under the validation layer; any message fails the run.
+    #[arg(long)]
+    validate: bool,
+}
+
 #[derive(clap::Args)]
 pub struct CompareArgs {
     /// An embedded scene or a `.gltf` / `.glb` file; its objects' BRDFs are folded onto 1, 2
     /// and 3 models for the table's columns.
     #[arg(long, default_value = "huge-lights")]
     scene: String,
-    #[arg(long, default_value_t = 1280)]
-    width: u32,
-    #[arg(long, default_value_t = 720)]
-    height: u32,
-    /// Timed frames per cell (after one warm-up frame).
-    #[arg(long, default_value_t = 5)]
-    frames: usize,
+    #[command(flatten)]
+    run: RunArgs,
     /// Light sizes of the light-size sweep, in percent of the screen.
     #[arg(long, value_delimiter = ',', default_value = "0.1,0.3,1,3,10,30,100")]
     light_sizes: Vec<f64>,
@@ -29,9 +39,6 @@ pub struct CompareArgs {
     /// Output directory: report.md, report.json and PNG plots.
     #[arg(long, default_value = "out/compare")]
     out: PathBuf,
-    /// Run under the validation layer; any message fails the run.
-    #[arg(long)]
-    validate: bool,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -52,32 +59,20 @@ pub struct SweepArgs {
     /// Scene (default: `default` for lut-res and tile-size, `alpha` for lightmap-res).
     #[arg(long)]
     scene: Option<String>,
-    #[arg(long, default_value_t = 1280)]
-    width: u32,
-    #[arg(long, default_value_t = 720)]
-    height: u32,
-    #[arg(long, default_value_t = 5)]
-    frames: usize,
+    #[command(flatten)]
+    run: RunArgs,
     /// Output directory: sweep.csv, sweep.json, pareto.png.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
-    #[arg(long)]
-    validate: bool,
 }
 
 #[derive(clap::Args)]
 pub struct CalibrateArgs {
-    #[arg(long, default_value_t = 1280)]
-    width: u32,
-    #[arg(long, default_value_t = 720)]
-    height: u32,
-    #[arg(long, default_value_t = 5)]
-    frames: usize,
+    #[command(flatten)]
+    run: RunArgs,
     /// Where the costs go (read back by `--costs`).
     #[arg(long, default_value = "out/costs.json")]
     out: PathBuf,
-    #[arg(long)]
-    validate: bool,
 }
 
 /// A spinner with a message, or a bar when the number of steps is known.
@@ -94,9 +89,6 @@ fn progress_bar(steps: Option<u64>) -> ProgressBar {
 }
 
 pub fn compare(args: &CompareArgs) -> Result<()> {
-    if args.frames == 0 {
-        bail!("--frames must be at least 1");
-    }
     if let Some(bad) = args
         .light_sizes
         .iter()
@@ -104,7 +96,8 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     {
         bail!("--light-sizes: {bad} is not a percentage in (0, 100]");
     }
-    let mut settings = CompareSettings::talk(args.width, args.height, args.frames);
+    let mut settings =
+        CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
     settings.scene = histencil_scene::load_scene(&args.scene)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = args
@@ -112,7 +105,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
         .as_deref()
         .map(histencil_lab::read_costs)
         .transpose()?;
-    let report = on_device(args.validate, |ctx| {
+    let report = on_device(args.run.validate, |ctx| {
         let bar = progress_bar(None);
         let report = histencil_lab::run_compare(ctx, &settings, &mut |what| {
             bar.set_message(what.to_owned());
@@ -141,7 +134,7 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
     };
     let scene =
         histencil_scene::load_scene(args.scene.as_deref().unwrap_or(param.default_scene()))?;
-    let report = on_device(args.validate, |ctx| {
+    let report = on_device(args.run.validate, |ctx| {
         let bar = progress_bar(Some(values.len() as u64));
         bar.set_message(format!("{} on {}", param.name(), scene.name));
         let report = histencil_lab::run_sweep(
@@ -149,9 +142,9 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
             scene,
             param,
             &values,
-            args.width,
-            args.height,
-            args.frames,
+            args.run.width,
+            args.run.height,
+            args.run.frames as usize,
             &mut |done, _| bar.set_position(done as u64),
         );
         bar.finish_and_clear();
@@ -164,12 +157,18 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
 }
 
 pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
-    let calibration = on_device(args.validate, |ctx| {
+    let calibration = on_device(args.run.validate, |ctx| {
         let bar = progress_bar(None);
-        let c = histencil_lab::calibrate(ctx, args.width, args.height, args.frames, &mut |what| {
-            bar.set_message(what.to_owned());
-            bar.tick();
-        });
+        let c = histencil_lab::calibrate(
+            ctx,
+            args.run.width,
+            args.run.height,
+            args.run.frames as usize,
+            &mut |what| {
+                bar.set_message(what.to_owned());
+                bar.tick();
+            },
+        );
         bar.finish_and_clear();
         Ok(c?)
     })?;

@@ -17,7 +17,7 @@
 
 use crate::measure::{time_lighting, Timing, WARM_UP_FRAMES};
 use crate::variants::{light_size_scene, with_brdf_count};
-use crate::{write_file, LabError, Result};
+use crate::{LabError, Result};
 use histencil_scene::Scene;
 use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Renderer, Technique};
 use serde_json::{json, Value};
@@ -148,8 +148,7 @@ impl Calibration {
     }
 
     pub fn write(&self, path: &Path) -> Result<()> {
-        let text = serde_json::to_string_pretty(&self.json()).expect("JSON values serialise");
-        write_file(path, text.as_bytes())
+        crate::write_json(path, &self.json())
     }
 }
 

@@ -44,6 +44,20 @@ pub enum LabError {
 
 pub type Result<T, E = LabError> = std::result::Result<T, E>;
 
+/// Creates `dir` and its parents, naming it in the error.
+pub(crate) fn create_dir(dir: &std::path::Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| LabError::Write {
+        path: dir.display().to_string(),
+        problem: e.to_string(),
+    })
+}
+
+/// Writes `value` as pretty JSON to `path`.
+pub(crate) fn write_json(path: &std::path::Path, value: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(value).expect("JSON values serialise");
+    write_file(path, text.as_bytes())
+}
+
 /// Writes `bytes` to `path`, naming the path in the error.
 pub(crate) fn write_file(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
     std::fs::write(path, bytes).map_err(|e| LabError::Write {

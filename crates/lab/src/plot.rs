@@ -83,25 +83,7 @@ pub fn line_chart(path: &Path, title: &str, x: Axis, y: Axis, series: &[Series])
     let yr = range(all().map(|p| y.map(p.1)));
     draw_png(path, |root| {
         let text = text_available();
-        let mut builder = ChartBuilder::on(root);
-        builder
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(64);
-        if text {
-            builder.caption(title, (FONT, 22));
-        }
-        let mut chart = builder.build_cartesian_2d(xr, yr)?;
-        let x_fmt = |v: &f64| short(x.unmap(*v));
-        let y_fmt = |v: &f64| short(y.unmap(*v));
-        let mut mesh = chart.configure_mesh();
-        mesh.x_label_formatter(&x_fmt).y_label_formatter(&y_fmt);
-        if text {
-            mesh.x_desc(x.label).y_desc(y.label);
-        } else {
-            mesh.x_labels(0).y_labels(0);
-        }
-        mesh.draw()?;
+        let mut chart = axes(root, title, (&x, xr), (&y, yr))?;
         for (i, s) in series.iter().enumerate() {
             let colour = Palette99::pick(i).to_rgba();
             let points: Vec<(f64, f64)> =
@@ -145,25 +127,7 @@ pub fn pareto_chart(
     let yr = range(points.iter().map(|p| y.map(p.1)));
     draw_png(path, |root| {
         let text = text_available();
-        let mut builder = ChartBuilder::on(root);
-        builder
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(64);
-        if text {
-            builder.caption(title, (FONT, 22));
-        }
-        let mut chart = builder.build_cartesian_2d(xr, yr)?;
-        let x_fmt = |v: &f64| short(x.unmap(*v));
-        let y_fmt = |v: &f64| short(y.unmap(*v));
-        let mut mesh = chart.configure_mesh();
-        mesh.x_label_formatter(&x_fmt).y_label_formatter(&y_fmt);
-        if text {
-            mesh.x_desc(x.label).y_desc(y.label);
-        } else {
-            mesh.x_labels(0).y_labels(0);
-        }
-        mesh.draw()?;
+        let mut chart = axes(root, title, (&x, xr), (&y, yr))?;
         let mapped = |(px, py): (f64, f64)| (x.map(px), y.map(py));
         chart.draw_series(LineSeries::new(
             front.iter().copied().map(mapped),
@@ -200,6 +164,43 @@ fn short(v: f64) -> String {
     } else {
         format!("{}", (v * 1e3).round() / 1e3)
     }
+}
+
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The chart's caption, axes and grid over `x` and `y` (in mapped coordinates), with tick labels
+/// in the axes' own units; text only when a font is available.
+fn axes<'a, 'b>(
+    root: &'a Root<'b>,
+    title: &str,
+    (x, xr): (&Axis, std::ops::Range<f64>),
+    (y, yr): (&Axis, std::ops::Range<f64>),
+) -> std::result::Result<Chart<'a, 'b>, Box<dyn std::error::Error + 'static>> {
+    let text = text_available();
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .margin(16)
+        .x_label_area_size(44)
+        .y_label_area_size(64);
+    if text {
+        builder.caption(title, (FONT, 22));
+    }
+    let mut chart = builder.build_cartesian_2d(xr, yr)?;
+    let x_fmt = |v: &f64| short(x.unmap(*v));
+    let y_fmt = |v: &f64| short(y.unmap(*v));
+    let mut mesh = chart.configure_mesh();
+    mesh.x_label_formatter(&x_fmt).y_label_formatter(&y_fmt);
+    if text {
+        mesh.x_desc(x.label).y_desc(y.label);
+    } else {
+        mesh.x_labels(0).y_labels(0);
+    }
+    mesh.draw()?;
+    Ok(chart)
 }
 
 type Root<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;

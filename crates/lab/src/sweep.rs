@@ -230,15 +230,11 @@ pub fn run_sweep(
 impl SweepReport {
     /// Writes `sweep.csv`, `sweep.json` and `pareto.png` into `dir`; returns their paths.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        std::fs::create_dir_all(dir).map_err(|e| LabError::Write {
-            path: dir.display().to_string(),
-            problem: e.to_string(),
-        })?;
+        crate::create_dir(dir)?;
         let csv = dir.join("sweep.csv");
         write_file(&csv, self.csv().as_bytes())?;
         let js = dir.join("sweep.json");
-        let text = serde_json::to_string_pretty(&self.json()).expect("JSON values serialise");
-        write_file(&js, text.as_bytes())?;
+        crate::write_json(&js, &self.json())?;
         let png = dir.join("pareto.png");
         let (speed, error) = self.param.columns();
         let points: Vec<(f64, f64, String)> = self

@@ -18,15 +18,11 @@ impl CompareReport {
     /// Writes `report.md`, `report.json` and the [`PLOTS`] into `dir` (created if needed);
     /// returns the paths written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        std::fs::create_dir_all(dir).map_err(|e| crate::LabError::Write {
-            path: dir.display().to_string(),
-            problem: e.to_string(),
-        })?;
+        crate::create_dir(dir)?;
         let md = dir.join("report.md");
         write_file(&md, self.markdown().as_bytes())?;
         let js = dir.join("report.json");
-        let text = serde_json::to_string_pretty(&self.json()).expect("JSON values serialise");
-        write_file(&js, text.as_bytes())?;
+        crate::write_json(&js, &self.json())?;
         let plots: Vec<PathBuf> = PLOTS.iter().map(|p| dir.join(p)).collect();
         self.plot_lighting(&plots[0])?;
         self.plot_sizes(&plots[1])?;
