@@ -42,11 +42,11 @@ pub fn time_passes(
     for _ in 0..WARM_UP_FRAMES {
         renderer.render(technique, Readback::NONE)?;
     }
-    let mut samples = Vec::with_capacity(frames);
-    for _ in 0..frames.max(1) {
-        let timings = renderer.render(technique, Readback::NONE)?.timings;
-        samples.push(passes.iter().filter_map(|p| timings.pass_ms(p)).sum());
-    }
+    let samples = renderer
+        .measure_frames(technique, frames)?
+        .iter()
+        .map(|timings| passes.iter().filter_map(|p| timings.pass_ms(p)).sum())
+        .collect();
     Ok(Timing::from_samples(samples))
 }
 

@@ -823,11 +823,21 @@ impl<'c> Renderer<'c> {
 
     /// Renders `frames` frames without readback and returns the median of each timing.
     pub fn measure(&mut self, technique: Technique, frames: usize) -> Result<FrameTimings> {
-        let mut all = Vec::new();
-        for _ in 0..frames.max(1) {
-            all.push(self.render(technique, Readback::NONE)?.timings);
-        }
-        Ok(FrameTimings::median(&all))
+        Ok(FrameTimings::median(
+            &self.measure_frames(technique, frames)?,
+        ))
+    }
+
+    /// Renders `frames` frames (at least one) without readback and returns each frame's
+    /// timings, for callers that want the spread as well as the median.
+    pub fn measure_frames(
+        &mut self,
+        technique: Technique,
+        frames: usize,
+    ) -> Result<Vec<FrameTimings>> {
+        (0..frames.max(1))
+            .map(|_| Ok(self.render(technique, Readback::NONE)?.timings))
+            .collect()
     }
 }
 
