@@ -13,6 +13,17 @@ pub struct ImageError {
     pub flip: f64,
 }
 
+impl ImageError {
+    /// The larger of the two errors, measure by measure.
+    pub fn worst(self, other: ImageError) -> ImageError {
+        ImageError {
+            max: self.max.max(other.max),
+            mean: self.mean.max(other.mean),
+            flip: self.flip.max(other.flip),
+        }
+    }
+}
+
 /// `actual` against `reference` (the same size; alpha is ignored).
 pub fn image_error(actual: &RgbaImage, reference: &RgbaImage) -> ImageError {
     assert_eq!(

@@ -128,11 +128,7 @@ impl Row {
     pub fn worst_error(&self) -> ImageError {
         self.cells
             .iter()
-            .fold(ImageError::default(), |w, c| ImageError {
-                max: w.max.max(c.error.max),
-                mean: w.mean.max(c.error.mean),
-                flip: w.flip.max(c.error.flip),
-            })
+            .fold(ImageError::default(), |w, c| w.worst(c.error))
     }
 }
 
@@ -298,12 +294,7 @@ pub fn run_compare(
         let mut error = ImageError::default();
         for (i, technique) in size_techniques().into_iter().enumerate() {
             timings[i] = time_lighting(&mut renderer, technique, frames)?;
-            let e = image_error(&frame(&mut renderer, technique)?, &reference);
-            error = ImageError {
-                max: error.max.max(e.max),
-                mean: error.mean.max(e.mean),
-                flip: error.flip.max(e.flip),
-            };
+            error = error.worst(image_error(&frame(&mut renderer, technique)?, &reference));
         }
         sizes.push(SizePoint {
             coverage,
