@@ -362,22 +362,8 @@ fn print_alpha_error(
     technique: Technique,
     ldr: &image::RgbaImage,
 ) -> Result<()> {
-    let only_ldr = Readback {
-        ldr: true,
-        ..Readback::NONE
-    };
     let mode = renderer.alpha_mode();
-    renderer.set_alpha_mode(AlphaMode::Forward);
-    let forward = renderer.render(technique, only_ldr);
-    renderer.set_alpha_mode(mode);
-    let forward = forward?.images.ldr.expect("requested");
-    let (w, h) = ldr.dimensions();
-    let background = Renderer::new(ctx, renderer.scene().without_alpha(), w, h)?
-        .render(technique, only_ldr)?
-        .images
-        .ldr
-        .expect("requested");
-    let e = histencil_vk::masked_error(ldr, &forward, &background).expect("same sizes");
+    let e = histencil_lab::AlphaReference::render(ctx, renderer, technique)?.error(ldr);
     println!(
         "alpha error against forward ({mode:?}): mean {:.3}/255, max {}/255 over {} pixels",
         e.mean, e.max, e.pixels

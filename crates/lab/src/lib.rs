@@ -10,6 +10,7 @@
 //! - [`calibrate`]: this device's per-pass overhead, branch tax and shade cost, the
 //!   [`CostModel`](histencil_vk::CostModel) that the adaptive technique chooses with.
 
+mod alpha_reference;
 pub mod calibrate;
 pub mod compare;
 mod image_error;
@@ -18,6 +19,7 @@ mod plot;
 pub mod sweep;
 mod variants;
 
+pub use alpha_reference::AlphaReference;
 pub use calibrate::{calibrate, read_costs, Calibration};
 pub use compare::{run_compare, CompareReport, CompareSettings};
 pub use image_error::{image_error, ImageError};

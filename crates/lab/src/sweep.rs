@@ -15,7 +15,7 @@
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis};
-use crate::{write_file, LabError, Result};
+use crate::{write_file, AlphaReference, LabError, Result};
 use histencil_scene::Scene;
 use histencil_vk::{AlphaMode, Backend, Context, FlushPolicy, Renderer, Technique};
 use serde_json::{json, Value};
@@ -111,7 +111,6 @@ pub fn run_sweep(
         )));
     }
     let name = scene.name.clone();
-    let background = scene.without_alpha();
     let mut renderer = Renderer::new(ctx, scene, width, height)?;
     let mut points = Vec::new();
     match param {
@@ -137,12 +136,8 @@ pub fn run_sweep(
         }
         SweepParam::LightmapRes => {
             let technique = Technique::DEFERRED;
-            renderer.set_alpha_mode(AlphaMode::Forward);
-            let reference = frame(&mut renderer, technique)?;
             renderer.set_alpha_mode(AlphaMode::Lightmap);
-            let mut without = Renderer::new(ctx, background, width, height)?;
-            let background = frame(&mut without, technique)?;
-            drop(without);
+            let reference = AlphaReference::render(ctx, &mut renderer, technique)?;
             for (i, &side) in values.iter().enumerate() {
                 renderer.set_lightmap_resolution(Some(side))?;
                 let speed = time_passes(
@@ -152,9 +147,8 @@ pub fn run_sweep(
                     frames,
                 )?;
                 let lit = frame(&mut renderer, technique)?;
-                let masked = histencil_vk::masked_error(&lit, &reference, &background)
-                    .expect("frames of one size");
-                let whole = image_error(&lit, &reference);
+                let masked = reference.error(&lit);
+                let whole = image_error(&lit, &reference.forward);
                 let atlas = renderer
                     .lightmap_layout()?
                     .map_or(0, |layout| layout.atlas.size().0);

@@ -1,0 +1,38 @@
+//! What an alpha-lit frame is measured against.
+
+use crate::measure::frame;
+use crate::Result;
+use histencil_vk::{masked_error, AlphaMode, Context, MaskedError, Renderer, Technique};
+use image::RgbaImage;
+
+/// The frame with forward-lit alpha entities (the reference), and the scene without them: where
+/// the two differ is where the entities cover the frame.
+pub struct AlphaReference {
+    pub forward: RgbaImage,
+    pub background: RgbaImage,
+}
+
+impl AlphaReference {
+    /// Renders both with `technique` for the opaque scene; `renderer`'s alpha mode is left as it
+    /// was.
+    pub fn render(ctx: &Context, renderer: &mut Renderer, technique: Technique) -> Result<Self> {
+        let mode = renderer.alpha_mode();
+        renderer.set_alpha_mode(AlphaMode::Forward);
+        let forward = frame(renderer, technique);
+        renderer.set_alpha_mode(mode);
+        let forward = forward?;
+        let (w, h) = forward.dimensions();
+        let mut without = Renderer::new(ctx, renderer.scene().without_alpha(), w, h)?;
+        let background = frame(&mut without, technique)?;
+        Ok(Self {
+            forward,
+            background,
+        })
+    }
+
+    /// `lit`'s error over the pixels the alpha entities cover (`lit` is a frame of the same
+    /// renderer, so of the same size).
+    pub fn error(&self, lit: &RgbaImage) -> MaskedError {
+        masked_error(lit, &self.forward, &self.background).expect("frames of one renderer")
+    }
+}
