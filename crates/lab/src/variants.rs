@@ -44,8 +44,9 @@ pub fn with_brdf_count(scene: &Scene, count: usize) -> Scene {
     out
 }
 
-/// Screen coverage of a light at the wall, as the adaptive technique estimates it: the
-/// projected sphere's area over the screen's.
+/// The wall's distance from the eye and the vertical field of view it is seen with. A light's
+/// coverage is the disc its range sphere cuts from the wall over the visible wall's area (the
+/// adaptive technique's own estimate, the projected sphere, is a little larger).
 const WALL_DISTANCE: f32 = 10.0;
 const FOV_Y_DEGREES: f32 = 60.0;
 
