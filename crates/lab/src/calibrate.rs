@@ -18,7 +18,6 @@
 use crate::measure::{time_lighting, Timing, WARM_UP_FRAMES};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::{LabError, Result};
-use histencil_scene::Scene;
 use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Renderer, Technique};
 use serde_json::{json, Value};
 use std::path::Path;
@@ -48,7 +47,9 @@ pub fn calibrate(
 ) -> Result<Calibration> {
     let aspect = width as f32 / height as f32;
     let mut measurements = Vec::new();
-    let mut extra_per_light = |coverage: f64, technique: Technique| -> Result<(f64, f64)> {
+    // Per technique: (1-BRDF time, extra time per extra BRDF), per light. One renderer per BRDF
+    // count times every technique on it.
+    let mut per_light = |coverage: f64, techniques: &[Technique]| -> Result<Vec<(f64, f64)>> {
         let wall = light_size_scene(coverage, aspect);
         let lights = wall.lights.len() as f64;
         // Extra BRDFs each light touches, on average (small lights at the wall's edge miss one).
@@ -58,29 +59,29 @@ pub fn calibrate(
             .map(|l| wall.brdfs_lit_by(l).len() as f64)
             .sum::<f64>();
         let extra_brdfs = (touched / lights - 1.0).max(1e-6);
-        let mut times = [0.0; 2];
+        let mut times = vec![[0.0; 2]; techniques.len()];
         for (slot, brdfs) in [1, 3].into_iter().enumerate() {
-            let what = format!("{technique:?}, {brdfs} BRDF(s), coverage {coverage}");
-            progress(&what);
-            let timing = lighting_time(
-                ctx,
-                &with_brdf_count(&wall, brdfs),
-                width,
-                height,
-                technique,
-                frames,
-            )?;
-            times[slot] = timing.median_ms / lights;
-            measurements.push((what, timing));
+            let scene = with_brdf_count(&wall, brdfs);
+            let mut renderer = Renderer::new(ctx, scene, width, height)?;
+            for (t, technique) in techniques.iter().enumerate() {
+                let what = format!("{technique:?}, {brdfs} BRDF(s), coverage {coverage}");
+                progress(&what);
+                let timing = time_lighting(&mut renderer, *technique, frames)?;
+                times[t][slot] = timing.median_ms / lights;
+                measurements.push((what, timing));
+            }
         }
-        Ok((times[0], (times[1] - times[0]) / extra_brdfs))
+        Ok(times
+            .iter()
+            .map(|[one, three]| (*one, (three - one) / extra_brdfs))
+            .collect())
     };
     let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
     let stencil = Technique::Stencil { backend, flush };
     let branching = Technique::Branching { backend, flush };
-    let (shade, tax) = extra_per_light(1.0, branching)?;
-    let (_, a) = extra_per_light(1.0, stencil)?;
-    let (_, b) = extra_per_light(SMALL_COVERAGE, stencil)?;
+    let full = per_light(1.0, &[branching, stencil])?;
+    let ((shade, tax), (_, a)) = (full[0], full[1]);
+    let (_, b) = per_light(SMALL_COVERAGE, &[stencil])?[0];
     let per_brdf = ((a - b) / (1.0 - SMALL_COVERAGE)).max(0.0);
     let costs = CostModel {
         pass_overhead_ms: ((a - per_brdf) / 2.0).max(0.0),
@@ -96,18 +97,6 @@ pub fn calibrate(
         costs,
         measurements,
     })
-}
-
-fn lighting_time(
-    ctx: &Context,
-    scene: &Scene,
-    width: u32,
-    height: u32,
-    technique: Technique,
-    frames: usize,
-) -> Result<Timing> {
-    let mut renderer = Renderer::new(ctx, scene.clone(), width, height)?;
-    time_lighting(&mut renderer, technique, frames)
 }
 
 const FIELDS: [&str; 4] = [
