@@ -1,7 +1,7 @@
 //! `compare`, `sweep` and `calibrate`: the lab's runs with a progress bar.
 
 use crate::on_device;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context as _, Result};
 use histencil_lab::{CompareSettings, SweepParam};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -88,7 +88,29 @@ fn progress_bar(steps: Option<u64>) -> ProgressBar {
     }
 }
 
+/// Runs `body` under a spinner that shows the step it last reported.
+fn with_spinner<T>(body: impl FnOnce(&mut dyn FnMut(&str)) -> T) -> T {
+    let bar = progress_bar(None);
+    let out = body(&mut |what| {
+        bar.set_message(what.to_owned());
+        bar.tick();
+    });
+    bar.finish_and_clear();
+    out
+}
+
+/// Creates the output directory before a long run, so a bad `--out` fails at once.
+fn create_out_dir(dir: &std::path::Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+}
+
+/// The `--costs` file's cost model, if one was given.
+pub fn read_costs_arg(path: Option<&std::path::Path>) -> Result<Option<histencil_vk::CostModel>> {
+    Ok(path.map(histencil_lab::read_costs).transpose()?)
+}
+
 pub fn compare(args: &CompareArgs) -> Result<()> {
+    create_out_dir(&args.out)?;
     if let Some(bad) = args
         .light_sizes
         .iter()
@@ -100,19 +122,11 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
         CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
     settings.scene = histencil_scene::load_scene(&args.scene)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
-    settings.costs = args
-        .costs
-        .as_deref()
-        .map(histencil_lab::read_costs)
-        .transpose()?;
+    settings.costs = read_costs_arg(args.costs.as_deref())?;
     let report = on_device(args.run.validate, |ctx| {
-        let bar = progress_bar(None);
-        let report = histencil_lab::run_compare(ctx, &settings, &mut |what| {
-            bar.set_message(what.to_owned());
-            bar.tick();
-        });
-        bar.finish_and_clear();
-        Ok(report?)
+        Ok(with_spinner(|step| {
+            histencil_lab::run_compare(ctx, &settings, step)
+        })?)
     })?;
     for path in report.write(&args.out)? {
         println!("wrote {}", path.display());
@@ -122,6 +136,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
 }
 
 pub fn sweep(args: &SweepArgs) -> Result<()> {
+    create_out_dir(&args.out)?;
     let param = match args.param {
         ParamArg::LutRes => SweepParam::LutRes,
         ParamArg::LightmapRes => SweepParam::LightmapRes,
@@ -157,22 +172,19 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
 }
 
 pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    crate::check_writable(&args.out)?;
     let calibration = on_device(args.run.validate, |ctx| {
-        let bar = progress_bar(None);
-        let c = histencil_lab::calibrate(
-            ctx,
-            args.run.width,
-            args.run.height,
-            args.run.frames as usize,
-            &mut |what| {
-                bar.set_message(what.to_owned());
-                bar.tick();
-            },
-        );
-        bar.finish_and_clear();
+        let c = with_spinner(|step| {
+            histencil_lab::calibrate(
+                ctx,
+                args.run.width,
+                args.run.height,
+                args.run.frames as usize,
+                step,
+            )
+        });
         Ok(c?)
     })?;
-    crate::check_writable(&args.out)?;
     calibration.write(&args.out)?;
     let c = &calibration.costs;
     println!(

@@ -276,11 +276,7 @@ fn check_writable(path: &Path) -> Result<()> {
 
 fn render(args: &RenderArgs) -> Result<()> {
     let scene = histencil_scene::load_scene(&args.scene)?;
-    let costs = args
-        .costs
-        .as_deref()
-        .map(histencil_lab::read_costs)
-        .transpose()?;
+    let costs = lab::read_costs_arg(args.costs.as_deref())?;
     for path in [
         Some(&args.out),
         args.hdr.as_ref(),
