@@ -16,7 +16,11 @@ vec3 srgb_encode(vec3 linear) {
 }
 
 void main() {
-    vec3 c = texelFetch(hdr, ivec2(gl_FragCoord.xy), 0).rgb * frame.tonemap.x;
-    c = max(c, vec3(0.0));
+    vec3 c = texelFetch(hdr, ivec2(gl_FragCoord.xy), 0).rgb;
+    // Light beyond the f16 target saturates it to +inf (and +inf blended "over" by an opaque
+    // alpha entity is NaN): both are the brightest value there is, so they tonemap to white
+    // rather than to the 0 that an unorm conversion makes of NaN.
+    c = mix(min(c, vec3(65504.0)), vec3(65504.0), isnan(c));
+    c = max(c * frame.tonemap.x, vec3(0.0));
     out_color = vec4(srgb_encode(c / (1.0 + c)), 1.0);
 }

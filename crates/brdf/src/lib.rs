@@ -33,6 +33,6 @@ mod models;
 mod vector;
 
 pub use id::{BrdfId, UnknownBrdf};
-pub use model::{Brdf, BrdfError, MODEL_NAMES};
+pub use model::{ranges, Brdf, BrdfError, Range, MODEL_NAMES};
 pub use models::*;
 pub use vector::{normalize, Real, V3};

@@ -71,7 +71,7 @@ pub enum BrdfError {
     BadParam {
         model: &'static str,
         param: &'static str,
-        rule: &'static str,
+        rule: String,
         value: String,
     },
     #[error("{model}: give exactly one of {options}")]
@@ -103,7 +103,7 @@ impl<'a> Params<'a> {
         Ok(Self { model, map })
     }
 
-    fn optional(&self, param: &'static str, rule: Rule) -> Result<Option<f64>, BrdfError> {
+    fn optional(&self, param: &'static str, rule: Range) -> Result<Option<f64>, BrdfError> {
         let Some(value) = self.map.get(param) else {
             return Ok(None);
         };
@@ -121,7 +121,7 @@ impl<'a> Params<'a> {
         }
     }
 
-    fn required(&self, param: &'static str, rule: Rule) -> Result<f64, BrdfError> {
+    fn required(&self, param: &'static str, rule: Range) -> Result<f64, BrdfError> {
         self.optional(param, rule)?.ok_or(BrdfError::MissingParam {
             model: self.model,
             param,
@@ -131,8 +131,8 @@ impl<'a> Params<'a> {
     /// Exactly one of two spellings of the same quantity.
     fn one_of(
         &self,
-        (a, rule_a): (&'static str, Rule),
-        (b, rule_b): (&'static str, Rule),
+        (a, rule_a): (&'static str, Range),
+        (b, rule_b): (&'static str, Range),
         options: &'static str,
     ) -> Result<Result<f64, f64>, BrdfError> {
         match (self.optional(a, rule_a)?, self.optional(b, rule_b)?) {
@@ -146,36 +146,60 @@ impl<'a> Params<'a> {
     }
 }
 
-#[derive(Clone, Copy)]
-enum Rule {
-    NonNegative,
-    Positive,
-    Unit,
+/// The values a parameter accepts: every physically meaningful value, and no more than the f32
+/// (GLSL) spelling evaluates without overflow, so the CPU reference and the GPU agree on every
+/// accepted input. `brdf-eval`, glTF extras and [`Brdf::check`] (which `Scene::validate` calls)
+/// all hold parameters to these.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
 }
 
-impl Rule {
-    fn holds(self, x: f64) -> bool {
-        x.is_finite()
-            && match self {
-                Rule::NonNegative => x >= 0.0,
-                Rule::Positive => x > 0.0,
-                Rule::Unit => (0.0..=1.0).contains(&x),
-            }
+impl Range {
+    const fn new(min: f64, max: f64) -> Self {
+        Self { min, max }
     }
 
-    fn text(self) -> &'static str {
-        match self {
-            Rule::NonNegative => "a finite number >= 0",
-            Rule::Positive => "a finite number > 0",
-            Rule::Unit => "a number in [0, 1]",
+    /// Whether `x` is a finite number inside the range.
+    pub fn holds(self, x: f64) -> bool {
+        x.is_finite() && (self.min..=self.max).contains(&x)
+    }
+
+    fn text(self) -> String {
+        if self.max == f64::MAX {
+            format!("a finite number >= {}", self.min)
+        } else {
+            format!("a number in [{}, {}]", self.min, self.max)
         }
     }
 }
 
+/// The parameter ranges, one per quantity (README "BRDF parameters").
+pub mod ranges {
+    use super::Range;
+    /// Albedo of Lambert, Oren-Nayar and skin: energy conservation bounds it by 1.
+    pub const RHO: Range = Range::new(0.0, 1.0);
+    /// Oren-Nayar's slope deviation in radians; beyond pi/2 it has no geometric meaning.
+    pub const SIGMA: Range = Range::new(0.0, std::f64::consts::FRAC_PI_2);
+    /// Blinn-Phong and Kajiya-Kay exponents: the hard cases test up to 1e4; beyond it the f32
+    /// power of a cosine rounded to 1 no longer tracks the f64 lobe.
+    pub const EXPONENT: Range = Range::new(0.0, 1e4);
+    /// GGX alpha and perceptual roughness (the GPU clamps alpha below at 1e-3).
+    pub const ROUGHNESS: Range = Range::new(0.0, 1.0);
+    /// Reflectances and weights: Fresnel f0 and f90, Kajiya-Kay kd and ks.
+    pub const UNIT: Range = Range::new(0.0, 1.0);
+    /// Skin curvature in 1/mm: the hard cases test 0 to 1e6 (a radius of 1 nm).
+    pub const CURVATURE_PER_MM: Range = Range::new(0.0, 1e6);
+    /// Skin radius in mm, the reciprocal of the curvature's range.
+    pub const RADIUS_MM: Range = Range::new(1e-6, f64::MAX);
+}
+
 impl Brdf {
     /// Parses a model name and its parameters, e.g. `ggx` with `{"perceptual_roughness": 0.5}`.
+    /// Every parameter is held to its [`ranges`].
     pub fn parse(name: &str, params: &Map<String, Value>) -> Result<Self, BrdfError> {
-        use Rule::*;
+        use ranges::*;
         let model = MODEL_NAMES
             .iter()
             .copied()
@@ -184,17 +208,14 @@ impl Brdf {
         let p = |accepted: &[&str]| Params::new(model, params, accepted);
         Ok(match model {
             "lambert" => Brdf::Lambert {
-                rho: p(&["rho"])?.required("rho", NonNegative)?,
+                rho: p(&["rho"])?.required("rho", RHO)?,
             },
             "blinn_phong" => Brdf::BlinnPhong {
-                exponent: p(&["n"])?.required("n", NonNegative)?,
+                exponent: p(&["n"])?.required("n", EXPONENT)?,
             },
             "oren_nayar_full" | "oren_nayar_qualitative" => {
                 let p = p(&["rho", "sigma"])?;
-                let (rho, sigma) = (
-                    p.required("rho", NonNegative)?,
-                    p.required("sigma", NonNegative)?,
-                );
+                let (rho, sigma) = (p.required("rho", RHO)?, p.required("sigma", SIGMA)?);
                 if model == "oren_nayar_full" {
                     Brdf::OrenNayarFull { rho, sigma }
                 } else {
@@ -205,41 +226,87 @@ impl Brdf {
                 let p = p(&["alpha", "perceptual_roughness", "f0", "f90"])?;
                 let alpha = p
                     .one_of(
-                        ("alpha", NonNegative),
-                        ("perceptual_roughness", NonNegative),
+                        ("alpha", ROUGHNESS),
+                        ("perceptual_roughness", ROUGHNESS),
                         "`alpha` or `perceptual_roughness`",
                     )?
                     .unwrap_or_else(|roughness| roughness * roughness);
                 Brdf::Ggx {
                     alpha,
-                    f0: p.optional("f0", Unit)?.unwrap_or(0.04),
-                    f90: p.optional("f90", Unit)?.unwrap_or(1.0),
+                    f0: p.optional("f0", UNIT)?.unwrap_or(0.04),
+                    f90: p.optional("f90", UNIT)?.unwrap_or(1.0),
                 }
             }
             "kajiya_kay" => {
                 let p = p(&["kd", "ks", "p"])?;
                 Brdf::KajiyaKay {
-                    kd: p.required("kd", NonNegative)?,
-                    ks: p.required("ks", NonNegative)?,
-                    p: p.required("p", NonNegative)?,
+                    kd: p.required("kd", UNIT)?,
+                    ks: p.required("ks", UNIT)?,
+                    p: p.required("p", EXPONENT)?,
                 }
             }
             "penner_skin" => {
                 let p = p(&["rho", "radius_mm", "curvature_per_mm"])?;
                 let curvature_per_mm = p
                     .one_of(
-                        ("curvature_per_mm", NonNegative),
-                        ("radius_mm", Positive),
+                        ("curvature_per_mm", CURVATURE_PER_MM),
+                        ("radius_mm", RADIUS_MM),
                         "`curvature_per_mm` or `radius_mm`",
                     )?
                     .unwrap_or_else(|radius| 1.0 / radius);
                 Brdf::PennerSkin {
-                    rho: p.required("rho", NonNegative)?,
+                    rho: p.required("rho", RHO)?,
                     curvature_per_mm,
                 }
             }
             _ => unreachable!("every name in MODEL_NAMES is handled"),
         })
+    }
+
+    /// Each parameter with its name and range.
+    fn named_params(&self) -> Vec<(&'static str, f64, Range)> {
+        use ranges::*;
+        match *self {
+            Brdf::Lambert { rho } => vec![("rho", rho, RHO)],
+            Brdf::BlinnPhong { exponent } => vec![("n", exponent, EXPONENT)],
+            Brdf::OrenNayarFull { rho, sigma } | Brdf::OrenNayarQualitative { rho, sigma } => {
+                vec![("rho", rho, RHO), ("sigma", sigma, SIGMA)]
+            }
+            Brdf::Ggx { alpha, f0, f90 } => vec![
+                ("alpha", alpha, ROUGHNESS),
+                ("f0", f0, UNIT),
+                ("f90", f90, UNIT),
+            ],
+            Brdf::KajiyaKay { kd, ks, p } => {
+                vec![("kd", kd, UNIT), ("ks", ks, UNIT), ("p", p, EXPONENT)]
+            }
+            Brdf::PennerSkin {
+                rho,
+                curvature_per_mm,
+            } => vec![
+                ("rho", rho, RHO),
+                ("curvature_per_mm", curvature_per_mm, CURVATURE_PER_MM),
+            ],
+        }
+    }
+
+    /// Holds every parameter to its [`ranges`]: what [`Brdf::parse`] accepts, for a `Brdf` built
+    /// in code.
+    pub fn check(&self) -> Result<(), BrdfError> {
+        let model = self.name();
+        match self
+            .named_params()
+            .into_iter()
+            .find(|(_, x, range)| !range.holds(*x))
+        {
+            Some((param, value, range)) => Err(BrdfError::BadParam {
+                model,
+                param,
+                rule: range.text(),
+                value: value.to_string(),
+            }),
+            None => Ok(()),
+        }
     }
 
     /// The model, without its parameters: what the stencil and the G-buffer store.
@@ -362,13 +429,86 @@ mod tests {
         assert!(msg(parse("phong", json!({}))).contains("unknown BRDF `phong`"));
         assert!(msg(parse("lambert", json!({"rho": 1, "x": 2}))).contains("unknown parameter `x`"));
         assert!(msg(parse("lambert", json!({}))).contains("missing parameter `rho`"));
-        assert!(msg(parse("lambert", json!({"rho": -1}))).contains(">= 0"));
+        assert!(msg(parse("lambert", json!({"rho": -1}))).contains("in [0, 1]"));
         assert!(msg(parse("lambert", json!({"rho": "a"}))).contains("\"a\""));
         assert!(msg(parse(
             "ggx",
             json!({"alpha": 0.1, "perceptual_roughness": 0.1})
         ))
         .contains("exactly one"));
-        assert!(msg(parse("penner_skin", json!({"rho": 1, "radius_mm": 0}))).contains("> 0"));
+        assert!(msg(parse("penner_skin", json!({"rho": 1, "radius_mm": 0}))).contains(">= 0.000001"));
+    }
+
+    /// Every model, every parameter: values just inside the range parse and pass `check`, values
+    /// past either end (and those only finite in f64) are refused by both, naming the parameter.
+    #[test]
+    fn every_parameter_is_held_to_its_range() {
+        let msg = |r: Result<Brdf, BrdfError>| r.unwrap_err().to_string();
+        let base = |name: &str| match name {
+            "lambert" => json!({"rho": 0.5}),
+            "blinn_phong" => json!({"n": 16}),
+            "ggx" => json!({"alpha": 0.1, "f0": 0.04, "f90": 1}),
+            "kajiya_kay" => json!({"kd": 0.5, "ks": 0.5, "p": 40}),
+            "penner_skin" => json!({"rho": 1, "curvature_per_mm": 0.5}),
+            _ => json!({"rho": 1, "sigma": 0.3}),
+        };
+        for name in MODEL_NAMES {
+            let params = base(name);
+            let keys: Vec<String> = params.as_object().unwrap().keys().cloned().collect();
+            for key in keys {
+                let brdf = parse(name, params.clone()).unwrap();
+                let range = brdf
+                    .named_params()
+                    .into_iter()
+                    .find(|(p, ..)| *p == key)
+                    .unwrap()
+                    .2;
+                for ok in [range.min, range.max.min(1e300)] {
+                    let mut p = params.clone();
+                    p[&key] = json!(ok);
+                    let parsed = parse(name, p).unwrap_or_else(|e| panic!("{name} {key}={ok}: {e}"));
+                    parsed.check().unwrap();
+                    let f32_params = parsed.packed_params().map(|x| x as f32);
+                    assert!(f32_params.iter().all(|x| x.is_finite()), "{name} {key}={ok}");
+                }
+                let hostile = [
+                    -1e-300, -1.0, 1e39, 1e300, f64::MAX, range.max * 1.0001 + 1e-9,
+                ];
+                for bad in hostile.into_iter().filter(|x| !range.holds(*x)) {
+                    let mut p = params.clone();
+                    p[&key] = json!(bad);
+                    let err = msg(parse(name, p));
+                    assert!(err.contains(&format!("`{key}`")), "{name} {key}={bad}: {err}");
+                    let mut built = brdf;
+                    set_param(&mut built, &key, bad);
+                    let err = built.check().unwrap_err().to_string();
+                    assert!(err.contains(&format!("`{key}`")), "{name} {key}={bad}: {err}");
+                }
+            }
+        }
+        // radius 1e-300 would be a curvature of 1e300, an f32 infinity.
+        assert!(msg(parse("penner_skin", json!({"rho": 1, "radius_mm": 1e-300}))).contains("radius_mm"));
+    }
+
+    fn set_param(brdf: &mut Brdf, key: &str, x: f64) {
+        match (brdf, key) {
+            (Brdf::Lambert { rho }, "rho")
+            | (Brdf::OrenNayarFull { rho, .. }, "rho")
+            | (Brdf::OrenNayarQualitative { rho, .. }, "rho")
+            | (Brdf::PennerSkin { rho, .. }, "rho") => *rho = x,
+            (Brdf::BlinnPhong { exponent }, "n") => *exponent = x,
+            (Brdf::OrenNayarFull { sigma, .. }, "sigma")
+            | (Brdf::OrenNayarQualitative { sigma, .. }, "sigma") => *sigma = x,
+            (Brdf::Ggx { alpha, .. }, "alpha") => *alpha = x,
+            (Brdf::Ggx { f0, .. }, "f0") => *f0 = x,
+            (Brdf::Ggx { f90, .. }, "f90") => *f90 = x,
+            (Brdf::KajiyaKay { kd, .. }, "kd") => *kd = x,
+            (Brdf::KajiyaKay { ks, .. }, "ks") => *ks = x,
+            (Brdf::KajiyaKay { p, .. }, "p") => *p = x,
+            (Brdf::PennerSkin { curvature_per_mm, .. }, "curvature_per_mm") => {
+                *curvature_per_mm = x
+            }
+            (b, k) => panic!("{b:?} has no {k}"),
+        }
     }
 }

@@ -114,9 +114,9 @@ impl ParticleSystem {
 }
 
 /// What is wrong with `opacity` and `material` shared by both kinds of entity, if anything.
-pub(crate) fn alpha_problem(opacity: f32, material: &Material) -> Option<&'static str> {
+pub(crate) fn alpha_problem(opacity: f32, material: &Material) -> Option<String> {
     if !(0.0..=1.0).contains(&opacity) {
-        return Some("opacity must lie in [0, 1]");
+        return Some("opacity must lie in [0, 1]".to_owned());
     }
     crate::types::material_problem(material)
 }

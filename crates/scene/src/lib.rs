@@ -17,4 +17,7 @@ pub use import::{
 pub use mesh::{
     light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, Mesh, Vertex, BOX_UV_INSET,
 };
-pub use types::{Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape};
+pub use types::{
+    unit_direction, Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape,
+    MAX_LIGHT_COLOR, MAX_TINT, MAX_WORLD_COORDINATE, RANGE_CAP_PER_EXTENT,
+};

@@ -176,20 +176,59 @@ pub enum SceneError {
     },
 }
 
+/// The largest magnitude of a world coordinate (object bounds, particles, lights, the camera).
+/// Beyond it f32 cannot place a light volume against the G-buffer (its spacing there is a whole
+/// unit), and squared distances in the light code approach f32's range.
+pub const MAX_WORLD_COORDINATE: f32 = 1e7;
+
+/// The largest tint component. Base colours are in `[0, 1]`; the slack keeps artistic
+/// over-brightening while `tint * brdf * light` stays finite in f32.
+pub const MAX_TINT: f32 = 1e3;
+
+/// The largest light colour component (radiance scale, intensity folded in): glTF suns reach
+/// 1e5 lux. With [`MAX_TINT`] and the steepest accepted BRDF the light code stays finite in f32
+/// (what exceeds the f16 HDR target saturates to white in the tonemap).
+pub const MAX_LIGHT_COLOR: f32 = 1e12;
+
+/// A light's range is capped at this many times the scene's extent (see
+/// [`Scene::normalise_lights`]): there the range window `(1 - (d/r)^4)^2` is exactly 1 in f32 at
+/// every distance the scene holds, so the cap changes no pixel, and the volume stays finite.
+pub const RANGE_CAP_PER_EXTENT: f32 = 1e3;
+
 /// What is wrong with a material, if anything.
-pub(crate) fn material_problem(m: &Material) -> Option<&'static str> {
-    if !finite3(m.tint) || m.tint.min_element() < 0.0 {
-        Some("tint must be finite and non-negative")
-    } else if !m
-        .brdf
-        .packed_params()
-        .iter()
-        .all(|p| p.is_finite() && *p >= 0.0)
-    {
-        Some("BRDF parameters must be finite and non-negative")
+pub(crate) fn material_problem(m: &Material) -> Option<String> {
+    if !finite3(m.tint) || m.tint.min_element() < 0.0 || m.tint.max_element() > MAX_TINT {
+        Some(format!(
+            "tint must be finite, in [0, {MAX_TINT}] per channel, got {}",
+            m.tint
+        ))
     } else {
-        None
+        m.brdf.check().err().map(|e| e.to_string())
     }
+}
+
+/// Whether every coordinate of the box lies within [`MAX_WORLD_COORDINATE`].
+fn inside_world((lo, hi): (Vec3, Vec3)) -> bool {
+    let limit = Vec3::splat(MAX_WORLD_COORDINATE);
+    lo.is_finite() && hi.is_finite() && lo.abs().cmple(limit).all() && hi.abs().cmple(limit).all()
+}
+
+fn outside_world_problem(bounds: (Vec3, Vec3)) -> Option<String> {
+    (!inside_world(bounds)).then(|| {
+        format!(
+            "lies outside the supported world range (coordinates within +-{MAX_WORLD_COORDINATE:e}): \
+             bounds {} to {}",
+            bounds.0, bounds.1
+        )
+    })
+}
+
+/// `v` scaled to unit length, computed in f64 after dividing by the largest component, so
+/// vectors of any finite non-zero length (1e-40 or 1e38) normalise; `None` for zero or
+/// non-finite ones.
+pub fn unit_direction(v: Vec3) -> Option<Vec3> {
+    histencil_brdf::normalize(v.to_array().map(f64::from))
+        .map(|u| Vec3::from_array(u.map(|x| x as f32)))
 }
 
 /// What is wrong with an imported mesh, if anything: it must be a non-empty triangle list with
@@ -224,9 +263,74 @@ fn mesh_problem(mesh: &Mesh) -> Option<&'static str> {
     None
 }
 
-fn transform_problem(transform: &Mat4) -> Option<&'static str> {
+fn transform_problem(transform: &Mat4) -> Option<String> {
     (!transform.is_finite() || transform.determinant() == 0.0)
-        .then_some("transform must be finite and invertible")
+        .then(|| "transform must be finite and invertible".to_owned())
+}
+
+fn camera_problem(c: &Camera) -> Option<String> {
+    let inside = |p: Vec3| inside_world((p, p));
+    let ok = inside(c.eye)
+        && inside(c.target)
+        && finite3(c.up)
+        && c.fov_y_radians > 0.0
+        && c.fov_y_radians < 3.0
+        && c.near > 0.0
+        && c.far > c.near
+        && c.far.is_finite()
+        && unit_direction(c.target - c.eye)
+            .zip(unit_direction(c.up))
+            .is_some_and(|(forward, up)| forward.cross(up).length() > 1e-6);
+    (!ok).then(|| {
+        format!(
+            "needs eye and target within +-{MAX_WORLD_COORDINATE:e}, a finite up not parallel to \
+             the view, 0 < fov < 3 rad, 0 < near < far: {c:?}"
+        )
+    })
+}
+
+fn light_problem(l: &Light) -> Option<String> {
+    let problem = |p: &str| Some(p.to_owned());
+    if !finite3(l.position) || !finite3(l.color) || !l.radius.is_finite() {
+        return problem("position, colour and radius must be finite (no NaN or Inf)");
+    }
+    if l.color.min_element() < 0.0 || l.color.max_element() > MAX_LIGHT_COLOR {
+        return Some(format!(
+            "colour must be in [0, {MAX_LIGHT_COLOR:e}] per channel, got {}",
+            l.color
+        ));
+    }
+    if l.is_local() && !inside_world((l.position, l.position)) {
+        return Some(format!(
+            "position {} lies outside the supported world range (+-{MAX_WORLD_COORDINATE:e})",
+            l.position
+        ));
+    }
+    match l.kind {
+        LightKind::Point => {}
+        LightKind::Spot {
+            direction,
+            inner_angle,
+            outer_angle,
+        } => {
+            if unit_direction(direction).is_none() {
+                return problem("spot direction must be a finite non-zero vector");
+            }
+            let max = 80f32.to_radians();
+            if !(inner_angle >= 0.0 && inner_angle < outer_angle && outer_angle <= max) {
+                return problem("spot angles need 0 <= inner < outer <= 80 degrees");
+            }
+        }
+        LightKind::Directional { direction } => {
+            if unit_direction(direction).is_none() {
+                return problem("directional direction must be a finite non-zero vector");
+            }
+        }
+    }
+    if l.is_local() && l.radius <= 0.0 {
+        return problem("radius must be positive (zero-size lights light nothing)");
+    }
+    None
 }
 
 fn finite3(v: Vec3) -> bool {
@@ -237,62 +341,9 @@ impl Scene {
     /// Checks everything a renderer relies on: finite numbers, positive light ranges, spot angles,
     /// a sane camera. Returns the first problem found.
     pub fn validate(&self) -> Result<(), SceneError> {
-        let c = &self.camera;
-        let camera_ok = finite3(c.eye)
-            && finite3(c.target)
-            && finite3(c.up)
-            && c.fov_y_radians > 0.0
-            && c.fov_y_radians < 3.0
-            && c.near > 0.0
-            && c.far > c.near
-            && c.far.is_finite()
-            && (c.target - c.eye).length() > 0.0
-            && (c.target - c.eye).cross(c.up).length() > 0.0;
-        if !camera_ok {
-            return Err(SceneError::BadCamera(format!(
-                "needs finite eye/target/up (not parallel), 0 < fov < 3 rad, 0 < near < far: {c:?}"
-            )));
-        }
         for (index, l) in self.lights.iter().enumerate() {
-            let bad = |problem: &str| SceneError::BadLight {
-                index,
-                problem: problem.to_owned(),
-            };
-            if !finite3(l.position) || !finite3(l.color) || !l.radius.is_finite() {
-                return Err(bad(
-                    "position, colour and radius must be finite (no NaN or Inf)",
-                ));
-            }
-            if l.color.min_element() < 0.0 {
-                return Err(bad("colour must not be negative"));
-            }
-            match l.kind {
-                LightKind::Point => {}
-                LightKind::Spot {
-                    direction,
-                    inner_angle,
-                    outer_angle,
-                } => {
-                    if !finite3(direction) || direction.length() == 0.0 {
-                        return Err(bad("spot direction must be a finite non-zero vector"));
-                    }
-                    let max = 80f32.to_radians();
-                    if !(inner_angle >= 0.0 && inner_angle < outer_angle && outer_angle <= max) {
-                        return Err(bad("spot angles need 0 <= inner < outer <= 80 degrees"));
-                    }
-                }
-                LightKind::Directional { direction } => {
-                    if !finite3(direction) || direction.length() == 0.0 {
-                        return Err(bad(
-                            "directional direction must be a finite non-zero vector",
-                        ));
-                    }
-                }
-            }
-            if l.is_local() && l.radius <= 0.0 {
-                return Err(bad(
-                    "radius must be positive (zero-size lights light nothing)",
-                ));
+            if let Some(problem) = light_problem(l) {
+                return Err(SceneError::BadLight { index, problem });
             }
         }
         for (index, mesh) in self.meshes.iter().enumerate() {
@@ -303,42 +354,94 @@ impl Scene {
         for (index, o) in self.objects.iter().enumerate() {
             let problem = self
                 .shape_problem(o.shape)
-                .or(transform_problem(&o.transform))
-                .or(material_problem(&o.material));
+                .or_else(|| transform_problem(&o.transform))
+                .or_else(|| outside_world_problem(o.world_bounds()))
+                .or_else(|| material_problem(&o.material));
             if let Some(problem) = problem {
                 return Err(SceneError::BadObject {
                     index,
                     name: o.name.clone(),
-                    problem: problem.to_owned(),
+                    problem,
                 });
             }
         }
-        let bad_alpha = |kind, index, name: &str, problem: &str| SceneError::BadAlphaEntity {
+        let bad_alpha = |kind, index, name: &str, problem: String| SceneError::BadAlphaEntity {
             kind,
             index,
             name: name.to_owned(),
-            problem: problem.to_owned(),
+            problem,
         };
         for (index, o) in self.alpha_objects.iter().enumerate() {
             let problem = self
                 .shape_problem(o.shape)
-                .or(transform_problem(&o.transform))
-                .or(alpha_problem(o.opacity, &o.material));
+                .or_else(|| transform_problem(&o.transform))
+                .or_else(|| outside_world_problem(o.world_bounds()))
+                .or_else(|| alpha_problem(o.opacity, &o.material));
             if let Some(problem) = problem {
                 return Err(bad_alpha("alpha object", index, &o.name, problem));
             }
         }
         for (index, p) in self.particle_systems.iter().enumerate() {
-            if let Some(problem) = p.problem().or(alpha_problem(p.opacity, &p.material)) {
+            let problem = p
+                .problem()
+                .map(str::to_owned)
+                .or_else(|| outside_world_problem(p.world_bounds()))
+                .or_else(|| alpha_problem(p.opacity, &p.material));
+            if let Some(problem) = problem {
                 return Err(bad_alpha("particle system", index, &p.name, problem));
             }
         }
-        Ok(())
+        // Last: a camera computed from bad content (a glTF without one is framed on its
+        // bounds) would otherwise take the blame for it.
+        camera_problem(&self.camera).map_or(Ok(()), |p| Err(SceneError::BadCamera(p)))
     }
 
-    fn shape_problem(&self, shape: Shape) -> Option<&'static str> {
+    /// The box holding every object, alpha entity, local light and the eye.
+    pub fn extent_bounds(&self) -> (Vec3, Vec3) {
+        let boxes = self
+            .objects
+            .iter()
+            .map(Object::world_bounds)
+            .chain(self.alpha_objects.iter().map(|o| o.world_bounds()))
+            .chain(self.particle_systems.iter().map(|p| p.world_bounds()))
+            .chain(
+                self.lights
+                    .iter()
+                    .filter(|l| l.is_local())
+                    .map(|l| (l.position, l.position)),
+            )
+            .chain(std::iter::once((self.camera.eye, self.camera.eye)));
+        boxes
+            .reduce(|(lo, hi), (l, h)| (lo.min(l), hi.max(h)))
+            .expect("the eye is always there")
+    }
+
+    /// Brings every light into the form the GPU evaluates exactly as the CPU does, changing no
+    /// pixel: directions become unit vectors (computed in f64, so any finite non-zero length
+    /// works), and a local light's range is capped at [`RANGE_CAP_PER_EXTENT`] times the
+    /// scene's extent (a range of 1e38 would overflow its volume's f32 transform; at the cap its
+    /// window is already exactly 1 everywhere in the scene). [`Scene::validate`] first.
+    pub fn normalise_lights(&mut self) {
+        let (lo, hi) = self.extent_bounds();
+        let cap = (hi - lo).length().max(1e-3) * RANGE_CAP_PER_EXTENT;
+        for light in &mut self.lights {
+            if light.is_local() {
+                light.radius = light.radius.min(cap);
+            }
+            match &mut light.kind {
+                LightKind::Point => {}
+                LightKind::Spot { direction, .. } | LightKind::Directional { direction } => {
+                    *direction = unit_direction(*direction).unwrap_or(*direction);
+                }
+            }
+        }
+    }
+
+    fn shape_problem(&self, shape: Shape) -> Option<String> {
         match shape {
-            Shape::Mesh(i) if i as usize >= self.meshes.len() => Some("mesh index out of range"),
+            Shape::Mesh(i) if i as usize >= self.meshes.len() => {
+                Some("mesh index out of range".to_owned())
+            }
             _ => None,
         }
     }

@@ -224,9 +224,12 @@ pub struct Renderer<'c> {
 
 impl<'c> Renderer<'c> {
     /// Validates the scene and the resolution, then builds everything a frame needs.
-    pub fn new(ctx: &'c Context, scene: Scene, width: u32, height: u32) -> Result<Self> {
-        scene.validate()?;
+    pub fn new(ctx: &'c Context, mut scene: Scene, width: u32, height: u32) -> Result<Self> {
+        // The resolution first: a scene built for a zero-sized view (a lab wall) would otherwise
+        // take the blame for it.
         let extent = check_extent(ctx, width, height)?;
+        scene.validate()?;
+        scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
         let stencil_layout = StencilLayout::new(brdfs.len().max(1) as u32, 0)?;
         let object_slots = scene

@@ -18,6 +18,10 @@
 
 mod buffers;
 mod material;
+mod uv_layout;
+
+pub use buffers::MAX_IMPORT_BYTES;
+use buffers::ReadLimit;
 
 pub use material::{material_from_gltf, MaterialError};
 
@@ -25,6 +29,7 @@ use crate::{
     AlphaObject, Camera, Light, LightKind, Mesh, Object, Scene, SceneError, Shape, Vertex,
 };
 use glam::{Mat4, Vec3};
+use gltf::accessor::{DataType, Dimensions};
 use gltf::khr_lights_punctual::Kind;
 use std::collections::HashMap;
 use std::path::Path;
@@ -32,7 +37,8 @@ use std::path::Path;
 /// Why a glTF file could not become a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum ImportError {
-    #[error("cannot read {path}: {problem}")]
+    /// `problem` names the path.
+    #[error("{problem}")]
     Io { path: String, problem: String },
     #[error("not a valid glTF file: {0}")]
     Parse(String),
@@ -79,10 +85,12 @@ pub fn load_scene(spec: &str) -> Result<Scene, ImportError> {
 
 /// Reads and imports a `.gltf` or `.glb` file; external buffers are read next to it.
 pub fn load_gltf(path: &Path) -> Result<Scene, ImportError> {
-    let bytes = std::fs::read(path).map_err(|e| ImportError::Io {
-        path: path.display().to_string(),
-        problem: e.to_string(),
-    })?;
+    let bytes = buffers::read_regular_file(path, ReadLimit::AtMost(MAX_IMPORT_BYTES)).map_err(
+        |problem| ImportError::Io {
+            path: path.display().to_string(),
+            problem,
+        },
+    )?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -129,6 +137,7 @@ pub fn import_gltf(
         None => framing_camera(&scene),
     };
     scene.validate()?;
+    scene.normalise_lights();
     Ok(scene)
 }
 
@@ -253,13 +262,25 @@ fn read_primitive(
         .get(&gltf::Semantic::Positions)
         .ok_or("has no POSITION attribute")?;
     let checked = [
-        Some(positions_accessor),
+        Some(positions_accessor.clone()),
         primitive.get(&gltf::Semantic::Normals),
         primitive.get(&gltf::Semantic::TexCoords(0)),
         primitive.indices(),
     ];
     for accessor in checked.iter().flatten() {
         buffers::check_accessor(accessor)?;
+    }
+    check_attribute_type("POSITION", &positions_accessor, &[DataType::F32], Dimensions::Vec3)?;
+    if let Some(normals) = primitive.get(&gltf::Semantic::Normals) {
+        check_attribute_type("NORMAL", &normals, &[DataType::F32], Dimensions::Vec3)?;
+    }
+    if let Some(uvs) = primitive.get(&gltf::Semantic::TexCoords(0)) {
+        let types = [DataType::F32, DataType::U8, DataType::U16];
+        check_attribute_type("TEXCOORD_0", &uvs, &types, Dimensions::Vec2)?;
+    }
+    if let Some(indices) = primitive.indices() {
+        let types = [DataType::U8, DataType::U16, DataType::U32];
+        check_attribute_type("indices", &indices, &types, Dimensions::Scalar)?;
     }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let positions: Vec<Vec3> = reader
@@ -281,8 +302,17 @@ fn read_primitive(
         return Err("an index is out of range".into());
     }
     let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
-    if needs_uv && uvs.is_none() {
-        return Err("an alphaMode BLEND primitive needs TEXCOORD_0 for its lightmap".into());
+    if needs_uv {
+        let uvs = uvs
+            .as_ref()
+            .ok_or("an alphaMode BLEND primitive needs TEXCOORD_0 for its lightmap")?;
+        if uvs.len() != positions.len() {
+            return Err("TEXCOORD_0 and POSITION counts differ".into());
+        }
+        let points: Vec<[f32; 3]> = positions.iter().map(|p| p.to_array()).collect();
+        if let Some(problem) = uv_layout::layout_problem(&points, &indices, uvs) {
+            return Err(format!("alphaMode BLEND: {problem}"));
+        }
     }
     let normals: Option<Vec<Vec3>> = reader
         .read_normals()
@@ -333,6 +363,41 @@ fn read_primitive(
     Ok((
         mesh,
         Mat4::from_translation(centre) * Mat4::from_scale(half),
+    ))
+}
+
+/// Holds an attribute to the types glTF 2.0 allows it (without `KHR_mesh_quantization`, which
+/// histencil does not take): the reader would otherwise read other bytes as floats. Integer
+/// texture coordinates must be normalised.
+fn check_attribute_type(
+    semantic: &str,
+    accessor: &gltf::Accessor,
+    types: &[DataType],
+    dimensions: Dimensions,
+) -> Result<(), String> {
+    let data_type = accessor.data_type();
+    let integer_uv = semantic.starts_with("TEXCOORD") && data_type != DataType::F32;
+    let normalised_ok = accessor.normalized() == integer_uv;
+    if types.contains(&data_type) && accessor.dimensions() == dimensions && normalised_ok {
+        return Ok(());
+    }
+    Err(format!(
+        "{semantic} (accessor {}) is {:?} {:?}{}; glTF 2.0 allows {} {:?}{}",
+        accessor.index(),
+        accessor.dimensions(),
+        data_type,
+        if accessor.normalized() { " normalized" } else { "" },
+        types
+            .iter()
+            .map(|t| format!("{t:?}"))
+            .collect::<Vec<_>>()
+            .join(" or "),
+        dimensions,
+        if semantic.starts_with("TEXCOORD") {
+            " (integers normalized)"
+        } else {
+            ""
+        }
     ))
 }
 
