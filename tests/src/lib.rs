@@ -1,6 +1,8 @@
 //! Helpers for histencil's end-to-end GPU tests: a validated context, rendering, and image
 //! comparison that writes `-actual`, `-expected` and `-difference` PNGs when a check fails.
 
+pub mod gltf_builder;
+
 use histencil_scene::Scene;
 use histencil_vk::{Context, ContextDesc, Frame, Readback, Renderer, Technique};
 use image::RgbaImage;

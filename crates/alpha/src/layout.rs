@@ -60,14 +60,12 @@ pub const ATLAS_PADDING: u32 = 1;
 
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LayoutError {
-    #[error("lightmap resolution {0} is out of range (2..=4096 texels a side)")]
+    #[error("lightmap resolution {0} is out of range (2..={max} texels a side)", max = MAX_FORCED_SIDE)]
     BadResolution(u32),
-    #[error("the lightmap atlas is full even at {side}x{side} texels with every region halved down to {min}: {source}", min = MIN_SIDE)]
-    AtlasFull {
-        side: u32,
-        #[source]
-        source: AtlasError,
-    },
+    /// `reason` is in the message, so it is not also the error's source (a chain would
+    /// print it twice).
+    #[error("the lightmap atlas is full even at {side}x{side} texels with every region halved down to {min}: {reason}", min = MIN_SIDE)]
+    AtlasFull { side: u32, reason: AtlasError },
 }
 
 /// Diameter in pixels that a sphere of `radius` at `centre` covers on a `viewport_height`-pixel
@@ -164,9 +162,16 @@ pub fn entities(scene: &Scene) -> impl Iterator<Item = EntityKey> {
 }
 
 /// The forced lightmap sides [`plan_layout`] and the renderer take.
-const FORCED_SIDES: std::ops::RangeInclusive<u32> = 2..=4096;
+/// Largest atlas side a renderer tries before regions are halved: 4096^2 texels is 256 MiB per
+/// f32 atlas, and every Vulkan 1.3 device allows 4096-texel images.
+pub const MAX_ATLAS_SIDE: u32 = 4096;
 
-/// Checks a forced lightmap side (2..=4096 texels).
+/// The largest forced side: one region of it, with its guard band on both sides, fills the
+/// largest atlas. (4096 itself cannot fit a 4096-texel atlas once the guard band is added.)
+pub const MAX_FORCED_SIDE: u32 = MAX_ATLAS_SIDE - 2 * ATLAS_PADDING;
+const FORCED_SIDES: std::ops::RangeInclusive<u32> = 2..=MAX_FORCED_SIDE;
+
+/// Checks a forced lightmap side (2..=[`MAX_FORCED_SIDE`] texels).
 ///
 /// # Errors
 /// [`LayoutError::BadResolution`] outside the range.
@@ -184,7 +189,7 @@ pub fn check_forced_side(side: u32) -> Result<(), LayoutError> {
 /// which were).
 ///
 /// # Errors
-/// [`LayoutError::BadResolution`] for a forced side outside 2..=4096, and
+/// [`LayoutError::BadResolution`] for a forced side outside 2..=[`MAX_FORCED_SIDE`], and
 /// [`LayoutError::AtlasFull`] when the entities do not fit even halved.
 pub fn plan_layout(
     scene: &Scene,
@@ -204,7 +209,7 @@ pub fn plan_layout(
         let downgrade = side >= max_side;
         match pack(&shapes, side, downgrade) {
             Ok(layout) => return Ok(layout),
-            Err(source) if downgrade => return Err(LayoutError::AtlasFull { side, source }),
+            Err(reason) if downgrade => return Err(LayoutError::AtlasFull { side, reason }),
             Err(_) => side = (side * 2).min(max_side),
         }
     }
@@ -231,7 +236,14 @@ fn pack(
         let (entity, shape) = shapes[i];
         let (w, h) = (shape.tiles * shape.tile_width, shape.tile_height);
         let allocation = if downgrade && shape.downgradable {
-            atlas.allocate_downgrading(w, h, MIN_SIDE.min(w.max(h)))?
+            // A row of slices can be wider than the whole atlas: halve it until it could fit
+            // (the allocation below halves further while there is no room).
+            let (mut w, mut h) = (w, h);
+            let min_side = MIN_SIDE.min(w.max(h));
+            while w.max(h) + 2 * ATLAS_PADDING > side && w.max(h) / 2 >= min_side {
+                (w, h) = (w.div_ceil(2), h.div_ceil(2));
+            }
+            atlas.allocate_downgrading(w, h, min_side)?
         } else {
             atlas.allocate(w, h)?
         };
@@ -244,7 +256,7 @@ fn pack(
                 tile_height: region.height,
                 ..shape
             },
-            downgraded: allocation.downgraded(),
+            downgraded: (region.width, region.height) != (w, h),
         });
     }
     Ok(LightmapLayout {
@@ -321,5 +333,24 @@ mod tests {
         assert!(matches!(err, LayoutError::AtlasFull { .. }), "{err}");
         let bad = plan_layout(&s, 720, Some(1), 256).err();
         assert_eq!(bad, Some(LayoutError::BadResolution(1)));
+    }
+
+    /// The documented largest side fits one entity (every layout kind), and one more does not
+    /// parse.
+    #[test]
+    fn the_largest_forced_side_fits() {
+        for name in ["alpha", "dust", "ribbon", "volume"] {
+            let mut s = histencil_scene::embedded(name).unwrap();
+            s.alpha_objects.truncate(1);
+            s.particle_systems
+                .truncate(usize::from(s.alpha_objects.is_empty()));
+            let layout = plan_layout(&s, 720, Some(MAX_FORCED_SIDE), MAX_ATLAS_SIDE)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(layout.regions.len(), 1);
+            let r = layout.regions[0];
+            assert_eq!(r.downgraded, r.shape.tiles > 1, "{name}: {r:?}");
+        }
+        assert!(check_forced_side(MAX_FORCED_SIDE + 1).is_err());
+        assert!(check_forced_side(1).is_err());
     }
 }

@@ -26,7 +26,7 @@ pub use atlas::{Allocation, Atlas, AtlasError, Region, RegionId};
 pub use layout::{
     bounding_sphere, check_forced_side, dust_grid, entities, plan_layout, projected_diameter,
     region_shape, EntityKey, EntityRegion, LayoutError, LightmapLayout, RegionShape, ATLAS_PADDING,
-    START_ATLAS_SIDE,
+    MAX_ATLAS_SIDE, MAX_FORCED_SIDE, START_ATLAS_SIDE,
 };
 pub use probes::{back_to_front, camera_axes, fit_frame, probe_point, ProbeFrame};
 pub use sizing::{side_for_coverage, MAX_SIDE, MIN_SIDE, PIXELS_PER_TEXEL};

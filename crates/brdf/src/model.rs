@@ -436,7 +436,9 @@ mod tests {
             json!({"alpha": 0.1, "perceptual_roughness": 0.1})
         ))
         .contains("exactly one"));
-        assert!(msg(parse("penner_skin", json!({"rho": 1, "radius_mm": 0}))).contains(">= 0.000001"));
+        assert!(
+            msg(parse("penner_skin", json!({"rho": 1, "radius_mm": 0}))).contains(">= 0.000001")
+        );
     }
 
     /// Every model, every parameter: values just inside the range parse and pass `check`, values
@@ -466,28 +468,45 @@ mod tests {
                 for ok in [range.min, range.max.min(1e300)] {
                     let mut p = params.clone();
                     p[&key] = json!(ok);
-                    let parsed = parse(name, p).unwrap_or_else(|e| panic!("{name} {key}={ok}: {e}"));
+                    let parsed =
+                        parse(name, p).unwrap_or_else(|e| panic!("{name} {key}={ok}: {e}"));
                     parsed.check().unwrap();
                     let f32_params = parsed.packed_params().map(|x| x as f32);
-                    assert!(f32_params.iter().all(|x| x.is_finite()), "{name} {key}={ok}");
+                    assert!(
+                        f32_params.iter().all(|x| x.is_finite()),
+                        "{name} {key}={ok}"
+                    );
                 }
                 let hostile = [
-                    -1e-300, -1.0, 1e39, 1e300, f64::MAX, range.max * 1.0001 + 1e-9,
+                    -1e-300,
+                    -1.0,
+                    1e39,
+                    1e300,
+                    f64::MAX,
+                    range.max * 1.0001 + 1e-9,
                 ];
                 for bad in hostile.into_iter().filter(|x| !range.holds(*x)) {
                     let mut p = params.clone();
                     p[&key] = json!(bad);
                     let err = msg(parse(name, p));
-                    assert!(err.contains(&format!("`{key}`")), "{name} {key}={bad}: {err}");
+                    assert!(
+                        err.contains(&format!("`{key}`")),
+                        "{name} {key}={bad}: {err}"
+                    );
                     let mut built = brdf;
                     set_param(&mut built, &key, bad);
                     let err = built.check().unwrap_err().to_string();
-                    assert!(err.contains(&format!("`{key}`")), "{name} {key}={bad}: {err}");
+                    assert!(
+                        err.contains(&format!("`{key}`")),
+                        "{name} {key}={bad}: {err}"
+                    );
                 }
             }
         }
         // radius 1e-300 would be a curvature of 1e300, an f32 infinity.
-        assert!(msg(parse("penner_skin", json!({"rho": 1, "radius_mm": 1e-300}))).contains("radius_mm"));
+        assert!(
+            msg(parse("penner_skin", json!({"rho": 1, "radius_mm": 1e-300}))).contains("radius_mm")
+        );
     }
 
     fn set_param(brdf: &mut Brdf, key: &str, x: f64) {
@@ -505,9 +524,12 @@ mod tests {
             (Brdf::KajiyaKay { kd, .. }, "kd") => *kd = x,
             (Brdf::KajiyaKay { ks, .. }, "ks") => *ks = x,
             (Brdf::KajiyaKay { p, .. }, "p") => *p = x,
-            (Brdf::PennerSkin { curvature_per_mm, .. }, "curvature_per_mm") => {
-                *curvature_per_mm = x
-            }
+            (
+                Brdf::PennerSkin {
+                    curvature_per_mm, ..
+                },
+                "curvature_per_mm",
+            ) => *curvature_per_mm = x,
             (b, k) => panic!("{b:?} has no {k}"),
         }
     }

@@ -7,7 +7,7 @@
 //! number and id, and does not stop the others.
 
 use anyhow::{bail, Context as _, Result};
-use histencil_brdf::{Brdf, V3};
+use histencil_brdf::{normalize, Brdf, V3};
 use std::io::{Read, Write};
 
 /// One parsed row: its id, BRDF and directions `[N, T, V, L]`.
@@ -170,10 +170,10 @@ pub fn evaluate_cpu(rows: &[Row]) -> Vec<[f64; 3]> {
 /// The GLSL spelling of every row, on `ctx`'s device.
 pub fn evaluate_gpu(ctx: &histencil_vk::Context, rows: &[Row]) -> Result<Vec<[f64; 3]>> {
     let mut evaluator = histencil_vk::BrdfEvaluator::new(ctx)?;
-    let input: Vec<_> = rows
-        .iter()
-        .map(|r| (r.brdf, r.dirs.map(|d| d.map(|x| x as f32))))
-        .collect();
+    // Directions are normalised in f64 first: a finite f64 vector (1e300, 1e-320) need not be
+    // one in f32, and every model depends only on the directions.
+    let unit = |d: V3<f64>| normalize(d).map_or([0.0; 3], |u| u.map(|x| x as f32));
+    let input: Vec<_> = rows.iter().map(|r| (r.brdf, r.dirs.map(unit))).collect();
     let values = evaluator.evaluate(ctx, &input);
     evaluator.destroy(ctx);
     Ok(values?.into_iter().map(|v| v.map(f64::from)).collect())

@@ -1,7 +1,7 @@
 //! `compare`, `sweep` and `calibrate`: the lab's runs with a progress bar.
 
 use crate::on_device;
-use anyhow::{bail, Context as _, Result};
+use anyhow::{bail, Result};
 use histencil_lab::{CompareSettings, SweepParam};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -99,18 +99,13 @@ fn with_spinner<T>(body: impl FnOnce(&mut dyn FnMut(&str)) -> T) -> T {
     out
 }
 
-/// Creates the output directory before a long run, so a bad `--out` fails at once.
-fn create_out_dir(dir: &std::path::Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
-}
-
 /// The `--costs` file's cost model, if one was given.
 pub fn read_costs_arg(path: Option<&std::path::Path>) -> Result<Option<histencil_vk::CostModel>> {
     Ok(path.map(histencil_lab::read_costs).transpose()?)
 }
 
 pub fn compare(args: &CompareArgs) -> Result<()> {
-    create_out_dir(&args.out)?;
+    histencil_vk::check_output_dir(&args.out)?;
     if let Some(bad) = args
         .light_sizes
         .iter()
@@ -120,7 +115,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     }
     let mut settings =
         CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
-    settings.scene = histencil_scene::load_scene(&args.scene)?;
+    settings.scene = crate::load_scene_arg(&args.scene)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;
     let report = on_device(args.run.validate, |ctx| {
@@ -136,7 +131,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
 }
 
 pub fn sweep(args: &SweepArgs) -> Result<()> {
-    create_out_dir(&args.out)?;
+    histencil_vk::check_output_dir(&args.out)?;
     let param = match args.param {
         ParamArg::LutRes => SweepParam::LutRes,
         ParamArg::LightmapRes => SweepParam::LightmapRes,
@@ -147,8 +142,7 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
     } else {
         args.values.clone()
     };
-    let scene =
-        histencil_scene::load_scene(args.scene.as_deref().unwrap_or(param.default_scene()))?;
+    let scene = crate::load_scene_arg(args.scene.as_deref().unwrap_or(param.default_scene()))?;
     let report = on_device(args.run.validate, |ctx| {
         let bar = progress_bar(Some(values.len() as u64));
         bar.set_message(format!("{} on {}", param.name(), scene.name));
@@ -172,7 +166,7 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
 }
 
 pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
-    crate::check_writable(&args.out)?;
+    histencil_vk::check_output_file(&args.out)?;
     let calibration = on_device(args.run.validate, |ctx| {
         let c = with_spinner(|step| {
             histencil_lab::calibrate(

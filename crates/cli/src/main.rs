@@ -5,7 +5,7 @@ use clap::{Parser, Subcommand};
 use histencil_vk::{
     AlphaMode, Backend, Context, ContextDesc, FlushPolicy, Readback, Renderer, Technique,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod brdf_eval;
@@ -106,7 +106,8 @@ struct RenderArgs {
     /// point per entity: the classic CPU light probe).
     #[arg(long, value_enum, default_value = "lightmap")]
     alpha: AlphaArg,
-    /// Lightmap side in texels for every alpha entity (2..=4096); default: from screen coverage
+    /// Lightmap side in texels for every alpha entity (2..=4094: one region and its guard band
+    /// fill the largest atlas, 4096); default: from screen coverage
     /// (8 to 128 texels).
     #[arg(long)]
     lightmap_resolution: Option<u32>,
@@ -255,27 +256,21 @@ fn parse_byte(text: &str) -> Result<u8, String> {
     parsed.map_err(|_| format!("`{text}` is not a byte (0-255 or 0x00-0xFF)"))
 }
 
-/// Fails early, with the path in the message, when an output cannot be written.
-fn check_writable(path: &Path) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create directory {}", dir.display()))?;
-    if path.is_dir() {
-        bail!("{} is a directory", path.display());
+/// The scene `--scene` names, with a warning on stderr when it has no lights: its image is
+/// black (every technique lights only), which is correct but looks like a failure.
+pub(crate) fn load_scene_arg(spec: &str) -> Result<histencil_scene::Scene> {
+    let scene = histencil_scene::load_scene(spec)?;
+    if scene.lights.is_empty() {
+        eprintln!(
+            "histencil: warning: scene `{spec}` has no lights, so every technique renders it \
+             black (glTF lights come from KHR_lights_punctual)"
+        );
     }
-    std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(())
+    Ok(scene)
 }
 
 fn render(args: &RenderArgs) -> Result<()> {
-    let scene = histencil_scene::load_scene(&args.scene)?;
+    let scene = load_scene_arg(&args.scene)?;
     let costs = lab::read_costs_arg(args.costs.as_deref())?;
     for path in [
         Some(&args.out),
@@ -285,7 +280,7 @@ fn render(args: &RenderArgs) -> Result<()> {
     .into_iter()
     .flatten()
     {
-        check_writable(path)?;
+        histencil_vk::check_output_file(path)?;
     }
     on_device(args.validate, |ctx| {
         let technique = args.technique();
@@ -417,6 +412,7 @@ fn on_device<T>(validate: bool, body: impl FnOnce(&Context) -> Result<T>) -> Res
 }
 
 fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
+    histencil_vk::check_output_file(&args.out)?;
     let input = std::fs::File::open(&args.cases)
         .with_context(|| format!("cannot read {}", args.cases.display()))?;
     let (rows, errors) =
@@ -431,10 +427,9 @@ fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
             true,
         ),
     };
-    check_writable(&args.out)?;
-    let out = std::fs::File::create(&args.out)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
-    brdf_eval::write_results(std::io::BufWriter::new(out), &rows, &values, as_f32)?;
+    let mut out = Vec::new();
+    brdf_eval::write_results(&mut out, &rows, &values, as_f32)?;
+    histencil_vk::write_atomically(&args.out, &out)?;
     println!("wrote {} ({} rows)", args.out.display(), rows.len());
     if !errors.is_empty() {
         bail!("{} row(s) could not be evaluated", errors.len());

@@ -201,3 +201,231 @@ fn brdf_eval_agrees_between_cpu_and_gpu_and_reports_bad_rows() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// No segment of a one-line error (split at `: `) says the same thing twice.
+fn assert_says_each_thing_once(stderr: &str) {
+    let segments: Vec<&str> = stderr.trim().split(": ").filter(|s| s.len() > 8).collect();
+    for (i, s) in segments.iter().enumerate() {
+        assert!(
+            !segments[i + 1..].contains(s),
+            "`{s}` said twice in {stderr}"
+        );
+    }
+}
+
+/// Failing runs of every command that writes files leave nothing behind (no file, empty or
+/// partial, no folder), and their one-line message names the cause once.
+#[test]
+fn failed_runs_leave_no_outputs_and_name_their_cause_once() {
+    let root = std::env::temp_dir().join(format!("histencil-no-outputs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let at = |p: &str| root.join(p).to_str().unwrap().to_owned();
+    let (png, exr, stencil, dir) = (at("a/x.png"), at("b/x.exr"), at("c/s.png"), at("report"));
+    let costs = at("d/costs.json");
+    let missing = at("missing.csv");
+    let runs: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "render",
+                "--width",
+                "0",
+                "--height",
+                "8",
+                "--out",
+                &png,
+                "--hdr",
+                &exr,
+                "--dump-stencil",
+                &stencil,
+            ],
+            "bad resolution 0x8",
+        ),
+        (
+            vec![
+                "render",
+                "--technique",
+                "lut",
+                "--lut-resolution",
+                "0",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--out",
+                &png,
+                "--hdr",
+                &exr,
+            ],
+            "LUT resolution 0 is out of range",
+        ),
+        (
+            vec![
+                "render",
+                "--scene",
+                "alpha",
+                "--lightmap-resolution",
+                "4095",
+                "--width",
+                "8",
+                "--height",
+                "8",
+                "--out",
+                &png,
+            ],
+            "lightmap resolution 4095 is out of range (2..=4094",
+        ),
+        (
+            vec!["compare", "--width", "0", "--out", &dir],
+            "bad resolution 0x720",
+        ),
+        (
+            vec![
+                "sweep", "--param", "lut-res", "--values", "1", "--width", "8", "--height", "8",
+                "--frames", "1", "--out", &dir,
+            ],
+            "LUT resolution 1 is out of range",
+        ),
+        (
+            vec!["calibrate", "--width", "0", "--out", &costs],
+            "bad resolution 0x720",
+        ),
+        (
+            vec!["brdf-eval", "--cases", &missing, "--out", &costs],
+            "missing.csv",
+        ),
+    ];
+    for (args, cause) in runs {
+        let (ok, _, stderr) = histencil(&args);
+        assert!(!ok, "{args:?} succeeded");
+        assert!(
+            stderr.contains(cause),
+            "{args:?}: expected `{cause}` in {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_says_each_thing_once(&stderr);
+        let left: Vec<_> = std::fs::read_dir(&root)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .filter(|n| n != "missing.csv")
+            .collect();
+        assert!(left.is_empty(), "{args:?} left {left:?}");
+    }
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// Directions of any finite length (1e300, 1e-320, both only finite in f64) evaluate on the GPU
+/// as on the CPU: they are normalised in f64 before they become f32.
+#[test]
+fn brdf_eval_takes_directions_of_any_finite_length_on_both_devices() {
+    let dir = std::env::temp_dir().join(format!("histencil-brdf-extreme-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = dir.join("cases.csv");
+    let mut text = String::from("id,brdf,params,N,T,V,L\n");
+    let models = [
+        ("lambert", r#"{""rho"": 0.8}"#),
+        ("ggx", r#"{""alpha"": 0.3}"#),
+        ("oren_nayar_full", r#"{""rho"": 0.8, ""sigma"": 0.4}"#),
+        ("kajiya_kay", r#"{""kd"": 0.5, ""ks"": 0.5, ""p"": 20}"#),
+    ];
+    for (m, (name, params)) in models.iter().enumerate() {
+        for (s, scale) in ["1e300", "1e-320", "1e-39", "1e38", "1"].iter().enumerate() {
+            // Each component written with the scale's exponent: "2" at "1e300" is "2e300".
+            let comp = |x: &str| {
+                if *scale == "1" {
+                    x.to_owned()
+                } else {
+                    format!("{x}{}", &scale[1..])
+                }
+            };
+            let (n, t, vv, l) = (
+                format!("{};{};{}", comp("0"), comp("0"), comp("1")),
+                format!("{};{};{}", comp("1"), comp("0"), comp("0")),
+                format!("{};{};{}", comp("2"), comp("1"), comp("9")),
+                format!("{};{};{}", comp("-3"), comp("1"), comp("8")),
+            );
+            text += &format!("m{m}s{s},{name},\"{params}\",{n},{t},{vv},{l}\n");
+        }
+    }
+    std::fs::write(&cases, text).unwrap();
+    let mut outputs = vec![];
+    for device in ["cpu", "gpu"] {
+        let out = dir.join(format!("{device}.csv"));
+        let (ok, _, stderr) = histencil(&[
+            "brdf-eval",
+            "--cases",
+            cases.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--device",
+            device,
+            "--validate",
+        ]);
+        assert!(ok, "{device}: {stderr}");
+        outputs.push(std::fs::read_to_string(out).unwrap());
+    }
+    let values = |text: &str| -> Vec<(String, f64)> {
+        text.lines()
+            .skip(1)
+            .map(|l| {
+                let (id, v) = l.split_once(',').unwrap();
+                (id.to_owned(), v.parse().unwrap())
+            })
+            .collect()
+    };
+    let (cpu, gpu) = (values(&outputs[0]), values(&outputs[1]));
+    assert_eq!(cpu.len(), 20);
+    for ((id, c), (_, g)) in cpu.iter().zip(&gpu) {
+        assert!(c.is_finite() && *c > 0.0, "{id}: cpu {c}");
+        assert!((c - g).abs() <= 1e-4 * c.abs(), "{id}: cpu {c} vs gpu {g}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A glTF without lights renders (black, correctly) and says why on stderr.
+#[test]
+fn a_scene_without_lights_is_announced() {
+    let dir = std::env::temp_dir().join(format!("histencil-no-lights-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // One triangle: 3 positions (36 bytes) as a base64 data URI.
+    let floats: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut uri = String::from("data:application/octet-stream;base64,");
+    for chunk in floats.chunks(3) {
+        let n = (u32::from(chunk[0]) << 16) | (u32::from(chunk[1]) << 8) | u32::from(chunk[2]);
+        for k in (0..4).rev() {
+            uri.push(B64[(n >> (6 * k) & 63) as usize] as char);
+        }
+    }
+    let gltf = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+        "nodes": [{{"mesh": 0}}], "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+        "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                        "min": [0, 0, 0], "max": [1, 1, 0]}}],
+        "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+        "buffers": [{{"byteLength": 36, "uri": "{uri}"}}]}}"#
+    );
+    let path = dir.join("dark.gltf");
+    std::fs::write(&path, gltf).unwrap();
+    let out = dir.join("dark.png");
+    let (ok, _, stderr) = histencil(&[
+        "render",
+        "--scene",
+        path.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--frames",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("has no lights"), "{stderr}");
+    assert!(out.exists());
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -45,6 +45,8 @@ pub fn calibrate(
     frames: usize,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Calibration> {
+    // Before the wall is built: its shape follows the aspect ratio.
+    histencil_vk::check_extent(ctx, width, height).map(drop)?;
     let aspect = width as f32 / height as f32;
     let mut measurements = Vec::new();
     // Per technique: (1-BRDF time, extra time per extra BRDF), per light. One renderer per BRDF

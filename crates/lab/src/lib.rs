@@ -60,10 +60,7 @@ pub(crate) fn write_json(path: &std::path::Path, value: &serde_json::Value) -> R
     write_file(path, text.as_bytes())
 }
 
-/// Writes `bytes` to `path`, naming the path in the error.
+/// Writes `bytes` to `path` whole or not at all ([`histencil_vk::write_atomically`]).
 pub(crate) fn write_file(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
-    std::fs::write(path, bytes).map_err(|e| LabError::Write {
-        path: path.display().to_string(),
-        problem: e.to_string(),
-    })
+    Ok(histencil_vk::write_atomically(path, bytes)?)
 }

@@ -101,6 +101,7 @@ pub fn run_sweep(
     frames: usize,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<SweepReport> {
+    histencil_vk::check_extent(ctx, width, height).map(drop)?;
     if values.is_empty() {
         return Err(LabError::Settings("no values to sweep".into()));
     }

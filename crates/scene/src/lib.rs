@@ -19,5 +19,6 @@ pub use mesh::{
 };
 pub use types::{
     unit_direction, Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape,
-    MAX_LIGHT_COLOR, MAX_TINT, MAX_WORLD_COORDINATE, RANGE_CAP_PER_EXTENT,
+    MAX_FAR_OVER_NEAR, MAX_LIGHT_COLOR, MAX_TINT, MAX_WORLD_COORDINATE, MIN_FOV_Y,
+    RANGE_CAP_PER_EXTENT,
 };

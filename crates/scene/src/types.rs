@@ -181,6 +181,14 @@ pub enum SceneError {
 /// unit), and squared distances in the light code approach f32's range.
 pub const MAX_WORLD_COORDINATE: f32 = 1e7;
 
+/// The largest far / near ratio: beyond it an f32 depth buffer maps most of the view to the
+/// same depth, and light volumes can no longer be depth-tested against the G-buffer.
+pub const MAX_FAR_OVER_NEAR: f32 = 1e6;
+
+/// The narrowest vertical field of view (radians): narrower, the projection's scale (one over
+/// the tangent) pushes clip coordinates toward f32's range.
+pub const MIN_FOV_Y: f32 = 1e-3;
+
 /// The largest tint component. Base colours are in `[0, 1]`; the slack keeps artistic
 /// over-brightening while `tint * brdf * light` stays finite in f32.
 pub const MAX_TINT: f32 = 1e3;
@@ -273,18 +281,20 @@ fn camera_problem(c: &Camera) -> Option<String> {
     let ok = inside(c.eye)
         && inside(c.target)
         && finite3(c.up)
-        && c.fov_y_radians > 0.0
+        && c.fov_y_radians >= MIN_FOV_Y
         && c.fov_y_radians < 3.0
         && c.near > 0.0
         && c.far > c.near
         && c.far.is_finite()
+        && c.far / c.near <= MAX_FAR_OVER_NEAR
         && unit_direction(c.target - c.eye)
             .zip(unit_direction(c.up))
             .is_some_and(|(forward, up)| forward.cross(up).length() > 1e-6);
     (!ok).then(|| {
         format!(
             "needs eye and target within +-{MAX_WORLD_COORDINATE:e}, a finite up not parallel to \
-             the view, 0 < fov < 3 rad, 0 < near < far: {c:?}"
+             the view, {MIN_FOV_Y} <= fov < 3 rad, 0 < near < far <= {MAX_FAR_OVER_NEAR:e} * \
+             near: {c:?}"
         )
     })
 }

@@ -22,18 +22,18 @@ pub enum Error {
     },
     #[error(transparent)]
     Scene(#[from] histencil_scene::SceneError),
-    #[error("stencil layout: {0}")]
+    #[error(transparent)]
     Layout(#[from] histencil_model::LayoutError),
-    #[error("lighting plan: {0}")]
+    #[error(transparent)]
     Plan(#[from] histencil_model::PlanError),
-    #[error("BRDF table: {0}")]
+    #[error(transparent)]
     Lut(#[from] histencil_brdf::lut::LutError),
     #[error(
         "the BRDF tables need {bytes} bytes, more than this device's storage-buffer range of \
          {limit} bytes: lower the LUT resolution"
     )]
     LutTooLarge { bytes: u64, limit: u64 },
-    #[error("alpha lightmaps: {0}")]
+    #[error(transparent)]
     Lightmap(#[from] histencil_alpha::LayoutError),
     #[error("{count} distinct materials; the G-buffer indexes at most {max}")]
     TooManyMaterials { count: usize, max: usize },

@@ -32,6 +32,7 @@ mod resources;
 mod shader_consts;
 pub mod state;
 mod targets;
+pub use targets::check_extent;
 mod timing;
 
 /// The compiled SPIR-V of every shader module (built by build.rs, never checked in).
@@ -48,7 +49,7 @@ pub use error::{Error, Result};
 pub use histencil_model::{CostModel, FlushPolicy, TileStats};
 pub use image_error::{masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
-pub use output::{save_exr, save_png};
+pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
 pub use readback::{FrameImages, Readback};
 pub use renderer::{Backend, Frame, Renderer, Technique, DEFAULT_LUT_RESOLUTION};
 pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown};

@@ -1,7 +1,11 @@
-//! Writing images to files, with errors that name the path.
+//! Writing output files, with errors that name the path, and never half-written: every file is
+//! written to a temporary file in its own folder and renamed over the final name once complete,
+//! so a failed or interrupted run leaves no empty or truncated output behind. The checks run
+//! before long work create nothing, so a failed run leaves no empty folders either.
 
 use crate::error::{Error, Result};
-use std::path::Path;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
 
 fn output_error(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::Output {
@@ -17,14 +21,146 @@ where
     [P::Subpixel]: image::EncodableLayout,
     C: std::ops::Deref<Target = [P::Subpixel]>,
 {
-    image
-        .save_with_format(path, image::ImageFormat::Png)
-        .map_err(|e| output_error(path, e))
+    save_image(image, path, image::ImageFormat::Png)
 }
 
 /// Writes a linear HDR image as OpenEXR (RGBA, 32-bit float).
 pub fn save_exr(image: &image::Rgba32FImage, path: &Path) -> Result<()> {
+    save_image(image, path, image::ImageFormat::OpenExr)
+}
+
+fn save_image<P, C>(
+    image: &image::ImageBuffer<P, C>,
+    path: &Path,
+    format: image::ImageFormat,
+) -> Result<()>
+where
+    P: image::Pixel + image::PixelWithColorType,
+    [P::Subpixel]: image::EncodableLayout,
+    C: std::ops::Deref<Target = [P::Subpixel]>,
+{
+    let mut bytes = Vec::new();
     image
-        .save_with_format(path, image::ImageFormat::OpenExr)
-        .map_err(|e| output_error(path, e))
+        .write_to(&mut std::io::Cursor::new(&mut bytes), format)
+        .map_err(|e| output_error(path, e))?;
+    write_atomically(path, &bytes)
+}
+
+/// Writes `bytes` to `path` whole or not at all: into a temporary file beside it, flushed, then
+/// renamed over `path`. Creates the parent folders.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = parent_of(path);
+    std::fs::create_dir_all(dir).map_err(|e| output_error(dir, e))?;
+    let temp = temp_name(path);
+    let written = std::fs::File::create(&temp)
+        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .and_then(|()| std::fs::rename(&temp, path));
+    written.map_err(|e| {
+        let _ = std::fs::remove_file(&temp);
+        output_error(path, e)
+    })
+}
+
+/// Fails early, naming the path, when `path` could not be written later; creates nothing. The
+/// nearest existing folder on its way must be writable (checked by creating and removing a
+/// probe file there), and `path` must not be a folder.
+pub fn check_output_file(path: &Path) -> Result<()> {
+    if path.as_os_str().is_empty() || path.file_name().is_none() {
+        return Err(output_error(path, "not a file name"));
+    }
+    if path.is_dir() {
+        return Err(output_error(path, "is a directory"));
+    }
+    check_writable_dir(parent_of(path)).map_err(|e| output_error(path, e))
+}
+
+/// Fails early when files could not be written into the folder `dir` later; creates nothing.
+pub fn check_output_dir(dir: &Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(output_error(dir, "exists and is not a directory"));
+    }
+    check_writable_dir(dir).map_err(|e| output_error(dir, e))
+}
+
+/// `dir` or its nearest existing ancestor is a folder a file can be created in.
+fn check_writable_dir(dir: &Path) -> std::result::Result<(), String> {
+    let mut existing = dir;
+    while !existing.exists() {
+        existing = match existing.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+    }
+    if !existing.is_dir() {
+        return Err(format!("{} is not a directory", existing.display()));
+    }
+    let probe = existing.join(format!(".histencil-probe-{}", std::process::id()));
+    std::fs::File::create(&probe)
+        .map_err(|e| format!("cannot write in {}: {e}", existing.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+fn parent_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// A hidden name beside `path`, unique to this process and call.
+fn temp_name(path: &Path) -> PathBuf {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    parent_of(path).join(format!(
+        ".{name}.{}-{}.tmp",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(tag: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("histencil-output-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    #[test]
+    fn checks_create_nothing_and_writes_leave_only_the_file() {
+        let dir = scratch("atomic");
+        let file = dir.join("a/b/out.png");
+        check_output_file(&file).unwrap();
+        check_output_dir(&dir.join("report")).unwrap();
+        assert!(!dir.exists(), "a check created {}", dir.display());
+        write_atomically(&file, b"abc").unwrap();
+        write_atomically(&file, b"de").unwrap();
+        assert_eq!(std::fs::read(&file).unwrap(), b"de");
+        let names: Vec<_> = std::fs::read_dir(file.parent().unwrap())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["out.png"]);
+        assert!(check_output_file(&dir.join("a"))
+            .unwrap_err()
+            .to_string()
+            .contains("directory"));
+        assert!(check_output_dir(&file)
+            .unwrap_err()
+            .to_string()
+            .contains("not a directory"));
+        assert!(check_output_file(&file.join("x")).is_err());
+        // A write that cannot finish (its folder is a file) leaves nothing behind.
+        assert!(write_atomically(&file.join("x"), b"abc").is_err());
+        assert_eq!(std::fs::read(&file).unwrap(), b"de");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

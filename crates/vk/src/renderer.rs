@@ -466,7 +466,8 @@ impl<'c> Renderer<'c> {
     /// (`histencil_alpha::side_for_coverage`). The atlas is laid out again on the next frame.
     ///
     /// # Errors
-    /// [`crate::Error::Lightmap`] for a side outside 2..=4096 (the renderer keeps its setting).
+    /// [`crate::Error::Lightmap`] for a side outside 2..=[`histencil_alpha::MAX_FORCED_SIDE`]
+    /// (the renderer keeps its setting).
     pub fn set_lightmap_resolution(&mut self, side: Option<u32>) -> Result<()> {
         if let Some(s) = side {
             histencil_alpha::check_forced_side(s)?;

@@ -238,6 +238,7 @@ pub fn run_compare(
     settings: &CompareSettings,
     progress: &mut dyn FnMut(&str),
 ) -> Result<CompareReport> {
+    histencil_vk::check_extent(ctx, settings.width, settings.height).map(drop)?;
     if settings.brdf_counts.first() != Some(&1) {
         return Err(crate::LabError::Settings(
             "the BRDF counts must start at 1: overheads are against the 1-BRDF time".into(),

@@ -251,7 +251,8 @@ mod tests {
 
     /// A folder holding `scene/` with a 16-byte `ok.bin`, next to an `outside.bin`.
     fn sandbox(tag: &str) -> PathBuf {
-        let root = std::env::temp_dir().join(format!("histencil-confine-{tag}-{}", std::process::id()));
+        let root =
+            std::env::temp_dir().join(format!("histencil-confine-{tag}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&root);
         std::fs::create_dir_all(root.join("scene/sub")).unwrap();
         std::fs::write(root.join("scene/ok.bin"), [7u8; 16]).unwrap();
@@ -296,13 +297,26 @@ mod tests {
             let start = std::time::Instant::now();
             let err = read_uri(uri, Some(&dir), 4).unwrap_err();
             assert!(err.contains(why), "`{uri}`: {err}");
-            assert!(start.elapsed().as_secs() < 5, "`{uri}` took {:?}", start.elapsed());
+            assert!(
+                start.elapsed().as_secs() < 5,
+                "`{uri}` took {:?}",
+                start.elapsed()
+            );
         }
-        for uri in ["ok.bin", "link-in.bin", "sub/deep.bin", "sub/../ok.bin", "ok%2Ebin"] {
+        for uri in [
+            "ok.bin",
+            "link-in.bin",
+            "sub/deep.bin",
+            "sub/../ok.bin",
+            "ok%2Ebin",
+        ] {
             assert_eq!(read_uri(uri, Some(&dir), 4).unwrap(), vec![7; 4], "{uri}");
         }
         let err = read_uri("ok.bin", Some(&dir), 17).unwrap_err();
-        assert!(err.contains("holds 16 bytes but byteLength declares 17"), "{err}");
+        assert!(
+            err.contains("holds 16 bytes but byteLength declares 17"),
+            "{err}"
+        );
         let err = read_regular_file(&dir.join("ok.bin"), ReadLimit::AtMost(15)).unwrap_err();
         assert!(err.contains("more than the 15"), "{err}");
         let err = read_regular_file(&dir.join("fifo.bin"), ReadLimit::AtMost(15)).unwrap_err();

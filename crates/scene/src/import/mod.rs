@@ -20,8 +20,8 @@ mod buffers;
 mod material;
 mod uv_layout;
 
-pub use buffers::MAX_IMPORT_BYTES;
 use buffers::ReadLimit;
+pub use buffers::MAX_IMPORT_BYTES;
 
 pub use material::{material_from_gltf, MaterialError};
 
@@ -50,11 +50,13 @@ pub enum ImportError {
         name: String,
         problem: String,
     },
-    #[error("material {index} (`{name}`): {source}")]
+    /// `problem` is in the message, so it is not also the error's source (a chain would print
+    /// it twice).
+    #[error("material {index} (`{name}`): {problem}")]
     Material {
         index: usize,
         name: String,
-        source: MaterialError,
+        problem: MaterialError,
     },
     #[error("light {index} (`{name}`): {problem}")]
     Light {
@@ -197,10 +199,10 @@ impl Importer<'_> {
                 pbr.metallic_factor(),
                 pbr.roughness_factor(),
             )
-            .map_err(|source| ImportError::Material {
+            .map_err(|problem| ImportError::Material {
                 index: gltf_material.index().unwrap_or(usize::MAX),
                 name: gltf_material.name().unwrap_or("default").to_owned(),
-                source,
+                problem,
             })?;
             let blend = gltf_material.alpha_mode() == gltf::material::AlphaMode::Blend;
             let key = (mesh.index(), primitive.index(), mirrored);
@@ -270,7 +272,12 @@ fn read_primitive(
     for accessor in checked.iter().flatten() {
         buffers::check_accessor(accessor)?;
     }
-    check_attribute_type("POSITION", &positions_accessor, &[DataType::F32], Dimensions::Vec3)?;
+    check_attribute_type(
+        "POSITION",
+        &positions_accessor,
+        &[DataType::F32],
+        Dimensions::Vec3,
+    )?;
     if let Some(normals) = primitive.get(&gltf::Semantic::Normals) {
         check_attribute_type("NORMAL", &normals, &[DataType::F32], Dimensions::Vec3)?;
     }
@@ -386,7 +393,11 @@ fn check_attribute_type(
         accessor.index(),
         accessor.dimensions(),
         data_type,
-        if accessor.normalized() { " normalized" } else { "" },
+        if accessor.normalized() {
+            " normalized"
+        } else {
+            ""
+        },
         types
             .iter()
             .map(|t| format!("{t:?}"))

@@ -151,7 +151,11 @@ mod tests {
         for (k, seed) in [(1, 0), (2, 1), (3, 0), (8, 5), (16, 2), (64, 3)] {
             for (lo, hi) in [(0.0, 1.0), (0.25, 0.75), (0.0, 0.001)] {
                 let (p, i, uv) = grid_mesh(k, lo, hi, seed);
-                assert_eq!(layout_problem(&p, &i, &uv), None, "k {k} seed {seed} {lo}..{hi}");
+                assert_eq!(
+                    layout_problem(&p, &i, &uv),
+                    None,
+                    "k {k} seed {seed} {lo}..{hi}"
+                );
             }
         }
     }
@@ -167,7 +171,9 @@ mod tests {
             for (v, out) in [(0, -1e-6), (uv.len() / 2, 1.0 + 1e-6), (uv.len() - 1, 1e30)] {
                 let mut bad = uv.clone();
                 bad[v][1] = out;
-                assert!(layout_problem(&p, &i, &bad).unwrap().contains("outside [0, 1]^2"));
+                assert!(layout_problem(&p, &i, &bad)
+                    .unwrap()
+                    .contains("outside [0, 1]^2"));
                 let mut nan = uv.clone();
                 nan[v][0] = f32::NAN;
                 assert!(layout_problem(&p, &i, &nan).unwrap().contains("outside"));
@@ -175,7 +181,9 @@ mod tests {
             // The layout drawn twice (a mesh whose halves share texels), or mirrored onto itself.
             let mut doubled = i.clone();
             doubled.extend(i.iter().rev());
-            assert!(layout_problem(&p, &doubled, &uv).unwrap().contains("overlap"));
+            assert!(layout_problem(&p, &doubled, &uv)
+                .unwrap()
+                .contains("overlap"));
             // One interior vertex moved across its neighbours folds triangles over each other
             // (with k = 2 its neighbourhood is the whole square: anywhere inside is valid).
             if k >= 3 {

@@ -66,8 +66,6 @@ impl AlphaMode {
 const PROBE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// The lightmap atlas: HDR radiance, as the lighting target.
 const LIGHTMAP_FORMAT: vk::Format = HDR_FORMAT;
-/// Largest atlas side tried before regions are halved: 4096^2 texels is 256 MiB per f32 atlas.
-const MAX_ATLAS_SIDE: u32 = 4096;
 
 /// Translucent surfaces: depth-tested against the opaque scene, not written (they do not hide
 /// each other; they are sorted instead).
@@ -165,7 +163,7 @@ impl AlphaLighting {
         forced_side: Option<u32>,
         frame_layout: vk::DescriptorSetLayout,
     ) -> Result<Self> {
-        let max_side = MAX_ATLAS_SIDE.min(ctx.max_image_dimension);
+        let max_side = histencil_alpha::MAX_ATLAS_SIDE.min(ctx.max_image_dimension);
         let layout = plan_layout(scene, extent.height, forced_side, max_side)?;
         let mut parts = Parts::default();
         match Self::create(ctx, scene, layout, frame_layout, &mut parts) {

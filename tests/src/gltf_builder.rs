@@ -1,0 +1,156 @@
+//! The glTF test scene, written from code: a cube and a floor in two BRDFs named in material
+//! `extras`, three `KHR_lights_punctual` lights, a camera and a translucent (`alphaMode: BLEND`)
+//! pane, with an external `.bin`. Shared by the glTF tests and the hostile-input generator.
+
+use crate::output_dir;
+use serde_json::{json, Value};
+use std::f32::consts::FRAC_1_SQRT_2 as H;
+use std::path::PathBuf;
+
+/// Binary data and the accessors that address it.
+#[derive(Default)]
+pub struct Bin {
+    pub bytes: Vec<u8>,
+    pub views: Vec<Value>,
+    pub accessors: Vec<Value>,
+}
+
+impl Bin {
+    /// Appends float vectors of `width` components; returns the accessor index.
+    pub fn floats(&mut self, data: &[f32], width: usize) -> usize {
+        let (kind, count) = (["", "SCALAR", "VEC2", "VEC3"][width], data.len() / width);
+        let mut accessor = json!({"componentType": 5126, "count": count, "type": kind});
+        if width == 3 {
+            let axis =
+                |k: usize, f: fn(f32, f32) -> f32| data.chunks(3).map(|v| v[k]).fold(data[k], f);
+            accessor["min"] = json!([0, 1, 2].map(|k| axis(k, f32::min)));
+            accessor["max"] = json!([0, 1, 2].map(|k| axis(k, f32::max)));
+        }
+        self.push(
+            data.iter().flat_map(|f| f.to_le_bytes()).collect(),
+            accessor,
+        )
+    }
+
+    pub fn indices(&mut self, data: &[u32]) -> usize {
+        let accessor = json!({"componentType": 5125, "count": data.len(), "type": "SCALAR"});
+        self.push(
+            data.iter().flat_map(|i| i.to_le_bytes()).collect(),
+            accessor,
+        )
+    }
+
+    pub fn push(&mut self, bytes: Vec<u8>, mut accessor: Value) -> usize {
+        self.views
+            .push(json!({"buffer": 0, "byteOffset": self.bytes.len(), "byteLength": bytes.len()}));
+        accessor["bufferView"] = json!(self.views.len() - 1);
+        self.bytes.extend(bytes);
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+}
+
+/// A cube of half-size 1 with 24 vertices (flat normals), counter-clockwise from outside.
+pub fn cube(bin: &mut Bin) -> Value {
+    let (mut p, mut n, mut idx) = (vec![], vec![], vec![]);
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut normal = [0.0; 3];
+            normal[axis] = sign;
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let base = (p.len() / 3) as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let mut q = normal;
+                q[u] = a;
+                q[v] = b;
+                p.extend(q);
+                n.extend(normal);
+            }
+            let quad = if sign > 0.0 {
+                [0, 1, 2, 0, 2, 3]
+            } else {
+                [0, 2, 1, 0, 3, 2]
+            };
+            idx.extend(quad.map(|k| base + k));
+        }
+    }
+    json!({"attributes": {"POSITION": bin.floats(&p, 3), "NORMAL": bin.floats(&n, 3)},
+           "indices": bin.indices(&idx)})
+}
+
+/// A quad in the XZ plane facing +Y, half-size 1, without normals (the importer makes them
+/// flat), with texture coordinates.
+pub fn quad(bin: &mut Bin) -> Value {
+    let p = [
+        -1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0, -1.0, -1.0, 0.0, -1.0,
+    ];
+    let uv = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0];
+    json!({"attributes": {"POSITION": bin.floats(&p, 3), "TEXCOORD_0": bin.floats(&uv, 2)},
+           "indices": bin.indices(&[0, 1, 2, 0, 2, 3])})
+}
+
+/// The test scene as glTF JSON and its binary buffer; `box_brdf` is the cube's BRDF name.
+pub fn test_gltf(box_brdf: &str) -> (Value, Vec<u8>) {
+    let mut bin = Bin::default();
+    let (cube, floor) = (cube(&mut bin), quad(&mut bin));
+    let mut glass = floor.clone();
+    glass["material"] = json!(2);
+    let mut floor_prim = floor;
+    floor_prim["material"] = json!(0);
+    let mut cube_prim = cube;
+    cube_prim["material"] = json!(1);
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "color": [1.0, 0.9, 0.8], "intensity": 12.0, "range": 6.0},
+            {"type": "point", "color": [0.4, 0.6, 1.0], "intensity": 8.0, "range": 5.0},
+            {"type": "spot", "color": [1.0, 1.0, 1.0], "intensity": 30.0, "range": 9.0,
+             "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.6}}
+        ]}},
+        "materials": [
+            {"name": "floor", "extras": {"brdf": "oren_nayar_full", "rho": 0.9, "sigma": 0.3},
+             "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.7, 1.0]}},
+            {"name": "box", "extras": {"brdf": box_brdf, "n": 32, "tint": [0.9, 0.3, 0.2]}},
+            {"name": "glass", "alphaMode": "BLEND",
+             "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.8, 1.0, 0.4],
+                                      "metallicFactor": 0.0, "roughnessFactor": 0.8}}
+        ],
+        "meshes": [{"name": "cube", "primitives": [cube_prim]},
+                   {"name": "floor", "primitives": [floor_prim]},
+                   {"name": "pane", "primitives": [glass]}],
+        "cameras": [{"type": "perspective",
+                     "perspective": {"yfov": 0.9, "znear": 0.1, "zfar": 50.0}}],
+        "nodes": [
+            {"name": "box", "mesh": 0, "translation": [0.0, 0.6, 0.0], "scale": [0.6, 0.6, 0.6],
+             "rotation": [0.0, 0.3826834, 0.0, 0.9238795]},
+            {"name": "floor", "mesh": 1, "scale": [5.0, 1.0, 5.0]},
+            {"name": "pane", "mesh": 2, "translation": [1.2, 1.0, 1.2],
+             "rotation": [H, 0.0, 0.0, H], "scale": [0.5, 1.0, 0.5]},
+            {"name": "warm", "extensions": {"KHR_lights_punctual": {"light": 0}},
+             "translation": [1.5, 2.0, 1.0]},
+            {"name": "cool", "extensions": {"KHR_lights_punctual": {"light": 1}},
+             "translation": [-1.5, 1.5, 0.5]},
+            {"name": "spot", "extensions": {"KHR_lights_punctual": {"light": 2}},
+             "translation": [0.0, 5.0, 0.0], "rotation": [-H, 0.0, 0.0, H]},
+            {"name": "camera", "camera": 0, "translation": [0.0, 3.0, 6.0],
+             "rotation": [-0.2297529, 0.0, 0.0, 0.9732489]}
+        ],
+        "scenes": [{"nodes": [0, 1, 2, 3, 4, 5, 6]}],
+        "scene": 0,
+        "bufferViews": bin.views,
+        "accessors": bin.accessors,
+        "buffers": [{"uri": "scene.bin", "byteLength": bin.bytes.len()}]
+    });
+    (doc, bin.bytes)
+}
+
+/// Writes `doc` and `bin` into a fresh directory; returns the `.gltf` path.
+pub fn write(name: &str, doc: &Value, bin: &[u8]) -> PathBuf {
+    let dir = output_dir().join(format!("gltf-{name}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("scene.bin"), bin).unwrap();
+    let path = dir.join("scene.gltf");
+    std::fs::write(&path, serde_json::to_vec_pretty(doc).unwrap()).unwrap();
+    path
+}
