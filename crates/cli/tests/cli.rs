@@ -14,6 +14,31 @@ fn histencil(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// `brdf-eval` of `cases` on the CPU and then the GPU (validated), writing into `dir`: each
+/// run's success, stderr and output file.
+fn brdf_eval_on_both_devices(
+    dir: &std::path::Path,
+    cases: &std::path::Path,
+) -> Vec<(bool, String, String)> {
+    ["cpu", "gpu"]
+        .into_iter()
+        .map(|device| {
+            let out = dir.join(format!("{device}.csv"));
+            let (ok, _, stderr) = histencil(&[
+                "brdf-eval",
+                "--cases",
+                cases.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--device",
+                device,
+                "--validate",
+            ]);
+            (ok, stderr, std::fs::read_to_string(out).unwrap_or_default())
+        })
+        .collect()
+}
+
 fn assert_one_line_error(args: &[&str], needle: &str) {
     let (ok, _, stderr) = histencil(args);
     assert!(!ok, "{args:?} succeeded");
@@ -160,26 +185,14 @@ fn brdf_eval_agrees_between_cpu_and_gpu_and_reports_bad_rows() {
     )
     .unwrap();
     let mut outputs = vec![];
-    for device in ["cpu", "gpu"] {
-        let out = dir.join(format!("{device}.csv"));
-        let args = [
-            "brdf-eval",
-            "--cases",
-            cases.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--device",
-            device,
-            "--validate",
-        ];
-        let (ok, _, stderr) = histencil(&args);
+    for (ok, stderr, output) in brdf_eval_on_both_devices(&dir, &cases) {
         assert!(!ok, "a bad row makes the run fail");
         assert!(
             stderr.contains("row 3 (id `c`): lambert: unknown parameter `albedo`"),
             "{stderr}"
         );
         assert!(!stderr.contains("panicked"), "{stderr}");
-        outputs.push(std::fs::read_to_string(out).unwrap());
+        outputs.push(output);
     }
     let values = |text: &str| -> Vec<f64> {
         text.lines()
@@ -349,20 +362,9 @@ fn brdf_eval_takes_directions_of_any_finite_length_on_both_devices() {
     }
     std::fs::write(&cases, text).unwrap();
     let mut outputs = vec![];
-    for device in ["cpu", "gpu"] {
-        let out = dir.join(format!("{device}.csv"));
-        let (ok, _, stderr) = histencil(&[
-            "brdf-eval",
-            "--cases",
-            cases.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--device",
-            device,
-            "--validate",
-        ]);
-        assert!(ok, "{device}: {stderr}");
-        outputs.push(std::fs::read_to_string(out).unwrap());
+    for (ok, stderr, output) in brdf_eval_on_both_devices(&dir, &cases) {
+        assert!(ok, "{stderr}");
+        outputs.push(output);
     }
     let values = |text: &str| -> Vec<(String, f64)> {
         text.lines()
