@@ -34,8 +34,6 @@ pub enum LabError {
     Vulkan(#[from] histencil_vk::Error),
     #[error(transparent)]
     Scene(#[from] histencil_scene::SceneError),
-    #[error("cannot write {path}: {problem}")]
-    Write { path: String, problem: String },
     #[error("cannot draw plot {path}: {problem}")]
     Plot { path: String, problem: String },
     #[error("cost model {path}: {problem}")]
@@ -45,14 +43,6 @@ pub enum LabError {
 }
 
 pub type Result<T, E = LabError> = std::result::Result<T, E>;
-
-/// Creates `dir` and its parents, naming it in the error.
-pub(crate) fn create_dir(dir: &std::path::Path) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| LabError::Write {
-        path: dir.display().to_string(),
-        problem: e.to_string(),
-    })
-}
 
 /// Writes `value` as pretty JSON to `path`.
 pub(crate) fn write_json(path: &std::path::Path, value: &serde_json::Value) -> Result<()> {

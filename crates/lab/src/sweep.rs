@@ -225,7 +225,6 @@ pub fn run_sweep(
 impl SweepReport {
     /// Writes `sweep.csv`, `sweep.json` and `pareto.png` into `dir`; returns their paths.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        crate::create_dir(dir)?;
         let csv = dir.join("sweep.csv");
         write_file(&csv, self.csv().as_bytes())?;
         let js = dir.join("sweep.json");

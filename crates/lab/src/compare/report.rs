@@ -18,7 +18,6 @@ impl CompareReport {
     /// Writes `report.md`, `report.json` and the [`PLOTS`] into `dir` (created if needed);
     /// returns the paths written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
-        crate::create_dir(dir)?;
         let md = dir.join("report.md");
         write_file(&md, self.markdown().as_bytes())?;
         let js = dir.join("report.json");
