@@ -145,6 +145,26 @@ pub fn test_gltf(box_brdf: &str) -> (Value, Vec<u8>) {
     (doc, bin.bytes)
 }
 
+/// `doc` with `bin` inlined as a base64 `data:` URI: one self-contained `.gltf` file.
+pub fn self_contained(doc: &Value, bin: &[u8]) -> Value {
+    use base64::Engine as _;
+    let mut doc = doc.clone();
+    doc["buffers"] = json!([{
+        "uri": format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(bin)
+        ),
+        "byteLength": bin.len()
+    }]);
+    doc
+}
+
+/// The committed copy of the test scene that `histencil check` runs in `tools/test`
+/// (`tests/scenes/two-brdfs.gltf`); `tests/tests/gltf.rs` holds it equal to [`test_gltf`].
+pub fn committed_scene_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/two-brdfs.gltf")
+}
+
 /// Writes `doc` and `bin` into a fresh directory; returns the `.gltf` path.
 pub fn write(name: &str, doc: &Value, bin: &[u8]) -> PathBuf {
     let dir = output_dir().join(format!("gltf-{name}"));

@@ -4,7 +4,7 @@
 //! errors: a truncated JSON, a truncated buffer, an unknown BRDF name.
 
 use histencil_scene::{load_scene, ImportError, MaterialError, Shape};
-use histencil_tests::gltf_builder::{test_gltf, write};
+use histencil_tests::gltf_builder::{committed_scene_path, self_contained, test_gltf, write};
 use histencil_tests::{assert_close, lit_fraction, output_dir, with_validated_context};
 use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
 use serde_json::json;
@@ -78,4 +78,31 @@ fn broken_gltf_files_give_the_documented_errors() {
     let path = write("missing-bin", &doc, &bin);
     let err = load_scene(path.to_str().unwrap()).unwrap_err();
     assert!(err.to_string().contains("missing.bin"), "{err}");
+}
+
+/// `tests/scenes/two-brdfs.gltf`, which `tools/test` runs `histencil check` on, is the test scene
+/// written here (a self-contained copy), so the check covers what these tests cover.
+/// `HISTENCIL_BLESS=1` rewrites it.
+#[test]
+fn the_committed_check_scene_is_the_test_scene() {
+    let (doc, bin) = test_gltf("blinn_phong");
+    let expected = self_contained(&doc, &bin);
+    let path = committed_scene_path();
+    if std::env::var_os("HISTENCIL_BLESS").is_some() {
+        let mut text = serde_json::to_string_pretty(&expected).unwrap();
+        text.push('\n');
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, text).unwrap();
+    }
+    let committed: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).expect("tests/scenes/two-brdfs.gltf"))
+            .expect("valid JSON");
+    assert!(
+        committed == expected,
+        "{} is not the test scene: rewrite it with HISTENCIL_BLESS=1",
+        path.display()
+    );
+    let scene = load_scene(path.to_str().unwrap()).expect("it imports");
+    assert_eq!(scene.brdfs_in_use().len(), 2);
+    assert_eq!(scene.alpha_objects.len(), 1);
 }

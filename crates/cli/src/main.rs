@@ -2,14 +2,14 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
-use histencil_vk::{
-    AlphaMode, Backend, Context, ContextDesc, FlushPolicy, Readback, Renderer, Technique,
-};
+use histencil_check::matrix::Platform;
+use histencil_vk::{AlphaMode, Context, ContextDesc, FlushPolicy, Readback, Renderer, Technique};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod brdf_eval;
 mod brdf_report;
+mod check;
 mod lab;
 
 #[derive(Parser)]
@@ -39,6 +39,10 @@ enum Command {
     /// Measure this device's per-pass overhead, branch tax and shade cost for the adaptive
     /// technique (`--costs`).
     Calibrate(lab::CalibrateArgs),
+    /// The validation-CI matrix: every technique, backend, flush policy, preserved pattern,
+    /// depth format and resolution a scene needs, under the validation layer, judged against
+    /// forward; JUnit XML and JSON reports. Exit 0 all passed, 1 any failure, 2 usage error.
+    Check(check::CheckArgs),
     /// Evaluate BRDF cases from a CSV file (id,brdf,params,N,T,V,L) into `id,value`.
     BrdfEval(BrdfEvalArgs),
     /// Print the error of the BRDF look-up tables against resolution and the error the G-buffer
@@ -197,22 +201,15 @@ enum FlushArg {
 
 impl RenderArgs {
     fn technique(&self) -> Technique {
+        // The check's platform vocabulary names the same five backends.
         let backend = match self.backend {
-            BackendArg::X360 => Backend::X360 {
-                zero_preserved: true,
-                save_restore: false,
-            },
-            BackendArg::X360NoZeroing => Backend::X360 {
-                zero_preserved: false,
-                save_restore: false,
-            },
-            BackendArg::X360SaveRestore => Backend::X360 {
-                zero_preserved: true,
-                save_restore: true,
-            },
-            BackendArg::Ps3 => Backend::Ps3,
-            BackendArg::Native => Backend::Native,
-        };
+            BackendArg::X360 => Platform::X360,
+            BackendArg::X360NoZeroing => Platform::X360NoZeroing,
+            BackendArg::X360SaveRestore => Platform::X360SaveRestore,
+            BackendArg::Ps3 => Platform::Ps3,
+            BackendArg::Native => Platform::Native,
+        }
+        .backend();
         let flush = match self.flush {
             FlushArg::Auto => FlushPolicy::Auto,
             FlushArg::Always => FlushPolicy::Always,
@@ -396,7 +393,7 @@ fn print_stats(renderer: &mut Renderer, technique: Technique) -> Result<()> {
 fn on_device<T>(validate: bool, body: impl FnOnce(&Context) -> Result<T>) -> Result<T> {
     let ctx = Context::new(ContextDesc {
         validation: validate,
-        device_filter: None,
+        ..ContextDesc::default()
     })?;
     let log = ctx.validation_log();
     let value = body(&ctx)?;
@@ -489,6 +486,7 @@ fn main() -> ExitCode {
         }
     };
     let result = match &cli.command {
+        Command::Check(args) => return check::check(args),
         Command::Render(args) => render(args),
         Command::Scenes => {
             scenes();

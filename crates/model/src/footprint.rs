@@ -106,6 +106,23 @@ impl Footprint {
         self.spans[((y - self.y0) * self.width + (x - self.x0)) as usize]
     }
 
+    /// Whether the light shades a surface at `surface_depth` in pixel (x, y): strictly between
+    /// its faces, or, for a viewer inside the volume ([`LightCase::ViewerInside`]), any surface
+    /// in the footprint: the plan draws that light full-screen (see `shade_raster`), and the
+    /// light's window gives exactly 0 beyond its range, so the shading count, not the light,
+    /// grows by the surfaces behind the back face. Classifies the footprint on every call
+    /// (linear in its size): an oracle for tests, not a per-pixel query for large frames.
+    pub fn shades(&self, x: u32, y: u32, surface_depth: f32) -> bool {
+        let Some(span) = self.span(x, y) else {
+            return false;
+        };
+        if self.case() == LightCase::ViewerInside {
+            surface_depth < 1.0
+        } else {
+            span.contains(surface_depth)
+        }
+    }
+
     /// Which plan this footprint needs.
     pub fn case(&self) -> LightCase {
         if self.full_screen {

@@ -128,6 +128,14 @@ pub enum PlanError {
 }
 
 /// Where the shading passes of a case rasterise, and their depth test.
+///
+/// A viewer inside a closed volume sees one back face through every pixel, so the volume covers
+/// the screen: it is drawn as the full-screen triangle, which rasterises each pixel exactly once
+/// (the light's window is exactly 0 beyond its range, so the extra surfaces get nothing). Its
+/// back faces did the same work but are not watertight there: the triangles that straddle the
+/// eye plane are clipped one by one, and two of them can both cover a pixel, which then gets the
+/// light twice (`histencil check` found one such pixel on the glTF test scene at 257x129 on
+/// lavapipe).
 fn shade_raster(case: LightCase) -> (Geometry, CullMode, DepthState) {
     match case {
         LightCase::Outside => (
@@ -135,12 +143,12 @@ fn shade_raster(case: LightCase) -> (Geometry, CullMode, DepthState) {
             CullMode::Back,
             DepthState::test(CompareOp::Less),
         ),
-        LightCase::CrossesNear | LightCase::ViewerInside => (
+        LightCase::CrossesNear => (
             Geometry::Volume,
             CullMode::Front,
             DepthState::test(CompareOp::Greater),
         ),
-        LightCase::FullScreen => (
+        LightCase::ViewerInside | LightCase::FullScreen => (
             Geometry::FullScreen,
             CullMode::None,
             DepthState::test(CompareOp::Greater),
@@ -465,7 +473,7 @@ mod tests {
     }
 
     #[test]
-    fn viewer_inside_shades_back_faces_in_front_of_the_surface_without_culling_bit() {
+    fn viewer_inside_shades_the_whole_screen_once_without_culling_bit() {
         let layout = StencilLayout::new(2, 0).unwrap();
         let plan = plan_light(
             &layout,
@@ -474,7 +482,8 @@ mod tests {
         )
         .unwrap();
         assert_eq!(labels(&plan), ["shade-brdf-0", "shade-brdf-1"]);
-        assert_eq!(plan[0].state.cull, CullMode::Front);
+        assert_eq!(plan[0].geometry, Geometry::FullScreen);
+        assert_eq!(plan[0].state.cull, CullMode::None);
         assert_eq!(plan[0].state.depth.compare, Some(CompareOp::Greater));
     }
 

@@ -169,7 +169,7 @@ fn a_256_square_frame_with_100_lights_is_lit_exactly() {
             for x in fp.x0..fp.x0 + fp.width {
                 let depth = frame.target.depth[target.index(x, y)];
                 let local = ((y - fp.y0) * fp.width + (x - fp.x0)) as usize;
-                let inside = fp.span(x, y).is_some_and(|s| s.contains(depth));
+                let inside = fp.shades(x, y, depth);
                 expected += u64::from(inside);
                 assert_eq!(result.lights[l].count[local], u8::from(inside));
             }

@@ -19,9 +19,7 @@ fn assert_shaded_exactly_inside(frame: &Frame, result: &SimResult) -> Result<(),
             for x in fp.x0..fp.x0 + fp.width {
                 let i = frame.target.index(x, y);
                 let local = ((y - fp.y0) * fp.width + (x - fp.x0)) as usize;
-                let inside = fp
-                    .span(x, y)
-                    .is_some_and(|s| s.contains(frame.target.depth[i]));
+                let inside = fp.shades(x, y, frame.target.depth[i]);
                 prop_assert_eq!(
                     shading.count[local],
                     u8::from(inside),

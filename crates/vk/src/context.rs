@@ -11,14 +11,52 @@ use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
+/// The depth-stencil formats the renderer can use: both have the 8 stencil bits the talk's
+/// layouts need. The depth precision differs (float against 24-bit fixed point), and engines
+/// ship on both, so `histencil check` runs its matrix on each the device has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum DepthStencilFormat {
+    /// `VK_FORMAT_D32_SFLOAT_S8_UINT`.
+    D32S8,
+    /// `VK_FORMAT_D24_UNORM_S8_UINT`.
+    D24S8,
+}
+
+impl DepthStencilFormat {
+    /// Both, in the order a device's format is probed when none is asked for.
+    pub const ALL: [DepthStencilFormat; 2] = [DepthStencilFormat::D32S8, DepthStencilFormat::D24S8];
+
+    pub fn vk(self) -> vk::Format {
+        match self {
+            DepthStencilFormat::D32S8 => vk::Format::D32_SFLOAT_S8_UINT,
+            DepthStencilFormat::D24S8 => vk::Format::D24_UNORM_S8_UINT,
+        }
+    }
+
+    /// The Vulkan name, e.g. `D32_SFLOAT_S8_UINT`.
+    pub fn vk_name(self) -> &'static str {
+        match self {
+            DepthStencilFormat::D32S8 => "D32_SFLOAT_S8_UINT",
+            DepthStencilFormat::D24S8 => "D24_UNORM_S8_UINT",
+        }
+    }
+}
+
 /// How to build a [`Context`].
 #[derive(Clone, Debug, Default)]
 pub struct ContextDesc {
     /// Enable the Khronos validation layer with synchronisation validation.
     pub validation: bool,
+    /// With `validation`: the layer's best-practices checks too (they warn about legal but slow
+    /// usage, so a clean run is a stronger claim and a noisier one).
+    pub best_practices: bool,
     /// Pick the first device whose name contains this (case-insensitive). `None` reads the
     /// `HISTENCIL_DEVICE` environment variable; without it, a discrete GPU is preferred.
     pub device_filter: Option<String>,
+    /// The depth-stencil format to render with; `None` takes the first of
+    /// [`DepthStencilFormat::ALL`] the device can attach. A requested format the device lacks
+    /// is [`Error::MissingFormat`].
+    pub depth_stencil: Option<DepthStencilFormat>,
 }
 
 impl ContextDesc {
@@ -26,7 +64,7 @@ impl ContextDesc {
     pub fn validated() -> Self {
         Self {
             validation: true,
-            device_filter: None,
+            ..Self::default()
         }
     }
 }
@@ -46,26 +84,69 @@ pub struct Context {
     validation: Arc<ValidationLog>,
     device_name: String,
     pub(crate) depth_stencil_format: vk::Format,
+    depth_stencil: DepthStencilFormat,
     pub(crate) timestamp_period_ns: f64,
     pub(crate) max_image_dimension: u32,
     pub(crate) max_storage_buffer_range: u32,
 }
 
+/// The format `wanted` names, or the first the device has; [`Error::MissingFormat`] when the
+/// device cannot attach it (or either).
 fn pick_depth_stencil_format(
     instance: &ash::Instance,
     pd: vk::PhysicalDevice,
-) -> Option<vk::Format> {
+    wanted: Option<DepthStencilFormat>,
+) -> Result<DepthStencilFormat> {
     let needed =
         vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
-    [
-        vk::Format::D32_SFLOAT_S8_UINT,
-        vk::Format::D24_UNORM_S8_UINT,
-    ]
-    .into_iter()
-    .find(|&f| {
-        let props = unsafe { instance.get_physical_device_format_properties(pd, f) };
-        props.optimal_tiling_features.contains(needed)
-    })
+    let candidates = match wanted {
+        Some(f) => vec![f],
+        None => DepthStencilFormat::ALL.to_vec(),
+    };
+    candidates
+        .iter()
+        .copied()
+        .find(|f| {
+            // SAFETY: `pd` was enumerated from `instance`, which is alive.
+            let props = unsafe { instance.get_physical_device_format_properties(pd, f.vk()) };
+            props.optimal_tiling_features.contains(needed)
+        })
+        .ok_or_else(|| {
+            let names: Vec<_> = candidates.iter().map(|f| f.vk_name()).collect();
+            Error::MissingFormat(format!(
+                "the device cannot use {} as a depth-stencil attachment copied out",
+                names.join(" or ")
+            ))
+        })
+}
+
+/// What `Context::new` has created so far, destroyed in reverse order if a later step fails:
+/// a failed `Context::new` leaks nothing (the device, the messenger and the instance included).
+struct Partial {
+    instance: Option<ash::Instance>,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    device: Option<ash::Device>,
+}
+
+impl Drop for Partial {
+    fn drop(&mut self) {
+        // SAFETY: every handle here was created by `Context::new` and nothing else holds it: a
+        // successful `new` takes them out (leaving `None` / null) before this runs.
+        unsafe {
+            if let Some(device) = self.device.take() {
+                device.destroy_device(None);
+            }
+            if let Some(di) = &self.debug_instance {
+                if self.messenger != vk::DebugUtilsMessengerEXT::null() {
+                    di.destroy_debug_utils_messenger(self.messenger, None);
+                }
+            }
+            if let Some(instance) = self.instance.take() {
+                instance.destroy_instance(None);
+            }
+        }
+    }
 }
 
 impl Context {
@@ -105,7 +186,10 @@ impl Context {
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
         let mut layers = Vec::new();
-        let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut enabled_features = vec![vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        if desc.best_practices {
+            enabled_features.push(vk::ValidationFeatureEnableEXT::BEST_PRACTICES);
+        }
         let mut validation_features =
             vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
         if desc.validation {
@@ -138,42 +222,33 @@ impl Context {
         }
         let instance =
             unsafe { entry.create_instance(&instance_info, None) }.call("vkCreateInstance")?;
-
-        let (debug_instance, messenger) = if debug_utils {
+        let mut partial = Partial {
+            instance: Some(instance.clone()),
+            debug_instance: None,
+            messenger: vk::DebugUtilsMessengerEXT::null(),
+            device: None,
+        };
+        if debug_utils {
             let di = ash::ext::debug_utils::Instance::new(&entry, &instance);
             // A fresh copy: messenger_for_create's pNext was rewritten by push_next.
-            let messenger = if desc.validation {
-                unsafe { di.create_debug_utils_messenger(&messenger_info, None) }
-                    .call("vkCreateDebugUtilsMessengerEXT")?
-            } else {
-                vk::DebugUtilsMessengerEXT::null()
-            };
-            (Some(di), messenger)
-        } else {
-            (None, vk::DebugUtilsMessengerEXT::null())
-        };
+            if desc.validation {
+                partial.messenger =
+                    unsafe { di.create_debug_utils_messenger(&messenger_info, None) }
+                        .call("vkCreateDebugUtilsMessengerEXT")?;
+            }
+            partial.debug_instance = Some(di);
+        }
 
         let filter = desc.device_filter.clone().or_else(|| {
             std::env::var("HISTENCIL_DEVICE")
                 .ok()
                 .filter(|s| !s.is_empty())
         });
-        let chosen = Self::pick_physical_device(&instance, filter.as_deref());
-        let (physical_device, queue_family, device_name) = match chosen {
-            Ok(c) => c,
-            Err(e) => {
-                unsafe {
-                    if let Some(di) = &debug_instance {
-                        di.destroy_debug_utils_messenger(messenger, None);
-                    }
-                    instance.destroy_instance(None);
-                }
-                return Err(e);
-            }
-        };
+        let (physical_device, queue_family, device_name) =
+            Self::pick_physical_device(&instance, filter.as_deref())?;
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
-        let depth_stencil_format = pick_depth_stencil_format(&instance, physical_device)
-            .ok_or_else(|| Error::NoDevice("no D32_SFLOAT_S8_UINT or D24_UNORM_S8_UINT".into()))?;
+        let depth_stencil =
+            pick_depth_stencil_format(&instance, physical_device, desc.depth_stencil)?;
 
         let priorities = [1.0];
         let queue_infos = [vk::DeviceQueueCreateInfo::default()
@@ -193,6 +268,7 @@ impl Context {
             .push_next(&mut features13);
         let device = unsafe { instance.create_device(physical_device, &device_info, None) }
             .call("vkCreateDevice")?;
+        partial.device = Some(device.clone());
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let debug_device =
             debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
@@ -210,6 +286,12 @@ impl Context {
             message: e.to_string(),
         })?;
 
+        // From here the context owns every handle and its Drop destroys them.
+        partial.device = None;
+        partial.instance = None;
+        let debug_instance = partial.debug_instance.take();
+        let messenger =
+            std::mem::replace(&mut partial.messenger, vk::DebugUtilsMessengerEXT::null());
         let ctx = Self {
             _entry: entry,
             instance,
@@ -222,7 +304,8 @@ impl Context {
             messenger,
             validation,
             device_name,
-            depth_stencil_format,
+            depth_stencil_format: depth_stencil.vk(),
+            depth_stencil,
             timestamp_period_ns: f64::from(props.limits.timestamp_period),
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
@@ -288,6 +371,11 @@ impl Context {
     /// The name of the device in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
     pub fn device_name(&self) -> &str {
         &self.device_name
+    }
+
+    /// The depth-stencil format every renderer on this context uses.
+    pub fn depth_stencil_format(&self) -> DepthStencilFormat {
+        self.depth_stencil
     }
 
     /// The validation message log; keep a clone to check it after the context is dropped

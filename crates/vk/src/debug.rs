@@ -1,20 +1,53 @@
 //! The validation-layer message log: every WARNING and ERROR message is kept, so a test can fail
-//! on it and `--validate` runs can print it and exit non-zero.
+//! on it, `--validate` runs can print it and exit non-zero, and `histencil check` can give each
+//! case the messages that arrived while it ran (by the log's length before and after).
 
 use ash::vk;
 use std::ffi::CStr;
+use std::fmt;
 use std::sync::Mutex;
+
+/// One WARNING or ERROR message.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ValidationMessage {
+    /// `ERROR` or `WARNING`.
+    pub severity: &'static str,
+    /// The layer's message id name, e.g. `SYNC-HAZARD-WRITE-AFTER-READ`
+    /// (`VUID-...` for a valid-usage rule); empty when the layer gives none.
+    pub id: String,
+    pub text: String,
+}
+
+impl fmt::Display for ValidationMessage {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "[{}] {}: {}", self.severity, self.id, self.text)
+    }
+}
 
 /// Messages the validation layer reported at WARNING or ERROR severity.
 #[derive(Default, Debug)]
 pub struct ValidationLog {
-    problems: Mutex<Vec<String>>,
+    messages: Mutex<Vec<ValidationMessage>>,
 }
 
 impl ValidationLog {
-    /// Every WARNING and ERROR message so far.
+    /// Every WARNING and ERROR message so far, as text.
     pub fn problems(&self) -> Vec<String> {
-        self.problems.lock().unwrap().clone()
+        self.lock().iter().map(|m| m.to_string()).collect()
+    }
+
+    /// How many messages arrived so far: a mark for [`ValidationLog::since`].
+    pub fn len(&self) -> usize {
+        self.lock().len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The messages that arrived after `mark` (a value of [`ValidationLog::len`]).
+    pub fn since(&self, mark: usize) -> Vec<ValidationMessage> {
+        self.lock().get(mark..).unwrap_or_default().to_vec()
     }
 
     /// Panics with every message when there is any: for tests.
@@ -28,8 +61,9 @@ impl ValidationLog {
         );
     }
 
-    fn record(&self, message: String) {
-        self.problems.lock().unwrap().push(message);
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<ValidationMessage>> {
+        // A panic while holding the lock leaves a valid Vec; keep reading it.
+        self.messages.lock().unwrap_or_else(|e| e.into_inner())
     }
 }
 
@@ -37,15 +71,18 @@ impl ValidationLog {
 /// messenger (the context destroys the messenger before dropping its log handle).
 pub(crate) unsafe extern "system" fn messenger_callback(
     severity: vk::DebugUtilsMessageSeverityFlagsEXT,
-    kind: vk::DebugUtilsMessageTypeFlagsEXT,
+    _kind: vk::DebugUtilsMessageTypeFlagsEXT,
     data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
     user_data: *mut std::ffi::c_void,
 ) -> vk::Bool32 {
-    let problem = severity.intersects(
-        vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-            | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
-    );
-    if problem && !data.is_null() && !user_data.is_null() {
+    let severity = if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        "ERROR"
+    } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+        "WARNING"
+    } else {
+        return vk::FALSE;
+    };
+    if !data.is_null() && !user_data.is_null() {
         // SAFETY: the layer passes a valid callback-data struct; user_data is the log (see above).
         let data = unsafe { &*data };
         let text = |p: *const std::ffi::c_char| {
@@ -56,11 +93,11 @@ pub(crate) unsafe extern "system" fn messenger_callback(
             }
         };
         let log = unsafe { &*(user_data as *const ValidationLog) };
-        log.record(format!(
-            "[{severity:?} {kind:?}] {}: {}",
-            text(data.p_message_id_name),
-            text(data.p_message)
-        ));
+        log.lock().push(ValidationMessage {
+            severity,
+            id: text(data.p_message_id_name),
+            text: text(data.p_message),
+        });
     }
     vk::FALSE
 }

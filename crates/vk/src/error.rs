@@ -7,6 +7,9 @@ pub enum Error {
     Loading(String),
     #[error("no suitable Vulkan 1.3 device: {0}")]
     NoDevice(String),
+    /// The device lacks a format that was asked for (a caller can skip that configuration).
+    #[error("missing format: {0}")]
+    MissingFormat(String),
     #[error("Vulkan call `{call}` failed: {result}")]
     Vulkan {
         call: &'static str,

@@ -43,8 +43,8 @@ pub mod shaders {
 pub use alpha::AlphaMode;
 pub use brdf_eval::BrdfEvaluator;
 pub use capture::SimulatorInputs;
-pub use context::{Context, ContextDesc};
-pub use debug::ValidationLog;
+pub use context::{Context, ContextDesc, DepthStencilFormat};
+pub use debug::{ValidationLog, ValidationMessage};
 pub use error::{Error, Result};
 pub use histencil_model::{CostModel, FlushPolicy, TileStats};
 pub use image_error::{masked_error, MaskedError};

@@ -52,10 +52,7 @@ impl Frame {
         for y in fp.y0..fp.y0 + fp.height {
             for x in fp.x0..fp.x0 + fp.width {
                 let i = self.target.index(x, y);
-                if fp
-                    .span(x, y)
-                    .is_some_and(|s| s.contains(self.target.depth[i]))
-                {
+                if fp.shades(x, y, self.target.depth[i]) {
                     slots.push(self.slot(i));
                 }
             }

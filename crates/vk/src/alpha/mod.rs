@@ -35,7 +35,7 @@ use histencil_model::{CompareOp, CullMode, DepthState, PassState};
 use histencil_scene::Scene;
 
 /// How the alpha pass lights translucent objects and particles.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum AlphaMode {
     /// The talk's technique: per-entity lightmaps lit on the GPU every frame.
     #[default]

@@ -1,0 +1,332 @@
+//! Judging one frame, on plain images (no device): its 8-bit error against the forward
+//! reference within the case's stated tolerance, and its stencil after lighting against what the
+//! backend promises.
+
+use crate::matrix::{Expect, Platform};
+use histencil_model::StencilLayout;
+use image::RgbaImage;
+
+/// A bound on the 8-bit error per channel: the largest difference and the mean over every
+/// channel of the pixels judged.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    pub max: u8,
+    pub mean: f64,
+}
+
+/// Exact techniques: every channel within one 8-bit step of forward (f16 HDR and float summation
+/// order differ between a light-volume pass and forward's loop).
+pub const EXACT: Tolerance = Tolerance { max: 1, mean: 1.0 };
+
+/// The LUT technique at its default resolution (32): the bound `tests/tests/techniques.rs`
+/// holds it to and the README documents (23/255 at most where Blinn-Phong 256 highlights fall
+/// between grid points; mean 0.02/255).
+pub const LUT: Tolerance = Tolerance {
+    max: 32,
+    mean: 0.05,
+};
+
+/// Lightmapped alpha entities over the pixels they cover: the README's figures at the default
+/// (coverage-chosen) lightmap sides, 13/255 mean on `alpha-many` at 1280x720, with margin for tiny
+/// frames where a region is 8 texels for a whole entity.
+pub const ALPHA_LIGHTMAP: Tolerance = Tolerance {
+    max: 255,
+    mean: 24.0,
+};
+
+/// The single light probe per entity over the pixels it covers: the README's 92/255 mean on
+/// `volume`. Only a gross failure (a black or white entity) exceeds it; what the case holds
+/// exactly is the rest of the frame, and its validation.
+pub const ALPHA_PROBE: Tolerance = Tolerance {
+    max: 255,
+    mean: 128.0,
+};
+
+/// The error of one image against another, over some of their pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImageError {
+    pub max: u8,
+    /// Mean absolute difference per channel, in 8-bit steps.
+    pub mean: f64,
+    /// Pixels judged.
+    pub pixels: usize,
+    /// Pixels with any channel beyond the tolerance's max.
+    pub over: usize,
+}
+
+impl ImageError {
+    pub fn within(&self, tolerance: Tolerance) -> bool {
+        self.max <= tolerance.max && self.mean <= tolerance.mean
+    }
+}
+
+/// The error of `actual` against `expected` over the pixels `judged` accepts (by index).
+///
+/// # Panics
+/// If the sizes differ: both come from one renderer.
+pub fn image_error(
+    actual: &RgbaImage,
+    expected: &RgbaImage,
+    tolerance: u8,
+    judged: impl Fn(usize) -> bool,
+) -> ImageError {
+    assert_eq!(actual.dimensions(), expected.dimensions());
+    let (mut max, mut sum, mut pixels, mut over) = (0u8, 0u64, 0usize, 0usize);
+    for (i, (a, e)) in actual.pixels().zip(expected.pixels()).enumerate() {
+        if !judged(i) {
+            continue;
+        }
+        let d = a.0.iter().zip(e.0).map(|(x, y)| x.abs_diff(y));
+        let worst = d.clone().max().unwrap_or(0);
+        max = max.max(worst);
+        sum += d.map(u64::from).sum::<u64>();
+        pixels += 1;
+        over += usize::from(worst > tolerance);
+    }
+    ImageError {
+        max,
+        mean: if pixels == 0 {
+            0.0
+        } else {
+            sum as f64 / (4 * pixels) as f64
+        },
+        pixels,
+        over,
+    }
+}
+
+/// The differences x 32 (so one 8-bit step shows), opaque: the `-difference.png` of a failure.
+pub fn difference_image(actual: &RgbaImage, expected: &RgbaImage) -> RgbaImage {
+    RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
+        let (a, e) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
+        let c = |i: usize| a.0[i].abs_diff(e.0[i]).saturating_mul(32);
+        image::Rgba([c(0), c(1), c(2), 255])
+    })
+}
+
+/// The image verdict of a case: its error over the pixels judged, and the bound.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageVerdict {
+    /// Over the whole frame, or with alpha cases over the pixels alpha entities cover.
+    pub error: ImageError,
+    pub tolerance: Tolerance,
+    /// Whether `error` covers only the alpha entities' pixels.
+    pub alpha_covered: bool,
+}
+
+impl ImageVerdict {
+    pub fn passed(&self) -> bool {
+        self.error.within(self.tolerance)
+    }
+
+    /// `max 12/255 (bound 1), mean 0.310/255 (bound 1) over 33153 pixels, 210 beyond the max`.
+    pub fn describe(&self) -> String {
+        let (e, t) = (&self.error, &self.tolerance);
+        format!(
+            "{}max {}/255 (bound {}), mean {:.3}/255 (bound {}) over {} pixels, {} beyond the max",
+            if self.alpha_covered {
+                "alpha-covered pixels: "
+            } else {
+                ""
+            },
+            e.max,
+            t.max,
+            e.mean,
+            t.mean,
+            e.pixels,
+            e.over
+        )
+    }
+}
+
+/// Judges `actual` against the forward reference `expected`.
+///
+/// An approximate alpha mode ([`Expect::Alpha`], with `alpha`: the forward frame without alpha
+/// entities and the mode's bound) is judged over the pixels alpha entities cover: where either
+/// the reference or the case differs from that background. (Where neither does, the case is
+/// within 1/255 of the reference by construction; the opaque frame under alpha entities is held
+/// exactly by the cases that light them forward.) Coverage cannot be read from the reference
+/// alone: an entity whose forward-lit colour equals the background there would be missed.
+pub fn judge_image(
+    expect: Expect,
+    actual: &RgbaImage,
+    expected: &RgbaImage,
+    alpha: Option<(&RgbaImage, Tolerance)>,
+) -> ImageVerdict {
+    match alpha {
+        None => {
+            let tolerance = if expect == Expect::Lut { LUT } else { EXACT };
+            ImageVerdict {
+                error: image_error(actual, expected, tolerance.max, |_| true),
+                tolerance,
+                alpha_covered: false,
+            }
+        }
+        Some((background, tolerance)) => {
+            let differs = |a: &image::Rgba<u8>, b: &image::Rgba<u8>| {
+                a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > EXACT.max)
+            };
+            let covered: Vec<bool> = (expected.pixels().zip(actual.pixels()))
+                .zip(background.pixels())
+                .map(|((e, a), b)| e != b || differs(a, b))
+                .collect();
+            ImageVerdict {
+                error: image_error(actual, expected, tolerance.max, |i| covered[i]),
+                tolerance,
+                alpha_covered: true,
+            }
+        }
+    }
+}
+
+/// What the frame's G-buffer pass wrote, per pixel: the BRDF slot of the surface there (`None`
+/// where no surface is).
+pub struct StencilInputs<'a> {
+    pub layout: StencilLayout,
+    pub slots: &'a [Option<u32>],
+    pub pattern: u8,
+    pub platform: Platform,
+    pub width: u32,
+}
+
+/// Checks the stencil after lighting: the culling bit clear everywhere, the BRDF bits as the
+/// G-buffer pass wrote them, and the preserved bits as the backend promises: intact on PS3-like,
+/// native and 360-like with save / restore; intact or zeroed (never anything else) on 360-like
+/// with zeroing. With `predicted` (the CPU simulator's stencil from the GPU's own inputs), the
+/// whole stencil must equal it, which pins down where 360-like zeroing happened.
+///
+/// Returns every problem found, each with its pixel count and first pixel.
+pub fn judge_stencil(
+    stencil: &[u8],
+    inputs: &StencilInputs<'_>,
+    predicted: Option<&[u8]>,
+) -> Vec<String> {
+    let layout = inputs.layout;
+    let preserved = layout.preserved_mask();
+    let zeroes = inputs.platform == Platform::X360;
+    let mut problems: Vec<(&str, usize, usize)> = Vec::new();
+    let mut note = |what: &'static str, i: usize| match problems.iter_mut().find(|p| p.0 == what) {
+        Some(p) => p.1 += 1,
+        None => problems.push((what, 1, i)),
+    };
+    for (i, (&value, slot)) in stencil.iter().zip(inputs.slots).enumerate() {
+        if value & layout.culling_mask() != 0 {
+            note("culling bit left set", i);
+        }
+        let (brdf, pattern) = match slot {
+            Some(slot) => (layout.brdf_reference(*slot), inputs.pattern & preserved),
+            None => (0, 0),
+        };
+        if value & layout.brdf_mask() != brdf {
+            note("BRDF bits differ from the G-buffer's", i);
+        }
+        let kept = value & preserved;
+        if kept != pattern && !(zeroes && kept == 0) {
+            note(
+                if zeroes {
+                    "preserved bits neither intact nor zeroed"
+                } else {
+                    "preserved bits not intact"
+                },
+                i,
+            );
+        }
+        if predicted.is_some_and(|p| p.get(i) != Some(&value)) {
+            note("stencil differs from the simulator's prediction", i);
+        }
+    }
+    problems
+        .into_iter()
+        .map(|(what, count, first)| {
+            let (x, y) = (first as u32 % inputs.width, first as u32 / inputs.width);
+            format!(
+                "{what} at {count} pixel(s), first ({x}, {y}): {:#04x}",
+                stencil[first]
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(pixels: &[[u8; 4]], width: u32) -> RgbaImage {
+        RgbaImage::from_raw(width, pixels.len() as u32 / width, pixels.concat()).unwrap()
+    }
+
+    #[test]
+    fn image_error_counts_only_judged_pixels() {
+        let a = image(&[[10, 10, 10, 255], [0, 0, 0, 255]], 2);
+        let b = image(&[[11, 10, 10, 255], [40, 0, 0, 255]], 2);
+        let all = image_error(&a, &b, 1, |_| true);
+        assert_eq!((all.max, all.pixels, all.over), (40, 2, 1));
+        assert!((all.mean - 41.0 / 8.0).abs() < 1e-12);
+        let first = image_error(&a, &b, 1, |i| i == 0);
+        assert_eq!((first.max, first.over), (1, 0));
+        assert!(first.within(EXACT));
+        assert!(!all.within(EXACT));
+    }
+
+    #[test]
+    fn alpha_cases_are_judged_where_either_frame_shows_an_entity() {
+        let background = image(&[[0, 0, 0, 255], [5, 5, 5, 255], [9, 9, 9, 255]], 3);
+        // Pixel 1: the reference shows an entity. Pixel 2: only the case does (an entity whose
+        // forward-lit colour equals the background). Pixel 0: neither.
+        let expected = image(&[[0, 0, 0, 255], [50, 50, 50, 255], [9, 9, 9, 255]], 3);
+        let actual = image(&[[1, 0, 0, 255], [60, 50, 50, 255], [9, 9, 99, 255]], 3);
+        let v = judge_image(
+            Expect::Alpha,
+            &actual,
+            &expected,
+            Some((&background, ALPHA_LIGHTMAP)),
+        );
+        assert_eq!((v.error.pixels, v.error.max), (2, 90));
+        assert!((v.error.mean - 100.0 / 8.0).abs() < 1e-12);
+        assert!(v.passed(), "{}", v.describe());
+        let tight = Tolerance {
+            max: 255,
+            mean: 12.0,
+        };
+        let v = judge_image(
+            Expect::Alpha,
+            &actual,
+            &expected,
+            Some((&background, tight)),
+        );
+        assert!(!v.passed(), "{}", v.describe());
+    }
+
+    #[test]
+    fn stencil_promises_per_backend() {
+        let layout = StencilLayout::new(2, 0).unwrap(); // culling 0x01, BRDF 0x02
+        let slots = [Some(0), Some(1), None];
+        let inputs = |platform| StencilInputs {
+            layout,
+            slots: &slots,
+            pattern: 0xA0,
+            platform,
+            width: 3,
+        };
+        let intact = [0xA0, 0xA2, 0x00];
+        let zeroed = [0x00, 0xA2, 0x00];
+        for platform in [Platform::Ps3, Platform::Native, Platform::X360SaveRestore] {
+            assert!(judge_stencil(&intact, &inputs(platform), None).is_empty());
+            let problems = judge_stencil(&zeroed, &inputs(platform), None);
+            assert_eq!(problems.len(), 1, "{problems:?}");
+            assert!(
+                problems[0].starts_with("preserved bits not intact at 1 pixel(s), first (0, 0)")
+            );
+        }
+        let x360 = inputs(Platform::X360);
+        assert!(judge_stencil(&zeroed, &x360, None).is_empty());
+        assert!(judge_stencil(&intact, &x360, None).is_empty());
+        // Zeroing must happen where the simulator says, not just anywhere.
+        let problems = judge_stencil(&zeroed, &x360, Some(&intact));
+        assert_eq!(problems.len(), 1, "{problems:?}");
+        // Half-zeroed bits, a stray culling bit, BRDF bits of the wrong slot.
+        let bad = [0x80, 0xA1, 0x02];
+        let problems = judge_stencil(&bad, &x360, None);
+        assert_eq!(problems.len(), 3, "{problems:?}");
+    }
+}

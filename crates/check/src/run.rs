@@ -1,0 +1,632 @@
+//! Running the matrix on a device: one validated context per depth-stencil format, one renderer
+//! per scene and resolution, the forward reference rendered first in the same process, then
+//! every case rendered, judged and given the validation messages that arrived while it ran.
+
+use crate::judge::{self, ImageVerdict, StencilInputs, ALPHA_LIGHTMAP, ALPHA_PROBE};
+use crate::matrix::{self, Case, Config, Expect, KnownWrong, Platform, SceneNeeds};
+use histencil_model::FlushPolicy;
+use histencil_scene::Scene;
+use histencil_vk::{
+    AlphaMode, Context, ContextDesc, DepthStencilFormat, Readback, Renderer, SimulatorInputs,
+    Technique, ValidationLog, ValidationMessage,
+};
+use image::{GrayImage, RgbaImage};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A scene to check, with the name it was asked for by (an embedded name or a glTF path).
+pub struct CheckScene {
+    pub name: String,
+    pub scene: Scene,
+}
+
+impl CheckScene {
+    /// The scene's name as a file-name component: the embedded name, or a glTF file's stem.
+    pub fn file_name(&self) -> String {
+        let stem = Path::new(&self.name)
+            .file_stem()
+            .map_or_else(|| self.name.clone(), |s| s.to_string_lossy().into_owned());
+        stem.chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect()
+    }
+}
+
+/// A deliberate defect, for proving that the check can fail (tests and `--inject-fault`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InjectedFault {
+    /// Every case on a hi-stencil backend is rendered without flushes, whatever it says.
+    DropFlushes,
+}
+
+/// How to run the matrix.
+#[derive(Clone, Debug, Default)]
+pub struct CheckOptions {
+    /// The resolutions 1x1, 7x5 and 257x129 only (the full run adds 1280x720).
+    pub quick: bool,
+    /// The validation layer's best-practices checks as well.
+    pub best_practices: bool,
+    /// Where a failing case writes its images, stencil dump and validation messages.
+    pub out: Option<PathBuf>,
+    /// Only cases whose `scene/case` name contains this.
+    pub filter: Option<String>,
+    pub inject: Option<InjectedFault>,
+}
+
+/// How a case ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    Passed,
+    Failed(String),
+    Skipped(String),
+}
+
+/// One case's result, with every number it was judged on.
+#[derive(Clone, Debug)]
+pub struct CaseResult {
+    /// The scene's name as asked for; `device` for a context's teardown.
+    pub scene: String,
+    pub name: String,
+    /// `None` for a teardown.
+    pub case: Option<Case>,
+    pub outcome: Outcome,
+    pub seconds: f64,
+    pub image: Option<ImageVerdict>,
+    pub stencil_problems: Vec<String>,
+    pub validation: Vec<ValidationMessage>,
+    /// A known-wrong case's evidence, or why a reference passed.
+    pub note: Option<String>,
+    /// Files written for a failure.
+    pub artifacts: Vec<PathBuf>,
+}
+
+impl CaseResult {
+    fn new(scene: &str, name: String, case: Option<Case>) -> Self {
+        Self {
+            scene: scene.to_owned(),
+            name,
+            case,
+            outcome: Outcome::Passed,
+            seconds: 0.0,
+            image: None,
+            stencil_problems: Vec::new(),
+            validation: Vec::new(),
+            note: None,
+            artifacts: Vec::new(),
+        }
+    }
+}
+
+/// The whole run.
+#[derive(Clone, Debug)]
+pub struct CheckReport {
+    pub device: String,
+    pub best_practices: bool,
+    pub quick: bool,
+    pub results: Vec<CaseResult>,
+    pub seconds: f64,
+}
+
+impl CheckReport {
+    pub fn failed(&self) -> usize {
+        self.count(|o| matches!(o, Outcome::Failed(_)))
+    }
+
+    pub fn skipped(&self) -> usize {
+        self.count(|o| matches!(o, Outcome::Skipped(_)))
+    }
+
+    pub fn passed(&self) -> usize {
+        self.count(|o| *o == Outcome::Passed)
+    }
+
+    fn count(&self, f: impl Fn(&Outcome) -> bool) -> usize {
+        self.results.iter().filter(|r| f(&r.outcome)).count()
+    }
+}
+
+/// What cannot be a case's failure: the device or its validation layer is not there at all.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckError {
+    #[error(transparent)]
+    Vulkan(#[from] histencil_vk::Error),
+    #[error("scene `{scene}`: {source}")]
+    Layout {
+        scene: String,
+        source: histencil_model::LayoutError,
+    },
+}
+
+/// Every case of `scenes`, per format and resolution, after `options.filter`: what `--list`
+/// prints and what [`run_check`] runs.
+pub fn planned_cases(
+    scenes: &[CheckScene],
+    options: &CheckOptions,
+) -> Result<Vec<(usize, Case)>, CheckError> {
+    let mut planned = Vec::new();
+    for format in DepthStencilFormat::ALL {
+        for (index, scene) in scenes.iter().enumerate() {
+            let needs = SceneNeeds::of(&scene.scene).map_err(|source| CheckError::Layout {
+                scene: scene.name.clone(),
+                source,
+            })?;
+            for size in matrix::resolutions(options.quick) {
+                for case in matrix::cases(needs, format, size) {
+                    let full = format!("{}/{}", scene.name, case.name());
+                    if options.filter.as_ref().is_none_or(|f| full.contains(f)) {
+                        planned.push((index, case));
+                    }
+                }
+            }
+        }
+    }
+    Ok(planned)
+}
+
+/// Runs the matrix. `progress` sees every result as it is made, with the number of cases
+/// planned (teardowns come on top).
+///
+/// # Errors
+/// No Vulkan device or no validation layer. Everything a case can do wrong (a renderer error
+/// included) is that case's failure instead.
+pub fn run_check(
+    scenes: &[CheckScene],
+    options: &CheckOptions,
+    mut progress: impl FnMut(&CaseResult, usize),
+) -> Result<CheckReport, CheckError> {
+    let start = Instant::now();
+    let planned = planned_cases(scenes, options)?;
+    let total = planned.len();
+    let mut results: Vec<CaseResult> = Vec::new();
+    let mut device = String::new();
+    let mut emit = |result: CaseResult, results: &mut Vec<CaseResult>| {
+        progress(&result, total);
+        results.push(result);
+    };
+    for format in DepthStencilFormat::ALL {
+        let mine: Vec<&(usize, Case)> =
+            planned.iter().filter(|(_, c)| c.format == format).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let ctx = match Context::new(ContextDesc {
+            validation: true,
+            best_practices: options.best_practices,
+            depth_stencil: Some(format),
+            ..ContextDesc::default()
+        }) {
+            Ok(ctx) => ctx,
+            Err(histencil_vk::Error::MissingFormat(reason)) => {
+                for (scene, case) in mine {
+                    let mut r = CaseResult::new(&scenes[*scene].name, case.name(), Some(*case));
+                    r.outcome = Outcome::Skipped(reason.clone());
+                    emit(r, &mut results);
+                }
+                continue;
+            }
+            Err(e) => return Err(e.into()),
+        };
+        device = ctx.device_name().to_owned();
+        let log = ctx.validation_log();
+        // Group by scene and resolution, in plan order: one renderer each.
+        let mut groups: Vec<((usize, u32, u32), Vec<Case>)> = Vec::new();
+        for (scene, case) in mine {
+            let key = (*scene, case.width, case.height);
+            match groups.last_mut() {
+                Some((k, cases)) if *k == key => cases.push(*case),
+                _ => groups.push((key, vec![*case])),
+            }
+        }
+        for ((scene, width, height), cases) in groups {
+            let group = Group {
+                ctx: &ctx,
+                log: &log,
+                scene: &scenes[scene],
+                size: (width, height),
+                options,
+            };
+            group.run(&cases, &mut |r| emit(r, &mut results));
+        }
+        let mark = log.len();
+        let teardown_start = Instant::now();
+        drop(ctx);
+        let mut r = CaseResult::new(
+            "device",
+            format!("teardown-{}", format.vk_name().to_lowercase()),
+            None,
+        );
+        r.validation = log.since(mark);
+        r.seconds = teardown_start.elapsed().as_secs_f64();
+        if let Some(first) = r.validation.first() {
+            r.outcome = Outcome::Failed(format!(
+                "{} validation message(s) at device destruction (leaked objects), first {}",
+                r.validation.len(),
+                first.id
+            ));
+        }
+        emit(r, &mut results);
+    }
+    Ok(CheckReport {
+        device,
+        best_practices: options.best_practices,
+        quick: options.quick,
+        results,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// One scene at one resolution on one context.
+struct Group<'a> {
+    ctx: &'a Context,
+    log: &'a ValidationLog,
+    scene: &'a CheckScene,
+    size: (u32, u32),
+    options: &'a CheckOptions,
+}
+
+/// What every case of a group is judged against.
+struct References {
+    forward: RgbaImage,
+    /// The forward frame without alpha entities (groups with alpha cases).
+    background: Option<RgbaImage>,
+}
+
+const IMAGES: Readback = Readback {
+    ldr: true,
+    hdr: false,
+    stencil: true,
+    brdf_ids: true,
+};
+
+impl Group<'_> {
+    fn run(&self, cases: &[Case], emit: &mut dyn FnMut(CaseResult)) {
+        let start = Instant::now();
+        let mark = self.log.len();
+        let setup = self.setup(cases);
+        let setup_messages = self.log.since(mark);
+        let (mut renderer, references) = match setup {
+            Ok(built) if setup_messages.is_empty() => built,
+            outcome => {
+                let reason = match outcome {
+                    Err(e) => format!("setting up the scene failed: {e}"),
+                    Ok(_) => format!(
+                        "{} validation message(s) while building the renderer and the forward \
+                         reference, first {}",
+                        setup_messages.len(),
+                        setup_messages[0].id
+                    ),
+                };
+                for case in cases {
+                    let mut r = self.result(case);
+                    r.validation.clone_from(&setup_messages);
+                    r.outcome = Outcome::Failed(reason.clone());
+                    emit(r);
+                }
+                return;
+            }
+        };
+        let setup_seconds = start.elapsed().as_secs_f64();
+        let mut simulated: HashMap<u8, Option<SimulatorInputs>> = HashMap::new();
+        for case in cases {
+            let start = Instant::now();
+            let mut r = match case.config {
+                None => self.reference(case, &references, setup_seconds),
+                Some(config) => self.case(case, config, &mut renderer, &references, &mut simulated),
+            };
+            if case.config.is_some() {
+                r.seconds = start.elapsed().as_secs_f64();
+            }
+            emit(r);
+        }
+    }
+
+    fn result(&self, case: &Case) -> CaseResult {
+        CaseResult::new(&self.scene.name, case.name(), Some(*case))
+    }
+
+    /// The renderer and the forward frames every case is judged against.
+    fn setup(&self, cases: &[Case]) -> histencil_vk::Result<(Renderer<'_>, References)> {
+        let (width, height) = self.size;
+        let scene = &self.scene.scene;
+        let forward = |renderer: &mut Renderer| -> histencil_vk::Result<RgbaImage> {
+            renderer.set_alpha_mode(AlphaMode::Forward);
+            let frame = renderer.render(Technique::Forward, IMAGES)?;
+            Ok(frame.images.ldr.expect("asked for"))
+        };
+        let mut renderer = Renderer::new(self.ctx, scene.clone(), width, height)?;
+        let reference = forward(&mut renderer)?;
+        let background = if cases.iter().any(|c| c.expect == Expect::Alpha) {
+            let mut bare = Renderer::new(self.ctx, scene.without_alpha(), width, height)?;
+            Some(forward(&mut bare)?)
+        } else {
+            None
+        };
+        Ok((
+            renderer,
+            References {
+                forward: reference,
+                background,
+            },
+        ))
+    }
+
+    /// The forward reference's own case: it built and rendered under validation (checked by the
+    /// caller), and a frame of a lit scene with more than a handful of pixels is not black.
+    fn reference(&self, case: &Case, references: &References, seconds: f64) -> CaseResult {
+        let mut r = self.result(case);
+        r.seconds = seconds;
+        let lit = references
+            .forward
+            .pixels()
+            .filter(|p| p.0[..3].iter().any(|c| *c > 0))
+            .count();
+        let pixels = (case.width * case.height) as usize;
+        r.note = Some(format!("{lit} of {pixels} pixels lit"));
+        if lit == 0 && pixels >= 1000 && !self.scene.scene.lights.is_empty() {
+            r.outcome = Outcome::Failed("the forward reference is black".into());
+        }
+        r
+    }
+
+    fn case(
+        &self,
+        case: &Case,
+        config: Config,
+        renderer: &mut Renderer,
+        references: &References,
+        simulated: &mut HashMap<u8, Option<SimulatorInputs>>,
+    ) -> CaseResult {
+        let mut r = self.result(case);
+        let mut technique = config.technique();
+        if self.options.inject == Some(InjectedFault::DropFlushes)
+            && config.platform.has_hi_stencil()
+            && config.lighting != matrix::Lighting::Deferred
+        {
+            technique = matrix::Config {
+                flush: FlushPolicy::Never,
+                ..config
+            }
+            .technique();
+        }
+        renderer.set_preserved_pattern(config.pattern);
+        renderer.set_alpha_mode(config.alpha);
+        let mark = self.log.len();
+        let frame = renderer.render(technique, IMAGES);
+        r.validation = self.log.since(mark);
+        let frame = match frame {
+            Ok(frame) => frame,
+            Err(e) => {
+                r.outcome = Outcome::Failed(format!("rendering failed: {e}"));
+                return r;
+            }
+        };
+        let images = frame.images;
+        let (ldr, stencil, ids) = (
+            images.ldr.expect("asked for"),
+            images.stencil.expect("asked for"),
+            images.brdf_ids.expect("asked for"),
+        );
+        let alpha_bound = match config.alpha {
+            AlphaMode::Lightmap => ALPHA_LIGHTMAP,
+            _ => ALPHA_PROBE,
+        };
+        let alpha = (case.expect == Expect::Alpha)
+            .then(|| references.background.as_ref().map(|b| (b, alpha_bound)))
+            .flatten();
+        let verdict = judge::judge_image(case.expect, &ldr, &references.forward, alpha);
+
+        // The simulator's stencil pins down where 360-like zeroing may happen; it needs the
+        // GPU's own f32 depths, and preserved bits to zero.
+        let needs_simulator = matches!(case.expect, Expect::Wrong(_))
+            || (config.platform == Platform::X360 && config.pattern != 0);
+        let inputs = if needs_simulator && case.format == DepthStencilFormat::D32S8 {
+            simulated
+                .entry(config.pattern)
+                .or_insert_with(|| capture(renderer, config.pattern))
+                .as_ref()
+        } else {
+            None
+        };
+        let brdfs = renderer.brdfs().to_vec();
+        let slots: Vec<Option<u32>> = ids
+            .iter()
+            .map(|id| id.and_then(|id| brdfs.iter().position(|b| *b == id).map(|s| s as u32)))
+            .collect();
+        let predicted = match inputs {
+            // What the configuration should do, whatever was rendered.
+            Some(inputs) if case.expect == Expect::Exact => {
+                Some(predict(renderer, inputs, config.technique()).map(|(_, stencil)| stencil))
+            }
+            _ => None,
+        };
+        let predicted = match predicted.transpose() {
+            Ok(p) => p,
+            Err(e) => {
+                r.outcome = Outcome::Failed(format!("simulating the case failed: {e}"));
+                return r;
+            }
+        };
+        r.stencil_problems = judge::judge_stencil(
+            stencil.as_raw(),
+            &StencilInputs {
+                layout: *renderer.stencil_layout(),
+                slots: &slots,
+                pattern: config.pattern,
+                platform: config.platform,
+                width: case.width,
+            },
+            predicted.as_deref(),
+        );
+        let judged_ok = verdict.passed() && r.stencil_problems.is_empty();
+        r.outcome = if let Some(first) = r.validation.first() {
+            Outcome::Failed(format!(
+                "{} validation message(s), first {}",
+                r.validation.len(),
+                if first.id.is_empty() {
+                    first.text.as_str()
+                } else {
+                    first.id.as_str()
+                }
+            ))
+        } else {
+            match case.expect {
+                Expect::Wrong(wrong) => {
+                    match known_wrong(renderer, inputs, config, wrong, judged_ok, &verdict) {
+                        Ok((outcome, note)) => {
+                            r.note = Some(note);
+                            outcome
+                        }
+                        Err(e) => Outcome::Failed(format!("simulating the case failed: {e}")),
+                    }
+                }
+                _ if judged_ok => Outcome::Passed,
+                _ => {
+                    let mut why = Vec::new();
+                    if !verdict.passed() {
+                        why.push(format!("image: {}", verdict.describe()));
+                    }
+                    why.extend(r.stencil_problems.iter().map(|p| format!("stencil: {p}")));
+                    Outcome::Failed(why.join("; "))
+                }
+            }
+        };
+        r.image = Some(verdict);
+        if matches!(r.outcome, Outcome::Failed(_)) {
+            if let Some(out) = &self.options.out {
+                r.artifacts = write_artifacts(
+                    &out.join(self.scene.file_name()),
+                    &case.name(),
+                    &ldr,
+                    &references.forward,
+                    &stencil,
+                    &r.validation,
+                );
+            }
+        }
+        r
+    }
+}
+
+/// The simulator's inputs with the preserved `pattern` in the G-buffer stencil, captured for
+/// the stencil technique (the footprints are per light, the plan is swapped per case); `None`
+/// when the device cannot give them.
+fn capture(renderer: &mut Renderer, pattern: u8) -> Option<SimulatorInputs> {
+    renderer.set_preserved_pattern(pattern);
+    let technique = Technique::Stencil {
+        backend: Platform::X360.backend(),
+        flush: FlushPolicy::Auto,
+    };
+    renderer.simulator_inputs(technique).ok()
+}
+
+/// The simulator run on `inputs` with `technique`'s plan.
+fn predict(
+    renderer: &Renderer,
+    inputs: &SimulatorInputs,
+    technique: Technique,
+) -> histencil_vk::Result<(histencil_model::SimResult, Vec<u8>)> {
+    let (plan, _) = renderer.plan(technique)?;
+    let inputs = SimulatorInputs {
+        plan,
+        ..inputs.clone()
+    };
+    let (result, target) = inputs.predict();
+    Ok((result, target.stencil))
+}
+
+/// A known-wrong case's outcome: where the simulator predicts it shades fewer fragments than
+/// its corrected configuration, it must fail the image or stencil judgement (passing means the
+/// check has gone blind); where it predicts no difference it is skipped as not applicable.
+fn known_wrong(
+    renderer: &Renderer,
+    inputs: Option<&SimulatorInputs>,
+    config: Config,
+    wrong: KnownWrong,
+    judged_ok: bool,
+    verdict: &ImageVerdict,
+) -> histencil_vk::Result<(Outcome, String)> {
+    let Some(inputs) = inputs else {
+        return Ok((
+            Outcome::Skipped("the simulator's inputs need D32_SFLOAT_S8_UINT depth".into()),
+            String::new(),
+        ));
+    };
+    let fixed = matrix::corrected(config);
+    let (broken, _) = predict(renderer, inputs, config.technique())?;
+    let (correct, _) = predict(renderer, inputs, fixed.technique())?;
+    let (lost, shaded) = (
+        correct
+            .stats
+            .fragments_shaded
+            .saturating_sub(broken.stats.fragments_shaded),
+        correct.stats.fragments_shaded,
+    );
+    let note = format!(
+        "{}: the simulator predicts {lost} of {shaded} fragments lost",
+        wrong.describe()
+    );
+    Ok(if lost == 0 {
+        (
+            Outcome::Skipped(format!(
+                "not applicable here: the simulator predicts that {} loses no fragment",
+                wrong.describe()
+            )),
+            note,
+        )
+    } else if judged_ok {
+        (
+            Outcome::Failed(format!(
+                "the check has gone blind: a known-wrong configuration passed ({note}; {})",
+                verdict.describe()
+            )),
+            note,
+        )
+    } else {
+        (Outcome::Passed, format!("failed as expected: {note}"))
+    })
+}
+
+/// Writes a failing case's `-actual.png`, `-expected.png`, `-difference.png`, `-stencil.png`
+/// (the raw stencil byte per pixel) and `-validation.txt`; returns what was written. A file that
+/// cannot be written is left out (the failure itself is what matters).
+fn write_artifacts(
+    dir: &Path,
+    name: &str,
+    actual: &RgbaImage,
+    expected: &RgbaImage,
+    stencil: &GrayImage,
+    validation: &[ValidationMessage],
+) -> Vec<PathBuf> {
+    let path = |suffix: &str| dir.join(format!("{name}-{suffix}"));
+    let mut written = Vec::new();
+    let mut keep = |p: PathBuf, ok: bool| {
+        if ok {
+            written.push(p);
+        }
+    };
+    let p = path("actual.png");
+    keep(p.clone(), histencil_vk::save_png(actual, &p).is_ok());
+    let p = path("expected.png");
+    keep(p.clone(), histencil_vk::save_png(expected, &p).is_ok());
+    let p = path("difference.png");
+    let difference = judge::difference_image(actual, expected);
+    keep(p.clone(), histencil_vk::save_png(&difference, &p).is_ok());
+    let p = path("stencil.png");
+    keep(p.clone(), histencil_vk::save_png(stencil, &p).is_ok());
+    if !validation.is_empty() {
+        let text: String = validation.iter().map(|m| format!("{m}\n")).collect();
+        let p = path("validation.txt");
+        keep(
+            p.clone(),
+            histencil_vk::write_atomically(&p, text.as_bytes()).is_ok(),
+        );
+    }
+    written
+}
