@@ -17,5 +17,5 @@ mod run;
 
 pub use run::{
     planned_cases, run_check, CaseResult, CheckError, CheckOptions, CheckReport, CheckScene,
-    InjectedFault, Outcome,
+    InjectedFault, Outcome, ACCEPTED_BEST_PRACTICES,
 };

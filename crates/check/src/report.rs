@@ -232,6 +232,7 @@ pub fn json(report: &CheckReport) -> Value {
                 "validation": r.validation.iter().map(|m| json!({
                     "severity": m.severity, "id": m.id, "text": m.text
                 })).collect::<Vec<_>>(),
+                "accepted_best_practices_messages": r.accepted,
                 "note": r.note,
                 "artifacts": r.artifacts.iter().map(|a| a.display().to_string()).collect::<Vec<_>>(),
             })
@@ -358,6 +359,7 @@ mod tests {
             image: None,
             stencil_problems: vec![],
             validation: vec![],
+            accepted: 0,
             note: None,
             artifacts: vec![],
         };

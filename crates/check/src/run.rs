@@ -39,6 +39,25 @@ impl CheckScene {
     }
 }
 
+/// Best-practices messages histencil accepts under `--best-practices`, with the reason; they
+/// are counted per case ([`CaseResult::accepted`]) instead of failing it. Only best-practices
+/// ids can be here: a validation or synchronisation message always fails.
+pub const ACCEPTED_BEST_PRACTICES: [(&str, &str); 1] = [(
+    "UNASSIGNED-BestPractices-SpirvDeprecated_WorkgroupSize",
+    "glslang declares the WorkgroupSize built-in for every compute shader's local size; the \
+     LocalSizeId mode that replaces it needs SPIR-V 1.6 (VK_KHR_maintenance4), and the shaders \
+     target SPIR-V 1.3 so that naga can validate them",
+)];
+
+/// The messages since `mark`, less the accepted best-practices ones (returned as a count).
+fn messages_since(log: &ValidationLog, mark: usize) -> (Vec<ValidationMessage>, usize) {
+    let (accepted, failing): (Vec<_>, Vec<_>) = log
+        .since(mark)
+        .into_iter()
+        .partition(|m| ACCEPTED_BEST_PRACTICES.iter().any(|(id, _)| m.id == *id));
+    (failing, accepted.len())
+}
+
 /// A deliberate defect, for proving that the check can fail (tests and `--inject-fault`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InjectedFault {
@@ -81,6 +100,8 @@ pub struct CaseResult {
     pub image: Option<ImageVerdict>,
     pub stencil_problems: Vec<String>,
     pub validation: Vec<ValidationMessage>,
+    /// Messages of [`ACCEPTED_BEST_PRACTICES`] that arrived during the case.
+    pub accepted: usize,
     /// A known-wrong case's evidence, or why a reference passed.
     pub note: Option<String>,
     /// Files written for a failure.
@@ -98,6 +119,7 @@ impl CaseResult {
             image: None,
             stencil_problems: Vec::new(),
             validation: Vec::new(),
+            accepted: 0,
             note: None,
             artifacts: Vec::new(),
         }
@@ -242,7 +264,7 @@ pub fn run_check(
             format!("teardown-{}", format.vk_name().to_lowercase()),
             None,
         );
-        r.validation = log.since(mark);
+        (r.validation, r.accepted) = messages_since(&log, mark);
         r.seconds = teardown_start.elapsed().as_secs_f64();
         if let Some(first) = r.validation.first() {
             r.outcome = Outcome::Failed(format!(
@@ -290,7 +312,7 @@ impl Group<'_> {
         let start = Instant::now();
         let mark = self.log.len();
         let setup = self.setup(cases);
-        let setup_messages = self.log.since(mark);
+        let (setup_messages, setup_accepted) = messages_since(self.log, mark);
         let (mut renderer, references) = match setup {
             Ok(built) if setup_messages.is_empty() => built,
             outcome => {
@@ -306,6 +328,7 @@ impl Group<'_> {
                 for case in cases {
                     let mut r = self.result(case);
                     r.validation.clone_from(&setup_messages);
+                    r.accepted = setup_accepted;
                     r.outcome = Outcome::Failed(reason.clone());
                     emit(r);
                 }
@@ -314,6 +337,8 @@ impl Group<'_> {
         };
         let setup_seconds = start.elapsed().as_secs_f64();
         let mut simulated: HashMap<u8, Option<SimulatorInputs>> = HashMap::new();
+        // Accepted messages of the setup count towards the group's first case.
+        let mut setup_accepted = setup_accepted;
         for case in cases {
             let start = Instant::now();
             let mut r = match case.config {
@@ -323,6 +348,7 @@ impl Group<'_> {
             if case.config.is_some() {
                 r.seconds = start.elapsed().as_secs_f64();
             }
+            r.accepted += std::mem::take(&mut setup_accepted);
             emit(r);
         }
     }
@@ -399,7 +425,7 @@ impl Group<'_> {
         renderer.set_alpha_mode(config.alpha);
         let mark = self.log.len();
         let frame = renderer.render(technique, IMAGES);
-        r.validation = self.log.since(mark);
+        (r.validation, r.accepted) = messages_since(self.log, mark);
         let frame = match frame {
             Ok(frame) => frame,
             Err(e) => {

@@ -40,7 +40,9 @@ pub fn access_info(
         ImageAccess::FragmentSampled => (
             vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
             S::FRAGMENT_SHADER,
-            A::SHADER_SAMPLED_READ,
+            // SHADER_READ rather than its sync2 refinement SHADER_SAMPLED_READ: the same
+            // dependency, and the one the best-practices layer expects with this layout.
+            A::SHADER_READ,
         ),
         ImageAccess::TransferSource => (
             vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
@@ -95,11 +97,24 @@ pub(crate) fn transition(
 /// fragment shaders, attachments, copies and compute many times a frame; one broad barrier
 /// between those phases is simpler to get right than a precise one per hand-over, and costs the
 /// same on a driver that serialises them anyway.
+///
+/// The stages are the ones histencil records (named rather than `ALL_COMMANDS`, which the
+/// best-practices layer flags); synchronisation validation in every test run would report a
+/// hazard through a stage missing here.
 pub(crate) fn memory_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
+    use vk::PipelineStageFlags2 as S;
+    let stages = S::VERTEX_INPUT
+        | S::VERTEX_SHADER
+        | S::EARLY_FRAGMENT_TESTS
+        | S::FRAGMENT_SHADER
+        | S::LATE_FRAGMENT_TESTS
+        | S::COLOR_ATTACHMENT_OUTPUT
+        | S::COMPUTE_SHADER
+        | S::ALL_TRANSFER;
     let barrier = [vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+        .src_stage_mask(stages)
         .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+        .dst_stage_mask(stages)
         .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
     let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };

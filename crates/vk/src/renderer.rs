@@ -289,9 +289,7 @@ impl<'c> Renderer<'c> {
             HDR_FORMAT,
             ctx.depth_stencil_format,
         );
-        let pool_info = vk::CommandPoolCreateInfo::default()
-            .queue_family_index(ctx.queue_family)
-            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
         let command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
             .call("vkCreateCommandPool")?;
         ctx.name(command_pool, "frame-command-pool");
@@ -688,12 +686,13 @@ impl<'c> Renderer<'c> {
         })
     }
 
-    /// Resets and begins the frame's command buffer.
+    /// Resets the frame's command pool (its one command buffer; resetting pools, not single
+    /// buffers, is what the best-practices layer asks for) and begins the command buffer.
     fn begin_commands(&self) -> Result<vk::CommandBuffer> {
         let (d, cmd) = (&self.ctx.device, self.cmd);
         unsafe {
-            d.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty())
-                .call("vkResetCommandBuffer")?;
+            d.reset_command_pool(self.command_pool, vk::CommandPoolResetFlags::empty())
+                .call("vkResetCommandPool")?;
             let begin = vk::CommandBufferBeginInfo::default()
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(cmd, &begin)

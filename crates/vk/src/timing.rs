@@ -117,7 +117,7 @@ fn timestamp_pool(ctx: &Context, name: &str, count: u32) -> Result<vk::QueryPool
 fn write_timestamp(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, index: u32) {
     unsafe {
         ctx.device
-            .cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, pool, index)
+            .cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::BOTTOM_OF_PIPE, pool, index)
     };
 }
 

@@ -529,8 +529,21 @@ impl AlphaLighting {
         ctx.begin_label(cmd, "alpha");
         self.bind_sets(ctx, cmd, frame_set);
         // Forward and probe frames never write the lightmap; the transition still gives the
-        // bound (and unread) image the layout its descriptor declares.
+        // bound (and unread) image the layout its descriptor declares. An atlas no frame has
+        // written yet is cleared first, so no read-only layout is entered from UNDEFINED.
         for image in [&mut self.positions, &mut self.normals, &mut self.lightmap] {
+            if image.last_access == ImageAccess::Nothing {
+                transition(
+                    ctx,
+                    cmd,
+                    image,
+                    ImageAccess::ColorAttachment,
+                    Contents::Discard,
+                );
+                let colors = [color_attachment(image, Load::Clear(CLEAR_BLACK))];
+                begin_rendering(ctx, cmd, image.extent, &colors, None);
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            }
             transition(
                 ctx,
                 cmd,
