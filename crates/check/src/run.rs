@@ -336,7 +336,7 @@ impl Group<'_> {
             }
         };
         let setup_seconds = start.elapsed().as_secs_f64();
-        let mut simulated: HashMap<u8, Option<SimulatorInputs>> = HashMap::new();
+        let mut simulated: HashMap<u8, Result<SimulatorInputs, String>> = HashMap::new();
         // Accepted messages of the setup count towards the group's first case.
         let mut setup_accepted = setup_accepted;
         for case in cases {
@@ -407,7 +407,7 @@ impl Group<'_> {
         config: Config,
         renderer: &mut Renderer,
         references: &References,
-        simulated: &mut HashMap<u8, Option<SimulatorInputs>>,
+        simulated: &mut HashMap<u8, Result<SimulatorInputs, String>>,
     ) -> CaseResult {
         let mut r = self.result(case);
         let mut technique = config.technique();
@@ -452,14 +452,18 @@ impl Group<'_> {
         // GPU's own f32 depths, and preserved bits to zero.
         let needs_simulator = matches!(case.expect, Expect::Wrong(_))
             || (config.platform == Platform::X360 && config.pattern != 0);
-        let inputs = if needs_simulator && case.format == DepthStencilFormat::D32S8 {
+        let inputs = if !needs_simulator {
+            Err(String::new())
+        } else if case.format != DepthStencilFormat::D32S8 {
+            Err("the simulator reads f32 depth: D32_SFLOAT_S8_UINT only".to_owned())
+        } else {
             simulated
                 .entry(config.pattern)
                 .or_insert_with(|| capture(renderer, config.pattern))
                 .as_ref()
-        } else {
-            None
+                .map_err(Clone::clone)
         };
+        let inputs = inputs.as_ref().map(|i| *i);
         let brdfs = renderer.brdfs().to_vec();
         let slots: Vec<Option<u32>> = ids
             .iter()
@@ -467,7 +471,7 @@ impl Group<'_> {
             .collect();
         let predicted = match inputs {
             // What the configuration should do, whatever was rendered.
-            Some(inputs) if case.expect == Expect::Exact => {
+            Ok(inputs) if case.expect == Expect::Exact => {
                 Some(predict(renderer, inputs, config.technique()).map(|(_, stencil)| stencil))
             }
             _ => None,
@@ -541,15 +545,17 @@ impl Group<'_> {
 }
 
 /// The simulator's inputs with the preserved `pattern` in the G-buffer stencil, captured for
-/// the stencil technique (the footprints are per light, the plan is swapped per case); `None`
-/// when the device cannot give them.
-fn capture(renderer: &mut Renderer, pattern: u8) -> Option<SimulatorInputs> {
+/// the stencil technique (the footprints are per light, the plan is swapped per case), or why
+/// the device cannot give them.
+fn capture(renderer: &mut Renderer, pattern: u8) -> Result<SimulatorInputs, String> {
     renderer.set_preserved_pattern(pattern);
     let technique = Technique::Stencil {
         backend: Platform::X360.backend(),
         flush: FlushPolicy::Auto,
     };
-    renderer.simulator_inputs(technique).ok()
+    renderer
+        .simulator_inputs(technique)
+        .map_err(|e| format!("capturing the simulator's inputs failed: {e}"))
 }
 
 /// The simulator run on `inputs` with `technique`'s plan.
@@ -572,17 +578,18 @@ fn predict(
 /// check has gone blind); where it predicts no difference it is skipped as not applicable.
 fn known_wrong(
     renderer: &Renderer,
-    inputs: Option<&SimulatorInputs>,
+    inputs: Result<&SimulatorInputs, &String>,
     config: Config,
     wrong: KnownWrong,
     judged_ok: bool,
     verdict: &ImageVerdict,
 ) -> histencil_vk::Result<(Outcome, String)> {
-    let Some(inputs) = inputs else {
-        return Ok((
-            Outcome::Skipped("the simulator's inputs need D32_SFLOAT_S8_UINT depth".into()),
-            String::new(),
-        ));
+    let inputs = match inputs {
+        Ok(inputs) => inputs,
+        Err(why) => {
+            let why = format!("cannot tell whether the failure must show here: {why}");
+            return Ok((Outcome::Skipped(why), String::new()));
+        }
     };
     let fixed = matrix::corrected(config);
     let (broken, _) = predict(renderer, inputs, config.technique())?;
