@@ -75,6 +75,18 @@ pub struct CalibrateArgs {
     out: PathBuf,
 }
 
+#[derive(clap::Args)]
+pub struct DemoArgs {
+    /// An embedded scene or a `.gltf` / `.glb` file.
+    #[arg(long, default_value = "default")]
+    scene: String,
+    #[command(flatten)]
+    run: RunArgs,
+    /// The contact sheet (PNG).
+    #[arg(long, default_value = "out/demo.png")]
+    out: PathBuf,
+}
+
 /// A spinner with a message, or a bar when the number of steps is known.
 fn progress_bar(steps: Option<u64>) -> ProgressBar {
     match steps {
@@ -192,6 +204,35 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         c.shade_ms,
         c.crossover_coverage()
             .map_or("never".to_owned(), |x| format!("{:.2} % of the screen", x * 100.0))
+    );
+    Ok(())
+}
+
+pub fn demo(args: &DemoArgs) -> Result<()> {
+    histencil_vk::check_output_file(&args.out)?;
+    let settings = histencil_lab::DemoSettings {
+        scene: crate::load_scene_arg(&args.scene)?,
+        width: args.run.width,
+        height: args.run.height,
+        frames: args.run.frames as usize,
+    };
+    let report = on_device(args.run.validate, |ctx| {
+        Ok(with_spinner(|step| {
+            histencil_lab::run_demo(ctx, settings, step)
+        })?)
+    })?;
+    histencil_vk::save_png(&report.sheet, &args.out)?;
+    println!("The talk on `{}`:\n", args.scene);
+    print!("{}", report.table());
+    println!(
+        "\nwrote {}: forward | stencil 360-like | difference x16 | stencil byte, then the \
+         talk's failures next to their fixes",
+        args.out.display()
+    );
+    println!(
+        "\nnext:\n  histencil compare --out out/compare        the talk's table on this device\n  \
+         histencil check --quick --junit out/junit.xml   the validation-CI matrix\n  \
+         histencil render --scene your.gltf --technique stencil --backend x360 --out out/yours.png"
     );
     Ok(())
 }

@@ -27,6 +27,9 @@ struct Cli {
 enum Command {
     /// Render a scene to PNG (and optionally EXR and a stencil dump).
     Render(RenderArgs),
+    /// A short tour of the talk: stencil on the 360-like, PS3-like and native backends next to
+    /// branching and forward, with times, errors and hi-stencil statistics, and a contact sheet.
+    Demo(lab::DemoArgs),
     /// List the embedded scenes: name, BRDFs in use, lights, alpha entities, description.
     Scenes,
     /// The talk's table on this device: lighting time with 1, 2, 3 BRDFs per technique and
@@ -493,6 +496,7 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Compare(args) => lab::compare(args),
+        Command::Demo(args) => lab::demo(args),
         Command::Sweep(args) => lab::sweep(args),
         Command::Calibrate(args) => lab::calibrate(args),
         Command::BrdfEval(args) => brdf_eval(args),

@@ -110,7 +110,15 @@ fn a_broken_renderer_fails_the_check_with_junit_failures_and_images() {
         assert_eq!((image.width(), image.height()), (257, 129));
     }
     // The same case without the fault passes: the failure was the fault's.
-    let (code, stdout, stderr) = check(&["--quick", "--scene", "default", "--filter", case]);
+    let (code, stdout, stderr) = check(&[
+        "--quick",
+        "--scene",
+        "default",
+        "--filter",
+        case,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(code, Some(0), "{stdout}\n{stderr}");
 }
 

@@ -431,3 +431,38 @@ fn a_scene_without_lights_is_announced() {
     assert!(out.exists());
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn demo_prints_the_tour_and_writes_the_contact_sheet_under_validation() {
+    let dir = std::env::temp_dir().join("histencil-cli-demo");
+    let _ = std::fs::remove_dir_all(&dir);
+    let sheet = dir.join("demo.png");
+    let (ok, stdout, stderr) = histencil(&[
+        "demo",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--frames",
+        "1",
+        "--validate",
+        "--out",
+        sheet.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    for row in [
+        "forward (reference)",
+        "branching, native",
+        "stencil, PS3-like",
+        "stencil, 360-like (zeroing)",
+        "stencil, 360-like (save/restore)",
+    ] {
+        assert!(stdout.contains(row), "{row}: {stdout}");
+    }
+    assert!(stdout.contains("flushes"), "{stdout}");
+    assert!(stdout.contains("histencil check"), "{stdout}");
+    // Four half-size tiles per row, two rows, each under a caption band.
+    let image = image::open(&sheet).expect("the contact sheet");
+    assert_eq!(image.width(), 4 * (48 + 6) + 6);
+    assert_eq!(image.height(), 2 * (32 + 30 + 6) + 6);
+}

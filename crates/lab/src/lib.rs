@@ -7,12 +7,17 @@
 //!   sweep showing where branching overtakes stencil and whether adaptive follows the better one.
 //! - [`sweep`]: speed against error for one setting (LUT resolution, lightmap resolution,
 //!   hi-stencil tile size), with its Pareto front.
+//! - [`demo`]: a short tour of the talk on one scene (`histencil demo`, `tools/demo`): the
+//!   techniques and backends side by side with their times, errors and hi-stencil statistics,
+//!   and a contact sheet of the frames, the stencil byte and the talk's failures.
 //! - [`calibrate`]: this device's per-pass overhead, branch tax and shade cost, the
 //!   [`CostModel`](histencil_vk::CostModel) that the adaptive technique chooses with.
 
 mod alpha_reference;
 pub mod calibrate;
 pub mod compare;
+mod contact_sheet;
+pub mod demo;
 mod image_error;
 mod measure;
 mod plot;
@@ -22,6 +27,7 @@ mod variants;
 pub use alpha_reference::AlphaReference;
 pub use calibrate::{calibrate, read_costs, Calibration};
 pub use compare::{run_compare, CompareReport, CompareSettings};
+pub use demo::{run_demo, DemoReport, DemoSettings};
 pub use image_error::{image_error, ImageError};
 pub use measure::Timing;
 pub use sweep::{run_sweep, SweepParam, SweepReport};

@@ -1,0 +1,243 @@
+//! The demo: a short tour of the talk on one scene. The talk's stencil technique on the 360-like
+//! backend (zeroing, with engine bits in the preserved stencil bits), on the PS3-like backend and
+//! on plain Vulkan, next to branching and the forward reference: each with its lighting time, its
+//! error against forward, its hi-stencil statistics and what happened to the engine's bits; and a
+//! contact sheet that shows the frame, its difference from forward, the stencil byte, and the
+//! talk's two failures next to their fixes.
+
+use crate::contact_sheet::{contact_sheet, difference, stencil_colours};
+use crate::image_error::{image_error, ImageError};
+use crate::measure::{frame, time_passes, Timing};
+use crate::Result;
+use histencil_scene::Scene;
+use histencil_vk::{Backend, Context, FlushPolicy, Readback, Renderer, Technique, TileStats};
+use image::{RgbImage, RgbaImage};
+use std::fmt::Write as _;
+
+/// The engine's bits in the preserved stencil bits, as in the talk's 360 story.
+pub const DEMO_PATTERN: u8 = 0xA0;
+
+/// What the demo renders.
+pub struct DemoSettings {
+    pub scene: Scene,
+    pub width: u32,
+    pub height: u32,
+    /// Timed frames per row (after one warm-up frame).
+    pub frames: usize,
+}
+
+/// One row of the demo's table.
+pub struct DemoRow {
+    pub label: &'static str,
+    pub technique: Technique,
+    /// Lighting (or, for forward, the forward pass) over the timed frames.
+    pub time: Timing,
+    /// `None` for the reference itself.
+    pub error: Option<ImageError>,
+    /// Emulated hi-stencil backends only.
+    pub tiles: Option<TileStats>,
+    /// Surface pixels whose engine bits survived lighting, and those zeroed.
+    pub preserved: Option<(usize, usize)>,
+}
+
+pub struct DemoReport {
+    pub device: String,
+    pub width: u32,
+    pub height: u32,
+    pub frames: usize,
+    pub rows: Vec<DemoRow>,
+    /// The contact sheet (`out/demo.png`).
+    pub sheet: RgbImage,
+}
+
+/// A frame's stencil after lighting and which of its pixels hold a surface.
+type StencilView = (image::GrayImage, Vec<bool>);
+
+const X360: Backend = Backend::X360 {
+    zero_preserved: true,
+    save_restore: false,
+};
+const X360_NO_ZEROING: Backend = Backend::X360 {
+    zero_preserved: false,
+    save_restore: false,
+};
+
+fn stencil(backend: Backend, flush: FlushPolicy) -> Technique {
+    Technique::Stencil { backend, flush }
+}
+
+/// The rows, in the table's order.
+fn configurations() -> [(&'static str, Technique); 6] {
+    let auto = FlushPolicy::Auto;
+    [
+        ("forward (reference)", Technique::Forward),
+        ("branching, native", Technique::DEFERRED),
+        ("stencil, native", stencil(Backend::Native, auto)),
+        ("stencil, PS3-like", stencil(Backend::Ps3, auto)),
+        ("stencil, 360-like (zeroing)", stencil(X360, auto)),
+        (
+            "stencil, 360-like (save/restore)",
+            stencil(
+                Backend::X360 {
+                    zero_preserved: true,
+                    save_restore: true,
+                },
+                auto,
+            ),
+        ),
+    ]
+}
+
+/// Runs the tour. `step` is told what is being rendered.
+pub fn run_demo(
+    ctx: &Context,
+    settings: DemoSettings,
+    step: &mut dyn FnMut(&str),
+) -> Result<DemoReport> {
+    let mut renderer = Renderer::new(ctx, settings.scene, settings.width, settings.height)?;
+    renderer.set_preserved_pattern(DEMO_PATTERN);
+    let layout = *renderer.stencil_layout();
+    let preserved_mask = layout.preserved_mask();
+    let all = Readback {
+        hdr: false,
+        ..Readback::ALL
+    };
+    let mut frames: Vec<(RgbaImage, Option<StencilView>)> = Vec::new();
+    let mut rows = Vec::new();
+    for (label, technique) in configurations() {
+        step(label);
+        let pass = if technique == Technique::Forward {
+            "forward"
+        } else {
+            "lighting"
+        };
+        let time = time_passes(&mut renderer, technique, &[pass], settings.frames)?;
+        let images = renderer.render(technique, all)?.images;
+        let ldr = images.ldr.expect("asked for");
+        let error = frames
+            .first()
+            .map(|(forward, _)| image_error(&ldr, forward));
+        let preserved = images
+            .stencil
+            .as_ref()
+            .zip(images.brdf_ids.as_ref())
+            .map(|(s, ids)| {
+                let surfaces = s.as_raw().iter().zip(ids).filter(|(_, id)| id.is_some());
+                let kept = surfaces
+                    .clone()
+                    .filter(|(v, _)| *v & preserved_mask == DEMO_PATTERN & preserved_mask)
+                    .count();
+                (kept, surfaces.count() - kept)
+            });
+        let tiles = match technique {
+            Technique::Stencil { backend, .. } if backend != Backend::Native => {
+                renderer.set_tile_stats(true);
+                let stats = renderer.render(technique, Readback::NONE);
+                renderer.set_tile_stats(false);
+                stats?.tile_stats
+            }
+            _ => None,
+        };
+        rows.push(DemoRow {
+            label,
+            technique,
+            time,
+            error,
+            tiles,
+            preserved: preserved.filter(|_| technique != Technique::Forward),
+        });
+        let surfaces = images
+            .brdf_ids
+            .map(|ids| ids.iter().map(Option::is_some).collect::<Vec<_>>());
+        frames.push((ldr, images.stencil.zip(surfaces)));
+    }
+    step("the talk's failures");
+    let no_zeroing = frame(&mut renderer, stencil(X360_NO_ZEROING, FlushPolicy::Auto))?;
+    let never = frame(&mut renderer, stencil(Backend::Ps3, FlushPolicy::Never))?;
+    let forward = frames[0].0.clone();
+    let x360 = frames[4].0.clone();
+    let (ps3, ps3_stencil) = frames[3].clone();
+    let (ps3_stencil, surfaces) = ps3_stencil.expect("asked for");
+    let max_difference = rows[4].error.map_or(0.0, |e| e.max);
+    let tiles = vec![
+        ("forward (reference)".to_owned(), forward.clone()),
+        ("stencil technique, 360-like".to_owned(), x360.clone()),
+        (
+            format!("difference x16 (max {max_difference}/255)"),
+            difference(&x360, &forward, 16),
+        ),
+        (
+            "PS3-like stencil: G BRDF id, B engine bits, R culling".to_owned(),
+            stencil_colours(&ps3_stencil, &layout, &surfaces),
+        ),
+        ("FAIL 360-like without zeroing".to_owned(), no_zeroing),
+        ("fix: zeroing as lights draw".to_owned(), x360),
+        ("FAIL PS3-like, no hi-stencil flush".to_owned(), never),
+        ("fix: flush before each test".to_owned(), ps3),
+    ];
+    Ok(DemoReport {
+        device: ctx.device_name().to_owned(),
+        width: settings.width,
+        height: settings.height,
+        frames: settings.frames,
+        rows,
+        sheet: contact_sheet(&halved(tiles), 4),
+    })
+}
+
+/// The tiles at half size, so that four frames fit a screen side by side.
+fn halved(tiles: Vec<(String, RgbaImage)>) -> Vec<(String, RgbaImage)> {
+    tiles
+        .into_iter()
+        .map(|(caption, t)| {
+            let (w, h) = ((t.width() / 2).max(1), (t.height() / 2).max(1));
+            let small = image::imageops::resize(&t, w, h, image::imageops::FilterType::Triangle);
+            (caption, small)
+        })
+        .collect()
+}
+
+impl DemoReport {
+    /// The table, in plain text.
+    pub fn table(&self) -> String {
+        let mut out = format!(
+            "{}x{}, device {}; lighting time: median (spread) of {} frames; error against \
+             forward: 8-bit max / mean, mean FLIP; engine bits 0x{DEMO_PATTERN:02X}\n\n",
+            self.width, self.height, self.device, self.frames
+        );
+        let _ = writeln!(
+            out,
+            "{:<34} {:>18} {:>22} {:>28} {:>22}",
+            "technique, backend",
+            "lighting ms",
+            "error (max/mean/FLIP)",
+            "hi-stencil tiles culled",
+            "engine bits kept"
+        );
+        for row in &self.rows {
+            let time = format!("{:.1} ({:.1})", row.time.median_ms, row.time.spread_ms());
+            let error = row.error.map_or("reference".to_owned(), |e| {
+                format!("{:.0} / {:.3} / {:.4}", e.max, e.mean, e.flip)
+            });
+            let tiles = row.tiles.map_or("-".to_owned(), |t| {
+                format!(
+                    "{} of {}, {} flushes",
+                    t.tiles_culled, t.tiles_tested, t.flushes
+                )
+            });
+            let preserved = row.preserved.map_or("-".to_owned(), |(kept, zeroed)| {
+                if zeroed == 0 {
+                    format!("all {kept} px")
+                } else {
+                    format!("{kept} px, {zeroed} zeroed")
+                }
+            });
+            let _ = writeln!(
+                out,
+                "{:<34} {:>18} {:>22} {:>28} {:>22}",
+                row.label, time, error, tiles, preserved
+            );
+        }
+        out
+    }
+}
