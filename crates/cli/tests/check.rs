@@ -81,44 +81,35 @@ fn a_clean_slice_passes_and_its_known_wrong_cases_fail_as_expected() {
 #[test]
 fn a_broken_renderer_fails_the_check_with_junit_failures_and_images() {
     let dir = fresh_dir("broken");
-    let (junit, out) = (dir.join("junit.xml"), dir.join("cases"));
+    let (junit_path, out_path) = (dir.join("junit.xml"), dir.join("cases"));
     let case = "stencil-ps3-auto-p00-lightmap-d32s8-257x129";
-    let (code, stdout, stderr) = check(&[
-        "--quick",
-        "--scene",
-        "default",
-        "--filter",
-        case,
-        "--inject-fault",
-        "drop-flushes",
-        "--junit",
-        junit.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (junit, out) = (junit_path.to_str().unwrap(), out_path.to_str().unwrap());
+    let one_case = [
+        "--quick", "--scene", "default", "--filter", case, "--out", out,
+    ];
+    let broken = [
+        &one_case[..],
+        &["--inject-fault", "drop-flushes", "--junit", junit],
+    ]
+    .concat();
+    let (code, stdout, stderr) = check(&broken);
     assert_eq!(code, Some(1), "{stdout}\n{stderr}");
     assert!(
         stderr.contains(&format!("FAILED default/{case}: image: max")),
         "{stderr}"
     );
-    let xml = text(&junit);
+    let xml = text(&junit_path);
     assert!(xml.contains("failures=\"1\""), "{xml}");
     assert!(xml.contains("type=\"image\""), "{xml}");
     for suffix in ["actual", "expected", "difference", "stencil"] {
-        let png = out.join("default").join(format!("{case}-{suffix}.png"));
+        let png = out_path
+            .join("default")
+            .join(format!("{case}-{suffix}.png"));
         let image = image::open(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display()));
         assert_eq!((image.width(), image.height()), (257, 129));
     }
     // The same case without the fault passes: the failure was the fault's.
-    let (code, stdout, stderr) = check(&[
-        "--quick",
-        "--scene",
-        "default",
-        "--filter",
-        case,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (code, stdout, stderr) = check(&one_case);
     assert_eq!(code, Some(0), "{stdout}\n{stderr}");
 }
 
