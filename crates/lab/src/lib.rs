@@ -21,6 +21,7 @@ pub mod demo;
 mod image_error;
 mod measure;
 mod plot;
+pub mod stats;
 pub mod sweep;
 mod variants;
 

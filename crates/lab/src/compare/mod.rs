@@ -4,11 +4,12 @@
 mod report;
 
 use crate::image_error::{image_error, ImageError};
-use crate::measure::{frame, time_lighting, Timing};
+use crate::measure::{frame, Timing};
+use crate::stats::{median_interval, ratio_interval, Interval, Verdict};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::Result;
 use histencil_scene::Scene;
-use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Renderer, Technique};
+use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Readback, Renderer, Technique};
 
 /// What a comparison run measures.
 #[derive(Clone, Debug)]
@@ -99,7 +100,17 @@ pub fn table_rows() -> Vec<(&'static str, Technique)> {
 pub struct Cell {
     pub brdfs: usize,
     pub lighting: Timing,
+    /// The lighting time of every round, in round order (rounds interleave every technique at
+    /// every BRDF count, so sample `i` of two cells was measured under the same load).
+    pub samples: Vec<f64>,
     pub error: ImageError,
+}
+
+impl Cell {
+    /// The median lighting time with its 95 % interval.
+    pub fn interval(&self) -> Interval {
+        median_interval(&self.samples)
+    }
 }
 
 /// One technique across the BRDF counts.
@@ -122,6 +133,13 @@ impl Row {
                 0.0
             },
         )
+    }
+
+    /// The time of the cell at `index` over this row's 1-BRDF time, paired by round: the median
+    /// ratio with its 95 % interval, and what it lets one say.
+    pub fn overhead_ratio(&self, index: usize) -> (Interval, Verdict) {
+        let ratio = ratio_interval(&self.cells[index].samples, &self.cells[0].samples);
+        (ratio, Verdict::of(&ratio))
     }
 
     /// The largest error over the row's cells, per measure.
@@ -260,27 +278,45 @@ pub fn run_compare(
         .collect();
     let mut breakdowns = Vec::new();
     let mut costs = None;
-    let last = *settings.brdf_counts.last().expect("not empty");
+    // Every renderer, reference and error first (the error frames warm every technique up),
+    // then the timed rounds, interleaved: one frame of every technique at every BRDF count
+    // per round, so that a burst of background load lands on all of them alike.
+    let mut renderers = Vec::new();
     for &brdfs in &settings.brdf_counts {
         let mut renderer = new_renderer(with_brdf_count(&settings.scene, brdfs))?;
         costs.get_or_insert(renderer.cost_model(Backend::Native));
-        progress(&format!("{brdfs} BRDF(s): forward reference"));
+        progress(&format!("{brdfs} BRDF(s): forward reference and errors"));
         let reference = frame(&mut renderer, Technique::Forward)?;
-        for (row, (name, technique)) in rows.iter_mut().zip(&rows_spec) {
-            progress(&format!("{brdfs} BRDF(s): {name}"));
-            let lighting = time_lighting(&mut renderer, *technique, frames)?;
-            let error = image_error(&frame(&mut renderer, *technique)?, &reference);
+        let mut errors = Vec::new();
+        for (_, technique) in &rows_spec {
+            errors.push(image_error(&frame(&mut renderer, *technique)?, &reference));
+        }
+        renderers.push((brdfs, renderer, errors));
+    }
+    let mut samples = vec![vec![Vec::new(); rows_spec.len()]; renderers.len()];
+    for round in 0..frames.max(1) {
+        progress(&format!("round {} of {}", round + 1, frames.max(1)));
+        for (count, (_, renderer, _)) in renderers.iter_mut().enumerate() {
+            for (row, (_, technique)) in rows_spec.iter().enumerate() {
+                samples[count][row].push(lighting_ms(renderer, *technique)?);
+            }
+        }
+    }
+    for (count, (brdfs, _, errors)) in renderers.iter().enumerate() {
+        for (r, (row, error)) in rows.iter_mut().zip(errors).enumerate() {
+            let times = std::mem::take(&mut samples[count][r]);
             row.cells.push(Cell {
-                brdfs,
-                lighting,
-                error,
+                brdfs: *brdfs,
+                lighting: Timing::from_samples(times.clone()),
+                samples: times,
+                error: *error,
             });
         }
-        if brdfs == last {
-            for (name, technique) in rows_spec.iter().filter(|(n, _)| n.starts_with("stencil")) {
-                progress(&format!("{brdfs} BRDF(s): {name} pass breakdown"));
-                breakdowns.push(breakdown(&mut renderer, name, *technique, brdfs, frames)?);
-            }
+    }
+    if let Some((brdfs, renderer, _)) = renderers.last_mut() {
+        for (name, technique) in rows_spec.iter().filter(|(n, _)| n.starts_with("stencil")) {
+            progress(&format!("{brdfs} BRDF(s): {name} pass breakdown"));
+            breakdowns.push(breakdown(renderer, name, *technique, *brdfs, frames)?);
         }
     }
     let aspect = w as f32 / h as f32;
@@ -291,12 +327,18 @@ pub fn run_compare(
         let lights = scene.lights.len();
         let mut renderer = new_renderer(scene)?;
         let reference = frame(&mut renderer, Technique::Forward)?;
-        let mut timings = [Timing::default(); 3];
         let mut error = ImageError::default();
-        for (i, technique) in size_techniques().into_iter().enumerate() {
-            timings[i] = time_lighting(&mut renderer, technique, frames)?;
+        for technique in size_techniques() {
             error = error.worst(image_error(&frame(&mut renderer, technique)?, &reference));
         }
+        // Interleaved, as the table.
+        let mut samples = [vec![], vec![], vec![]];
+        for _ in 0..frames.max(1) {
+            for (i, technique) in size_techniques().into_iter().enumerate() {
+                samples[i].push(lighting_ms(&mut renderer, technique)?);
+            }
+        }
+        let timings = samples.map(Timing::from_samples);
         sizes.push(SizePoint {
             coverage,
             lights,
@@ -319,6 +361,12 @@ pub fn run_compare(
         costs: costs.expect("at least one BRDF count"),
         costs_calibrated: settings.costs.is_some(),
     })
+}
+
+/// The lighting pass's time in one frame.
+fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<f64> {
+    let timings = renderer.render(technique, Readback::NONE)?.timings;
+    Ok(timings.pass_ms("lighting").unwrap_or(0.0))
 }
 
 /// Branching, stencil and adaptive on the native backend: the light-size sweep's three.

@@ -69,9 +69,12 @@ impl CompareReport {
         let _ = writeln!(
             md,
             "# histencil compare\n\nDevice: **{}**. Scene `{}` ({} lights) at {}x{}. Lighting-pass \
-             GPU time, median of {} frames after {WARM_UP_FRAMES} warm-up (± spread, max - min). \
-             Error against the forward reference of the same scene: 8-bit max / mean, and mean \
-             FLIP.\n",
+             GPU time over {} rounds after a warm-up frame; each round renders one frame of every \
+             technique at every BRDF count in turn, so background load hits all alike. Table: \
+             median [95 % interval of the median, order statistics]; overheads are the median of \
+             the per-round ratios to the row's 1-BRDF time, with their interval, and a verdict \
+             only where the interval excludes 0 (else indistinguishable). Error against the \
+             forward reference of the same scene: 8-bit max / mean, and mean FLIP.\n",
             self.device, self.scene, self.scene_lights, self.width, self.height, self.frames
         );
         md += "## Lighting time against BRDF count\n\n";
@@ -301,13 +304,28 @@ fn time_text(t: &Timing) -> String {
     format!("{:.3} ms ±{:.3}", t.median_ms, t.spread_ms())
 }
 
+/// `12.345 ms [12.1, 12.6]`, and for a cell over the 1-BRDF one its overhead as the median
+/// paired ratio with its interval and the verdict they allow:
+/// `(+3.2 % [+1.1, +5.0], slower)`.
 fn cell_text(row: &Row, i: usize) -> String {
-    let t = time_text(&row.cells[i].lighting);
+    let c = row.cells[i].interval();
+    let t = format!("{:.3} ms [{:.3}, {:.3}]", c.median, c.lo, c.hi);
     if i == 0 {
         return t;
     }
-    let (ms, pct) = row.overhead(i);
-    format!("{t} ({ms:+.3} ms, {pct:+.1} %)")
+    let (ratio, verdict) = row.overhead_ratio(i);
+    let pct = |r: f64| 100.0 * (r - 1.0);
+    format!(
+        "{t} ({:+.1} % [{:+.1}, {:+.1}], {})",
+        pct(ratio.median),
+        pct(ratio.lo),
+        pct(ratio.hi),
+        verdict.word()
+    )
+}
+
+fn interval_json(i: &crate::stats::Interval) -> Value {
+    json!({"median": i.median, "lo": i.lo, "hi": i.hi, "samples": i.samples})
 }
 
 fn error_text(e: &ImageError) -> String {
@@ -329,11 +347,16 @@ fn row_json(row: &Row) -> Value {
         .enumerate()
         .map(|(i, c)| {
             let (ms, pct) = row.overhead(i);
+            let (ratio, verdict) = row.overhead_ratio(i);
             json!({
                 "brdfs": c.brdfs,
                 "lighting": timing_json(&c.lighting),
+                "lighting_interval_ms": interval_json(&c.interval()),
+                "lighting_samples_ms": c.samples,
                 "overhead_ms": ms,
                 "overhead_percent": pct,
+                "overhead_ratio": interval_json(&ratio),
+                "verdict_against_1_brdf": verdict.word(),
                 "error": error_json(&c.error),
             })
         })

@@ -1,0 +1,166 @@
+//! Statistics that a noisy machine cannot talk into a verdict: the median with a
+//! distribution-free 95 % confidence interval (order statistics of the binomial), ratios paired
+//! by round, and verdicts only where an interval excludes "no difference".
+//!
+//! Timings on a shared machine are neither normal nor independent of time: background load comes
+//! in bursts. The lab therefore interleaves what it compares (one frame of each in turn, per
+//! round), so a burst hits all alike, and compares them by the ratio within each round; the
+//! median of those ratios, with its order-statistic interval, needs no assumption about the
+//! shape of the noise.
+
+/// A median and its 95 % confidence interval.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Interval {
+    pub lo: f64,
+    pub median: f64,
+    pub hi: f64,
+    /// Samples it was computed from.
+    pub samples: usize,
+}
+
+impl Interval {
+    /// Half the interval's width relative to the median (`0.03` is +-3 %); infinite without
+    /// samples or for a zero median.
+    pub fn relative_half_width(&self) -> f64 {
+        if self.samples == 0 || self.median == 0.0 {
+            f64::INFINITY
+        } else {
+            (self.hi - self.lo) / 2.0 / self.median.abs()
+        }
+    }
+
+    /// Whether the interval contains `value`.
+    pub fn contains(&self, value: f64) -> bool {
+        self.lo <= value && value <= self.hi
+    }
+}
+
+/// `P(X <= k)` for `X ~ Binomial(n, 1/2)`.
+fn binomial_half_cdf(k: usize, n: usize) -> f64 {
+    // Terms in log space: n is at most a few thousand frames, C(n, i) overflows f64 from 1030.
+    let ln_half_n = n as f64 * 0.5f64.ln();
+    let mut ln_choose = 0.0; // ln C(n, 0)
+    let mut sum = 0.0;
+    for i in 0..=k.min(n) {
+        if i > 0 {
+            ln_choose += ((n - i + 1) as f64).ln() - (i as f64).ln();
+        }
+        sum += (ln_choose + ln_half_n).exp();
+    }
+    sum.min(1.0)
+}
+
+/// The median of `samples` with the order-statistic interval: the narrowest symmetric pair of
+/// ranks whose coverage, from `X ~ Binomial(n, 1/2)`, is still at least 95 %. Below 6 samples
+/// even the whole range (min to max, returned then) covers less than 95 %.
+pub fn median_interval(samples: &[f64]) -> Interval {
+    let mut sorted: Vec<f64> = samples.iter().copied().filter(|v| v.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    if n == 0 {
+        return Interval::default();
+    }
+    let median = if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        (sorted[n / 2 - 1] + sorted[n / 2]) / 2.0
+    };
+    // [x_(j), x_(n+1-j)] (1-based ranks) covers the median with probability
+    // 1 - 2 P(X <= j - 1): take the largest j for which that is still at least 95 %.
+    let mut j = 0;
+    while j < n / 2 && 2.0 * binomial_half_cdf(j, n) <= 0.05 {
+        j += 1;
+    }
+    let (lo, hi) = if j == 0 {
+        (sorted[0], sorted[n - 1])
+    } else {
+        (sorted[j - 1], sorted[n - j])
+    };
+    Interval {
+        lo,
+        median,
+        hi,
+        samples: n,
+    }
+}
+
+/// The interval of `numerator[i] / denominator[i]`, paired by round `i`.
+pub fn ratio_interval(numerator: &[f64], denominator: &[f64]) -> Interval {
+    let ratios: Vec<f64> = numerator
+        .iter()
+        .zip(denominator)
+        .filter(|(_, d)| **d > 0.0)
+        .map(|(n, d)| n / d)
+        .collect();
+    median_interval(&ratios)
+}
+
+/// What the data says about a ratio `a / b` of times.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// `a` takes less time: the whole interval is below 1.
+    Faster,
+    /// The whole interval is above 1.
+    Slower,
+    /// The interval contains 1: the data cannot tell them apart.
+    Indistinguishable,
+}
+
+impl Verdict {
+    pub fn of(ratio: &Interval) -> Verdict {
+        if ratio.samples == 0 || ratio.contains(1.0) {
+            Verdict::Indistinguishable
+        } else if ratio.hi < 1.0 {
+            Verdict::Faster
+        } else {
+            Verdict::Slower
+        }
+    }
+
+    pub fn word(self) -> &'static str {
+        match self {
+            Verdict::Faster => "faster",
+            Verdict::Slower => "slower",
+            Verdict::Indistinguishable => "indistinguishable",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_binomial_matches_known_values() {
+        assert!((binomial_half_cdf(0, 1) - 0.5).abs() < 1e-12);
+        assert!((binomial_half_cdf(2, 4) - 11.0 / 16.0).abs() < 1e-12);
+        assert!((binomial_half_cdf(5000, 5000) - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_median_interval_uses_the_textbook_ranks() {
+        // n = 20: the 95 % interval is [x_(6), x_(15)] in 1-based ranks (coverage 95.9 %).
+        let samples: Vec<f64> = (1..=20).map(f64::from).collect();
+        let i = median_interval(&samples);
+        assert_eq!((i.lo, i.median, i.hi, i.samples), (6.0, 10.5, 15.0, 20));
+        // Too few samples for 95 %: the whole range.
+        let i = median_interval(&[3.0, 1.0, 2.0]);
+        assert_eq!((i.lo, i.median, i.hi), (1.0, 2.0, 3.0));
+        assert_eq!(median_interval(&[]).samples, 0);
+    }
+
+    #[test]
+    fn verdicts_need_intervals_that_exclude_one() {
+        let a = [10.0, 11.0, 10.5, 10.2, 10.8, 10.1, 10.9, 10.4, 10.6, 10.3];
+        let b: Vec<f64> = a.iter().map(|x| x * 2.0).collect();
+        assert_eq!(Verdict::of(&ratio_interval(&a, &b)), Verdict::Faster);
+        assert_eq!(Verdict::of(&ratio_interval(&b, &a)), Verdict::Slower);
+        // Noise around equality.
+        let c = [10.0, 11.0, 9.0, 10.5, 9.5, 10.2, 9.8, 10.1, 9.9, 10.0];
+        let d = [10.1, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0];
+        assert_eq!(
+            Verdict::of(&ratio_interval(&c, &d)),
+            Verdict::Indistinguishable
+        );
+    }
+}
