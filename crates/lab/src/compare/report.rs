@@ -71,7 +71,8 @@ impl CompareReport {
             "# histencil compare\n\nDevice: **{}**. Scene `{}` ({} lights) at {}x{}. Lighting-pass \
              GPU time over {} rounds after a warm-up frame; each round renders one frame of every \
              technique at every BRDF count in turn, so background load hits all alike. Table: \
-             median [95 % interval of the median, order statistics]; overheads are the median of \
+             median [95 % interval of the median, order statistics; below 6 rounds no interval \
+             reaches 95 % and the whole range is shown]; overheads are the median of \
              the per-round ratios to the row's 1-BRDF time, with their interval, and a verdict \
              only where the interval excludes 0 (else indistinguishable). Error against the \
              forward reference of the same scene: 8-bit max / mean, and mean FLIP.\n",
