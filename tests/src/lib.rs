@@ -46,30 +46,14 @@ pub struct ImageDiff {
     pub pixels_differing: usize,
 }
 
+/// The whole frame's differences, as `histencil check` judges them
+/// ([`histencil_check::judge::image_error`]): a pixel differs when any channel does.
 pub fn diff(a: &RgbaImage, b: &RgbaImage) -> ImageDiff {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let mut max = 0u8;
-    let mut sum = 0u64;
-    let mut pixels_differing = 0;
-    for (pa, pb) in a.pixels().zip(b.pixels()) {
-        let d =
-            pa.0.iter()
-                .zip(pb.0)
-                .map(|(x, y)| x.abs_diff(y))
-                .max()
-                .unwrap();
-        pixels_differing += usize::from(d > 0);
-        max = max.max(d);
-        sum +=
-            pa.0.iter()
-                .zip(pb.0)
-                .map(|(x, y)| u64::from(x.abs_diff(y)))
-                .sum::<u64>();
-    }
+    let e = histencil_check::judge::image_error(a, b, 0, |_| true);
     ImageDiff {
-        max,
-        mean: sum as f64 / (a.len() as f64),
-        pixels_differing,
+        max: e.max,
+        mean: e.mean,
+        pixels_differing: e.over,
     }
 }
 
@@ -88,12 +72,7 @@ pub fn assert_close(
         expected
             .save(dir.join(format!("{name}-expected.png")))
             .unwrap();
-        let difference = RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
-            let (a, e) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
-            let c = |i: usize| a.0[i].abs_diff(e.0[i]).saturating_mul(32);
-            image::Rgba([c(0), c(1), c(2), 255])
-        });
-        difference
+        histencil_vk::difference_image(actual, expected, 32)
             .save(dir.join(format!("{name}-difference.png")))
             .unwrap();
         panic!(

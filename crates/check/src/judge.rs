@@ -95,15 +95,6 @@ pub fn image_error(
     }
 }
 
-/// The differences x 32 (so one 8-bit step shows), opaque: the `-difference.png` of a failure.
-pub fn difference_image(actual: &RgbaImage, expected: &RgbaImage) -> RgbaImage {
-    RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
-        let (a, e) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
-        let c = |i: usize| a.0[i].abs_diff(e.0[i]).saturating_mul(32);
-        image::Rgba([c(0), c(1), c(2), 255])
-    })
-}
-
 /// The image verdict of a case: its error over the pixels judged, and the bound.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageVerdict {

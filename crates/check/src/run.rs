@@ -411,9 +411,9 @@ impl Group<'_> {
     ) -> CaseResult {
         let mut r = self.result(case);
         let mut technique = config.technique();
+        // Deferred runs on the native backend: no hi-stencil, nothing to drop.
         if self.options.inject == Some(InjectedFault::DropFlushes)
             && config.platform.has_hi_stencil()
-            && config.lighting != matrix::Lighting::Deferred
         {
             technique = matrix::Config {
                 flush: FlushPolicy::Never,
@@ -463,8 +463,8 @@ impl Group<'_> {
                 .as_ref()
                 .map_err(Clone::clone)
         };
-        let inputs = inputs.as_ref().map(|i| *i);
-        let brdfs = renderer.brdfs().to_vec();
+        let inputs = inputs.as_ref().copied();
+        let brdfs = renderer.brdfs();
         let slots: Vec<Option<u32>> = ids
             .iter()
             .map(|id| id.and_then(|id| brdfs.iter().position(|b| *b == id).map(|s| s as u32)))
@@ -565,11 +565,7 @@ fn predict(
     technique: Technique,
 ) -> histencil_vk::Result<(histencil_model::SimResult, Vec<u8>)> {
     let (plan, _) = renderer.plan(technique)?;
-    let inputs = SimulatorInputs {
-        plan,
-        ..inputs.clone()
-    };
-    let (result, target) = inputs.predict();
+    let (result, target) = inputs.predict_plan(&plan);
     Ok((result, target.stencil))
 }
 
@@ -649,7 +645,7 @@ fn write_artifacts(
     let p = path("expected.png");
     keep(p.clone(), histencil_vk::save_png(expected, &p).is_ok());
     let p = path("difference.png");
-    let difference = judge::difference_image(actual, expected);
+    let difference = histencil_vk::difference_image(actual, expected, 32);
     keep(p.clone(), histencil_vk::save_png(&difference, &p).is_ok());
     let p = path("stencil.png");
     keep(p.clone(), histencil_vk::save_png(stencil, &p).is_ok());

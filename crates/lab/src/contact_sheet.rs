@@ -1,6 +1,6 @@
 //! A labelled contact sheet: frames side by side in a grid, each under a caption, so a person
-//! can see what a run did instead of reading it. Also the two false-colour views the demo puts
-//! on it: a difference image and the stencil byte split into its fields.
+//! can see what a run did instead of reading it. Also the stencil byte split into its fields,
+//! in false colour, for the demo to put on it.
 
 use crate::plot::text_available;
 use histencil_model::StencilLayout;
@@ -54,15 +54,6 @@ pub fn contact_sheet(tiles: &[(String, RgbaImage)], columns: usize) -> RgbImage 
         sheet = RgbImage::from_raw(sw, sh, raw).expect("the buffer keeps its size");
     }
     sheet
-}
-
-/// `|actual - expected|` per channel times `scale`, opaque.
-pub fn difference(actual: &RgbaImage, expected: &RgbaImage, scale: u8) -> RgbaImage {
-    RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
-        let (a, e) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
-        let c = |i: usize| a.0[i].abs_diff(e.0[i]).saturating_mul(scale);
-        image::Rgba([c(0), c(1), c(2), 255])
-    })
 }
 
 /// The stencil byte in false colour, one field per channel: red where the culling bit is set

@@ -5,7 +5,7 @@
 //! contact sheet that shows the frame, its difference from forward, the stencil byte, and the
 //! talk's two failures next to their fixes.
 
-use crate::contact_sheet::{contact_sheet, difference, stencil_colours};
+use crate::contact_sheet::{contact_sheet, stencil_colours};
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, time_passes, Timing};
 use crate::Result;
@@ -154,17 +154,27 @@ pub fn run_demo(
     step("the talk's failures");
     let no_zeroing = frame(&mut renderer, stencil(X360_NO_ZEROING, FlushPolicy::Auto))?;
     let never = frame(&mut renderer, stencil(Backend::Ps3, FlushPolicy::Never))?;
-    let forward = frames[0].0.clone();
-    let x360 = frames[4].0.clone();
-    let (ps3, ps3_stencil) = frames[3].clone();
+    // Rows by technique, not by their place in the table.
+    let row = |technique: Technique| {
+        rows.iter()
+            .position(|r| r.technique == technique)
+            .expect("every technique shown is a row")
+    };
+    let (x360_row, ps3_row) = (
+        row(stencil(X360, FlushPolicy::Auto)),
+        row(stencil(Backend::Ps3, FlushPolicy::Auto)),
+    );
+    let forward = frames[row(Technique::Forward)].0.clone();
+    let x360 = frames[x360_row].0.clone();
+    let (ps3, ps3_stencil) = frames[ps3_row].clone();
     let (ps3_stencil, surfaces) = ps3_stencil.expect("asked for");
-    let max_difference = rows[4].error.map_or(0.0, |e| e.max);
+    let max_difference = rows[x360_row].error.map_or(0.0, |e| e.max);
     let tiles = vec![
         ("forward (reference)".to_owned(), forward.clone()),
         ("stencil technique, 360-like".to_owned(), x360.clone()),
         (
             format!("difference x16 (max {max_difference}/255)"),
-            difference(&x360, &forward, 16),
+            histencil_vk::difference_image(&x360, &forward, 16),
         ),
         (
             "PS3-like stencil: G BRDF id, B engine bits, R culling".to_owned(),

@@ -37,12 +37,19 @@ pub struct SimulatorInputs {
 impl SimulatorInputs {
     /// Runs the simulator: what the GPU frame's lighting will do, and the stencil it leaves.
     pub fn predict(&self) -> (SimResult, SoftTarget) {
+        self.predict_plan(&self.plan)
+    }
+
+    /// [`SimulatorInputs::predict`] for another plan of the same lights (the same planned light
+    /// indices, e.g. another backend or flush policy): the captured footprints serve every plan
+    /// of a frame, so one capture answers for all of them.
+    pub fn predict_plan(&self, plan: &FramePlan) -> (SimResult, SoftTarget) {
         let simulator = Simulator {
             layout: self.layout,
             tile_size: self.tile_size,
         };
         let mut target = self.target.clone();
-        let result = simulator.run(&mut target, &self.plan, &self.footprints);
+        let result = simulator.run(&mut target, plan, &self.footprints);
         (result, target)
     }
 }

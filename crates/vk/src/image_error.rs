@@ -4,6 +4,20 @@
 
 use image::RgbaImage;
 
+/// `|actual - expected|` per colour channel times `scale` (saturating, so one 8-bit step shows
+/// at 16 or 32), opaque: the difference image of a failed comparison or a contact sheet.
+///
+/// # Panics
+/// If the sizes differ: both frames come from one renderer.
+pub fn difference_image(actual: &RgbaImage, expected: &RgbaImage, scale: u8) -> RgbaImage {
+    assert_eq!(actual.dimensions(), expected.dimensions());
+    RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
+        let (a, e) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
+        let c = |i: usize| a.0[i].abs_diff(e.0[i]).saturating_mul(scale);
+        image::Rgba([c(0), c(1), c(2), 255])
+    })
+}
+
 /// Absolute 8-bit colour error over a mask.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MaskedError {
@@ -67,5 +81,15 @@ mod tests {
         assert_eq!((e.pixels, e.max), (1, 3));
         assert!((e.mean - 1.0).abs() < 1e-12);
         assert!(masked_error(&actual, &RgbaImage::new(1, 1), &background).is_none());
+    }
+
+    #[test]
+    fn differences_are_scaled_saturated_and_opaque() {
+        let a = RgbaImage::from_pixel(1, 1, image::Rgba([10, 200, 7, 0]));
+        let b = RgbaImage::from_pixel(1, 1, image::Rgba([11, 0, 7, 9]));
+        assert_eq!(
+            difference_image(&a, &b, 32).get_pixel(0, 0).0,
+            [32, 255, 0, 255]
+        );
     }
 }

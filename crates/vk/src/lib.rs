@@ -47,7 +47,7 @@ pub use context::{Context, ContextDesc, DepthStencilFormat};
 pub use debug::{ValidationLog, ValidationMessage};
 pub use error::{Error, Result};
 pub use histencil_model::{CostModel, FlushPolicy, TileStats};
-pub use image_error::{masked_error, MaskedError};
+pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
 pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
 pub use readback::{FrameImages, Readback};

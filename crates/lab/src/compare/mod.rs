@@ -99,7 +99,6 @@ pub fn table_rows() -> Vec<(&'static str, Technique)> {
 #[derive(Clone, Debug)]
 pub struct Cell {
     pub brdfs: usize,
-    pub lighting: Timing,
     /// The lighting time of every round, in round order (rounds interleave every technique at
     /// every BRDF count, so sample `i` of two cells was measured under the same load).
     pub samples: Vec<f64>,
@@ -107,6 +106,11 @@ pub struct Cell {
 }
 
 impl Cell {
+    /// The median lighting time and the spread of the rounds.
+    pub fn lighting(&self) -> Timing {
+        Timing::from_samples(self.samples.clone())
+    }
+
     /// The median lighting time with its 95 % interval.
     pub fn interval(&self) -> Interval {
         median_interval(&self.samples)
@@ -123,8 +127,8 @@ pub struct Row {
 impl Row {
     /// `(ms, %)` of the cell at `index` over this row's first (1-BRDF) cell.
     pub fn overhead(&self, index: usize) -> (f64, f64) {
-        let base = self.cells[0].lighting.median_ms;
-        let extra = self.cells[index].lighting.median_ms - base;
+        let base = self.cells[0].lighting().median_ms;
+        let extra = self.cells[index].lighting().median_ms - base;
         (
             extra,
             if base > 0.0 {
@@ -304,11 +308,9 @@ pub fn run_compare(
     }
     for (count, (brdfs, _, errors)) in renderers.iter().enumerate() {
         for (r, (row, error)) in rows.iter_mut().zip(errors).enumerate() {
-            let times = std::mem::take(&mut samples[count][r]);
             row.cells.push(Cell {
                 brdfs: *brdfs,
-                lighting: Timing::from_samples(times.clone()),
-                samples: times,
+                samples: std::mem::take(&mut samples[count][r]),
                 error: *error,
             });
         }

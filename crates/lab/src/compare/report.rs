@@ -213,7 +213,7 @@ impl CompareReport {
                 points: r
                     .cells
                     .iter()
-                    .map(|c| (c.brdfs as f64, c.lighting.median_ms))
+                    .map(|c| (c.brdfs as f64, c.lighting().median_ms))
                     .collect(),
             })
             .collect();
@@ -274,7 +274,11 @@ impl CompareReport {
             .iter()
             .map(|r| {
                 let last = r.cells.last().expect("cells");
-                (last.lighting.median_ms, last.error.mean, r.name.to_owned())
+                (
+                    last.lighting().median_ms,
+                    last.error.mean,
+                    r.name.to_owned(),
+                )
             })
             .collect();
         plot::pareto_chart(
@@ -351,7 +355,7 @@ fn row_json(row: &Row) -> Value {
             let (ratio, verdict) = row.overhead_ratio(i);
             json!({
                 "brdfs": c.brdfs,
-                "lighting": timing_json(&c.lighting),
+                "lighting": timing_json(&c.lighting()),
                 "lighting_interval_ms": interval_json(&c.interval()),
                 "lighting_samples_ms": c.samples,
                 "overhead_ms": ms,
