@@ -158,7 +158,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
     with_validated_context(|ctx| {
         let mut renderer = Renderer::new(ctx, scene, SIZE, SIZE).expect("renderer");
         let (backend, flush) = (Backend::Ps3, FlushPolicy::Auto);
-        let plan = |renderer: &Renderer, technique| renderer.plan(technique).expect("plan").0;
+        let plan = |renderer: &Renderer, technique| renderer.plan(technique).expect("plan");
         let adaptive = Technique::Adaptive { backend, flush };
         let free_stencil = CostModel {
             pass_overhead_ms: 0.0,

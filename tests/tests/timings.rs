@@ -35,8 +35,8 @@ fn pass_groups_are_timed_per_brdf() {
             assert!(ms.is_finite() && ms >= 0.0, "{group}: {ms}");
         }
         assert!(lighting.group_ms("shade-branching").is_none());
-        let (plan, lights) = renderer.plan(STENCIL).unwrap();
-        assert_eq!(lighting.per_light.len(), lights.len());
+        let plan = renderer.plan(STENCIL).unwrap();
+        assert_eq!(lighting.per_light.len(), plan.lights.len());
         assert_eq!(
             plan.passes().count(),
             plan.steps.len(),
@@ -66,8 +66,8 @@ fn one_brdf_scene_runs_the_plain_deferred_passes() {
     let scene = histencil_scene::embedded("brdfs-1").unwrap();
     with_validated_context(|ctx| {
         let renderer = Renderer::new(ctx, scene, 64, 64).expect("renderer");
-        let (stencil, _) = renderer.plan(STENCIL).unwrap();
-        let (deferred, _) = renderer.plan(Technique::DEFERRED).unwrap();
+        let stencil = renderer.plan(STENCIL).unwrap();
+        let deferred = renderer.plan(Technique::DEFERRED).unwrap();
         let kinds =
             |p: &histencil_model::FramePlan| p.passes().map(|p| p.kind).collect::<Vec<PassKind>>();
         assert!(!kinds(&stencil)
@@ -82,9 +82,10 @@ fn lights_draw_once_per_brdf_they_touch() {
     let scene = histencil_scene::embedded("brdfs-6").unwrap();
     with_validated_context(|ctx| {
         let renderer = Renderer::new(ctx, scene.clone(), 64, 64).expect("renderer");
-        let (plan, lights) = renderer.plan(STENCIL).unwrap();
-        for (planned, &index) in lights.iter().enumerate() {
-            let touched = scene.brdfs_lit_by(&scene.lights[index as usize]).len();
+        let plan = renderer.plan(STENCIL).unwrap();
+        for (planned, light) in plan.lights.iter().enumerate() {
+            let index = light.input;
+            let touched = scene.brdfs_lit_by(&scene.lights[index]).len();
             let shades = plan
                 .steps
                 .iter()
@@ -93,6 +94,6 @@ fn lights_draw_once_per_brdf_they_touch() {
             assert_eq!(shades, touched, "light {index}");
         }
         // Lights out of every object's reach are not drawn at all.
-        assert!(lights.len() <= scene.lights.len());
+        assert!(plan.lights.len() <= scene.lights.len());
     });
 }

@@ -564,7 +564,7 @@ fn predict(
     inputs: &SimulatorInputs,
     technique: Technique,
 ) -> histencil_vk::Result<(histencil_model::SimResult, Vec<u8>)> {
-    let (plan, _) = renderer.plan(technique)?;
+    let plan = renderer.plan(technique)?;
     let (result, target) = inputs.predict_plan(&plan);
     Ok((result, target.stencil))
 }

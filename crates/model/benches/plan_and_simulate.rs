@@ -38,7 +38,7 @@ fn bench(c: &mut Criterion) {
     for (name, backend) in &backends {
         group.bench_function(BenchmarkId::new("plan", name), |b| {
             b.iter(|| {
-                FramePlan::build(
+                FramePlan::from_requests(
                     &layout,
                     &**backend,
                     black_box(&scene.requests),
@@ -48,7 +48,8 @@ fn bench(c: &mut Criterion) {
             })
         });
         let plan =
-            FramePlan::build(&layout, &**backend, &scene.requests, FlushPolicy::Auto).unwrap();
+            FramePlan::from_requests(&layout, &**backend, &scene.requests, FlushPolicy::Auto)
+                .unwrap();
         let sim = Simulator {
             layout,
             tile_size: 8,

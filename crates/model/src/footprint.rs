@@ -5,21 +5,24 @@
 //! analytically, and any other convex volume can be given through [`Footprint::from_fn`].
 
 use crate::plan::LightCase;
+use crate::view::DepthConvention;
 
-/// Where a volume crosses one pixel's ray, in depth-buffer units (0 near, 1 far).
+/// Where a volume crosses one pixel's ray, in depth-buffer units of the footprint's
+/// [`DepthConvention`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Span {
     /// `None` when the near plane clips the front face (viewer inside, or near crossing).
     pub front: Option<f32>,
-    /// Clamped to 1 (volume pipelines clamp depth).
+    /// Clamped to the far depth (volume pipelines clamp depth).
     pub back: f32,
 }
 
 impl Span {
-    /// The definition of "surface inside the light": strictly between the faces. Sky (depth 1)
-    /// is never inside.
-    pub fn contains(&self, surface_depth: f32) -> bool {
-        self.front.is_none_or(|f| f < surface_depth) && surface_depth < self.back
+    /// The definition of "surface inside the light": strictly between the faces, nearer than
+    /// the back face and farther than the front one. Sky (the far depth) is never inside.
+    pub fn contains(&self, depth: DepthConvention, surface_depth: f32) -> bool {
+        self.front.is_none_or(|f| depth.nearer(f, surface_depth))
+            && depth.nearer(surface_depth, self.back)
     }
 }
 
@@ -32,11 +35,19 @@ pub struct Footprint {
     pub height: u32,
     spans: Vec<Option<Span>>,
     full_screen: bool,
+    depth: DepthConvention,
 }
 
 impl Footprint {
-    /// Spans from a function of the pixel, over `[x0, x0 + width) x [y0, y0 + height)`.
-    pub fn from_fn(
+    /// Spans (standard depth) from a function of the pixel, over
+    /// `[x0, x0 + width) x [y0, y0 + height)`.
+    pub fn from_fn(rect: (u32, u32, u32, u32), span: impl Fn(u32, u32) -> Option<Span>) -> Self {
+        Self::from_fn_in(DepthConvention::Standard, rect, span)
+    }
+
+    /// Spans in `depth`'s convention from a function of the pixel.
+    pub fn from_fn_in(
+        depth: DepthConvention,
         (x0, y0, width, height): (u32, u32, u32, u32),
         span: impl Fn(u32, u32) -> Option<Span>,
     ) -> Self {
@@ -53,7 +64,34 @@ impl Footprint {
             height,
             spans,
             full_screen: false,
+            depth,
         }
+    }
+
+    /// The same footprint in `depth`'s convention: standard depths as they are, reversed ones
+    /// as `1 - d`, which is exact for the depths tests build (multiples of a power of two).
+    pub fn in_convention(mut self, depth: DepthConvention) -> Self {
+        if depth != self.depth {
+            for span in self.spans.iter_mut().flatten() {
+                span.front = span.front.map(|f| 1.0 - f);
+                span.back = 1.0 - span.back;
+            }
+            self.depth = depth;
+        }
+        self
+    }
+
+    /// Spans of any function in the footprint's convention, e.g. to quantise depths.
+    pub fn map_depths(mut self, f: impl Fn(f32) -> f32) -> Self {
+        for span in self.spans.iter_mut().flatten() {
+            span.front = span.front.map(&f);
+            span.back = f(span.back);
+        }
+        self
+    }
+
+    pub fn depth(&self) -> DepthConvention {
+        self.depth
     }
 
     /// A light without a volume: the full-screen triangle at depth 1.
@@ -117,9 +155,9 @@ impl Footprint {
             return false;
         };
         if self.case() == LightCase::ViewerInside {
-            surface_depth < 1.0
+            self.depth.nearer(surface_depth, self.depth.far())
         } else {
-            span.contains(surface_depth)
+            span.contains(self.depth, surface_depth)
         }
     }
 
@@ -174,12 +212,20 @@ mod tests {
             front: Some(0.2),
             back: 0.6,
         };
-        assert!(s.contains(0.4));
-        assert!(!s.contains(0.2) && !s.contains(0.6));
+        let standard = DepthConvention::Standard;
+        assert!(s.contains(standard, 0.4));
+        assert!(!s.contains(standard, 0.2) && !s.contains(standard, 0.6));
         let sky = Span {
             front: None,
             back: 1.0,
         };
-        assert!(!sky.contains(1.0));
+        assert!(!sky.contains(standard, 1.0));
+        let reversed = Span {
+            front: Some(0.8),
+            back: 0.4,
+        };
+        let r = DepthConvention::Reversed;
+        assert!(reversed.contains(r, 0.6) && !reversed.contains(r, 0.8));
+        assert!(!reversed.contains(r, 0.4) && !reversed.contains(r, 0.2));
     }
 }

@@ -1,9 +1,10 @@
 //! A frame's lighting as one ordered list of steps: every light's passes, the hi-stencil flushes
 //! the flush policy inserts, and the save / restore of preserved bits where a platform needs it.
 
-use crate::backend::PlatformBackend;
+use crate::backend::PlatformCaps;
 use crate::layout::StencilLayout;
-use crate::plan::{plan_light, LightRequest, Pass, PlanError};
+use crate::plan::{plan_light, LightCase, LightRequest, LightTechnique, Pass, PlanError};
+use crate::view::DepthConvention;
 
 /// When pending hi-stencil state is made visible to later tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -19,7 +20,7 @@ pub enum FlushPolicy {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Step {
-    /// A pass of light `light` (its index in the request list).
+    /// A pass of light `light` (its index in [`FramePlan::lights`]).
     Pass { light: usize, pass: Pass },
     /// Pending hi-stencil state becomes active.
     FlushHiStencil,
@@ -38,34 +39,110 @@ impl Step {
     }
 }
 
+/// One light the frame draws, and why it is drawn as it is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedLight {
+    /// The light's index in the caller's light list.
+    pub input: usize,
+    /// The estimated fraction of the screen its volume covers (1 for lights reaching the near
+    /// plane and for full-screen lights); `None` for plans built from bare requests.
+    pub coverage: Option<f64>,
+    /// Its case, the BRDF slots it touches and the technique chosen for it.
+    pub request: LightRequest,
+}
+
+impl PlannedLight {
+    /// Bare requests, numbered in order, without coverage.
+    pub fn numbered(requests: impl IntoIterator<Item = LightRequest>) -> Vec<Self> {
+        requests
+            .into_iter()
+            .enumerate()
+            .map(|(input, request)| Self {
+                input,
+                coverage: None,
+                request,
+            })
+            .collect()
+    }
+}
+
 /// The lighting of a frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FramePlan {
+    /// The depth convention the passes' depth tests are written for.
+    pub depth: DepthConvention,
+    /// The lights drawn, in drawing order; lights that touch nothing or that the view cannot
+    /// see are not here.
+    pub lights: Vec<PlannedLight>,
     pub steps: Vec<Step>,
 }
 
 impl FramePlan {
+    /// A plan that draws nothing (the forward frame has no lighting passes).
+    pub fn empty(depth: DepthConvention) -> Self {
+        Self {
+            depth,
+            lights: Vec::new(),
+            steps: Vec::new(),
+        }
+    }
+
     /// Plans every light in order, then inserts flushes and the save / restore steps.
     pub fn build(
         layout: &StencilLayout,
-        backend: &dyn PlatformBackend,
-        lights: &[LightRequest],
+        caps: &PlatformCaps,
+        depth: DepthConvention,
+        lights: Vec<PlannedLight>,
         policy: FlushPolicy,
     ) -> Result<Self, PlanError> {
-        let caps = backend.caps();
         let mut steps = Vec::new();
-        for (light, request) in lights.iter().enumerate() {
-            for pass in plan_light(layout, &caps, request)? {
+        for (light, planned) in lights.iter().enumerate() {
+            for pass in plan_light(layout, caps, depth, &planned.request)? {
                 steps.push(Step::Pass { light, pass });
             }
         }
         let mut steps = insert_flushes(steps, policy);
-        let preserved = layout.preserved_mask();
-        if caps.save_restore_preserved && caps.zero_preserved_as_we_go && preserved != 0 {
-            steps.insert(0, Step::SavePreserved { mask: preserved });
-            steps.push(Step::RestorePreserved { mask: preserved });
+        // Only the engine's declared bits come back; free bits may stay zeroed.
+        let engine = layout.engine_mask();
+        if caps.save_restore_preserved && caps.zero_preserved_as_we_go && engine != 0 {
+            steps.insert(0, Step::SavePreserved { mask: engine });
+            steps.push(Step::RestorePreserved { mask: engine });
         }
-        Ok(Self { steps })
+        Ok(Self {
+            depth,
+            lights,
+            steps,
+        })
+    }
+
+    /// Plans bare requests (numbered in order, standard depth) for the platform `backend`: what
+    /// tests and what-if studies build by hand.
+    pub fn from_requests(
+        layout: &StencilLayout,
+        backend: &dyn crate::backend::PlatformBackend,
+        requests: &[LightRequest],
+        policy: FlushPolicy,
+    ) -> Result<Self, PlanError> {
+        Self::build(
+            layout,
+            &backend.caps(),
+            DepthConvention::Standard,
+            PlannedLight::numbered(requests.iter().cloned()),
+            policy,
+        )
+    }
+
+    /// The input index of each drawn light, in drawing order.
+    pub fn light_inputs(&self) -> Vec<usize> {
+        self.lights.iter().map(|l| l.input).collect()
+    }
+
+    /// Whether drawn light `light` is drawn full-screen (no volume to rasterise).
+    pub fn is_full_screen(&self, light: usize) -> bool {
+        matches!(
+            self.lights[light].request.case,
+            LightCase::FullScreen | LightCase::ViewerInside
+        )
     }
 
     pub fn passes(&self) -> impl Iterator<Item = &Pass> {
@@ -92,9 +169,25 @@ impl FramePlan {
             .sum()
     }
 
-    /// A printable description, one step per line.
+    /// A printable description: one line per drawn light (its case, coverage, BRDF slots and
+    /// technique), then one line per step.
     pub fn describe(&self) -> String {
-        let mut out = String::new();
+        let mut out = format!("depth {:?}\n", self.depth);
+        for (index, light) in self.lights.iter().enumerate() {
+            let request = &light.request;
+            let coverage = light.coverage.map_or(String::new(), |c| {
+                format!(", {:.2} % of the screen", 100.0 * c)
+            });
+            let technique = match (request.affected.len(), request.technique) {
+                (..=1, _) | (_, LightTechnique::SingleBrdf) => "single BRDF",
+                (_, LightTechnique::Stencil) => "stencil",
+                (_, LightTechnique::Branching) => "branching",
+            };
+            out.push_str(&format!(
+                "light {index} (input {}): {:?}{coverage}, BRDF slots {:?}, {technique}\n",
+                light.input, request.case, request.affected
+            ));
+        }
         for step in &self.steps {
             let line = match step {
                 Step::Pass { light, pass } => format!("light {light}: {}", pass.label()),

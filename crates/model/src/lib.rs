@@ -18,11 +18,17 @@
 //! ```
 //!
 //! With 8 BRDFs in use: `culling_mask = 0x01`, `brdf_mask = 0x0E`, `brdf_shift = 1`, preserved
-//! `0xF0`. The layout here is derived from the number of BRDFs a scene uses, never hard-coded.
+//! `0xF0`. The BRDF field's width is derived from the number of BRDFs a scene uses, never
+//! hard-coded; an engine that keeps its own data in some stencil bits puts the culling bit and the
+//! BRDF field wherever its bits are not ([`StencilLayout::with_positions`]).
 
 //!
 //! # What this crate decides
-//! - [`StencilLayout`]: where the bits sit, derived from the BRDF count;
+//! - [`plan_frame`]: the whole frame's plan from plain inputs an engine has at hand
+//!   ([`PlanInputs`]: light shapes, per-BRDF world boxes, a [`View`] from its own matrices with
+//!   standard or reversed depth and a finite or infinite far plane), with one [`PlanSettings`]
+//!   value per frame. No GPU, so every decision is testable on the CPU;
+//! - [`StencilLayout`]: where the bits sit, derived from the BRDF count, at the engine's positions;
 //! - [`plan_light`] / [`FramePlan`]: the ordered passes of every light with their full
 //!   [`PassState`], for a [`PlatformBackend`] described as data ([`PlatformCaps`]);
 //! - [`insert_flushes`]: when the hi-stencil surface must be flushed ([`FlushPolicy`]);
@@ -42,19 +48,27 @@ mod footprint;
 mod frame;
 mod layout;
 mod plan;
+mod planner;
 mod sim;
 mod state;
 mod synthetic;
 mod tiles;
+mod view;
 
 pub use backend::{Native, PlatformBackend, PlatformCaps, Ps3Like, X360Like};
 pub use chooser::{CostModel, TalkFigures};
 pub use footprint::{Footprint, Span};
-pub use frame::{insert_flushes, write_test_dependencies, FlushPolicy, FramePlan, Step};
-pub use layout::{LayoutError, StencilLayout};
+pub use frame::{
+    insert_flushes, write_test_dependencies, FlushPolicy, FramePlan, PlannedLight, Step,
+};
+pub use layout::{LayoutError, StencilBits, StencilLayout};
 pub use plan::{
     plan_light, Geometry, LightCase, LightRequest, LightTechnique, Pass, PassKind, PlanError,
     Shader,
+};
+pub use planner::{
+    plan_frame, Aabb, LightShape, PlanInputs, PlanSettings, TechniqueChoice, MAX_SPOT_ANGLE,
+    VOLUME_OVERSHOOT,
 };
 pub use sim::{LightShading, SimResult, Simulator, SoftTarget, NOT_SHADED};
 pub use state::{
@@ -62,3 +76,4 @@ pub use state::{
 };
 pub use synthetic::{SyntheticDesc, SyntheticFrame};
 pub use tiles::{TileStats, TileSurface};
+pub use view::{DepthConvention, FarPlane, Perspective, View, ViewDesc, ViewError};

@@ -1,9 +1,11 @@
 //! Light pass plans: the ordered passes that light one volume, each with its full state.
 //!
-//! Depth convention (no reverse-Z): a surface at depth `d` lies inside a light volume whose
-//! front face is at `f` and back face at `b` along the pixel's ray when `f < d < b`. Sky pixels
-//! have `d = 1` and are never lit. Volume pipelines clamp depth, so a back face beyond the far
-//! plane sits at 1 and a volume crossing the far plane needs no special case.
+//! Written here for standard depth (near 0, far 1); with reversed depth every depth compare is
+//! mirrored ([`DepthConvention::orient`]) and full-screen passes sit at depth 0. A surface at
+//! depth `d` lies inside a light volume whose front face is at `f` and back face at `b` along the
+//! pixel's ray when `f < d < b` (nearer than, in the reversed case). Sky pixels lie at the far
+//! depth and are never lit. Volume pipelines clamp depth, so a back face beyond the far plane
+//! sits at the far depth and a volume crossing the far plane needs no special case.
 //!
 //! ```text
 //! Outside (the talk):  setup    back faces, depth b <= d  -> culling bit := 1
@@ -13,8 +15,8 @@
 //! Crosses near plane:  setup    front faces, depth f >= d -> culling bit := 1
 //!                      mask b / shade b on back faces, depth b > d
 //!                      cleanup  front faces, no depth     -> culling bit := 0
-//! Viewer inside:       mask b / shade b on back faces, depth b > d; no culling bit
-//! Full screen:         mask b / shade b on a full-screen triangle at depth 1 with 1 > d
+//! Viewer inside:       mask b / shade b on a full-screen triangle at the far depth, far > d
+//! Full screen:         the same
 //! ```
 //! 360-like with zeroing: setup and cleanup write `!brdf_mask` (preserved bits := 0) and every
 //! case not starting with a back-face setup first draws a `zero-preserved` pass over the whole
@@ -27,6 +29,7 @@ use crate::layout::StencilLayout;
 use crate::state::{
     CompareOp, CullMode, DepthState, FaceStencil, HiStencilState, PassState, StencilOp,
 };
+use crate::view::DepthConvention;
 
 /// How the light volume relates to the camera.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -66,7 +69,7 @@ pub struct LightRequest {
 pub enum Geometry {
     /// The light's convex volume; [`PassState::cull`] says which faces remain.
     Volume,
-    /// A full-screen triangle at depth 1.
+    /// A full-screen triangle at the far depth ([`DepthConvention::far`]).
     FullScreen,
 }
 
@@ -125,6 +128,16 @@ pub enum PlanError {
     SlotOutOfRange { slot: u32, brdfs: u32 },
     #[error("single-BRDF technique asked for a light affecting {count} BRDFs")]
     SingleWithManyBrdfs { count: usize },
+    #[error("light {index}: {problem}")]
+    BadLight { index: usize, problem: &'static str },
+    #[error("bounds {index} of BRDF slot {slot}: {problem}")]
+    BadBounds {
+        slot: u32,
+        index: usize,
+        problem: &'static str,
+    },
+    #[error("view: {0}")]
+    View(#[from] crate::view::ViewError),
 }
 
 /// Where the shading passes of a case rasterise, and their depth test.
@@ -136,32 +149,25 @@ pub enum PlanError {
 /// eye plane are clipped one by one, and two of them can both cover a pixel, which then gets the
 /// light twice (`histencil check` found one such pixel on the glTF test scene at 257x129 on
 /// lavapipe).
-fn shade_raster(case: LightCase) -> (Geometry, CullMode, DepthState) {
+fn shade_raster(case: LightCase, depth: DepthConvention) -> (Geometry, CullMode, DepthState) {
+    let test = |op| DepthState::test(depth.orient(op));
     match case {
-        LightCase::Outside => (
-            Geometry::Volume,
-            CullMode::Back,
-            DepthState::test(CompareOp::Less),
-        ),
-        LightCase::CrossesNear => (
-            Geometry::Volume,
-            CullMode::Front,
-            DepthState::test(CompareOp::Greater),
-        ),
+        LightCase::Outside => (Geometry::Volume, CullMode::Back, test(CompareOp::Less)),
+        LightCase::CrossesNear => (Geometry::Volume, CullMode::Front, test(CompareOp::Greater)),
         LightCase::ViewerInside | LightCase::FullScreen => (
             Geometry::FullScreen,
             CullMode::None,
-            DepthState::test(CompareOp::Greater),
+            test(CompareOp::Greater),
         ),
     }
 }
 
 /// The faces that mark (and later clear) the culling bit, and the depth test that marks it:
 /// surfaces behind the back face (outside) or in front of the front face (near crossing).
-fn culling_raster(case: LightCase) -> Option<(CullMode, CompareOp)> {
+fn culling_raster(case: LightCase, depth: DepthConvention) -> Option<(CullMode, CompareOp)> {
     match case {
-        LightCase::Outside => Some((CullMode::Front, CompareOp::LessOrEqual)),
-        LightCase::CrossesNear => Some((CullMode::Back, CompareOp::GreaterOrEqual)),
+        LightCase::Outside => Some((CullMode::Front, depth.orient(CompareOp::LessOrEqual))),
+        LightCase::CrossesNear => Some((CullMode::Back, depth.orient(CompareOp::GreaterOrEqual))),
         LightCase::ViewerInside | LightCase::FullScreen => None,
     }
 }
@@ -222,10 +228,11 @@ fn normalise(
     Ok((slots, technique))
 }
 
-/// Builds the passes of one light, in order.
+/// Builds the passes of one light, in order, for a depth buffer following `depth`.
 pub fn plan_light(
     layout: &StencilLayout,
     caps: &PlatformCaps,
+    convention: DepthConvention,
     request: &LightRequest,
 ) -> Result<Vec<Pass>, PlanError> {
     let (slots, technique) = normalise(layout, request)?;
@@ -255,8 +262,8 @@ pub fn plan_light(
         write,
         test: !write,
     };
-    let (geometry, cull, depth) = shade_raster(request.case);
-    let culling_faces = culling_raster(request.case);
+    let culling_faces = culling_raster(request.case, convention);
+    let (geometry, cull, depth) = shade_raster(request.case, convention);
 
     // Stencil-writing passes before any shading.
     let mut passes = Vec::new();
@@ -393,6 +400,7 @@ mod tests {
         let plan = plan_light(
             &layout,
             &caps,
+            DepthConvention::Standard,
             &request(LightCase::Outside, &[0, 3], LightTechnique::Stencil),
         )
         .unwrap();
@@ -425,6 +433,7 @@ mod tests {
         let plan = plan_light(
             &layout,
             &Ps3Like.caps(),
+            DepthConvention::Standard,
             &request(LightCase::Outside, &[1, 2], LightTechnique::Stencil),
         )
         .unwrap();
@@ -442,6 +451,7 @@ mod tests {
         let plan = plan_light(
             &layout,
             &Native.caps(),
+            DepthConvention::Standard,
             &request(LightCase::Outside, &[0, 1, 2], LightTechnique::Stencil),
         )
         .unwrap();
@@ -464,6 +474,7 @@ mod tests {
         let plan = plan_light(
             &layout,
             &Ps3Like.caps(),
+            DepthConvention::Standard,
             &request(LightCase::Outside, &[0], LightTechnique::Stencil),
         )
         .unwrap();
@@ -478,6 +489,7 @@ mod tests {
         let plan = plan_light(
             &layout,
             &Native.caps(),
+            DepthConvention::Standard,
             &request(LightCase::ViewerInside, &[0, 1], LightTechnique::Stencil),
         )
         .unwrap();
@@ -493,6 +505,7 @@ mod tests {
         let plan = plan_light(
             &layout,
             &X360Like::default().caps(),
+            DepthConvention::Standard,
             &request(LightCase::CrossesNear, &[0, 1], LightTechnique::Stencil),
         )
         .unwrap();
@@ -519,11 +532,44 @@ mod tests {
         let plan = plan_light(
             &layout,
             &X360Like::default().caps(),
+            DepthConvention::Standard,
             &request(LightCase::Outside, &[0, 1], LightTechnique::Branching),
         )
         .unwrap();
         assert_eq!(labels(&plan), ["setup", "shade-branching", "cleanup"]);
         assert!(plan.iter().all(|p| p.state.hi_stencil.is_none()));
+    }
+
+    /// Reversed depth mirrors every depth compare and nothing else.
+    #[test]
+    fn reversed_depth_mirrors_the_depth_tests_only() {
+        let layout = StencilLayout::new(4, 2).unwrap();
+        for case in [
+            LightCase::Outside,
+            LightCase::CrossesNear,
+            LightCase::ViewerInside,
+            LightCase::FullScreen,
+        ] {
+            for caps in [X360Like::default().caps(), Ps3Like.caps(), Native.caps()] {
+                let request = request(case, &[0, 2], LightTechnique::Stencil);
+                let standard =
+                    plan_light(&layout, &caps, DepthConvention::Standard, &request).unwrap();
+                let reversed =
+                    plan_light(&layout, &caps, DepthConvention::Reversed, &request).unwrap();
+                assert_eq!(standard.len(), reversed.len());
+                for (s, r) in standard.iter().zip(&reversed) {
+                    let mirrored = s
+                        .state
+                        .depth
+                        .compare
+                        .map(|op| DepthConvention::Reversed.orient(op));
+                    assert_eq!(r.state.depth.compare, mirrored, "{case:?} {}", s.label());
+                    let depth = r.state.depth;
+                    assert_eq!(PassState { depth, ..s.state }, r.state);
+                    assert_eq!((s.kind, s.geometry), (r.kind, r.geometry));
+                }
+            }
+        }
     }
 
     #[test]
@@ -534,6 +580,7 @@ mod tests {
             plan_light(
                 &layout,
                 &caps,
+                DepthConvention::Standard,
                 &request(LightCase::Outside, &[2], LightTechnique::Stencil)
             ),
             Err(PlanError::SlotOutOfRange { slot: 2, brdfs: 2 })
@@ -542,6 +589,7 @@ mod tests {
             plan_light(
                 &layout,
                 &caps,
+                DepthConvention::Standard,
                 &request(LightCase::Outside, &[0, 1], LightTechnique::SingleBrdf)
             ),
             Err(PlanError::SingleWithManyBrdfs { count: 2 })
@@ -549,6 +597,7 @@ mod tests {
         assert!(plan_light(
             &layout,
             &caps,
+            DepthConvention::Standard,
             &request(LightCase::Outside, &[], LightTechnique::Stencil)
         )
         .unwrap()

@@ -14,7 +14,8 @@ use crate::tiles::{TileStats, TileSurface};
 pub struct SoftTarget {
     pub width: u32,
     pub height: u32,
-    /// Surface depth per pixel; 1 where there is no surface.
+    /// Surface depth per pixel; the far depth of the plan's convention where there is no
+    /// surface.
     pub depth: Vec<f32>,
     pub stencil: Vec<u8>,
 }
@@ -72,14 +73,18 @@ impl Simulator {
     /// Executes `plan` on `target`; `footprints[i]` is the coverage of light `i`.
     ///
     /// # Panics
-    /// If a step names a light without a footprint, or a footprint exceeds the target: caller
-    /// bugs, not data errors.
+    /// If a step names a light without a footprint, a footprint exceeds the target or follows
+    /// another depth convention than the plan: caller bugs, not data errors.
     pub fn run(
         &self,
         target: &mut SoftTarget,
         plan: &FramePlan,
         footprints: &[Footprint],
     ) -> SimResult {
+        assert!(
+            footprints.iter().all(|f| f.depth() == plan.depth),
+            "footprints and plan follow different depth conventions"
+        );
         let tiles = TileSurface::new(target.width, target.height, self.tile_size);
         let mut run = Run {
             layout: self.layout,
@@ -102,7 +107,14 @@ impl Simulator {
             }
             match step {
                 Step::Pass { light, pass } => {
-                    run.pass(index as u32, pass, &footprints[*light], &mut lights[*light])
+                    let far = plan.depth.far();
+                    run.pass(
+                        index as u32,
+                        pass,
+                        far,
+                        &footprints[*light],
+                        &mut lights[*light],
+                    )
                 }
                 Step::FlushHiStencil => {
                     run.tiles.flush();
@@ -148,7 +160,14 @@ impl Run<'_> {
         })
     }
 
-    fn pass(&mut self, step: u32, pass: &Pass, footprint: &Footprint, shading: &mut LightShading) {
+    fn pass(
+        &mut self,
+        step: u32,
+        pass: &Pass,
+        far: f32,
+        footprint: &Footprint,
+        shading: &mut LightShading,
+    ) {
         let state = &pass.state;
         let front_facing = match (pass.geometry, state.cull) {
             (Geometry::FullScreen, _) | (Geometry::Volume, CullMode::Back) => true,
@@ -167,7 +186,7 @@ impl Run<'_> {
                     continue;
                 };
                 let fragment_depth = match pass.geometry {
-                    Geometry::FullScreen => 1.0,
+                    Geometry::FullScreen => far,
                     Geometry::Volume if front_facing => match span.front {
                         Some(front) => front,
                         None => continue,

@@ -44,7 +44,7 @@ fn lit_pixels(
         affected: vec![0, 1],
         technique: LightTechnique::Stencil,
     };
-    let plan = FramePlan::build(&layout, backend, &[request], policy).unwrap();
+    let plan = FramePlan::from_requests(&layout, backend, &[request], policy).unwrap();
     let mut target = target.clone();
     let result = Simulator { layout, tile_size }.run(&mut target, &plan, &[footprint]);
     let lit = result.lights[0]
@@ -122,10 +122,12 @@ fn the_360_plan_with_save_restore_reads_like_the_talk() {
         affected: vec![0, 2],
         technique: LightTechnique::Stencil,
     };
-    let plan = FramePlan::build(&layout, &backend, &[request], FlushPolicy::Auto).unwrap();
+    let plan = FramePlan::from_requests(&layout, &backend, &[request], FlushPolicy::Auto).unwrap();
     assert_eq!(
         plan.describe(),
-        "save preserved bits 0xf0\n\
+        "depth Standard\n\
+         light 0 (input 0): Outside, BRDF slots [0, 2], stencil\n\
+         save preserved bits 0xf0\n\
          light 0: setup\n\
          light 0: mask-brdf-0\n\
          flush hi-stencil\n\
@@ -155,7 +157,8 @@ fn a_256_square_frame_with_100_lights_is_lit_exactly() {
         radius_px: (4.0, 64.0),
         seed: 0x2545_F491_4F6C_DD1D,
     });
-    let plan = FramePlan::build(&layout, &Ps3Like, &frame.requests, FlushPolicy::Auto).unwrap();
+    let plan =
+        FramePlan::from_requests(&layout, &Ps3Like, &frame.requests, FlushPolicy::Auto).unwrap();
     let mut target = frame.target.clone();
     let result = Simulator {
         layout,

@@ -1,12 +1,14 @@
 //! Property tests of the plans, run on the CPU simulator against an independent oracle: a pixel
 //! is lit by a light exactly when its surface lies strictly between the volume's faces
-//! ([`Span::contains`]).
+//! ([`Span::contains`]). Layouts put the culling bit and the BRDF field anywhere in the byte;
+//! the same frames mirrored into reversed depth must give the same result bit for bit.
 
 mod common;
 
 use common::{backend, frame, Backend, Frame};
 use histencil_model::{
-    insert_flushes, write_test_dependencies, FlushPolicy, FramePlan, SimResult, Step, NOT_SHADED,
+    insert_flushes, write_test_dependencies, DepthConvention, FlushPolicy, FramePlan, SimResult,
+    Step, NOT_SHADED,
 };
 use proptest::prelude::*;
 
@@ -97,19 +99,36 @@ proptest! {
         }
         prop_assert!(stencil == fine_stencil, "hi-stencil changed the stencil");
 
+        // What lighting may zero where a light volume is drawn: nothing (PS3-like, native),
+        // the free bits (360-like saving and restoring the engine's), every preserved bit.
         let preserved = frame.layout.preserved_mask();
-        match backend {
-            Backend::Native | Backend::Ps3 | Backend::X360 { save_restore: true, .. } => {
-                prop_assert!(stencil == frame.target.stencil, "stencil not kept bit for bit");
-            }
-            Backend::X360 { save_restore: false, .. } => {
-                let touched = touched_by_lights(&frame);
-                for (i, (&after, &before)) in stencil.iter().zip(&frame.target.stencil).enumerate() {
-                    let expected = if touched[i] { before & !preserved } else { before };
-                    prop_assert_eq!(after, expected, "pixel {}", i);
-                }
-            }
+        let zeroed = match backend {
+            Backend::Native | Backend::Ps3 => 0,
+            Backend::X360 { save_restore: true, .. } => preserved & !frame.layout.engine_mask(),
+            Backend::X360 { save_restore: false, .. } => preserved,
+        };
+        let touched = touched_by_lights(&frame);
+        for (i, (&after, &before)) in stencil.iter().zip(&frame.target.stencil).enumerate() {
+            let expected = if touched[i] { before & !zeroed } else { before };
+            prop_assert_eq!(after, expected, "pixel {} layout {:?}", i, frame.layout);
         }
+    }
+
+    #[test]
+    fn reversed_depth_lights_the_same_pixels_bit_for_bit(
+        frame in frame(),
+        backend in backend(),
+        tile_size in 1u32..=16,
+    ) {
+        let standard = frame.in_convention(DepthConvention::Standard);
+        let reversed = frame.in_convention(DepthConvention::Reversed);
+        let plan = reversed.plan(&backend, FlushPolicy::Auto);
+        let (result, stencil) = reversed.simulate(&plan, tile_size);
+        assert_shaded_exactly_inside(&reversed, &result)?;
+        let (expected, expected_stencil) =
+            standard.simulate(&standard.plan(&backend, FlushPolicy::Auto), tile_size);
+        prop_assert!(result == expected, "reversed depth shaded other pixels");
+        prop_assert!(stencil == expected_stencil, "reversed depth left another stencil");
     }
 
     #[test]

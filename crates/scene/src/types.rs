@@ -2,6 +2,7 @@ use crate::alpha::{alpha_problem, transformed_unit_cube};
 use crate::{AlphaObject, Mesh, ParticleSystem};
 use glam::{Mat4, Vec3};
 use histencil_brdf::{Brdf, BrdfId};
+use histencil_model::{Aabb, DepthConvention, LightShape, ViewDesc};
 
 /// A scene: a camera, opaque objects, lights, and alpha entities (translucent objects and particle
 /// systems, drawn after lighting). Plain data; [`Scene::validate`] says whether a renderer can take
@@ -38,6 +39,15 @@ impl Camera {
     /// Vulkan clip space: depth 0 at `near`, 1 at `far`, y down.
     pub fn projection(&self, aspect: f32) -> Mat4 {
         glam::camera::rh::proj::vulkan::perspective(self.fov_y_radians, aspect, self.near, self.far)
+    }
+
+    /// The view as the frame planner takes it (standard depth, finite far plane).
+    pub fn view_desc(&self, aspect: f32) -> ViewDesc {
+        ViewDesc {
+            world_to_view: self.view().to_cols_array_2d(),
+            view_to_clip: self.projection(aspect).to_cols_array_2d(),
+            depth: DepthConvention::Standard,
+        }
     }
 
     /// Distance from the eye to a corner of the near plane: a sphere farther than this plus its
@@ -133,6 +143,27 @@ impl Light {
             position,
             radius,
             color,
+        }
+    }
+
+    /// What the frame planner needs of the light: where its volume is.
+    pub fn shape(&self) -> LightShape {
+        match self.kind {
+            LightKind::Point => LightShape::Point {
+                position: self.position.into(),
+                range: self.radius,
+            },
+            LightKind::Spot {
+                direction,
+                outer_angle,
+                ..
+            } => LightShape::Spot {
+                position: self.position.into(),
+                direction: direction.into(),
+                range: self.radius,
+                outer_angle,
+            },
+            LightKind::Directional { .. } => LightShape::Directional,
         }
     }
 
@@ -475,6 +506,22 @@ impl Scene {
     /// stencil slot.
     pub fn brdfs_in_use(&self) -> Vec<BrdfId> {
         distinct_brdfs(self.objects.iter())
+    }
+
+    /// The frame planner's BRDF bounds: for each BRDF of `brdfs` (a slot each), the world boxes
+    /// of its objects.
+    pub fn brdf_bounds(&self, brdfs: &[BrdfId]) -> Vec<Vec<Aabb>> {
+        let mut bounds = vec![Vec::new(); brdfs.len()];
+        for object in &self.objects {
+            if let Some(slot) = brdfs.iter().position(|b| *b == object.material.brdf.id()) {
+                let (lo, hi) = object.world_bounds();
+                bounds[slot].push(Aabb {
+                    min: lo.into(),
+                    max: hi.into(),
+                });
+            }
+        }
+        bounds
     }
 
     /// The BRDFs of the objects that `light` can reach (world bounds against its range sphere;

@@ -17,8 +17,8 @@ use crate::shaders;
 use crate::state::apply;
 use ash::vk;
 use histencil_model::{
-    CullMode, DepthState, Footprint, FramePlan, Geometry, PassState, SimResult, Simulator,
-    SoftTarget, Span, StencilLayout, Step,
+    CullMode, DepthState, Footprint, FramePlan, PassState, SimResult, Simulator, SoftTarget, Span,
+    StencilLayout,
 };
 use histencil_scene::{Light, LightKind};
 
@@ -219,11 +219,4 @@ impl FootprintCapture {
             buffer.destroy(ctx);
         }
     }
-}
-
-/// Whether planned light `light` is drawn full screen (a light without a volume).
-pub(crate) fn is_full_screen(plan: &FramePlan, light: usize) -> bool {
-    plan.steps.iter().any(|s| {
-        matches!(s, Step::Pass { light: l, pass } if *l == light && pass.geometry == Geometry::FullScreen)
-    })
 }

@@ -73,10 +73,6 @@ pub struct Meshes {
     pub sphere: GpuMesh,
     pub light_sphere: GpuMesh,
     pub light_cone: GpuMesh,
-    /// Distance from the centre to the farthest vertex of the unit light sphere mesh.
-    pub light_sphere_bound: f32,
-    /// `(farthest radial, axial)` extent of the unit light cone mesh.
-    pub light_cone_bound: (f32, f32),
     /// The scene's imported meshes (`Shape::Mesh`), in `Scene::meshes` order.
     pub imported: Vec<GpuMesh>,
 }
@@ -86,18 +82,10 @@ impl Meshes {
     pub fn new(ctx: &Context, imported: &[Mesh]) -> Result<Self> {
         let sphere_volume = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
         let cone_volume = light_cone(CONE_SIDES);
-        let far = |m: &Mesh, f: fn([f32; 3]) -> f32| {
-            m.vertices.iter().map(|v| f(v.position)).fold(0.0, f32::max)
-        };
         Ok(Self {
             unit_box: GpuMesh::new(ctx, "box-mesh", &unit_box())?,
             unit_box_bake: GpuMesh::new(ctx, "box-bake-mesh", &unit_box_bake())?,
             sphere: GpuMesh::new(ctx, "sphere-mesh", &uv_sphere(48, 24))?,
-            light_sphere_bound: far(&sphere_volume, |p| glam::Vec3::from(p).length()),
-            light_cone_bound: (
-                far(&cone_volume, |p| glam::Vec2::new(p[0], p[1]).length()),
-                far(&cone_volume, |p| p[2]),
-            ),
             light_sphere: GpuMesh::new(ctx, "light-sphere-mesh", &sphere_volume)?,
             light_cone: GpuMesh::new(ctx, "light-cone-mesh", &cone_volume)?,
             imported: imported
@@ -137,5 +125,32 @@ impl Meshes {
         {
             m.destroy(ctx);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use histencil_model::VOLUME_OVERSHOOT;
+
+    fn farthest(m: &Mesh, f: fn([f32; 3]) -> f32) -> f64 {
+        m.vertices
+            .iter()
+            .map(|v| f64::from(f(v.position)))
+            .fold(0.0, f64::max)
+    }
+
+    /// The planner bounds light volumes by `VOLUME_OVERSHOOT` times their range: the meshes
+    /// drawn must stay inside that.
+    #[test]
+    fn light_volumes_stay_within_the_planners_bound() {
+        let sphere = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
+        let reach = farthest(&sphere, |p| glam::Vec3::from(p).length());
+        assert!(reach > 1.0 && reach <= VOLUME_OVERSHOOT, "{reach}");
+        let cone = light_cone(CONE_SIDES);
+        let radial = farthest(&cone, |p| glam::Vec2::new(p[0], p[1]).length());
+        let axial = farthest(&cone, |p| p[2]);
+        assert!(radial > 1.0 && radial <= VOLUME_OVERSHOOT, "{radial}");
+        assert!(axial > 1.0 && axial <= VOLUME_OVERSHOOT, "{axial}");
     }
 }

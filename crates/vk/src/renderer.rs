@@ -1,7 +1,7 @@
 //! The renderer: owns a scene's GPU resources and records / submits whole frames.
 
 use crate::alpha::{AlphaLighting, AlphaMode};
-use crate::capture::{is_full_screen, FootprintCapture, SimulatorInputs};
+use crate::capture::{FootprintCapture, SimulatorInputs};
 use crate::context::Context;
 use crate::descriptors::write_storage_buffers;
 use crate::descriptors::{DescriptorTargets, Descriptors};
@@ -12,7 +12,7 @@ use crate::lut::LutTables;
 use crate::meshes::Meshes;
 use crate::passes::geometry::GeometryPass;
 use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
-use crate::passes::lighting::{classify, mesh_bound, screen_coverage, LightingPass};
+use crate::passes::lighting::LightingPass;
 use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::{
@@ -26,8 +26,9 @@ use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
-    CostModel, FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native,
-    PlatformBackend, Ps3Like, SoftTarget, StencilLayout, TalkFigures, TileStats, X360Like,
+    plan_frame, CostModel, DepthConvention, FlushPolicy, Footprint, FramePlan, LightShape,
+    LightTechnique, Native, PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like,
+    SoftTarget, StencilLayout, TalkFigures, TechniqueChoice, TileStats, View, X360Like,
 };
 use histencil_scene::Scene;
 
@@ -514,50 +515,34 @@ impl<'c> Renderer<'c> {
         self.light_pipelines.count()
     }
 
-    /// The lighting plan of a frame: each light that touches an object, classified against the
-    /// camera, with the BRDF slots it touches. Also returns the scene index of each planned
-    /// light.
-    pub fn plan(&self, technique: Technique) -> Result<(FramePlan, Vec<u32>)> {
+    /// The lighting plan of a frame, from histencil-model's planner on the scene's plain inputs:
+    /// each light that touches an object and that the camera can see, classified against the
+    /// camera, with the BRDF slots it touches ([`FramePlan::lights`] says which scene light each
+    /// planned light is).
+    pub fn plan(&self, technique: Technique) -> Result<FramePlan> {
         let Some((light_technique, backend, flush)) = technique.light_technique() else {
-            return Ok((FramePlan { steps: vec![] }, vec![]));
+            return Ok(FramePlan::empty(DepthConvention::Standard));
         };
         let aspect = self.extent.width as f32 / self.extent.height as f32;
-        let mut requests = Vec::new();
-        let mut indices = Vec::new();
-        for (index, light) in self.scene.lights.iter().enumerate() {
-            let affected: Vec<u32> = self
-                .scene
-                .brdfs_lit_by(light)
-                .into_iter()
-                .map(|id| slot_of(&self.brdfs, id))
-                .collect();
-            if affected.is_empty() {
-                continue;
-            }
-            let bound = mesh_bound(light, &self.meshes);
-            let case = classify(light, bound, &self.scene.camera, aspect);
-            let chosen = match technique {
-                Technique::Adaptive { .. } => {
-                    let coverage = screen_coverage(light, bound, &self.scene.camera, aspect, case);
-                    self.cost_model(backend)
-                        .choose(coverage, affected.len() as u32)
-                }
-                _ => light_technique,
-            };
-            requests.push(LightRequest {
-                case,
-                affected,
-                technique: chosen,
-            });
-            indices.push(index as u32);
-        }
-        let plan = FramePlan::build(
-            &self.stencil_layout,
-            backend.platform().as_ref(),
-            &requests,
+        let view = View::new(&self.scene.camera.view_desc(aspect)).map_err(PlanError::from)?;
+        let shapes: Vec<LightShape> = self.scene.lights.iter().map(|l| l.shape()).collect();
+        let brdf_bounds = self.scene.brdf_bounds(&self.brdfs);
+        let technique = match (technique, light_technique) {
+            (Technique::Adaptive { .. }, _) => TechniqueChoice::Adaptive(self.cost_model(backend)),
+            (_, LightTechnique::Branching) => TechniqueChoice::Branching,
+            _ => TechniqueChoice::Stencil,
+        };
+        let inputs = PlanInputs {
+            lights: &shapes,
+            brdf_bounds: &brdf_bounds,
+            view: &view,
+        };
+        let settings = PlanSettings {
+            technique,
+            caps: backend.platform().caps(),
             flush,
-        )?;
-        Ok((plan, indices))
+        };
+        Ok(plan_frame(&self.stencil_layout, &inputs, &settings)?)
     }
 
     /// Renders one frame and waits for it. `readback` says which images to copy back.
@@ -568,7 +553,7 @@ impl<'c> Renderer<'c> {
             ..readback
         };
         let ctx = self.ctx;
-        let (plan, light_indices) = self.plan(technique)?;
+        let plan = self.plan(technique)?;
         let count_stats = self.tile_stats && technique != Technique::Forward;
         let brdf_source = technique.brdf_source();
         if brdf_source == BrdfSource::Table {
@@ -617,7 +602,6 @@ impl<'c> Renderer<'c> {
                     ctx,
                     cmd,
                     plan: &plan,
-                    light_indices: &light_indices,
                     lights: &self.scene.lights,
                     brdfs: &self.brdfs,
                     meshes: &self.meshes,
@@ -762,7 +746,7 @@ impl<'c> Renderer<'c> {
     /// f32 depths), besides the errors of [`Renderer::plan`] and of Vulkan calls.
     pub fn simulator_inputs(&mut self, technique: Technique) -> Result<SimulatorInputs> {
         let ctx = self.ctx;
-        let (plan, light_indices) = self.plan(technique)?;
+        let plan = self.plan(technique)?;
         let mut capture =
             FootprintCapture::new(ctx, self.descriptors.lighting_pipeline_layout, self.extent)?;
         let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
@@ -783,8 +767,9 @@ impl<'c> Renderer<'c> {
                 stencil: stencil.read().to_vec(),
             };
             let mut footprints = Vec::new();
-            for (planned, &index) in light_indices.iter().enumerate() {
-                if is_full_screen(&plan, planned) {
+            for (planned, light) in plan.lights.iter().enumerate() {
+                let index = light.input as u32;
+                if plan.is_full_screen(planned) {
                     footprints.push(Footprint::full_screen(target.width, target.height));
                     continue;
                 }

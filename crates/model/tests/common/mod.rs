@@ -1,8 +1,11 @@
 //! A random frame for the simulator: surface depths, BRDF slots, preserved bits and lights.
+// Each test binary uses its own part of this module.
+#![allow(dead_code)]
 
 use histencil_model::{
-    FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native, PlatformBackend,
-    Ps3Like, SimResult, Simulator, SoftTarget, StencilLayout, X360Like,
+    DepthConvention, FlushPolicy, Footprint, FramePlan, LightRequest, LightTechnique, Native,
+    PlannedLight, PlatformBackend, Ps3Like, SimResult, Simulator, SoftTarget, StencilBits,
+    StencilLayout, X360Like,
 };
 use proptest::prelude::*;
 
@@ -35,8 +38,14 @@ pub struct LightSpec {
 #[derive(Clone, Debug)]
 pub struct Frame {
     pub layout: StencilLayout,
+    pub depth: DepthConvention,
     pub target: SoftTarget,
     pub lights: Vec<LightSpec>,
+}
+
+/// Depths on a grid of 1/4096, which `1 - d` maps exactly onto itself.
+fn on_grid(d: f32) -> f32 {
+    (d * 4096.0).round() / 4096.0
 }
 
 impl Frame {
@@ -81,7 +90,28 @@ impl Frame {
     }
 
     pub fn plan(&self, backend: &Backend, policy: FlushPolicy) -> FramePlan {
-        FramePlan::build(&self.layout, &*backend.boxed(), &self.requests(), policy).unwrap()
+        let lights = PlannedLight::numbered(self.requests());
+        let caps = backend.boxed().caps();
+        FramePlan::build(&self.layout, &caps, self.depth, lights, policy).unwrap()
+    }
+
+    /// The same frame with every depth `d` on the grid, then, with `Reversed`, as `1 - d`.
+    pub fn in_convention(&self, depth: DepthConvention) -> Frame {
+        let mirror = |d: f32| match depth {
+            DepthConvention::Standard => on_grid(d),
+            DepthConvention::Reversed => 1.0 - on_grid(d),
+        };
+        let mut frame = self.clone();
+        frame.depth = depth;
+        frame.target.depth = self.target.depth.iter().map(|&d| mirror(d)).collect();
+        for light in &mut frame.lights {
+            light.footprint = light
+                .footprint
+                .clone()
+                .map_depths(on_grid)
+                .in_convention(depth);
+        }
+        frame
     }
 
     /// Runs `plan`; returns the result and the final stencil.
@@ -129,18 +159,45 @@ fn light(width: u32, height: u32) -> impl Strategy<Value = LightSpec> {
         )
 }
 
-/// Frames up to 40x40 with 1-8 BRDFs, random preserved bits and 1-8 lights.
+/// A layout for `brdfs` BRDFs: the talk's, or the culling bit and BRDF field at random
+/// positions with a random subset of the other bits declared the engine's.
+pub fn layout(brdfs: u32) -> impl Strategy<Value = StencilLayout> {
+    (any::<bool>(), 0u32..8, 0u32..8, any::<u8>()).prop_map(
+        move |(talks, culling_bit, brdf_shift, engine)| {
+            let talks_layout = StencilLayout::new(brdfs, 0).unwrap();
+            if talks {
+                return talks_layout;
+            }
+            let brdf_bits = talks_layout.brdf_bits();
+            let brdf_shift = brdf_shift % (9 - brdf_bits);
+            let field = (((1u32 << brdf_bits) - 1) << brdf_shift) as u8;
+            // The first bit outside the field from `culling_bit` on; 8 bits, at most 3 taken.
+            let culling_bit = (0..8)
+                .map(|i| (culling_bit + i) % 8)
+                .find(|b| field & (1 << b) == 0)
+                .unwrap();
+            let bits = StencilBits {
+                culling_bit,
+                brdf_shift,
+                engine_mask: engine & !(field | 1 << culling_bit),
+            };
+            StencilLayout::with_positions(brdfs, bits).unwrap()
+        },
+    )
+}
+
+/// Frames up to 40x40 with 1-8 BRDFs in any layout, random preserved bits and 1-8 lights.
 pub fn frame() -> impl Strategy<Value = Frame> {
     (4u32..40, 4u32..40, 1u32..=8).prop_flat_map(|(width, height, brdfs)| {
         let n = (width * height) as usize;
-        let layout = StencilLayout::new(brdfs, 0).unwrap();
         (
+            layout(brdfs),
             proptest::collection::vec(0..brdfs, n),
             proptest::collection::vec(any::<u8>(), n),
             proptest::collection::vec(prop_oneof![3 => 0.0f32..1.0, 1 => Just(1.0f32)], n),
             proptest::collection::vec(light(width, height), 1..8),
         )
-            .prop_map(move |(slots, preserved, depth, lights)| {
+            .prop_map(move |(layout, slots, preserved, depth, lights)| {
                 let stencil = slots
                     .iter()
                     .zip(&preserved)
@@ -150,6 +207,7 @@ pub fn frame() -> impl Strategy<Value = Frame> {
                     .collect();
                 Frame {
                     layout,
+                    depth: DepthConvention::Standard,
                     target: SoftTarget {
                         width,
                         height,

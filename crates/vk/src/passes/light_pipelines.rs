@@ -274,7 +274,8 @@ mod tests {
             technique: LightTechnique::Stencil,
         };
         let plan =
-            FramePlan::build(&layout, &X360Like::default(), &[request], FlushPolicy::Auto).unwrap();
+            FramePlan::from_requests(&layout, &X360Like::default(), &[request], FlushPolicy::Auto)
+                .unwrap();
         let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula);
         let shaders: Vec<LightShader> = keys.iter().map(|k| k.1).collect();
         let tiles = TileWork::TestAndCount;

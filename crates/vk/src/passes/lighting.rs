@@ -26,40 +26,10 @@ use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
-    DepthState, FaceStencil, FramePlan, Geometry, LightCase, Pass, PassKind, PassState, Shader,
-    StencilOp, Step,
+    DepthState, FaceStencil, FramePlan, Geometry, Pass, PassKind, PassState, Shader, StencilOp,
+    Step,
 };
-use histencil_scene::{Camera, Light, LightKind};
-
-/// The radius of a sphere containing `light`'s volume mesh, as a multiple of its range.
-pub fn mesh_bound(light: &Light, meshes: &Meshes) -> f32 {
-    match light.kind {
-        LightKind::Spot { outer_angle, .. } => {
-            let (radial, axial) = meshes.light_cone_bound;
-            let radial = radial * outer_angle.tan();
-            (radial * radial + axial * axial).sqrt()
-        }
-        _ => meshes.light_sphere_bound,
-    }
-}
-
-/// How a light is drawn (see `histencil_model::LightCase`). Conservative where it cannot be
-/// sure: [`LightCase::CrossesNear`]'s plan is correct for any volume, the others are faster
-/// special cases taken only when they certainly apply.
-pub fn classify(light: &Light, mesh_bound: f32, camera: &Camera, aspect: f32) -> LightCase {
-    if !light.is_local() {
-        return LightCase::FullScreen;
-    }
-    let near = camera.near_corner_distance(aspect);
-    let distance = (light.position - camera.eye).length();
-    let viewer_inside_sphere = distance + near < light.radius;
-    match light.kind {
-        // The sphere mesh contains the range sphere: eye and near plane are inside the mesh.
-        LightKind::Point if viewer_inside_sphere => LightCase::ViewerInside,
-        _ if distance <= light.radius * mesh_bound + near => LightCase::CrossesNear,
-        _ => LightCase::Outside,
-    }
-}
+use histencil_scene::{Light, LightKind};
 
 /// The talk's pass group of a planned pass, for timings: `setup`, `mask-<brdf>`, `shade-<brdf>`
 /// (`-branching` for the uber shader, `-lut` for the table shader), `cleanup`, `zero-preserved`.
@@ -78,35 +48,10 @@ pub fn pass_group(kind: PassKind, brdfs: &[BrdfId], source: BrdfSource) -> Strin
     }
 }
 
-/// The fraction of the screen a light covers, for the technique chooser: the projected disc of
-/// the sphere around its volume mesh for lights outside it, 1 for lights that reach the near
-/// plane or have no volume. An estimate (a sphere's projection is an ellipse off-axis), which is
-/// all a cost model linear in coverage can use.
-pub fn screen_coverage(
-    light: &Light,
-    mesh_bound: f32,
-    camera: &Camera,
-    aspect: f32,
-    case: LightCase,
-) -> f64 {
-    if case != LightCase::Outside {
-        return 1.0;
-    }
-    let distance = f64::from((light.position - camera.eye).length());
-    let radius = f64::from(light.radius * mesh_bound);
-    let sin = (radius / distance).min(1.0);
-    let tan = sin / (1.0 - sin * sin).sqrt().max(1e-9);
-    // In units of half the screen height; the screen is 2 * aspect by 2 of them.
-    let disc_radius = tan / f64::from((camera.fov_y_radians * 0.5).tan());
-    (std::f64::consts::PI * disc_radius * disc_radius / (4.0 * f64::from(aspect))).min(1.0)
-}
-
 pub struct LightingPass<'a> {
     pub ctx: &'a Context,
     pub cmd: vk::CommandBuffer,
     pub plan: &'a FramePlan,
-    /// The scene light each planned light index stands for.
-    pub light_indices: &'a [u32],
     pub lights: &'a [Light],
     pub brdfs: &'a [BrdfId],
     pub meshes: &'a Meshes,
@@ -214,9 +159,10 @@ impl LightingPass<'_> {
                             ctx.end_label(cmd);
                         }
                         current_light = Some(*light);
-                        ctx.begin_label(cmd, &format!("light-{}", self.light_indices[*light]));
+                        let input = self.plan.lights[*light].input;
+                        ctx.begin_label(cmd, &format!("light-{input}"));
                     }
-                    let scene_light = self.light_indices[*light];
+                    let scene_light = self.plan.lights[*light].input as u32;
                     ctx.begin_label(cmd, &pass.label());
                     self.record_pass(
                         targets,
@@ -404,54 +350,5 @@ impl LightingPass<'_> {
                 _ => self.meshes.light_sphere.draw(ctx, cmd),
             },
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::Vec3;
-
-    #[test]
-    fn classification_is_conservative_near_the_eye() {
-        let scene = histencil_scene::embedded("default").unwrap();
-        let camera = scene.camera;
-        let bound = 1.01;
-        let mut light = Light::point(camera.eye + Vec3::new(0.0, 0.0, -5.0), 1.0, Vec3::ONE);
-        assert_eq!(classify(&light, bound, &camera, 1.0), LightCase::Outside);
-        light.radius = 4.95;
-        assert_eq!(
-            classify(&light, bound, &camera, 1.0),
-            LightCase::CrossesNear
-        );
-        light.radius = 5.05;
-        // Eye inside the range sphere, but the near plane may poke out of it.
-        assert_eq!(
-            classify(&light, bound, &camera, 1.0),
-            LightCase::CrossesNear
-        );
-        light.radius = 5.5;
-        assert_eq!(
-            classify(&light, bound, &camera, 1.0),
-            LightCase::ViewerInside
-        );
-        light.kind = LightKind::Directional {
-            direction: Vec3::NEG_Y,
-        };
-        assert_eq!(classify(&light, bound, &camera, 1.0), LightCase::FullScreen);
-    }
-
-    #[test]
-    fn coverage_falls_with_distance_and_is_full_near_the_eye() {
-        let scene = histencil_scene::embedded("default").unwrap();
-        let camera = scene.camera;
-        let forward = (camera.target - camera.eye).normalize();
-        let light = |d: f32| Light::point(camera.eye + forward * d, 1.0, Vec3::ONE);
-        let near = screen_coverage(&light(3.0), 1.0, &camera, 1.0, LightCase::Outside);
-        let far = screen_coverage(&light(30.0), 1.0, &camera, 1.0, LightCase::Outside);
-        assert!(far < near && far > 0.0, "{near} {far}");
-        assert!(near <= 1.0);
-        let inside = screen_coverage(&light(0.5), 1.0, &camera, 1.0, LightCase::CrossesNear);
-        assert_eq!(inside, 1.0);
     }
 }

@@ -1,0 +1,450 @@
+//! The frame planner on plain inputs: an engine's lights, the world bounds of each BRDF's
+//! objects and its view in, the [`FramePlan`] out. Pure and without a GPU, so an engine can
+//! plan on any thread and a test can check every decision on the CPU.
+//!
+//! Per light, in order:
+//! 1. **Reach**: the BRDF slots whose boxes the light's range sphere reaches (every slot with
+//!    objects, for a directional light). A light that reaches none is not drawn.
+//! 2. **Visibility**: a volume the frustum cannot see is not drawn.
+//! 3. **Case** ([`LightCase`]): a point light whose range sphere holds the whole near-plane
+//!    rectangle is drawn full-screen (every pixel's ray starts inside it); a volume that may
+//!    touch the near-plane rectangle crosses the near plane; any other volume is outside. Where
+//!    it cannot be sure the planner takes the case that is correct for any volume
+//!    ([`LightCase::CrossesNear`]).
+//! 4. **Coverage**: the screen fraction of the volume's bounding sphere (an estimate: the
+//!    ellipse inscribed in its exact screen rectangle), 1 for lights reaching the near plane.
+//! 5. **Technique**: the caller's, or per light from a [`CostModel`] on coverage and BRDF count.
+
+use crate::backend::PlatformCaps;
+use crate::chooser::CostModel;
+use crate::frame::{FlushPolicy, FramePlan, PlannedLight};
+use crate::layout::StencilLayout;
+use crate::plan::{LightCase, LightRequest, LightTechnique, PlanError};
+use crate::view::View;
+use glam::DVec3;
+
+/// How far histencil's light-volume meshes may reach beyond the light's range: they contain the
+/// range sphere (points) or the range cone closed by its cap (spots), and no vertex lies farther
+/// than this factor of it (for spots, along the axis and across it). The planner bounds volumes
+/// with it; `histencil-scene` tests its meshes against it.
+pub const VOLUME_OVERSHOOT: f64 = 1.05;
+
+/// The widest spot cone the volume mesh is built for (half-angle, radians): 80 degrees.
+pub const MAX_SPOT_ANGLE: f32 = 80.0 * std::f32::consts::PI / 180.0;
+
+/// An axis-aligned box in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+impl Aabb {
+    /// Whether the sphere reaches strictly into the box.
+    fn reached_by(&self, centre: DVec3, radius: f64) -> bool {
+        let lo = DVec3::from(self.min.map(f64::from));
+        let hi = DVec3::from(self.max.map(f64::from));
+        centre.clamp(lo, hi).distance(centre) < radius
+    }
+
+    fn problem(&self) -> Option<&'static str> {
+        let finite = self.min.iter().chain(&self.max).all(|v| v.is_finite());
+        if !finite {
+            Some("a corner is not finite")
+        } else if (0..3).any(|i| self.min[i] > self.max[i]) {
+            Some("min exceeds max")
+        } else {
+            None
+        }
+    }
+}
+
+/// What the planner needs of a light: where its volume is. Colours and intensities do not
+/// change the plan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightShape {
+    /// Lights the sphere of `range` around `position`.
+    Point { position: [f32; 3], range: f32 },
+    /// Lights the cone from `position` along `direction` (need not be unit length) with
+    /// half-angle `outer_angle` (radians, below [`MAX_SPOT_ANGLE`]), up to `range`.
+    Spot {
+        position: [f32; 3],
+        direction: [f32; 3],
+        range: f32,
+        outer_angle: f32,
+    },
+    /// Lights everything; drawn full-screen.
+    Directional,
+}
+
+impl LightShape {
+    fn problem(&self) -> Option<&'static str> {
+        let finite = |v: &[f32]| v.iter().all(|c| c.is_finite());
+        if let Some((position, range)) = match *self {
+            LightShape::Point { position, range }
+            | LightShape::Spot {
+                position, range, ..
+            } => Some((position, range)),
+            LightShape::Directional => None,
+        } {
+            if !finite(&position) {
+                return Some("position is not finite");
+            }
+            if !(range > 0.0 && range.is_finite()) {
+                return Some("range must be positive and finite");
+            }
+        }
+        if let LightShape::Spot {
+            direction,
+            outer_angle,
+            ..
+        } = *self
+        {
+            let length = DVec3::from(direction.map(f64::from)).length();
+            if !(length > 0.0 && length.is_finite()) {
+                return Some("direction must be finite and not zero");
+            }
+            if !(outer_angle > 0.0 && outer_angle < MAX_SPOT_ANGLE) {
+                return Some("outer angle must lie between 0 and 80 degrees");
+            }
+        }
+        None
+    }
+
+    /// The range sphere: what the light can reach.
+    fn reach(&self) -> Option<(DVec3, f64)> {
+        match *self {
+            LightShape::Point { position, range }
+            | LightShape::Spot {
+                position, range, ..
+            } => Some((DVec3::from(position.map(f64::from)), f64::from(range))),
+            LightShape::Directional => None,
+        }
+    }
+
+    /// A sphere containing the volume mesh histencil draws for the light.
+    fn volume_bound(&self) -> Option<(DVec3, f64)> {
+        match *self {
+            LightShape::Point { position, range } => Some((
+                DVec3::from(position.map(f64::from)),
+                f64::from(range) * VOLUME_OVERSHOOT,
+            )),
+            LightShape::Spot {
+                position,
+                direction,
+                range,
+                outer_angle,
+            } => {
+                // The cone is the hull of its apex and its cap disc (radius rho at height h):
+                // the smallest sphere holding both.
+                let h = f64::from(range) * VOLUME_OVERSHOOT;
+                let rho = h * f64::from(outer_angle).tan();
+                let axis = DVec3::from(direction.map(f64::from)).normalize();
+                let apex = DVec3::from(position.map(f64::from));
+                let (along, radius) = if rho >= h {
+                    (h, rho)
+                } else {
+                    let z = (h * h + rho * rho) / (2.0 * h);
+                    (z, z)
+                };
+                Some((apex + axis * along, radius))
+            }
+            LightShape::Directional => None,
+        }
+    }
+}
+
+/// How the BRDFs of the frame's lights are separated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TechniqueChoice {
+    /// The talk's technique for every light.
+    Stencil,
+    /// One branching shader per light.
+    Branching,
+    /// Per light, whichever the cost model predicts cheaper for its coverage and BRDF count.
+    Adaptive(CostModel),
+}
+
+/// Everything the planner reads: plain values an engine has at hand.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanInputs<'a> {
+    pub lights: &'a [LightShape],
+    /// Per BRDF slot (the layout's), the world boxes of the objects with that BRDF: one box per
+    /// object, or one around them all. Slots past the end have no objects.
+    pub brdf_bounds: &'a [Vec<Aabb>],
+    pub view: &'a View,
+}
+
+/// How the frame is to be drawn: plain values, one per frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanSettings {
+    pub technique: TechniqueChoice,
+    /// The platform whose stencil and hi-stencil behaviour the passes follow.
+    pub caps: PlatformCaps,
+    pub flush: FlushPolicy,
+}
+
+/// How a light's volume meets the near-plane rectangle. Conservative: the margins only ever
+/// move a light towards [`LightCase::CrossesNear`], whose plan is right for any volume.
+fn classify(view: &View, shape: &LightShape, bound: (DVec3, f64)) -> LightCase {
+    const MARGIN: f64 = 1e-5;
+    if let LightShape::Point { .. } = shape {
+        let (centre, range) = shape.reach().expect("a point light has a range");
+        // The mesh contains the range sphere, so the near plane inside it is inside the mesh.
+        if view.near_plane_inside(centre, range * (1.0 - MARGIN)) {
+            return LightCase::ViewerInside;
+        }
+    }
+    let (centre, radius) = bound;
+    if view.distance_to_near_plane(centre) <= radius * (1.0 + MARGIN) {
+        LightCase::CrossesNear
+    } else {
+        LightCase::Outside
+    }
+}
+
+/// Plans a frame on plain inputs.
+///
+/// # Errors
+/// [`PlanError::BadLight`] and [`PlanError::BadBounds`] name the input that cannot be planned
+/// with; [`PlanError::SlotOutOfRange`] when bounds are given for more BRDFs than the layout has.
+pub fn plan_frame(
+    layout: &StencilLayout,
+    inputs: &PlanInputs,
+    settings: &PlanSettings,
+) -> Result<FramePlan, PlanError> {
+    if inputs.brdf_bounds.len() > layout.brdfs_in_use() as usize {
+        return Err(PlanError::SlotOutOfRange {
+            slot: inputs.brdf_bounds.len() as u32 - 1,
+            brdfs: layout.brdfs_in_use(),
+        });
+    }
+    for (slot, boxes) in inputs.brdf_bounds.iter().enumerate() {
+        for (index, bounds) in boxes.iter().enumerate() {
+            if let Some(problem) = bounds.problem() {
+                return Err(PlanError::BadBounds {
+                    slot: slot as u32,
+                    index,
+                    problem,
+                });
+            }
+        }
+    }
+    let view = inputs.view;
+    let mut lights = Vec::new();
+    for (index, shape) in inputs.lights.iter().enumerate() {
+        if let Some(problem) = shape.problem() {
+            return Err(PlanError::BadLight { index, problem });
+        }
+        let reach = shape.reach();
+        let affected: Vec<u32> = (0..inputs.brdf_bounds.len() as u32)
+            .filter(|&slot| {
+                let boxes = &inputs.brdf_bounds[slot as usize];
+                match reach {
+                    Some((centre, radius)) => boxes.iter().any(|b| b.reached_by(centre, radius)),
+                    None => !boxes.is_empty(),
+                }
+            })
+            .collect();
+        if affected.is_empty() {
+            continue;
+        }
+        let (case, coverage) = match shape.volume_bound() {
+            None => (LightCase::FullScreen, 1.0),
+            Some(bound) => {
+                if view.culls_sphere(bound.0, bound.1) {
+                    continue;
+                }
+                let case = classify(view, shape, bound);
+                let coverage = match case {
+                    LightCase::Outside => view.sphere_coverage(bound.0, bound.1),
+                    _ => 1.0,
+                };
+                (case, coverage)
+            }
+        };
+        let technique = match settings.technique {
+            // One BRDF needs neither technique (`plan_light` would say the same).
+            _ if affected.len() == 1 => LightTechnique::SingleBrdf,
+            TechniqueChoice::Stencil => LightTechnique::Stencil,
+            TechniqueChoice::Branching => LightTechnique::Branching,
+            TechniqueChoice::Adaptive(costs) => costs.choose(coverage, affected.len() as u32),
+        };
+        lights.push(PlannedLight {
+            input: index,
+            coverage: Some(coverage),
+            request: LightRequest {
+                case,
+                affected,
+                technique,
+            },
+        });
+    }
+    FramePlan::build(layout, &settings.caps, view.depth(), lights, settings.flush)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::{Native, PlatformBackend};
+    use crate::view::{DepthConvention, FarPlane, Perspective};
+
+    fn view() -> View {
+        let camera = Perspective {
+            eye: [0.0, 0.0, 10.0],
+            target: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y_radians: 1.0,
+            aspect: 1.0,
+            near: 0.1,
+            far: FarPlane::Infinite,
+            depth: DepthConvention::Reversed,
+        };
+        View::new(&camera.desc()).unwrap()
+    }
+
+    fn plan(lights: &[LightShape], bounds: &[Vec<Aabb>]) -> Result<FramePlan, PlanError> {
+        let view = view();
+        plan_frame(
+            &StencilLayout::new(2, 0).unwrap(),
+            &PlanInputs {
+                lights,
+                brdf_bounds: bounds,
+                view: &view,
+            },
+            &PlanSettings {
+                technique: TechniqueChoice::Stencil,
+                caps: Native.caps(),
+                flush: FlushPolicy::Auto,
+            },
+        )
+    }
+
+    const UNIT: Aabb = Aabb {
+        min: [-1.0; 3],
+        max: [1.0; 3],
+    };
+
+    /// Every kind of bad light and bad box is an error naming it, never a panic or a plan.
+    #[test]
+    fn bad_inputs_are_errors_that_name_them() {
+        let point = |position: [f32; 3], range| LightShape::Point { position, range };
+        let spot = |direction: [f32; 3], outer_angle| LightShape::Spot {
+            position: [0.0; 3],
+            direction,
+            range: 1.0,
+            outer_angle,
+        };
+        let bad_lights = [
+            point([f32::NAN, 0.0, 0.0], 1.0),
+            point([0.0; 3], 0.0),
+            point([0.0; 3], -1.0),
+            point([0.0; 3], f32::INFINITY),
+            point([0.0; 3], f32::NAN),
+            spot([0.0; 3], 0.5),
+            spot([f32::NAN, 0.0, 1.0], 0.5),
+            spot([0.0, 0.0, 1.0], 0.0),
+            spot([0.0, 0.0, 1.0], MAX_SPOT_ANGLE),
+            spot([0.0, 0.0, 1.0], f32::NAN),
+        ];
+        for light in bad_lights {
+            let lights = [point([0.0; 3], 1.0), light];
+            let err = plan(&lights, &[vec![UNIT]]).unwrap_err();
+            assert!(
+                matches!(err, PlanError::BadLight { index: 1, .. }),
+                "{light:?}: {err}"
+            );
+            assert!(err.to_string().starts_with("light 1: "), "{err}");
+        }
+        let bad_boxes = [
+            Aabb {
+                min: [1.0, 0.0, 0.0],
+                max: [0.0, 1.0, 1.0],
+            },
+            Aabb {
+                min: [f32::NEG_INFINITY; 3],
+                max: [0.0; 3],
+            },
+            Aabb {
+                min: [0.0; 3],
+                max: [f32::NAN; 3],
+            },
+        ];
+        for bounds in bad_boxes {
+            let err = plan(&[], &[vec![], vec![UNIT, bounds]]).unwrap_err();
+            assert!(
+                matches!(
+                    err,
+                    PlanError::BadBounds {
+                        slot: 1,
+                        index: 1,
+                        ..
+                    }
+                ),
+                "{bounds:?}: {err}"
+            );
+        }
+        let err = plan(&[], &[vec![], vec![], vec![UNIT]]).unwrap_err();
+        assert_eq!(err, PlanError::SlotOutOfRange { slot: 2, brdfs: 2 });
+    }
+
+    /// Light 0 reaches slot 0's box only, light 1 both, light 2 nothing; the directional light
+    /// every slot with objects; the spot is bounded around its cone, not its apex.
+    #[test]
+    fn reach_follows_the_range_sphere() {
+        let far_box = Aabb {
+            min: [4.0, -1.0, -1.0],
+            max: [6.0, 1.0, 1.0],
+        };
+        let lights = [
+            LightShape::Point {
+                position: [0.0; 3],
+                range: 2.0,
+            },
+            LightShape::Point {
+                position: [2.5, 0.0, 0.0],
+                range: 2.0,
+            },
+            LightShape::Point {
+                position: [0.0, 5.0, 0.0],
+                range: 1.0,
+            },
+            LightShape::Directional,
+        ];
+        let plan = plan(&lights, &[vec![UNIT], vec![far_box]]).unwrap();
+        let reach: Vec<(usize, Vec<u32>)> = plan
+            .lights
+            .iter()
+            .map(|l| (l.input, l.request.affected.clone()))
+            .collect();
+        assert_eq!(
+            reach,
+            [(0, vec![0]), (1, vec![0, 1]), (3, vec![0, 1])],
+            "{}",
+            plan.describe()
+        );
+        let narrow = LightShape::Spot {
+            position: [0.0; 3],
+            direction: [0.0, 0.0, -2.0],
+            range: 10.0,
+            outer_angle: 0.1,
+        };
+        let (centre, radius) = narrow.volume_bound().unwrap();
+        // Half way down a narrow cone, a little more than half its length in radius.
+        assert!(
+            (centre.z + 5.3).abs() < 0.1 && radius < 5.4,
+            "{centre} {radius}"
+        );
+        let wide = LightShape::Spot {
+            position: [0.0; 3],
+            direction: [0.0, 0.0, -2.0],
+            range: 10.0,
+            outer_angle: 1.2,
+        };
+        let (centre, radius) = wide.volume_bound().unwrap();
+        assert!(
+            (centre.z + 10.5).abs() < 1e-9 && radius > 10.5,
+            "{centre} {radius}"
+        );
+    }
+}
