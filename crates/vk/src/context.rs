@@ -1,8 +1,10 @@
 //! The Vulkan context: instance, device, queue, memory allocator, validation log and the naming /
-//! labelling helpers every other module uses.
+//! labelling helpers every other module uses. Owned ([`Context::new`], for histencil's tools) or
+//! lent by an engine ([`Context::from_raw`]), which keeps its device, allocator and messenger.
 
-use crate::debug::{messenger_callback, ValidationLog};
+use crate::debug::ValidationLog;
 use crate::error::{Error, Result, VkCall};
+use crate::requirements::REQUIREMENTS;
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{CStr, CString};
@@ -69,15 +71,38 @@ impl ContextDesc {
     }
 }
 
-/// One Vulkan device and what hangs off it. Dropping it waits for the device, frees the allocator,
-/// destroys the device (the validation layer reports leaked objects then) and the instance.
+/// An engine's device, lent to histencil: the handles the engine created, which it keeps and
+/// destroys itself after every histencil object made with them.
+pub struct BorrowedDevice {
+    pub instance: ash::Instance,
+    pub device: ash::Device,
+    pub physical_device: vk::PhysicalDevice,
+    /// The family of `queue`; it must fit [`REQUIREMENTS`].
+    pub queue_family: u32,
+    pub queue: vk::Queue,
+    /// The engine's allocator for `device`; histencil's allocations are named `histencil`-side
+    /// and freed before its objects are dropped.
+    pub allocator: Arc<Mutex<Allocator>>,
+    /// `VK_EXT_debug_utils` is enabled on `instance`: histencil then names its objects and
+    /// labels its passes (the engine's messenger receives any validation message).
+    pub debug_utils: bool,
+    /// As [`ContextDesc::depth_stencil`].
+    pub depth_stencil: Option<DepthStencilFormat>,
+}
+
+/// One Vulkan device and what hangs off it. Dropping an owned context waits for the device, frees
+/// the allocator, destroys the device (the validation layer reports leaked objects then) and the
+/// instance; dropping a borrowed one destroys nothing of the engine's.
 pub struct Context {
-    _entry: ash::Entry,
+    /// Keeps the loader loaded; `None` when the engine's instance is borrowed.
+    _entry: Option<ash::Entry>,
+    /// Whether the instance, device, messenger and allocator are histencil's to destroy.
+    owned: bool,
     pub(crate) instance: ash::Instance,
     pub(crate) device: ash::Device,
     pub(crate) queue: vk::Queue,
     pub(crate) queue_family: u32,
-    pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub(crate) allocator: ManuallyDrop<Arc<Mutex<Allocator>>>,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
     messenger: vk::DebugUtilsMessengerEXT,
@@ -197,18 +222,8 @@ impl Context {
             extensions.push(ash::ext::validation_features::NAME.as_ptr());
         }
         let validation = Arc::new(ValidationLog::default());
-        let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-            .message_severity(
-                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
-            )
-            .message_type(
-                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
-                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
-                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
-            )
-            .pfn_user_callback(Some(messenger_callback))
-            .user_data(Arc::as_ptr(&validation) as *mut std::ffi::c_void);
+        // SAFETY: the context keeps `validation` until after it destroys the messenger.
+        let messenger_info = unsafe { ValidationLog::messenger_create_info(&validation) };
         // Chained into instance creation too, so messages from vkCreateInstance are caught.
         let mut messenger_for_create = messenger_info;
         let mut instance_info = vk::InstanceCreateInfo::default()
@@ -246,7 +261,6 @@ impl Context {
         });
         let (physical_device, queue_family, device_name) =
             Self::pick_physical_device(&instance, filter.as_deref())?;
-        let props = unsafe { instance.get_physical_device_properties(physical_device) };
         let depth_stencil =
             pick_depth_stencil_format(&instance, physical_device, desc.depth_stencil)?;
 
@@ -254,14 +268,8 @@ impl Context {
         let queue_infos = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        // Fragment stores and atomics: the hi-stencil emulation marks and counts tiles from fragment
-        // shaders (every desktop driver and lavapipe have it).
-        let features = vk::PhysicalDeviceFeatures::default()
-            .depth_clamp(true)
-            .fragment_stores_and_atomics(true);
-        let mut features13 = vk::PhysicalDeviceVulkan13Features::default()
-            .dynamic_rendering(true)
-            .synchronization2(true);
+        let features = REQUIREMENTS.features();
+        let mut features13 = REQUIREMENTS.features13();
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_features(&features)
@@ -292,13 +300,16 @@ impl Context {
         let debug_instance = partial.debug_instance.take();
         let messenger =
             std::mem::replace(&mut partial.messenger, vk::DebugUtilsMessengerEXT::null());
+        // SAFETY: `physical_device` was enumerated from `instance`.
+        let limits = unsafe { instance.get_physical_device_properties(physical_device) }.limits;
         let ctx = Self {
-            _entry: entry,
+            _entry: Some(entry),
+            owned: true,
             instance,
             device,
             queue,
             queue_family,
-            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            allocator: ManuallyDrop::new(Arc::new(Mutex::new(allocator))),
             debug_instance,
             debug_device,
             messenger,
@@ -306,13 +317,92 @@ impl Context {
             device_name,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
-            timestamp_period_ns: f64::from(props.limits.timestamp_period),
-            max_image_dimension: props.limits.max_image_dimension2_d,
-            max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            timestamp_period_ns: f64::from(limits.timestamp_period),
+            max_image_dimension: limits.max_image_dimension2_d,
+            max_storage_buffer_range: limits.max_storage_buffer_range,
         };
         ctx.name(ctx.device.handle(), "histencil-device");
         ctx.name(ctx.queue, "graphics-queue");
         Ok(ctx)
+    }
+
+    /// A context on an engine's device. Nothing is created but the debug-utils function table;
+    /// dropping the context destroys nothing of the engine's. Validation messages go to the
+    /// engine's messenger ([`ValidationLog::messenger_create_info`] routes them into a log), so
+    /// [`Context::validation_log`] stays empty.
+    ///
+    /// # Errors
+    /// [`Error::NoDevice`] when the physical device or the queue family lacks what
+    /// [`REQUIREMENTS`] asks; [`Error::MissingFormat`] as [`Context::new`].
+    ///
+    /// # Safety
+    /// The caller guarantees that:
+    /// - every handle in `lent` is valid and outlives this context and everything made with it;
+    /// - `device` was created from `physical_device` of `instance` with at least the features of
+    ///   [`REQUIREMENTS`] enabled, and `queue` is a queue of `queue_family` on it;
+    /// - `allocator` was created for `device`;
+    /// - `debug_utils` is true only if `VK_EXT_debug_utils` is enabled on `instance`;
+    /// - while histencil's owned-device tools ([`crate::Renderer`]) submit to `queue` and wait,
+    ///   nothing else uses that queue (Vulkan requires queues to be externally synchronised).
+    pub unsafe fn from_raw(lent: BorrowedDevice) -> Result<Self> {
+        let BorrowedDevice {
+            instance,
+            device,
+            physical_device,
+            queue_family,
+            queue,
+            allocator,
+            debug_utils,
+            depth_stencil,
+        } = lent;
+        // SAFETY: the caller's promise that `physical_device` belongs to `instance`.
+        let missing = unsafe { REQUIREMENTS.missing(&instance, physical_device) };
+        if !missing.is_empty() {
+            return Err(Error::NoDevice(format!(
+                "the lent device lacks {}",
+                missing.join(", ")
+            )));
+        }
+        // SAFETY: as above.
+        if !unsafe { REQUIREMENTS.queue_family_fits(&instance, physical_device, queue_family) } {
+            return Err(Error::NoDevice(format!(
+                "queue family {queue_family} of the lent device cannot draw, compute and write \
+                 timestamps"
+            )));
+        }
+        let depth_stencil = pick_depth_stencil_format(&instance, physical_device, depth_stencil)?;
+        // SAFETY: as above.
+        let props = unsafe { instance.get_physical_device_properties(physical_device) };
+        let device_name = props
+            .device_name_as_c_str()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let debug_device =
+            debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
+        Ok(Self {
+            _entry: None,
+            owned: false,
+            instance,
+            device,
+            queue,
+            queue_family,
+            allocator: ManuallyDrop::new(allocator),
+            debug_instance: None,
+            debug_device,
+            messenger: vk::DebugUtilsMessengerEXT::null(),
+            validation: Arc::new(ValidationLog::default()),
+            device_name,
+            depth_stencil_format: depth_stencil.vk(),
+            depth_stencil,
+            timestamp_period_ns: f64::from(props.limits.timestamp_period),
+            max_image_dimension: props.limits.max_image_dimension2_d,
+            max_storage_buffer_range: props.limits.max_storage_buffer_range,
+        })
+    }
+
+    /// Whether histencil created (and will destroy) the device.
+    pub fn owns_device(&self) -> bool {
+        self.owned
     }
 
     fn pick_physical_device(
@@ -330,13 +420,14 @@ impl Context {
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
             seen.push(name.clone());
-            if props.api_version < vk::API_VERSION_1_3 {
+            // SAFETY: `pd` was just enumerated from the live `instance`.
+            if !unsafe { REQUIREMENTS.missing(instance, pd) }.is_empty() {
                 continue;
             }
             let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-            let Some(family) = families.iter().position(|f| {
-                f.queue_flags.contains(vk::QueueFlags::GRAPHICS) && f.timestamp_valid_bits > 0
-            }) else {
+            let Some(family) = (0..families.len() as u32)
+                .find(|&f| unsafe { REQUIREMENTS.queue_family_fits(instance, pd, f) })
+            else {
                 continue;
             };
             if let Some(f) = filter {
@@ -350,7 +441,7 @@ impl Context {
                 vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
                 _ => 3,
             };
-            candidates.push((rank, pd, family as u32, name));
+            candidates.push((rank, pd, family, name));
         }
         candidates.sort_by_key(|c| c.0);
         candidates
@@ -414,9 +505,16 @@ impl Context {
 
 impl Drop for Context {
     fn drop(&mut self) {
+        if !self.owned {
+            // The engine's allocator, device and instance stay; only our reference goes.
+            // SAFETY: dropped once, here, and never used again.
+            unsafe { ManuallyDrop::drop(&mut self.allocator) };
+            return;
+        }
         unsafe {
             let _ = self.device.device_wait_idle();
-            // The allocator frees its memory blocks; it must go before the device.
+            // The allocator frees its memory blocks; it must go before the device. An owned
+            // context never hands its allocator out, so this is the last reference.
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);
             if let Some(di) = &self.debug_instance {

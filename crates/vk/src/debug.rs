@@ -61,6 +61,30 @@ impl ValidationLog {
         );
     }
 
+    /// A messenger description (ERROR and WARNING, every message type) that records into `log`:
+    /// for an engine that lends histencil its device and wants its messages kept the same way.
+    /// Chain it into `VkInstanceCreateInfo` too, to catch messages of instance creation.
+    ///
+    /// # Safety
+    /// The messenger created from it calls back with a pointer to `log`: the caller keeps an
+    /// `Arc` of `log` alive until that messenger is destroyed.
+    pub unsafe fn messenger_create_info(
+        log: &std::sync::Arc<ValidationLog>,
+    ) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
+        vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(messenger_callback))
+            .user_data(std::sync::Arc::as_ptr(log) as *mut std::ffi::c_void)
+    }
+
     fn lock(&self) -> std::sync::MutexGuard<'_, Vec<ValidationMessage>> {
         // A panic while holding the lock leaves a valid Vec; keep reading it.
         self.messages.lock().unwrap_or_else(|e| e.into_inner())
