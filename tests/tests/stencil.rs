@@ -4,6 +4,7 @@
 //! preserved bits where lights draw (the talk's price for its missing read mask) and never
 //! changes them otherwise; with save / restore they survive there too.
 
+use histencil_model::StencilBits;
 use histencil_tests::with_validated_context;
 use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
 
@@ -105,6 +106,80 @@ fn culling_bit_clear_brdf_bits_intact_and_preserved_bits_as_the_backend_says() {
                 assert_eq!(seen_slots.len(), brdfs.len(), "{name}: every BRDF visible");
                 if label == "stencil-x360" {
                     assert!(zeroed > 0, "{name}: the 360-like backend zeroed nothing");
+                }
+            }
+        });
+    }
+}
+
+/// An engine's own bit positions: culling bit 6, the BRDF field from bit 3, the engine's data in
+/// bits 0-2 and 7. Every backend lights the same image, bit for bit, as with the talk's layout,
+/// keeps the engine's bits (360-like: with save / restore), and leaves the culling bit clear.
+#[test]
+fn engine_bit_positions_light_the_same_image_and_keep_the_engines_bits() {
+    const ENGINE: u8 = 0x87;
+    let bits = StencilBits {
+        culling_bit: 6,
+        brdf_shift: 3,
+        engine_mask: ENGINE,
+    };
+    let flush = FlushPolicy::Auto;
+    let techniques = [
+        Technique::Stencil {
+            backend: Backend::Native,
+            flush,
+        },
+        Technique::Stencil {
+            backend: Backend::Ps3,
+            flush,
+        },
+        Technique::Branching {
+            backend: Backend::Ps3,
+            flush,
+        },
+        Technique::Stencil {
+            backend: Backend::X360 {
+                zero_preserved: true,
+                save_restore: true,
+            },
+            flush,
+        },
+    ];
+    for name in ["default", "brdfs-6", "near-far"] {
+        let scene = histencil_scene::embedded(name).unwrap();
+        with_validated_context(|ctx| {
+            let mut talks = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
+            let mut engine =
+                Renderer::with_stencil_bits(ctx, scene.clone(), SIZE, SIZE, Some(bits))
+                    .expect("renderer at the engine's bits");
+            engine.set_preserved_pattern(ENGINE);
+            let layout = *engine.stencil_layout();
+            assert_eq!(
+                (layout.culling_mask(), layout.engine_mask()),
+                (0x40, ENGINE)
+            );
+            for technique in techniques {
+                let expected = talks.render(technique, Readback::ALL).expect("frame");
+                let frame = engine.render(technique, Readback::ALL).expect("frame");
+                assert!(
+                    frame.images.ldr == expected.images.ldr,
+                    "{name} {technique:?}: another image at the engine's bit positions"
+                );
+                let stencil = frame.images.stencil.unwrap();
+                let ids = frame.images.brdf_ids.unwrap();
+                for (i, (value, id)) in stencil.as_raw().iter().zip(&ids).enumerate() {
+                    let at = (i as u32 % SIZE, i as u32 / SIZE);
+                    assert_eq!(
+                        value & 0x40,
+                        0,
+                        "{name} {technique:?}: culling bit at {at:?}"
+                    );
+                    let engine_bits = if id.is_some() { ENGINE } else { 0 };
+                    assert_eq!(
+                        value & ENGINE,
+                        engine_bits,
+                        "{name} {technique:?}: engine bits at {at:?}: {value:#04x}"
+                    );
                 }
             }
         });

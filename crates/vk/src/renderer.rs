@@ -28,7 +28,8 @@ use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
     plan_frame, CostModel, DepthConvention, FlushPolicy, Footprint, FramePlan, LightShape,
     LightTechnique, Native, PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like,
-    SoftTarget, StencilLayout, TalkFigures, TechniqueChoice, TileStats, View, X360Like,
+    SoftTarget, StencilBits, StencilLayout, TalkFigures, TechniqueChoice, TileStats, View,
+    X360Like,
 };
 use histencil_scene::Scene;
 
@@ -224,15 +225,36 @@ pub struct Renderer<'c> {
 }
 
 impl<'c> Renderer<'c> {
-    /// Validates the scene and the resolution, then builds everything a frame needs.
-    pub fn new(ctx: &'c Context, mut scene: Scene, width: u32, height: u32) -> Result<Self> {
+    /// Validates the scene and the resolution, then builds everything a frame needs, with the
+    /// talk's stencil layout (culling bit 0, BRDF bits above it).
+    pub fn new(ctx: &'c Context, scene: Scene, width: u32, height: u32) -> Result<Self> {
+        Self::with_stencil_bits(ctx, scene, width, height, None)
+    }
+
+    /// As [`Renderer::new`], with the culling bit and the BRDF field where an engine wants them
+    /// (`None`: the talk's layout).
+    ///
+    /// # Errors
+    /// [`crate::Error::Layout`] when the scene's BRDFs do not fit at those positions, besides the
+    /// errors of [`Renderer::new`].
+    pub fn with_stencil_bits(
+        ctx: &'c Context,
+        mut scene: Scene,
+        width: u32,
+        height: u32,
+        bits: Option<StencilBits>,
+    ) -> Result<Self> {
         // The resolution first: a scene built for a zero-sized view (a lab wall) would otherwise
         // take the blame for it.
         let extent = check_extent(ctx, width, height)?;
         scene.validate()?;
         scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
-        let stencil_layout = StencilLayout::new(brdfs.len().max(1) as u32, 0)?;
+        let brdf_count = brdfs.len().max(1) as u32;
+        let stencil_layout = match bits {
+            None => StencilLayout::new(brdf_count, 0)?,
+            Some(bits) => StencilLayout::with_positions(brdf_count, bits)?,
+        };
         let object_slots = scene
             .objects
             .iter()
