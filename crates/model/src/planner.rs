@@ -205,6 +205,52 @@ fn classify(view: &View, shape: &LightShape, bound: (DVec3, f64)) -> LightCase {
 
 /// Plans a frame on plain inputs.
 ///
+/// An engine with its data in stencil bits 0 and 1, a reversed-Z camera with an infinite far
+/// plane, two BRDFs and two lights, on the PS3-like platform:
+/// ```
+/// use histencil_model::*;
+///
+/// let layout = StencilLayout::with_positions(
+///     2,
+///     StencilBits { culling_bit: 7, brdf_shift: 6, engine_mask: 0x03 },
+/// )?;
+/// let camera = Perspective {
+///     eye: [0.0, 2.0, 10.0],
+///     target: [0.0; 3],
+///     up: [0.0, 1.0, 0.0],
+///     fov_y_radians: 1.0,
+///     aspect: 16.0 / 9.0,
+///     near: 0.1,
+///     far: FarPlane::Infinite,
+///     depth: DepthConvention::Reversed,
+/// };
+/// let view = View::new(&camera.desc())?; // or ViewDesc { the engine's own matrices }
+/// let floor = Aabb { min: [-10.0, -1.0, -10.0], max: [10.0, 0.0, 10.0] };
+/// let statue = Aabb { min: [-1.0, 0.0, -1.0], max: [1.0, 3.0, 1.0] };
+/// let lights = [
+///     LightShape::Point { position: [0.0, 1.0, 2.0], range: 3.0 },
+///     LightShape::Point { position: [8.0, 1.0, -8.0], range: 2.0 },
+/// ];
+/// let plan = plan_frame(
+///     &layout,
+///     &PlanInputs { lights: &lights, brdf_bounds: &[vec![floor], vec![statue]], view: &view },
+///     &PlanSettings {
+///         technique: TechniqueChoice::Stencil,
+///         caps: Ps3Like.caps(),
+///         flush: FlushPolicy::Auto,
+///     },
+/// )?;
+/// // The first light touches both BRDFs and is drawn once per BRDF; the second only the floor.
+/// assert_eq!(plan.lights[0].request.affected, [0, 1]);
+/// assert_eq!(plan.lights[1].request.affected, [0]);
+/// assert_eq!(plan.lights[0].request.case, LightCase::Outside);
+/// // Reversed Z: the shade passes test "nearer" as GREATER.
+/// let shade = plan.passes().find(|p| matches!(p.kind, PassKind::Shade(_))).unwrap();
+/// assert_eq!(shade.state.depth.compare, Some(CompareOp::Greater));
+/// print!("{}", plan.describe());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+///
 /// # Errors
 /// [`PlanError::BadLight`] and [`PlanError::BadBounds`] name the input that cannot be planned
 /// with; [`PlanError::SlotOutOfRange`] when bounds are given for more BRDFs than the layout has.
