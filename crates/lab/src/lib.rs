@@ -10,7 +10,7 @@
 //! - [`demo`]: a short tour of the talk on one scene (`histencil demo`, `tools/demo`): the
 //!   techniques and backends side by side with their times, errors and hi-stencil statistics,
 //!   and a contact sheet of the frames, the stencil byte and the talk's failures.
-//! - [`calibrate`]: this device's per-pass overhead, branch tax and shade cost, the
+//! - [`calibrate()`]: this device's per-pass overhead, branch tax and shade cost, the
 //!   [`CostModel`](histencil_vk::CostModel) that the adaptive technique chooses with.
 
 mod alpha_reference;

@@ -1,5 +1,5 @@
 //! Declared image accesses and the one place barriers are derived from them. A pass says how it
-//! will use an image next; [`transition`] turns "last access -> next access" into a barrier.
+//! will use an image next; `transition` turns "last access -> next access" into a barrier.
 
 use crate::context::Context;
 use crate::resources::{subresource_range, Image};

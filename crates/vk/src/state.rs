@@ -1,5 +1,5 @@
 //! The one translation from histencil-model's pass state (plain data, also executed by the CPU
-//! simulator) to Vulkan dynamic state. Every draw of every pass goes through [`apply`], so what
+//! simulator) to Vulkan dynamic state. Every draw of every pass goes through `apply`, so what
 //! the GPU does and what the model simulates cannot drift apart.
 //!
 //! Hi-stencil state is not Vulkan state: the GPU tile surface that emulates it is recorded by

@@ -17,7 +17,7 @@ pub struct CompareSettings {
     pub scene: Scene,
     pub width: u32,
     pub height: u32,
-    /// Timed frames per cell, after [`crate::measure::WARM_UP_FRAMES`].
+    /// Timed frames per cell, after `measure::WARM_UP_FRAMES` warm-up frames.
     pub frames: usize,
     /// The adaptive technique's costs; `None`: fitted to the talk's figures.
     pub costs: Option<CostModel>,

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 pub const PLOTS: [&str; 3] = ["lighting.png", "light-size.png", "speed-vs-error.png"];
 
 impl CompareReport {
-    /// Writes `report.md`, `report.json` and the [`PLOTS`] into `dir` (created if needed);
+    /// Writes `report.md`, `report.json` and the plots (`PLOTS`) into `dir` (created if needed);
     /// returns the paths written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
         let md = dir.join("report.md");

@@ -1,12 +1,12 @@
 //! The deferred lighting pass, driven by histencil-model's frame plan: every light's passes
 //! (setup, per-BRDF mask and shade, cleanup, as `plan_light` derives them for the platform
-//! backend), with the state of each draw translated by [`crate::state::apply`].
+//! backend), with the state of each draw translated by `state::apply`.
 //!
 //! This module only decides how each light is classified and which BRDFs it touches, and records
 //! the plan; the stencil logic lives in the model, where the CPU simulator checks it.
 //!
 //! On backends with hi-stencil, the plan's hi-stencil writes, tests and flushes run on the GPU
-//! tile surface of [`crate::hi_stencil`], so its failures (stale tiles without a flush, preserved
+//! tile surface of `crate::hi_stencil`, so its failures (stale tiles without a flush, preserved
 //! bits on 360-like hardware without zeroing) show in the image as they would on the console.
 
 use super::light_pipelines::{
