@@ -132,11 +132,6 @@ impl FramePlan {
         )
     }
 
-    /// The input index of each drawn light, in drawing order.
-    pub fn light_inputs(&self) -> Vec<usize> {
-        self.lights.iter().map(|l| l.input).collect()
-    }
-
     /// Whether drawn light `light` is drawn full-screen (no volume to rasterise).
     pub fn is_full_screen(&self, light: usize) -> bool {
         matches!(

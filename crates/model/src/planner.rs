@@ -41,7 +41,7 @@ pub struct Aabb {
 
 impl Aabb {
     /// Whether the sphere reaches strictly into the box.
-    fn reached_by(&self, centre: DVec3, radius: f64) -> bool {
+    fn reached_by_sphere(&self, centre: DVec3, radius: f64) -> bool {
         let lo = DVec3::from(self.min.map(f64::from));
         let hi = DVec3::from(self.max.map(f64::from));
         centre.clamp(lo, hi).distance(centre) < radius
@@ -109,6 +109,14 @@ impl LightShape {
             }
         }
         None
+    }
+
+    /// Whether the light can add anything inside `bounds`: its range sphere reaches into the box
+    /// (always, for a directional light). Exact culling: a light's falloff is zero at and beyond
+    /// its range.
+    pub fn reaches(&self, bounds: &Aabb) -> bool {
+        self.reach()
+            .is_none_or(|(centre, radius)| bounds.reached_by_sphere(centre, radius))
     }
 
     /// The range sphere: what the light can reach.
@@ -188,10 +196,10 @@ pub struct PlanSettings {
 /// move a light towards [`LightCase::CrossesNear`], whose plan is right for any volume.
 fn classify(view: &View, shape: &LightShape, bound: (DVec3, f64)) -> LightCase {
     const MARGIN: f64 = 1e-5;
-    if let LightShape::Point { .. } = shape {
-        let (centre, range) = shape.reach().expect("a point light has a range");
+    if let LightShape::Point { position, range } = *shape {
         // The mesh contains the range sphere, so the near plane inside it is inside the mesh.
-        if view.near_plane_inside(centre, range * (1.0 - MARGIN)) {
+        let centre = DVec3::from(position.map(f64::from));
+        if view.near_plane_inside(centre, f64::from(range) * (1.0 - MARGIN)) {
             return LightCase::ViewerInside;
         }
     }
@@ -282,14 +290,11 @@ pub fn plan_frame(
         if let Some(problem) = shape.problem() {
             return Err(PlanError::BadLight { index, problem });
         }
-        let reach = shape.reach();
         let affected: Vec<u32> = (0..inputs.brdf_bounds.len() as u32)
             .filter(|&slot| {
-                let boxes = &inputs.brdf_bounds[slot as usize];
-                match reach {
-                    Some((centre, radius)) => boxes.iter().any(|b| b.reached_by(centre, radius)),
-                    None => !boxes.is_empty(),
-                }
+                inputs.brdf_bounds[slot as usize]
+                    .iter()
+                    .any(|b| shape.reaches(b))
             })
             .collect();
         if affected.is_empty() {

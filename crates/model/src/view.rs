@@ -226,12 +226,10 @@ impl View {
         let c = &self.near_corners;
         let normal = (c[1] - c[0]).cross(c[3] - c[0]).normalize();
         let on_plane = point - normal * normal.dot(point - c[0]);
+        // The corners wind counter-clockwise about `normal`, which they define.
         let inside = (0..4).all(|i| {
             let (a, b) = (c[i], c[(i + 1) % 4]);
             (b - a).cross(on_plane - a).dot(normal) >= 0.0
-        }) || (0..4).all(|i| {
-            let (a, b) = (c[i], c[(i + 1) % 4]);
-            (b - a).cross(on_plane - a).dot(normal) <= 0.0
         });
         if inside {
             return (point - on_plane).length();

@@ -49,14 +49,6 @@ impl Camera {
             depth: DepthConvention::Standard,
         }
     }
-
-    /// Distance from the eye to a corner of the near plane: a sphere farther than this plus its
-    /// radius from the eye cannot touch the near plane.
-    pub fn near_corner_distance(&self, aspect: f32) -> f32 {
-        let ty = (self.fov_y_radians * 0.5).tan();
-        let tx = ty * aspect;
-        self.near * (1.0 + tx * tx + ty * ty).sqrt()
-    }
 }
 
 /// The shape of an object, in object space.
@@ -176,7 +168,11 @@ impl Light {
     /// box (always, for a directional light). Exact culling: the light's falloff is zero at and
     /// beyond its range.
     pub fn reaches_box(&self, lo: Vec3, hi: Vec3) -> bool {
-        !self.is_local() || self.position.clamp(lo, hi).distance(self.position) < self.radius
+        // The planner's test, so that what a scene reports and what a frame draws agree.
+        self.shape().reaches(&Aabb {
+            min: lo.into(),
+            max: hi.into(),
+        })
     }
 }
 

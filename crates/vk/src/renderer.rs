@@ -26,10 +26,9 @@ use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
-    plan_frame, CostModel, DepthConvention, FlushPolicy, Footprint, FramePlan, LightShape,
-    LightTechnique, Native, PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like,
-    SoftTarget, StencilBits, StencilLayout, TalkFigures, TechniqueChoice, TileStats, View,
-    X360Like,
+    plan_frame, CostModel, DepthConvention, FlushPolicy, Footprint, FramePlan, LightShape, Native,
+    PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like, SoftTarget, StencilBits,
+    StencilLayout, TalkFigures, TechniqueChoice, TileStats, View, X360Like,
 };
 use histencil_scene::Scene;
 
@@ -103,22 +102,24 @@ impl Technique {
         flush: FlushPolicy::Auto,
     };
 
-    fn light_technique(self) -> Option<(LightTechnique, Backend, FlushPolicy)> {
-        match self {
-            Technique::Forward => None,
-            Technique::Stencil { backend, flush } => {
-                Some((LightTechnique::Stencil, backend, flush))
-            }
-            Technique::Branching { backend, flush } => {
-                Some((LightTechnique::Branching, backend, flush))
-            }
-            // Refined per light by the cost model; stencil is the talk's default.
+    /// What the planner is asked for; `None` for the forward frame, which has no lighting
+    /// passes. `costs` gives the adaptive technique's cost model for a backend.
+    fn plan_settings(self, costs: impl FnOnce(Backend) -> CostModel) -> Option<PlanSettings> {
+        let (technique, backend, flush) = match self {
+            Technique::Forward => return None,
+            Technique::Stencil { backend, flush } => (TechniqueChoice::Stencil, backend, flush),
+            Technique::Branching { backend, flush } => (TechniqueChoice::Branching, backend, flush),
             Technique::Adaptive { backend, flush } => {
-                Some((LightTechnique::Stencil, backend, flush))
+                (TechniqueChoice::Adaptive(costs(backend)), backend, flush)
             }
             // Planned as branching: one draw per light, whatever the pixel's BRDF.
-            Technique::Lut { backend, flush } => Some((LightTechnique::Branching, backend, flush)),
-        }
+            Technique::Lut { backend, flush } => (TechniqueChoice::Branching, backend, flush),
+        };
+        Some(PlanSettings {
+            technique,
+            caps: backend.platform().caps(),
+            flush,
+        })
     }
 
     fn brdf_source(self) -> BrdfSource {
@@ -542,27 +543,17 @@ impl<'c> Renderer<'c> {
     /// camera, with the BRDF slots it touches ([`FramePlan::lights`] says which scene light each
     /// planned light is).
     pub fn plan(&self, technique: Technique) -> Result<FramePlan> {
-        let Some((light_technique, backend, flush)) = technique.light_technique() else {
+        let Some(settings) = technique.plan_settings(|backend| self.cost_model(backend)) else {
             return Ok(FramePlan::empty(DepthConvention::Standard));
         };
         let aspect = self.extent.width as f32 / self.extent.height as f32;
         let view = View::new(&self.scene.camera.view_desc(aspect)).map_err(PlanError::from)?;
         let shapes: Vec<LightShape> = self.scene.lights.iter().map(|l| l.shape()).collect();
         let brdf_bounds = self.scene.brdf_bounds(&self.brdfs);
-        let technique = match (technique, light_technique) {
-            (Technique::Adaptive { .. }, _) => TechniqueChoice::Adaptive(self.cost_model(backend)),
-            (_, LightTechnique::Branching) => TechniqueChoice::Branching,
-            _ => TechniqueChoice::Stencil,
-        };
         let inputs = PlanInputs {
             lights: &shapes,
             brdf_bounds: &brdf_bounds,
             view: &view,
-        };
-        let settings = PlanSettings {
-            technique,
-            caps: backend.platform().caps(),
-            flush,
         };
         Ok(plan_frame(&self.stencil_layout, &inputs, &settings)?)
     }
