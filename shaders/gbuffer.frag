@@ -1,7 +1,9 @@
 #version 460
-// G-buffer pass: stores the surface for the deferred light shaders (layout: include/gbuffer.glsl).
-// The BRDF id also goes into the stencil BRDF bits, through the draw's dynamic stencil reference.
+// G-buffer pass: stores the surface for the deferred light shaders, through the same contract an
+// engine's G-buffer shader writes (include/gbuffer_write.glsl). The BRDF slot also goes into the
+// stencil BRDF bits, through the draw's dynamic stencil reference.
 #include "draw.glsl"
+#include "gbuffer_write.glsl"
 
 layout(location = 0) in vec3 in_world_position;
 layout(location = 1) in vec3 in_world_normal;
@@ -13,7 +15,9 @@ layout(location = 2) out vec4 out_material;
 
 void main() {
     Surface s = surface_from_draw(in_world_position, in_world_normal);
-    out_albedo = vec4(s.tint, draw.tint.w);
-    out_normal_depth = vec4(s.normal, in_linear_depth);
-    out_material = vec4(s.params.xyz, float(s.brdf));
+    GBufferTexel t = gbuffer_encode(s.tint, s.normal, in_linear_depth, s.params.xyz, s.brdf,
+                                    uint(draw.tint.w));
+    out_albedo = t.albedo;
+    out_normal_depth = t.normal_depth;
+    out_material = t.material;
 }

@@ -21,6 +21,6 @@ void main() {
     // alpha entity is NaN): both are the brightest value there is, so they tonemap to white
     // rather than to the 0 that an unorm conversion makes of NaN.
     c = mix(min(c, vec3(65504.0)), vec3(65504.0), isnan(c));
-    c = max(c * frame.tonemap.x, vec3(0.0));
+    c = max(c * frame.settings.x, vec3(0.0));
     out_color = vec4(srgb_encode(c / (1.0 + c)), 1.0);
 }

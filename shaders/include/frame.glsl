@@ -13,8 +13,8 @@ layout(set = 0, binding = 0, std140) uniform Frame {
     mat4 inv_view;
     vec4 eye;        // xyz: camera position
     vec4 viewport;   // width, height, 1/width, 1/height
-    vec4 projection; // tan(fov_x / 2), tan(fov_y / 2), near, far
-    vec4 tonemap;    // x: exposure
+    vec4 projection; // (1/P00, 1/P11, P20, P21): view.xy / -view.z = (ndc.xy + zw) * xy
+    vec4 settings;   // x: exposure, y: the far plane's depth (1, or 0 with reversed Z)
     uvec4 counts;    // x: number of lights
 } frame;
 

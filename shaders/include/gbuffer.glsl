@@ -1,8 +1,5 @@
-// G-buffer layout, written by gbuffer.frag and read by the deferred light shaders (set 1).
-//   albedo:       RGBA16F  rgb tint, a material index (the LUT technique's table; integers are
-//                          exact in f16 up to 2048)
-//   normal_depth: RGBA32F  xyz world normal, w linear view depth (0 = no geometry)
-//   material:     RGBA32F  xyz BRDF parameters, w BRDF id
+// The G-buffer read back by the deferred light shaders (set 1). Its layout is the contract in
+// gbuffer_write.glsl, which histencil's G-buffer pass and an engine's write through.
 // Float formats keep the deferred path within 1/255 of the forward reference: parameters are
 // stored exactly as the forward pass reads them. What compact encodings would add is measured by
 // `histencil brdf-report` (histencil_brdf::encoding).
@@ -28,7 +25,7 @@ bool gbuffer_load(vec2 frag_coord, out Surface s) {
     vec4 albedo = texelFetch(gbuffer_albedo, px, 0);
     vec4 material = texelFetch(gbuffer_material, px, 0);
     vec2 ndc = frag_coord * frame.viewport.zw * 2.0 - 1.0;
-    vec3 view_position = vec3(ndc.x * frame.projection.x, -ndc.y * frame.projection.y, -1.0) * linear_depth;
+    vec3 view_position = vec3((ndc + frame.projection.zw) * frame.projection.xy, -1.0) * linear_depth;
     s.position = (frame.inv_view * vec4(view_position, 1.0)).xyz;
     s.normal = normal_depth.xyz;
     s.tint = albedo.rgb;

@@ -1,6 +1,7 @@
 //! Helpers for histencil's end-to-end GPU tests: a validated context, rendering, and image
 //! comparison that writes `-actual`, `-expected` and `-difference` PNGs when a check fails.
 
+pub mod engine;
 pub mod gltf_builder;
 
 use histencil_scene::Scene;

@@ -1,9 +1,76 @@
 //! Declared image accesses and the one place barriers are derived from them. A pass says how it
-//! will use an image next; `transition` turns "last access -> next access" into a barrier.
+//! will use an image next; `transition` turns "the image's current state -> next access" into a
+//! barrier, whoever owns the image: histencil's own targets and an engine's images handed in as
+//! [`ImageRef`]s go through the same code.
 
 use crate::context::Context;
-use crate::resources::{subresource_range, Image};
+use crate::resources::subresource_range;
 use ash::vk;
+
+/// Where an image stands: its layout and the last stages and accesses that touched it (the
+/// source half of the next barrier).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageState {
+    pub layout: vk::ImageLayout,
+    pub stage: vk::PipelineStageFlags2,
+    pub access: vk::AccessFlags2,
+}
+
+impl ImageState {
+    /// Not used yet: contents undefined, nothing to wait for.
+    pub const UNDEFINED: ImageState = ImageState {
+        layout: vk::ImageLayout::UNDEFINED,
+        stage: vk::PipelineStageFlags2::NONE,
+        access: vk::AccessFlags2::NONE,
+    };
+
+    /// The state an [`ImageAccess`] leaves an image in.
+    pub fn after(access: ImageAccess) -> ImageState {
+        let (layout, stage, access) = access_info(access);
+        ImageState {
+            layout,
+            stage,
+            access,
+        }
+    }
+}
+
+/// An image histencil records against without owning it: its handles, what it is, and its
+/// current state. Recording functions take it `&mut` and leave the state the image is in after
+/// the commands they recorded, which is what the caller's next barrier starts from.
+///
+/// One mip level, one array layer, every aspect of the format (depth and stencil both for a
+/// depth-stencil format); `view` is a 2D view over the aspects histencil samples or attaches.
+#[derive(Clone, Copy, Debug)]
+pub struct ImageRef {
+    pub image: vk::Image,
+    pub view: vk::ImageView,
+    pub format: vk::Format,
+    pub extent: vk::Extent2D,
+    pub state: ImageState,
+}
+
+impl ImageRef {
+    /// The aspects barriers and copies address: depth and stencil for a depth-stencil format,
+    /// colour otherwise.
+    pub fn aspect(&self) -> vk::ImageAspectFlags {
+        aspect_of(self.format)
+    }
+}
+
+/// Every aspect of `format`.
+pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
+    use vk::Format as F;
+    use vk::ImageAspectFlags as A;
+    match format {
+        F::D16_UNORM | F::X8_D24_UNORM_PACK32 | F::D32_SFLOAT => A::DEPTH,
+        F::S8_UINT => A::STENCIL,
+        F::D16_UNORM_S8_UINT | F::D24_UNORM_S8_UINT | F::D32_SFLOAT_S8_UINT => {
+            A::DEPTH | A::STENCIL
+        }
+        _ => A::COLOR,
+    }
+}
 
 /// How an image is used by the next commands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,15 +127,19 @@ pub(crate) enum Contents {
     Keep,
 }
 
-/// Records the barrier that takes `image` from its last access to `next`.
+/// Records the barrier that takes `image` from its current state to `next`.
 pub(crate) fn transition(
     ctx: &Context,
     cmd: vk::CommandBuffer,
-    image: &mut Image,
+    image: &mut ImageRef,
     next: ImageAccess,
     contents: Contents,
 ) {
-    let (old_layout, src_stage, src_access) = access_info(image.last_access);
+    let ImageState {
+        layout: old_layout,
+        stage: src_stage,
+        access: src_access,
+    } = image.state;
     let (new_layout, dst_stage, dst_access) = access_info(next);
     let old_layout = match contents {
         Contents::Discard => vk::ImageLayout::UNDEFINED,
@@ -83,12 +154,12 @@ pub(crate) fn transition(
         .new_layout(new_layout)
         .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image.handle)
-        .subresource_range(subresource_range(image.aspect));
+        .image(image.image)
+        .subresource_range(subresource_range(image.aspect()));
     let barriers = [barrier];
     let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
-    image.last_access = next;
+    image.state = ImageState::after(next);
 }
 
 /// A global memory barrier: every write recorded before is visible to every access after.

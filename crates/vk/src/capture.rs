@@ -8,7 +8,7 @@ use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::meshes::Meshes;
+use crate::meshes::LightVolumes;
 use crate::passes::{begin_rendering, color_attachment, Load};
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::readback::{copy_image_to_buffer, host_readable};
@@ -20,7 +20,7 @@ use histencil_model::{
     CullMode, DepthState, Footprint, FramePlan, PassState, SimResult, Simulator, SoftTarget, Span,
     StencilLayout,
 };
-use histencil_scene::{Light, LightKind};
+use histencil_scene::Light;
 
 /// Everything `histencil_model::Simulator` needs to predict a frame.
 #[derive(Clone, Debug)]
@@ -91,8 +91,7 @@ impl FootprintCapture {
             },
         )?;
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
-        let color = vk::ImageAspectFlags::COLOR;
-        let image = |name| Image::new(ctx, name, DEPTH_FORMAT, extent, usage, color);
+        let image = |name| Image::new(ctx, name, DEPTH_FORMAT, extent, usage);
         let bytes = u64::from(extent.width) * u64::from(extent.height) * 4;
         let buffer = |name| Buffer::readback(ctx, name, bytes);
         Ok(Self {
@@ -113,7 +112,7 @@ impl FootprintCapture {
         ctx: &Context,
         cmd: vk::CommandBuffer,
         pipeline_layout: vk::PipelineLayout,
-        meshes: &Meshes,
+        volumes: &LightVolumes,
         light: (u32, &Light),
     ) {
         ctx.begin_label(cmd, &format!("capture-footprint-{}", light.0));
@@ -160,10 +159,7 @@ impl FootprintCapture {
                     hi_stencil: None,
                 },
             );
-            match light.1.kind {
-                LightKind::Spot { .. } => meshes.light_cone.draw(ctx, cmd),
-                _ => meshes.light_sphere.draw(ctx, cmd),
-            }
+            volumes.draw(ctx, cmd, &light.1.kind);
             unsafe { ctx.device.cmd_end_rendering(cmd) };
             copy_image_to_buffer(
                 ctx,

@@ -206,46 +206,102 @@ pub(crate) fn create_storage_buffer_set(
     Ok((pool, set))
 }
 
-/// Points bindings 0, 1, ... of `set` at the storage buffers `buffers`.
-pub(crate) fn write_storage_buffers(ctx: &Context, set: vk::DescriptorSet, buffers: &[vk::Buffer]) {
-    let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+/// Points a [`FRAME_SET`] at the frame's uniform buffer and light buffer.
+pub(crate) fn write_frame_set(
+    ctx: &Context,
+    set: vk::DescriptorSet,
+    uniforms: vk::Buffer,
+    lights: vk::Buffer,
+) {
+    let info = |buffer| {
+        [vk::DescriptorBufferInfo::default()
+            .buffer(buffer)
+            .range(vk::WHOLE_SIZE)]
+    };
+    let (ubo, ssbo) = (info(uniforms), info(lights));
+    let writes = [
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(0)
+            .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+            .buffer_info(&ubo),
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(1)
+            .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+            .buffer_info(&ssbo),
+    ];
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+}
+
+/// Points bindings 0, 1, ... of `set` at the sampled images `views`, read in
+/// `SHADER_READ_ONLY_OPTIMAL`.
+pub(crate) fn write_sampled_images(ctx: &Context, set: vk::DescriptorSet, views: &[vk::ImageView]) {
+    let infos: Vec<_> = views
         .iter()
-        .map(|b| {
-            [vk::DescriptorBufferInfo::default()
-                .buffer(*b)
-                .range(vk::WHOLE_SIZE)]
+        .map(|v| {
+            vk::DescriptorImageInfo::default()
+                .image_view(*v)
+                .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
         })
         .collect();
-    let writes: Vec<_> = infos
+    write_in_order(
+        ctx,
+        set,
+        vk::DescriptorType::SAMPLED_IMAGE,
+        &infos,
+        |w, info| w.image_info(info),
+    );
+}
+
+/// Points bindings 0, 1, ... of `set` at the storage buffers `buffers`.
+pub(crate) fn write_storage_buffers(ctx: &Context, set: vk::DescriptorSet, buffers: &[vk::Buffer]) {
+    let infos: Vec<_> = buffers
         .iter()
-        .enumerate()
-        .map(|(i, info)| {
-            vk::WriteDescriptorSet::default()
+        .map(|b| {
+            vk::DescriptorBufferInfo::default()
+                .buffer(*b)
+                .range(vk::WHOLE_SIZE)
+        })
+        .collect();
+    write_in_order(
+        ctx,
+        set,
+        vk::DescriptorType::STORAGE_BUFFER,
+        &infos,
+        |w, info| w.buffer_info(info),
+    );
+}
+
+/// One write per element of `infos`, to bindings 0, 1, ... of `set`.
+fn write_in_order<'a, T>(
+    ctx: &Context,
+    set: vk::DescriptorSet,
+    ty: vk::DescriptorType,
+    infos: &'a [T],
+    attach: impl Fn(vk::WriteDescriptorSet<'a>, &'a [T]) -> vk::WriteDescriptorSet<'a>,
+) {
+    let writes: Vec<_> = (0..infos.len())
+        .map(|i| {
+            let write = vk::WriteDescriptorSet::default()
                 .dst_set(set)
                 .dst_binding(i as u32)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .buffer_info(info)
+                .descriptor_type(ty);
+            attach(write, &infos[i..=i])
         })
         .collect();
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 
-/// The frame's set layouts, pipeline layouts, pool and sets.
+/// The renderer's own set layouts, pipeline layouts, pool and sets: the mesh passes' and the
+/// tonemap's (the lighting has its own, `deferred_lighting.rs`).
 pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
-    pub gbuffer_layout: vk::DescriptorSetLayout,
-    pub hi_stencil_layout: vk::DescriptorSetLayout,
-    pub lut_layout: vk::DescriptorSetLayout,
     pub tonemap_layout: vk::DescriptorSetLayout,
     pub mesh_pipeline_layout: vk::PipelineLayout,
-    pub lighting_pipeline_layout: vk::PipelineLayout,
     pub tonemap_pipeline_layout: vk::PipelineLayout,
     pool: vk::DescriptorPool,
     pub frame_set: vk::DescriptorSet,
-    pub gbuffer_set: vk::DescriptorSet,
-    pub hi_stencil_set: vk::DescriptorSet,
-    /// Written when the LUT technique first needs its tables.
-    pub lut_set: vk::DescriptorSet,
     pub tonemap_set: vk::DescriptorSet,
 }
 
@@ -273,9 +329,6 @@ pub(crate) fn create_pipeline_layout(
 pub struct DescriptorTargets {
     pub frame_uniforms: vk::Buffer,
     pub lights: vk::Buffer,
-    pub gbuffer_views: [vk::ImageView; 3],
-    /// Bindings 0..=3 of [`HI_STENCIL_SET`], in order.
-    pub hi_stencil: [vk::Buffer; 4],
     pub hdr_view: vk::ImageView,
 }
 
@@ -283,18 +336,11 @@ impl Descriptors {
     pub fn new(ctx: &Context, targets: &DescriptorTargets) -> Result<Self> {
         let set_layout = |name, set| create_set_layout(ctx, name, set, GRAPHICS_STAGES);
         let frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
-        let gbuffer_layout = set_layout("gbuffer-set-layout", GBUFFER_SET)?;
-        let hi_stencil_layout = set_layout("hi-stencil-set-layout", HI_STENCIL_SET)?;
-        let lut_layout = set_layout("lut-set-layout", LUT_SET)?;
         let tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
         let pipeline_layout = |name, sets: &[vk::DescriptorSetLayout]| {
             create_pipeline_layout(ctx, name, sets, GRAPHICS_STAGES, PUSH_CONSTANT_BYTES)
         };
         let mesh_pipeline_layout = pipeline_layout("mesh-pipeline-layout", &[frame_layout])?;
-        let lighting_pipeline_layout = pipeline_layout(
-            "lighting-pipeline-layout",
-            &[frame_layout, gbuffer_layout, hi_stencil_layout, lut_layout],
-        )?;
         let tonemap_pipeline_layout =
             pipeline_layout("tonemap-pipeline-layout", &[frame_layout, tonemap_layout])?;
 
@@ -304,120 +350,52 @@ impl Descriptors {
                 .descriptor_count(1),
             vk::DescriptorPoolSize::default()
                 .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1 + (HI_STENCIL_SET.len() + LUT_SET.len()) as u32),
+                .descriptor_count(1),
             vk::DescriptorPoolSize::default()
                 .ty(vk::DescriptorType::SAMPLED_IMAGE)
-                .descriptor_count(4),
+                .descriptor_count(1),
         ];
         let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(5)
+            .max_sets(2)
             .pool_sizes(&sizes);
         let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
             .call("vkCreateDescriptorPool")?;
         ctx.name(pool, "frame-descriptor-pool");
-        let layouts = [
-            frame_layout,
-            gbuffer_layout,
-            hi_stencil_layout,
-            lut_layout,
-            tonemap_layout,
-        ];
+        let layouts = [frame_layout, tonemap_layout];
         let alloc = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(pool)
             .set_layouts(&layouts);
         let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .call("vkAllocateDescriptorSets")?;
-        let names = [
-            "frame-set",
-            "gbuffer-set",
-            "hi-stencil-set",
-            "lut-set",
-            "tonemap-set",
-        ];
+        let names = ["frame-set", "tonemap-set"];
         for (set, name) in sets.iter().zip(names) {
             ctx.name(*set, name);
         }
         let d = Self {
             frame_layout,
-            gbuffer_layout,
-            hi_stencil_layout,
-            lut_layout,
             tonemap_layout,
             mesh_pipeline_layout,
-            lighting_pipeline_layout,
             tonemap_pipeline_layout,
             pool,
             frame_set: sets[0],
-            gbuffer_set: sets[1],
-            hi_stencil_set: sets[2],
-            lut_set: sets[3],
-            tonemap_set: sets[4],
+            tonemap_set: sets[1],
         };
         d.write(ctx, targets);
         Ok(d)
     }
 
     fn write(&self, ctx: &Context, t: &DescriptorTargets) {
-        let ubo = [vk::DescriptorBufferInfo::default()
-            .buffer(t.frame_uniforms)
-            .range(vk::WHOLE_SIZE)];
-        let ssbo = [vk::DescriptorBufferInfo::default()
-            .buffer(t.lights)
-            .range(vk::WHOLE_SIZE)];
-        let image = |view| {
-            [vk::DescriptorImageInfo::default()
-                .image_view(view)
-                .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
-        };
-        let gbuffer: Vec<_> = t.gbuffer_views.iter().map(|v| image(*v)).collect();
-        let hdr = image(t.hdr_view);
-        let mut writes = vec![
-            vk::WriteDescriptorSet::default()
-                .dst_set(self.frame_set)
-                .dst_binding(0)
-                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
-                .buffer_info(&ubo),
-            vk::WriteDescriptorSet::default()
-                .dst_set(self.frame_set)
-                .dst_binding(1)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .buffer_info(&ssbo),
-            vk::WriteDescriptorSet::default()
-                .dst_set(self.tonemap_set)
-                .dst_binding(0)
-                .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-                .image_info(&hdr),
-        ];
-        for (i, info) in gbuffer.iter().enumerate() {
-            writes.push(
-                vk::WriteDescriptorSet::default()
-                    .dst_set(self.gbuffer_set)
-                    .dst_binding(i as u32)
-                    .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-                    .image_info(info),
-            );
-        }
-        unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
-        write_storage_buffers(ctx, self.hi_stencil_set, &t.hi_stencil);
+        write_frame_set(ctx, self.frame_set, t.frame_uniforms, t.lights);
+        write_sampled_images(ctx, self.tonemap_set, &[t.hdr_view]);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);
-            for l in [
-                self.mesh_pipeline_layout,
-                self.lighting_pipeline_layout,
-                self.tonemap_pipeline_layout,
-            ] {
+            for l in [self.mesh_pipeline_layout, self.tonemap_pipeline_layout] {
                 ctx.device.destroy_pipeline_layout(l, None);
             }
-            for l in [
-                self.frame_layout,
-                self.gbuffer_layout,
-                self.hi_stencil_layout,
-                self.lut_layout,
-                self.tonemap_layout,
-            ] {
+            for l in [self.frame_layout, self.tonemap_layout] {
                 ctx.device.destroy_descriptor_set_layout(l, None);
             }
         }

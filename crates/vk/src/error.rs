@@ -40,6 +40,9 @@ pub enum Error {
     Lightmap(#[from] histencil_alpha::LayoutError),
     #[error("{count} distinct materials; the G-buffer indexes at most {max}")]
     TooManyMaterials { count: usize, max: usize },
+    /// A frame or lighting description that does not fit (an engine's input).
+    #[error("bad lighting frame: {0}")]
+    BadFrame(String),
     #[error("not supported yet: {0}")]
     Unsupported(&'static str),
     #[error("cannot write `{path}`: {message}")]

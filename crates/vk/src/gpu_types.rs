@@ -4,6 +4,7 @@
 use crate::shader_consts::LIGHT_KINDS;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
+use histencil_model::ViewDesc;
 use histencil_scene::{Camera, Light, LightKind, Material};
 
 /// `Frame` in frame.glsl (std140).
@@ -16,10 +17,23 @@ pub struct FrameUniforms {
     pub inv_view: [[f32; 4]; 4],
     pub eye: [f32; 4],
     pub viewport: [f32; 4],
+    /// How a pixel's view ray is rebuilt from its NDC: `(1 / P00, 1 / P11, P20, P21)` of the
+    /// projection `P` (`m[column][row]`), so `view.xy / -view.z = (ndc.xy + zw) * xy`; off-centre
+    /// (jittered) projections included.
     pub projection: [f32; 4],
-    pub tonemap: [f32; 4],
+    /// x: exposure; y: the far plane's depth (1, or 0 with reversed Z), where full-screen light
+    /// passes are drawn.
+    pub settings: [f32; 4],
     pub counts: [u32; 4],
 }
+
+/// A view the light shaders cannot rebuild positions in.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the view-to-clip matrix is not a perspective projection with clip w = -view z (a \
+     right-handed view space looking down -Z, as glam's look_at_rh and perspective_rh make): {0}"
+)]
+pub struct ProjectionError(pub &'static str);
 
 /// Exposure applied before tonemapping.
 pub const EXPOSURE: f32 = 1.0;
@@ -42,10 +56,55 @@ impl FrameUniforms {
                 1.0 / width as f32,
                 1.0 / height as f32,
             ],
-            projection: [tan_y * aspect, tan_y, camera.near, camera.far],
-            tonemap: [EXPOSURE, 0.0, 0.0, 0.0],
+            // The camera's projection is glam's Vulkan one: P11 = -1 / tan_y (y down), centred.
+            projection: [tan_y * aspect, -tan_y, 0.0, 0.0],
+            settings: [EXPOSURE, 1.0, 0.0, 0.0],
             counts: [light_count, 0, 0, 0],
         }
+    }
+
+    /// The uniforms of an engine's view at `width` x `height`: the matrices as given, the eye
+    /// from the inverse view, the ray reconstruction from the projection.
+    ///
+    /// # Errors
+    /// [`ProjectionError`] for an orthographic projection or one whose clip w is not `-z`; the
+    /// matrices' other checks are [`histencil_model::View::new`]'s.
+    pub fn from_view(
+        desc: &ViewDesc,
+        width: u32,
+        height: u32,
+        light_count: u32,
+    ) -> Result<Self, ProjectionError> {
+        let view = Mat4::from_cols_array_2d(&desc.world_to_view);
+        let proj = Mat4::from_cols_array_2d(&desc.view_to_clip);
+        // Clip w must be -z: row 3 of P is (0, 0, -1, 0).
+        let w_row = proj.row(3);
+        if w_row != glam::Vec4::new(0.0, 0.0, -1.0, 0.0) {
+            return Err(ProjectionError("its last row is not (0, 0, -1, 0)"));
+        }
+        let (p00, p11) = (proj.x_axis.x, proj.y_axis.y);
+        if !(p00.is_normal() && p11.is_normal()) || proj.x_axis.y != 0.0 || proj.y_axis.x != 0.0 {
+            return Err(ProjectionError(
+                "x and y do not scale independently by finite non-zero factors",
+            ));
+        }
+        let inv_view = view.inverse();
+        Ok(Self {
+            view: desc.world_to_view,
+            proj: desc.view_to_clip,
+            view_proj: (proj * view).to_cols_array_2d(),
+            inv_view: inv_view.to_cols_array_2d(),
+            eye: inv_view.w_axis.to_array(),
+            viewport: [
+                width as f32,
+                height as f32,
+                1.0 / width as f32,
+                1.0 / height as f32,
+            ],
+            projection: [1.0 / p00, 1.0 / p11, proj.z_axis.x, proj.z_axis.y],
+            settings: [EXPOSURE, desc.depth.far(), 0.0, 0.0],
+            counts: [light_count, 0, 0, 0],
+        })
     }
 }
 
@@ -142,6 +201,74 @@ const _: () = assert!(PUSH_CONSTANT_BYTES <= 128);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The camera's own uniforms and those rebuilt from its matrices agree: the engine path and
+    /// histencil's reconstruct the same rays.
+    #[test]
+    fn uniforms_from_the_cameras_matrices_match_the_camera() {
+        let camera = Camera {
+            eye: Vec3::new(1.0, 2.0, 5.0),
+            target: Vec3::new(0.0, 0.5, 0.0),
+            up: Vec3::Y,
+            fov_y_radians: 0.9,
+            near: 0.1,
+            far: 50.0,
+        };
+        let from_camera = FrameUniforms::new(&camera, 320, 200, 3);
+        let desc = camera.view_desc(320.0 / 200.0);
+        let from_view = FrameUniforms::from_view(&desc, 320, 200, 3).unwrap();
+        for (a, b) in from_camera.projection.iter().zip(from_view.projection) {
+            assert!((a - b).abs() <= 1e-6 * a.abs().max(1.0), "{a} vs {b}");
+        }
+        for (a, b) in from_camera.eye.iter().zip(from_view.eye) {
+            assert!((a - b).abs() <= 1e-5, "{a} vs {b}");
+        }
+        assert_eq!(from_view.settings[1], 1.0);
+        let reversed = ViewDesc {
+            depth: histencil_model::DepthConvention::Reversed,
+            ..desc
+        };
+        let r = FrameUniforms::from_view(&reversed, 320, 200, 3).unwrap();
+        assert_eq!(r.settings[1], 0.0);
+    }
+
+    #[test]
+    fn orthographic_and_left_handed_projections_are_refused() {
+        use glam::Vec4;
+        let rows = |w: Vec4| {
+            Mat4::from_rows(
+                Vec4::new(1.0, 0.0, 0.0, 0.0),
+                Vec4::new(0.0, -1.0, 0.0, 0.0),
+                Vec4::new(0.0, 0.0, 0.01, 0.1),
+                w,
+            )
+        };
+        let ortho = rows(Vec4::new(0.0, 0.0, 0.0, 1.0));
+        let left_handed = rows(Vec4::new(0.0, 0.0, 1.0, 0.0));
+        let sheared = Mat4 {
+            x_axis: Vec4::new(1.0, 0.5, 0.0, 0.0),
+            ..rows(Vec4::new(0.0, 0.0, -1.0, 0.0))
+        };
+        assert!(FrameUniforms::from_view(
+            &ViewDesc {
+                world_to_view: Mat4::IDENTITY.to_cols_array_2d(),
+                view_to_clip: rows(Vec4::new(0.0, 0.0, -1.0, 0.0)).to_cols_array_2d(),
+                depth: histencil_model::DepthConvention::Standard,
+            },
+            8,
+            8,
+            0
+        )
+        .is_ok());
+        for proj in [ortho, left_handed, sheared] {
+            let desc = ViewDesc {
+                world_to_view: Mat4::IDENTITY.to_cols_array_2d(),
+                view_to_clip: proj.to_cols_array_2d(),
+                depth: histencil_model::DepthConvention::Standard,
+            };
+            assert!(FrameUniforms::from_view(&desc, 8, 8, 0).is_err());
+        }
+    }
 
     #[test]
     fn block_sizes_match_the_glsl() {

@@ -13,13 +13,13 @@
 //! testing draw is preceded by `hi_stencil_count.frag` over the same geometry, and light shaders
 //! count the fragments they shade.
 
-use crate::access::{memory_barrier, transition, Contents, ImageAccess};
+use crate::access::{memory_barrier, transition, Contents, ImageAccess, ImageRef};
 use crate::compute::ComputePipeline;
 use crate::context::Context;
 use crate::descriptors::{create_storage_buffer_set, HI_STENCIL_UPDATE_SET};
 use crate::error::Result;
 use crate::readback::{copy_image_to_buffer, host_readable};
-use crate::resources::{Buffer, Image};
+use crate::resources::Buffer;
 use crate::shader_consts::HI_STENCIL_TILE;
 use crate::shaders;
 use crate::state::compare_op;
@@ -165,6 +165,9 @@ impl HiStencilSurface {
     /// Outside rendering, before lighting: every tile passes, no tile is marked, statistics zero.
     pub fn record_reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         let d = &ctx.device;
+        // The previous frame's lighting (in flight, in an earlier submission) may still use
+        // the surface.
+        memory_barrier(ctx, cmd);
         unsafe {
             d.cmd_fill_buffer(cmd, self.active.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
@@ -194,7 +197,7 @@ impl HiStencilSurface {
         &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        depth_stencil: &mut Image,
+        depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
         stamp: u32,
     ) {
@@ -219,7 +222,7 @@ impl HiStencilSurface {
     }
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
-    pub fn record_save(&self, ctx: &Context, cmd: vk::CommandBuffer, depth_stencil: &mut Image) {
+    pub fn record_save(&self, ctx: &Context, cmd: vk::CommandBuffer, depth_stencil: &mut ImageRef) {
         self.copy_stencil(ctx, cmd, depth_stencil, CopyTo::Saved);
     }
 
@@ -227,7 +230,7 @@ impl HiStencilSurface {
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        depth_stencil: &mut Image,
+        depth_stencil: &mut ImageRef,
         to: CopyTo,
     ) {
         let buffer = match to {

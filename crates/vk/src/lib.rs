@@ -16,6 +16,7 @@ mod capture;
 mod compute;
 mod context;
 mod debug;
+mod deferred_lighting;
 pub mod descriptors;
 mod error;
 pub mod gpu_types;
@@ -33,7 +34,7 @@ mod resources;
 mod shader_consts;
 pub mod state;
 mod targets;
-pub use targets::check_extent;
+pub use targets::{check_extent, GBUFFER_FORMATS};
 mod timing;
 
 /// The compiled SPIR-V of every shader module (built by build.rs, never checked in).
@@ -41,12 +42,17 @@ pub mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
 
+pub use access::{aspect_of, ImageRef, ImageState};
 pub use alpha::AlphaMode;
 pub use brdf_eval::BrdfEvaluator;
 pub use capture::SimulatorInputs;
 pub use context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat};
 pub use debug::{ValidationLog, ValidationMessage};
+pub use deferred_lighting::{
+    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, LightingTargets,
+};
 pub use error::{Error, Result};
+pub use gpu_types::ProjectionError;
 pub use histencil_model::{CostModel, FlushPolicy, TileStats};
 pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};

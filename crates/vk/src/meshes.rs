@@ -1,10 +1,13 @@
-//! The scene's meshes on the GPU: object shapes and the two light-volume meshes.
+//! Meshes on the GPU: the scene's object shapes, and the two light-volume meshes the lighting
+//! draws.
 
 use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
 use ash::vk;
-use histencil_scene::{light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, Mesh, Shape};
+use histencil_scene::{
+    light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, LightKind, Mesh, Shape,
+};
 
 pub struct GpuMesh {
     pub vertices: Buffer,
@@ -13,7 +16,7 @@ pub struct GpuMesh {
 }
 
 impl GpuMesh {
-    fn new(ctx: &Context, name: &str, mesh: &Mesh) -> Result<Self> {
+    pub(crate) fn new(ctx: &Context, name: &str, mesh: &Mesh) -> Result<Self> {
         let vertex_bytes: Vec<u8> = mesh
             .vertices
             .iter()
@@ -26,21 +29,29 @@ impl GpuMesh {
             })
             .collect();
         let index_bytes: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
-        Ok(Self {
-            vertices: Buffer::with_data(
-                ctx,
-                &format!("{name}-vertices"),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-                &vertex_bytes,
-            )?,
-            indices: Buffer::with_data(
-                ctx,
-                &format!("{name}-indices"),
-                vk::BufferUsageFlags::INDEX_BUFFER,
-                &index_bytes,
-            )?,
-            index_count: mesh.indices.len() as u32,
-        })
+        let mut vertices = Buffer::with_data(
+            ctx,
+            &format!("{name}-vertices"),
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+            &vertex_bytes,
+        )?;
+        let indices = Buffer::with_data(
+            ctx,
+            &format!("{name}-indices"),
+            vk::BufferUsageFlags::INDEX_BUFFER,
+            &index_bytes,
+        );
+        match indices {
+            Ok(indices) => Ok(Self {
+                vertices,
+                indices,
+                index_count: mesh.indices.len() as u32,
+            }),
+            Err(e) => {
+                vertices.destroy(ctx);
+                Err(e)
+            }
+        }
     }
 
     /// Binds and draws the whole mesh.
@@ -55,7 +66,7 @@ impl GpuMesh {
         }
     }
 
-    fn destroy(&mut self, ctx: &Context) {
+    pub(crate) fn destroy(&mut self, ctx: &Context) {
         self.vertices.destroy(ctx);
         self.indices.destroy(ctx);
     }
@@ -66,33 +77,76 @@ pub const SPHERE_SEGMENTS: u32 = 24;
 pub const SPHERE_RINGS: u32 = 12;
 pub const CONE_SIDES: u32 = 24;
 
+/// The light volumes: a sphere circumscribing a point light's range, a cone a spot light's.
+pub struct LightVolumes {
+    pub sphere: GpuMesh,
+    pub cone: GpuMesh,
+}
+
+impl LightVolumes {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let sphere = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
+        let mut sphere = GpuMesh::new(ctx, "light-sphere-mesh", &sphere)?;
+        match GpuMesh::new(ctx, "light-cone-mesh", &light_cone(CONE_SIDES)) {
+            Ok(cone) => Ok(Self { sphere, cone }),
+            Err(e) => {
+                sphere.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// Draws the volume of a light of `kind` (the vertex shader places it).
+    pub(crate) fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, kind: &LightKind) {
+        match kind {
+            LightKind::Spot { .. } => self.cone.draw(ctx, cmd),
+            _ => self.sphere.draw(ctx, cmd),
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.sphere.destroy(ctx);
+        self.cone.destroy(ctx);
+    }
+}
+
 pub struct Meshes {
     pub unit_box: GpuMesh,
     /// The box as the lightmap bake draws it (`histencil_scene::unit_box_bake`).
     pub unit_box_bake: GpuMesh,
     pub sphere: GpuMesh,
-    pub light_sphere: GpuMesh,
-    pub light_cone: GpuMesh,
     /// The scene's imported meshes (`Shape::Mesh`), in `Scene::meshes` order.
     pub imported: Vec<GpuMesh>,
 }
 
 impl Meshes {
-    /// The built-in shapes and light volumes, and the scene's `imported` meshes.
+    /// The built-in shapes and the scene's `imported` meshes. A failure half way frees the
+    /// meshes made so far.
     pub fn new(ctx: &Context, imported: &[Mesh]) -> Result<Self> {
-        let sphere_volume = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
-        let cone_volume = light_cone(CONE_SIDES);
+        let builtin = [unit_box(), unit_box_bake(), uv_sphere(48, 24)];
+        let builtin_names = ["box-mesh", "box-bake-mesh", "sphere-mesh"].map(String::from);
+        let imported_names = (0..imported.len()).map(|i| format!("imported-mesh-{i}"));
+        let names = builtin_names.into_iter().chain(imported_names);
+        let mut made: Vec<GpuMesh> = Vec::new();
+        for (name, mesh) in names.zip(builtin.iter().chain(imported)) {
+            match GpuMesh::new(ctx, &name, mesh) {
+                Ok(m) => made.push(m),
+                Err(e) => {
+                    for mut m in made {
+                        m.destroy(ctx);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        let mut made = made.into_iter();
+        let mut next = || made.next().expect("three built-in meshes");
+        let (unit_box, unit_box_bake, sphere) = (next(), next(), next());
         Ok(Self {
-            unit_box: GpuMesh::new(ctx, "box-mesh", &unit_box())?,
-            unit_box_bake: GpuMesh::new(ctx, "box-bake-mesh", &unit_box_bake())?,
-            sphere: GpuMesh::new(ctx, "sphere-mesh", &uv_sphere(48, 24))?,
-            light_sphere: GpuMesh::new(ctx, "light-sphere-mesh", &sphere_volume)?,
-            light_cone: GpuMesh::new(ctx, "light-cone-mesh", &cone_volume)?,
-            imported: imported
-                .iter()
-                .enumerate()
-                .map(|(i, m)| GpuMesh::new(ctx, &format!("imported-mesh-{i}"), m))
-                .collect::<Result<_>>()?,
+            unit_box,
+            unit_box_bake,
+            sphere,
+            imported: made.collect(),
         })
     }
 
@@ -117,8 +171,6 @@ impl Meshes {
             &mut self.unit_box,
             &mut self.unit_box_bake,
             &mut self.sphere,
-            &mut self.light_sphere,
-            &mut self.light_cone,
         ]
         .into_iter()
         .chain(&mut self.imported)

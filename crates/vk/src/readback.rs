@@ -1,9 +1,10 @@
 //! Copying the frame's images back to the host: tonemapped colour, HDR colour and the raw stencil.
 
+use crate::access::ImageRef;
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::error::Result;
-use crate::resources::{Buffer, Image};
+use crate::resources::Buffer;
 use crate::targets::Targets;
 use ash::vk;
 use histencil_brdf::BrdfId;
@@ -51,7 +52,7 @@ pub struct FrameImages {
 pub(crate) fn copy_image_to_buffer(
     ctx: &Context,
     cmd: vk::CommandBuffer,
-    image: &mut Image,
+    image: &mut ImageRef,
     aspect: vk::ImageAspectFlags,
     buffer: &Buffer,
 ) {
@@ -70,7 +71,7 @@ pub(crate) fn copy_image_to_buffer(
     unsafe {
         ctx.device.cmd_copy_image_to_buffer(
             cmd,
-            image.handle,
+            image.image,
             vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             buffer.handle,
             &[region],

@@ -3,16 +3,14 @@
 use crate::alpha::{AlphaLighting, AlphaMode};
 use crate::capture::{FootprintCapture, SimulatorInputs};
 use crate::context::Context;
-use crate::descriptors::write_storage_buffers;
+use crate::deferred_lighting::{DeferredLighting, LightingDesc, LightingFrame, LightingTargets};
 use crate::descriptors::{DescriptorTargets, Descriptors};
 use crate::error::{Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
-use crate::hi_stencil::HiStencilSurface;
 use crate::lut::LutTables;
 use crate::meshes::Meshes;
 use crate::passes::geometry::GeometryPass;
-use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
-use crate::passes::lighting::LightingPass;
+use crate::passes::light_pipelines::BrdfSource;
 use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::{
@@ -21,14 +19,14 @@ use crate::readback::{
 use crate::resources::Buffer;
 use crate::shader_consts::HI_STENCIL_TILE;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
-use crate::timing::{FrameTimings, StepTimer, Timestamps};
+use crate::timing::{FrameTimings, Timestamps};
 use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
     plan_frame, CostModel, DepthConvention, FlushPolicy, Footprint, FramePlan, LightShape, Native,
     PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like, SoftTarget, StencilBits,
-    StencilLayout, TalkFigures, TechniqueChoice, TileStats, View, X360Like,
+    StencilLayout, TalkFigures, TechniqueChoice, TileStats, View, ViewDesc, X360Like,
 };
 use histencil_scene::Scene;
 
@@ -202,15 +200,14 @@ pub struct Renderer<'c> {
     alpha: Option<AlphaLighting>,
     /// Written into the preserved stencil bits by the G-buffer pass (the engine's own bits).
     preserved_pattern: u8,
-    light_pipelines: LightPipelines,
+    /// The lighting passes, as an engine records them, into this renderer's targets.
+    lighting: DeferredLighting<'c>,
     /// Per-step lighting timestamps, when asked for.
     pass_timing: bool,
-    step_timer: Option<StepTimer>,
     /// The adaptive technique's costs; `None`: fitted to the talk's figures for the backend.
     cost_model: Option<CostModel>,
     /// Count hi-stencil tile and fragment statistics, when asked for.
     tile_stats: bool,
-    hi_stencil: HiStencilSurface,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -263,9 +260,20 @@ impl<'c> Renderer<'c> {
             .collect();
         let (materials, object_materials) = distinct_materials(&scene);
 
+        let lighting = DeferredLighting::new(
+            ctx,
+            &LightingDesc {
+                layout: stencil_layout,
+                brdfs: brdfs.clone(),
+                extent,
+                depth_stencil_format: ctx.depth_stencil_format,
+                hdr_format: HDR_FORMAT,
+                frames_in_flight: 1,
+                max_lights: scene.lights.len() as u32,
+            },
+        )?;
         let targets = Targets::new(ctx, extent)?;
         let meshes = Meshes::new(ctx, &scene.meshes)?;
-        let hi_stencil = HiStencilSurface::new(ctx, extent)?;
         let uniforms = FrameUniforms::new(&scene.camera, width, height, scene.lights.len() as u32);
         let frame_uniforms = Buffer::with_data(
             ctx,
@@ -285,12 +293,6 @@ impl<'c> Renderer<'c> {
             &DescriptorTargets {
                 frame_uniforms: frame_uniforms.handle,
                 lights: lights.handle,
-                gbuffer_views: [
-                    targets.gbuffer[0].view,
-                    targets.gbuffer[1].view,
-                    targets.gbuffer[2].view,
-                ],
-                hi_stencil: hi_stencil.light_set_buffers(),
                 hdr_view: targets.hdr.view,
             },
         )?;
@@ -298,7 +300,7 @@ impl<'c> Renderer<'c> {
             ctx,
             &PipelineLayouts {
                 mesh: descriptors.mesh_pipeline_layout,
-                lighting: descriptors.lighting_pipeline_layout,
+                lighting: lighting.pipeline_layout(),
                 tonemap: descriptors.tonemap_pipeline_layout,
             },
             &TargetFormats {
@@ -308,11 +310,6 @@ impl<'c> Renderer<'c> {
                 depth_stencil: ctx.depth_stencil_format,
             },
         )?;
-        let light_pipelines = LightPipelines::new(
-            descriptors.lighting_pipeline_layout,
-            HDR_FORMAT,
-            ctx.depth_stencil_format,
-        );
         let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
         let command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
             .call("vkCreateCommandPool")?;
@@ -346,12 +343,10 @@ impl<'c> Renderer<'c> {
             lightmap_side: None,
             alpha: None,
             preserved_pattern: 0,
-            light_pipelines,
+            lighting,
             pass_timing: false,
-            step_timer: None,
             tile_stats: false,
             cost_model: None,
-            hi_stencil,
             extent,
             targets,
             meshes,
@@ -468,7 +463,7 @@ impl<'c> Renderer<'c> {
                 });
             }
             let tables = LutTables::new(self.ctx, &self.materials, self.lut_resolution)?;
-            write_storage_buffers(self.ctx, self.descriptors.lut_set, &tables.buffers());
+            self.lighting.set_lut_tables(&tables.buffers());
             self.lut_tables = Some(tables);
         }
         Ok(self.lut_tables.as_ref().expect("baked above"))
@@ -535,7 +530,7 @@ impl<'c> Renderer<'c> {
 
     /// Light pipelines created so far.
     pub fn light_pipeline_count(&self) -> usize {
-        self.light_pipelines.count()
+        self.lighting.pipeline_count()
     }
 
     /// The lighting plan of a frame, from histencil-model's planner on the scene's plain inputs:
@@ -546,8 +541,7 @@ impl<'c> Renderer<'c> {
         let Some(settings) = technique.plan_settings(|backend| self.cost_model(backend)) else {
             return Ok(FramePlan::empty(DepthConvention::Standard));
         };
-        let aspect = self.extent.width as f32 / self.extent.height as f32;
-        let view = View::new(&self.scene.camera.view_desc(aspect)).map_err(PlanError::from)?;
+        let view = View::new(&self.view_desc()).map_err(PlanError::from)?;
         let shapes: Vec<LightShape> = self.scene.lights.iter().map(|l| l.shape()).collect();
         let brdf_bounds = self.scene.brdf_bounds(&self.brdfs);
         let inputs = PlanInputs {
@@ -556,6 +550,12 @@ impl<'c> Renderer<'c> {
             view: &view,
         };
         Ok(plan_frame(&self.stencil_layout, &inputs, &settings)?)
+    }
+
+    /// The camera as the planner and the lighting take it.
+    fn view_desc(&self) -> ViewDesc {
+        let aspect = self.extent.width as f32 / self.extent.height as f32;
+        self.scene.camera.view_desc(aspect)
     }
 
     /// Renders one frame and waits for it. `readback` says which images to copy back.
@@ -573,34 +573,7 @@ impl<'c> Renderer<'c> {
             self.lut_tables()?;
         }
         self.alpha_lighting()?;
-        prepare_pipelines(
-            ctx,
-            &mut self.light_pipelines,
-            &plan,
-            &self.brdfs,
-            count_stats,
-            brdf_source,
-        )?;
         let time_steps = self.pass_timing && technique != Technique::Forward;
-        if time_steps {
-            let needed = plan.steps.len() as u32 + 1;
-            if self
-                .step_timer
-                .as_ref()
-                .is_none_or(|t| t.capacity() < needed)
-            {
-                if let Some(mut old) = self.step_timer.take() {
-                    old.destroy(ctx);
-                }
-                self.step_timer = Some(StepTimer::new(ctx, needed.next_power_of_two())?);
-            }
-        }
-        let light_sets = [
-            self.descriptors.frame_set,
-            self.descriptors.gbuffer_set,
-            self.descriptors.hi_stencil_set,
-            self.descriptors.lut_set,
-        ];
         let cmd = self.begin_commands()?;
         self.timestamps.begin_frame(ctx, cmd);
         match technique {
@@ -611,30 +584,19 @@ impl<'c> Renderer<'c> {
             _ => {
                 self.record_geometry(false);
                 self.timestamps.mark(ctx, cmd, "gbuffer");
-                LightingPass {
-                    ctx,
-                    cmd,
-                    plan: &plan,
+                let view = self.view_desc();
+                let frame = LightingFrame {
+                    slot: 0,
+                    view: &view,
                     lights: &self.scene.lights,
-                    brdfs: &self.brdfs,
-                    meshes: &self.meshes,
-                    pipelines: &self.light_pipelines,
-                    pipeline_layout: self.descriptors.lighting_pipeline_layout,
-                    // The LUT set is written only once tables exist.
-                    sets: &light_sets[..if brdf_source == BrdfSource::Table {
-                        4
-                    } else {
-                        3
-                    }],
-                    brdf_source,
-                    extent: self.extent,
-                    count_stats,
-                }
-                .record(
-                    &mut self.targets,
-                    &mut self.hi_stencil,
-                    self.step_timer.as_mut().filter(|_| time_steps),
-                )?;
+                    plan: &plan,
+                    clear_hdr: true,
+                    timestamps: time_steps,
+                };
+                let mut targets = self.targets.lighting();
+                self.lighting
+                    .record_with(cmd, &frame, &mut targets, count_stats, brdf_source)?;
+                self.targets.lit(&targets);
                 self.timestamps.mark(ctx, cmd, "lighting");
             }
         }
@@ -668,14 +630,11 @@ impl<'c> Renderer<'c> {
         self.readback.record(ctx, cmd, &mut self.targets, readback);
         self.submit_and_wait()?;
         let mut timings = self.timestamps.read(ctx)?;
-        if let Some(timer) = self.step_timer.as_ref().filter(|_| time_steps) {
-            timings.lighting = Some(timer.read(ctx)?);
+        if time_steps {
+            timings.lighting = self.lighting.step_timings(0)?;
         }
         let images = self.readback.read(readback)?;
-        let tile_stats = count_stats.then(|| TileStats {
-            flushes: plan.flushes() as u64,
-            ..self.hi_stencil.read_stats()
-        });
+        let tile_stats = count_stats.then(|| self.lighting.tile_stats(&plan));
         Ok(Frame {
             timings,
             images,
@@ -720,11 +679,22 @@ impl<'c> Renderer<'c> {
         Ok(())
     }
 
-    /// Records the forward pass or the G-buffer pass.
+    /// Records the forward pass or the G-buffer pass into the renderer's targets.
     fn record_geometry(&mut self, forward: bool) {
-        let geometry = GeometryPass {
+        let cmd = self.cmd;
+        let mut targets = self.targets.lighting();
+        if forward {
+            self.geometry_pass(cmd, true).record_forward(&mut targets);
+        } else {
+            self.record_gbuffer_into(cmd, &mut targets);
+        }
+        self.targets.lit(&targets);
+    }
+
+    fn geometry_pass(&self, cmd: vk::CommandBuffer, forward: bool) -> GeometryPass<'_> {
+        GeometryPass {
             ctx: self.ctx,
-            cmd: self.cmd,
+            cmd,
             scene: &self.scene,
             meshes: &self.meshes,
             pipeline: if forward {
@@ -736,17 +706,52 @@ impl<'c> Renderer<'c> {
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
             material_indices: &self.object_materials,
-        };
-        if forward {
-            geometry.record_forward(&mut self.targets);
-        } else {
-            geometry.record_gbuffer(
-                &mut self.targets,
-                &self.stencil_layout,
-                &self.object_slots,
-                self.preserved_pattern,
-            );
         }
+    }
+
+    fn record_gbuffer_into(&self, cmd: vk::CommandBuffer, targets: &mut LightingTargets) {
+        self.geometry_pass(cmd, false).record_gbuffer(
+            targets,
+            &self.stencil_layout,
+            &self.object_slots,
+            self.preserved_pattern,
+        );
+    }
+
+    /// Records histencil's G-buffer pass of the scene (its camera, its objects) into another
+    /// owner's images: the G-buffer and depth-stencil of `targets` are cleared and written, in
+    /// the formats of the contract ([`crate::GBUFFER_FORMATS`], the context's depth-stencil
+    /// format), and left attached-ready with their states updated; the HDR image is untouched.
+    /// For engines and tests that light histencil's scenes with [`crate::DeferredLighting`].
+    ///
+    /// # Errors
+    /// [`crate::Error::BadFrame`] when an image's extent or format differs from the renderer's.
+    ///
+    /// # Safety
+    /// `cmd` is recording, outside a render pass, on the renderer's device; the G-buffer and
+    /// depth-stencil images of `targets` are live with `COLOR_ATTACHMENT` and
+    /// `DEPTH_STENCIL_ATTACHMENT` usage, and their states are true when `cmd` executes.
+    pub unsafe fn record_gbuffer(
+        &self,
+        cmd: vk::CommandBuffer,
+        targets: &mut LightingTargets,
+    ) -> Result<()> {
+        let images = targets.gbuffer.iter().zip(GBUFFER_FORMATS);
+        let ds = (&targets.depth_stencil, self.ctx.depth_stencil_format);
+        for (image, format) in images.chain([ds]) {
+            if image.extent != self.extent || image.format != format {
+                return Err(crate::Error::BadFrame(format!(
+                    "a {:?} {}x{} image where the G-buffer pass writes {format:?} {}x{}",
+                    image.format,
+                    image.extent.width,
+                    image.extent.height,
+                    self.extent.width,
+                    self.extent.height
+                )));
+            }
+        }
+        self.record_gbuffer_into(cmd, targets);
+        Ok(())
     }
 
     /// The CPU simulator's inputs for `technique`'s frame, captured from the GPU: the G-buffer
@@ -760,8 +765,8 @@ impl<'c> Renderer<'c> {
     pub fn simulator_inputs(&mut self, technique: Technique) -> Result<SimulatorInputs> {
         let ctx = self.ctx;
         let plan = self.plan(technique)?;
-        let mut capture =
-            FootprintCapture::new(ctx, self.descriptors.lighting_pipeline_layout, self.extent)?;
+        let layout = self.lighting.pipeline_layout();
+        let mut capture = FootprintCapture::new(ctx, layout, self.extent)?;
         let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
         let mut depth = Buffer::readback(ctx, "depth-readback", pixels * 4)?;
         let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
@@ -791,20 +796,14 @@ impl<'c> Renderer<'c> {
                     ctx.device.cmd_bind_descriptor_sets(
                         cmd,
                         vk::PipelineBindPoint::GRAPHICS,
-                        self.descriptors.lighting_pipeline_layout,
+                        layout,
                         0,
                         &[self.descriptors.frame_set],
                         &[],
                     );
                 }
                 let light = &self.scene.lights[index as usize];
-                capture.record(
-                    ctx,
-                    cmd,
-                    self.descriptors.lighting_pipeline_layout,
-                    &self.meshes,
-                    (index, light),
-                );
+                capture.record(ctx, cmd, layout, self.lighting.volumes(), (index, light));
                 self.submit_and_wait()?;
                 footprints.push(capture.footprint()?);
             }
@@ -851,12 +850,8 @@ impl Drop for Renderer<'_> {
             ctx.device.destroy_command_pool(self.command_pool, None);
         }
         self.timestamps.destroy(ctx);
-        if let Some(t) = self.step_timer.as_mut() {
-            t.destroy(ctx);
-        }
         self.readback.destroy(ctx);
         self.pipelines.destroy(ctx);
-        self.light_pipelines.destroy(ctx);
         if let Some(t) = self.lut_tables.as_mut() {
             t.destroy(ctx);
         }
@@ -864,7 +859,6 @@ impl Drop for Renderer<'_> {
             a.destroy(ctx);
         }
         self.descriptors.destroy(ctx);
-        self.hi_stencil.destroy(ctx);
         self.lights.destroy(ctx);
         self.frame_uniforms.destroy(ctx);
         self.meshes.destroy(ctx);

@@ -2,7 +2,7 @@
 //! destroyed explicitly with the context (`destroy`), never by `Drop`, so teardown order stays in
 //! the owner's hands.
 
-use crate::access::ImageAccess;
+use crate::access::{ImageRef, ImageState};
 use crate::context::Context;
 use crate::error::{Error, Result, VkCall};
 use ash::vk;
@@ -144,16 +144,24 @@ impl Buffer {
     }
 }
 
-/// A 2D image, its memory, one view over all its aspects' sampling aspect, and its last access
-/// (from which the next barrier is derived).
+/// A 2D image histencil owns: its memory, and an [`ImageRef`] (handles, one view over all its
+/// aspects, current state) that the passes record against, as they do an engine's images.
 pub struct Image {
-    pub handle: vk::Image,
-    pub view: vk::ImageView,
-    pub format: vk::Format,
-    pub extent: vk::Extent2D,
-    pub aspect: vk::ImageAspectFlags,
-    pub(crate) last_access: ImageAccess,
+    target: ImageRef,
     allocation: Option<Allocation>,
+}
+
+impl std::ops::Deref for Image {
+    type Target = ImageRef;
+    fn deref(&self) -> &ImageRef {
+        &self.target
+    }
+}
+
+impl std::ops::DerefMut for Image {
+    fn deref_mut(&mut self) -> &mut ImageRef {
+        &mut self.target
+    }
 }
 
 impl Image {
@@ -163,8 +171,8 @@ impl Image {
         format: vk::Format,
         extent: vk::Extent2D,
         usage: vk::ImageUsageFlags,
-        aspect: vk::ImageAspectFlags,
     ) -> Result<Self> {
+        let aspect = crate::access::aspect_of(format);
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -190,34 +198,47 @@ impl Image {
                 return Err(e);
             }
         };
-        unsafe {
-            ctx.device
-                .bind_image_memory(handle, allocation.memory(), allocation.offset())
-        }
-        .call("vkBindImageMemory")?;
+        // Binding and the view: on failure the image and its memory go too.
         let view_info = vk::ImageViewCreateInfo::default()
             .image(handle)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
             .subresource_range(subresource_range(aspect));
-        let view =
-            unsafe { ctx.device.create_image_view(&view_info, None) }.call("vkCreateImageView")?;
+        let view = unsafe {
+            ctx.device
+                .bind_image_memory(handle, allocation.memory(), allocation.offset())
+                .call("vkBindImageMemory")
+                .and_then(|()| {
+                    ctx.device
+                        .create_image_view(&view_info, None)
+                        .call("vkCreateImageView")
+                })
+        };
+        let view = match view {
+            Ok(v) => v,
+            Err(e) => {
+                unsafe { ctx.device.destroy_image(handle, None) };
+                free(ctx, allocation);
+                return Err(e);
+            }
+        };
         ctx.name(view, &format!("{name}-view"));
         Ok(Self {
-            handle,
-            view,
-            format,
-            extent,
-            aspect,
-            last_access: ImageAccess::Nothing,
+            target: ImageRef {
+                image: handle,
+                view,
+                format,
+                extent,
+                state: ImageState::UNDEFINED,
+            },
             allocation: Some(allocation),
         })
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
-            ctx.device.destroy_image_view(self.view, None);
-            ctx.device.destroy_image(self.handle, None);
+            ctx.device.destroy_image_view(self.target.view, None);
+            ctx.device.destroy_image(self.target.image, None);
         }
         if let Some(a) = self.allocation.take() {
             free(ctx, a);

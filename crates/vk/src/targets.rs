@@ -2,15 +2,19 @@
 //! and captures).
 
 use crate::context::Context;
+use crate::deferred_lighting::LightingTargets;
 use crate::error::{Error, Result};
 use crate::resources::Image;
 use ash::vk;
 
+/// The G-buffer's formats, in binding order: albedo, normal-depth, material
+/// (`shaders/include/gbuffer_write.glsl` says what each channel holds).
 pub const GBUFFER_FORMATS: [vk::Format; 3] = [
     vk::Format::R16G16B16A16_SFLOAT, // gbuffer-albedo
     vk::Format::R32G32B32A32_SFLOAT, // gbuffer-normal-depth
     vk::Format::R32G32B32A32_SFLOAT, // gbuffer-material
 ];
+/// The renderer's HDR target format (an engine's may differ).
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 
@@ -43,12 +47,11 @@ pub fn check_extent(ctx: &Context, width: u32, height: u32) -> Result<vk::Extent
 impl Targets {
     pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
         use vk::ImageUsageFlags as U;
-        let color = vk::ImageAspectFlags::COLOR;
         let gbuffer_usage = U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC;
         let names = ["gbuffer-albedo", "gbuffer-normal-depth", "gbuffer-material"];
         let mut gbuffer = Vec::new();
         for (name, format) in names.into_iter().zip(GBUFFER_FORMATS) {
-            gbuffer.push(Image::new(ctx, name, format, extent, gbuffer_usage, color)?);
+            gbuffer.push(Image::new(ctx, name, format, extent, gbuffer_usage)?);
         }
         let gbuffer: [Image; 3] = gbuffer.try_into().ok().expect("three G-buffer targets");
         Ok(Self {
@@ -59,7 +62,6 @@ impl Targets {
                 ctx.depth_stencil_format,
                 extent,
                 U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
-                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
             )?,
             hdr: Image::new(
                 ctx,
@@ -67,7 +69,6 @@ impl Targets {
                 HDR_FORMAT,
                 extent,
                 U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC,
-                color,
             )?,
             ldr: Image::new(
                 ctx,
@@ -75,9 +76,26 @@ impl Targets {
                 LDR_FORMAT,
                 extent,
                 U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
-                color,
             )?,
         })
+    }
+
+    /// The targets the lighting records against, with their current states.
+    pub fn lighting(&self) -> LightingTargets {
+        LightingTargets {
+            gbuffer: [*self.gbuffer[0], *self.gbuffer[1], *self.gbuffer[2]],
+            depth_stencil: *self.depth_stencil,
+            hdr: *self.hdr,
+        }
+    }
+
+    /// Takes back the states the lighting left `lit` in.
+    pub fn lit(&mut self, lit: &LightingTargets) {
+        for (image, state) in self.gbuffer.iter_mut().zip(&lit.gbuffer) {
+            image.state = state.state;
+        }
+        self.depth_stencil.state = lit.depth_stencil.state;
+        self.hdr.state = lit.hdr.state;
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -189,7 +189,6 @@ impl AlphaLighting {
         };
         use vk::ImageUsageFlags as U;
         let usage = U::COLOR_ATTACHMENT | U::SAMPLED;
-        let color = vk::ImageAspectFlags::COLOR;
         for (name, format) in [
             ("alpha-position-atlas", PROBE_FORMAT),
             ("alpha-normal-atlas", PROBE_FORMAT),
@@ -197,7 +196,7 @@ impl AlphaLighting {
         ] {
             parts
                 .images
-                .push(Image::new(ctx, name, format, extent, usage, color)?);
+                .push(Image::new(ctx, name, format, extent, usage)?);
         }
 
         let entity_lights = entity_lights(scene, &layout.regions);
@@ -532,7 +531,7 @@ impl AlphaLighting {
         // bound (and unread) image the layout its descriptor declares. An atlas no frame has
         // written yet is cleared first, so no read-only layout is entered from UNDEFINED.
         for image in [&mut self.positions, &mut self.normals, &mut self.lightmap] {
-            if image.last_access == ImageAccess::Nothing {
+            if image.state.layout == vk::ImageLayout::UNDEFINED {
                 transition(
                     ctx,
                     cmd,
@@ -552,7 +551,8 @@ impl AlphaLighting {
                 Contents::Keep,
             );
         }
-        begin_hdr_rendering(ctx, cmd, targets, extent, Load::Keep, Load::Keep);
+        let attachments = (&mut *targets.hdr, &mut *targets.depth_stencil);
+        begin_hdr_rendering(ctx, cmd, attachments, extent, Load::Keep, Load::Keep);
         let d = &ctx.device;
         let objects = scene.alpha_objects.len();
         for &entity in &self.order {

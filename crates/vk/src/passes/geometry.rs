@@ -7,10 +7,10 @@ use super::{
 };
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
+use crate::deferred_lighting::LightingTargets;
 use crate::gpu_types::DrawPush;
 use crate::meshes::Meshes;
 use crate::state::{apply, with_stencil, OPAQUE};
-use crate::targets::Targets;
 use ash::vk;
 use histencil_model::{FaceStencil, PassState, StencilLayout, StencilOp};
 use histencil_scene::Scene;
@@ -80,7 +80,7 @@ impl GeometryPass<'_> {
     /// Writes the G-buffer and each draw's BRDF slot into the stencil BRDF bits.
     pub fn record_gbuffer(
         &self,
-        targets: &mut Targets,
+        targets: &mut LightingTargets,
         layout: &StencilLayout,
         slots: &[u32],
         preserved_pattern: u8,
@@ -129,13 +129,13 @@ impl GeometryPass<'_> {
     }
 
     /// The forward reference: lit HDR colour straight from the meshes.
-    pub fn record_forward(&self, targets: &mut Targets) {
+    pub fn record_forward(&self, targets: &mut LightingTargets) {
         let (ctx, cmd) = (self.ctx, self.cmd);
         ctx.begin_label(cmd, "forward");
         begin_hdr_rendering(
             ctx,
             cmd,
-            targets,
+            (&mut targets.hdr, &mut targets.depth_stencil),
             self.extent,
             Load::Clear(CLEAR_BLACK),
             Load::Clear(CLEAR_DEPTH_STENCIL),

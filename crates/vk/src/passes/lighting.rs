@@ -15,13 +15,13 @@ use super::light_pipelines::{
 use super::{begin_hdr_rendering, Load, CLEAR_BLACK};
 use crate::access::{memory_barrier, transition, Contents, ImageAccess};
 use crate::context::Context;
+use crate::deferred_lighting::LightingTargets;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
 use crate::hi_stencil::HiStencilSurface;
-use crate::meshes::Meshes;
+use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
-use crate::targets::Targets;
 use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
@@ -29,7 +29,7 @@ use histencil_model::{
     DepthState, FaceStencil, FramePlan, Geometry, Pass, PassKind, PassState, Shader, StencilOp,
     Step,
 };
-use histencil_scene::{Light, LightKind};
+use histencil_scene::Light;
 
 /// The talk's pass group of a planned pass, for timings: `setup`, `mask-<brdf>`, `shade-<brdf>`
 /// (`-branching` for the uber shader, `-lut` for the table shader), `cleanup`, `zero-preserved`.
@@ -54,7 +54,7 @@ pub struct LightingPass<'a> {
     pub plan: &'a FramePlan,
     pub lights: &'a [Light],
     pub brdfs: &'a [BrdfId],
-    pub meshes: &'a Meshes,
+    pub volumes: &'a LightVolumes,
     pub pipelines: &'a LightPipelines,
     pub pipeline_layout: vk::PipelineLayout,
     /// Frame, G-buffer and hi-stencil sets, and the LUT set when shading from tables.
@@ -63,18 +63,20 @@ pub struct LightingPass<'a> {
     pub extent: vk::Extent2D,
     /// Count tile and fragment statistics (extra draws and atomics).
     pub count_stats: bool,
+    /// Clear the HDR target first (otherwise light adds onto it).
+    pub clear_hdr: bool,
 }
 
 /// Whether the HDR and depth-stencil attachments are bound. Hi-stencil writes, flushes and the
 /// preserved-bit copy happen outside rendering, so the lighting pass is split around them.
 struct Rendering {
     open: bool,
-    /// The HDR target was cleared by the first opening.
+    /// The HDR target needs no clear (done by the first opening, or not asked for).
     cleared: bool,
 }
 
 impl Rendering {
-    fn open(&mut self, pass: &LightingPass, targets: &mut Targets) {
+    fn open(&mut self, pass: &LightingPass, targets: &mut LightingTargets) {
         if self.open {
             return;
         }
@@ -83,7 +85,15 @@ impl Rendering {
         } else {
             Load::Clear(CLEAR_BLACK)
         };
-        begin_hdr_rendering(pass.ctx, pass.cmd, targets, pass.extent, hdr, Load::Keep);
+        let attachments = (&mut targets.hdr, &mut targets.depth_stencil);
+        begin_hdr_rendering(
+            pass.ctx,
+            pass.cmd,
+            attachments,
+            pass.extent,
+            hdr,
+            Load::Keep,
+        );
         self.open = true;
         self.cleared = true;
     }
@@ -112,7 +122,7 @@ impl LightingPass<'_> {
     /// Records the plan; with `timer`, a timestamp after every step.
     pub(crate) fn record(
         &self,
-        targets: &mut Targets,
+        targets: &mut LightingTargets,
         hi_stencil: &mut HiStencilSurface,
         mut timer: Option<&mut StepTimer>,
     ) -> Result<()> {
@@ -144,7 +154,7 @@ impl LightingPass<'_> {
         }
         let mut rendering = Rendering {
             open: false,
-            cleared: false,
+            cleared: !self.clear_hdr,
         };
         rendering.open(self, targets);
         if let Some(t) = timer.as_deref_mut() {
@@ -225,7 +235,7 @@ impl LightingPass<'_> {
     /// tile update of a hi-stencil write.
     fn record_pass(
         &self,
-        targets: &mut Targets,
+        targets: &mut LightingTargets,
         hi_stencil: &mut HiStencilSurface,
         rendering: &mut Rendering,
         step: usize,
@@ -345,10 +355,10 @@ impl LightingPass<'_> {
         apply(ctx, cmd, state);
         match geometry {
             Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
-            Geometry::Volume => match self.lights[push.light_index as usize].kind {
-                LightKind::Spot { .. } => self.meshes.light_cone.draw(ctx, cmd),
-                _ => self.meshes.light_sphere.draw(ctx, cmd),
-            },
+            Geometry::Volume => {
+                let kind = &self.lights[push.light_index as usize].kind;
+                self.volumes.draw(ctx, cmd, kind);
+            }
         }
     }
 }

@@ -6,10 +6,8 @@ pub mod light_pipelines;
 pub mod lighting;
 pub mod tonemap;
 
-use crate::access::{transition, Contents, ImageAccess};
+use crate::access::{transition, Contents, ImageAccess, ImageRef};
 use crate::context::Context;
-use crate::resources::Image;
-use crate::targets::Targets;
 use ash::vk;
 
 /// How a pass treats an attachment at the start of rendering.
@@ -19,12 +17,15 @@ pub(crate) enum Load {
     Keep,
 }
 
-pub(crate) fn color_attachment(image: &Image, load: Load) -> vk::RenderingAttachmentInfo<'static> {
+pub(crate) fn color_attachment(
+    image: &ImageRef,
+    load: Load,
+) -> vk::RenderingAttachmentInfo<'static> {
     attachment(image, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, load)
 }
 
 pub(crate) fn depth_stencil_attachment(
-    image: &Image,
+    image: &ImageRef,
     load: Load,
 ) -> vk::RenderingAttachmentInfo<'static> {
     attachment(
@@ -35,7 +36,7 @@ pub(crate) fn depth_stencil_attachment(
 }
 
 fn attachment(
-    image: &Image,
+    image: &ImageRef,
     layout: vk::ImageLayout,
     load: Load,
 ) -> vk::RenderingAttachmentInfo<'static> {
@@ -99,7 +100,7 @@ pub(crate) fn begin_rendering(
 pub(crate) fn begin_hdr_rendering(
     ctx: &Context,
     cmd: vk::CommandBuffer,
-    targets: &mut Targets,
+    (hdr_image, depth_stencil): (&mut ImageRef, &mut ImageRef),
     extent: vk::Extent2D,
     hdr: Load,
     depth: Load,
@@ -111,19 +112,18 @@ pub(crate) fn begin_hdr_rendering(
     transition(
         ctx,
         cmd,
-        &mut targets.hdr,
+        hdr_image,
         ImageAccess::ColorAttachment,
         contents(hdr),
     );
-    let depth_contents = contents(depth);
     transition(
         ctx,
         cmd,
-        &mut targets.depth_stencil,
+        depth_stencil,
         ImageAccess::DepthStencilAttachment,
-        depth_contents,
+        contents(depth),
     );
-    let colors = [color_attachment(&targets.hdr, hdr)];
-    let ds = depth_stencil_attachment(&targets.depth_stencil, depth);
+    let colors = [color_attachment(hdr_image, hdr)];
+    let ds = depth_stencil_attachment(depth_stencil, depth);
     begin_rendering(ctx, cmd, extent, &colors, Some(&ds));
 }

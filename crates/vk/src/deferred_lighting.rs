@@ -1,0 +1,550 @@
+//! The talk's lighting as a part an engine records into its own frame: [`DeferredLighting`]
+//! records a [`FramePlan`] into the caller's command buffer, against the caller's G-buffer,
+//! depth-stencil and HDR images ([`LightingTargets`]), with the camera and lights of that frame.
+//! It submits nothing and waits for nothing; [`crate::Renderer`] lights its frames through it
+//! too.
+//!
+//! Frames in flight: each of the `frames_in_flight` slots has its own uniform and light buffers
+//! and descriptor sets, written when a frame is recorded into that slot. The caller cycles the
+//! slots and records into one again only after the GPU finished the frame that last used it
+//! (the engine's own fence per frame in flight does this).
+//!
+//! The G-buffer contract (`shaders/include/gbuffer_write.glsl` writes it, `gbuffer.glsl` reads
+//! it): [`crate::GBUFFER_FORMATS`] in that order, each pixel's BRDF slot in the stencil's BRDF
+//! field with the culling bit clear ([`gbuffer_stencil_reference`]), standard or reversed depth as
+//! the [`ViewDesc`] says.
+
+use crate::access::ImageRef;
+use crate::context::Context;
+use crate::descriptors::{
+    create_pipeline_layout, create_set_layout, write_frame_set, write_sampled_images,
+    write_storage_buffers, FRAME_SET, GBUFFER_SET, GRAPHICS_STAGES, HI_STENCIL_SET, LUT_SET,
+};
+use crate::error::{Error, Result, VkCall};
+use crate::gpu_types::{FrameUniforms, GpuLight, PUSH_CONSTANT_BYTES};
+use crate::hi_stencil::HiStencilSurface;
+use crate::meshes::LightVolumes;
+use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
+use crate::passes::lighting::LightingPass;
+use crate::resources::Buffer;
+use crate::targets::GBUFFER_FORMATS;
+use crate::timing::{LightingBreakdown, StepTimer};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use histencil_brdf::BrdfId;
+use histencil_model::{FramePlan, StencilLayout, Step, TileStats, ViewDesc};
+use histencil_scene::Light;
+
+/// What a [`DeferredLighting`] is made for: fixed for its lifetime.
+#[derive(Clone, Debug)]
+pub struct LightingDesc {
+    /// Where the culling bit, the BRDF field and the engine's bits sit in the stencil.
+    pub layout: StencilLayout,
+    /// The BRDF of each stencil slot, in slot order.
+    pub brdfs: Vec<BrdfId>,
+    /// The size of every target.
+    pub extent: vk::Extent2D,
+    /// The depth-stencil target's format (a format with a stencil aspect).
+    pub depth_stencil_format: vk::Format,
+    /// The HDR target's format: any colour format the device blends into.
+    pub hdr_format: vk::Format,
+    /// How many frames the caller records before it waits for the oldest (at least 1).
+    pub frames_in_flight: u32,
+    /// The most lights a frame may carry.
+    pub max_lights: u32,
+}
+
+/// The caller's images a frame is lit in, each with its current state. Recording leaves every
+/// [`ImageRef::state`] as the recorded commands leave the image, for the caller's next barrier:
+/// the G-buffer images sampled by fragment shaders, the depth-stencil and HDR images attached.
+#[derive(Clone, Copy, Debug)]
+pub struct LightingTargets {
+    /// Albedo, normal-depth, material, in [`crate::GBUFFER_FORMATS`]; usage `SAMPLED`.
+    pub gbuffer: [ImageRef; 3],
+    /// The G-buffer pass's depth and stencil; usage `DEPTH_STENCIL_ATTACHMENT | TRANSFER_SRC`
+    /// (the hi-stencil emulation and 360-like save/restore copy the stencil out).
+    pub depth_stencil: ImageRef,
+    /// Where light accumulates; usage `COLOR_ATTACHMENT`.
+    pub hdr: ImageRef,
+}
+
+/// One frame's lighting.
+#[derive(Clone, Copy, Debug)]
+pub struct LightingFrame<'a> {
+    /// Which frame-in-flight slot's buffers and sets this frame uses (`< frames_in_flight`).
+    pub slot: u32,
+    /// The camera, as the plan was made with it.
+    pub view: &'a ViewDesc,
+    /// The frame's lights; the plan's light inputs index them.
+    pub lights: &'a [Light],
+    /// The plan, from [`histencil_model::plan_frame`] on the same lights and view.
+    pub plan: &'a FramePlan,
+    /// Clear the HDR target to black first; otherwise light adds onto its contents.
+    pub clear_hdr: bool,
+    /// Write a GPU timestamp after every step ([`DeferredLighting::step_timings`]).
+    pub timestamps: bool,
+}
+
+/// The per-frame-in-flight part: buffers the host writes at record time and the sets that point
+/// at them and at the frame's G-buffer.
+struct Slot {
+    uniforms: Buffer,
+    lights: Buffer,
+    frame_set: vk::DescriptorSet,
+    gbuffer_set: vk::DescriptorSet,
+    timer: Option<StepTimer>,
+}
+
+/// The lighting passes of the talk, recorded into an engine's frames.
+pub struct DeferredLighting<'c> {
+    ctx: &'c Context,
+    desc: LightingDesc,
+    /// Frame, G-buffer, hi-stencil and LUT set layouts: sets 0 to 3 of every light pipeline.
+    set_layouts: [vk::DescriptorSetLayout; 4],
+    pipeline_layout: vk::PipelineLayout,
+    pool: vk::DescriptorPool,
+    hi_stencil_set: vk::DescriptorSet,
+    lut_set: vk::DescriptorSet,
+    /// The LUT set is written once tables exist (`set_lut_tables`); binding an unwritten set
+    /// is invalid.
+    lut_written: bool,
+    slots: Vec<Slot>,
+    hi_stencil: Option<HiStencilSurface>,
+    volumes: Option<LightVolumes>,
+    pipelines: LightPipelines,
+}
+
+/// The stencil reference with which an engine's G-buffer pass writes BRDF slot `slot`, and the
+/// write mask: the BRDF field and the culling bit (which must be 0 when lighting starts), so the
+/// engine's own bits are left as they are. `None` for a slot the layout does not have.
+pub fn gbuffer_stencil_reference(layout: &StencilLayout, slot: u32) -> Option<(u8, u8)> {
+    (slot < layout.brdfs_in_use()).then(|| {
+        (
+            layout.brdf_reference(slot),
+            layout.brdf_mask() | layout.culling_mask(),
+        )
+    })
+}
+
+impl<'c> DeferredLighting<'c> {
+    /// Creates the pipeline layout, the light volumes, the hi-stencil emulation and every slot's
+    /// buffers and sets. Light pipelines are made when a plan first needs them
+    /// ([`DeferredLighting::prepare`]). A failure half way frees what was made.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] for a zero extent, a depth format without stencil, no frames in
+    /// flight or too many BRDFs for the layout; Vulkan and allocation errors.
+    pub fn new(ctx: &'c Context, desc: &LightingDesc) -> Result<Self> {
+        check_desc(desc)?;
+        let mut this = Self {
+            ctx,
+            desc: desc.clone(),
+            set_layouts: [vk::DescriptorSetLayout::null(); 4],
+            pipeline_layout: vk::PipelineLayout::null(),
+            pool: vk::DescriptorPool::null(),
+            hi_stencil_set: vk::DescriptorSet::null(),
+            lut_set: vk::DescriptorSet::null(),
+            lut_written: false,
+            slots: Vec::new(),
+            hi_stencil: None,
+            volumes: None,
+            pipelines: LightPipelines::new(
+                vk::PipelineLayout::null(),
+                desc.hdr_format,
+                desc.depth_stencil_format,
+            ),
+        };
+        // On an error `this` drops, destroying what exists so far.
+        this.create()?;
+        Ok(this)
+    }
+
+    fn create(&mut self) -> Result<()> {
+        let ctx = self.ctx;
+        let named = [
+            ("frame-set-layout", FRAME_SET),
+            ("gbuffer-set-layout", GBUFFER_SET),
+            ("hi-stencil-set-layout", HI_STENCIL_SET),
+            ("lut-set-layout", LUT_SET),
+        ];
+        for (i, (name, set)) in named.into_iter().enumerate() {
+            self.set_layouts[i] = create_set_layout(ctx, name, set, GRAPHICS_STAGES)?;
+        }
+        self.pipeline_layout = create_pipeline_layout(
+            ctx,
+            "lighting-pipeline-layout",
+            &self.set_layouts,
+            GRAPHICS_STAGES,
+            PUSH_CONSTANT_BYTES,
+        )?;
+        self.pipelines = LightPipelines::new(
+            self.pipeline_layout,
+            self.desc.hdr_format,
+            self.desc.depth_stencil_format,
+        );
+        self.volumes = Some(LightVolumes::new(ctx)?);
+        self.hi_stencil = Some(HiStencilSurface::new(ctx, self.desc.extent)?);
+
+        let slots = self.desc.frames_in_flight;
+        let storage_per_slot = 1;
+        let shared_storage = (HI_STENCIL_SET.len() + LUT_SET.len()) as u32;
+        let sizes = [
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::UNIFORM_BUFFER)
+                .descriptor_count(slots),
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(slots * storage_per_slot + shared_storage),
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::SAMPLED_IMAGE)
+                .descriptor_count(slots * GBUFFER_SET.len() as u32),
+        ];
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(2 * slots + 2)
+            .pool_sizes(&sizes);
+        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
+            .call("vkCreateDescriptorPool")?;
+        ctx.name(self.pool, "lighting-descriptor-pool");
+        let [frame_layout, gbuffer_layout, hi_stencil_layout, lut_layout] = self.set_layouts;
+        let mut layouts = vec![hi_stencil_layout, lut_layout];
+        for _ in 0..slots {
+            layouts.extend([frame_layout, gbuffer_layout]);
+        }
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(self.pool)
+            .set_layouts(&layouts);
+        let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+            .call("vkAllocateDescriptorSets")?;
+        self.hi_stencil_set = sets[0];
+        ctx.name(sets[0], "hi-stencil-set");
+        ctx.name(sets[1], "lut-set");
+        let hi = self.hi_stencil.as_ref().expect("made above");
+        write_storage_buffers(ctx, self.hi_stencil_set, &hi.light_set_buffers());
+        self.lut_set = sets[1];
+
+        let light_bytes = u64::from(self.desc.max_lights.max(1)) * size_of::<GpuLight>() as u64;
+        for (i, pair) in sets[2..].chunks(2).enumerate() {
+            let (frame_set, gbuffer_set) = (pair[0], pair[1]);
+            ctx.name(frame_set, &format!("lighting-frame-set-{i}"));
+            ctx.name(gbuffer_set, &format!("lighting-gbuffer-set-{i}"));
+            let uniforms = Buffer::new(
+                ctx,
+                &format!("lighting-uniforms-{i}"),
+                size_of::<FrameUniforms>() as u64,
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?;
+            let lights = Buffer::new(
+                ctx,
+                &format!("lighting-lights-{i}"),
+                light_bytes,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                MemoryLocation::CpuToGpu,
+            );
+            let lights = match lights {
+                Ok(l) => l,
+                Err(e) => {
+                    let mut uniforms = uniforms;
+                    uniforms.destroy(ctx);
+                    return Err(e);
+                }
+            };
+            write_frame_set(ctx, frame_set, uniforms.handle, lights.handle);
+            self.slots.push(Slot {
+                uniforms,
+                lights,
+                frame_set,
+                gbuffer_set,
+                timer: None,
+            });
+        }
+        Ok(())
+    }
+}
+
+fn bad(message: String) -> Error {
+    Error::BadFrame(message)
+}
+
+fn check_desc(desc: &LightingDesc) -> Result<()> {
+    let e = desc.extent;
+    if e.width == 0 || e.height == 0 {
+        return Err(bad(format!("a {}x{} lighting extent", e.width, e.height)));
+    }
+    if !crate::access::aspect_of(desc.depth_stencil_format).contains(vk::ImageAspectFlags::STENCIL)
+    {
+        return Err(bad(format!(
+            "depth format {:?} has no stencil for the BRDF ids",
+            desc.depth_stencil_format
+        )));
+    }
+    if desc.frames_in_flight == 0 {
+        return Err(bad("frames_in_flight must be at least 1".into()));
+    }
+    let slots = desc.layout.brdfs_in_use() as usize;
+    if desc.brdfs.len() > slots {
+        return Err(bad(format!(
+            "{} BRDFs for a stencil layout with {slots} BRDF slots",
+            desc.brdfs.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Checks one frame against the lighting's description: the slot, the light count, the plan's
+/// light indices and depth convention, and every target's extent and format.
+fn check_frame(
+    desc: &LightingDesc,
+    frame: &LightingFrame,
+    targets: &LightingTargets,
+) -> Result<()> {
+    if frame.slot >= desc.frames_in_flight {
+        return Err(bad(format!(
+            "slot {} of {} frames in flight",
+            frame.slot, desc.frames_in_flight
+        )));
+    }
+    if frame.lights.len() > desc.max_lights as usize {
+        return Err(bad(format!(
+            "{} lights, more than the {} this lighting was made for",
+            frame.lights.len(),
+            desc.max_lights
+        )));
+    }
+    if let Some(l) = frame
+        .plan
+        .lights
+        .iter()
+        .find(|l| l.input >= frame.lights.len())
+    {
+        return Err(bad(format!(
+            "the plan lights input {} of {} lights",
+            l.input,
+            frame.lights.len()
+        )));
+    }
+    if frame.plan.depth != frame.view.depth {
+        return Err(bad(format!(
+            "the plan is for {:?} depth, the view is {:?}",
+            frame.plan.depth, frame.view.depth
+        )));
+    }
+    let expect = |what: &str, image: &ImageRef, format: vk::Format| {
+        if image.extent != desc.extent {
+            return Err(bad(format!(
+                "{what} is {}x{}, the lighting {}x{}",
+                image.extent.width, image.extent.height, desc.extent.width, desc.extent.height
+            )));
+        }
+        if image.format != format {
+            return Err(bad(format!(
+                "{what} is {:?}, the lighting expects {format:?}",
+                image.format
+            )));
+        }
+        Ok(())
+    };
+    let names = [
+        "G-buffer albedo",
+        "G-buffer normal-depth",
+        "G-buffer material",
+    ];
+    for ((image, name), format) in targets.gbuffer.iter().zip(names).zip(GBUFFER_FORMATS) {
+        expect(name, image, format)?;
+    }
+    expect(
+        "the depth-stencil target",
+        &targets.depth_stencil,
+        desc.depth_stencil_format,
+    )?;
+    expect("the HDR target", &targets.hdr, desc.hdr_format)
+}
+
+impl DeferredLighting<'_> {
+    /// What this lighting was made for.
+    pub fn desc(&self) -> &LightingDesc {
+        &self.desc
+    }
+
+    /// Creates every light pipeline `plan` uses, so the first frame that needs them does not
+    /// compile them while recording.
+    pub fn prepare(&mut self, plan: &FramePlan) -> Result<()> {
+        self.prepare_for(plan, false, BrdfSource::Formula)
+    }
+
+    fn prepare_for(
+        &mut self,
+        plan: &FramePlan,
+        count_stats: bool,
+        source: BrdfSource,
+    ) -> Result<()> {
+        let (ctx, brdfs) = (self.ctx, &self.desc.brdfs);
+        prepare_pipelines(ctx, &mut self.pipelines, plan, brdfs, count_stats, source)
+    }
+
+    /// Light pipelines created so far.
+    pub fn pipeline_count(&self) -> usize {
+        self.pipelines.count()
+    }
+
+    /// Records `frame`'s lighting into `cmd` against `targets`, and leaves each target's state
+    /// as the commands leave the image. Outside any render pass; binds its own pipelines and
+    /// sets, sets the dynamic state it uses, and leaves the HDR and depth-stencil images
+    /// attached-ready.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] when the frame does not fit this lighting (see [`LightingFrame`]), or
+    /// the view's projection cannot be inverted per pixel; pipeline creation errors. Nothing is
+    /// recorded on an error.
+    ///
+    /// # Safety
+    /// - `cmd` is in the recording state, on a queue family with graphics, from the device of
+    ///   the context this lighting was made with.
+    /// - The images of `targets` are live, from that device, with the usages
+    ///   [`LightingTargets`] lists, and their `state`s are true when `cmd` executes: the layout
+    ///   each subresource is in, and the stages and accesses of the last commands before it that
+    ///   touched it (`ImageState::UNDEFINED` discards contents, so not for the G-buffer or
+    ///   depth-stencil).
+    /// - The GPU has finished every command buffer that recorded into `frame.slot` before;
+    ///   this call rewrites that slot's buffers and descriptor sets.
+    pub unsafe fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightingFrame,
+        targets: &mut LightingTargets,
+    ) -> Result<()> {
+        self.record_with(cmd, frame, targets, false, BrdfSource::Formula)
+    }
+
+    /// [`DeferredLighting::record`] with hi-stencil statistics and the BRDF source, for the
+    /// renderer's lab techniques.
+    pub(crate) fn record_with(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightingFrame,
+        targets: &mut LightingTargets,
+        count_stats: bool,
+        source: BrdfSource,
+    ) -> Result<()> {
+        check_frame(&self.desc, frame, targets)?;
+        let e = self.desc.extent;
+        let uniforms =
+            FrameUniforms::from_view(frame.view, e.width, e.height, frame.lights.len() as u32)
+                .map_err(|p| bad(p.to_string()))?;
+        if source == BrdfSource::Table && !self.lut_written {
+            return Err(Error::Unsupported(
+                "the LUT technique before its tables exist",
+            ));
+        }
+        self.prepare_for(frame.plan, count_stats, source)?;
+        let ctx = self.ctx;
+        let slot = &mut self.slots[frame.slot as usize];
+        if frame.timestamps {
+            let needed = frame.plan.steps.len() as u32 + 1;
+            if slot.timer.as_ref().is_none_or(|t| t.capacity() < needed) {
+                if let Some(mut old) = slot.timer.take() {
+                    old.destroy(ctx);
+                }
+                slot.timer = Some(StepTimer::new(ctx, needed.next_power_of_two())?);
+            }
+        }
+        slot.uniforms.write(bytemuck::bytes_of(&uniforms));
+        let gpu_lights: Vec<GpuLight> = frame.lights.iter().map(GpuLight::new).collect();
+        slot.lights.write(bytemuck::cast_slice(&gpu_lights));
+        write_sampled_images(ctx, slot.gbuffer_set, &targets.gbuffer.map(|g| g.view));
+        let mut sets = vec![slot.frame_set, slot.gbuffer_set, self.hi_stencil_set];
+        if source == BrdfSource::Table {
+            sets.push(self.lut_set);
+        }
+        let pass = LightingPass {
+            ctx,
+            cmd,
+            plan: frame.plan,
+            lights: frame.lights,
+            brdfs: &self.desc.brdfs,
+            volumes: self.volumes.as_ref().expect("made with the lighting"),
+            pipelines: &self.pipelines,
+            pipeline_layout: self.pipeline_layout,
+            sets: &sets,
+            brdf_source: source,
+            extent: self.desc.extent,
+            count_stats,
+            clear_hdr: frame.clear_hdr,
+        };
+        let timer = slot.timer.as_mut().filter(|_| frame.timestamps);
+        let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
+        pass.record(targets, hi_stencil, timer)
+    }
+
+    /// The per-step GPU times of the last frame recorded into `slot` with timestamps, once the
+    /// GPU has finished it (`None` when that frame had none). Waits for the query results.
+    pub fn step_timings(&self, slot: u32) -> Result<Option<LightingBreakdown>> {
+        match self.slots.get(slot as usize).and_then(|s| s.timer.as_ref()) {
+            Some(t) => Ok(Some(t.read(self.ctx)?)),
+            None => Ok(None),
+        }
+    }
+
+    /// The hi-stencil statistics of the last frame recorded with them, once the GPU finished it;
+    /// `flushes` from `plan`. Shared by all slots: for callers that finish a frame before the
+    /// next one counts.
+    pub(crate) fn tile_stats(&self, plan: &FramePlan) -> TileStats {
+        let hi = self.hi_stencil.as_ref().expect("made with the lighting");
+        TileStats {
+            flushes: plan
+                .steps
+                .iter()
+                .filter(|s| matches!(s, Step::FlushHiStencil))
+                .count() as u64,
+            ..hi.read_stats()
+        }
+    }
+
+    /// Points the LUT set at the tables' buffers (headers, values). The tables must outlive
+    /// every frame recorded with [`BrdfSource::Table`] after this.
+    pub(crate) fn set_lut_tables(&mut self, buffers: &[vk::Buffer; 2]) {
+        write_storage_buffers(self.ctx, self.lut_set, buffers);
+        self.lut_written = true;
+    }
+
+    pub(crate) fn pipeline_layout(&self) -> vk::PipelineLayout {
+        self.pipeline_layout
+    }
+
+    pub(crate) fn volumes(&self) -> &LightVolumes {
+        self.volumes.as_ref().expect("made with the lighting")
+    }
+}
+
+impl Drop for DeferredLighting<'_> {
+    /// Waits for the device to go idle (teardown only; recording never waits), then frees
+    /// everything, also after a creation that failed half way.
+    fn drop(&mut self) {
+        let ctx = self.ctx;
+        let d = &ctx.device;
+        unsafe {
+            let _ = d.device_wait_idle();
+        }
+        self.pipelines.destroy(ctx);
+        for slot in &mut self.slots {
+            slot.uniforms.destroy(ctx);
+            slot.lights.destroy(ctx);
+            if let Some(t) = slot.timer.as_mut() {
+                t.destroy(ctx);
+            }
+        }
+        if let Some(h) = self.hi_stencil.as_mut() {
+            h.destroy(ctx);
+        }
+        if let Some(v) = self.volumes.as_mut() {
+            v.destroy(ctx);
+        }
+        unsafe {
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_pipeline_layout(self.pipeline_layout, None);
+            for l in self.set_layouts {
+                d.destroy_descriptor_set_layout(l, None);
+            }
+        }
+    }
+}

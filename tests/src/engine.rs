@@ -1,0 +1,282 @@
+//! An engine played by a test: its own instance with the validation layer and synchronisation
+//! validation, its own messenger, device and gpu-allocator allocator, created from
+//! `histencil_vk::REQUIREMENTS` and lent to histencil through `Context::from_raw`.
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use histencil_vk::{BorrowedDevice, ValidationLog, REQUIREMENTS};
+use std::sync::{Arc, Mutex};
+
+/// The engine's side: what it created, in creation order.
+pub struct Engine {
+    _entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub debug: ash::ext::debug_utils::Instance,
+    pub messenger: vk::DebugUtilsMessengerEXT,
+    pub physical_device: vk::PhysicalDevice,
+    pub queue_family: u32,
+    pub device: ash::Device,
+    pub allocator: Arc<Mutex<Allocator>>,
+    pub log: Arc<ValidationLog>,
+}
+
+impl Engine {
+    /// Creates the instance, messenger, device and allocator.
+    pub fn start() -> Self {
+        let entry = unsafe { ash::Entry::load() }.expect("Vulkan loader");
+        let log = Arc::new(ValidationLog::default());
+        let app = vk::ApplicationInfo::default().api_version(REQUIREMENTS.api_version);
+        let layers = [c"VK_LAYER_KHRONOS_validation".as_ptr()];
+        let extensions = [
+            ash::ext::debug_utils::NAME.as_ptr(),
+            ash::ext::validation_features::NAME.as_ptr(),
+        ];
+        let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
+        // SAFETY: `log` lives in the engine until after the messenger is destroyed.
+        let messenger_info = unsafe { ValidationLog::messenger_create_info(&log) };
+        let mut on_create = messenger_info;
+        let info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions)
+            .push_next(&mut features)
+            .push_next(&mut on_create);
+        let instance = unsafe { entry.create_instance(&info, None) }.expect("instance");
+        let debug = ash::ext::debug_utils::Instance::new(&entry, &instance);
+        let messenger = unsafe { debug.create_debug_utils_messenger(&messenger_info, None) }
+            .expect("messenger");
+        let filter = std::env::var("HISTENCIL_DEVICE")
+            .unwrap_or_default()
+            .to_lowercase();
+        let (physical_device, queue_family) = unsafe { instance.enumerate_physical_devices() }
+            .unwrap()
+            .into_iter()
+            .filter(|&pd| {
+                let props = unsafe { instance.get_physical_device_properties(pd) };
+                let name = props.device_name_as_c_str().unwrap().to_string_lossy();
+                name.to_lowercase().contains(&filter)
+                    && unsafe { REQUIREMENTS.missing(&instance, pd) }.is_empty()
+            })
+            .find_map(|pd| {
+                (0..8)
+                    .find(|&f| unsafe { REQUIREMENTS.queue_family_fits(&instance, pd, f) })
+                    .map(|f| (pd, f))
+            })
+            .expect("a device that meets histencil's requirements");
+        let priorities = [1.0];
+        let queues = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let core = REQUIREMENTS.features();
+        let mut features13 = REQUIREMENTS.features13();
+        let info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queues)
+            .enabled_features(&core)
+            .push_next(&mut features13);
+        let device =
+            unsafe { instance.create_device(physical_device, &info, None) }.expect("device");
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .expect("allocator");
+        Self {
+            _entry: entry,
+            instance,
+            debug,
+            messenger,
+            physical_device,
+            queue_family,
+            device,
+            allocator: Arc::new(Mutex::new(allocator)),
+            log,
+        }
+    }
+
+    pub fn lend(&self, queue_family: u32) -> BorrowedDevice {
+        BorrowedDevice {
+            instance: self.instance.clone(),
+            device: self.device.clone(),
+            physical_device: self.physical_device,
+            queue_family,
+            queue: unsafe { self.device.get_device_queue(self.queue_family, 0) },
+            allocator: self.allocator.clone(),
+            debug_utils: true,
+            depth_stencil: None,
+        }
+    }
+
+    /// Destroys everything in reverse order; returns the messenger's log.
+    pub fn destroy(self) -> Arc<ValidationLog> {
+        let allocator = Arc::try_unwrap(self.allocator)
+            .unwrap_or_else(|_| panic!("histencil kept a reference to the engine's allocator"));
+        drop(allocator);
+        unsafe {
+            self.device.destroy_device(None);
+            self.debug
+                .destroy_debug_utils_messenger(self.messenger, None);
+            self.instance.destroy_instance(None);
+        }
+        self.log
+    }
+}
+
+/// An image the engine made with its own allocator, and one view over all its aspects.
+pub struct EngineImage {
+    pub image: vk::Image,
+    pub view: vk::ImageView,
+    pub format: vk::Format,
+    pub extent: vk::Extent2D,
+    allocation: gpu_allocator::vulkan::Allocation,
+}
+
+impl EngineImage {
+    /// As histencil sees it, in state `state`.
+    pub fn as_ref(&self, state: histencil_vk::ImageState) -> histencil_vk::ImageRef {
+        histencil_vk::ImageRef {
+            image: self.image,
+            view: self.view,
+            format: self.format,
+            extent: self.extent,
+            state,
+        }
+    }
+}
+
+/// A host-readable buffer the engine copies into.
+pub struct EngineBuffer {
+    pub buffer: vk::Buffer,
+    allocation: gpu_allocator::vulkan::Allocation,
+}
+
+impl EngineBuffer {
+    pub fn bytes(&self) -> &[u8] {
+        self.allocation.mapped_slice().expect("host visible")
+    }
+}
+
+impl Engine {
+    pub fn image(
+        &self,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+    ) -> EngineImage {
+        use gpu_allocator::vulkan::{AllocationCreateDesc, AllocationScheme};
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(usage);
+        let d = &self.device;
+        let image = unsafe { d.create_image(&info, None) }.expect("image");
+        let requirements = unsafe { d.get_image_memory_requirements(image) };
+        let allocation = self
+            .allocator
+            .lock()
+            .unwrap()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location: gpu_allocator::MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .expect("image memory");
+        unsafe { d.bind_image_memory(image, allocation.memory(), allocation.offset()) }
+            .expect("bind");
+        let aspect = histencil_vk::aspect_of(format);
+        let range = vk::ImageSubresourceRange::default()
+            .aspect_mask(aspect)
+            .level_count(1)
+            .layer_count(1);
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(range);
+        let view = unsafe { d.create_image_view(&view_info, None) }.expect("view");
+        EngineImage {
+            image,
+            view,
+            format,
+            extent,
+            allocation,
+        }
+    }
+
+    /// A command pool with one primary command buffer.
+    pub fn command_buffer(&self) -> (vk::CommandPool, vk::CommandBuffer) {
+        let d = &self.device;
+        let info = vk::CommandPoolCreateInfo::default().queue_family_index(self.queue_family);
+        let pool = unsafe { d.create_command_pool(&info, None) }.expect("command pool");
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .command_buffer_count(1);
+        let cmd = unsafe { d.allocate_command_buffers(&alloc) }.expect("command buffer")[0];
+        (pool, cmd)
+    }
+
+    pub fn free_image(&self, image: EngineImage) {
+        unsafe {
+            self.device.destroy_image_view(image.view, None);
+            self.device.destroy_image(image.image, None);
+        }
+        self.allocator
+            .lock()
+            .unwrap()
+            .free(image.allocation)
+            .expect("free");
+    }
+
+    pub fn readback_buffer(&self, size: u64) -> EngineBuffer {
+        use gpu_allocator::vulkan::{AllocationCreateDesc, AllocationScheme};
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(vk::BufferUsageFlags::TRANSFER_DST);
+        let buffer = unsafe { self.device.create_buffer(&info, None) }.expect("buffer");
+        let requirements = unsafe { self.device.get_buffer_memory_requirements(buffer) };
+        let allocation = self
+            .allocator
+            .lock()
+            .unwrap()
+            .allocate(&AllocationCreateDesc {
+                name: "engine-readback",
+                requirements,
+                location: gpu_allocator::MemoryLocation::GpuToCpu,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .expect("buffer memory");
+        unsafe {
+            self.device
+                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())
+        }
+        .expect("bind");
+        EngineBuffer { buffer, allocation }
+    }
+
+    pub fn free_buffer(&self, buffer: EngineBuffer) {
+        unsafe { self.device.destroy_buffer(buffer.buffer, None) };
+        self.allocator
+            .lock()
+            .unwrap()
+            .free(buffer.allocation)
+            .expect("free");
+    }
+}

@@ -1,0 +1,519 @@
+//! histencil's lighting recorded into an engine's frames: the test plays the engine (its own
+//! device, allocator, images, command pools and fences, two frames in flight), moves the lights
+//! every frame, plans each frame on plain data and records `DeferredLighting` into its own
+//! command buffers, against its own images handed in with their current state. Its last frame
+//! must equal histencil's Renderer lighting the same state, and the validation layer with
+//! synchronisation validation must see nothing, leak reports included.
+
+use ash::vk;
+use glam::Vec3;
+use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
+use histencil_tests::engine::{Engine, EngineImage};
+use histencil_vk::{
+    Backend, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame, LightingTargets,
+    Readback, Renderer, Technique, GBUFFER_FORMATS,
+};
+
+const WIDTH: u32 = 96;
+const HEIGHT: u32 = 64;
+const FRAMES: usize = 7;
+const IN_FLIGHT: usize = 2;
+
+/// The scene's lights at frame `f`: each circles its own position. Directions are unit vectors
+/// and ranges capped as the renderer's scene validation leaves them (`normalise_lights`).
+fn lights_at(scene: &histencil_scene::Scene, f: usize) -> Vec<histencil_scene::Light> {
+    let mut moved = scene.clone();
+    moved.lights = scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let angle = 0.7 * f as f32 + i as f32;
+            let offset = Vec3::new(angle.cos(), 0.0, angle.sin()) * 0.6;
+            histencil_scene::Light {
+                position: l.position + offset,
+                ..*l
+            }
+        })
+        .collect();
+    moved.normalise_lights();
+    moved.lights
+}
+
+/// One frame slot of the engine: its pool, command buffer and fence.
+struct Slot {
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+fn hdr_floats(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(2)
+        .map(|h| f16_to_f32(u16::from_le_bytes([h[0], h[1]])))
+        .collect()
+}
+
+/// IEEE half to single, exactly.
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exponent = i32::from((h >> 10) & 0x1F);
+    let mantissa = f32::from(h & 0x3FF);
+    match exponent {
+        0 => sign * mantissa * 2f32.powi(-24),
+        31 => sign * f32::INFINITY,
+        e => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+#[test]
+fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
+    let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
+    assert!(scene.lights.len() >= 4 && scene.brdfs_in_use().len() >= 3);
+    let engine = Engine::start();
+    let extent = vk::Extent2D {
+        width: WIDTH,
+        height: HEIGHT,
+    };
+    let engine_hdr_last;
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let ds_format = ctx.depth_stencil_format().vk();
+        let renderer = Renderer::new(&ctx, scene.clone(), WIDTH, HEIGHT).unwrap();
+        let layout = *renderer.stencil_layout();
+        let brdfs = renderer.brdfs().to_vec();
+        let mut lighting = DeferredLighting::new(
+            &ctx,
+            &LightingDesc {
+                layout,
+                brdfs: brdfs.clone(),
+                extent,
+                depth_stencil_format: ds_format,
+                hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+                frames_in_flight: IN_FLIGHT as u32,
+                max_lights: scene.lights.len() as u32,
+            },
+        )
+        .unwrap();
+
+        // The engine's images: its own usages (a superset of the contract's).
+        use vk::ImageUsageFlags as U;
+        let names = ["albedo", "normal-depth", "material"];
+        let gbuffer: Vec<EngineImage> = names
+            .iter()
+            .zip(GBUFFER_FORMATS)
+            .map(|(n, f)| engine.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+            .collect();
+        let depth = engine.image(
+            "depth",
+            ds_format,
+            extent,
+            U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
+        );
+        let hdr_format = vk::Format::R16G16B16A16_SFLOAT;
+        let hdr_usage = U::COLOR_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC;
+        let hdr = engine.image("hdr", hdr_format, extent, hdr_usage);
+        let readback = engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8);
+        let mut targets = LightingTargets {
+            gbuffer: [0, 1, 2].map(|i| gbuffer[i].as_ref(ImageState::UNDEFINED)),
+            depth_stencil: depth.as_ref(ImageState::UNDEFINED),
+            hdr: hdr.as_ref(ImageState::UNDEFINED),
+        };
+
+        let d = &engine.device;
+        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
+        let slots: Vec<Slot> = (0..IN_FLIGHT)
+            .map(|_| {
+                let (pool, cmd) = engine.command_buffer();
+                let signalled =
+                    vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+                let fence = unsafe { d.create_fence(&signalled, None) }.unwrap();
+                Slot { pool, cmd, fence }
+            })
+            .collect();
+
+        let view = scene.camera.view_desc(WIDTH as f32 / HEIGHT as f32);
+        let checked_view = View::new(&view).unwrap();
+        let brdf_bounds = scene.brdf_bounds(&brdfs);
+        let settings = PlanSettings {
+            technique: TechniqueChoice::Stencil,
+            caps: Backend::Ps3.platform().caps(),
+            flush: FlushPolicy::Auto,
+        };
+        let mut plans_differ = false;
+        let mut last_plan = None;
+        for f in 0..FRAMES {
+            let slot = &slots[f % IN_FLIGHT];
+            let lights = lights_at(&scene, f);
+            let shapes: Vec<_> = lights.iter().map(|l| l.shape()).collect();
+            let inputs = PlanInputs {
+                lights: &shapes,
+                brdf_bounds: &brdf_bounds,
+                view: &checked_view,
+            };
+            let plan = plan_frame(&layout, &inputs, &settings).unwrap();
+            plans_differ |= last_plan.as_ref().is_some_and(|p| *p != plan);
+            unsafe {
+                // The engine waits for the frame that last used this slot, nothing more.
+                d.wait_for_fences(&[slot.fence], true, u64::MAX).unwrap();
+                d.reset_fences(&[slot.fence]).unwrap();
+                d.reset_command_pool(slot.pool, vk::CommandPoolResetFlags::empty())
+                    .unwrap();
+                d.begin_command_buffer(
+                    slot.cmd,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .unwrap();
+                renderer.record_gbuffer(slot.cmd, &mut targets).unwrap();
+                // Odd frames: the engine clears HDR itself and lighting adds onto it, from a
+                // layout histencil did not choose.
+                let clear_hdr = f % 2 == 0;
+                if !clear_hdr {
+                    clear_color(d, slot.cmd, &mut targets.hdr);
+                }
+                let frame = LightingFrame {
+                    slot: (f % IN_FLIGHT) as u32,
+                    view: &view,
+                    lights: &lights,
+                    plan: &plan,
+                    clear_hdr,
+                    timestamps: f == FRAMES - 1,
+                };
+                lighting.record(slot.cmd, &frame, &mut targets).unwrap();
+                if f == FRAMES - 1 {
+                    copy_to_buffer(d, slot.cmd, &mut targets.hdr, readback.buffer);
+                }
+                d.end_command_buffer(slot.cmd).unwrap();
+                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
+                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+                d.queue_submit2(queue, &[submit], slot.fence).unwrap();
+            }
+            last_plan = Some(plan);
+        }
+        assert!(plans_differ, "the moving lights never changed the plan");
+        let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
+        unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        engine_hdr_last = hdr_floats(readback.bytes());
+        let timings = lighting
+            .step_timings(((FRAMES - 1) % IN_FLIGHT) as u32)
+            .unwrap()
+            .expect("the last frame was timed");
+        assert!(
+            timings.groups.iter().any(|(g, _)| g.starts_with("shade-")),
+            "{:?}",
+            timings.groups
+        );
+        assert!(
+            lighting
+                .step_timings((FRAMES % IN_FLIGHT) as u32)
+                .unwrap()
+                .is_none(),
+            "only the last frame asked for timestamps"
+        );
+
+        // histencil's own renderer, lighting the last frame's state: the same pixels, bit for
+        // bit.
+        scene.lights = lights_at(&scene, FRAMES - 1);
+        let mut reference = Renderer::new(&ctx, scene.clone(), WIDTH, HEIGHT).unwrap();
+        let technique = Technique::Stencil {
+            backend: Backend::Ps3,
+            flush: FlushPolicy::Auto,
+        };
+        let readback_hdr = Readback {
+            hdr: true,
+            ..Readback::NONE
+        };
+        let expected = reference.render(technique, readback_hdr).unwrap();
+        let expected = expected.images.hdr.unwrap().into_raw();
+        assert_eq!(expected.len(), engine_hdr_last.len());
+        let lit = expected.iter().filter(|v| **v > 0.0).count();
+        assert!(lit > expected.len() / 8, "the reference is mostly dark");
+        let differing = expected
+            .iter()
+            .zip(&engine_hdr_last)
+            .filter(|(e, a)| e.to_bits() != a.to_bits())
+            .count();
+        assert_eq!(differing, 0, "channels differ from the renderer's frame");
+
+        drop(reference);
+        drop(lighting);
+        drop(renderer);
+        unsafe {
+            for s in &slots {
+                d.destroy_fence(s.fence, None);
+                d.destroy_command_pool(s.pool, None);
+            }
+        }
+        for image in gbuffer.into_iter().chain([depth, hdr]) {
+            engine.free_image(image);
+        }
+        engine.free_buffer(readback);
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
+    }
+    engine.destroy().assert_clean();
+}
+
+/// The engine's own clear of its HDR image, tracked in the image's state.
+unsafe fn clear_color(d: &ash::Device, cmd: vk::CommandBuffer, image: &mut histencil_vk::ImageRef) {
+    let state = ImageState {
+        layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+        stage: vk::PipelineStageFlags2::CLEAR,
+        access: vk::AccessFlags2::TRANSFER_WRITE,
+    };
+    barrier(d, cmd, image, state, true);
+    let range = color_range();
+    let black = vk::ClearColorValue { float32: [0.0; 4] };
+    d.cmd_clear_color_image(cmd, image.image, state.layout, &black, &[range]);
+}
+
+unsafe fn copy_to_buffer(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut histencil_vk::ImageRef,
+    buffer: vk::Buffer,
+) {
+    let state = ImageState {
+        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        stage: vk::PipelineStageFlags2::COPY,
+        access: vk::AccessFlags2::TRANSFER_READ,
+    };
+    barrier(d, cmd, image, state, false);
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .layer_count(1),
+        )
+        .image_extent(vk::Extent3D {
+            width: image.extent.width,
+            height: image.extent.height,
+            depth: 1,
+        });
+    d.cmd_copy_image_to_buffer(cmd, image.image, state.layout, buffer, &[region]);
+    let host = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::COPY)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host));
+}
+
+fn color_range() -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange::default()
+        .aspect_mask(vk::ImageAspectFlags::COLOR)
+        .level_count(1)
+        .layer_count(1)
+}
+
+/// The engine's barrier from the image's tracked state to `next`.
+unsafe fn barrier(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut histencil_vk::ImageRef,
+    next: ImageState,
+    discard: bool,
+) {
+    let old = if discard {
+        vk::ImageLayout::UNDEFINED
+    } else {
+        image.state.layout
+    };
+    let b = [vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(image.state.stage)
+        .src_access_mask(image.state.access)
+        .dst_stage_mask(next.stage)
+        .dst_access_mask(next.access)
+        .old_layout(old)
+        .new_layout(next.layout)
+        .image(image.image)
+        .subresource_range(color_range())];
+    d.cmd_pipeline_barrier2(
+        cmd,
+        &vk::DependencyInfo::default().image_memory_barriers(&b),
+    );
+    image.state = next;
+}
+
+/// Every description and frame that does not fit is refused with `BadFrame` before anything is
+/// recorded (the command buffer ends empty and valid), one case per class of mistake.
+#[test]
+fn frames_that_do_not_fit_are_refused_before_recording() {
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
+    let engine = Engine::start();
+    let extent = vk::Extent2D {
+        width: 32,
+        height: 16,
+    };
+    {
+        // SAFETY: as in the frames-in-flight test.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let ds_format = ctx.depth_stencil_format().vk();
+        let renderer = Renderer::new(&ctx, scene.clone(), extent.width, extent.height).unwrap();
+        let layout = *renderer.stencil_layout();
+        let desc = LightingDesc {
+            layout,
+            brdfs: renderer.brdfs().to_vec(),
+            extent,
+            depth_stencil_format: ds_format,
+            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+            frames_in_flight: 2,
+            max_lights: scene.lights.len() as u32,
+        };
+        let bad_descs = [
+            LightingDesc {
+                extent: vk::Extent2D {
+                    width: 0,
+                    height: 16,
+                },
+                ..desc.clone()
+            },
+            LightingDesc {
+                depth_stencil_format: vk::Format::D32_SFLOAT,
+                ..desc.clone()
+            },
+            LightingDesc {
+                frames_in_flight: 0,
+                ..desc.clone()
+            },
+            LightingDesc {
+                brdfs: [desc.brdfs.clone(), desc.brdfs.clone()].concat(),
+                ..desc.clone()
+            },
+        ];
+        for bad in &bad_descs {
+            let err = DeferredLighting::new(&ctx, bad).err().expect("refused");
+            assert!(matches!(err, histencil_vk::Error::BadFrame(_)), "{err}");
+        }
+
+        let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();
+        use vk::ImageUsageFlags as U;
+        let gbuffer: Vec<EngineImage> = GBUFFER_FORMATS
+            .iter()
+            .map(|f| engine.image("g", *f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+            .collect();
+        let depth = engine.image("d", ds_format, extent, U::DEPTH_STENCIL_ATTACHMENT);
+        let hdr_format = vk::Format::R16G16B16A16_SFLOAT;
+        let hdr = engine.image("h", hdr_format, extent, U::COLOR_ATTACHMENT);
+        let small = engine.image(
+            "s",
+            hdr_format,
+            vk::Extent2D {
+                width: 8,
+                height: 8,
+            },
+            U::COLOR_ATTACHMENT,
+        );
+        let targets = LightingTargets {
+            gbuffer: [0, 1, 2].map(|i| gbuffer[i].as_ref(ImageState::UNDEFINED)),
+            depth_stencil: depth.as_ref(ImageState::UNDEFINED),
+            hdr: hdr.as_ref(ImageState::UNDEFINED),
+        };
+        let view = scene.camera.view_desc(2.0);
+        let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
+        let bounds = scene.brdf_bounds(renderer.brdfs());
+        let plan = plan_frame(
+            &layout,
+            &PlanInputs {
+                lights: &shapes,
+                brdf_bounds: &bounds,
+                view: &View::new(&view).unwrap(),
+            },
+            &PlanSettings {
+                technique: TechniqueChoice::Stencil,
+                caps: Backend::Native.platform().caps(),
+                flush: FlushPolicy::Auto,
+            },
+        )
+        .unwrap();
+        let frame = LightingFrame {
+            slot: 0,
+            view: &view,
+            lights: &scene.lights,
+            plan: &plan,
+            clear_hdr: true,
+            timestamps: false,
+        };
+        let reversed = histencil_model::ViewDesc {
+            depth: histencil_model::DepthConvention::Reversed,
+            ..view
+        };
+        let mut orthographic = view;
+        orthographic.view_to_clip[2][3] = 0.0;
+        orthographic.view_to_clip[3][3] = 1.0;
+        let few_lights = &scene.lights[..2];
+        let cases: Vec<(&str, LightingFrame, LightingTargets)> = vec![
+            ("slot", LightingFrame { slot: 2, ..frame }, targets),
+            (
+                "plan lights input",
+                LightingFrame {
+                    lights: few_lights,
+                    ..frame
+                },
+                targets,
+            ),
+            (
+                "depth",
+                LightingFrame {
+                    view: &reversed,
+                    ..frame
+                },
+                targets,
+            ),
+            (
+                "perspective",
+                LightingFrame {
+                    view: &orthographic,
+                    ..frame
+                },
+                targets,
+            ),
+            (
+                "is 8x8",
+                frame,
+                LightingTargets {
+                    hdr: small.as_ref(ImageState::UNDEFINED),
+                    ..targets
+                },
+            ),
+            (
+                "expects",
+                frame,
+                LightingTargets {
+                    gbuffer: [targets.gbuffer[1], targets.gbuffer[0], targets.gbuffer[2]],
+                    ..targets
+                },
+            ),
+        ];
+        let d = &engine.device;
+        unsafe {
+            let (pool, cmd) = engine.command_buffer();
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            for (expected, frame, mut targets) in cases {
+                let before = targets;
+                let err = lighting
+                    .record(cmd, &frame, &mut targets)
+                    .expect_err(expected);
+                assert!(
+                    matches!(err, histencil_vk::Error::BadFrame(_))
+                        && err.to_string().contains(expected),
+                    "{expected}: {err}"
+                );
+                assert_eq!(
+                    targets.hdr.state, before.hdr.state,
+                    "{expected}: state changed"
+                );
+            }
+            d.end_command_buffer(cmd).unwrap();
+            d.destroy_command_pool(pool, None);
+        }
+        drop(lighting);
+        drop(renderer);
+        for image in gbuffer.into_iter().chain([depth, hdr, small]) {
+            engine.free_image(image);
+        }
+    }
+    engine.destroy().assert_clean();
+}
