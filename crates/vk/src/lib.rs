@@ -58,6 +58,6 @@ pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
 pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
 pub use readback::{FrameImages, Readback};
-pub use renderer::{Backend, Frame, Renderer, Technique, DEFAULT_LUT_RESOLUTION};
+pub use renderer::{Backend, Frame, FrameDesc, Renderer, Technique, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
 pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown};

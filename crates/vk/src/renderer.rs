@@ -24,9 +24,10 @@ use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
-    plan_frame, CostModel, DepthConvention, FlushPolicy, Footprint, FramePlan, LightShape, Native,
-    PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like, SoftTarget, StencilBits,
-    StencilLayout, TalkFigures, TechniqueChoice, TileStats, View, ViewDesc, X360Like,
+    plan_frame, CostModel, DepthConvention, FarPlane, FlushPolicy, Footprint, FramePlan,
+    LightShape, Native, Perspective, PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like,
+    SoftTarget, StencilBits, StencilLayout, TalkFigures, TechniqueChoice, TileStats, View,
+    ViewDesc, X360Like,
 };
 use histencil_scene::Scene;
 
@@ -167,6 +168,32 @@ fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
         .iter()
         .position(|b| *b == id)
         .expect("brdfs_in_use lists every object's BRDF") as u32
+}
+
+/// One frame of the renderer: what to render and how, as one value (rather than settings that
+/// stick to the renderer).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameDesc {
+    pub technique: Technique,
+    /// Which images to copy back.
+    pub readback: Readback,
+    /// Which end of depth is near in the renderer's depth buffer: its G-buffer, forward and
+    /// alpha passes and the lighting plan follow it, as an engine's reversed-Z frame would.
+    pub depth: DepthConvention,
+    /// Project with the far plane at infinity (the camera's `far` unused).
+    pub infinite_far: bool,
+}
+
+impl FrameDesc {
+    /// `technique`'s frame with standard depth and the camera's far plane.
+    pub fn new(technique: Technique, readback: Readback) -> Self {
+        Self {
+            technique,
+            readback,
+            depth: DepthConvention::Standard,
+            infinite_far: false,
+        }
+    }
 }
 
 /// A rendered frame: its GPU timings, the images asked for, and the hi-stencil statistics when
@@ -538,10 +565,14 @@ impl<'c> Renderer<'c> {
     /// camera, with the BRDF slots it touches ([`FramePlan::lights`] says which scene light each
     /// planned light is).
     pub fn plan(&self, technique: Technique) -> Result<FramePlan> {
+        self.plan_in(technique, &self.view_desc())
+    }
+
+    fn plan_in(&self, technique: Technique, view: &ViewDesc) -> Result<FramePlan> {
         let Some(settings) = technique.plan_settings(|backend| self.cost_model(backend)) else {
-            return Ok(FramePlan::empty(DepthConvention::Standard));
+            return Ok(FramePlan::empty(view.depth));
         };
-        let view = View::new(&self.view_desc()).map_err(PlanError::from)?;
+        let view = View::new(view).map_err(PlanError::from)?;
         let shapes: Vec<LightShape> = self.scene.lights.iter().map(|l| l.shape()).collect();
         let brdf_bounds = self.scene.brdf_bounds(&self.brdfs);
         let inputs = PlanInputs {
@@ -552,21 +583,78 @@ impl<'c> Renderer<'c> {
         Ok(plan_frame(&self.stencil_layout, &inputs, &settings)?)
     }
 
-    /// The camera as the planner and the lighting take it.
+    /// The camera as the planner and the lighting take it, with standard depth and its own far
+    /// plane.
     fn view_desc(&self) -> ViewDesc {
         let aspect = self.extent.width as f32 / self.extent.height as f32;
         self.scene.camera.view_desc(aspect)
     }
 
+    /// The camera with depth stored as `depth` says, its far plane at infinity if asked.
+    fn view_desc_in(&self, depth: DepthConvention, infinite_far: bool) -> ViewDesc {
+        if depth == DepthConvention::Standard && !infinite_far {
+            return self.view_desc();
+        }
+        let c = &self.scene.camera;
+        Perspective {
+            eye: c.eye.into(),
+            target: c.target.into(),
+            up: c.up.into(),
+            fov_y_radians: c.fov_y_radians,
+            aspect: self.extent.width as f32 / self.extent.height as f32,
+            near: c.near,
+            far: if infinite_far {
+                FarPlane::Infinite
+            } else {
+                FarPlane::Finite(c.far)
+            },
+            depth,
+        }
+        .desc()
+    }
+
+    /// The mesh and alpha passes' uniforms for `view`: the camera's own (the forward reference's
+    /// eye and rays stay as they always were), with the projection and far depth of `view`.
+    fn uniforms(&self, view: &ViewDesc) -> Result<FrameUniforms> {
+        let (w, h) = (self.extent.width, self.extent.height);
+        let lights = self.scene.lights.len() as u32;
+        let camera = FrameUniforms::new(&self.scene.camera, w, h, lights);
+        if *view == self.view_desc() {
+            return Ok(camera);
+        }
+        let projected = FrameUniforms::from_view(view, w, h, lights)
+            .map_err(|p| crate::Error::BadFrame(p.to_string()))?;
+        Ok(FrameUniforms {
+            proj: projected.proj,
+            view_proj: projected.view_proj,
+            settings: projected.settings,
+            ..camera
+        })
+    }
+
     /// Renders one frame and waits for it. `readback` says which images to copy back.
     pub fn render(&mut self, technique: Technique, readback: Readback) -> Result<Frame> {
+        self.render_frame(&FrameDesc::new(technique, readback))
+    }
+
+    /// Renders the frame `desc` describes and waits for it.
+    pub fn render_frame(&mut self, desc: &FrameDesc) -> Result<Frame> {
+        let FrameDesc {
+            technique,
+            readback,
+            depth,
+            infinite_far,
+        } = *desc;
         // Only the deferred path has a G-buffer to read BRDF ids from.
         let readback = Readback {
             brdf_ids: readback.brdf_ids && technique != Technique::Forward,
             ..readback
         };
         let ctx = self.ctx;
-        let plan = self.plan(technique)?;
+        let view = self.view_desc_in(depth, infinite_far);
+        self.frame_uniforms
+            .write(bytemuck::bytes_of(&self.uniforms(&view)?));
+        let plan = self.plan_in(technique, &view)?;
         let count_stats = self.tile_stats && technique != Technique::Forward;
         let brdf_source = technique.brdf_source();
         if brdf_source == BrdfSource::Table {
@@ -578,13 +666,12 @@ impl<'c> Renderer<'c> {
         self.timestamps.begin_frame(ctx, cmd);
         match technique {
             Technique::Forward => {
-                self.record_geometry(true);
+                self.record_geometry(true, depth);
                 self.timestamps.mark(ctx, cmd, "forward");
             }
             _ => {
-                self.record_geometry(false);
+                self.record_geometry(false, depth);
                 self.timestamps.mark(ctx, cmd, "gbuffer");
-                let view = self.view_desc();
                 let frame = LightingFrame {
                     slot: 0,
                     view: &view,
@@ -612,8 +699,7 @@ impl<'c> Renderer<'c> {
                 meshes,
                 &mut self.targets,
                 frame_set,
-                self.alpha_mode,
-                self.extent,
+                (self.alpha_mode, self.extent, depth),
             );
             self.timestamps.mark(ctx, cmd, "alpha");
         }
@@ -680,18 +766,24 @@ impl<'c> Renderer<'c> {
     }
 
     /// Records the forward pass or the G-buffer pass into the renderer's targets.
-    fn record_geometry(&mut self, forward: bool) {
+    fn record_geometry(&mut self, forward: bool, depth: DepthConvention) {
         let cmd = self.cmd;
         let mut targets = self.targets.lighting();
         if forward {
-            self.geometry_pass(cmd, true).record_forward(&mut targets);
+            self.geometry_pass(cmd, true, depth)
+                .record_forward(&mut targets);
         } else {
-            self.record_gbuffer_into(cmd, &mut targets);
+            self.record_gbuffer_into(cmd, &mut targets, depth);
         }
         self.targets.lit(&targets);
     }
 
-    fn geometry_pass(&self, cmd: vk::CommandBuffer, forward: bool) -> GeometryPass<'_> {
+    fn geometry_pass(
+        &self,
+        cmd: vk::CommandBuffer,
+        forward: bool,
+        depth: DepthConvention,
+    ) -> GeometryPass<'_> {
         GeometryPass {
             ctx: self.ctx,
             cmd,
@@ -706,11 +798,17 @@ impl<'c> Renderer<'c> {
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
             material_indices: &self.object_materials,
+            depth,
         }
     }
 
-    fn record_gbuffer_into(&self, cmd: vk::CommandBuffer, targets: &mut LightingTargets) {
-        self.geometry_pass(cmd, false).record_gbuffer(
+    fn record_gbuffer_into(
+        &self,
+        cmd: vk::CommandBuffer,
+        targets: &mut LightingTargets,
+        depth: DepthConvention,
+    ) {
+        self.geometry_pass(cmd, false, depth).record_gbuffer(
             targets,
             &self.stencil_layout,
             &self.object_slots,
@@ -750,7 +848,7 @@ impl<'c> Renderer<'c> {
                 )));
             }
         }
-        self.record_gbuffer_into(cmd, targets);
+        self.record_gbuffer_into(cmd, targets, DepthConvention::Standard);
         Ok(())
     }
 
@@ -772,7 +870,7 @@ impl<'c> Renderer<'c> {
         let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
         let result = (|| {
             let cmd = self.begin_commands()?;
-            self.record_geometry(false);
+            self.record_geometry(false, DepthConvention::Standard);
             let image = &mut self.targets.depth_stencil;
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);

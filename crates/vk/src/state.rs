@@ -7,7 +7,9 @@
 
 use crate::context::Context;
 use ash::vk;
-use histencil_model::{CompareOp, CullMode, DepthState, FaceStencil, PassState, StencilOp};
+use histencil_model::{
+    CompareOp, CullMode, DepthConvention, DepthState, FaceStencil, PassState, StencilOp,
+};
 
 pub fn compare_op(op: CompareOp) -> vk::CompareOp {
     match op {
@@ -61,6 +63,17 @@ pub const FULLSCREEN: PassState = PassState {
     color_write: true,
     hi_stencil: None,
 };
+
+/// `state`, written for standard depth, with its depth compare as `depth` spells it.
+pub fn oriented(state: PassState, depth: DepthConvention) -> PassState {
+    PassState {
+        depth: DepthState {
+            compare: state.depth.compare.map(|op| depth.orient(op)),
+            ..state.depth
+        },
+        ..state
+    }
+}
 
 /// `state` with `face` on both faces.
 pub fn with_stencil(state: PassState, face: FaceStencil) -> PassState {

@@ -24,14 +24,14 @@ use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::{Buffer, Image};
 use crate::shader_consts::ALPHA_MODES;
 use crate::shaders;
-use crate::state::{apply, FULLSCREEN};
+use crate::state::{apply, oriented, FULLSCREEN};
 use crate::targets::{Targets, HDR_FORMAT};
 use ash::vk;
 use gpu::{entity_lights, entity_records, AlphaDrawPush};
 use histencil_alpha::{
     back_to_front, plan_layout, sprite_vertices, EntityKey, LightmapLayout, SpriteVertex,
 };
-use histencil_model::{CompareOp, CullMode, DepthState, PassState};
+use histencil_model::{CompareOp, CullMode, DepthConvention, DepthState, PassState};
 use histencil_scene::Scene;
 
 /// How the alpha pass lights translucent objects and particles.
@@ -522,8 +522,7 @@ impl AlphaLighting {
         meshes: &Meshes,
         targets: &mut Targets,
         frame_set: vk::DescriptorSet,
-        mode: AlphaMode,
-        extent: vk::Extent2D,
+        (mode, extent, depth): (AlphaMode, vk::Extent2D, DepthConvention),
     ) {
         ctx.begin_label(cmd, "alpha");
         self.bind_sets(ctx, cmd, frame_set);
@@ -565,7 +564,7 @@ impl AlphaLighting {
                             self.object_pipeline,
                         );
                     }
-                    apply(ctx, cmd, &ALPHA_OBJECTS);
+                    apply(ctx, cmd, &oriented(ALPHA_OBJECTS, depth));
                     let push = AlphaDrawPush {
                         entity: i as u32,
                         mode: mode.code(),
@@ -584,7 +583,7 @@ impl AlphaLighting {
                         );
                         d.cmd_bind_vertex_buffers(cmd, 0, &[self.sprites.handle], &[0]);
                     }
-                    apply(ctx, cmd, &PARTICLES);
+                    apply(ctx, cmd, &oriented(PARTICLES, depth));
                     let push = AlphaDrawPush {
                         entity: (objects + i) as u32,
                         mode: mode.code(),

@@ -2,17 +2,17 @@
 //! the forward reference (every object lit by every light, per pixel).
 
 use super::{
-    begin_hdr_rendering, begin_rendering, color_attachment, depth_stencil_attachment, Load,
-    CLEAR_BLACK, CLEAR_DEPTH_STENCIL,
+    begin_hdr_rendering, begin_rendering, clear_depth_stencil, color_attachment,
+    depth_stencil_attachment, Load, CLEAR_BLACK,
 };
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::deferred_lighting::LightingTargets;
 use crate::gpu_types::DrawPush;
 use crate::meshes::Meshes;
-use crate::state::{apply, with_stencil, OPAQUE};
+use crate::state::{apply, oriented, with_stencil, OPAQUE};
 use ash::vk;
-use histencil_model::{FaceStencil, PassState, StencilLayout, StencilOp};
+use histencil_model::{DepthConvention, FaceStencil, PassState, StencilLayout, StencilOp};
 use histencil_scene::Scene;
 
 pub struct GeometryPass<'a> {
@@ -26,6 +26,8 @@ pub struct GeometryPass<'a> {
     pub extent: vk::Extent2D,
     /// Each object's material index (its LUT table), stored in the G-buffer.
     pub material_indices: &'a [u32],
+    /// Which end of depth is near: the depth test and the clear follow it.
+    pub depth: DepthConvention,
 }
 
 /// The stencil state with which the G-buffer pass writes `slot` (a BRDF's index among those in
@@ -116,12 +118,13 @@ impl GeometryPass<'_> {
             .zip(clears)
             .map(|(i, clear)| color_attachment(i, Load::Clear(clear)))
             .collect();
-        let ds = depth_stencil_attachment(&targets.depth_stencil, Load::Clear(CLEAR_DEPTH_STENCIL));
+        let clear = Load::Clear(clear_depth_stencil(self.depth));
+        let ds = depth_stencil_attachment(&targets.depth_stencil, clear);
         begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
         self.draw_objects(
             |i| match gbuffer_stencil(layout, slots[i], preserved_pattern) {
-                Some(s) => with_stencil(OPAQUE, s),
-                None => OPAQUE,
+                Some(s) => with_stencil(oriented(OPAQUE, self.depth), s),
+                None => oriented(OPAQUE, self.depth),
             },
         );
         unsafe { ctx.device.cmd_end_rendering(cmd) };
@@ -138,9 +141,9 @@ impl GeometryPass<'_> {
             (&mut targets.hdr, &mut targets.depth_stencil),
             self.extent,
             Load::Clear(CLEAR_BLACK),
-            Load::Clear(CLEAR_DEPTH_STENCIL),
+            Load::Clear(clear_depth_stencil(self.depth)),
         );
-        self.draw_objects(|_| OPAQUE);
+        self.draw_objects(|_| oriented(OPAQUE, self.depth));
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }

@@ -9,6 +9,7 @@ pub mod tonemap;
 use crate::access::{transition, Contents, ImageAccess, ImageRef};
 use crate::context::Context;
 use ash::vk;
+use histencil_model::DepthConvention;
 
 /// How a pass treats an attachment at the start of rendering.
 #[derive(Clone, Copy)]
@@ -56,12 +57,15 @@ pub(crate) const CLEAR_BLACK: vk::ClearValue = vk::ClearValue {
     color: vk::ClearColorValue { float32: [0.0; 4] },
 };
 
-pub(crate) const CLEAR_DEPTH_STENCIL: vk::ClearValue = vk::ClearValue {
-    depth_stencil: vk::ClearDepthStencilValue {
-        depth: 1.0,
-        stencil: 0,
-    },
-};
+/// The depth-stencil clear: the far plane's depth, stencil 0.
+pub(crate) fn clear_depth_stencil(depth: DepthConvention) -> vk::ClearValue {
+    vk::ClearValue {
+        depth_stencil: vk::ClearDepthStencilValue {
+            depth: depth.far(),
+            stencil: 0,
+        },
+    }
+}
 
 /// Begins dynamic rendering over the whole `extent` and sets viewport and scissor.
 pub(crate) fn begin_rendering(
