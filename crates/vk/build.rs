@@ -1,7 +1,13 @@
-//! Compiles every GLSL stage under `shaders/` to SPIR-V with shaderc, validates each module with
-//! naga, and writes `shaders.rs` (one `include_bytes!` per module) into OUT_DIR. SPIR-V never
-//! enters git. Shared code lives in `shaders/include`; `generated.glsl` carries the constants that
-//! Rust owns (BRDF ids from histencil-brdf, light kinds from src/shader_consts.rs).
+//! Compiles every GLSL stage under `shaders/` to SPIR-V with `glslc` (shaderc's compiler, run as a
+//! program), validates each module with naga, and writes `shaders.rs` (one `include_bytes!` per
+//! module) into OUT_DIR. SPIR-V never enters git. Shared code lives in `shaders/include`;
+//! `generated.glsl` carries the constants that Rust owns (BRDF ids from histencil-brdf, light
+//! kinds from src/shader_consts.rs).
+//!
+//! Why a program and not the shaderc crate: linking shaderc into a build script needs
+//! per-distribution link flags (Debian 12's libshaderc.so is under-linked), which cargo only
+//! takes from a `.cargo/config.toml` that a crate depending on histencil-vk would have to copy.
+//! Running `glslc` links nothing, so an engine's workspace builds histencil-vk as it is.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -61,12 +67,44 @@ fn generated_glsl() -> String {
     s + "#endif\n"
 }
 
-fn stage_of(path: &Path) -> Option<shaderc::ShaderKind> {
-    match path.extension()?.to_str()? {
-        "vert" => Some(shaderc::ShaderKind::Vertex),
-        "frag" => Some(shaderc::ShaderKind::Fragment),
-        "comp" => Some(shaderc::ShaderKind::Compute),
-        _ => None,
+fn is_stage(path: &Path) -> bool {
+    matches!(
+        path.extension().and_then(|e| e.to_str()),
+        Some("vert" | "frag" | "comp")
+    )
+}
+
+/// The `glslc` to run: `HISTENCIL_GLSLC`, or the one on `PATH`.
+fn glslc() -> PathBuf {
+    println!("cargo:rerun-if-env-changed=HISTENCIL_GLSLC");
+    std::env::var_os("HISTENCIL_GLSLC")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("glslc"))
+}
+
+/// Compiles `path` to `out` with the options the renderer's shaders are written for.
+fn compile(glslc: &Path, path: &Path, includes: &[&Path], out: &Path) {
+    let mut command = std::process::Command::new(glslc);
+    // Vulkan 1.3 semantics, SPIR-V 1.3: from 1.4 glslang copies structs out of buffers with
+    // OpCopyLogical, which naga's SPIR-V front end does not parse. Nothing here needs 1.4+.
+    command.args(["--target-env=vulkan1.3", "--target-spv=spv1.3", "-O0", "-Werror"]);
+    for dir in includes {
+        command.arg(format!("-I{}", dir.display()));
+    }
+    command.arg(path).arg("-o").arg(out);
+    let output = command.output().unwrap_or_else(|e| {
+        panic!(
+            "histencil-vk compiles its shaders with glslc, which could not be run ({e}). \
+             Install it (Debian and Ubuntu: `apt install glslc`; elsewhere the Vulkan SDK) \
+             or point HISTENCIL_GLSLC at it."
+        )
+    });
+    if !output.status.success() {
+        panic!(
+            "glslc failed on {}:\n{}",
+            path.display(),
+            String::from_utf8_lossy(&output.stderr)
+        );
     }
 }
 
@@ -98,11 +136,11 @@ fn main() {
     let generated = generated_glsl();
     std::fs::write(out_dir.join("generated.glsl"), &generated).unwrap();
 
-    let compiler = shaderc::Compiler::new().expect("shaderc compiler");
+    let glslc = glslc();
     let mut sources: Vec<PathBuf> = std::fs::read_dir(&shader_dir)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| stage_of(p).is_some())
+        .filter(|p| is_stage(p))
         .collect();
     sources.sort();
     for entry in std::fs::read_dir(&include_dir).unwrap() {
@@ -114,47 +152,12 @@ fn main() {
     for path in &sources {
         println!("cargo:rerun-if-changed={}", path.display());
         let file_name = path.file_name().unwrap().to_str().unwrap().to_owned();
-        let source = std::fs::read_to_string(path).unwrap();
-        let mut options = shaderc::CompileOptions::new().unwrap();
-        options.set_target_env(
-            shaderc::TargetEnv::Vulkan,
-            shaderc::EnvVersion::Vulkan1_3 as u32,
-        );
-        // SPIR-V 1.3: from 1.4 glslang copies structs out of buffers with OpCopyLogical, which
-        // naga's SPIR-V front end does not parse. Nothing here needs 1.4+.
-        options.set_target_spirv(shaderc::SpirvVersion::V1_3);
-        options.set_optimization_level(shaderc::OptimizationLevel::Zero);
-        options.set_warnings_as_errors();
-        let include_dir = include_dir.clone();
-        let generated = generated.clone();
-        options.set_include_callback(move |requested, _kind, _from, _depth| {
-            if requested == "generated.glsl" {
-                return Ok(shaderc::ResolvedInclude {
-                    resolved_name: "generated.glsl".into(),
-                    content: generated.clone(),
-                });
-            }
-            let p = include_dir.join(requested);
-            std::fs::read_to_string(&p)
-                .map(|content| shaderc::ResolvedInclude {
-                    resolved_name: p.display().to_string(),
-                    content,
-                })
-                .map_err(|e| format!("{}: {e}", p.display()))
-        });
-        let artifact = compiler
-            .compile_into_spirv(
-                &source,
-                stage_of(path).unwrap(),
-                &file_name,
-                "main",
-                Some(&options),
-            )
-            .unwrap_or_else(|e| panic!("shaderc failed on {file_name}:\n{e}"));
-        let spirv = artifact.as_binary_u8();
         let spv_name = format!("{file_name}.spv");
-        std::fs::write(out_dir.join(&spv_name), spirv).unwrap();
-        validate_with_naga(&file_name, spirv);
+        let spv_path = out_dir.join(&spv_name);
+        // generated.glsl sits in OUT_DIR.
+        compile(&glslc, path, &[&include_dir, &out_dir], &spv_path);
+        let spirv = std::fs::read(&spv_path).unwrap();
+        validate_with_naga(&file_name, &spirv);
         let const_name = file_name.replace('.', "_").to_uppercase();
         writeln!(
             table,
