@@ -131,6 +131,9 @@ fn main() {
     let include_dir = shader_dir.join("include");
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     println!("cargo:rerun-if-changed={}", shader_dir.display());
+    // For dependents' build scripts: DEP_HISTENCIL_GLSL_INCLUDE.
+    let include_dir_abs = include_dir.canonicalize().unwrap_or_else(|_| include_dir.clone());
+    println!("cargo:include={}", include_dir_abs.display());
     println!("cargo:rerun-if-changed=src/shader_consts.rs");
 
     let generated = generated_glsl();

@@ -1,0 +1,339 @@
+//! The engine's own Vulkan: instance with the validation layer and synchronisation validation, a
+//! messenger that counts what it reports, a device made with what histencil requires
+//! (`histencil_vk::REQUIREMENTS`), a gpu-allocator allocator, and images and buffers from it.
+
+use ash::vk;
+use gpu_allocator::vulkan::{
+    Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc,
+};
+use gpu_allocator::MemoryLocation;
+use histencil_vk::{
+    aspect_of, BorrowedDevice, DepthStencilFormat, ImageRef, ImageState, REQUIREMENTS,
+};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// Validation errors and warnings seen so far.
+pub static MESSAGES: AtomicUsize = AtomicUsize::new(0);
+
+unsafe extern "system" fn on_message(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    _user: *mut std::ffi::c_void,
+) -> vk::Bool32 {
+    use vk::DebugUtilsMessageSeverityFlagsEXT as S;
+    if severity.intersects(S::ERROR | S::WARNING) {
+        MESSAGES.fetch_add(1, Ordering::SeqCst);
+        let text = unsafe { (*data).message_as_c_str() }
+            .map(|m| m.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        eprintln!("validation: {text}");
+    }
+    vk::FALSE
+}
+
+pub struct Gpu {
+    _entry: ash::Entry,
+    pub instance: ash::Instance,
+    debug: ash::ext::debug_utils::Instance,
+    messenger: vk::DebugUtilsMessengerEXT,
+    pub physical_device: vk::PhysicalDevice,
+    pub queue_family: u32,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+    pub allocator: Arc<Mutex<Allocator>>,
+}
+
+impl Gpu {
+    pub fn new() -> Self {
+        let entry = unsafe { ash::Entry::load() }.expect("the Vulkan loader");
+        let app = vk::ApplicationInfo::default().api_version(REQUIREMENTS.api_version);
+        let layers = [c"VK_LAYER_KHRONOS_validation".as_ptr()];
+        let extensions = [
+            ash::ext::debug_utils::NAME.as_ptr(),
+            ash::ext::validation_features::NAME.as_ptr(),
+        ];
+        let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
+        let messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(
+                vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                    | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+            )
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(on_message));
+        let mut on_create = messenger_info;
+        let info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions)
+            .push_next(&mut features)
+            .push_next(&mut on_create);
+        let instance = unsafe { entry.create_instance(&info, None) }.expect("instance");
+        let debug = ash::ext::debug_utils::Instance::new(&entry, &instance);
+        let messenger = unsafe { debug.create_debug_utils_messenger(&messenger_info, None) }
+            .expect("messenger");
+        let filter = std::env::var("HISTENCIL_DEVICE")
+            .unwrap_or_default()
+            .to_lowercase();
+        let (physical_device, queue_family) = unsafe { instance.enumerate_physical_devices() }
+            .expect("devices")
+            .into_iter()
+            .filter(|&pd| {
+                let props = unsafe { instance.get_physical_device_properties(pd) };
+                let name = props.device_name_as_c_str().unwrap().to_string_lossy();
+                name.to_lowercase().contains(&filter)
+                    && unsafe { REQUIREMENTS.missing(&instance, pd) }.is_empty()
+            })
+            .find_map(|pd| {
+                let families =
+                    unsafe { instance.get_physical_device_queue_family_properties(pd) }.len();
+                (0..families as u32)
+                    .find(|&f| unsafe { REQUIREMENTS.queue_family_fits(&instance, pd, f) })
+                    .map(|f| (pd, f))
+            })
+            .expect("a Vulkan 1.3 device with what histencil requires");
+        let priorities = [1.0];
+        let queues = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let core = REQUIREMENTS.features();
+        let mut features13 = REQUIREMENTS.features13();
+        let device_extensions: Vec<_> = REQUIREMENTS
+            .device_extensions
+            .iter()
+            .map(|e| e.as_ptr())
+            .collect();
+        let info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queues)
+            .enabled_extension_names(&device_extensions)
+            .enabled_features(&core)
+            .push_next(&mut features13);
+        let device =
+            unsafe { instance.create_device(physical_device, &info, None) }.expect("device");
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .expect("allocator");
+        Self {
+            _entry: entry,
+            instance,
+            debug,
+            messenger,
+            physical_device,
+            queue_family,
+            device,
+            queue,
+            allocator: Arc::new(Mutex::new(allocator)),
+        }
+    }
+
+    /// The device as histencil borrows it.
+    pub fn lend(&self) -> BorrowedDevice {
+        BorrowedDevice {
+            instance: self.instance.clone(),
+            device: self.device.clone(),
+            physical_device: self.physical_device,
+            queue_family: self.queue_family,
+            queue: self.queue,
+            allocator: self.allocator.clone(),
+            debug_utils: true,
+            depth_stencil: Some(DepthStencilFormat::D32S8),
+        }
+    }
+
+    fn allocate(
+        &self,
+        name: &str,
+        requirements: vk::MemoryRequirements,
+        location: MemoryLocation,
+        linear: bool,
+    ) -> Allocation {
+        self.allocator
+            .lock()
+            .unwrap()
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
+            .expect("memory")
+    }
+
+    pub fn image(
+        &self,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+    ) -> Image {
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(usage);
+        let d = &self.device;
+        let image = unsafe { d.create_image(&info, None) }.expect("image");
+        let allocation = self.allocate(
+            name,
+            unsafe { d.get_image_memory_requirements(image) },
+            MemoryLocation::GpuOnly,
+            false,
+        );
+        unsafe { d.bind_image_memory(image, allocation.memory(), allocation.offset()) }
+            .expect("bind");
+        let range = vk::ImageSubresourceRange::default()
+            .aspect_mask(aspect_of(format))
+            .level_count(1)
+            .layer_count(1);
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(range);
+        let view = unsafe { d.create_image_view(&view_info, None) }.expect("view");
+        Image {
+            target: ImageRef {
+                image,
+                view,
+                format,
+                extent,
+                state: ImageState::UNDEFINED,
+            },
+            allocation,
+        }
+    }
+
+    pub fn buffer(
+        &self,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Buffer {
+        let info = vk::BufferCreateInfo::default().size(size).usage(usage);
+        let buffer = unsafe { self.device.create_buffer(&info, None) }.expect("buffer");
+        let requirements = unsafe { self.device.get_buffer_memory_requirements(buffer) };
+        let allocation = self.allocate(name, requirements, location, true);
+        unsafe {
+            self.device
+                .bind_buffer_memory(buffer, allocation.memory(), allocation.offset())
+        }
+        .expect("bind");
+        Buffer { buffer, allocation }
+    }
+
+    pub fn free_image(&self, image: Image) {
+        unsafe {
+            self.device.destroy_image_view(image.target.view, None);
+            self.device.destroy_image(image.target.image, None);
+        }
+        self.allocator
+            .lock()
+            .unwrap()
+            .free(image.allocation)
+            .expect("free");
+    }
+
+    pub fn free_buffer(&self, buffer: Buffer) {
+        unsafe { self.device.destroy_buffer(buffer.buffer, None) };
+        self.allocator
+            .lock()
+            .unwrap()
+            .free(buffer.allocation)
+            .expect("free");
+    }
+
+    /// Destroys the allocator, device, messenger and instance, in that order.
+    pub fn destroy(self) {
+        let allocator = Arc::try_unwrap(self.allocator)
+            .unwrap_or_else(|_| panic!("someone still holds the allocator"));
+        drop(allocator);
+        unsafe {
+            self.device.destroy_device(None);
+            self.debug
+                .destroy_debug_utils_messenger(self.messenger, None);
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// An engine image: its memory, and histencil's view of it with the state the engine tracks.
+pub struct Image {
+    pub target: ImageRef,
+    allocation: Allocation,
+}
+
+pub struct Buffer {
+    pub buffer: vk::Buffer,
+    allocation: Allocation,
+}
+
+impl Buffer {
+    pub fn bytes(&self) -> &[u8] {
+        self.allocation.mapped_slice().expect("host visible")
+    }
+
+    pub fn write(&mut self, bytes: &[u8]) {
+        self.allocation.mapped_slice_mut().expect("host visible")[..bytes.len()]
+            .copy_from_slice(bytes);
+    }
+}
+
+/// The engine's barrier: from the image's tracked state to `next`, contents kept unless
+/// `discard`.
+pub fn barrier(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut ImageRef,
+    next: ImageState,
+    discard: bool,
+) {
+    let old = if discard {
+        vk::ImageLayout::UNDEFINED
+    } else {
+        image.state.layout
+    };
+    let range = vk::ImageSubresourceRange::default()
+        .aspect_mask(image.aspect())
+        .level_count(1)
+        .layer_count(1);
+    let b = [vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(image.state.stage)
+        .src_access_mask(image.state.access)
+        .dst_stage_mask(next.stage)
+        .dst_access_mask(next.access)
+        .old_layout(old)
+        .new_layout(next.layout)
+        .image(image.image)
+        .subresource_range(range)];
+    unsafe {
+        device.cmd_pipeline_barrier2(
+            cmd,
+            &vk::DependencyInfo::default().image_memory_barriers(&b),
+        )
+    };
+    image.state = next;
+}

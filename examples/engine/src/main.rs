@@ -1,0 +1,454 @@
+//! An engine that adopts histencil's lighting. It owns everything: instance, device, allocator
+//! (`device.rs`), its world (`world.rs`), its G-buffer pass and shaders (`gbuffer.rs`), a
+//! reversed-Z D32S8 depth buffer with its own data in stencil bits 6 and 7, command buffers and
+//! fences with two frames in flight. histencil plans each frame on plain data
+//! (`histencil_model::plan_frame`) and records its stencil-masked light volumes into the engine's
+//! command buffer (`histencil_vk::DeferredLighting`), alternating the PS3-like and native
+//! platform behaviours. The last frame of each is compared with histencil's forward reference of
+//! the same state, and the engine's stencil bits are checked to survive lighting.
+
+mod device;
+mod gbuffer;
+mod world;
+
+use ash::vk;
+use device::{barrier, Buffer, Gpu, Image};
+use gbuffer::{CameraBlock, GBufferPass, DEPTH_FORMAT, ENGINE_MASK};
+use gpu_allocator::MemoryLocation;
+use histencil_model::{
+    plan_frame, DepthConvention, FarPlane, FlushPolicy, Perspective, PlanInputs, PlanSettings,
+    StencilBits, StencilLayout, TechniqueChoice, View, ViewDesc,
+};
+use histencil_vk::{
+    Backend, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame, LightingTargets,
+    Readback, Renderer, Technique, GBUFFER_FORMATS,
+};
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+use world::World;
+
+const WIDTH: u32 = 160;
+const HEIGHT: u32 = 96;
+const FRAMES: usize = 120;
+const IN_FLIGHT: usize = 2;
+const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+/// Frame `f`'s platform behaviour: PS3-like and native in turn.
+fn backend(f: usize) -> Backend {
+    if f % 2 == 0 {
+        Backend::Ps3
+    } else {
+        Backend::Native
+    }
+}
+
+/// The engine's camera: reversed Z, no far plane.
+fn view(frame: usize) -> ViewDesc {
+    let c = world::camera(frame);
+    Perspective {
+        eye: c.eye.into(),
+        target: c.target.into(),
+        up: c.up.into(),
+        fov_y_radians: c.fov_y_radians,
+        aspect: WIDTH as f32 / HEIGHT as f32,
+        near: c.near,
+        far: FarPlane::Infinite,
+        depth: DepthConvention::Reversed,
+    }
+    .desc()
+}
+
+/// A frame slot: the engine's command pool and buffer, fence, and camera block.
+struct Slot {
+    pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    camera: Buffer,
+    camera_set: vk::DescriptorSet,
+}
+
+/// What the last frame of each backend copies back.
+struct Capture {
+    frame: usize,
+    hdr: Buffer,
+    stencil_before: Buffer,
+    stencil_after: Buffer,
+}
+
+fn main() {
+    let gpu = Gpu::new();
+    let extent = vk::Extent2D {
+        width: WIDTH,
+        height: HEIGHT,
+    };
+    let world = World::new();
+    // histencil's bits where this engine wants them: the culling bit at 5, the BRDF field from
+    // bit 1; bits 6 and 7 are the engine's.
+    let layout = StencilLayout::with_positions(
+        world.brdfs.len() as u32,
+        StencilBits {
+            culling_bit: 5,
+            brdf_shift: 1,
+            engine_mask: ENGINE_MASK,
+        },
+    )
+    .expect("the engine's bit positions fit");
+
+    // SAFETY: the engine's handles outlive the context, its device was made with histencil's
+    // REQUIREMENTS, and the engine submits from this thread only.
+    let ctx = unsafe { Context::from_raw(gpu.lend()) }.expect("histencil on the engine's device");
+    let mut lighting = DeferredLighting::new(
+        &ctx,
+        &LightingDesc {
+            layout,
+            brdfs: world.brdfs.clone(),
+            extent,
+            depth_stencil_format: DEPTH_FORMAT,
+            hdr_format: HDR_FORMAT,
+            frames_in_flight: IN_FLIGHT as u32,
+            max_lights: world::LIGHTS as u32,
+        },
+    )
+    .expect("lighting");
+
+    let gbuffer_pass = GBufferPass::new(&gpu);
+    use vk::ImageUsageFlags as U;
+    let gbuffer: Vec<Image> = ["albedo", "normal-depth", "material"]
+        .iter()
+        .zip(GBUFFER_FORMATS)
+        .map(|(n, f)| gpu.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+        .collect();
+    let depth = gpu.image(
+        "depth",
+        DEPTH_FORMAT,
+        extent,
+        U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
+    );
+    let hdr = gpu.image(
+        "hdr",
+        HDR_FORMAT,
+        extent,
+        U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
+    );
+    let mut targets = LightingTargets {
+        gbuffer: [gbuffer[0].target, gbuffer[1].target, gbuffer[2].target],
+        depth_stencil: depth.target,
+        hdr: hdr.target,
+    };
+
+    let d = &gpu.device;
+    let pool_sizes = [vk::DescriptorPoolSize::default()
+        .ty(vk::DescriptorType::UNIFORM_BUFFER)
+        .descriptor_count(IN_FLIGHT as u32)];
+    let descriptor_pool = unsafe {
+        d.create_descriptor_pool(
+            &vk::DescriptorPoolCreateInfo::default()
+                .max_sets(IN_FLIGHT as u32)
+                .pool_sizes(&pool_sizes),
+            None,
+        )
+    }
+    .unwrap();
+    let mut slots: Vec<Slot> = (0..IN_FLIGHT)
+        .map(|i| unsafe {
+            let pool = d
+                .create_command_pool(
+                    &vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queue_family),
+                    None,
+                )
+                .unwrap();
+            let cmd = d
+                .allocate_command_buffers(
+                    &vk::CommandBufferAllocateInfo::default()
+                        .command_pool(pool)
+                        .command_buffer_count(1),
+                )
+                .unwrap()[0];
+            let fence = d
+                .create_fence(
+                    &vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED),
+                    None,
+                )
+                .unwrap();
+            let camera = gpu.buffer(
+                &format!("camera-{i}"),
+                std::mem::size_of::<CameraBlock>() as u64,
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                MemoryLocation::CpuToGpu,
+            );
+            let layouts = [gbuffer_pass.set_layout];
+            let camera_set = d
+                .allocate_descriptor_sets(
+                    &vk::DescriptorSetAllocateInfo::default()
+                        .descriptor_pool(descriptor_pool)
+                        .set_layouts(&layouts),
+                )
+                .unwrap()[0];
+            let info = [vk::DescriptorBufferInfo::default()
+                .buffer(camera.buffer)
+                .range(vk::WHOLE_SIZE)];
+            let write = vk::WriteDescriptorSet::default()
+                .dst_set(camera_set)
+                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+                .buffer_info(&info);
+            d.update_descriptor_sets(&[write], &[]);
+            Slot {
+                pool,
+                cmd,
+                fence,
+                camera,
+                camera_set,
+            }
+        })
+        .collect();
+    let pixels = u64::from(WIDTH * HEIGHT);
+    let readback = |name: &str, size| {
+        gpu.buffer(
+            name,
+            size,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )
+    };
+    let mut captures: Vec<Capture> = [FRAMES - 2, FRAMES - 1]
+        .map(|frame| Capture {
+            frame,
+            hdr: readback("hdr-readback", pixels * 8),
+            stencil_before: readback("stencil-before", pixels),
+            stencil_after: readback("stencil-after", pixels),
+        })
+        .into();
+
+    let brdf_bounds = world.brdf_bounds();
+    let started = Instant::now();
+    for f in 0..FRAMES {
+        let slot = &mut slots[f % IN_FLIGHT];
+        let view = view(f);
+        let lights = world::lights(f);
+        let shapes: Vec<_> = lights.iter().map(|l| l.shape()).collect();
+        let checked = View::new(&view).expect("the engine's view");
+        let settings = PlanSettings {
+            technique: TechniqueChoice::Stencil,
+            caps: backend(f).platform().caps(),
+            flush: FlushPolicy::Auto,
+        };
+        let inputs = PlanInputs {
+            lights: &shapes,
+            brdf_bounds: &brdf_bounds,
+            view: &checked,
+        };
+        let plan = plan_frame(&layout, &inputs, &settings).expect("a plan");
+        let capture = captures.iter().find(|c| c.frame == f);
+        unsafe {
+            // Wait for the frame that last used this slot: the only wait, and the engine's own.
+            d.wait_for_fences(&[slot.fence], true, u64::MAX).unwrap();
+            d.reset_fences(&[slot.fence]).unwrap();
+            slot.camera.write(bytemuck::bytes_of(&CameraBlock {
+                view: view.world_to_view,
+                proj: view.view_to_clip,
+            }));
+            d.reset_command_pool(slot.pool, vk::CommandPoolResetFlags::empty())
+                .unwrap();
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            d.begin_command_buffer(slot.cmd, &begin).unwrap();
+            gbuffer_pass.record(
+                d,
+                slot.cmd,
+                slot.camera_set,
+                &world,
+                &layout,
+                &mut targets.gbuffer,
+                &mut targets.depth_stencil,
+            );
+            if let Some(c) = capture {
+                copy_stencil(
+                    d,
+                    slot.cmd,
+                    &mut targets.depth_stencil,
+                    c.stencil_before.buffer,
+                );
+            }
+            let frame = LightingFrame {
+                slot: (f % IN_FLIGHT) as u32,
+                view: &view,
+                lights: &lights,
+                plan: &plan,
+                clear_hdr: true,
+                timestamps: false,
+            };
+            // SAFETY: the command buffer is recording on the engine's device; the images' states
+            // are the ones the engine's own barriers left; this slot's last frame has finished.
+            lighting
+                .record(slot.cmd, &frame, &mut targets)
+                .expect("lighting recorded");
+            if let Some(c) = capture {
+                copy_stencil(
+                    d,
+                    slot.cmd,
+                    &mut targets.depth_stencil,
+                    c.stencil_after.buffer,
+                );
+                copy_color(d, slot.cmd, &mut targets.hdr, c.hdr.buffer);
+                host_barrier(d, slot.cmd);
+            }
+            d.end_command_buffer(slot.cmd).unwrap();
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(gpu.queue, &[submit], slot.fence).unwrap();
+        }
+    }
+    let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
+    unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+    let engine_ms = started.elapsed().as_secs_f64() * 1e3 / FRAMES as f64;
+
+    // histencil's forward reference of each captured state, and the Renderer's own stencil frame
+    // of the same state for the frame time.
+    let mut worst = 0u8;
+    let mut intact = true;
+    let mut renderer_ms = 0.0;
+    for c in &captures {
+        let scene = world::scene(&world, c.frame);
+        let mut renderer = Renderer::new(&ctx, scene, WIDTH, HEIGHT).expect("reference renderer");
+        let readback = Readback {
+            hdr: true,
+            ..Readback::NONE
+        };
+        let forward = renderer
+            .render(Technique::Forward, readback)
+            .expect("forward");
+        let forward = forward.images.hdr.expect("hdr").into_raw();
+        let ours: Vec<f32> = c
+            .hdr
+            .bytes()
+            .chunks_exact(2)
+            .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+            .collect();
+        for (a, b) in forward.chunks_exact(4).zip(ours.chunks_exact(4)) {
+            for ch in 0..3 {
+                worst = worst.max(tonemap(a[ch]).abs_diff(tonemap(b[ch])));
+            }
+        }
+        let before = c.stencil_before.bytes();
+        let after = c.stencil_after.bytes();
+        let marked = before.iter().filter(|s| **s & ENGINE_MASK != 0).count();
+        intact &= marked > 0
+            && before
+                .iter()
+                .zip(after)
+                .all(|(b, a)| (b ^ a) & ENGINE_MASK == 0);
+        let technique = Technique::Stencil {
+            backend: backend(c.frame),
+            flush: FlushPolicy::Auto,
+        };
+        let timed = Instant::now();
+        let runs = 5;
+        for _ in 0..runs {
+            renderer
+                .render(technique, Readback::NONE)
+                .expect("renderer frame");
+        }
+        renderer_ms += timed.elapsed().as_secs_f64() * 1e3 / runs as f64 / captures.len() as f64;
+    }
+    println!(
+        "engine: {engine_ms:.1} ms per frame with {IN_FLIGHT} in flight (wall clock, validation on); \
+         histencil's Renderer on the same state: {renderer_ms:.1} ms per frame (it waits for each)"
+    );
+
+    drop(lighting);
+    unsafe {
+        d.device_wait_idle().unwrap();
+        for s in slots.drain(..) {
+            d.destroy_fence(s.fence, None);
+            d.destroy_command_pool(s.pool, None);
+            gpu.free_buffer(s.camera);
+        }
+        d.destroy_descriptor_pool(descriptor_pool, None);
+    }
+    for c in captures.drain(..) {
+        gpu.free_buffer(c.hdr);
+        gpu.free_buffer(c.stencil_before);
+        gpu.free_buffer(c.stencil_after);
+    }
+    for image in gbuffer.into_iter().chain([depth, hdr]) {
+        gpu.free_image(image);
+    }
+    gbuffer_pass.destroy(&gpu);
+    drop(ctx);
+    gpu.destroy();
+    let messages = device::MESSAGES.load(Ordering::SeqCst);
+    println!(
+        "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward, \
+         engine stencil bits {}, {messages} validation messages",
+        if intact { "intact" } else { "NOT intact" }
+    );
+    if worst > 1 || !intact || messages > 0 {
+        std::process::exit(1);
+    }
+}
+
+/// histencil's tonemap (exposure 1, Reinhard, sRGB), on the CPU, to 8 bits.
+fn tonemap(x: f32) -> u8 {
+    let c = (x.max(0.0) / (1.0 + x.max(0.0))).clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
+
+const TRANSFER_READ: ImageState = ImageState {
+    layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+    stage: vk::PipelineStageFlags2::COPY,
+    access: vk::AccessFlags2::TRANSFER_READ,
+};
+
+unsafe fn copy_stencil(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut histencil_vk::ImageRef,
+    buffer: vk::Buffer,
+) {
+    copy(d, cmd, image, vk::ImageAspectFlags::STENCIL, buffer);
+}
+
+unsafe fn copy_color(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut histencil_vk::ImageRef,
+    buffer: vk::Buffer,
+) {
+    copy(d, cmd, image, vk::ImageAspectFlags::COLOR, buffer);
+}
+
+unsafe fn copy(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut histencil_vk::ImageRef,
+    aspect: vk::ImageAspectFlags,
+    buffer: vk::Buffer,
+) {
+    barrier(d, cmd, image, TRANSFER_READ, false);
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(aspect)
+                .layer_count(1),
+        )
+        .image_extent(vk::Extent3D {
+            width: image.extent.width,
+            height: image.extent.height,
+            depth: 1,
+        });
+    d.cmd_copy_image_to_buffer(cmd, image.image, TRANSFER_READ.layout, buffer, &[region]);
+}
+
+unsafe fn host_barrier(d: &ash::Device, cmd: vk::CommandBuffer) {
+    let b = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::COPY)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b));
+}

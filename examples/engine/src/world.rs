@@ -1,0 +1,171 @@
+//! The engine's world: a floor and eight boxes in four BRDFs, 64 point lights and a camera, all
+//! animated by frame number. Its own types; `histencil_scene` only for the forward reference.
+
+use glam::{Mat4, Quat, Vec3};
+use histencil_brdf::{Brdf, BrdfId};
+use histencil_model::Aabb;
+use histencil_scene::{Camera, Light, Material, Object as SceneObject, Scene, Shape};
+
+pub const LIGHTS: usize = 64;
+
+/// The engine's own stencil data: what it keeps in its two bits.
+pub const WALKABLE: u8 = 0x80;
+pub const DYNAMIC: u8 = 0x40;
+
+pub struct Object {
+    /// Places the unit cube `[-1, 1]^3`.
+    pub transform: Mat4,
+    pub brdf: Brdf,
+    pub tint: Vec3,
+    /// The engine's bits for this object's pixels.
+    pub stencil: u8,
+}
+
+pub struct World {
+    pub objects: Vec<Object>,
+    /// The BRDFs in use; an index here is a stencil slot.
+    pub brdfs: Vec<BrdfId>,
+}
+
+impl World {
+    pub fn new() -> Self {
+        let mut objects = vec![Object {
+            transform: Mat4::from_scale_rotation_translation(
+                Vec3::new(8.0, 0.1, 8.0),
+                Quat::IDENTITY,
+                Vec3::new(0.0, -0.1, 0.0),
+            ),
+            brdf: Brdf::Lambert { rho: 0.8 },
+            tint: Vec3::new(0.8, 0.78, 0.74),
+            stencil: WALKABLE,
+        }];
+        let brdfs = [
+            Brdf::Ggx {
+                alpha: 0.3,
+                f0: 0.04,
+                f90: 1.0,
+            },
+            Brdf::OrenNayarFull {
+                rho: 0.7,
+                sigma: 0.5,
+            },
+            Brdf::BlinnPhong { exponent: 40.0 },
+        ];
+        for i in 0..8 {
+            let angle = i as f32 * std::f32::consts::TAU / 8.0;
+            let height = 0.4 + 0.15 * (i % 3) as f32;
+            objects.push(Object {
+                transform: Mat4::from_scale_rotation_translation(
+                    Vec3::new(0.45, height, 0.45),
+                    Quat::from_rotation_y(angle * 0.7),
+                    Vec3::new(3.0 * angle.cos(), height, 3.0 * angle.sin()),
+                ),
+                brdf: brdfs[i % 3],
+                tint: Vec3::new(0.9, 0.5 + 0.05 * i as f32, 0.3 + 0.08 * i as f32),
+                stencil: DYNAMIC,
+            });
+        }
+        let mut ids: Vec<BrdfId> = Vec::new();
+        for o in &objects {
+            if !ids.contains(&o.brdf.id()) {
+                ids.push(o.brdf.id());
+            }
+        }
+        Self {
+            objects,
+            brdfs: ids,
+        }
+    }
+
+    pub fn slot(&self, object: &Object) -> u32 {
+        self.brdfs
+            .iter()
+            .position(|b| *b == object.brdf.id())
+            .unwrap() as u32
+    }
+
+    /// Each BRDF slot's object bounds, as the planner takes them.
+    pub fn brdf_bounds(&self) -> Vec<Vec<Aabb>> {
+        let mut bounds = vec![Vec::new(); self.brdfs.len()];
+        for o in &self.objects {
+            let corners = (0..8).map(|c| {
+                let unit = Vec3::new(
+                    if c & 1 == 0 { -1.0 } else { 1.0 },
+                    if c & 2 == 0 { -1.0 } else { 1.0 },
+                    if c & 4 == 0 { -1.0 } else { 1.0 },
+                );
+                o.transform.transform_point3(unit)
+            });
+            let (min, max) = corners.fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), p| (lo.min(p), hi.max(p)),
+            );
+            bounds[self.slot(o) as usize].push(Aabb {
+                min: min.to_array(),
+                max: max.to_array(),
+            });
+        }
+        bounds
+    }
+}
+
+/// 64 point lights circling the room at frame `frame`, each on its own orbit.
+pub fn lights(frame: usize) -> Vec<Light> {
+    (0..LIGHTS)
+        .map(|i| {
+            let t = frame as f32 * 0.05;
+            let ring = 1.0 + (i % 4) as f32 * 1.1;
+            let phase = i as f32 * 2.399 + t * (1.0 + (i % 3) as f32 * 0.5);
+            let position = Vec3::new(
+                ring * phase.cos(),
+                0.3 + 0.25 * (i % 5) as f32,
+                ring * phase.sin(),
+            );
+            let hue = i as f32 * 0.37;
+            let color = Vec3::new(
+                0.6 + 0.4 * hue.sin(),
+                0.6 + 0.4 * (hue + 2.1).sin(),
+                0.6 + 0.4 * (hue + 4.2).sin(),
+            ) * 0.6;
+            Light::point(position, 1.2 + 0.4 * (i % 4) as f32, color)
+        })
+        .collect()
+}
+
+/// The camera at frame `frame`, orbiting the room.
+pub fn camera(frame: usize) -> Camera {
+    let angle = 0.4 + frame as f32 * 0.01;
+    Camera {
+        eye: Vec3::new(7.0 * angle.cos(), 3.5, 7.0 * angle.sin()),
+        target: Vec3::new(0.0, 0.3, 0.0),
+        up: Vec3::Y,
+        fov_y_radians: 0.9,
+        near: 0.1,
+        // The engine's own projection has no far plane; everything lies well within this one.
+        far: 100.0,
+    }
+}
+
+/// The same state as a histencil scene, for histencil's forward reference.
+pub fn scene(world: &World, frame: usize) -> Scene {
+    Scene {
+        name: "engine-example".into(),
+        description: "the example engine's world".into(),
+        camera: camera(frame),
+        objects: world
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| SceneObject {
+                name: format!("object-{i}"),
+                shape: Shape::Box,
+                transform: o.transform,
+                material: Material::new(o.brdf, o.tint),
+            })
+            .collect(),
+        lights: lights(frame),
+        alpha_objects: Vec::new(),
+        particle_systems: Vec::new(),
+        meshes: Vec::new(),
+    }
+}
