@@ -96,6 +96,58 @@ struct Slot {
 }
 
 /// The lighting passes of the talk, recorded into an engine's frames.
+///
+/// What an engine writes per frame, after its own G-buffer pass and before its own post
+/// passes (the whole engine: `examples/engine`):
+///
+/// ```no_run
+/// use ash::vk;
+/// use histencil_model::{
+///     plan_frame, FlushPolicy, PlanInputs, PlanSettings, StencilLayout, TechniqueChoice, View,
+///     ViewDesc,
+/// };
+/// use histencil_scene::Light;
+/// use histencil_vk::{Backend, DeferredLighting, ImageRef, LightingFrame, LightingTargets};
+///
+/// /// `gbuffer`, `depth_stencil` and `hdr` carry the states the engine's barriers left.
+/// fn light(
+///     lighting: &mut DeferredLighting,
+///     cmd: vk::CommandBuffer,
+///     frame_index: u64,
+///     view: &ViewDesc,
+///     lights: &[Light],
+///     brdf_bounds: &[Vec<histencil_model::Aabb>],
+///     images: ([ImageRef; 3], ImageRef, ImageRef),
+/// ) -> Result<LightingTargets, Box<dyn std::error::Error>> {
+///     let layout: StencilLayout = lighting.desc().layout;
+///     let shapes: Vec<_> = lights.iter().map(Light::shape).collect();
+///     let inputs = PlanInputs {
+///         lights: &shapes,
+///         brdf_bounds,
+///         view: &View::new(view)?,
+///     };
+///     let settings = PlanSettings {
+///         technique: TechniqueChoice::Stencil,
+///         caps: Backend::Native.platform().caps(),
+///         flush: FlushPolicy::Auto,
+///     };
+///     let plan = plan_frame(&layout, &inputs, &settings)?;
+///     let (gbuffer, depth_stencil, hdr) = images;
+///     let mut targets = LightingTargets { gbuffer, depth_stencil, hdr };
+///     let frame = LightingFrame {
+///         slot: (frame_index % 2) as u32,
+///         view,
+///         lights,
+///         plan: &plan,
+///         clear_hdr: true,
+///         timestamps: false,
+///     };
+///     // SAFETY: `cmd` is recording on the lighting's device, the images' states are true, and
+///     // the frame two frames ago (the last one in this slot) has finished on the GPU.
+///     unsafe { lighting.record(cmd, &frame, &mut targets)? };
+///     Ok(targets) // each image's state now, for the engine's next barrier
+/// }
+/// ```
 pub struct DeferredLighting<'c> {
     ctx: &'c Context,
     desc: LightingDesc,
