@@ -87,7 +87,12 @@ fn compile(glslc: &Path, path: &Path, includes: &[&Path], out: &Path) {
     let mut command = std::process::Command::new(glslc);
     // Vulkan 1.3 semantics, SPIR-V 1.3: from 1.4 glslang copies structs out of buffers with
     // OpCopyLogical, which naga's SPIR-V front end does not parse. Nothing here needs 1.4+.
-    command.args(["--target-env=vulkan1.3", "--target-spv=spv1.3", "-O0", "-Werror"]);
+    command.args([
+        "--target-env=vulkan1.3",
+        "--target-spv=spv1.3",
+        "-O0",
+        "-Werror",
+    ]);
     for dir in includes {
         command.arg(format!("-I{}", dir.display()));
     }
@@ -132,7 +137,9 @@ fn main() {
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     println!("cargo:rerun-if-changed={}", shader_dir.display());
     // For dependents' build scripts: DEP_HISTENCIL_GLSL_INCLUDE.
-    let include_dir_abs = include_dir.canonicalize().unwrap_or_else(|_| include_dir.clone());
+    let include_dir_abs = include_dir
+        .canonicalize()
+        .unwrap_or_else(|_| include_dir.clone());
     println!("cargo:include={}", include_dir_abs.display());
     println!("cargo:rerun-if-changed=src/shader_consts.rs");
 
