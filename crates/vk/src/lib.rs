@@ -34,6 +34,7 @@ mod resources;
 mod shader_consts;
 pub mod state;
 mod targets;
+mod technique;
 pub use targets::{check_extent, GBUFFER_FORMATS};
 mod timing;
 
@@ -58,6 +59,7 @@ pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
 pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
 pub use readback::{FrameImages, Readback};
-pub use renderer::{Backend, Frame, FrameDesc, Renderer, Technique, DEFAULT_LUT_RESOLUTION};
+pub use renderer::{Frame, Renderer, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
+pub use technique::{Backend, FrameDesc, Technique};
 pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown};

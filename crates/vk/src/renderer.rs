@@ -19,115 +19,17 @@ use crate::readback::{
 use crate::resources::Buffer;
 use crate::shader_consts::HI_STENCIL_TILE;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
+use crate::technique::{Backend, FrameDesc, Technique};
 use crate::timing::{FrameTimings, Timestamps};
 use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
-    plan_frame, CostModel, DepthConvention, FarPlane, FlushPolicy, Footprint, FramePlan,
-    LightShape, Native, Perspective, PlanError, PlanInputs, PlanSettings, PlatformBackend, Ps3Like,
-    SoftTarget, StencilBits, StencilLayout, TalkFigures, TechniqueChoice, TileStats, View,
-    ViewDesc, X360Like,
+    plan_frame, CostModel, DepthConvention, FarPlane, Footprint, FramePlan, LightShape,
+    Perspective, PlanError, PlanInputs, SoftTarget, StencilBits, StencilLayout, TalkFigures,
+    TileStats, View, ViewDesc,
 };
 use histencil_scene::Scene;
-
-/// The platform whose stencil and hi-stencil behaviour the lighting plan follows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Backend {
-    /// 360-like: hi-stencil without a read mask. `zero_preserved` zeroes the engine's preserved
-    /// bits as lights draw (the talk's fix); without it, hi-stencil fails on preserved bits.
-    /// `save_restore` (with zeroing) copies them aside before lighting and writes them back after.
-    X360 {
-        zero_preserved: bool,
-        save_restore: bool,
-    },
-    /// PS3-like: hi-stencil with a read mask; preserved bits survive.
-    Ps3,
-    /// Plain Vulkan: no hi-stencil.
-    Native,
-}
-
-impl Backend {
-    pub fn platform(self) -> Box<dyn PlatformBackend> {
-        match self {
-            Backend::X360 {
-                zero_preserved,
-                save_restore,
-            } => Box::new(X360Like {
-                zero_preserved,
-                save_restore,
-            }),
-            Backend::Ps3 => Box::new(Ps3Like),
-            Backend::Native => Box::new(Native),
-        }
-    }
-}
-
-/// How the frame is lit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Technique {
-    /// The forward reference: every object lit by every light per pixel.
-    Forward,
-    /// The talk's technique: each light volume drawn once per BRDF it touches, masked by the
-    /// BRDF id in the stencil, with one shader per BRDF.
-    Stencil {
-        backend: Backend,
-        flush: FlushPolicy,
-    },
-    /// One uber light shader branching on the G-buffer's BRDF id; one draw per light.
-    Branching {
-        backend: Backend,
-        flush: FlushPolicy,
-    },
-    /// Stencil or branching per light, whichever the renderer's [`CostModel`] predicts cheaper
-    /// for the light's screen coverage and BRDF count (the talk's "tiny lights? try branching").
-    Adaptive {
-        backend: Backend,
-        flush: FlushPolicy,
-    },
-    /// The talk's third option: one draw per light, as branching, with every BRDF read from its
-    /// material's look-up table ([`Renderer::set_lut_resolution`]) instead of its formula.
-    /// Approximate: its error against forward falls with the table resolution.
-    Lut {
-        backend: Backend,
-        flush: FlushPolicy,
-    },
-}
-
-impl Technique {
-    /// Plain deferred shading: branching, no hi-stencil.
-    pub const DEFERRED: Technique = Technique::Branching {
-        backend: Backend::Native,
-        flush: FlushPolicy::Auto,
-    };
-
-    /// What the planner is asked for; `None` for the forward frame, which has no lighting
-    /// passes. `costs` gives the adaptive technique's cost model for a backend.
-    fn plan_settings(self, costs: impl FnOnce(Backend) -> CostModel) -> Option<PlanSettings> {
-        let (technique, backend, flush) = match self {
-            Technique::Forward => return None,
-            Technique::Stencil { backend, flush } => (TechniqueChoice::Stencil, backend, flush),
-            Technique::Branching { backend, flush } => (TechniqueChoice::Branching, backend, flush),
-            Technique::Adaptive { backend, flush } => {
-                (TechniqueChoice::Adaptive(costs(backend)), backend, flush)
-            }
-            // Planned as branching: one draw per light, whatever the pixel's BRDF.
-            Technique::Lut { backend, flush } => (TechniqueChoice::Branching, backend, flush),
-        };
-        Some(PlanSettings {
-            technique,
-            caps: backend.platform().caps(),
-            flush,
-        })
-    }
-
-    fn brdf_source(self) -> BrdfSource {
-        match self {
-            Technique::Lut { .. } => BrdfSource::Table,
-            _ => BrdfSource::Formula,
-        }
-    }
-}
 
 /// The LUT technique's table resolution until [`Renderer::set_lut_resolution`] says otherwise:
 /// the `brdf-report` tables put the broad lobes within about 1e-3 of their formula at 32
@@ -168,32 +70,6 @@ fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
         .iter()
         .position(|b| *b == id)
         .expect("brdfs_in_use lists every object's BRDF") as u32
-}
-
-/// One frame of the renderer: what to render and how, as one value (rather than settings that
-/// stick to the renderer).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FrameDesc {
-    pub technique: Technique,
-    /// Which images to copy back.
-    pub readback: Readback,
-    /// Which end of depth is near in the renderer's depth buffer: its G-buffer, forward and
-    /// alpha passes and the lighting plan follow it, as an engine's reversed-Z frame would.
-    pub depth: DepthConvention,
-    /// Project with the far plane at infinity (the camera's `far` unused).
-    pub infinite_far: bool,
-}
-
-impl FrameDesc {
-    /// `technique`'s frame with standard depth and the camera's far plane.
-    pub fn new(technique: Technique, readback: Readback) -> Self {
-        Self {
-            technique,
-            readback,
-            depth: DepthConvention::Standard,
-            infinite_far: false,
-        }
-    }
 }
 
 /// A rendered frame: its GPU timings, the images asked for, and the hi-stencil statistics when
