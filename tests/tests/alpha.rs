@@ -4,7 +4,7 @@
 use glam::Vec3;
 use histencil_scene::{glass_sphere, Light, ParticleLayout, Scene};
 use histencil_tests::{output_dir, with_validated_context};
-use histencil_vk::{masked_error, AlphaMode, Context, Readback, Renderer, Technique};
+use histencil_vk::{masked_error, AlphaMode, Context, FrameDesc, Readback, Renderer, Technique};
 use image::RgbaImage;
 
 const SIZE: u32 = 192;
@@ -13,19 +13,18 @@ const SIZE: u32 = 192;
 /// lightmaps of `side` texels (`None`: from coverage).
 fn frame(ctx: &Context, scene: &Scene, mode: AlphaMode, side: Option<u32>) -> RgbaImage {
     let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-    renderer.set_alpha_mode(mode);
     renderer
         .set_lightmap_resolution(side)
         .expect("lightmap side");
-    let frame = renderer
-        .render(
-            Technique::Forward,
-            Readback {
-                ldr: true,
-                ..Readback::NONE
-            },
-        )
-        .expect("frame");
+    let readback = Readback {
+        ldr: true,
+        ..Readback::NONE
+    };
+    let desc = FrameDesc {
+        alpha: mode,
+        ..FrameDesc::new(Technique::Forward, readback)
+    };
+    let frame = renderer.render_frame(&desc).expect("frame");
     frame.images.ldr.expect("ldr")
 }
 

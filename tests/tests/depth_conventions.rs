@@ -40,7 +40,6 @@ fn reversed_z_and_infinite_far_light_what_standard_depth_lights() {
         for name in ["brdfs-3", "near-far", "inside", "alpha"] {
             let scene = histencil_scene::embedded(name).unwrap();
             let mut renderer = Renderer::new(ctx, scene, WIDTH, HEIGHT).unwrap();
-            renderer.set_preserved_pattern(0xA0);
             for technique in techniques {
                 let readback = Readback {
                     ldr: true,
@@ -51,6 +50,7 @@ fn reversed_z_and_infinite_far_light_what_standard_depth_lights() {
                     let desc = FrameDesc {
                         depth,
                         infinite_far,
+                        preserved_pattern: 0xA0,
                         ..FrameDesc::new(technique, readback)
                     };
                     renderer.render_frame(&desc).unwrap().images

@@ -8,7 +8,7 @@
 //! "Exact" below means within 1/255 of the forward reference, like every deferred technique.
 
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Technique};
 use image::RgbaImage;
 
 const SIZE: u32 = 160;
@@ -22,9 +22,14 @@ fn x360(zero_preserved: bool, save_restore: bool) -> Backend {
     }
 }
 
-fn image(renderer: &mut Renderer, technique: Technique) -> RgbaImage {
+/// The LDR frame of `technique` with `pattern` in the engine's stencil bits.
+fn image(renderer: &mut Renderer, technique: Technique, pattern: u8) -> RgbaImage {
+    let desc = FrameDesc {
+        preserved_pattern: pattern,
+        ..FrameDesc::new(technique, Readback::ALL)
+    };
     renderer
-        .render(technique, Readback::ALL)
+        .render_frame(&desc)
         .expect("frame")
         .images
         .ldr
@@ -53,14 +58,14 @@ fn x360_without_zeroing_loses_lights_on_preserved_bits_and_the_fixes_restore_the
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-            let forward = image(&mut renderer, Technique::Forward);
+            let forward = image(&mut renderer, Technique::Forward, 0);
             assert!(
                 lit_fraction(&forward) > 0.5,
                 "{name}: reference mostly black"
             );
             let auto = FlushPolicy::Auto;
             // Without engine data the missing read mask is harmless.
-            let clean = image(&mut renderer, stencil(x360(false, false), auto));
+            let clean = image(&mut renderer, stencil(x360(false, false), auto), 0);
             assert_close(
                 &format!("hi-{name}-no-pattern"),
                 &clean,
@@ -68,15 +73,14 @@ fn x360_without_zeroing_loses_lights_on_preserved_bits_and_the_fixes_restore_the
                 TOLERANCE,
             );
 
-            renderer.set_preserved_pattern(PATTERN);
-            let broken = image(&mut renderer, stencil(x360(false, false), auto));
+            let broken = image(&mut renderer, stencil(x360(false, false), auto), PATTERN);
             assert_broken(&format!("{name} x360 without zeroing"), &broken, &forward);
             for (label, backend) in [
                 ("zeroing", x360(true, false)),
                 ("save-restore", x360(true, true)),
                 ("ps3", Backend::Ps3),
             ] {
-                let fixed = image(&mut renderer, stencil(backend, auto));
+                let fixed = image(&mut renderer, stencil(backend, auto), PATTERN);
                 assert_close(&format!("hi-{name}-{label}"), &fixed, &forward, TOLERANCE);
             }
         });
@@ -89,15 +93,15 @@ fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-            let forward = image(&mut renderer, Technique::Forward);
+            let forward = image(&mut renderer, Technique::Forward, 0);
             for backend in [Backend::Ps3, x360(true, false)] {
                 let label = format!("{name} {backend:?}");
-                let never = image(&mut renderer, stencil(backend, FlushPolicy::Never));
+                let never = image(&mut renderer, stencil(backend, FlushPolicy::Never), 0);
                 assert_broken(&format!("{label} flush never"), &never, &forward);
-                let auto = image(&mut renderer, stencil(backend, FlushPolicy::Auto));
+                let auto = image(&mut renderer, stencil(backend, FlushPolicy::Auto), 0);
                 assert_close(&format!("hi-{name}-auto"), &auto, &forward, TOLERANCE);
                 // Extra flushes change nothing once every test sees its own mask.
-                let always = image(&mut renderer, stencil(backend, FlushPolicy::Always));
+                let always = image(&mut renderer, stencil(backend, FlushPolicy::Always), 0);
                 assert_eq!(
                     diff(&always, &auto).pixels_differing,
                     0,
@@ -144,12 +148,15 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-            renderer.set_preserved_pattern(PATTERN);
-            renderer.set_tile_stats(true);
             for (label, technique) in cases {
-                let inputs = renderer.simulator_inputs(technique).expect("inputs");
+                let desc = FrameDesc {
+                    preserved_pattern: PATTERN,
+                    tile_stats: true,
+                    ..FrameDesc::new(technique, Readback::ALL)
+                };
+                let inputs = renderer.simulator_inputs(desc).expect("inputs");
                 let (sim, predicted) = inputs.predict();
-                let frame = renderer.render(technique, Readback::ALL).expect("frame");
+                let frame = renderer.render_frame(&desc).expect("frame");
                 let stats = frame.tile_stats.expect("statistics were asked for");
                 println!("{name} {label}: {stats:?}");
                 assert!(stats.tiles_tested > 0, "{name} {label}: nothing tested");

@@ -6,7 +6,7 @@
 
 use histencil_model::StencilBits;
 use histencil_tests::with_validated_context;
-use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Technique};
 
 const SIZE: u32 = 128;
 const PATTERN: u8 = 0xA0;
@@ -62,12 +62,15 @@ fn culling_bit_clear_brdf_bits_intact_and_preserved_bits_as_the_backend_says() {
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-            renderer.set_preserved_pattern(PATTERN);
             let layout = *renderer.stencil_layout();
             let brdfs = renderer.brdfs().to_vec();
             let preserved = layout.preserved_mask();
             for (label, technique) in techniques {
-                let frame = renderer.render(technique, Readback::ALL).expect("frame");
+                let desc = FrameDesc {
+                    preserved_pattern: PATTERN,
+                    ..FrameDesc::new(technique, Readback::ALL)
+                };
+                let frame = renderer.render_frame(&desc).expect("frame");
                 let stencil = frame.images.stencil.unwrap();
                 let ids = frame.images.brdf_ids.unwrap();
                 let mut seen_slots = std::collections::BTreeSet::new();
@@ -152,7 +155,6 @@ fn engine_bit_positions_light_the_same_image_and_keep_the_engines_bits() {
             let mut engine =
                 Renderer::with_stencil_bits(ctx, scene.clone(), SIZE, SIZE, Some(bits))
                     .expect("renderer at the engine's bits");
-            engine.set_preserved_pattern(ENGINE);
             let layout = *engine.stencil_layout();
             assert_eq!(
                 (layout.culling_mask(), layout.engine_mask()),
@@ -160,7 +162,11 @@ fn engine_bit_positions_light_the_same_image_and_keep_the_engines_bits() {
             );
             for technique in techniques {
                 let expected = talks.render(technique, Readback::ALL).expect("frame");
-                let frame = engine.render(technique, Readback::ALL).expect("frame");
+                let desc = FrameDesc {
+                    preserved_pattern: ENGINE,
+                    ..FrameDesc::new(technique, Readback::ALL)
+                };
+                let frame = engine.render_frame(&desc).expect("frame");
                 assert!(
                     frame.images.ldr == expected.images.ldr,
                     "{name} {technique:?}: another image at the engine's bit positions"

@@ -4,7 +4,7 @@
 
 use histencil_model::PassKind;
 use histencil_tests::with_validated_context;
-use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Technique};
 
 const STENCIL: Technique = Technique::Stencil {
     backend: Backend::Native,
@@ -16,9 +16,12 @@ fn pass_groups_are_timed_per_brdf() {
     let scene = histencil_scene::embedded("brdfs-3").unwrap();
     with_validated_context(|ctx| {
         let mut renderer = Renderer::new(ctx, scene, 96, 96).expect("renderer");
-        renderer.set_pass_timing(true);
+        let timed = |technique: Technique| FrameDesc {
+            pass_timing: true,
+            ..technique.into()
+        };
         let timings = renderer
-            .render(STENCIL, Readback::NONE)
+            .render_frame(&timed(STENCIL))
             .expect("frame")
             .timings;
         let lighting = timings.lighting.expect("breakdown asked for");
@@ -44,7 +47,7 @@ fn pass_groups_are_timed_per_brdf() {
         );
 
         let branching = renderer
-            .render(Technique::DEFERRED, Readback::NONE)
+            .render_frame(&timed(Technique::DEFERRED))
             .expect("frame")
             .timings
             .lighting
@@ -52,7 +55,6 @@ fn pass_groups_are_timed_per_brdf() {
         assert!(branching.group_ms("shade-branching").is_some());
         assert!(branching.group_ms("shade-ggx").is_none());
 
-        renderer.set_pass_timing(false);
         let plain = renderer
             .render(STENCIL, Readback::NONE)
             .expect("frame")

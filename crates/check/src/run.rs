@@ -7,8 +7,8 @@ use crate::matrix::{self, Case, Config, Expect, KnownWrong, Platform, SceneNeeds
 use histencil_model::FlushPolicy;
 use histencil_scene::Scene;
 use histencil_vk::{
-    AlphaMode, Context, ContextDesc, DepthStencilFormat, Readback, Renderer, SimulatorInputs,
-    Technique, ValidationLog, ValidationMessage,
+    AlphaMode, Context, ContextDesc, DepthStencilFormat, FrameDesc, Readback, Renderer,
+    SimulatorInputs, Technique, ValidationLog, ValidationMessage,
 };
 use image::{GrayImage, RgbaImage};
 use std::collections::HashMap;
@@ -362,8 +362,11 @@ impl Group<'_> {
         let (width, height) = self.size;
         let scene = &self.scene.scene;
         let forward = |renderer: &mut Renderer| -> histencil_vk::Result<RgbaImage> {
-            renderer.set_alpha_mode(AlphaMode::Forward);
-            let frame = renderer.render(Technique::Forward, IMAGES)?;
+            let forward = FrameDesc {
+                alpha: AlphaMode::Forward,
+                ..FrameDesc::new(Technique::Forward, IMAGES)
+            };
+            let frame = renderer.render_frame(&forward)?;
             Ok(frame.images.ldr.expect("asked for"))
         };
         let mut renderer = Renderer::new(self.ctx, scene.clone(), width, height)?;
@@ -421,10 +424,13 @@ impl Group<'_> {
             }
             .technique();
         }
-        renderer.set_preserved_pattern(config.pattern);
-        renderer.set_alpha_mode(config.alpha);
+        let desc = FrameDesc {
+            preserved_pattern: config.pattern,
+            alpha: config.alpha,
+            ..FrameDesc::new(technique, IMAGES)
+        };
         let mark = self.log.len();
-        let frame = renderer.render(technique, IMAGES);
+        let frame = renderer.render_frame(&desc);
         (r.validation, r.accepted) = messages_since(self.log, mark);
         let frame = match frame {
             Ok(frame) => frame,
@@ -548,13 +554,16 @@ impl Group<'_> {
 /// the stencil technique (the footprints are per light, the plan is swapped per case), or why
 /// the device cannot give them.
 fn capture(renderer: &mut Renderer, pattern: u8) -> Result<SimulatorInputs, String> {
-    renderer.set_preserved_pattern(pattern);
     let technique = Technique::Stencil {
         backend: Platform::X360.backend(),
         flush: FlushPolicy::Auto,
     };
+    let desc = FrameDesc {
+        preserved_pattern: pattern,
+        ..technique.into()
+    };
     renderer
-        .simulator_inputs(technique)
+        .simulator_inputs(desc)
         .map_err(|e| format!("capturing the simulator's inputs failed: {e}"))
 }
 

@@ -3,7 +3,9 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
 use histencil_check::matrix::Platform;
-use histencil_vk::{AlphaMode, Context, ContextDesc, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{
+    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, Technique,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -285,31 +287,27 @@ fn render(args: &RenderArgs) -> Result<()> {
     on_device(args.validate, |ctx| {
         let technique = args.technique();
         let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
-        renderer.set_preserved_pattern(args.preserved_pattern);
         renderer.set_cost_model(costs);
         renderer.set_lut_resolution(args.lut_resolution)?;
-        renderer.set_alpha_mode(args.alpha.mode());
         renderer.set_lightmap_resolution(args.lightmap_resolution)?;
+        let readback = Readback {
+            ldr: true,
+            hdr: args.hdr.is_some(),
+            stencil: args.dump_stencil.is_some(),
+            brdf_ids: false,
+        };
+        let desc = FrameDesc {
+            preserved_pattern: args.preserved_pattern,
+            alpha: args.alpha.mode(),
+            ..FrameDesc::new(technique, readback)
+        };
         if args.stats {
-            print_stats(&mut renderer, technique)?;
+            print_stats(&mut renderer, &desc)?;
         }
-        let frame = renderer.render(
-            technique,
-            Readback {
-                ldr: true,
-                hdr: args.hdr.is_some(),
-                stencil: args.dump_stencil.is_some(),
-                brdf_ids: false,
-            },
-        )?;
-        let images = frame.images;
+        let images = renderer.render_frame(&desc)?.images;
         if args.alpha_error {
-            print_alpha_error(
-                ctx,
-                &mut renderer,
-                technique,
-                images.ldr.as_ref().expect("requested"),
-            )?;
+            let ldr = images.ldr.as_ref().expect("requested");
+            print_alpha_error(ctx, &mut renderer, &desc, ldr)?;
         }
         histencil_vk::save_png(images.ldr.as_ref().expect("requested"), &args.out)?;
         println!("wrote {}", args.out.display());
@@ -321,8 +319,11 @@ fn render(args: &RenderArgs) -> Result<()> {
             histencil_vk::save_png(stencil, path)?;
             println!("wrote {}", path.display());
         }
-        renderer.set_pass_timing(args.timings);
-        let timings = renderer.measure(technique, args.frames)?;
+        let timed = FrameDesc {
+            pass_timing: args.timings,
+            ..desc
+        };
+        let timings = renderer.measure(timed, args.frames)?;
         let passes: Vec<String> = timings
             .passes
             .iter()
@@ -350,11 +351,11 @@ fn render(args: &RenderArgs) -> Result<()> {
 fn print_alpha_error(
     ctx: &Context,
     renderer: &mut Renderer,
-    technique: Technique,
+    desc: &FrameDesc,
     ldr: &image::RgbaImage,
 ) -> Result<()> {
-    let mode = renderer.alpha_mode();
-    let e = histencil_lab::AlphaReference::render(ctx, renderer, technique)?.error(ldr);
+    let mode = desc.alpha;
+    let e = histencil_lab::AlphaReference::render(ctx, renderer, desc.technique)?.error(ldr);
     println!(
         "alpha error against forward ({mode:?}): mean {:.3}/255, max {}/255 over {} pixels",
         e.mean, e.max, e.pixels
@@ -363,16 +364,19 @@ fn print_alpha_error(
 }
 
 /// Prints the GPU's hi-stencil statistics of one frame next to the simulator's prediction.
-fn print_stats(renderer: &mut Renderer, technique: Technique) -> Result<()> {
-    if technique == Technique::Forward {
+fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
+    if desc.technique == Technique::Forward {
         bail!("--stats needs a deferred technique: the forward reference has no lighting passes");
     }
-    let inputs = renderer.simulator_inputs(technique)?;
+    let inputs = renderer.simulator_inputs(*desc)?;
     let predicted = inputs.predict().0.stats;
-    renderer.set_tile_stats(true);
-    let frame = renderer.render(technique, Readback::NONE);
-    renderer.set_tile_stats(false);
-    let gpu = frame?.tile_stats.expect("statistics were asked for");
+    let counted = FrameDesc {
+        tile_stats: true,
+        readback: Readback::NONE,
+        ..*desc
+    };
+    let frame = renderer.render_frame(&counted)?;
+    let gpu = frame.tile_stats.expect("statistics were asked for");
     println!(
         "hi-stencil ({}x{}-pixel tiles): {} tiles tested, {} culled, {} fragments shaded, {} flushes; \
          simulator {}",

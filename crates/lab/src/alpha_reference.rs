@@ -2,7 +2,7 @@
 
 use crate::measure::frame;
 use crate::Result;
-use histencil_vk::{masked_error, AlphaMode, Context, MaskedError, Renderer, Technique};
+use histencil_vk::{masked_error, AlphaMode, Context, FrameDesc, MaskedError, Renderer, Technique};
 use image::RgbaImage;
 
 /// The frame with forward-lit alpha entities (the reference), and the scene without them: where
@@ -13,14 +13,13 @@ pub struct AlphaReference {
 }
 
 impl AlphaReference {
-    /// Renders both with `technique` for the opaque scene; `renderer`'s alpha mode is left as it
-    /// was.
+    /// Renders both with `technique` for the opaque scene.
     pub fn render(ctx: &Context, renderer: &mut Renderer, technique: Technique) -> Result<Self> {
-        let mode = renderer.alpha_mode();
-        renderer.set_alpha_mode(AlphaMode::Forward);
-        let forward = frame(renderer, technique);
-        renderer.set_alpha_mode(mode);
-        let forward = forward?;
+        let forward_alpha = FrameDesc {
+            alpha: AlphaMode::Forward,
+            ..technique.into()
+        };
+        let forward = frame(renderer, forward_alpha)?;
         let (w, h) = forward.dimensions();
         let mut without = Renderer::new(ctx, renderer.scene().without_alpha(), w, h)?;
         let background = frame(&mut without, technique)?;

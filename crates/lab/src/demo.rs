@@ -10,7 +10,9 @@ use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, time_passes, Timing};
 use crate::Result;
 use histencil_scene::Scene;
-use histencil_vk::{Backend, Context, FlushPolicy, Readback, Renderer, Technique, TileStats};
+use histencil_vk::{
+    Backend, Context, FlushPolicy, FrameDesc, Readback, Renderer, Technique, TileStats,
+};
 use image::{RgbImage, RgbaImage};
 use std::fmt::Write as _;
 
@@ -95,7 +97,6 @@ pub fn run_demo(
     step: &mut dyn FnMut(&str),
 ) -> Result<DemoReport> {
     let mut renderer = Renderer::new(ctx, settings.scene, settings.width, settings.height)?;
-    renderer.set_preserved_pattern(DEMO_PATTERN);
     let layout = *renderer.stencil_layout();
     let preserved_mask = layout.preserved_mask();
     let all = Readback {
@@ -111,8 +112,12 @@ pub fn run_demo(
         } else {
             "lighting"
         };
-        let time = time_passes(&mut renderer, technique, &[pass], settings.frames)?;
-        let images = renderer.render(technique, all)?.images;
+        let desc = FrameDesc {
+            preserved_pattern: DEMO_PATTERN,
+            ..FrameDesc::new(technique, all)
+        };
+        let time = time_passes(&mut renderer, desc, &[pass], settings.frames)?;
+        let images = renderer.render_frame(&desc)?.images;
         let ldr = images.ldr.expect("asked for");
         let error = frames
             .first()
@@ -131,10 +136,12 @@ pub fn run_demo(
             });
         let tiles = match technique {
             Technique::Stencil { backend, .. } if backend != Backend::Native => {
-                renderer.set_tile_stats(true);
-                let stats = renderer.render(technique, Readback::NONE);
-                renderer.set_tile_stats(false);
-                stats?.tile_stats
+                let counted = FrameDesc {
+                    tile_stats: true,
+                    readback: Readback::NONE,
+                    ..desc
+                };
+                renderer.render_frame(&counted)?.tile_stats
             }
             _ => None,
         };

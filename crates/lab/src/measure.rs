@@ -1,7 +1,7 @@
 //! Timing a technique over frames, and the frame it renders.
 
 use crate::Result;
-use histencil_vk::{median_of_sorted, Readback, Renderer, Technique};
+use histencil_vk::{median_of_sorted, FrameDesc, Readback, Renderer, Technique};
 use image::RgbaImage;
 
 /// Milliseconds of one measured quantity over frames: the median and the spread.
@@ -35,15 +35,19 @@ pub const WARM_UP_FRAMES: usize = 1;
 /// The summed time of `passes` in each of `frames` frames after the warm-up.
 pub fn time_passes(
     renderer: &mut Renderer,
-    technique: Technique,
+    desc: impl Into<FrameDesc>,
     passes: &[&str],
     frames: usize,
 ) -> Result<Timing> {
+    let desc = FrameDesc {
+        readback: Readback::NONE,
+        ..desc.into()
+    };
     for _ in 0..WARM_UP_FRAMES {
-        renderer.render(technique, Readback::NONE)?;
+        renderer.render_frame(&desc)?;
     }
     let samples = renderer
-        .measure_frames(technique, frames)?
+        .measure_frames(desc, frames)?
         .iter()
         .map(|timings| passes.iter().filter_map(|p| timings.pass_ms(p)).sum())
         .collect();
@@ -60,11 +64,14 @@ pub fn time_lighting(
 }
 
 /// The tonemapped frame.
-pub fn frame(renderer: &mut Renderer, technique: Technique) -> Result<RgbaImage> {
-    let readback = Readback {
-        ldr: true,
-        ..Readback::NONE
+pub fn frame(renderer: &mut Renderer, desc: impl Into<FrameDesc>) -> Result<RgbaImage> {
+    let desc = FrameDesc {
+        readback: Readback {
+            ldr: true,
+            ..Readback::NONE
+        },
+        ..desc.into()
     };
-    let images = renderer.render(technique, readback)?.images;
+    let images = renderer.render_frame(&desc)?.images;
     Ok(images.ldr.expect("the LDR frame was asked for"))
 }

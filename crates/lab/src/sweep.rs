@@ -17,7 +17,7 @@ use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis};
 use crate::{write_file, AlphaReference, LabError, Result};
 use histencil_scene::Scene;
-use histencil_vk::{AlphaMode, Backend, Context, FlushPolicy, Renderer, Technique};
+use histencil_vk::{Backend, Context, FlushPolicy, Renderer, Technique};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -137,7 +137,6 @@ pub fn run_sweep(
         }
         SweepParam::LightmapRes => {
             let technique = Technique::DEFERRED;
-            renderer.set_alpha_mode(AlphaMode::Lightmap);
             let reference = AlphaReference::render(ctx, &mut renderer, technique)?;
             for (i, &side) in values.iter().enumerate() {
                 renderer.set_lightmap_resolution(Some(side))?;

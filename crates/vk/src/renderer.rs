@@ -1,6 +1,6 @@
 //! The renderer: owns a scene's GPU resources and records / submits whole frames.
 
-use crate::alpha::{AlphaLighting, AlphaMode};
+use crate::alpha::AlphaLighting;
 use crate::capture::{FootprintCapture, SimulatorInputs};
 use crate::context::Context;
 use crate::deferred_lighting::{DeferredLighting, LightingDesc, LightingFrame, LightingTargets};
@@ -73,7 +73,7 @@ fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
 }
 
 /// A rendered frame: its GPU timings, the images asked for, and the hi-stencil statistics when
-/// [`Renderer::set_tile_stats`] is on (deferred techniques only).
+/// [`FrameDesc::tile_stats`] asks for them (deferred techniques only).
 pub struct Frame {
     pub timings: FrameTimings,
     pub images: FrameImages,
@@ -95,22 +95,15 @@ pub struct Renderer<'c> {
     lut_resolution: u32,
     /// Baked when the LUT technique first renders at `lut_resolution`.
     lut_tables: Option<LutTables>,
-    alpha_mode: AlphaMode,
     /// Lightmap region side for every entity; `None`: from screen coverage.
     lightmap_side: Option<u32>,
     /// Created at the first frame of a scene with alpha entities (and again when the lightmap
     /// resolution changes).
     alpha: Option<AlphaLighting>,
-    /// Written into the preserved stencil bits by the G-buffer pass (the engine's own bits).
-    preserved_pattern: u8,
     /// The lighting passes, as an engine records them, into this renderer's targets.
     lighting: DeferredLighting<'c>,
-    /// Per-step lighting timestamps, when asked for.
-    pass_timing: bool,
     /// The adaptive technique's costs; `None`: fitted to the talk's figures for the backend.
     cost_model: Option<CostModel>,
-    /// Count hi-stencil tile and fragment statistics, when asked for.
-    tile_stats: bool,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -242,13 +235,9 @@ impl<'c> Renderer<'c> {
             object_materials,
             lut_resolution: DEFAULT_LUT_RESOLUTION,
             lut_tables: None,
-            alpha_mode: AlphaMode::default(),
             lightmap_side: None,
             alpha: None,
-            preserved_pattern: 0,
             lighting,
-            pass_timing: false,
-            tile_stats: false,
             cost_model: None,
             extent,
             targets,
@@ -279,38 +268,20 @@ impl<'c> Renderer<'c> {
         &self.brdfs
     }
 
-    /// Sets the engine's bits that the G-buffer pass writes into the preserved stencil bits
-    /// (only the bits of [`StencilLayout::preserved_mask`] are kept).
-    pub fn set_preserved_pattern(&mut self, pattern: u8) {
-        self.preserved_pattern = pattern;
-    }
-
-    /// The stencil value each object's G-buffer draw writes, preserved pattern included.
-    pub fn object_stencil_values(&self) -> Vec<u8> {
+    /// The stencil value each object's G-buffer draw writes with `preserved_pattern` in the
+    /// preserved bits ([`FrameDesc::preserved_pattern`]).
+    pub fn object_stencil_values(&self, preserved_pattern: u8) -> Vec<u8> {
         self.object_slots
             .iter()
             .map(|s| {
                 crate::passes::geometry::gbuffer_stencil(
                     &self.stencil_layout,
                     *s,
-                    self.preserved_pattern,
+                    preserved_pattern,
                 )
                 .map_or(0, |f| f.reference)
             })
             .collect()
-    }
-
-    /// With `on`, frames time every lighting step and report the talk's pass groups
-    /// ([`FrameTimings::lighting`]). Off by default: timestamps between draws can serialise them.
-    pub fn set_pass_timing(&mut self, on: bool) {
-        self.pass_timing = on;
-    }
-
-    /// With `on`, deferred frames count hi-stencil statistics ([`Frame::tile_stats`]): tiles
-    /// tested and culled, fragments shaded, flushes. Off by default: counting adds a draw per
-    /// hi-stencil test and an atomic per shaded fragment.
-    pub fn set_tile_stats(&mut self, on: bool) {
-        self.tile_stats = on;
     }
 
     /// The costs [`Technique::Adaptive`] chooses with, e.g. calibrated on this device. Without
@@ -370,15 +341,6 @@ impl<'c> Renderer<'c> {
             self.lut_tables = Some(tables);
         }
         Ok(self.lut_tables.as_ref().expect("baked above"))
-    }
-
-    /// How the alpha pass lights translucent objects and particles (default: lightmaps).
-    pub fn set_alpha_mode(&mut self, mode: AlphaMode) {
-        self.alpha_mode = mode;
-    }
-
-    pub fn alpha_mode(&self) -> AlphaMode {
-        self.alpha_mode
     }
 
     /// Gives every alpha entity's lightmap `side` texels a side (a ribbon `side` texels along
@@ -520,6 +482,10 @@ impl<'c> Renderer<'c> {
             readback,
             depth,
             infinite_far,
+            alpha: alpha_mode,
+            preserved_pattern: _,
+            pass_timing,
+            tile_stats,
         } = *desc;
         // Only the deferred path has a G-buffer to read BRDF ids from.
         let readback = Readback {
@@ -531,22 +497,22 @@ impl<'c> Renderer<'c> {
         self.frame_uniforms
             .write(bytemuck::bytes_of(&self.uniforms(&view)?));
         let plan = self.plan_in(technique, &view)?;
-        let count_stats = self.tile_stats && technique != Technique::Forward;
+        let count_stats = tile_stats && technique != Technique::Forward;
         let brdf_source = technique.brdf_source();
         if brdf_source == BrdfSource::Table {
             self.lut_tables()?;
         }
         self.alpha_lighting()?;
-        let time_steps = self.pass_timing && technique != Technique::Forward;
+        let time_steps = pass_timing && technique != Technique::Forward;
         let cmd = self.begin_commands()?;
         self.timestamps.begin_frame(ctx, cmd);
         match technique {
             Technique::Forward => {
-                self.record_geometry(true, depth);
+                self.record_geometry(true, desc);
                 self.timestamps.mark(ctx, cmd, "forward");
             }
             _ => {
-                self.record_geometry(false, depth);
+                self.record_geometry(false, desc);
                 self.timestamps.mark(ctx, cmd, "gbuffer");
                 let frame = LightingFrame {
                     slot: 0,
@@ -566,7 +532,7 @@ impl<'c> Renderer<'c> {
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            alpha.record_lightmaps(ctx, cmd, scene, meshes, frame_set, self.alpha_mode);
+            alpha.record_lightmaps(ctx, cmd, scene, meshes, frame_set, alpha_mode);
             self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
             alpha.record_alpha(
                 ctx,
@@ -575,7 +541,7 @@ impl<'c> Renderer<'c> {
                 meshes,
                 &mut self.targets,
                 frame_set,
-                (self.alpha_mode, self.extent, depth),
+                (alpha_mode, self.extent, depth),
             );
             self.timestamps.mark(ctx, cmd, "alpha");
         }
@@ -642,14 +608,15 @@ impl<'c> Renderer<'c> {
     }
 
     /// Records the forward pass or the G-buffer pass into the renderer's targets.
-    fn record_geometry(&mut self, forward: bool, depth: DepthConvention) {
+    fn record_geometry(&mut self, forward: bool, desc: &FrameDesc) {
         let cmd = self.cmd;
         let mut targets = self.targets.lighting();
         if forward {
-            self.geometry_pass(cmd, true, depth)
+            self.geometry_pass(cmd, true, desc.depth)
                 .record_forward(&mut targets);
         } else {
-            self.record_gbuffer_into(cmd, &mut targets, depth);
+            let (depth, pattern) = (desc.depth, desc.preserved_pattern);
+            self.record_gbuffer_into(cmd, &mut targets, depth, pattern);
         }
         self.targets.lit(&targets);
     }
@@ -683,12 +650,13 @@ impl<'c> Renderer<'c> {
         cmd: vk::CommandBuffer,
         targets: &mut LightingTargets,
         depth: DepthConvention,
+        preserved_pattern: u8,
     ) {
         self.geometry_pass(cmd, false, depth).record_gbuffer(
             targets,
             &self.stencil_layout,
             &self.object_slots,
-            self.preserved_pattern,
+            preserved_pattern,
         );
     }
 
@@ -724,7 +692,7 @@ impl<'c> Renderer<'c> {
                 )));
             }
         }
-        self.record_gbuffer_into(cmd, targets, DepthConvention::Standard);
+        self.record_gbuffer_into(cmd, targets, DepthConvention::Standard, 0);
         Ok(())
     }
 
@@ -736,9 +704,15 @@ impl<'c> Renderer<'c> {
     /// # Errors
     /// [`crate::Error::Unsupported`] without a 32-bit float depth buffer (the simulator compares
     /// f32 depths), besides the errors of [`Renderer::plan`] and of Vulkan calls.
-    pub fn simulator_inputs(&mut self, technique: Technique) -> Result<SimulatorInputs> {
+    pub fn simulator_inputs(&mut self, desc: impl Into<FrameDesc>) -> Result<SimulatorInputs> {
+        let desc = &desc.into();
+        if desc.depth != DepthConvention::Standard || desc.infinite_far {
+            return Err(crate::Error::Unsupported(
+                "simulator inputs of a frame with reversed depth or an infinite far plane",
+            ));
+        }
         let ctx = self.ctx;
-        let plan = self.plan(technique)?;
+        let plan = self.plan(desc.technique)?;
         let layout = self.lighting.pipeline_layout();
         let mut capture = FootprintCapture::new(ctx, layout, self.extent)?;
         let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
@@ -746,7 +720,7 @@ impl<'c> Renderer<'c> {
         let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
         let result = (|| {
             let cmd = self.begin_commands()?;
-            self.record_geometry(false, DepthConvention::Standard);
+            self.record_geometry(false, desc);
             let image = &mut self.targets.depth_stencil;
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
@@ -795,22 +769,25 @@ impl<'c> Renderer<'c> {
         result
     }
 
-    /// Renders `frames` frames without readback and returns the median of each timing.
-    pub fn measure(&mut self, technique: Technique, frames: usize) -> Result<FrameTimings> {
-        Ok(FrameTimings::median(
-            &self.measure_frames(technique, frames)?,
-        ))
+    /// Renders `frames` frames of `desc` without readback and returns the median of each
+    /// timing.
+    pub fn measure(&mut self, desc: impl Into<FrameDesc>, frames: usize) -> Result<FrameTimings> {
+        Ok(FrameTimings::median(&self.measure_frames(desc, frames)?))
     }
 
-    /// Renders `frames` frames (at least one) without readback and returns each frame's
-    /// timings, for callers that want the spread as well as the median.
+    /// Renders `frames` frames (at least one) of `desc` without readback and returns each
+    /// frame's timings, for callers that want the spread as well as the median.
     pub fn measure_frames(
         &mut self,
-        technique: Technique,
+        desc: impl Into<FrameDesc>,
         frames: usize,
     ) -> Result<Vec<FrameTimings>> {
+        let desc = FrameDesc {
+            readback: Readback::NONE,
+            ..desc.into()
+        };
         (0..frames.max(1))
-            .map(|_| Ok(self.render(technique, Readback::NONE)?.timings))
+            .map(|_| Ok(self.render_frame(&desc)?.timings))
             .collect()
     }
 }

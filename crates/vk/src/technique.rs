@@ -1,6 +1,7 @@
 //! What a renderer frame is: its lighting technique (the talk's, and the ones it is compared
 //! with), the platform behaviour the plan follows, and the frame description that carries them.
 
+use crate::alpha::AlphaMode;
 use crate::passes::light_pipelines::BrdfSource;
 use crate::readback::Readback;
 use histencil_model::{
@@ -110,7 +111,8 @@ impl Technique {
 }
 
 /// One frame of the renderer: what to render and how, as one value (rather than settings that
-/// stick to the renderer).
+/// stick to the renderer). What stays on the renderer rebuilds resources when it changes (LUT
+/// resolution, lightmap sides) or is calibration (the cost model).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameDesc {
     pub technique: Technique,
@@ -121,16 +123,41 @@ pub struct FrameDesc {
     pub depth: DepthConvention,
     /// Project with the far plane at infinity (the camera's `far` unused).
     pub infinite_far: bool,
+    /// How the alpha pass lights translucent objects and particles.
+    pub alpha: AlphaMode,
+    /// The engine's bits the G-buffer pass writes into the preserved stencil bits (only those
+    /// of `StencilLayout::preserved_mask` are kept).
+    pub preserved_pattern: u8,
+    /// Time every lighting step and report the talk's pass groups
+    /// (`FrameTimings::lighting`). Off by default: timestamps between draws can serialise them.
+    pub pass_timing: bool,
+    /// Count hi-stencil statistics (`Frame::tile_stats`): tiles tested and culled, fragments
+    /// shaded, flushes. Off by default: counting adds a draw per hi-stencil test and an atomic
+    /// per shaded fragment.
+    pub tile_stats: bool,
+}
+
+/// A technique's frame with everything else at its default and nothing read back (what timing
+/// loops take).
+impl From<Technique> for FrameDesc {
+    fn from(technique: Technique) -> Self {
+        FrameDesc::new(technique, Readback::NONE)
+    }
 }
 
 impl FrameDesc {
-    /// `technique`'s frame with standard depth and the camera's far plane.
+    /// `technique`'s frame with standard depth and the camera's far plane, alpha lightmaps, no
+    /// preserved pattern, no step timing or statistics.
     pub fn new(technique: Technique, readback: Readback) -> Self {
         Self {
             technique,
             readback,
             depth: DepthConvention::Standard,
             infinite_far: false,
+            alpha: AlphaMode::default(),
+            preserved_pattern: 0,
+            pass_timing: false,
+            tile_stats: false,
         }
     }
 }

@@ -11,7 +11,7 @@ const MAX_MARKS: u32 = 16;
 pub struct FrameTimings {
     pub passes: Vec<(&'static str, f64)>,
     /// The lighting pass broken down by the talk's pass groups, when asked for
-    /// (`Renderer::set_pass_timing`).
+    /// (`FrameDesc::pass_timing`).
     pub lighting: Option<LightingBreakdown>,
 }
 

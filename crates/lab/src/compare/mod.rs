@@ -9,7 +9,9 @@ use crate::stats::{median_interval, ratio_interval, Interval, Verdict};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::Result;
 use histencil_scene::Scene;
-use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{
+    Backend, Context, CostModel, FlushPolicy, FrameDesc, Readback, Renderer, Technique,
+};
 
 /// What a comparison run measures.
 #[derive(Clone, Debug)]
@@ -390,10 +392,14 @@ fn breakdown(
     brdfs: usize,
     frames: usize,
 ) -> Result<Breakdown> {
-    renderer.set_pass_timing(true);
-    let measured = renderer.measure(technique, frames.max(1));
-    renderer.set_pass_timing(false);
-    let lighting = measured?.lighting.unwrap_or_default();
+    let timed = FrameDesc {
+        pass_timing: true,
+        ..technique.into()
+    };
+    let lighting = renderer
+        .measure(timed, frames.max(1))?
+        .lighting
+        .unwrap_or_default();
     let mut b = Breakdown {
         name,
         brdfs,
