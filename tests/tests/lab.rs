@@ -52,7 +52,17 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
     let mut settings = CompareSettings::talk(64, 64, 2);
     // Fewer light sizes than the command's seven keep the test short; each is a full run.
     settings.light_sizes = vec![0.01, 0.1, 1.0];
+    // A target no run reaches and no budget: sampling stops at the minimum, for the budget.
+    settings.target_ci = Some(1e-9);
+    settings.budget = std::time::Duration::ZERO;
     let report = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
+    use histencil_lab::stats::Stop;
+    assert_eq!(report.sampled.rounds, 2);
+    assert!(matches!(report.sampled.stop, Stop::Budget | Stop::Target));
+    for p in &report.sizes {
+        assert_eq!(p.sampled.rounds, 2);
+        assert!(p.samples.iter().all(|s| s.len() == 2));
+    }
     let dir = output_dir().join("compare");
     let written = report.write(&dir).unwrap();
     assert_eq!(written.len(), 5);

@@ -39,6 +39,13 @@ pub struct CompareArgs {
     /// Output directory: report.md, report.json and PNG plots.
     #[arg(long, default_value = "out/compare")]
     out: PathBuf,
+    /// Keep sampling (past --frames rounds) until every overhead's 95 % interval is within
+    /// ±this many percent, or --budget-s runs out. Without it, --frames rounds exactly.
+    #[arg(long)]
+    target_ci: Option<f64>,
+    /// Seconds each measurement set (the table; each light size) may keep sampling for.
+    #[arg(long, default_value_t = 60.0)]
+    budget_s: f64,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -125,8 +132,19 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     {
         bail!("--light-sizes: {bad} is not a percentage in (0, 100]");
     }
+    if let Some(bad) = args.target_ci.filter(|c| !(*c > 0.0 && *c < 100.0)) {
+        bail!("--target-ci: {bad} is not a percentage in (0, 100)");
+    }
+    if !(args.budget_s.is_finite() && args.budget_s >= 0.0 && args.budget_s <= 86_400.0) {
+        bail!(
+            "--budget-s: {} is not between 0 and 86400 seconds",
+            args.budget_s
+        );
+    }
     let mut settings =
         CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
+    settings.target_ci = args.target_ci.map(|c| c / 100.0);
+    settings.budget = std::time::Duration::from_secs_f64(args.budget_s);
     settings.scene = crate::load_scene_arg(&args.scene)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;

@@ -126,9 +126,154 @@ impl Verdict {
     }
 }
 
+/// How long a measurement keeps sampling: at least `min_rounds` rounds, then until every
+/// interval it tracks is narrow enough or its time budget is spent.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampling {
+    pub min_rounds: usize,
+    /// Stop once every tracked interval's relative half-width is at most this (`0.03`: +-3 %);
+    /// `None`: stop at `min_rounds`.
+    pub target: Option<f64>,
+    /// Wall-clock time a measurement may take before it stops short of the target.
+    pub budget: std::time::Duration,
+    /// A cap on rounds, whatever the budget (the interval of the median narrows like
+    /// 1/sqrt(rounds); past a few hundred rounds more buys little).
+    pub max_rounds: usize,
+}
+
+/// Why a measurement stopped sampling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stop {
+    /// `min_rounds` done and no target asked for.
+    Rounds,
+    /// Every tracked interval reached the target.
+    Target,
+    /// The budget ran out first.
+    Budget,
+    /// `max_rounds` ran out first.
+    MaxRounds,
+}
+
+impl Stop {
+    pub fn word(self) -> &'static str {
+        match self {
+            Stop::Rounds => "rounds",
+            Stop::Target => "target reached",
+            Stop::Budget => "budget spent",
+            Stop::MaxRounds => "round cap",
+        }
+    }
+}
+
+impl Sampling {
+    /// A fixed number of rounds.
+    pub fn rounds(n: usize) -> Self {
+        Self {
+            min_rounds: n.max(1),
+            target: None,
+            budget: std::time::Duration::MAX,
+            max_rounds: n.max(1),
+        }
+    }
+
+    /// Whether to stop after `rounds` rounds taking `elapsed`, with the tracked intervals now
+    /// `widths` wide (relative half-widths), and why. Pure, so the rule is unit-tested.
+    pub fn stop(
+        &self,
+        rounds: usize,
+        widths: &[f64],
+        elapsed: std::time::Duration,
+    ) -> Option<Stop> {
+        if rounds < self.min_rounds {
+            return None;
+        }
+        let Some(target) = self.target else {
+            return Some(Stop::Rounds);
+        };
+        if widths.iter().all(|w| *w <= target) {
+            Some(Stop::Target)
+        } else if rounds >= self.max_rounds {
+            Some(Stop::MaxRounds)
+        } else if elapsed >= self.budget {
+            Some(Stop::Budget)
+        } else {
+            None
+        }
+    }
+}
+
+/// What a measurement's sampling came to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampled {
+    pub rounds: usize,
+    pub stop: Stop,
+    /// The widest tracked interval at the end (relative half-width).
+    pub widest: f64,
+    pub seconds: f64,
+}
+
+/// Runs rounds of `round` until `sampling` says stop; `widths` gives the tracked intervals'
+/// relative half-widths after each round.
+pub fn sample<E>(
+    sampling: &Sampling,
+    mut round: impl FnMut(usize) -> Result<(), E>,
+    widths: impl Fn() -> Vec<f64>,
+) -> Result<Sampled, E> {
+    let start = std::time::Instant::now();
+    let mut rounds = 0;
+    loop {
+        round(rounds)?;
+        rounds += 1;
+        let w = widths();
+        if let Some(stop) = sampling.stop(rounds, &w, start.elapsed()) {
+            return Ok(Sampled {
+                rounds,
+                stop,
+                widest: w.iter().copied().fold(0.0, f64::max),
+                seconds: start.elapsed().as_secs_f64(),
+            });
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sampling_stops_at_the_target_the_budget_or_the_cap_never_before_the_minimum() {
+        use std::time::Duration;
+        let s = Sampling {
+            min_rounds: 5,
+            target: Some(0.03),
+            budget: Duration::from_secs(10),
+            max_rounds: 100,
+        };
+        let narrow = [0.01, 0.03];
+        let wide = [0.01, 0.2];
+        let early = Duration::from_secs(1);
+        assert_eq!(s.stop(4, &narrow, early), None, "the minimum comes first");
+        assert_eq!(s.stop(4, &wide, Duration::from_secs(60)), None);
+        assert_eq!(s.stop(5, &narrow, early), Some(Stop::Target));
+        assert_eq!(s.stop(5, &wide, early), None);
+        assert_eq!(
+            s.stop(9, &wide, Duration::from_secs(10)),
+            Some(Stop::Budget)
+        );
+        assert_eq!(s.stop(100, &wide, early), Some(Stop::MaxRounds));
+        assert_eq!(s.stop(5, &[f64::INFINITY], early), None, "no interval yet");
+        let fixed = Sampling::rounds(3);
+        assert_eq!(fixed.stop(2, &wide, early), None);
+        assert_eq!(fixed.stop(3, &wide, early), Some(Stop::Rounds));
+        let mut n = 0;
+        let round = |_| {
+            n += 1;
+            Ok::<_, ()>(())
+        };
+        let sampled = sample(&fixed, round, || vec![0.5]).unwrap();
+        assert_eq!((n, sampled.rounds, sampled.stop), (3, 3, Stop::Rounds));
+        assert_eq!(sampled.widest, 0.5);
+    }
 
     #[test]
     fn the_binomial_matches_known_values() {

@@ -5,7 +5,7 @@ mod report;
 
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, Timing};
-use crate::stats::{median_interval, ratio_interval, Interval, Verdict};
+use crate::stats::{median_interval, ratio_interval, sample, Interval, Sampled, Sampling, Verdict};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::Result;
 use histencil_scene::Scene;
@@ -19,8 +19,14 @@ pub struct CompareSettings {
     pub scene: Scene,
     pub width: u32,
     pub height: u32,
-    /// Timed frames per cell, after `measure::WARM_UP_FRAMES` warm-up frames.
+    /// Timed frames per cell, after `measure::WARM_UP_FRAMES` warm-up frames: the rounds every
+    /// measurement takes at least.
     pub frames: usize,
+    /// Keep sampling until every overhead's interval is at most this wide (relative
+    /// half-width, `0.03`: +-3 %), or `budget` runs out; `None`: `frames` rounds exactly.
+    pub target_ci: Option<f64>,
+    /// Wall-clock time each measurement set (the table; each light size) may sample for.
+    pub budget: std::time::Duration,
     /// The adaptive technique's costs; `None`: fitted to the talk's figures.
     pub costs: Option<CostModel>,
     /// BRDF counts of the table's columns (the talk's 1, 2, 3).
@@ -37,6 +43,8 @@ impl CompareSettings {
             width,
             height,
             frames,
+            target_ci: None,
+            budget: std::time::Duration::from_secs(60),
             costs: None,
             brdf_counts: vec![1, 2, 3],
             light_sizes: vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0],
@@ -195,9 +203,39 @@ pub struct SizePoint {
     pub adaptive: Timing,
     /// The worst of the three techniques' errors against forward.
     pub error: ImageError,
+    /// Every round's lighting time of branching, stencil and adaptive, interleaved.
+    pub samples: [Vec<f64>; 3],
+    pub sampled: Sampled,
 }
 
 impl SizePoint {
+    /// Stencil's time over branching's, paired by round: below 1 stencil is faster.
+    pub fn stencil_over_branching(&self) -> (Interval, Verdict) {
+        let r = ratio_interval(&self.samples[1], &self.samples[0]);
+        (r, Verdict::of(&r))
+    }
+
+    /// Which is faster where the data can tell: `"stencil"`, `"branching"` or
+    /// `"indistinguishable"`.
+    pub fn faster(&self) -> &'static str {
+        match self.stencil_over_branching().1 {
+            Verdict::Faster => "stencil",
+            Verdict::Slower => "branching",
+            Verdict::Indistinguishable => "indistinguishable",
+        }
+    }
+
+    /// Adaptive's time over the better (by median) of branching and stencil, paired by round,
+    /// with its interval.
+    pub fn adaptive_over_best_interval(&self) -> Interval {
+        let best = if self.branching.median_ms <= self.stencil.median_ms {
+            &self.samples[0]
+        } else {
+            &self.samples[1]
+        };
+        ratio_interval(&self.samples[2], best)
+    }
+
     /// Adaptive's time over the better of branching and stencil (1 is ideal).
     pub fn adaptive_over_best(&self) -> f64 {
         let best = self.branching.median_ms.min(self.stencil.median_ms);
@@ -221,6 +259,10 @@ pub struct CompareReport {
     pub rows: Vec<Row>,
     pub breakdowns: Vec<Breakdown>,
     pub sizes: Vec<SizePoint>,
+    /// How the table's rounds ended.
+    pub sampled: Sampled,
+    /// The interval width asked for, if any.
+    pub target_ci: Option<f64>,
     /// The costs the adaptive rows used.
     pub costs: CostModel,
     pub costs_calibrated: bool,
@@ -240,6 +282,37 @@ impl CompareReport {
             .collect();
         stencil_wins_from(&gains)
     }
+}
+
+impl CompareReport {
+    /// What the intervals let one say about the crossover: the smallest swept coverage from
+    /// which stencil is faster at every larger size with intervals that exclude a tie, and the
+    /// largest up to which branching is, likewise. Between them the data cannot place it.
+    pub fn crossover_bounds(&self) -> (Option<f64>, Option<f64>) {
+        let verdicts: Vec<(f64, Verdict)> = self
+            .sizes
+            .iter()
+            .map(|p| (p.coverage, p.stencil_over_branching().1))
+            .collect();
+        sure_bounds(&verdicts)
+    }
+}
+
+/// See [`CompareReport::crossover_bounds`]; `verdicts` of stencil over branching by increasing
+/// coverage.
+fn sure_bounds(verdicts: &[(f64, Verdict)]) -> (Option<f64>, Option<f64>) {
+    let stencil_from = verdicts
+        .iter()
+        .rposition(|(_, v)| *v != Verdict::Faster)
+        .map_or(Some(0), |i| (i + 1 < verdicts.len()).then_some(i + 1))
+        .and_then(|i| verdicts.get(i).map(|p| p.0));
+    let branching_until = verdicts
+        .iter()
+        .position(|(_, v)| *v != Verdict::Slower)
+        .map_or(verdicts.len(), |i| i)
+        .checked_sub(1)
+        .map(|i| verdicts[i].0);
+    (stencil_from, branching_until)
 }
 
 /// See [`CompareReport::measured_crossover`]; `gains` are `(coverage, branching - stencil ms)`
@@ -299,15 +372,40 @@ pub fn run_compare(
         }
         renderers.push((brdfs, renderer, errors));
     }
-    let mut samples = vec![vec![Vec::new(); rows_spec.len()]; renderers.len()];
-    for round in 0..frames.max(1) {
-        progress(&format!("round {} of {}", round + 1, frames.max(1)));
-        for (count, (_, renderer, _)) in renderers.iter_mut().enumerate() {
-            for (row, (_, technique)) in rows_spec.iter().enumerate() {
-                samples[count][row].push(lighting_ms(renderer, *technique)?);
+    let sampling = Sampling {
+        min_rounds: frames.max(1),
+        target: settings.target_ci,
+        budget: settings.budget,
+        max_rounds: MAX_ROUNDS,
+    };
+    let samples = std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; renderers.len()]);
+    // The widths a verdict rests on: every overhead ratio against the 1-BRDF cell.
+    let overhead_widths = || {
+        let s = samples.borrow();
+        (1..s.len())
+            .flat_map(|count| {
+                let s = &s;
+                (0..rows_spec.len()).map(move |row| {
+                    ratio_interval(&s[count][row], &s[0][row]).relative_half_width()
+                })
+            })
+            .collect::<Vec<_>>()
+    };
+    let table_sampled = sample(
+        &sampling,
+        |round| -> Result<()> {
+            progress(&format!("round {}", round + 1));
+            for (count, (_, renderer, _)) in renderers.iter_mut().enumerate() {
+                for (row, (_, technique)) in rows_spec.iter().enumerate() {
+                    let ms = lighting_ms(renderer, *technique)?;
+                    samples.borrow_mut()[count][row].push(ms);
+                }
             }
-        }
-    }
+            Ok(())
+        },
+        overhead_widths,
+    )?;
+    let mut samples = samples.into_inner();
     for (count, (brdfs, _, errors)) in renderers.iter().enumerate() {
         for (r, (row, error)) in rows.iter_mut().zip(errors).enumerate() {
             row.cells.push(Cell {
@@ -335,14 +433,27 @@ pub fn run_compare(
         for technique in size_techniques() {
             error = error.worst(image_error(&frame(&mut renderer, technique)?, &reference));
         }
-        // Interleaved, as the table.
-        let mut samples = [vec![], vec![], vec![]];
-        for _ in 0..frames.max(1) {
-            for (i, technique) in size_techniques().into_iter().enumerate() {
-                samples[i].push(lighting_ms(&mut renderer, technique)?);
-            }
-        }
-        let timings = samples.map(Timing::from_samples);
+        // Interleaved, as the table; tracked: every pair's ratio.
+        let samples = std::cell::RefCell::new([vec![], vec![], vec![]]);
+        let pair_widths = || {
+            let s = samples.borrow();
+            [(1, 0), (2, 0), (2, 1)]
+                .map(|(a, b)| ratio_interval(&s[a], &s[b]).relative_half_width())
+                .to_vec()
+        };
+        let sampled = sample(
+            &sampling,
+            |_| -> Result<()> {
+                for (i, technique) in size_techniques().into_iter().enumerate() {
+                    let ms = lighting_ms(&mut renderer, technique)?;
+                    samples.borrow_mut()[i].push(ms);
+                }
+                Ok(())
+            },
+            pair_widths,
+        )?;
+        let samples = samples.into_inner();
+        let timings = samples.clone().map(Timing::from_samples);
         sizes.push(SizePoint {
             coverage,
             lights,
@@ -350,6 +461,8 @@ pub fn run_compare(
             stencil: timings[1],
             adaptive: timings[2],
             error,
+            samples,
+            sampled,
         });
     }
     Ok(CompareReport {
@@ -362,10 +475,15 @@ pub fn run_compare(
         rows,
         breakdowns,
         sizes,
+        sampled: table_sampled,
+        target_ci: settings.target_ci,
         costs: costs.expect("at least one BRDF count"),
         costs_calibrated: settings.costs.is_some(),
     })
 }
+
+/// The most rounds one measurement set takes, whatever its target and budget.
+pub const MAX_ROUNDS: usize = 400;
 
 /// The lighting pass's time in one frame.
 fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<f64> {
@@ -424,7 +542,34 @@ fn breakdown(
 
 #[cfg(test)]
 mod tests {
-    use super::stencil_wins_from;
+    use super::{stencil_wins_from, sure_bounds};
+    use crate::stats::Verdict::{Faster, Indistinguishable, Slower};
+
+    #[test]
+    fn the_crossover_bounds_rest_on_separated_intervals_only() {
+        let v = [
+            (0.001, Slower),
+            (0.01, Slower),
+            (0.1, Indistinguishable),
+            (0.3, Faster),
+            (1.0, Faster),
+        ];
+        assert_eq!(sure_bounds(&v), (Some(0.3), Some(0.01)));
+        // A tie at the largest size: stencil is never surely faster for good.
+        assert_eq!(
+            sure_bounds(&[(0.1, Faster), (1.0, Indistinguishable)]),
+            (None, None)
+        );
+        assert_eq!(
+            sure_bounds(&[(0.1, Faster), (1.0, Faster)]),
+            (Some(0.1), None)
+        );
+        assert_eq!(
+            sure_bounds(&[(0.1, Slower), (1.0, Slower)]),
+            (None, Some(1.0))
+        );
+        assert_eq!(sure_bounds(&[]), (None, None));
+    }
 
     #[test]
     fn the_crossover_is_where_stencil_starts_to_win_for_good() {

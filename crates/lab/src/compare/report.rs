@@ -5,6 +5,7 @@ use super::{Breakdown, CompareReport, Row, SizePoint};
 use crate::image_error::ImageError;
 use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis, Series};
+use crate::stats::median_interval;
 use crate::{write_file, Result};
 use histencil_model::TalkFigures;
 use serde_json::{json, Value};
@@ -42,6 +43,7 @@ impl CompareReport {
                 "frames": self.frames,
                 "warm_up_frames": WARM_UP_FRAMES,
             },
+            "table_sampling": sampled_json(&self.sampled),
             "rows": self.rows.iter().map(row_json).collect::<Vec<_>>(),
             "breakdown": self.breakdowns.iter().map(breakdown_json).collect::<Vec<_>>(),
             "light_sizes": self.sizes.iter().map(size_json).collect::<Vec<_>>(),
@@ -60,6 +62,13 @@ impl CompareReport {
         if let Some(x) = self.costs.crossover_coverage() {
             crossover.insert("model_coverage".into(), json!(x));
         }
+        let (stencil_from, branching_until) = self.crossover_bounds();
+        if let Some(x) = stencil_from {
+            crossover.insert("stencil_surely_faster_from".into(), json!(x));
+        }
+        if let Some(x) = branching_until {
+            crossover.insert("branching_surely_faster_until".into(), json!(x));
+        }
         out["crossover"] = Value::Object(crossover);
         out
     }
@@ -69,7 +78,7 @@ impl CompareReport {
         let _ = writeln!(
             md,
             "# histencil compare\n\nDevice: **{}**. Scene `{}` ({} lights) at {}x{}. Lighting-pass \
-             GPU time over {} rounds after a warm-up frame; each round renders one frame of every \
+             GPU time over at least {} rounds after a warm-up frame; each round renders one frame of every \
              technique at every BRDF count in turn, so background load hits all alike. Table: \
              median [95 % interval of the median, order statistics; below 6 rounds no interval \
              reaches 95 % and the whole range is shown]; overheads are the median of \
@@ -77,6 +86,20 @@ impl CompareReport {
              only where the interval excludes 0 (else indistinguishable). Error against the \
              forward reference of the same scene: 8-bit max / mean, and mean FLIP.\n",
             self.device, self.scene, self.scene_lights, self.width, self.height, self.frames
+        );
+        let t = &self.sampled;
+        let _ = writeln!(
+            md,
+            "Sampling: the table took {} rounds in {:.1} s ({}; at least {} rounds{}); its widest \
+             overhead interval is ±{:.1} %. Each light size samples the same way (its rounds are \
+             in its row).\n",
+            t.rounds,
+            t.seconds,
+            t.stop.word(),
+            self.frames,
+            self.target_ci
+                .map_or(String::new(), |c| format!(", target ±{:.1} %", 100.0 * c)),
+            100.0 * t.widest
         );
         md += "## Lighting time against BRDF count\n\n";
         md += "Overheads are against each row's own 1-BRDF time in this run; the error column is \
@@ -161,23 +184,24 @@ impl CompareReport {
                A striped wall in three BRDFs under lights covering the given fraction of the \
                screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
                screens. Native backend; the error is the worst of the three techniques.\n\n\
-               | coverage | lights | branching | stencil | adaptive | faster | adaptive / best | error max / mean / FLIP |\n\
-               |---|---|---|---|---|---|---|---|\n";
+               | coverage | lights | rounds | branching | stencil | adaptive | stencil / branching | faster | adaptive / best | error max / mean / FLIP |\n\
+               |---|---|---|---|---|---|---|---|---|---|\n";
         for p in &self.sizes {
-            let faster = if p.branching.median_ms < p.stencil.median_ms {
-                "branching"
-            } else {
-                "stencil"
-            };
+            let (ratio, _) = p.stencil_over_branching();
+            let best = p.adaptive_over_best_interval();
             let _ = writeln!(
                 md,
-                "| {:.1} % | {} | {} | {} | {} | {faster} | {:.2} | {} |",
+                "| {:.1} % | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} |",
                 p.coverage * 100.0,
                 p.lights,
-                time_text(&p.branching),
-                time_text(&p.stencil),
-                time_text(&p.adaptive),
-                p.adaptive_over_best(),
+                p.sampled.rounds,
+                p.sampled.stop.word(),
+                interval_text(&median_interval(&p.samples[0])),
+                interval_text(&median_interval(&p.samples[1])),
+                interval_text(&median_interval(&p.samples[2])),
+                ratio_text(&ratio),
+                p.faster(),
+                ratio_text(&best),
                 error_text(&p.error)
             );
         }
@@ -190,10 +214,18 @@ impl CompareReport {
             .costs
             .crossover_coverage()
             .map_or("never".to_owned(), |x| format!("{:.2} %", x * 100.0));
+        let (stencil_from, branching_until) = self.crossover_bounds();
+        let pct = |x: Option<f64>, none: &str| {
+            x.map_or(none.to_owned(), |x| format!("{:.2} %", x * 100.0))
+        };
         let _ = writeln!(
             md,
-            "\nStencil stays faster than branching from {measured}; the adaptive technique's cost \
+            "\nStencil stays faster than branching from {measured} by the medians; with the \
+             intervals, branching is surely faster up to {} and stencil surely faster from {} \
+             (in between the data cannot place the crossover). The adaptive technique's cost \
              model ({}) puts the change at {model}.",
+            pct(branching_until, "no swept size"),
+            pct(stencil_from, "no swept size on"),
             if self.costs_calibrated {
                 "calibrated on this device"
             } else {
@@ -305,8 +337,14 @@ fn brdfs_label(n: usize) -> String {
     }
 }
 
-fn time_text(t: &Timing) -> String {
-    format!("{:.3} ms ±{:.3}", t.median_ms, t.spread_ms())
+/// `12.345 ms [12.1, 12.6]`: a median with its 95 % interval.
+fn interval_text(i: &crate::stats::Interval) -> String {
+    format!("{:.3} ms [{:.3}, {:.3}]", i.median, i.lo, i.hi)
+}
+
+/// `0.82 [0.79, 0.85]`: a ratio's median with its 95 % interval.
+fn ratio_text(i: &crate::stats::Interval) -> String {
+    format!("{:.2} [{:.2}, {:.2}]", i.median, i.lo, i.hi)
 }
 
 /// `12.345 ms [12.1, 12.6]`, and for a cell over the 1-BRDF one its overhead as the median
@@ -394,6 +432,20 @@ fn size_json(p: &SizePoint) -> Value {
         "stencil": timing_json(&p.stencil),
         "adaptive": timing_json(&p.adaptive),
         "adaptive_over_best": p.adaptive_over_best(),
+        "adaptive_over_best_interval": interval_json(&p.adaptive_over_best_interval()),
+        "stencil_over_branching": interval_json(&p.stencil_over_branching().0),
+        "faster": p.faster(),
+        "samples_ms": {"branching": p.samples[0], "stencil": p.samples[1], "adaptive": p.samples[2]},
+        "sampling": sampled_json(&p.sampled),
         "error": error_json(&p.error),
+    })
+}
+
+fn sampled_json(s: &crate::stats::Sampled) -> Value {
+    json!({
+        "rounds": s.rounds,
+        "stopped": s.stop.word(),
+        "widest_relative_half_width": if s.widest.is_finite() { json!(s.widest) } else { Value::Null },
+        "seconds": s.seconds,
     })
 }
