@@ -4,6 +4,7 @@
 //! falls as the setting grows; calibration gives finite costs that `--costs` reads back into
 //! the adaptive technique.
 
+use histencil_lab::stats::Sampling;
 use histencil_lab::{calibrate, read_costs, run_compare, run_sweep, CompareSettings, SweepParam};
 use histencil_tests::{output_dir, with_validated_context};
 use histencil_vk::{Backend, Renderer};
@@ -167,7 +168,9 @@ fn sweeps_write_csv_json_and_a_pareto_plot_and_error_falls() {
 
 #[test]
 fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
-    let calibration = with_validated_context(|ctx| calibrate(ctx, 96, 64, 1, &mut |_| {}).unwrap());
+    let calibration = with_validated_context(|ctx| {
+        calibrate(ctx, 96, 64, &Sampling::rounds(2), &mut |_| {}).unwrap()
+    });
     let c = calibration.costs;
     for x in [
         c.pass_overhead_ms,
@@ -178,6 +181,17 @@ fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
         assert!(x.is_finite() && x >= 0.0, "{c:?}");
     }
     assert!(c.shade_ms > 0.0, "{c:?}");
+    assert_eq!(calibration.sampled.rounds, 2);
+    let costs = [
+        c.pass_overhead_ms,
+        c.stencil_per_brdf_ms,
+        c.branch_tax_per_brdf_ms,
+        c.shade_ms,
+    ];
+    let intervals = c.interval.expect("measured costs carry intervals");
+    for (x, (lo, hi)) in costs.iter().zip(intervals) {
+        assert!(lo <= *x && *x <= hi, "{c:?}");
+    }
     let path = output_dir().join("costs.json");
     calibration.write(&path).unwrap();
     let read = read_costs(&path).unwrap();

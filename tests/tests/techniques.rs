@@ -165,6 +165,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             stencil_per_brdf_ms: 0.0,
             branch_tax_per_brdf_ms: 1.0,
             shade_ms: 1.0,
+            interval: None,
         };
         renderer.set_cost_model(Some(free_stencil));
         assert_eq!(
@@ -176,6 +177,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             stencil_per_brdf_ms: 1.0,
             branch_tax_per_brdf_ms: 0.0,
             shade_ms: 1.0,
+            interval: None,
         };
         renderer.set_cost_model(Some(free_branching));
         assert_eq!(

@@ -39,13 +39,47 @@ pub struct CompareArgs {
     /// Output directory: report.md, report.json and PNG plots.
     #[arg(long, default_value = "out/compare")]
     out: PathBuf,
-    /// Keep sampling (past --frames rounds) until every overhead's 95 % interval is within
-    /// ±this many percent, or --budget-s runs out. Without it, --frames rounds exactly.
+    #[command(flatten)]
+    sampling: SamplingArgs,
+}
+
+/// How long a measurement samples (compare, calibrate).
+#[derive(clap::Args)]
+pub struct SamplingArgs {
+    /// Keep sampling (past --frames rounds) until every tracked 95 % interval is within ±this
+    /// many percent, or --budget-s runs out. Without it, --frames rounds exactly.
     #[arg(long)]
     target_ci: Option<f64>,
-    /// Seconds each measurement set (the table; each light size) may keep sampling for.
+    /// Seconds each measurement set (compare: the table, each light size) may sample for.
     #[arg(long, default_value_t = 60.0)]
     budget_s: f64,
+}
+
+impl SamplingArgs {
+    /// The sampling rule, at least `frames` rounds; refuses percentages and budgets that make
+    /// no sense.
+    fn sampling(&self, frames: u64) -> Result<histencil_lab::stats::Sampling> {
+        if let Some(bad) = self.target_ci.filter(|c| !(*c > 0.0 && *c < 100.0)) {
+            bail!("--target-ci: {bad} is not a percentage in (0, 100)");
+        }
+        if !(self.budget_s.is_finite() && self.budget_s >= 0.0 && self.budget_s <= 86_400.0) {
+            bail!(
+                "--budget-s: {} is not between 0 and 86400 seconds",
+                self.budget_s
+            );
+        }
+        let rounds = frames as usize;
+        Ok(histencil_lab::stats::Sampling {
+            min_rounds: rounds,
+            target: self.target_ci.map(|c| c / 100.0),
+            budget: std::time::Duration::from_secs_f64(self.budget_s),
+            max_rounds: if self.target_ci.is_some() {
+                histencil_lab::MAX_ROUNDS.max(rounds)
+            } else {
+                rounds
+            },
+        })
+    }
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -80,6 +114,8 @@ pub struct CalibrateArgs {
     /// Where the costs go (read back by `--costs`).
     #[arg(long, default_value = "out/costs.json")]
     out: PathBuf,
+    #[command(flatten)]
+    sampling: SamplingArgs,
 }
 
 #[derive(clap::Args)]
@@ -132,19 +168,11 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     {
         bail!("--light-sizes: {bad} is not a percentage in (0, 100]");
     }
-    if let Some(bad) = args.target_ci.filter(|c| !(*c > 0.0 && *c < 100.0)) {
-        bail!("--target-ci: {bad} is not a percentage in (0, 100)");
-    }
-    if !(args.budget_s.is_finite() && args.budget_s >= 0.0 && args.budget_s <= 86_400.0) {
-        bail!(
-            "--budget-s: {} is not between 0 and 86400 seconds",
-            args.budget_s
-        );
-    }
+    let sampling = args.sampling.sampling(args.run.frames)?;
     let mut settings =
         CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
-    settings.target_ci = args.target_ci.map(|c| c / 100.0);
-    settings.budget = std::time::Duration::from_secs_f64(args.budget_s);
+    settings.target_ci = sampling.target;
+    settings.budget = sampling.budget;
     settings.scene = crate::load_scene_arg(&args.scene)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;
@@ -197,31 +225,34 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
 
 pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     histencil_vk::check_output_file(&args.out)?;
+    let sampling = args.sampling.sampling(args.run.frames)?;
     let calibration = on_device(args.run.validate, |ctx| {
         let c = with_spinner(|step| {
-            histencil_lab::calibrate(
-                ctx,
-                args.run.width,
-                args.run.height,
-                args.run.frames as usize,
-                step,
-            )
+            histencil_lab::calibrate(ctx, args.run.width, args.run.height, &sampling, step)
         });
         Ok(c?)
     })?;
     calibration.write(&args.out)?;
     let c = &calibration.costs;
+    let iv = c.interval.unwrap_or_default();
+    let with = |x: f64, i: usize| format!("{x:.4} ms [{:.4}, {:.4}]", iv[i].0, iv[i].1);
     println!(
-        "wrote {} ({}): pass overhead {:.4} ms, stencil {:.4} ms and branch tax {:.4} ms per extra \
-         BRDF per full-screen light, shade {:.4} ms; stencil wins above {}",
+        "wrote {} ({}; {} rounds, {}): pass overhead {}, stencil {} and branch tax {} per extra \
+         BRDF per full-screen light, shade {} (medians over rounds, 95 % intervals); stencil \
+         wins above {}",
         args.out.display(),
         calibration.device,
-        c.pass_overhead_ms,
-        c.stencil_per_brdf_ms,
-        c.branch_tax_per_brdf_ms,
-        c.shade_ms,
+        calibration.sampled.rounds,
+        calibration.sampled.stop.word(),
+        with(c.pass_overhead_ms, 0),
+        with(c.stencil_per_brdf_ms, 1),
+        with(c.branch_tax_per_brdf_ms, 2),
+        with(c.shade_ms, 3),
         c.crossover_coverage()
-            .map_or("never".to_owned(), |x| format!("{:.2} % of the screen", x * 100.0))
+            .map_or("never".to_owned(), |x| format!(
+                "{:.2} % of the screen",
+                x * 100.0
+            ))
     );
     Ok(())
 }

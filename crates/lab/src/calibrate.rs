@@ -15,7 +15,8 @@
 //! the 1-BRDF time per full-screen light. Extras are each technique's 3-BRDF time minus its own
 //! 1-BRDF time on the same wall, so what both share (setup, cleanup, the shading itself) cancels.
 
-use crate::measure::{time_lighting, Timing, WARM_UP_FRAMES};
+use crate::measure::{Timing, WARM_UP_FRAMES};
+use crate::stats::{median_interval, sample, Interval, Sampled, Sampling};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::{LabError, Result};
 use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Renderer, Technique};
@@ -31,72 +32,136 @@ pub struct Calibration {
     pub device: String,
     pub width: u32,
     pub height: u32,
+    /// Rounds taken (each renders one frame of every measured kind, interleaved).
     pub frames: usize,
+    /// The median over rounds of each round's fit, with the 95 % intervals in
+    /// [`CostModel::interval`].
     pub costs: CostModel,
+    /// How the sampling ended.
+    pub sampled: Sampled,
     /// `(what, lighting time)` of every measured frame kind.
     pub measurements: Vec<(String, Timing)>,
 }
 
-/// Measures the four costs at `width` x `height`; `progress` is told each step.
+/// One measured frame kind: the wall at a coverage, a BRDF count, a technique.
+struct Kind {
+    what: String,
+    renderer: usize,
+    technique: Technique,
+    /// Per-light lighting time of every round.
+    per_light_ms: Vec<f64>,
+}
+
+/// Measures the four costs at `width` x `height` over interleaved rounds (at least
+/// `sampling.min_rounds`, until each cost's interval is within the target or the budget is
+/// spent); every round fits all four costs from its own frames, and each cost is the median of
+/// those fits with its order-statistic interval. `progress` is told each step.
 pub fn calibrate(
     ctx: &Context,
     width: u32,
     height: u32,
-    frames: usize,
+    sampling: &Sampling,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Calibration> {
     // Before the wall is built: its shape follows the aspect ratio.
     histencil_vk::check_extent(ctx, width, height).map(drop)?;
     let aspect = width as f32 / height as f32;
-    let mut measurements = Vec::new();
-    // Per technique: (1-BRDF time, extra time per extra BRDF), per light. One renderer per BRDF
-    // count times every technique on it.
-    let mut per_light = |coverage: f64, techniques: &[Technique]| -> Result<Vec<(f64, f64)>> {
-        let wall = light_size_scene(coverage, aspect);
+    let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
+    let stencil = Technique::Stencil { backend, flush };
+    let branching = Technique::Branching { backend, flush };
+    // Full-screen lights: branching and stencil; small lights: stencil. 1 and 3 BRDFs each.
+    let walls = [
+        (1.0, vec![branching, stencil]),
+        (SMALL_COVERAGE, vec![stencil]),
+    ];
+    let mut renderers = Vec::new();
+    let mut kinds = Vec::new();
+    // Extra BRDFs each light touches, on average (small lights at the wall's edge miss one).
+    let mut extra_brdfs = Vec::new();
+    for (coverage, techniques) in &walls {
+        let wall = light_size_scene(*coverage, aspect);
         let lights = wall.lights.len() as f64;
-        // Extra BRDFs each light touches, on average (small lights at the wall's edge miss one).
         let touched = wall
             .lights
             .iter()
             .map(|l| wall.brdfs_lit_by(l).len() as f64)
             .sum::<f64>();
-        let extra_brdfs = (touched / lights - 1.0).max(1e-6);
-        let mut times = vec![[0.0; 2]; techniques.len()];
-        for (slot, brdfs) in [1, 3].into_iter().enumerate() {
-            let scene = with_brdf_count(&wall, brdfs);
-            let mut renderer = Renderer::new(ctx, scene, width, height)?;
-            for (t, technique) in techniques.iter().enumerate() {
-                let what = format!("{technique:?}, {brdfs} BRDF(s), coverage {coverage}");
-                progress(&what);
-                let timing = time_lighting(&mut renderer, *technique, frames)?;
-                times[t][slot] = timing.median_ms / lights;
-                measurements.push((what, timing));
+        extra_brdfs.push((touched / lights - 1.0).max(1e-6));
+        for brdfs in [1, 3] {
+            progress(&format!("coverage {coverage}, {brdfs} BRDF(s): building"));
+            let mut renderer = Renderer::new(ctx, with_brdf_count(&wall, brdfs), width, height)?;
+            for technique in techniques {
+                for _ in 0..WARM_UP_FRAMES {
+                    renderer.render(*technique, histencil_vk::Readback::NONE)?;
+                }
+                kinds.push(Kind {
+                    what: format!("{technique:?}, {brdfs} BRDF(s), coverage {coverage}"),
+                    renderer: renderers.len(),
+                    technique: *technique,
+                    per_light_ms: Vec::new(),
+                });
             }
+            renderers.push((renderer, lights));
         }
-        Ok(times
-            .iter()
-            .map(|[one, three]| (*one, (three - one) / extra_brdfs))
-            .collect())
+    }
+    // Kinds in push order: full 1 BRDF (branching, stencil), full 3 (branching, stencil),
+    // small 1 (stencil), small 3 (stencil).
+    let fit = |k: &[Kind], round: usize| -> [f64; 4] {
+        let t = |i: usize| k[i].per_light_ms[round];
+        let (shade, tax) = (t(0), (t(2) - t(0)) / extra_brdfs[0]);
+        let a = (t(3) - t(1)) / extra_brdfs[0];
+        let b = (t(5) - t(4)) / extra_brdfs[1];
+        let per_brdf = (a - b) / (1.0 - SMALL_COVERAGE);
+        [(a - per_brdf) / 2.0, per_brdf, tax, shade]
     };
-    let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
-    let stencil = Technique::Stencil { backend, flush };
-    let branching = Technique::Branching { backend, flush };
-    let full = per_light(1.0, &[branching, stencil])?;
-    let ((shade, tax), (_, a)) = (full[0], full[1]);
-    let (_, b) = per_light(SMALL_COVERAGE, &[stencil])?[0];
-    let per_brdf = ((a - b) / (1.0 - SMALL_COVERAGE)).max(0.0);
+    let kinds = std::cell::RefCell::new(kinds);
+    let fits = std::cell::RefCell::new(Vec::<[f64; 4]>::new());
+    let widths = || {
+        let f = fits.borrow();
+        (0..4)
+            .map(|i| median_interval(&f.iter().map(|x| x[i]).collect::<Vec<_>>()))
+            .map(|iv| iv.relative_half_width())
+            .collect()
+    };
+    let sampled = sample(
+        sampling,
+        |round| -> Result<()> {
+            progress(&format!("round {}", round + 1));
+            let mut k = kinds.borrow_mut();
+            for kind in k.iter_mut() {
+                let (renderer, lights) = &mut renderers[kind.renderer];
+                let timings = renderer.render(kind.technique, histencil_vk::Readback::NONE)?;
+                let ms = timings.timings.pass_ms("lighting").unwrap_or(0.0);
+                kind.per_light_ms.push(ms / *lights);
+            }
+            fits.borrow_mut().push(fit(&k, round));
+            Ok(())
+        },
+        widths,
+    )?;
+    let fits = fits.into_inner();
+    let intervals: [Interval; 4] =
+        std::array::from_fn(|i| median_interval(&fits.iter().map(|x| x[i]).collect::<Vec<_>>()));
+    let m = |i: usize| intervals[i].median.max(0.0);
     let costs = CostModel {
-        pass_overhead_ms: ((a - per_brdf) / 2.0).max(0.0),
-        stencil_per_brdf_ms: per_brdf,
-        branch_tax_per_brdf_ms: tax.max(0.0),
-        shade_ms: shade.max(0.0),
+        pass_overhead_ms: m(0),
+        stencil_per_brdf_ms: m(1),
+        branch_tax_per_brdf_ms: m(2),
+        shade_ms: m(3),
+        interval: Some(intervals.map(|iv| (iv.lo.max(0.0), iv.hi.max(0.0)))),
     };
+    let measurements = kinds
+        .into_inner()
+        .into_iter()
+        .map(|k| (k.what, Timing::from_samples(k.per_light_ms)))
+        .collect();
     Ok(Calibration {
         device: ctx.device_name().to_owned(),
         width,
         height,
-        frames,
+        frames: sampled.rounds,
         costs,
+        sampled,
         measurements,
     })
 }
@@ -126,11 +191,22 @@ impl Calibration {
             "settings": {"width": self.width, "height": self.height, "frames": self.frames,
                          "warm_up_frames": WARM_UP_FRAMES},
             "measurements": self.measurements.iter().map(|(what, t)| json!({
-                "what": what, "median_ms": t.median_ms, "min_ms": t.min_ms, "max_ms": t.max_ms,
+                "what": what, "per_light_median_ms": t.median_ms, "min_ms": t.min_ms,
+                "max_ms": t.max_ms,
             })).collect::<Vec<_>>(),
+            "sampling": {"rounds": self.sampled.rounds, "stopped": self.sampled.stop.word(),
+                         "seconds": self.sampled.seconds},
         });
         for (name, value) in FIELDS.iter().zip(fields(&self.costs)) {
             out[*name] = json!(value);
+        }
+        if let Some(iv) = self.costs.interval {
+            let intervals: serde_json::Map<String, Value> = FIELDS
+                .iter()
+                .zip(iv)
+                .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
+                .collect();
+            out["intervals"] = Value::Object(intervals);
         }
         if let Some(x) = self.costs.crossover_coverage() {
             out["crossover_coverage"] = json!(x);
@@ -160,11 +236,37 @@ pub fn read_costs(path: &Path) -> Result<CostModel> {
             .filter(|x| x.is_finite() && *x >= 0.0)
             .ok_or_else(|| bad(format!("`{name}` must be a finite, non-negative number")))?;
     }
+    // Intervals are optional (costs written by hand have none); when present each is a
+    // `[lo, hi]` pair around its cost.
+    let interval = match value.get("intervals") {
+        None | Some(Value::Null) => None,
+        Some(iv) => {
+            let mut out = [(0.0, 0.0); 4];
+            for ((slot, name), cost) in out.iter_mut().zip(FIELDS).zip(v) {
+                let pair = iv
+                    .get(name)
+                    .and_then(Value::as_array)
+                    .filter(|p| p.len() == 2)
+                    .and_then(|p| Some((p[0].as_f64()?, p[1].as_f64()?)))
+                    .filter(|(lo, hi)| {
+                        lo.is_finite() && hi.is_finite() && *lo >= 0.0 && lo <= &cost && cost <= *hi
+                    })
+                    .ok_or_else(|| {
+                        bad(format!(
+                            "`intervals.{name}` must be [lo, hi], finite, with lo <= {name} <= hi"
+                        ))
+                    })?;
+                *slot = pair;
+            }
+            Some(out)
+        }
+    };
     Ok(CostModel {
         pass_overhead_ms: v[0],
         stencil_per_brdf_ms: v[1],
         branch_tax_per_brdf_ms: v[2],
         shade_ms: v[3],
+        interval,
     })
 }
 
@@ -181,6 +283,7 @@ mod tests {
             stencil_per_brdf_ms: 0.2,
             branch_tax_per_brdf_ms: 0.5,
             shade_ms: 2.0,
+            interval: Some([(0.0, 0.02), (0.1, 0.3), (0.5, 0.5), (1.5, 2.5)]),
         };
         let calibration = Calibration {
             device: "test".into(),
@@ -188,11 +291,35 @@ mod tests {
             height: 64,
             frames: 1,
             costs,
+            sampled: Sampled {
+                rounds: 1,
+                stop: crate::stats::Stop::Rounds,
+                widest: 0.0,
+                seconds: 0.0,
+            },
             measurements: vec![],
         };
         let path = dir.join("costs.json");
         calibration.write(&path).unwrap();
         assert_eq!(read_costs(&path).unwrap(), costs);
+        // Hand-written costs without intervals still read; a bad interval is named.
+        std::fs::write(
+            &path,
+            r#"{"pass_overhead_ms": 0, "stencil_per_brdf_ms": 1, "branch_tax_per_brdf_ms": 2,
+                "shade_ms": 3}"#,
+        )
+        .unwrap();
+        assert_eq!(read_costs(&path).unwrap().interval, None);
+        std::fs::write(
+            &path,
+            r#"{"pass_overhead_ms": 0, "stencil_per_brdf_ms": 1, "branch_tax_per_brdf_ms": 2,
+                "shade_ms": 3, "intervals": {"pass_overhead_ms": [0, 1],
+                "stencil_per_brdf_ms": [2, 3], "branch_tax_per_brdf_ms": [2, 2],
+                "shade_ms": [3, 3]}}"#,
+        )
+        .unwrap();
+        let err = read_costs(&path).unwrap_err().to_string();
+        assert!(err.contains("intervals.stencil_per_brdf_ms"), "{err}");
         std::fs::write(&path, r#"{"pass_overhead_ms": -1}"#).unwrap();
         let err = read_costs(&path).unwrap_err().to_string();
         assert!(

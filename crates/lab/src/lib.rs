@@ -27,7 +27,7 @@ mod variants;
 
 pub use alpha_reference::AlphaReference;
 pub use calibrate::{calibrate, read_costs, Calibration};
-pub use compare::{run_compare, CompareReport, CompareSettings};
+pub use compare::{run_compare, CompareReport, CompareSettings, MAX_ROUNDS};
 pub use demo::{run_demo, DemoReport, DemoSettings};
 pub use image_error::{image_error, ImageError};
 pub use measure::Timing;

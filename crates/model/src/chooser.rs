@@ -8,6 +8,11 @@
 //! ```
 //! Stencil costs a fixed overhead per extra pass, branching a tax per pixel: huge lights favour
 //! stencil, tiny ones branching (the talk's "tiny lights? try branching instead").
+//!
+//! Costs measured on a device come with 95 % intervals ([`CostModel::interval`]). The chooser
+//! takes stencil only where it is cheaper at every end of those intervals; where the intervals
+//! cannot tell the two apart it takes branching, the simpler technique (one draw per light, no
+//! mask passes, no stencil state), rather than act on noise.
 
 use crate::plan::LightTechnique;
 
@@ -23,6 +28,9 @@ pub struct CostModel {
     pub branch_tax_per_brdf_ms: f64,
     /// Shading one BRDF, full screen (the single-BRDF light).
     pub shade_ms: f64,
+    /// The 95 % interval `(lo, hi)` of each cost above, in field order, when the costs were
+    /// measured; `None` for costs taken as exact (fitted to the talk's figures).
+    pub interval: Option<[(f64, f64); 4]>,
 }
 
 /// One platform row of the talk's measurements (huge lights, milliseconds).
@@ -76,6 +84,23 @@ impl CostModel {
             stencil_per_brdf_ms: (per_extra(figures.stencil) - 2.0 * pass_overhead_ms).max(0.0),
             branch_tax_per_brdf_ms: per_extra(figures.branching),
             shade_ms: figures.one_brdf,
+            interval: None,
+        }
+    }
+
+    /// The costs at one end of their intervals (`hi`: the upper ends), or these costs when they
+    /// have none.
+    fn at(&self, hi: bool) -> CostModel {
+        let Some(iv) = self.interval else {
+            return *self;
+        };
+        let pick = |i: usize| if hi { iv[i].1 } else { iv[i].0 };
+        CostModel {
+            pass_overhead_ms: pick(0),
+            stencil_per_brdf_ms: pick(1),
+            branch_tax_per_brdf_ms: pick(2),
+            shade_ms: pick(3),
+            interval: None,
         }
     }
 
@@ -92,13 +117,19 @@ impl CostModel {
         }
     }
 
-    /// The cheaper technique; a single affected BRDF needs neither.
+    /// The cheaper technique; a single affected BRDF needs neither. Stencil only where its
+    /// most expensive prediction (upper interval ends) still undercuts branching's cheapest
+    /// (lower ends); a tie, or a difference the intervals cannot resolve, goes to branching.
     pub fn choose(&self, coverage: f64, brdfs: u32) -> LightTechnique {
         if brdfs <= 1 {
             return LightTechnique::SingleBrdf;
         }
-        let stencil = self.extra_ms(LightTechnique::Stencil, coverage, brdfs);
-        let branching = self.extra_ms(LightTechnique::Branching, coverage, brdfs);
+        let stencil = self
+            .at(true)
+            .extra_ms(LightTechnique::Stencil, coverage, brdfs);
+        let branching = self
+            .at(false)
+            .extra_ms(LightTechnique::Branching, coverage, brdfs);
         if stencil < branching {
             LightTechnique::Stencil
         } else {
@@ -172,6 +203,33 @@ mod tests {
             assert_eq!(model.choose(crossover * 1.01, 3), LightTechnique::Stencil);
             assert_eq!(model.choose(crossover * 0.99, 3), LightTechnique::Branching);
         }
+    }
+
+    /// Where measured intervals overlap the chooser does not act on the medians: a light the
+    /// medians give to stencil by a hair goes to branching, one stencil wins at every interval
+    /// end stays stencil.
+    #[test]
+    fn unresolved_differences_go_to_the_simpler_technique() {
+        let exact = CostModel {
+            pass_overhead_ms: 0.01,
+            stencil_per_brdf_ms: 0.2,
+            branch_tax_per_brdf_ms: 0.5,
+            shade_ms: 2.0,
+            interval: None,
+        };
+        let crossover = exact.crossover_coverage().unwrap();
+        let just_above = crossover * 1.05;
+        assert_eq!(exact.choose(just_above, 3), LightTechnique::Stencil);
+        let measured = CostModel {
+            interval: Some([(0.008, 0.012), (0.18, 0.22), (0.45, 0.55), (1.9, 2.1)]),
+            ..exact
+        };
+        assert_eq!(measured.choose(just_above, 3), LightTechnique::Branching);
+        assert_eq!(measured.choose(1.0, 3), LightTechnique::Stencil);
+        assert_eq!(
+            measured.choose(crossover * 0.5, 3),
+            LightTechnique::Branching
+        );
     }
 
     #[test]
