@@ -35,10 +35,12 @@ pub fn text_available() -> bool {
     })
 }
 
-/// One named series of `(x, y)` points.
+/// One named series of `(x, y)` points, with an error bar `(lo, hi)` per point (the 95 %
+/// interval) or none (`bars` empty).
 pub struct Series {
     pub name: String,
     pub points: Vec<(f64, f64)>,
+    pub bars: Vec<(f64, f64)>,
 }
 
 /// Axis description: label and whether it is logarithmic (base 10).
@@ -79,8 +81,13 @@ fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 /// A line chart of `series`, one colour each, with markers at the points.
 pub fn line_chart(path: &Path, title: &str, x: Axis, y: Axis, series: &[Series]) -> Result<()> {
     let all = || series.iter().flat_map(|s| s.points.iter());
+    let bar_ends = || {
+        series
+            .iter()
+            .flat_map(|s| s.bars.iter().flat_map(|b| [b.0, b.1]))
+    };
     let xr = range(all().map(|p| x.map(p.0)));
-    let yr = range(all().map(|p| y.map(p.1)));
+    let yr = range(all().map(|p| p.1).chain(bar_ends()).map(|v| y.map(v)));
     draw_png(path, |root| {
         let text = text_available();
         let mut chart = axes(root, title, (&x, xr), (&y, yr))?;
@@ -95,11 +102,14 @@ pub fn line_chart(path: &Path, title: &str, x: Axis, y: Axis, series: &[Series])
                     PathElement::new(vec![(px, py), (px + 20, py)], colour.stroke_width(2))
                 });
             }
-            chart.draw_series(
-                points
-                    .into_iter()
-                    .map(|p| Circle::new(p, 4, colour.filled())),
-            )?;
+            chart.draw_series(points.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
+            let bars = points.iter().zip(&s.bars).map(|(p, (lo, hi))| {
+                PathElement::new(
+                    vec![(p.0, y.map(*lo)), (p.0, y.map(*hi))],
+                    colour.stroke_width(2),
+                )
+            });
+            chart.draw_series(bars)?;
         }
         if text {
             chart
@@ -251,6 +261,7 @@ mod tests {
         let series = [Series {
             name: "a".into(),
             points: vec![(0.001, 1.0), (0.1, 3.0), (1.0, 2.0)],
+            bars: vec![(0.9, 1.1), (2.5, 3.5), (1.9, 2.2)],
         }];
         let (x, y) = (
             Axis {

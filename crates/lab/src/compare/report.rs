@@ -245,7 +245,12 @@ impl CompareReport {
                 points: r
                     .cells
                     .iter()
-                    .map(|c| (c.brdfs as f64, c.lighting().median_ms))
+                    .map(|c| (c.brdfs as f64, c.interval().median))
+                    .collect(),
+                bars: r
+                    .cells
+                    .iter()
+                    .map(|c| (c.interval().lo, c.interval().hi))
                     .collect(),
             })
             .collect();
@@ -265,26 +270,35 @@ impl CompareReport {
     }
 
     fn plot_sizes(&self, path: &Path) -> Result<()> {
-        let per_light = |f: fn(&SizePoint) -> &Timing| -> Vec<(f64, f64)> {
-            self.sizes
-                .iter()
-                .map(|p| (p.coverage * 100.0, f(p).median_ms / p.lights.max(1) as f64))
-                .collect()
-        };
-        let series = [
-            Series {
-                name: "branching".into(),
-                points: per_light(|p| &p.branching),
-            },
-            Series {
-                name: "stencil".into(),
-                points: per_light(|p| &p.stencil),
-            },
-            Series {
-                name: "adaptive".into(),
-                points: per_light(|p| &p.adaptive),
-            },
-        ];
+        // Per light: each technique's median and interval over the size point's rounds.
+        let series = ["branching", "stencil", "adaptive"]
+            .into_iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let per_light: Vec<(f64, crate::stats::Interval)> = self
+                    .sizes
+                    .iter()
+                    .map(|p| {
+                        let n = p.lights.max(1) as f64;
+                        let iv = median_interval(&p.samples[i]);
+                        (
+                            p.coverage * 100.0,
+                            crate::stats::Interval {
+                                lo: iv.lo / n,
+                                median: iv.median / n,
+                                hi: iv.hi / n,
+                                ..iv
+                            },
+                        )
+                    })
+                    .collect();
+                Series {
+                    name: name.into(),
+                    points: per_light.iter().map(|(c, iv)| (*c, iv.median)).collect(),
+                    bars: per_light.iter().map(|(_, iv)| (iv.lo, iv.hi)).collect(),
+                }
+            })
+            .collect::<Vec<_>>();
         plot::line_chart(
             path,
             "Lighting time per light against light size (3 BRDFs)",
