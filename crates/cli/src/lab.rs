@@ -159,7 +159,19 @@ pub fn read_costs_arg(path: Option<&std::path::Path>) -> Result<Option<histencil
     Ok(path.map(histencil_lab::read_costs).transpose()?)
 }
 
+/// llvmpipe's timings are steadiest with one rasteriser thread: at 320x180, 15 interleaved
+/// rounds gave overhead intervals of ±2.7 to ±3.6 % with `LP_NUM_THREADS=1` against ±4.4 to
+/// ±8.8 % with 2 on a 2-core machine (README, "Measured"), at 1.6 times the time per round, so
+/// tighter per second too. The lab's timing commands take it as their default unless the caller
+/// set it; other drivers ignore the variable. Runs before any thread or Vulkan object exists.
+fn steady_llvmpipe() {
+    if std::env::var_os("LP_NUM_THREADS").is_none() {
+        std::env::set_var("LP_NUM_THREADS", "1");
+    }
+}
+
 pub fn compare(args: &CompareArgs) -> Result<()> {
+    steady_llvmpipe();
     histencil_vk::check_output_dir(&args.out)?;
     if let Some(bad) = args
         .light_sizes
@@ -189,6 +201,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
 }
 
 pub fn sweep(args: &SweepArgs) -> Result<()> {
+    steady_llvmpipe();
     histencil_vk::check_output_dir(&args.out)?;
     let param = match args.param {
         ParamArg::LutRes => SweepParam::LutRes,
@@ -224,6 +237,7 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
 }
 
 pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    steady_llvmpipe();
     histencil_vk::check_output_file(&args.out)?;
     let sampling = args.sampling.sampling(args.run.frames)?;
     let calibration = on_device(args.run.validate, |ctx| {

@@ -263,6 +263,9 @@ pub struct CompareReport {
     pub sampled: Sampled,
     /// The interval width asked for, if any.
     pub target_ci: Option<f64>,
+    /// `LP_NUM_THREADS` when the run started: llvmpipe's rasteriser threads, which decide how
+    /// noisy its timings are (README, "Measured").
+    pub lp_num_threads: Option<String>,
     /// The costs the adaptive rows used.
     pub costs: CostModel,
     pub costs_calibrated: bool,
@@ -477,6 +480,7 @@ pub fn run_compare(
         sizes,
         sampled: table_sampled,
         target_ci: settings.target_ci,
+        lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
         costs: costs.expect("at least one BRDF count"),
         costs_calibrated: settings.costs.is_some(),
     })

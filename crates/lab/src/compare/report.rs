@@ -44,6 +44,7 @@ impl CompareReport {
                 "warm_up_frames": WARM_UP_FRAMES,
             },
             "table_sampling": sampled_json(&self.sampled),
+            "environment": {"LP_NUM_THREADS": self.lp_num_threads},
             "rows": self.rows.iter().map(row_json).collect::<Vec<_>>(),
             "breakdown": self.breakdowns.iter().map(breakdown_json).collect::<Vec<_>>(),
             "light_sizes": self.sizes.iter().map(size_json).collect::<Vec<_>>(),
@@ -88,6 +89,9 @@ impl CompareReport {
             self.device, self.scene, self.scene_lights, self.width, self.height, self.frames
         );
         let t = &self.sampled;
+        if let Some(n) = &self.lp_num_threads {
+            let _ = writeln!(md, "Environment: `LP_NUM_THREADS={n}`.\n");
+        }
         let _ = writeln!(
             md,
             "Sampling: the table took {} rounds in {:.1} s ({}; at least {} rounds{}); its widest \
