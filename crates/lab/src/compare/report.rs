@@ -44,7 +44,6 @@ impl CompareReport {
                 "warm_up_frames": WARM_UP_FRAMES,
             },
             "table_sampling": sampled_json(&self.sampled),
-            "environment": {"LP_NUM_THREADS": self.lp_num_threads},
             "rows": self.rows.iter().map(row_json).collect::<Vec<_>>(),
             "breakdown": self.breakdowns.iter().map(breakdown_json).collect::<Vec<_>>(),
             "light_sizes": self.sizes.iter().map(size_json).collect::<Vec<_>>(),
@@ -71,6 +70,10 @@ impl CompareReport {
             crossover.insert("branching_surely_faster_until".into(), json!(x));
         }
         out["crossover"] = Value::Object(crossover);
+        // Only what was set: the report's values are all present and finite.
+        if let Some(n) = &self.lp_num_threads {
+            out["settings"]["environment"] = json!({ "LP_NUM_THREADS": n });
+        }
         out
     }
 
@@ -459,11 +462,15 @@ fn size_json(p: &SizePoint) -> Value {
     })
 }
 
+/// How sampling ended; the widest interval only when there is one (at least two rounds).
 fn sampled_json(s: &crate::stats::Sampled) -> Value {
-    json!({
+    let mut out = json!({
         "rounds": s.rounds,
         "stopped": s.stop.word(),
-        "widest_relative_half_width": if s.widest.is_finite() { json!(s.widest) } else { Value::Null },
         "seconds": s.seconds,
-    })
+    });
+    if s.widest.is_finite() {
+        out["widest_relative_half_width"] = json!(s.widest);
+    }
+    out
 }
