@@ -58,6 +58,20 @@ impl ImageRef {
     }
 }
 
+/// The caller's images a frame is lit in, each with its current state. Recording leaves every
+/// [`ImageRef::state`] as the recorded commands leave the image, for the caller's next barrier:
+/// the G-buffer images sampled by fragment shaders, the depth-stencil and HDR images attached.
+#[derive(Clone, Copy, Debug)]
+pub struct LightingTargets {
+    /// Albedo, normal-depth, material, in [`crate::GBUFFER_FORMATS`]; usage `SAMPLED`.
+    pub gbuffer: [ImageRef; 3],
+    /// The G-buffer pass's depth and stencil; usage `DEPTH_STENCIL_ATTACHMENT | TRANSFER_SRC`
+    /// (the hi-stencil emulation and 360-like save/restore copy the stencil out).
+    pub depth_stencil: ImageRef,
+    /// Where light accumulates; usage `COLOR_ATTACHMENT`.
+    pub hdr: ImageRef,
+}
+
 /// Every aspect of `format`.
 pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
     use vk::Format as F;

@@ -14,7 +14,7 @@
 //! field with the culling bit clear ([`gbuffer_stencil_reference`]), standard or reversed depth as
 //! the [`ViewDesc`] says.
 
-use crate::access::ImageRef;
+use crate::access::{ImageRef, LightingTargets};
 use crate::context::Context;
 use crate::descriptors::{
     create_pipeline_layout, create_set_layout, write_frame_set, write_sampled_images,
@@ -52,20 +52,6 @@ pub struct LightingDesc {
     pub frames_in_flight: u32,
     /// The most lights a frame may carry.
     pub max_lights: u32,
-}
-
-/// The caller's images a frame is lit in, each with its current state. Recording leaves every
-/// [`ImageRef::state`] as the recorded commands leave the image, for the caller's next barrier:
-/// the G-buffer images sampled by fragment shaders, the depth-stencil and HDR images attached.
-#[derive(Clone, Copy, Debug)]
-pub struct LightingTargets {
-    /// Albedo, normal-depth, material, in [`crate::GBUFFER_FORMATS`]; usage `SAMPLED`.
-    pub gbuffer: [ImageRef; 3],
-    /// The G-buffer pass's depth and stencil; usage `DEPTH_STENCIL_ATTACHMENT | TRANSFER_SRC`
-    /// (the hi-stencil emulation and 360-like save/restore copy the stencil out).
-    pub depth_stencil: ImageRef,
-    /// Where light accumulates; usage `COLOR_ATTACHMENT`.
-    pub hdr: ImageRef,
 }
 
 /// One frame's lighting.

@@ -43,14 +43,14 @@ pub mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
 
-pub use access::{aspect_of, ImageRef, ImageState};
+pub use access::{aspect_of, ImageRef, ImageState, LightingTargets};
 pub use alpha::AlphaMode;
 pub use brdf_eval::BrdfEvaluator;
 pub use capture::SimulatorInputs;
 pub use context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat};
 pub use debug::{ValidationLog, ValidationMessage};
 pub use deferred_lighting::{
-    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, LightingTargets,
+    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame,
 };
 pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;

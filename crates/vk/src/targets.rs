@@ -1,8 +1,8 @@
 //! The frame's render targets, named after their role (the names show up in validation messages
 //! and captures).
 
+use crate::access::LightingTargets;
 use crate::context::Context;
-use crate::deferred_lighting::LightingTargets;
 use crate::error::{Error, Result};
 use crate::resources::Image;
 use ash::vk;

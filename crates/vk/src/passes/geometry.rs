@@ -5,9 +5,8 @@ use super::{
     begin_hdr_rendering, begin_rendering, clear_depth_stencil, color_attachment,
     depth_stencil_attachment, Load, CLEAR_BLACK,
 };
-use crate::access::{transition, Contents, ImageAccess};
+use crate::access::{transition, Contents, ImageAccess, LightingTargets};
 use crate::context::Context;
-use crate::deferred_lighting::LightingTargets;
 use crate::gpu_types::DrawPush;
 use crate::meshes::Meshes;
 use crate::state::{apply, oriented, with_stencil, OPAQUE};

@@ -13,9 +13,8 @@ use super::light_pipelines::{
     pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
 };
 use super::{begin_hdr_rendering, Load, CLEAR_BLACK};
-use crate::access::{memory_barrier, transition, Contents, ImageAccess};
+use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
 use crate::context::Context;
-use crate::deferred_lighting::LightingTargets;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
 use crate::hi_stencil::HiStencilSurface;

@@ -1,33 +1,30 @@
-//! The renderer: owns a scene's GPU resources and records / submits whole frames.
+//! The renderer: owns a scene's GPU resources and records / submits whole frames. This file
+//! holds what it owns and how it is made and configured; `frame.rs` the order of a frame's
+//! passes, `simulator.rs` what the CPU simulator is given.
+
+mod frame;
+mod simulator;
 
 use crate::alpha::AlphaLighting;
-use crate::capture::{FootprintCapture, SimulatorInputs};
 use crate::context::Context;
-use crate::deferred_lighting::{DeferredLighting, LightingDesc, LightingFrame, LightingTargets};
+use crate::deferred_lighting::{DeferredLighting, LightingDesc};
 use crate::descriptors::{DescriptorTargets, Descriptors};
 use crate::error::{Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::lut::LutTables;
 use crate::meshes::Meshes;
-use crate::passes::geometry::GeometryPass;
-use crate::passes::light_pipelines::BrdfSource;
-use crate::passes::tonemap::TonemapPass;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
-use crate::readback::{
-    copy_image_to_buffer, host_readable, FrameImages, Readback, ReadbackBuffers,
-};
+use crate::readback::{FrameImages, ReadbackBuffers};
 use crate::resources::Buffer;
-use crate::shader_consts::HI_STENCIL_TILE;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
-use crate::technique::{Backend, FrameDesc, Technique};
+use crate::technique::{Backend, Technique};
 use crate::timing::{FrameTimings, Timestamps};
 use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{
-    plan_frame, CostModel, DepthConvention, FarPlane, Footprint, FramePlan, LightShape,
-    Perspective, PlanError, PlanInputs, SoftTarget, StencilBits, StencilLayout, TalkFigures,
-    TileStats, View, ViewDesc,
+    plan_frame, CostModel, DepthConvention, FarPlane, FramePlan, LightShape, Perspective,
+    PlanError, PlanInputs, StencilBits, StencilLayout, TalkFigures, TileStats, View, ViewDesc,
 };
 use histencil_scene::Scene;
 
@@ -73,7 +70,7 @@ fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
 }
 
 /// A rendered frame: its GPU timings, the images asked for, and the hi-stencil statistics when
-/// [`FrameDesc::tile_stats`] asks for them (deferred techniques only).
+/// [`crate::FrameDesc::tile_stats`] asks for them (deferred techniques only).
 pub struct Frame {
     pub timings: FrameTimings,
     pub images: FrameImages,
@@ -269,7 +266,7 @@ impl<'c> Renderer<'c> {
     }
 
     /// The stencil value each object's G-buffer draw writes with `preserved_pattern` in the
-    /// preserved bits ([`FrameDesc::preserved_pattern`]).
+    /// preserved bits ([`crate::FrameDesc::preserved_pattern`]).
     pub fn object_stencil_values(&self, preserved_pattern: u8) -> Vec<u8> {
         self.object_slots
             .iter()
@@ -468,327 +465,6 @@ impl<'c> Renderer<'c> {
             settings: projected.settings,
             ..camera
         })
-    }
-
-    /// Renders one frame and waits for it. `readback` says which images to copy back.
-    pub fn render(&mut self, technique: Technique, readback: Readback) -> Result<Frame> {
-        self.render_frame(&FrameDesc::new(technique, readback))
-    }
-
-    /// Renders the frame `desc` describes and waits for it.
-    pub fn render_frame(&mut self, desc: &FrameDesc) -> Result<Frame> {
-        let FrameDesc {
-            technique,
-            readback,
-            depth,
-            infinite_far,
-            alpha: alpha_mode,
-            preserved_pattern: _,
-            pass_timing,
-            tile_stats,
-        } = *desc;
-        // Only the deferred path has a G-buffer to read BRDF ids from.
-        let readback = Readback {
-            brdf_ids: readback.brdf_ids && technique != Technique::Forward,
-            ..readback
-        };
-        let ctx = self.ctx;
-        let view = self.view_desc_in(depth, infinite_far);
-        self.frame_uniforms
-            .write(bytemuck::bytes_of(&self.uniforms(&view)?));
-        let plan = self.plan_in(technique, &view)?;
-        let count_stats = tile_stats && technique != Technique::Forward;
-        let brdf_source = technique.brdf_source();
-        if brdf_source == BrdfSource::Table {
-            self.lut_tables()?;
-        }
-        self.alpha_lighting()?;
-        let time_steps = pass_timing && technique != Technique::Forward;
-        let cmd = self.begin_commands()?;
-        self.timestamps.begin_frame(ctx, cmd);
-        match technique {
-            Technique::Forward => {
-                self.record_geometry(true, desc);
-                self.timestamps.mark(ctx, cmd, "forward");
-            }
-            _ => {
-                self.record_geometry(false, desc);
-                self.timestamps.mark(ctx, cmd, "gbuffer");
-                let frame = LightingFrame {
-                    slot: 0,
-                    view: &view,
-                    lights: &self.scene.lights,
-                    plan: &plan,
-                    clear_hdr: true,
-                    timestamps: time_steps,
-                };
-                let mut targets = self.targets.lighting();
-                self.lighting
-                    .record_with(cmd, &frame, &mut targets, count_stats, brdf_source)?;
-                self.targets.lit(&targets);
-                self.timestamps.mark(ctx, cmd, "lighting");
-            }
-        }
-        if let Some(alpha) = self.alpha.as_mut() {
-            let frame_set = self.descriptors.frame_set;
-            let (scene, meshes) = (&self.scene, &self.meshes);
-            alpha.record_lightmaps(ctx, cmd, scene, meshes, frame_set, alpha_mode);
-            self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
-            alpha.record_alpha(
-                ctx,
-                cmd,
-                scene,
-                meshes,
-                &mut self.targets,
-                frame_set,
-                (alpha_mode, self.extent, depth),
-            );
-            self.timestamps.mark(ctx, cmd, "alpha");
-        }
-        TonemapPass {
-            ctx,
-            cmd,
-            pipeline: self.pipelines.tonemap,
-            pipeline_layout: self.descriptors.tonemap_pipeline_layout,
-            sets: [self.descriptors.frame_set, self.descriptors.tonemap_set],
-            extent: self.extent,
-        }
-        .record(&mut self.targets);
-        self.timestamps.mark(ctx, cmd, "tonemap");
-        self.readback.record(ctx, cmd, &mut self.targets, readback);
-        self.submit_and_wait()?;
-        let mut timings = self.timestamps.read(ctx)?;
-        if time_steps {
-            timings.lighting = self.lighting.step_timings(0)?;
-        }
-        let images = self.readback.read(readback)?;
-        let tile_stats = count_stats.then(|| self.lighting.tile_stats(&plan));
-        Ok(Frame {
-            timings,
-            images,
-            tile_stats,
-        })
-    }
-
-    /// Resets the frame's command pool (its one command buffer; resetting pools, not single
-    /// buffers, is what the best-practices layer asks for) and begins the command buffer.
-    fn begin_commands(&self) -> Result<vk::CommandBuffer> {
-        let (d, cmd) = (&self.ctx.device, self.cmd);
-        unsafe {
-            d.reset_command_pool(self.command_pool, vk::CommandPoolResetFlags::empty())
-                .call("vkResetCommandPool")?;
-            let begin = vk::CommandBufferBeginInfo::default()
-                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-            d.begin_command_buffer(cmd, &begin)
-                .call("vkBeginCommandBuffer")?;
-        }
-        Ok(cmd)
-    }
-
-    /// Ends, submits and waits for the frame's command buffer.
-    fn submit_and_wait(&self) -> Result<()> {
-        let (ctx, cmd) = (self.ctx, self.cmd);
-        unsafe {
-            ctx.device
-                .end_command_buffer(cmd)
-                .call("vkEndCommandBuffer")?;
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            ctx.device
-                .queue_submit2(ctx.queue, &[submit], self.fence)
-                .call("vkQueueSubmit2")?;
-            ctx.device
-                .wait_for_fences(&[self.fence], true, u64::MAX)
-                .call("vkWaitForFences")?;
-            ctx.device
-                .reset_fences(&[self.fence])
-                .call("vkResetFences")?;
-        }
-        Ok(())
-    }
-
-    /// Records the forward pass or the G-buffer pass into the renderer's targets.
-    fn record_geometry(&mut self, forward: bool, desc: &FrameDesc) {
-        let cmd = self.cmd;
-        let mut targets = self.targets.lighting();
-        if forward {
-            self.geometry_pass(cmd, true, desc.depth)
-                .record_forward(&mut targets);
-        } else {
-            let (depth, pattern) = (desc.depth, desc.preserved_pattern);
-            self.record_gbuffer_into(cmd, &mut targets, depth, pattern);
-        }
-        self.targets.lit(&targets);
-    }
-
-    fn geometry_pass(
-        &self,
-        cmd: vk::CommandBuffer,
-        forward: bool,
-        depth: DepthConvention,
-    ) -> GeometryPass<'_> {
-        GeometryPass {
-            ctx: self.ctx,
-            cmd,
-            scene: &self.scene,
-            meshes: &self.meshes,
-            pipeline: if forward {
-                self.pipelines.forward
-            } else {
-                self.pipelines.gbuffer
-            },
-            pipeline_layout: self.descriptors.mesh_pipeline_layout,
-            frame_set: self.descriptors.frame_set,
-            extent: self.extent,
-            material_indices: &self.object_materials,
-            depth,
-        }
-    }
-
-    fn record_gbuffer_into(
-        &self,
-        cmd: vk::CommandBuffer,
-        targets: &mut LightingTargets,
-        depth: DepthConvention,
-        preserved_pattern: u8,
-    ) {
-        self.geometry_pass(cmd, false, depth).record_gbuffer(
-            targets,
-            &self.stencil_layout,
-            &self.object_slots,
-            preserved_pattern,
-        );
-    }
-
-    /// Records histencil's G-buffer pass of the scene (its camera, its objects) into another
-    /// owner's images: the G-buffer and depth-stencil of `targets` are cleared and written, in
-    /// the formats of the contract ([`crate::GBUFFER_FORMATS`], the context's depth-stencil
-    /// format), and left attached-ready with their states updated; the HDR image is untouched.
-    /// For engines and tests that light histencil's scenes with [`crate::DeferredLighting`].
-    ///
-    /// # Errors
-    /// [`crate::Error::BadFrame`] when an image's extent or format differs from the renderer's.
-    ///
-    /// # Safety
-    /// `cmd` is recording, outside a render pass, on the renderer's device; the G-buffer and
-    /// depth-stencil images of `targets` are live with `COLOR_ATTACHMENT` and
-    /// `DEPTH_STENCIL_ATTACHMENT` usage, and their states are true when `cmd` executes.
-    pub unsafe fn record_gbuffer(
-        &self,
-        cmd: vk::CommandBuffer,
-        targets: &mut LightingTargets,
-    ) -> Result<()> {
-        let images = targets.gbuffer.iter().zip(GBUFFER_FORMATS);
-        let ds = (&targets.depth_stencil, self.ctx.depth_stencil_format);
-        for (image, format) in images.chain([ds]) {
-            if image.extent != self.extent || image.format != format {
-                return Err(crate::Error::BadFrame(format!(
-                    "a {:?} {}x{} image where the G-buffer pass writes {format:?} {}x{}",
-                    image.format,
-                    image.extent.width,
-                    image.extent.height,
-                    self.extent.width,
-                    self.extent.height
-                )));
-            }
-        }
-        self.record_gbuffer_into(cmd, targets, DepthConvention::Standard, 0);
-        Ok(())
-    }
-
-    /// The CPU simulator's inputs for `technique`'s frame, captured from the GPU: the G-buffer
-    /// pass's depth and stencil, the plan, and each planned light's footprint as rasterised.
-    /// `histencil_model::Simulator` run on them predicts the stencil and the hi-stencil
-    /// statistics ([`Frame::tile_stats`]) the GPU frame produces.
-    ///
-    /// # Errors
-    /// [`crate::Error::Unsupported`] without a 32-bit float depth buffer (the simulator compares
-    /// f32 depths), besides the errors of [`Renderer::plan`] and of Vulkan calls.
-    pub fn simulator_inputs(&mut self, desc: impl Into<FrameDesc>) -> Result<SimulatorInputs> {
-        let desc = &desc.into();
-        if desc.depth != DepthConvention::Standard || desc.infinite_far {
-            return Err(crate::Error::Unsupported(
-                "simulator inputs of a frame with reversed depth or an infinite far plane",
-            ));
-        }
-        let ctx = self.ctx;
-        let plan = self.plan(desc.technique)?;
-        let layout = self.lighting.pipeline_layout();
-        let mut capture = FootprintCapture::new(ctx, layout, self.extent)?;
-        let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
-        let mut depth = Buffer::readback(ctx, "depth-readback", pixels * 4)?;
-        let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
-        let result = (|| {
-            let cmd = self.begin_commands()?;
-            self.record_geometry(false, desc);
-            let image = &mut self.targets.depth_stencil;
-            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
-            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
-            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
-            self.submit_and_wait()?;
-            let target = SoftTarget {
-                width: self.extent.width,
-                height: self.extent.height,
-                depth: bytemuck::cast_slice(depth.read()).to_vec(),
-                stencil: stencil.read().to_vec(),
-            };
-            let mut footprints = Vec::new();
-            for (planned, light) in plan.lights.iter().enumerate() {
-                let index = light.input as u32;
-                if plan.is_full_screen(planned) {
-                    footprints.push(Footprint::full_screen(target.width, target.height));
-                    continue;
-                }
-                let cmd = self.begin_commands()?;
-                unsafe {
-                    ctx.device.cmd_bind_descriptor_sets(
-                        cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        layout,
-                        0,
-                        &[self.descriptors.frame_set],
-                        &[],
-                    );
-                }
-                let light = &self.scene.lights[index as usize];
-                capture.record(ctx, cmd, layout, self.lighting.volumes(), (index, light));
-                self.submit_and_wait()?;
-                footprints.push(capture.footprint()?);
-            }
-            Ok(SimulatorInputs {
-                layout: self.stencil_layout,
-                tile_size: HI_STENCIL_TILE,
-                target,
-                plan,
-                footprints,
-            })
-        })();
-        capture.destroy(ctx);
-        depth.destroy(ctx);
-        stencil.destroy(ctx);
-        result
-    }
-
-    /// Renders `frames` frames of `desc` without readback and returns the median of each
-    /// timing.
-    pub fn measure(&mut self, desc: impl Into<FrameDesc>, frames: usize) -> Result<FrameTimings> {
-        Ok(FrameTimings::median(&self.measure_frames(desc, frames)?))
-    }
-
-    /// Renders `frames` frames (at least one) of `desc` without readback and returns each
-    /// frame's timings, for callers that want the spread as well as the median.
-    pub fn measure_frames(
-        &mut self,
-        desc: impl Into<FrameDesc>,
-        frames: usize,
-    ) -> Result<Vec<FrameTimings>> {
-        let desc = FrameDesc {
-            readback: Readback::NONE,
-            ..desc.into()
-        };
-        (0..frames.max(1))
-            .map(|_| Ok(self.render_frame(&desc)?.timings))
-            .collect()
     }
 }
 

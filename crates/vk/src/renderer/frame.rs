@@ -1,0 +1,267 @@
+//! One renderer frame: its passes in order (G-buffer or forward, lighting through
+//! `DeferredLighting`, alpha lightmaps and the alpha pass, tonemap, readback), submitted and
+//! waited for.
+
+use super::{Frame, Renderer};
+use crate::access::LightingTargets;
+use crate::deferred_lighting::LightingFrame;
+use crate::error::{Result, VkCall};
+use crate::passes::geometry::GeometryPass;
+use crate::passes::light_pipelines::BrdfSource;
+use crate::passes::tonemap::TonemapPass;
+use crate::readback::Readback;
+use crate::targets::GBUFFER_FORMATS;
+use crate::technique::{FrameDesc, Technique};
+use crate::timing::FrameTimings;
+use ash::vk;
+use histencil_model::DepthConvention;
+
+impl Renderer<'_> {
+    /// Renders one frame and waits for it. `readback` says which images to copy back.
+    pub fn render(&mut self, technique: Technique, readback: Readback) -> Result<Frame> {
+        self.render_frame(&FrameDesc::new(technique, readback))
+    }
+
+    /// Renders the frame `desc` describes and waits for it.
+    pub fn render_frame(&mut self, desc: &FrameDesc) -> Result<Frame> {
+        let FrameDesc {
+            technique,
+            readback,
+            depth,
+            infinite_far,
+            alpha: alpha_mode,
+            preserved_pattern: _,
+            pass_timing,
+            tile_stats,
+        } = *desc;
+        // Only the deferred path has a G-buffer to read BRDF ids from.
+        let readback = Readback {
+            brdf_ids: readback.brdf_ids && technique != Technique::Forward,
+            ..readback
+        };
+        let ctx = self.ctx;
+        let view = self.view_desc_in(depth, infinite_far);
+        self.frame_uniforms
+            .write(bytemuck::bytes_of(&self.uniforms(&view)?));
+        let plan = self.plan_in(technique, &view)?;
+        let count_stats = tile_stats && technique != Technique::Forward;
+        let brdf_source = technique.brdf_source();
+        if brdf_source == BrdfSource::Table {
+            self.lut_tables()?;
+        }
+        self.alpha_lighting()?;
+        let time_steps = pass_timing && technique != Technique::Forward;
+        let cmd = self.begin_commands()?;
+        self.timestamps.begin_frame(ctx, cmd);
+        match technique {
+            Technique::Forward => {
+                self.record_geometry(true, desc);
+                self.timestamps.mark(ctx, cmd, "forward");
+            }
+            _ => {
+                self.record_geometry(false, desc);
+                self.timestamps.mark(ctx, cmd, "gbuffer");
+                let frame = LightingFrame {
+                    slot: 0,
+                    view: &view,
+                    lights: &self.scene.lights,
+                    plan: &plan,
+                    clear_hdr: true,
+                    timestamps: time_steps,
+                };
+                let mut targets = self.targets.lighting();
+                self.lighting
+                    .record_with(cmd, &frame, &mut targets, count_stats, brdf_source)?;
+                self.targets.lit(&targets);
+                self.timestamps.mark(ctx, cmd, "lighting");
+            }
+        }
+        if let Some(alpha) = self.alpha.as_mut() {
+            let frame_set = self.descriptors.frame_set;
+            let (scene, meshes) = (&self.scene, &self.meshes);
+            alpha.record_lightmaps(ctx, cmd, scene, meshes, frame_set, alpha_mode);
+            self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
+            alpha.record_alpha(
+                ctx,
+                cmd,
+                scene,
+                meshes,
+                &mut self.targets,
+                frame_set,
+                (alpha_mode, self.extent, depth),
+            );
+            self.timestamps.mark(ctx, cmd, "alpha");
+        }
+        TonemapPass {
+            ctx,
+            cmd,
+            pipeline: self.pipelines.tonemap,
+            pipeline_layout: self.descriptors.tonemap_pipeline_layout,
+            sets: [self.descriptors.frame_set, self.descriptors.tonemap_set],
+            extent: self.extent,
+        }
+        .record(&mut self.targets);
+        self.timestamps.mark(ctx, cmd, "tonemap");
+        self.readback.record(ctx, cmd, &mut self.targets, readback);
+        self.submit_and_wait()?;
+        let mut timings = self.timestamps.read(ctx)?;
+        if time_steps {
+            timings.lighting = self.lighting.step_timings(0)?;
+        }
+        let images = self.readback.read(readback)?;
+        let tile_stats = count_stats.then(|| self.lighting.tile_stats(&plan));
+        Ok(Frame {
+            timings,
+            images,
+            tile_stats,
+        })
+    }
+
+    /// Resets the frame's command pool (its one command buffer; resetting pools, not single
+    /// buffers, is what the best-practices layer asks for) and begins the command buffer.
+    pub(super) fn begin_commands(&self) -> Result<vk::CommandBuffer> {
+        let (d, cmd) = (&self.ctx.device, self.cmd);
+        unsafe {
+            d.reset_command_pool(self.command_pool, vk::CommandPoolResetFlags::empty())
+                .call("vkResetCommandPool")?;
+            let begin = vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            d.begin_command_buffer(cmd, &begin)
+                .call("vkBeginCommandBuffer")?;
+        }
+        Ok(cmd)
+    }
+
+    /// Ends, submits and waits for the frame's command buffer.
+    pub(super) fn submit_and_wait(&self) -> Result<()> {
+        let (ctx, cmd) = (self.ctx, self.cmd);
+        unsafe {
+            ctx.device
+                .end_command_buffer(cmd)
+                .call("vkEndCommandBuffer")?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            ctx.device
+                .queue_submit2(ctx.queue, &[submit], self.fence)
+                .call("vkQueueSubmit2")?;
+            ctx.device
+                .wait_for_fences(&[self.fence], true, u64::MAX)
+                .call("vkWaitForFences")?;
+            ctx.device
+                .reset_fences(&[self.fence])
+                .call("vkResetFences")?;
+        }
+        Ok(())
+    }
+
+    /// Records the forward pass or the G-buffer pass into the renderer's targets.
+    pub(super) fn record_geometry(&mut self, forward: bool, desc: &FrameDesc) {
+        let cmd = self.cmd;
+        let mut targets = self.targets.lighting();
+        if forward {
+            self.geometry_pass(cmd, true, desc.depth)
+                .record_forward(&mut targets);
+        } else {
+            let (depth, pattern) = (desc.depth, desc.preserved_pattern);
+            self.record_gbuffer_into(cmd, &mut targets, depth, pattern);
+        }
+        self.targets.lit(&targets);
+    }
+
+    fn geometry_pass(
+        &self,
+        cmd: vk::CommandBuffer,
+        forward: bool,
+        depth: DepthConvention,
+    ) -> GeometryPass<'_> {
+        GeometryPass {
+            ctx: self.ctx,
+            cmd,
+            scene: &self.scene,
+            meshes: &self.meshes,
+            pipeline: if forward {
+                self.pipelines.forward
+            } else {
+                self.pipelines.gbuffer
+            },
+            pipeline_layout: self.descriptors.mesh_pipeline_layout,
+            frame_set: self.descriptors.frame_set,
+            extent: self.extent,
+            material_indices: &self.object_materials,
+            depth,
+        }
+    }
+
+    fn record_gbuffer_into(
+        &self,
+        cmd: vk::CommandBuffer,
+        targets: &mut LightingTargets,
+        depth: DepthConvention,
+        preserved_pattern: u8,
+    ) {
+        self.geometry_pass(cmd, false, depth).record_gbuffer(
+            targets,
+            &self.stencil_layout,
+            &self.object_slots,
+            preserved_pattern,
+        );
+    }
+
+    /// Records histencil's G-buffer pass of the scene (its camera, its objects) into another
+    /// owner's images: the G-buffer and depth-stencil of `targets` are cleared and written, in
+    /// the formats of the contract ([`crate::GBUFFER_FORMATS`], the context's depth-stencil
+    /// format), and left attached-ready with their states updated; the HDR image is untouched.
+    /// For engines and tests that light histencil's scenes with [`crate::DeferredLighting`].
+    ///
+    /// # Errors
+    /// [`crate::Error::BadFrame`] when an image's extent or format differs from the renderer's.
+    ///
+    /// # Safety
+    /// `cmd` is recording, outside a render pass, on the renderer's device; the G-buffer and
+    /// depth-stencil images of `targets` are live with `COLOR_ATTACHMENT` and
+    /// `DEPTH_STENCIL_ATTACHMENT` usage, and their states are true when `cmd` executes.
+    pub unsafe fn record_gbuffer(
+        &self,
+        cmd: vk::CommandBuffer,
+        targets: &mut LightingTargets,
+    ) -> Result<()> {
+        let images = targets.gbuffer.iter().zip(GBUFFER_FORMATS);
+        let ds = (&targets.depth_stencil, self.ctx.depth_stencil_format);
+        for (image, format) in images.chain([ds]) {
+            if image.extent != self.extent || image.format != format {
+                return Err(crate::Error::BadFrame(format!(
+                    "a {:?} {}x{} image where the G-buffer pass writes {format:?} {}x{}",
+                    image.format,
+                    image.extent.width,
+                    image.extent.height,
+                    self.extent.width,
+                    self.extent.height
+                )));
+            }
+        }
+        self.record_gbuffer_into(cmd, targets, DepthConvention::Standard, 0);
+        Ok(())
+    }
+
+    /// Renders `frames` frames of `desc` without readback and returns the median of each
+    /// timing.
+    pub fn measure(&mut self, desc: impl Into<FrameDesc>, frames: usize) -> Result<FrameTimings> {
+        Ok(FrameTimings::median(&self.measure_frames(desc, frames)?))
+    }
+
+    /// Renders `frames` frames (at least one) of `desc` without readback and returns each
+    /// frame's timings, for callers that want the spread as well as the median.
+    pub fn measure_frames(
+        &mut self,
+        desc: impl Into<FrameDesc>,
+        frames: usize,
+    ) -> Result<Vec<FrameTimings>> {
+        let desc = FrameDesc {
+            readback: Readback::NONE,
+            ..desc.into()
+        };
+        (0..frames.max(1))
+            .map(|_| Ok(self.render_frame(&desc)?.timings))
+            .collect()
+    }
+}

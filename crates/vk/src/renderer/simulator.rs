@@ -1,0 +1,86 @@
+//! The CPU simulator's inputs, captured from the GPU's own frame.
+
+use super::Renderer;
+use crate::capture::{FootprintCapture, SimulatorInputs};
+use crate::error::Result;
+use crate::readback::{copy_image_to_buffer, host_readable};
+use crate::resources::Buffer;
+use crate::shader_consts::HI_STENCIL_TILE;
+use crate::technique::FrameDesc;
+use ash::vk;
+use histencil_model::{DepthConvention, Footprint, SoftTarget};
+
+impl Renderer<'_> {
+    /// The CPU simulator's inputs for `technique`'s frame, captured from the GPU: the G-buffer
+    /// pass's depth and stencil, the plan, and each planned light's footprint as rasterised.
+    /// `histencil_model::Simulator` run on them predicts the stencil and the hi-stencil
+    /// statistics ([`super::Frame::tile_stats`]) the GPU frame produces.
+    ///
+    /// # Errors
+    /// [`crate::Error::Unsupported`] without a 32-bit float depth buffer (the simulator compares
+    /// f32 depths), besides the errors of [`Renderer::plan`] and of Vulkan calls.
+    pub fn simulator_inputs(&mut self, desc: impl Into<FrameDesc>) -> Result<SimulatorInputs> {
+        let desc = &desc.into();
+        if desc.depth != DepthConvention::Standard || desc.infinite_far {
+            return Err(crate::Error::Unsupported(
+                "simulator inputs of a frame with reversed depth or an infinite far plane",
+            ));
+        }
+        let ctx = self.ctx;
+        let plan = self.plan(desc.technique)?;
+        let layout = self.lighting.pipeline_layout();
+        let mut capture = FootprintCapture::new(ctx, layout, self.extent)?;
+        let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
+        let mut depth = Buffer::readback(ctx, "depth-readback", pixels * 4)?;
+        let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
+        let result = (|| {
+            let cmd = self.begin_commands()?;
+            self.record_geometry(false, desc);
+            let image = &mut self.targets.depth_stencil;
+            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
+            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
+            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
+            self.submit_and_wait()?;
+            let target = SoftTarget {
+                width: self.extent.width,
+                height: self.extent.height,
+                depth: bytemuck::cast_slice(depth.read()).to_vec(),
+                stencil: stencil.read().to_vec(),
+            };
+            let mut footprints = Vec::new();
+            for (planned, light) in plan.lights.iter().enumerate() {
+                let index = light.input as u32;
+                if plan.is_full_screen(planned) {
+                    footprints.push(Footprint::full_screen(target.width, target.height));
+                    continue;
+                }
+                let cmd = self.begin_commands()?;
+                unsafe {
+                    ctx.device.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        layout,
+                        0,
+                        &[self.descriptors.frame_set],
+                        &[],
+                    );
+                }
+                let light = &self.scene.lights[index as usize];
+                capture.record(ctx, cmd, layout, self.lighting.volumes(), (index, light));
+                self.submit_and_wait()?;
+                footprints.push(capture.footprint()?);
+            }
+            Ok(SimulatorInputs {
+                layout: self.stencil_layout,
+                tile_size: HI_STENCIL_TILE,
+                target,
+                plan,
+                footprints,
+            })
+        })();
+        capture.destroy(ctx);
+        depth.destroy(ctx);
+        stencil.destroy(ctx);
+        result
+    }
+}
