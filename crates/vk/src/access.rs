@@ -4,7 +4,6 @@
 //! [`ImageRef`]s go through the same code.
 
 use crate::context::Context;
-use crate::resources::subresource_range;
 use ash::vk;
 
 /// Where an image stands: its layout and the last stages and accesses that touched it (the
@@ -70,6 +69,14 @@ pub struct LightingTargets {
     pub depth_stencil: ImageRef,
     /// Where light accumulates; usage `COLOR_ATTACHMENT`.
     pub hdr: ImageRef,
+}
+
+/// The one mip level and array layer histencil's images have, over `aspect`.
+pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange::default()
+        .aspect_mask(aspect)
+        .level_count(1)
+        .layer_count(1)
 }
 
 /// Every aspect of `format`.

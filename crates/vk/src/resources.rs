@@ -2,7 +2,7 @@
 //! destroyed explicitly with the context (`destroy`), never by `Drop`, so teardown order stays in
 //! the owner's hands.
 
-use crate::access::{ImageRef, ImageState};
+use crate::access::{subresource_range, ImageRef, ImageState};
 use crate::context::Context;
 use crate::error::{Error, Result, VkCall};
 use ash::vk;
@@ -244,13 +244,6 @@ impl Image {
             free(ctx, a);
         }
     }
-}
-
-pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
-    vk::ImageSubresourceRange::default()
-        .aspect_mask(aspect)
-        .level_count(1)
-        .layer_count(1)
 }
 
 #[cfg(test)]
