@@ -93,6 +93,7 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
                 hdr_format: vk::Format::R16G16B16A16_SFLOAT,
                 frames_in_flight: IN_FLIGHT as u32,
                 max_lights: scene.lights.len() as u32,
+                hi_stencil: true,
             },
         )
         .unwrap();
@@ -360,6 +361,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             hdr_format: vk::Format::R16G16B16A16_SFLOAT,
             frames_in_flight: 2,
             max_lights: scene.lights.len() as u32,
+            hi_stencil: true,
         };
         let bad_descs = [
             LightingDesc {
@@ -509,6 +511,55 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             d.end_command_buffer(cmd).unwrap();
             d.destroy_command_pool(pool, None);
         }
+
+        // Without the hi-stencil emulation: a PS3-like plan is refused, a native one records
+        // and runs (on a one-tile surface) with nothing for the validation layer to report.
+        let mut native_only = DeferredLighting::new(
+            &ctx,
+            &LightingDesc {
+                hi_stencil: false,
+                ..desc.clone()
+            },
+        )
+        .unwrap();
+        let ps3_plan = plan_frame(
+            &layout,
+            &PlanInputs {
+                lights: &shapes,
+                brdf_bounds: &bounds,
+                view: &View::new(&view).unwrap(),
+            },
+            &PlanSettings {
+                technique: TechniqueChoice::Stencil,
+                caps: Backend::Ps3.platform().caps(),
+                flush: FlushPolicy::Auto,
+            },
+        )
+        .unwrap();
+        unsafe {
+            let (pool, cmd) = engine.command_buffer();
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            let mut t = targets;
+            let ps3 = LightingFrame {
+                plan: &ps3_plan,
+                ..frame
+            };
+            let err = native_only.record(cmd, &ps3, &mut t).expect_err("refused");
+            assert!(err.to_string().contains("hi-stencil"), "{err}");
+            native_only
+                .record(cmd, &frame, &mut t)
+                .expect("a native plan");
+            d.end_command_buffer(cmd).unwrap();
+            let queue = d.get_device_queue(engine.queue_family, 0);
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], vk::Fence::null())
+                .unwrap();
+            d.queue_wait_idle(queue).unwrap();
+            d.destroy_command_pool(pool, None);
+        }
+        drop(native_only);
         drop(lighting);
         drop(renderer);
         for image in gbuffer.into_iter().chain([depth, hdr, small]) {

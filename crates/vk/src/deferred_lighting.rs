@@ -52,6 +52,10 @@ pub struct LightingDesc {
     pub frames_in_flight: u32,
     /// The most lights a frame may carry.
     pub max_lights: u32,
+    /// Emulate console hi-stencil, which the PS3-like and 360-like plans use (and 360-like
+    /// save/restore): a word per 8x8 tile and two bytes per pixel of scratch. Without it only
+    /// plans for the native backend can be recorded.
+    pub hi_stencil: bool,
 }
 
 /// One frame's lighting.
@@ -221,7 +225,16 @@ impl<'c> DeferredLighting<'c> {
             self.desc.depth_stencil_format,
         );
         self.volumes = Some(LightVolumes::new(ctx)?);
-        self.hi_stencil = Some(HiStencilSurface::new(ctx, self.desc.extent)?);
+        // Without the emulation the light pipelines still bind its set: a one-tile surface.
+        let surface = if self.desc.hi_stencil {
+            self.desc.extent
+        } else {
+            vk::Extent2D {
+                width: 1,
+                height: 1,
+            }
+        };
+        self.hi_stencil = Some(HiStencilSurface::new(ctx, surface)?);
 
         let slots = self.desc.frames_in_flight;
         let storage_per_slot = 1;
@@ -329,6 +342,15 @@ fn check_desc(desc: &LightingDesc) -> Result<()> {
     Ok(())
 }
 
+/// Whether recording `plan` needs the hi-stencil emulation: a hi-stencil test, write or flush,
+/// or the stencil copy of a 360-like save/restore.
+fn needs_hi_stencil(plan: &FramePlan) -> bool {
+    plan.steps.iter().any(|step| match step {
+        Step::Pass { pass, .. } => pass.state.tests_hi_stencil() || pass.state.writes_hi_stencil(),
+        Step::FlushHiStencil | Step::SavePreserved { .. } | Step::RestorePreserved { .. } => true,
+    })
+}
+
 /// Checks one frame against the lighting's description: the slot, the light count, the plan's
 /// light indices and depth convention, and every target's extent and format.
 fn check_frame(
@@ -360,6 +382,13 @@ fn check_frame(
             l.input,
             frame.lights.len()
         )));
+    }
+    if !desc.hi_stencil && needs_hi_stencil(frame.plan) {
+        return Err(bad(
+            "the plan uses hi-stencil (a PS3-like or 360-like backend), and this lighting was \
+             made without it (LightingDesc::hi_stencil)"
+                .into(),
+        ));
     }
     if frame.plan.depth != frame.view.depth {
         return Err(bad(format!(
@@ -465,6 +494,11 @@ impl DeferredLighting<'_> {
         source: BrdfSource,
     ) -> Result<()> {
         check_frame(&self.desc, frame, targets)?;
+        if count_stats && !self.desc.hi_stencil {
+            return Err(Error::Unsupported(
+                "hi-stencil statistics from a lighting made without hi-stencil",
+            ));
+        }
         let e = self.desc.extent;
         let uniforms =
             FrameUniforms::from_view(frame.view, e.width, e.height, frame.lights.len() as u32)

@@ -107,6 +107,8 @@ fn main() {
             hdr_format: HDR_FORMAT,
             frames_in_flight: IN_FLIGHT as u32,
             max_lights: world::LIGHTS as u32,
+            // The PS3-like frames need the emulated hi-stencil.
+            hi_stencil: true,
         },
     )
     .expect("lighting");

@@ -163,6 +163,7 @@ impl<'c> Renderer<'c> {
                 hdr_format: HDR_FORMAT,
                 frames_in_flight: 1,
                 max_lights: scene.lights.len() as u32,
+                hi_stencil: true,
             },
         )?;
         let targets = Targets::new(ctx, extent)?;
