@@ -18,7 +18,7 @@ void main() {
     } else if (alpha_draw.mode == ALPHA_MODE_PROBE) {
         lit = probe_lighting(e, s);
     } else {
-        lit = sample_tile(e, 0u, in_uv);
+        lit = lightmap_object(lightmap, e, in_uv);
     }
     float a = e.tint_opacity.w;
     out_color = vec4(lit * a, a);

@@ -13,14 +13,13 @@ void main() {
     vec3 P;
     vec3 N;
     if (kind == ALPHA_OBJECT) {
-        ivec2 texel = ivec2(gl_FragCoord.xy);
-        vec4 p = texelFetch(position_atlas, texel, 0);
-        if (p.w == 0.0) {
+        AlphaProbe probe = probes[e.shape.z + uint(local.y) * e.region.z + uint(local.x)];
+        if (probe.position.w == 0.0) {
             out_color = vec4(0.0);
             return;
         }
-        P = (e.model * vec4(p.xyz, 1.0)).xyz;
-        N = normalize(transpose(inverse(mat3(e.model))) * texelFetch(normal_atlas, texel, 0).xyz);
+        P = (e.model * vec4(probe.position.xyz, 1.0)).xyz;
+        N = normalize(transpose(inverse(mat3(e.model))) * probe.normal.xyz);
     } else if (kind == ALPHA_DUST) {
         uint i = uint(local.y) * e.region.z + uint(local.x);
         if (i >= e.shape.w) {

@@ -26,7 +26,7 @@ void main() {
         lit = probe_lighting(e, s);
     } else {
         // Dust reads its mote's texel (flat: the interpolated copy may round off the index).
-        lit = particle_lightmap(e, P, e.shape.x == ALPHA_DUST ? in_mote : in_param);
+        lit = lightmap_particle(lightmap, e, P, e.shape.x == ALPHA_DUST ? in_mote : in_param);
     }
     out_color = vec4(lit * coverage, coverage);
 }

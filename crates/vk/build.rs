@@ -56,8 +56,12 @@ fn generated_glsl() -> String {
         weights.join(", ")
     )
     .unwrap();
-    let alpha = ALPHA_KINDS.into_iter().chain(ALPHA_MODES);
-    for (name, value) in LIGHT_KINDS.into_iter().chain(LIGHT_DRAW_FLAGS).chain(alpha) {
+    // ALPHA_KINDS are spelled in include/alpha_entity.glsl, which engines include on its own.
+    for (name, value) in LIGHT_KINDS
+        .into_iter()
+        .chain(LIGHT_DRAW_FLAGS)
+        .chain(ALPHA_MODES)
+    {
         writeln!(s, "#define {name} {value}u").unwrap();
     }
     writeln!(s, "#define HI_STENCIL_TILE {HI_STENCIL_TILE}u").unwrap();
@@ -65,6 +69,20 @@ fn generated_glsl() -> String {
         writeln!(s, "#define {} {}u", axes.glsl_constant(), axes.index()).unwrap();
     }
     s + "#endif\n"
+}
+
+/// The entity kinds are spelled by hand in the self-contained `alpha_entity.glsl` (an engine
+/// includes it without `generated.glsl`): hold them to [`ALPHA_KINDS`].
+fn check_alpha_kinds(path: &Path) {
+    let text = std::fs::read_to_string(path).unwrap();
+    for (name, value) in ALPHA_KINDS {
+        let line = format!("#define {name} {value}u");
+        assert!(
+            text.lines().any(|l| l.trim() == line),
+            "{} must say `{line}` (ALPHA_KINDS in src/shader_consts.rs)",
+            path.display()
+        );
+    }
 }
 
 fn is_stage(path: &Path) -> bool {
@@ -145,6 +163,7 @@ fn main() {
 
     let generated = generated_glsl();
     std::fs::write(out_dir.join("generated.glsl"), &generated).unwrap();
+    check_alpha_kinds(&include_dir.join("alpha_entity.glsl"));
 
     let glslc = glslc();
     let mut sources: Vec<PathBuf> = std::fs::read_dir(&shader_dir)

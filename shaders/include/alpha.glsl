@@ -1,25 +1,13 @@
-// Alpha entities (translucent objects, particle systems) and where their light probes are.
-// Rust mirrors: crates/vk/src/alpha/gpu.rs (GpuAlphaEntity, AlphaDrawPush); the probe frame is
-// histencil_alpha::ProbeFrame, the layouts histencil_alpha::plan_layout.
+// Alpha entities (translucent objects, particle systems) and where their light probes are: set 1
+// of the lightmap pass and of histencil's alpha pass.
+// Rust mirrors: crates/vk/src/alpha/gpu.rs (AlphaEntityRecord, AlphaDrawPush); the probe frame
+// is histencil_alpha::ProbeFrame, the layouts histencil_alpha::plan_regions, the object probes
+// histencil_alpha::bake_probes.
 #ifndef ALPHA_GLSL
 #define ALPHA_GLSL
 
 #include "light.glsl"
-
-#extension GL_EXT_samplerless_texture_functions : require
-
-struct AlphaEntity {
-    mat4 model;           // object -> world (identity for particle systems)
-    vec4 tint_opacity;    // rgb tint, w opacity
-    vec4 params;          // xyz the BRDF's packed parameters, w BRDF id
-    uvec4 region;         // xy: the region's first texel in the atlas; zw: one tile's size
-    uvec4 shape;          // x: ALPHA_* kind, y: tiles (slices), z: first point, w: point count
-    vec4 centre_radius;   // xyz: probe frame centre (the single probe's point), w: its radius
-    vec4 right_depth;     // xyz: unit right, w: half depth of the slice stack
-    vec4 up;              // xyz: unit up
-    vec4 forward;         // xyz: unit view direction
-    uvec4 light_range;    // x: first index into `entity_lights`, y: count
-};
+#include "alpha_entity.glsl"
 
 layout(set = 1, binding = 0, std430) readonly buffer AlphaEntities {
     AlphaEntity entities[];
@@ -35,9 +23,15 @@ layout(set = 1, binding = 2, std430) readonly buffer AlphaEntityLights {
     uint entity_lights[];
 };
 
-// Baked object-space positions (w = 1 where a surface covers the texel) and normals.
-layout(set = 1, binding = 3) uniform texture2D position_atlas;
-layout(set = 1, binding = 4) uniform texture2D normal_atlas;
+// Objects' baked probes (histencil_alpha::Probe): object-space position (w = 1 where the mesh
+// covers the texel) and normal, row by row per region from AlphaEntity.shape.z.
+struct AlphaProbe {
+    vec4 position;
+    vec4 normal;
+};
+layout(set = 1, binding = 3, std430) readonly buffer AlphaProbes {
+    AlphaProbe probes[];
+};
 
 layout(push_constant) uniform AlphaDraw {
     uint entity; // into `entities`
@@ -71,20 +65,6 @@ vec3 frame_probe(AlphaEntity e, vec2 uv, uint k) {
     float r = e.centre_radius.w;
     return e.centre_radius.xyz + e.right_depth.xyz * r * (2.0 * uv.x - 1.0)
         - e.up.xyz * r * (2.0 * uv.y - 1.0) + e.forward.xyz * depth;
-}
-
-// `(u, v, slice)` of the probe nearest P (histencil_alpha::ProbeFrame::locate).
-vec3 frame_locate(AlphaEntity e, vec3 P) {
-    vec3 d = P - e.centre_radius.xyz;
-    float r = e.centre_radius.w;
-    uint n = e.shape.y;
-    float s = 0.0;
-    if (n > 1u) {
-        float half_depth = e.right_depth.w;
-        s = clamp((dot(d, e.forward.xyz) + half_depth) / (2.0 * half_depth) * float(n - 1u),
-                  0.0, float(n - 1u));
-    }
-    return vec3(0.5 + 0.5 * dot(d, e.right_depth.xyz) / r, 0.5 - 0.5 * dot(d, e.up.xyz) / r, s);
 }
 
 // The point at `t` in [0, 1] along a ribbon: linear between control points, evenly in index.

@@ -1,10 +1,15 @@
 //! Which lightmap region each alpha entity gets: its texel layout (from the talk's
 //! parameterisations) and its size (from screen coverage), packed into one atlas whose size is
-//! derived from what the scene needs.
+//! derived from what the entities need.
+//!
+//! The planner works on plain values ([`EntityDesc`]: what an entity is, its world bounds, its
+//! coverage on screen if the caller knows better, a forced side), so an engine plans its own
+//! entities the way histencil plans a scene's ([`scene_entities`], [`plan_layout`]).
 
 use crate::{side_for_coverage, Atlas, AtlasError, Region, MIN_SIDE};
-use glam::Vec3;
-use histencil_scene::{Camera, ParticleLayout, ParticleSystem, Scene};
+use glam::{Mat4, Vec3};
+use histencil_model::ViewDesc;
+use histencil_scene::{Camera, ParticleLayout, ParticleSystem, Scene, MAX_SLICES};
 
 /// An alpha entity of a scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -25,6 +30,86 @@ impl EntityKey {
     }
 }
 
+/// What an alpha entity is, as far as its lightmap's texel layout goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EntityKind {
+    /// A translucent mesh: one square region in its lightmap UV layout.
+    Surface,
+    /// A particle system of `count` particles laid out as `layout` says.
+    Particles { layout: ParticleLayout, count: u32 },
+}
+
+/// One alpha entity, as the planner needs it: plain values an engine has.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EntityDesc {
+    pub kind: EntityKind,
+    /// World-space box around everything the entity draws.
+    pub bounds: (Vec3, Vec3),
+    /// How many pixels the entity spans on screen; `None`: the diameter its bounds' sphere
+    /// projects to. (A ribbon's scene entry gives its projected length.)
+    pub coverage_px: Option<f32>,
+    /// A forced region side (a ribbon: texels along it), 2..=[`MAX_FORCED_SIDE`]; `None`: from
+    /// coverage.
+    pub side: Option<u32>,
+}
+
+/// Where the camera is and how it sees: what sizing and the probe frames need from a view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Viewer {
+    pub eye: Vec3,
+    /// Unit camera axes: right, up, and forward (the view direction).
+    pub right: Vec3,
+    pub up: Vec3,
+    pub forward: Vec3,
+    /// `tan(fov_y / 2)`.
+    pub tan_half_fov_y: f32,
+    /// Distances below this count as this (an entity around the eye is as large as it gets).
+    pub near: f32,
+}
+
+impl Viewer {
+    /// A scene camera's viewer.
+    pub fn from_camera(camera: &Camera) -> Self {
+        let forward = (camera.target - camera.eye).normalize();
+        let right = forward.cross(camera.up).normalize();
+        Self {
+            eye: camera.eye,
+            right,
+            up: right.cross(forward),
+            forward,
+            tan_half_fov_y: (camera.fov_y_radians * 0.5).tan(),
+            near: camera.near,
+        }
+    }
+
+    /// The viewer of an engine's view: axes and eye from the inverse of `world_to_view` (a
+    /// rigid transform), the field of view from the projection's `P11`. `None` when the view
+    /// matrix cannot be inverted or `P11` is not a finite non-zero scale.
+    pub fn from_view(view: &ViewDesc) -> Option<Self> {
+        let world_to_view = Mat4::from_cols_array_2d(&view.world_to_view);
+        let p11 = view.view_to_clip[1][1];
+        let det = world_to_view.determinant();
+        if !(det.is_normal() && p11.is_normal()) {
+            return None;
+        }
+        let inv = world_to_view.inverse();
+        let axis = |v: glam::Vec4| v.truncate().normalize_or_zero();
+        let viewer = Self {
+            eye: inv.w_axis.truncate(),
+            right: axis(inv.x_axis),
+            up: axis(inv.y_axis),
+            forward: -axis(inv.z_axis),
+            tan_half_fov_y: 1.0 / p11.abs(),
+            near: 1e-3,
+        };
+        let finite = [viewer.eye, viewer.right, viewer.up, viewer.forward]
+            .iter()
+            .all(|v| v.is_finite());
+        (finite && viewer.forward != Vec3::ZERO && viewer.tan_half_fov_y.is_finite())
+            .then_some(viewer)
+    }
+}
+
 /// How an entity's probes sit in its region: `tiles` tiles of `tile_width x tile_height` texels
 /// side by side (a slice each for sliced systems, one otherwise).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,7 +124,6 @@ pub struct RegionShape {
 /// An entity's place in the atlas.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EntityRegion {
-    pub entity: EntityKey,
     /// The whole region: `shape.tiles` tiles side by side.
     pub region: Region,
     /// The tiles as granted (halved when the atlas was full).
@@ -47,10 +131,20 @@ pub struct EntityRegion {
     pub downgraded: bool,
 }
 
-/// Every entity's region, and the atlas they were packed into.
+/// Every entity's region (in the order the entities were given), and the atlas they were packed
+/// into.
 pub struct LightmapLayout {
     pub atlas: Atlas,
     pub regions: Vec<EntityRegion>,
+}
+
+impl std::fmt::Debug for LightmapLayout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LightmapLayout")
+            .field("atlas_size", &self.atlas.size())
+            .field("regions", &self.regions)
+            .finish()
+    }
 }
 
 /// The smallest atlas tried; it doubles until everything fits.
@@ -66,14 +160,15 @@ pub enum LayoutError {
     /// print it twice).
     #[error("the lightmap atlas is full even at {side}x{side} texels with every region halved down to {min}: {reason}", min = MIN_SIDE)]
     AtlasFull { side: u32, reason: AtlasError },
+    #[error("alpha entity {index}: {reason}")]
+    BadEntity { index: usize, reason: &'static str },
 }
 
 /// Diameter in pixels that a sphere of `radius` at `centre` covers on a `viewport_height`-pixel
-/// tall view from `camera` (at least the near plane away).
-pub fn projected_diameter(camera: &Camera, centre: Vec3, radius: f32, viewport_height: u32) -> f32 {
-    let distance = (centre - camera.eye).length().max(camera.near);
-    let tan = (camera.fov_y_radians * 0.5).tan();
-    2.0 * radius / (2.0 * distance * tan) * viewport_height as f32
+/// tall view from `viewer` (at least the near plane away).
+pub fn projected_diameter(viewer: &Viewer, centre: Vec3, radius: f32, viewport_height: u32) -> f32 {
+    let distance = (centre - viewer.eye).length().max(viewer.near);
+    2.0 * radius / (2.0 * distance * viewer.tan_half_fov_y) * viewport_height as f32
 }
 
 /// Centre and radius of a sphere containing the box `lo..hi`.
@@ -81,22 +176,44 @@ pub fn bounding_sphere((lo, hi): (Vec3, Vec3)) -> (Vec3, f32) {
     ((lo + hi) * 0.5, (hi - lo).length() * 0.5)
 }
 
-/// The texel layout of `entity`: its size from screen coverage, or `forced_side` texels.
-pub fn region_shape(
-    scene: &Scene,
-    entity: EntityKey,
-    viewport_height: u32,
-    forced_side: Option<u32>,
-) -> RegionShape {
+/// What is wrong with `desc`, if anything: bounds that are not finite or inside out, a forced
+/// side out of range, a particle system without particles, a slice count outside
+/// 2..=`MAX_SLICES`, a ribbon of fewer than two points.
+pub fn entity_problem(desc: &EntityDesc) -> Option<&'static str> {
+    let (lo, hi) = desc.bounds;
+    if !(lo.is_finite() && hi.is_finite()) || lo.cmpgt(hi).any() {
+        return Some("its bounds must be finite with min <= max on every axis");
+    }
+    if desc.coverage_px.is_some_and(|c| !c.is_finite() || c < 0.0) {
+        return Some("its coverage must be finite and not negative");
+    }
+    if desc.side.is_some_and(|s| check_forced_side(s).is_err()) {
+        return Some("its forced side is outside 2..=4094 texels");
+    }
+    match desc.kind {
+        EntityKind::Surface => None,
+        EntityKind::Particles { count: 0, .. } => Some("a particle system needs a particle"),
+        EntityKind::Particles {
+            layout: ParticleLayout::Slices { count },
+            ..
+        } if !(2..=MAX_SLICES).contains(&count) => Some("slices need 2 to 32 slices"),
+        EntityKind::Particles {
+            layout: ParticleLayout::Ribbon,
+            count: 1,
+        } => Some("a ribbon needs at least two control points"),
+        EntityKind::Particles { .. } => None,
+    }
+}
+
+/// The texel layout of `desc`: its size from screen coverage, or its forced side.
+pub fn region_shape(desc: &EntityDesc, viewer: &Viewer, viewport_height: u32) -> RegionShape {
     let side = || {
-        let (centre, radius) = bounding_sphere(entity.world_bounds(scene));
-        forced_side.unwrap_or_else(|| {
-            side_for_coverage(projected_diameter(
-                &scene.camera,
-                centre,
-                radius,
-                viewport_height,
-            ))
+        desc.side.unwrap_or_else(|| {
+            let coverage = desc.coverage_px.unwrap_or_else(|| {
+                let (centre, radius) = bounding_sphere(desc.bounds);
+                projected_diameter(viewer, centre, radius, viewport_height)
+            });
+            side_for_coverage(coverage)
         })
     };
     let square = |tiles, side| RegionShape {
@@ -105,31 +222,27 @@ pub fn region_shape(
         tile_height: side,
         downgradable: true,
     };
-    match entity {
-        EntityKey::Object(_) => square(1, side()),
-        EntityKey::System(i) => {
-            let system = &scene.particle_systems[i];
-            match system.layout {
-                ParticleLayout::Billboard => square(1, side()),
-                ParticleLayout::Slices { count } => square(count, side()),
-                ParticleLayout::Dust => {
-                    let (w, h) = dust_grid(system.particles.len() as u32);
-                    RegionShape {
-                        tiles: 1,
-                        tile_width: w,
-                        tile_height: h,
-                        downgradable: false,
-                    }
-                }
-                ParticleLayout::Ribbon => RegionShape {
+    match desc.kind {
+        EntityKind::Surface => square(1, side()),
+        EntityKind::Particles { layout, count } => match layout {
+            ParticleLayout::Billboard => square(1, side()),
+            ParticleLayout::Slices { count } => square(count, side()),
+            ParticleLayout::Dust => {
+                let (w, h) = dust_grid(count);
+                RegionShape {
                     tiles: 1,
-                    tile_width: forced_side
-                        .unwrap_or_else(|| ribbon_texels(scene, system, viewport_height)),
-                    tile_height: 1,
-                    downgradable: true,
-                },
+                    tile_width: w,
+                    tile_height: h,
+                    downgradable: false,
+                }
             }
-        }
+            ParticleLayout::Ribbon => RegionShape {
+                tiles: 1,
+                tile_width: side(),
+                tile_height: 1,
+                downgradable: true,
+            },
+        },
     }
 }
 
@@ -139,19 +252,17 @@ pub fn dust_grid(motes: u32) -> (u32, u32) {
     (w, motes.div_ceil(w).max(1))
 }
 
-/// Texels along a ribbon: one per [`crate::PIXELS_PER_TEXEL`] pixels of its projected length,
-/// as for a region side.
-fn ribbon_texels(scene: &Scene, system: &ParticleSystem, viewport_height: u32) -> u32 {
-    let length_px: f32 = system
+/// A ribbon's projected length in pixels: the sum of its segments' projected lengths.
+fn ribbon_length_px(viewer: &Viewer, system: &ParticleSystem, viewport_height: u32) -> f32 {
+    system
         .particles
         .windows(2)
         .map(|w| {
             let mid = (w[0].position + w[1].position) * 0.5;
             let half = (w[1].position - w[0].position).length() * 0.5;
-            projected_diameter(&scene.camera, mid, half, viewport_height)
+            projected_diameter(viewer, mid, half, viewport_height)
         })
-        .sum();
-    side_for_coverage(length_px)
+        .sum()
 }
 
 /// Every alpha entity of `scene`, objects first.
@@ -159,6 +270,41 @@ pub fn entities(scene: &Scene) -> impl Iterator<Item = EntityKey> {
     (0..scene.alpha_objects.len())
         .map(EntityKey::Object)
         .chain((0..scene.particle_systems.len()).map(EntityKey::System))
+}
+
+/// The descriptions of `scene`'s alpha entities in [`entities`] order, seen from its camera at
+/// `viewport_height` pixels, every side forced to `forced_side` if given.
+pub fn scene_entities(
+    scene: &Scene,
+    viewport_height: u32,
+    forced_side: Option<u32>,
+) -> Vec<EntityDesc> {
+    let viewer = Viewer::from_camera(&scene.camera);
+    entities(scene)
+        .map(|key| {
+            let bounds = key.world_bounds(scene);
+            let (kind, coverage_px) = match key {
+                EntityKey::Object(_) => (EntityKind::Surface, None),
+                EntityKey::System(i) => {
+                    let s = &scene.particle_systems[i];
+                    let coverage = (s.layout == ParticleLayout::Ribbon)
+                        .then(|| ribbon_length_px(&viewer, s, viewport_height));
+                    let count = s.particles.len() as u32;
+                    let kind = EntityKind::Particles {
+                        layout: s.layout,
+                        count,
+                    };
+                    (kind, coverage)
+                }
+            };
+            EntityDesc {
+                kind,
+                bounds,
+                coverage_px,
+                side: forced_side,
+            }
+        })
+        .collect()
 }
 
 /// The forced lightmap sides [`plan_layout`] and the renderer take.
@@ -183,14 +329,12 @@ pub fn check_forced_side(side: u32) -> Result<(), LayoutError> {
     }
 }
 
-/// Packs every entity's region into the smallest square atlas from [`START_ATLAS_SIDE`]
-/// (doubling) up to `max_side` that holds them all at full size. When even `max_side` does not,
-/// regions are halved where they allow it ([`Atlas::allocate_downgrading`]; the result says
-/// which were).
+/// Plans `scene`'s lightmap layout ([`plan_regions`] on [`scene_entities`]): regions in
+/// [`entities`] order.
 ///
 /// # Errors
-/// [`LayoutError::BadResolution`] for a forced side outside 2..=[`MAX_FORCED_SIDE`], and
-/// [`LayoutError::AtlasFull`] when the entities do not fit even halved.
+/// As [`plan_regions`]; [`LayoutError::BadResolution`] for a forced side outside
+/// 2..=[`MAX_FORCED_SIDE`].
 pub fn plan_layout(
     scene: &Scene,
     viewport_height: u32,
@@ -200,8 +344,35 @@ pub fn plan_layout(
     if let Some(side) = forced_side {
         check_forced_side(side)?;
     }
-    let shapes: Vec<(EntityKey, RegionShape)> = entities(scene)
-        .map(|e| (e, region_shape(scene, e, viewport_height, forced_side)))
+    let descs = scene_entities(scene, viewport_height, forced_side);
+    let viewer = Viewer::from_camera(&scene.camera);
+    plan_regions(&descs, &viewer, viewport_height, max_side)
+}
+
+/// Packs every entity's region into the smallest square atlas from [`START_ATLAS_SIDE`]
+/// (doubling) up to `max_side` that holds them all at full size. When even `max_side` does not,
+/// regions are halved where they allow it ([`Atlas::allocate_downgrading`]; the result says
+/// which were). Regions come back in `descs` order.
+///
+/// # Errors
+/// [`LayoutError::BadEntity`] for a description [`entity_problem`] refuses, and
+/// [`LayoutError::AtlasFull`] when the entities do not fit even halved.
+pub fn plan_regions(
+    descs: &[EntityDesc],
+    viewer: &Viewer,
+    viewport_height: u32,
+    max_side: u32,
+) -> Result<LightmapLayout, LayoutError> {
+    if let Some((index, reason)) = descs
+        .iter()
+        .enumerate()
+        .find_map(|(i, d)| entity_problem(d).map(|r| (i, r)))
+    {
+        return Err(LayoutError::BadEntity { index, reason });
+    }
+    let shapes: Vec<RegionShape> = descs
+        .iter()
+        .map(|d| region_shape(d, viewer, viewport_height))
         .collect();
     let max_side = max_side.clamp(1, Atlas::MAX_SIDE);
     let mut side = START_ATLAS_SIDE.min(max_side);
@@ -215,16 +386,12 @@ pub fn plan_layout(
     }
 }
 
-fn pack(
-    shapes: &[(EntityKey, RegionShape)],
-    side: u32,
-    downgrade: bool,
-) -> Result<LightmapLayout, AtlasError> {
+fn pack(shapes: &[RegionShape], side: u32, downgrade: bool) -> Result<LightmapLayout, AtlasError> {
     let mut atlas = Atlas::new(side, side, ATLAS_PADDING)?;
     // Largest first: shelf packing wastes less, and the order (hence the layout) is fixed.
     let mut order: Vec<usize> = (0..shapes.len()).collect();
     order.sort_by_key(|&i| {
-        let s = shapes[i].1;
+        let s = shapes[i];
         (
             std::cmp::Reverse(s.tile_height),
             std::cmp::Reverse(s.tiles * s.tile_width),
@@ -233,7 +400,7 @@ fn pack(
     });
     let mut regions = vec![None; shapes.len()];
     for i in order {
-        let (entity, shape) = shapes[i];
+        let shape = shapes[i];
         let (w, h) = (shape.tiles * shape.tile_width, shape.tile_height);
         let allocation = if downgrade && shape.downgradable {
             // A row of slices can be wider than the whole atlas: halve it until it could fit
@@ -249,7 +416,6 @@ fn pack(
         };
         let region = allocation.region;
         regions[i] = Some(EntityRegion {
-            entity,
             region,
             shape: RegionShape {
                 tile_width: region.width / shape.tiles,
@@ -296,25 +462,26 @@ mod tests {
 
     #[test]
     fn region_shapes_follow_the_layouts() {
+        let shape_of = |s: &Scene, index: usize, height: u32, forced: Option<u32>| {
+            let viewer = Viewer::from_camera(&s.camera);
+            region_shape(&scene_entities(s, height, forced)[index], &viewer, height)
+        };
         let s = scene("volume");
-        let shape = region_shape(&s, EntityKey::System(0), 720, Some(32));
+        let shape = shape_of(&s, 0, 720, Some(32));
         assert_eq!(
             (shape.tiles, shape.tile_width, shape.tile_height),
             (8, 32, 32)
         );
         let s = scene("dust");
-        let shape = region_shape(&s, EntityKey::System(0), 720, Some(32));
+        let shape = shape_of(&s, 0, 720, Some(32));
         assert_eq!((shape.tile_width, shape.tile_height), (25, 24));
         assert!(shape.tile_width * shape.tile_height >= 600 && !shape.downgradable);
         let s = scene("ribbon");
-        assert_eq!(
-            region_shape(&s, EntityKey::System(0), 720, None).tile_height,
-            1
-        );
+        assert_eq!(shape_of(&s, 0, 720, None).tile_height, 1);
         // Coverage: the same sphere seen on a taller viewport gets at least as many texels.
         let s = scene("alpha");
-        let small = region_shape(&s, EntityKey::Object(0), 180, None).tile_width;
-        let large = region_shape(&s, EntityKey::Object(0), 1440, None).tile_width;
+        let small = shape_of(&s, 0, 180, None).tile_width;
+        let large = shape_of(&s, 0, 1440, None).tile_width;
         assert!(small < large, "{small} {large}");
     }
 
@@ -327,9 +494,7 @@ mod tests {
         assert!(capped.regions.iter().any(|r| r.downgraded));
         s.particle_systems[0].layout = ParticleLayout::Dust;
         s.particle_systems[0].particles = s.particle_systems[0].particles.repeat(400);
-        let err = plan_layout(&s, 720, Some(128), 256)
-            .err()
-            .expect("too many motes");
+        let err = plan_layout(&s, 720, Some(128), 256).expect_err("too many motes");
         assert!(matches!(err, LayoutError::AtlasFull { .. }), "{err}");
         let bad = plan_layout(&s, 720, Some(1), 256).err();
         assert_eq!(bad, Some(LayoutError::BadResolution(1)));

@@ -11,23 +11,28 @@
 //!   (a shelf allocator, etagere), with a guard band against filtering across regions and a
 //!   documented downgrade when the atlas is full;
 //! - [`side_for_coverage`]: how many texels an entity gets from its size on screen;
-//! - [`plan_layout`]: every entity's region shape (a square for objects and billboards, a row
+//! - [`plan_regions`] (and [`plan_layout`] for a scene): every entity's region shape (a square for objects and billboards, a row
 //!   of slices, a grid of motes, a line of texels for ribbons) packed into an atlas sized to fit;
+//! - [`bake_probes`]: a translucent mesh's probes (position and normal per texel of its region),
+//!   rasterised from its lightmap UV layout;
 //! - [`fit_frame`]: the camera-facing probe quad (and slices) around a particle system;
 //! - [`sprite_vertices`] and [`back_to_front`]: the alpha pass's geometry and blending order.
 
 mod atlas;
+mod bake;
 mod layout;
 mod probes;
 mod sizing;
 mod sprites;
 
 pub use atlas::{Allocation, Atlas, AtlasError, Region, RegionId};
+pub use bake::{bake_probes, BakedProbes, Probe};
 pub use layout::{
-    bounding_sphere, check_forced_side, dust_grid, entities, plan_layout, projected_diameter,
-    region_shape, EntityKey, EntityRegion, LayoutError, LightmapLayout, RegionShape, ATLAS_PADDING,
+    bounding_sphere, check_forced_side, dust_grid, entities, entity_problem, plan_layout,
+    plan_regions, projected_diameter, region_shape, scene_entities, EntityDesc, EntityKey,
+    EntityKind, EntityRegion, LayoutError, LightmapLayout, RegionShape, Viewer, ATLAS_PADDING,
     MAX_ATLAS_SIDE, MAX_FORCED_SIDE, START_ATLAS_SIDE,
 };
-pub use probes::{back_to_front, camera_axes, fit_frame, probe_point, ProbeFrame};
+pub use probes::{back_to_front, camera_axes, fit_frame, particle_bounds, probe_point, ProbeFrame};
 pub use sizing::{side_for_coverage, MAX_SIDE, MIN_SIDE, PIXELS_PER_TEXEL};
 pub use sprites::{sprite_vertices, SpriteVertex};

@@ -2,9 +2,9 @@
 //! talk's quad, and the stack of slices through its depth), and the order in which entities are
 //! blended.
 
-use crate::layout::{bounding_sphere, EntityKey};
+use crate::layout::{bounding_sphere, EntityKey, Viewer};
 use glam::Vec3;
-use histencil_scene::{Camera, ParticleSystem, Scene};
+use histencil_scene::{Camera, Particle, Scene};
 
 /// A camera-facing frame around a particle system. Probe `(u, v)` of slice `k` of `n` sits at
 /// `centre + right * radius * (2u - 1) - up * radius * (2v - 1) + forward * depth_k`, with
@@ -25,28 +25,33 @@ pub struct ProbeFrame {
 
 /// The camera's unit right, up and forward axes.
 pub fn camera_axes(camera: &Camera) -> (Vec3, Vec3, Vec3) {
-    let forward = (camera.target - camera.eye).normalize();
-    let right = forward.cross(camera.up).normalize();
-    (right, right.cross(forward), forward)
+    let v = Viewer::from_camera(camera);
+    (v.right, v.up, v.forward)
 }
 
-/// The frame fitted around `system` and centred on it: centred on its bounds, its radius the
-/// farthest sprite edge from that centre.
-pub fn fit_frame(camera: &Camera, system: &ParticleSystem) -> ProbeFrame {
-    let (centre, _) = bounding_sphere(system.world_bounds());
-    let radius = system
-        .particles
+/// The box around `particles`' sprites (each a sphere of its size).
+pub fn particle_bounds(particles: &[Particle]) -> (Vec3, Vec3) {
+    particles.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p.position - p.size), hi.max(p.position + p.size)),
+    )
+}
+
+/// The frame that `viewer` sees fitted around a system of `particles`: centred on their bounds,
+/// its radius the farthest sprite edge from that centre, its axes the viewer's.
+pub fn fit_frame(viewer: &Viewer, particles: &[Particle]) -> ProbeFrame {
+    let (centre, _) = bounding_sphere(particle_bounds(particles));
+    let radius = particles
         .iter()
         .map(|p| (p.position - centre).length() + p.size)
         .fold(0.0, f32::max);
-    let (right, up, forward) = camera_axes(camera);
     ProbeFrame {
         centre,
         radius,
         half_depth: radius,
-        right,
-        up,
-        forward,
+        right: viewer.right,
+        up: viewer.up,
+        forward: viewer.forward,
     }
 }
 
@@ -104,7 +109,8 @@ mod tests {
     #[test]
     fn probes_and_locate_are_inverse() {
         let scene = histencil_scene::embedded("volume").unwrap();
-        let frame = fit_frame(&scene.camera, &scene.particle_systems[0]);
+        let viewer = Viewer::from_camera(&scene.camera);
+        let frame = fit_frame(&viewer, &scene.particle_systems[0].particles);
         // The GPU records use the frame's centre as the system's single probe point.
         assert_eq!(frame.centre, probe_point(&scene, EntityKey::System(0)));
         for (u, v, k) in [(0.25, 0.75, 0), (0.5, 0.5, 3), (0.9, 0.1, 7)] {

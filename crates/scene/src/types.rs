@@ -230,6 +230,14 @@ pub const MAX_LIGHT_COLOR: f32 = 1e12;
 /// every distance the scene holds, so the cap changes no pixel, and the volume stays finite.
 pub const RANGE_CAP_PER_EXTENT: f32 = 1e3;
 
+impl Material {
+    /// What is wrong with the material, if anything: a tint outside `[0, MAX_TINT]` or not
+    /// finite, or BRDF parameters its model refuses.
+    pub fn problem(&self) -> Option<String> {
+        material_problem(self)
+    }
+}
+
 /// What is wrong with a material, if anything.
 pub(crate) fn material_problem(m: &Material) -> Option<String> {
     if !finite3(m.tint) || m.tint.min_element() < 0.0 || m.tint.max_element() > MAX_TINT {

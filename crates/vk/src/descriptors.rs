@@ -87,13 +87,12 @@ pub const LUT_EVAL_SET: &[BindingDesc] = &[
 ];
 
 /// Set 1 of the alpha pipelines (include/alpha.glsl): entity records, dust and ribbon points,
-/// each entity's light list, and the baked position and normal atlases.
+/// each entity's light list, and the objects' baked probes.
 pub const ALPHA_SET: &[BindingDesc] = &[
     binding(0, BindingKind::StorageBuffer, ""),
     binding(1, BindingKind::StorageBuffer, ""),
     binding(2, BindingKind::StorageBuffer, ""),
-    binding(3, BindingKind::SampledImage, "position_atlas"),
-    binding(4, BindingKind::SampledImage, "normal_atlas"),
+    binding(3, BindingKind::StorageBuffer, ""),
 ];
 /// Set 2 of the alpha pass (include/alpha_lightmap.glsl): the lightmap atlas. A set of its own
 /// because the lightmap pass renders into it.
@@ -107,6 +106,8 @@ pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
 pub const HI_STENCIL_UPDATE_LAYOUT: &[&[BindingDesc]] = &[HI_STENCIL_UPDATE_SET];
 pub const LUT_EVAL_LAYOUT: &[&[BindingDesc]] = &[LUT_EVAL_SET];
 pub const ALPHA_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET, ALPHA_LIGHTMAP_SET];
+/// The lightmap pass renders into the atlas, so it does not bind it.
+pub const LIGHTMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET];
 
 /// Every shader module and the pipeline layout it is used with.
 pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
@@ -125,9 +126,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("tonemap.frag", TONEMAP_LAYOUT),
     ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
     ("lut_eval.comp", LUT_EVAL_LAYOUT),
-    ("alpha_bake.vert", ALPHA_LAYOUT),
-    ("alpha_bake.frag", ALPHA_LAYOUT),
-    ("lightmap.frag", ALPHA_LAYOUT),
+    ("lightmap.frag", LIGHTMAP_LAYOUT),
     ("alpha_object.vert", ALPHA_LAYOUT),
     ("alpha_object.frag", ALPHA_LAYOUT),
     ("particle.vert", ALPHA_LAYOUT),

@@ -44,7 +44,10 @@ pub mod shaders {
 }
 
 pub use access::{aspect_of, ImageRef, ImageState, LightingTargets};
-pub use alpha::AlphaMode;
+pub use alpha::{
+    mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord, AlphaLightmaps,
+    AlphaLightmapsDesc, AlphaMode, LightmapFrame,
+};
 pub use brdf_eval::BrdfEvaluator;
 pub use capture::SimulatorInputs;
 pub use context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat};

@@ -5,9 +5,7 @@ use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
 use ash::vk;
-use histencil_scene::{
-    light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, LightKind, Mesh, Shape,
-};
+use histencil_scene::{light_cone, light_sphere, unit_box, uv_sphere, LightKind, Mesh, Shape};
 
 pub struct GpuMesh {
     pub vertices: Buffer,
@@ -110,10 +108,11 @@ impl LightVolumes {
     }
 }
 
+/// The sphere's segments around and rings from pole to pole (drawn, and baked for lightmaps).
+pub(crate) const SPHERE_DETAIL: (u32, u32) = (48, 24);
+
 pub struct Meshes {
     pub unit_box: GpuMesh,
-    /// The box as the lightmap bake draws it (`histencil_scene::unit_box_bake`).
-    pub unit_box_bake: GpuMesh,
     pub sphere: GpuMesh,
     /// The scene's imported meshes (`Shape::Mesh`), in `Scene::meshes` order.
     pub imported: Vec<GpuMesh>,
@@ -123,8 +122,8 @@ impl Meshes {
     /// The built-in shapes and the scene's `imported` meshes. A failure half way frees the
     /// meshes made so far.
     pub fn new(ctx: &Context, imported: &[Mesh]) -> Result<Self> {
-        let builtin = [unit_box(), unit_box_bake(), uv_sphere(48, 24)];
-        let builtin_names = ["box-mesh", "box-bake-mesh", "sphere-mesh"].map(String::from);
+        let builtin = [unit_box(), uv_sphere(SPHERE_DETAIL.0, SPHERE_DETAIL.1)];
+        let builtin_names = ["box-mesh", "sphere-mesh"].map(String::from);
         let imported_names = (0..imported.len()).map(|i| format!("imported-mesh-{i}"));
         let names = builtin_names.into_iter().chain(imported_names);
         let mut made: Vec<GpuMesh> = Vec::new();
@@ -140,11 +139,10 @@ impl Meshes {
             }
         }
         let mut made = made.into_iter();
-        let mut next = || made.next().expect("three built-in meshes");
-        let (unit_box, unit_box_bake, sphere) = (next(), next(), next());
+        let mut next = || made.next().expect("two built-in meshes");
+        let (unit_box, sphere) = (next(), next());
         Ok(Self {
             unit_box,
-            unit_box_bake,
             sphere,
             imported: made.collect(),
         })
@@ -158,22 +156,10 @@ impl Meshes {
         }
     }
 
-    /// The mesh the lightmap bake draws for `shape` (its whole UV layout covered).
-    pub fn bake_shape(&self, shape: Shape) -> &GpuMesh {
-        match shape {
-            Shape::Box => &self.unit_box_bake,
-            Shape::Sphere | Shape::Mesh(_) => self.shape(shape),
-        }
-    }
-
     pub fn destroy(&mut self, ctx: &Context) {
-        for m in [
-            &mut self.unit_box,
-            &mut self.unit_box_bake,
-            &mut self.sphere,
-        ]
-        .into_iter()
-        .chain(&mut self.imported)
+        for m in [&mut self.unit_box, &mut self.sphere]
+            .into_iter()
+            .chain(&mut self.imported)
         {
             m.destroy(ctx);
         }

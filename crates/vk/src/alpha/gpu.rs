@@ -1,19 +1,24 @@
-//! The alpha passes' GPU records (include/alpha.glsl) and how a scene fills them.
+//! The alpha passes' GPU records (include/alpha_entity.glsl, alpha.glsl) and how a frame's
+//! entities fill them.
 
+use super::entity::{AlphaEntity, AlphaEntityKind};
 use crate::shader_consts::ALPHA_KINDS;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use histencil_alpha::{fit_frame, probe_point, EntityKey, EntityRegion, ProbeFrame};
-use histencil_scene::{Material, ParticleLayout, Scene};
+use histencil_alpha::{bake_probes, fit_frame, EntityRegion, Probe, ProbeFrame, Viewer};
+use histencil_scene::{Light, Material, ParticleLayout};
 
-/// `AlphaEntity` in alpha.glsl (std430).
+/// One entity's lightmap record: `AlphaEntity` in `shaders/include/alpha_entity.glsl` (std430,
+/// 208 bytes), which an engine's alpha shader reads to sample the atlas.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuAlphaEntity {
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct AlphaEntityRecord {
     pub model: [[f32; 4]; 4],
     pub tint_opacity: [f32; 4],
     pub params: [f32; 4],
+    /// xy: the region's first texel in the atlas; zw: one tile's size.
     pub region: [u32; 4],
+    /// x: kind, y: tiles, z: first point or probe, w: point count.
     pub shape: [u32; 4],
     pub centre_radius: [f32; 4],
     pub right_depth: [f32; 4],
@@ -41,115 +46,105 @@ fn kind_code(name: &str) -> u32 {
         .1
 }
 
-/// Per entity (in `regions` order), the lights whose range reaches its bounds.
-pub fn entity_lights(scene: &Scene, regions: &[EntityRegion]) -> Vec<Vec<u32>> {
-    regions
-        .iter()
-        .map(|r| {
-            let (lo, hi) = r.entity.world_bounds(scene);
-            (0..scene.lights.len() as u32)
-                .filter(|l| scene.lights[*l as usize].reaches_box(lo, hi))
-                .collect()
-        })
-        .collect()
+/// What a frame's lightmap pass reads: every entity's record (in entity order), the dust and
+/// ribbon points and object probes they index, and their light lists flattened (each record's
+/// `light_range` points into it).
+#[derive(Default)]
+pub(crate) struct FrameRecords {
+    pub records: Vec<AlphaEntityRecord>,
+    pub points: Vec<[f32; 4]>,
+    pub probes: Vec<Probe>,
+    pub light_list: Vec<u32>,
+    /// Per entity, the lights whose range reaches its bounds.
+    pub entity_lights: Vec<Vec<u32>>,
 }
 
-/// The records of every entity (in `regions` order, which is `histencil_alpha::entities`
-/// order), the dust and ribbon points they index, and their light lists flattened (each
-/// record's `light_range` points into it).
-pub fn entity_records(
-    scene: &Scene,
+/// The records of `entities` in their `regions`, seen by `viewer`, lit by the `lights` that
+/// reach each one's bounds.
+pub(crate) fn frame_records(
+    entities: &[AlphaEntity],
     regions: &[EntityRegion],
-    lights: &[Vec<u32>],
-) -> (Vec<GpuAlphaEntity>, Vec<[f32; 4]>, Vec<u32>) {
-    let mut light_list: Vec<u32> = Vec::new();
-    let mut points: Vec<[f32; 4]> = Vec::new();
-    let records = regions
-        .iter()
-        .map(|r| {
-            let region = [
-                r.region.x,
-                r.region.y,
-                r.shape.tile_width,
-                r.shape.tile_height,
-            ];
-            match r.entity {
-                EntityKey::Object(i) => {
-                    let o = &scene.alpha_objects[i];
-                    let frame = ProbeFrame {
-                        centre: probe_point(scene, r.entity),
-                        radius: 1.0,
-                        half_depth: 0.0,
-                        right: Vec3::X,
-                        up: Vec3::Y,
-                        forward: Vec3::Z,
-                    };
-                    record(
-                        o.transform,
-                        &o.material,
-                        o.opacity,
-                        region,
-                        [kind_code("ALPHA_OBJECT"), 1, 0, 0],
-                        &frame,
-                    )
-                }
-                EntityKey::System(i) => {
-                    let s = &scene.particle_systems[i];
-                    // Centred on the system's bounds: also its single probe's point.
-                    let frame = fit_frame(&scene.camera, s);
-                    let first = points.len() as u32;
-                    let count = s.particles.len() as u32;
-                    let kind = match s.layout {
-                        ParticleLayout::Billboard | ParticleLayout::Slices { .. } => "ALPHA_SLICES",
-                        ParticleLayout::Dust => "ALPHA_DUST",
-                        ParticleLayout::Ribbon => "ALPHA_RIBBON",
-                    };
-                    if matches!(s.layout, ParticleLayout::Dust | ParticleLayout::Ribbon) {
-                        points.extend(
-                            s.particles
-                                .iter()
-                                .map(|p| p.position.extend(p.size).to_array()),
-                        );
-                    }
-                    let shape = [kind_code(kind), r.shape.tiles, first, count];
-                    record(
-                        Mat4::IDENTITY,
-                        &s.material,
-                        s.opacity,
-                        region,
-                        shape,
-                        &frame,
-                    )
-                }
+    viewer: &Viewer,
+    lights: &[Light],
+) -> FrameRecords {
+    let mut out = FrameRecords::default();
+    for (entity, r) in entities.iter().zip(regions) {
+        let (lo, hi) = entity.world_bounds();
+        let reaching: Vec<u32> = (0..lights.len() as u32)
+            .filter(|&l| lights[l as usize].reaches_box(lo, hi))
+            .collect();
+        let region = [
+            r.region.x,
+            r.region.y,
+            r.shape.tile_width,
+            r.shape.tile_height,
+        ];
+        let mut record = match entity.kind {
+            AlphaEntityKind::Object {
+                probe_mesh,
+                transform,
+                ..
+            } => {
+                let baked = bake_probes(probe_mesh, r.shape.tile_width, r.shape.tile_height);
+                let first = out.probes.len() as u32;
+                out.probes.extend(baked.probes);
+                let frame = ProbeFrame {
+                    centre: transform.w_axis.truncate(),
+                    radius: 1.0,
+                    half_depth: 0.0,
+                    right: Vec3::X,
+                    up: Vec3::Y,
+                    forward: Vec3::Z,
+                };
+                let shape = [kind_code("ALPHA_OBJECT"), 1, first, 0];
+                record(transform, entity, region, shape, &frame)
             }
-        })
-        .zip(lights)
-        .map(|(mut record, lights): (GpuAlphaEntity, &Vec<u32>)| {
-            record.light_range = [light_list.len() as u32, lights.len() as u32, 0, 0];
-            light_list.extend(lights);
-            record
-        })
-        .collect();
-    (records, points, light_list)
+            AlphaEntityKind::Particles { layout, particles } => {
+                // Centred on the system's bounds: also its single probe's point.
+                let frame = fit_frame(viewer, particles);
+                let first = out.points.len() as u32;
+                let kind = match layout {
+                    ParticleLayout::Billboard | ParticleLayout::Slices { .. } => "ALPHA_SLICES",
+                    ParticleLayout::Dust => "ALPHA_DUST",
+                    ParticleLayout::Ribbon => "ALPHA_RIBBON",
+                };
+                if matches!(layout, ParticleLayout::Dust | ParticleLayout::Ribbon) {
+                    out.points.extend(
+                        particles
+                            .iter()
+                            .map(|p| p.position.extend(p.size).to_array()),
+                    );
+                }
+                let count = particles.len() as u32;
+                let shape = [kind_code(kind), r.shape.tiles, first, count];
+                record(Mat4::IDENTITY, entity, region, shape, &frame)
+            }
+        };
+        record.light_range = [out.light_list.len() as u32, reaching.len() as u32, 0, 0];
+        out.light_list.extend(&reaching);
+        out.entity_lights.push(reaching);
+        out.records.push(record);
+    }
+    out
 }
 
 fn record(
     model: Mat4,
-    material: &Material,
-    opacity: f32,
+    entity: &AlphaEntity,
     region: [u32; 4],
     shape: [u32; 4],
     frame: &ProbeFrame,
-) -> GpuAlphaEntity {
-    let p = material.brdf.packed_params();
-    GpuAlphaEntity {
+) -> AlphaEntityRecord {
+    let Material { brdf, tint } = entity.material;
+    let p = brdf.packed_params();
+    AlphaEntityRecord {
         model: model.to_cols_array_2d(),
-        tint_opacity: material.tint.extend(opacity).to_array(),
+        tint_opacity: tint.extend(entity.opacity).to_array(),
         params: [
             p[0] as f32,
             p[1] as f32,
             p[2] as f32,
-            material.brdf.model_index() as f32,
+            brdf.model_index() as f32,
         ],
         region,
         shape,
@@ -164,28 +159,44 @@ fn record(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::alpha::scene_alpha_entities;
 
     #[test]
     fn records_match_the_glsl_block() {
-        assert_eq!(std::mem::size_of::<GpuAlphaEntity>(), 64 + 9 * 16);
+        assert_eq!(std::mem::size_of::<AlphaEntityRecord>(), 64 + 9 * 16);
         assert_eq!(std::mem::size_of::<AlphaDrawPush>(), 16);
+        assert_eq!(std::mem::size_of::<Probe>(), 32);
     }
 
     #[test]
-    fn dust_and_ribbons_index_their_points() {
+    fn dust_ribbons_and_objects_index_their_points_and_probes() {
         let mut scene = histencil_scene::embedded("dust").unwrap();
-        let ribbon = histencil_scene::embedded("ribbon")
-            .unwrap()
-            .particle_systems[0]
-            .clone();
-        scene.particle_systems.push(ribbon);
+        let other = histencil_scene::embedded("ribbon").unwrap();
+        scene
+            .particle_systems
+            .push(other.particle_systems[0].clone());
+        let glass = histencil_scene::embedded("alpha").unwrap();
+        scene.alpha_objects.push(glass.alpha_objects[0].clone());
         let layout = histencil_alpha::plan_layout(&scene, 256, None, 4096).unwrap();
-        let lights = entity_lights(&scene, &layout.regions);
-        let (records, points, list) = entity_records(&scene, &layout.regions, &lights);
-        assert_eq!(list.len(), lights.iter().map(Vec::len).sum::<usize>());
-        assert_eq!(records[1].light_range[0] as usize, lights[0].len());
-        assert_eq!(records[0].shape[2..], [0, 600]);
-        assert_eq!(records[1].shape[2..], [600, 64]);
-        assert_eq!(points.len(), 664);
+        let meshes = crate::alpha::ProbeMeshes::new(&scene);
+        let entities = scene_alpha_entities(&scene, &meshes);
+        let viewer = Viewer::from_camera(&scene.camera);
+        let out = frame_records(&entities, &layout.regions, &viewer, &scene.lights);
+        let lights = &out.entity_lights;
+        assert_eq!(
+            out.light_list.len(),
+            lights.iter().map(Vec::len).sum::<usize>()
+        );
+        assert_eq!(out.records[1].light_range[0] as usize, lights[0].len());
+        // The object first: its probes fill its region.
+        let object = layout.regions[0].shape;
+        assert_eq!(out.records[0].shape[2], 0);
+        assert_eq!(
+            out.probes.len() as u32,
+            object.tile_width * object.tile_height
+        );
+        assert_eq!(out.records[1].shape[2..], [0, 600]);
+        assert_eq!(out.records[2].shape[2..], [600, 64]);
+        assert_eq!(out.points.len(), 664);
     }
 }

@@ -1,25 +1,31 @@
 //! The talk's second technique on the GPU: translucent objects and particle systems lit through
 //! per-entity lightmaps, then blended over the lit frame.
 //!
-//! Once (at the first frame): each alpha mesh is drawn in its UV layout into its region of the
-//! position atlas, leaving one object-space probe (position and normal) per texel. Every frame:
-//! each entity's region of the lightmap atlas is lit by the lights that reach its bounds, one
-//! additive draw per light with the deferred pass's light code (`lightmap.frag`); then the alpha
-//! pass draws the entities far to near, sampling their regions. The probes of particle systems
-//! are not baked: they follow the camera (a quad or slices fitted around the system), a mote
-//! (dust), or the ribbon's control points, and `lightmap.frag` computes them per texel.
+//! Every frame: each entity's region of the lightmap atlas is lit by the lights that reach its
+//! bounds, one additive draw per light with the deferred pass's light code (`lightmap.frag`,
+//! recorded by [`AlphaLightmaps`], the part an engine uses on its own entities); then
+//! histencil's alpha pass draws the entities far to near, sampling their regions
+//! (`lightmap_sample.glsl`). An object's probes are baked on the CPU from its mesh's UV layout
+//! ([`histencil_alpha::bake_probes`]); a particle system's follow the camera (a quad or slices
+//! fitted around the system), a mote (dust), or the ribbon's control points, and
+//! `lightmap.frag` computes them per texel.
 
+mod entity;
 mod gpu;
+mod lightmaps;
+
+pub use entity::{mesh_bounds, AlphaEntity, AlphaEntityKind};
+pub use gpu::AlphaEntityRecord;
+pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::descriptors::{
-    create_pipeline_layout, create_set_layout, write_storage_buffers, ALPHA_LIGHTMAP_SET,
-    ALPHA_SET, GRAPHICS_STAGES,
+    create_pipeline_layout, create_set_layout, ALPHA_LIGHTMAP_SET, GRAPHICS_STAGES,
 };
 use crate::error::{Result, VkCall};
-use crate::meshes::Meshes;
-use crate::passes::{begin_hdr_rendering, begin_rendering, color_attachment, Load, CLEAR_BLACK};
+use crate::meshes::{Meshes, SPHERE_DETAIL};
+use crate::passes::{begin_cleared, begin_hdr_rendering, Load};
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::{Buffer, Image};
 use crate::shader_consts::ALPHA_MODES;
@@ -27,12 +33,13 @@ use crate::shaders;
 use crate::state::{apply, oriented, FULLSCREEN};
 use crate::targets::{Targets, HDR_FORMAT};
 use ash::vk;
-use gpu::{entity_lights, entity_records, AlphaDrawPush};
+use glam::Vec3;
+use gpu::AlphaDrawPush;
 use histencil_alpha::{
     back_to_front, plan_layout, sprite_vertices, EntityKey, LightmapLayout, SpriteVertex,
 };
-use histencil_model::{CompareOp, CullMode, DepthConvention, DepthState, PassState};
-use histencil_scene::Scene;
+use histencil_model::{CompareOp, CullMode, DepthConvention, DepthState, PassState, ViewDesc};
+use histencil_scene::{unit_box_bake, uv_sphere, Mesh, Scene, Shape};
 
 /// How the alpha pass lights translucent objects and particles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -62,8 +69,6 @@ impl AlphaMode {
     }
 }
 
-/// Position and normal atlases: f32, the probes' positions are the lighting's inputs.
-const PROBE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// The lightmap atlas: HDR radiance, as the lighting target.
 const LIGHTMAP_FORMAT: vk::Format = HDR_FORMAT;
 
@@ -82,37 +87,81 @@ const PARTICLES: PassState = PassState {
     ..ALPHA_OBJECTS
 };
 
-/// A scene's alpha entities on the GPU: atlases, records, sprites and pipelines.
-pub(crate) struct AlphaLighting {
+/// The CPU meshes whose UV layouts hold a scene's object probes: the box's bake layout (faces
+/// extended into their gutters), the sphere, the imported meshes.
+pub(crate) struct ProbeMeshes {
+    unit_box: Mesh,
+    sphere: Mesh,
+    imported: Vec<Mesh>,
+}
+
+impl ProbeMeshes {
+    pub(crate) fn new(scene: &Scene) -> Self {
+        Self {
+            unit_box: unit_box_bake(),
+            sphere: uv_sphere(SPHERE_DETAIL.0, SPHERE_DETAIL.1),
+            imported: scene.meshes.clone(),
+        }
+    }
+
+    fn get(&self, shape: Shape) -> &Mesh {
+        match shape {
+            Shape::Box => &self.unit_box,
+            Shape::Sphere => &self.sphere,
+            Shape::Mesh(i) => &self.imported[i as usize],
+        }
+    }
+}
+
+/// `scene`'s alpha entities as an engine would hand them over, in
+/// [`histencil_alpha::entities`] order. Scene shapes fill `[-1, 1]^3`.
+pub(crate) fn scene_alpha_entities<'a>(
+    scene: &'a Scene,
+    meshes: &'a ProbeMeshes,
+) -> Vec<AlphaEntity<'a>> {
+    let objects = scene.alpha_objects.iter().map(|o| AlphaEntity {
+        kind: AlphaEntityKind::Object {
+            probe_mesh: meshes.get(o.shape),
+            transform: o.transform,
+            local_bounds: (Vec3::NEG_ONE, Vec3::ONE),
+        },
+        material: o.material,
+        opacity: o.opacity,
+    });
+    let systems = scene.particle_systems.iter().map(|s| AlphaEntity {
+        kind: AlphaEntityKind::Particles {
+            layout: s.layout,
+            particles: &s.particles,
+        },
+        material: s.material,
+        opacity: s.opacity,
+    });
+    objects.chain(systems).collect()
+}
+
+/// A scene's alpha entities on the GPU: the lightmaps (as an engine records them), the atlas,
+/// the sprites and histencil's alpha pass.
+pub(crate) struct AlphaLighting<'c> {
     layout: LightmapLayout,
+    probe_meshes: ProbeMeshes,
     /// Blending order.
     order: Vec<EntityKey>,
     /// Per particle system: its first sprite vertex and vertex count.
     sprite_ranges: Vec<(u32, u32)>,
-    /// Per entity (record order): the lights that reach it.
-    entity_lights: Vec<Vec<u32>>,
-    baked: bool,
-    positions: Image,
-    normals: Image,
+    lightmap_draws: usize,
+    lightmaps: AlphaLightmaps<'c>,
     lightmap: Image,
-    entities: Buffer,
-    points: Buffer,
-    light_list: Buffer,
     sprites: Buffer,
-    alpha_set_layout: vk::DescriptorSetLayout,
     lightmap_set_layout: vk::DescriptorSetLayout,
     pipeline_layout: vk::PipelineLayout,
     pool: vk::DescriptorPool,
-    alpha_set: vk::DescriptorSet,
     lightmap_set: vk::DescriptorSet,
-    bake_pipeline: vk::Pipeline,
-    lightmap_pipeline: vk::Pipeline,
     object_pipeline: vk::Pipeline,
     particle_pipeline: vk::Pipeline,
 }
 
-/// Every Vulkan object an [`AlphaLighting`] owns, created step by step so a failure part-way
-/// destroys what exists.
+/// The alpha pass's own Vulkan objects, created step by step so a failure part-way destroys what
+/// exists.
 #[derive(Default)]
 struct Parts {
     images: Vec<Image>,
@@ -149,15 +198,15 @@ impl Parts {
     }
 }
 
-impl AlphaLighting {
+impl<'c> AlphaLighting<'c> {
     /// Plans the lightmap layout for `scene` seen at `extent` (region sides from coverage, or
-    /// `forced_side`), and creates the atlases, buffers and pipelines.
+    /// `forced_side`), and creates the lightmaps, the atlas, the sprites and the pipelines.
     ///
     /// # Errors
     /// [`crate::Error::Lightmap`] when the layout cannot be planned (bad forced side, atlas
     /// full), besides Vulkan errors.
     pub fn new(
-        ctx: &Context,
+        ctx: &'c Context,
         scene: &Scene,
         extent: vk::Extent2D,
         forced_side: Option<u32>,
@@ -165,8 +214,15 @@ impl AlphaLighting {
     ) -> Result<Self> {
         let max_side = histencil_alpha::MAX_ATLAS_SIDE.min(ctx.max_image_dimension);
         let layout = plan_layout(scene, extent.height, forced_side, max_side)?;
+        let lightmaps = AlphaLightmaps::new(
+            ctx,
+            &AlphaLightmapsDesc {
+                atlas_format: LIGHTMAP_FORMAT,
+                frames_in_flight: 1,
+            },
+        )?;
         let mut parts = Parts::default();
-        match Self::create(ctx, scene, layout, frame_layout, &mut parts) {
+        match Self::create(ctx, scene, layout, lightmaps, frame_layout, &mut parts) {
             Ok(built) => Ok(built),
             Err(e) => {
                 parts.destroy(ctx);
@@ -176,9 +232,10 @@ impl AlphaLighting {
     }
 
     fn create(
-        ctx: &Context,
+        ctx: &'c Context,
         scene: &Scene,
         layout: LightmapLayout,
+        lightmaps: AlphaLightmaps<'c>,
         frame_layout: vk::DescriptorSetLayout,
         parts: &mut Parts,
     ) -> Result<Self> {
@@ -188,37 +245,14 @@ impl AlphaLighting {
             height: h,
         };
         use vk::ImageUsageFlags as U;
-        let usage = U::COLOR_ATTACHMENT | U::SAMPLED;
-        for (name, format) in [
-            ("alpha-position-atlas", PROBE_FORMAT),
-            ("alpha-normal-atlas", PROBE_FORMAT),
-            ("alpha-lightmap-atlas", LIGHTMAP_FORMAT),
-        ] {
-            parts
-                .images
-                .push(Image::new(ctx, name, format, extent, usage)?);
-        }
+        parts.images.push(Image::new(
+            ctx,
+            "alpha-lightmap-atlas",
+            LIGHTMAP_FORMAT,
+            extent,
+            U::COLOR_ATTACHMENT | U::SAMPLED,
+        )?);
 
-        let entity_lights = entity_lights(scene, &layout.regions);
-        let (records, mut points, mut light_list) =
-            entity_records(scene, &layout.regions, &entity_lights);
-        // A storage buffer binding needs a non-empty range.
-        if points.is_empty() {
-            points.push([0.0; 4]);
-        }
-        if light_list.is_empty() {
-            light_list.push(0);
-        }
-        for (name, bytes) in [
-            ("alpha-entities", bytemuck::cast_slice::<_, u8>(&records)),
-            ("alpha-points", bytemuck::cast_slice(&points)),
-            ("alpha-entity-lights", bytemuck::cast_slice(&light_list)),
-        ] {
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            parts
-                .buffers
-                .push(Buffer::with_data(ctx, name, usage, bytes)?);
-        }
         let mut sprites: Vec<SpriteVertex> = Vec::new();
         let mut sprite_ranges = Vec::new();
         let objects = scene.alpha_objects.len() as u32;
@@ -237,9 +271,6 @@ impl AlphaLighting {
             bytemuck::cast_slice(&sprites),
         )?);
 
-        let alpha_set_layout =
-            create_set_layout(ctx, "alpha-set-layout", ALPHA_SET, GRAPHICS_STAGES)?;
-        parts.set_layouts.push(alpha_set_layout);
         let lightmap_set_layout = create_set_layout(
             ctx,
             "alpha-lightmap-set-layout",
@@ -250,99 +281,73 @@ impl AlphaLighting {
         let pipeline_layout = create_pipeline_layout(
             ctx,
             "alpha-pipeline-layout",
-            &[frame_layout, alpha_set_layout, lightmap_set_layout],
+            &[
+                frame_layout,
+                lightmaps.alpha_set_layout(),
+                lightmap_set_layout,
+            ],
             GRAPHICS_STAGES,
             size_of::<AlphaDrawPush>() as u32,
         )?;
         parts.pipeline_layout = Some(pipeline_layout);
-        let (pool, alpha_set, lightmap_set) =
-            create_sets(ctx, parts, [alpha_set_layout, lightmap_set_layout])?;
+        let (pool, lightmap_set) = create_lightmap_set(ctx, parts, lightmap_set_layout)?;
 
-        let probe_formats = [PROBE_FORMAT, PROBE_FORMAT];
-        let lightmap_formats = [LIGHTMAP_FORMAT];
+        // The alpha pass: blended over the lit HDR frame, tested against its depth.
         let hdr = [HDR_FORMAT];
-        let base = PipelineDesc {
-            name: "alpha-bake-pipeline",
-            vertex: ("alpha_bake.vert", shaders::ALPHA_BAKE_VERT),
-            fragment: Some(("alpha_bake.frag", shaders::ALPHA_BAKE_FRAG)),
+        let objects_desc = PipelineDesc {
+            name: "alpha-object-pipeline",
+            vertex: ("alpha_object.vert", shaders::ALPHA_OBJECT_VERT),
+            fragment: Some(("alpha_object.frag", shaders::ALPHA_OBJECT_FRAG)),
             layout: pipeline_layout,
             vertex_input: VertexInput::PositionNormalUv,
-            color_formats: &probe_formats,
+            color_formats: &hdr,
             color_writes: true,
-            blend: Blend::Off,
-            depth_stencil_format: vk::Format::UNDEFINED,
+            blend: Blend::PremultipliedOver,
+            depth_stencil_format: ctx.depth_stencil_format,
             depth_clamp: false,
             specialization: &[],
         };
-        // The alpha pass: blended over the lit HDR frame, tested against its depth.
-        let over_the_frame = PipelineDesc {
-            color_formats: &hdr,
-            blend: Blend::PremultipliedOver,
-            depth_stencil_format: ctx.depth_stencil_format,
-            ..base
+        let particles_desc = PipelineDesc {
+            name: "alpha-particle-pipeline",
+            vertex: ("particle.vert", shaders::PARTICLE_VERT),
+            fragment: Some(("particle.frag", shaders::PARTICLE_FRAG)),
+            vertex_input: VertexInput::Sprite,
+            ..objects_desc
         };
-        let descs = [
-            PipelineDesc { ..base },
-            PipelineDesc {
-                name: "alpha-lightmap-pipeline",
-                vertex: ("fullscreen.vert", shaders::FULLSCREEN_VERT),
-                fragment: Some(("lightmap.frag", shaders::LIGHTMAP_FRAG)),
-                vertex_input: VertexInput::None,
-                color_formats: &lightmap_formats,
-                blend: Blend::Additive,
-                ..base
-            },
-            PipelineDesc {
-                name: "alpha-object-pipeline",
-                vertex: ("alpha_object.vert", shaders::ALPHA_OBJECT_VERT),
-                fragment: Some(("alpha_object.frag", shaders::ALPHA_OBJECT_FRAG)),
-                ..over_the_frame
-            },
-            PipelineDesc {
-                name: "alpha-particle-pipeline",
-                vertex: ("particle.vert", shaders::PARTICLE_VERT),
-                fragment: Some(("particle.frag", shaders::PARTICLE_FRAG)),
-                vertex_input: VertexInput::Sprite,
-                ..over_the_frame
-            },
-        ];
-        for desc in &descs {
+        for desc in [&objects_desc, &particles_desc] {
             parts.pipelines.push(create_pipeline(ctx, desc)?);
         }
+        write_sampled_image(ctx, lightmap_set, 0, parts.images[0].view);
 
-        let images = &parts.images;
-        let storage: Vec<vk::Buffer> = parts.buffers[..3].iter().map(|b| b.handle).collect();
-        write_storage_buffers(ctx, alpha_set, &storage);
-        write_sampled_image(ctx, alpha_set, 3, images[0].view);
-        write_sampled_image(ctx, alpha_set, 4, images[1].view);
-        write_sampled_image(ctx, lightmap_set, 0, images[2].view);
-
+        let probe_meshes = ProbeMeshes::new(scene);
+        let lightmap_draws = scene_alpha_entities(scene, &probe_meshes)
+            .iter()
+            .map(|e| {
+                let (lo, hi) = e.world_bounds();
+                scene
+                    .lights
+                    .iter()
+                    .filter(|l| l.reaches_box(lo, hi))
+                    .count()
+            })
+            .sum();
         let order = back_to_front(scene);
-        let mut images = std::mem::take(&mut parts.images).into_iter();
-        let mut buffers = std::mem::take(&mut parts.buffers).into_iter();
+        let lightmap = parts.images.pop().expect("the atlas");
+        let sprites = parts.buffers.pop().expect("the sprites");
         let mut pipelines = std::mem::take(&mut parts.pipelines).into_iter();
-        let mut next = move || images.next().expect("three atlases");
         let built = Self {
             layout,
+            probe_meshes,
             order,
             sprite_ranges,
-            entity_lights,
-            baked: false,
-            positions: next(),
-            normals: next(),
-            lightmap: next(),
-            entities: buffers.next().expect("entities"),
-            points: buffers.next().expect("points"),
-            light_list: buffers.next().expect("light list"),
-            sprites: buffers.next().expect("sprites"),
-            alpha_set_layout,
+            lightmap_draws,
+            lightmaps,
+            lightmap,
+            sprites,
             lightmap_set_layout,
             pipeline_layout,
             pool,
-            alpha_set,
             lightmap_set,
-            bake_pipeline: pipelines.next().expect("bake"),
-            lightmap_pipeline: pipelines.next().expect("lightmap"),
             object_pipeline: pipelines.next().expect("objects"),
             particle_pipeline: pipelines.next().expect("particles"),
         };
@@ -357,41 +362,32 @@ impl AlphaLighting {
 
     /// How many lightmap draws a frame makes: one per (entity, light that reaches it).
     pub fn lightmap_draws(&self) -> usize {
-        self.entity_lights.iter().map(Vec::len).sum()
+        self.lightmap_draws
     }
 
-    /// Records the probe bake (first frame only) and, in lightmap mode, the lightmap pass into
-    /// `cmd`.
+    /// Writes the frame's entity records (every mode reads them) and, in lightmap mode, records
+    /// the lightmap pass into `cmd`, as an engine would.
     pub fn record_lightmaps(
         &mut self,
-        ctx: &Context,
         cmd: vk::CommandBuffer,
         scene: &Scene,
-        meshes: &Meshes,
-        frame_set: vk::DescriptorSet,
+        view: &ViewDesc,
         mode: AlphaMode,
-    ) {
-        self.bind_sets(ctx, cmd, frame_set);
-        if !self.baked {
-            self.record_bake(ctx, cmd, scene, meshes);
-            self.baked = true;
-        }
+    ) -> Result<()> {
+        let entities = scene_alpha_entities(scene, &self.probe_meshes);
+        let frame = LightmapFrame {
+            slot: 0,
+            view,
+            lights: &scene.lights,
+            entities: &entities,
+            layout: &self.layout,
+        };
+        self.lightmaps.write_frame(&frame, &self.lightmap)?;
         if mode == AlphaMode::Lightmap {
-            self.record_lighting(ctx, cmd);
+            self.lightmaps
+                .record_pass(cmd, 0, &self.layout, &mut self.lightmap);
         }
-    }
-
-    fn bind_sets(&self, ctx: &Context, cmd: vk::CommandBuffer, frame_set: vk::DescriptorSet) {
-        unsafe {
-            ctx.device.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline_layout,
-                0,
-                &[frame_set, self.alpha_set, self.lightmap_set],
-                &[],
-            );
-        }
+        Ok(())
     }
 
     fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, push: AlphaDrawPush) {
@@ -404,112 +400,6 @@ impl AlphaLighting {
                 bytemuck::bytes_of(&push),
             );
         }
-    }
-
-    /// Draws each alpha mesh in its UV layout into its region of the position and normal
-    /// atlases (cleared to w = 0: no probe).
-    fn record_bake(
-        &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        scene: &Scene,
-        meshes: &Meshes,
-    ) {
-        ctx.begin_label(cmd, "alpha-probe-bake");
-        for image in [&mut self.positions, &mut self.normals] {
-            transition(
-                ctx,
-                cmd,
-                image,
-                ImageAccess::ColorAttachment,
-                Contents::Discard,
-            );
-        }
-        let colors = [
-            color_attachment(&self.positions, Load::Clear(CLEAR_BLACK)),
-            color_attachment(&self.normals, Load::Clear(CLEAR_BLACK)),
-        ];
-        begin_rendering(ctx, cmd, self.positions.extent, &colors, None);
-        unsafe {
-            ctx.device
-                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.bake_pipeline);
-        }
-        apply(ctx, cmd, &FULLSCREEN);
-        for (index, r) in self.layout.regions.iter().enumerate() {
-            let EntityKey::Object(i) = r.entity else {
-                continue;
-            };
-            set_region(ctx, cmd, r.region);
-            self.push(
-                ctx,
-                cmd,
-                AlphaDrawPush {
-                    entity: index as u32,
-                    ..Default::default()
-                },
-            );
-            meshes
-                .bake_shape(scene.alpha_objects[i].shape)
-                .draw(ctx, cmd);
-        }
-        unsafe { ctx.device.cmd_end_rendering(cmd) };
-        ctx.end_label(cmd);
-    }
-
-    /// Lights every entity's region: one additive draw per light that reaches it.
-    fn record_lighting(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
-        ctx.begin_label(cmd, "alpha-lightmaps");
-        for image in [&mut self.positions, &mut self.normals] {
-            transition(
-                ctx,
-                cmd,
-                image,
-                ImageAccess::FragmentSampled,
-                Contents::Keep,
-            );
-        }
-        transition(
-            ctx,
-            cmd,
-            &mut self.lightmap,
-            ImageAccess::ColorAttachment,
-            Contents::Discard,
-        );
-        let colors = [color_attachment(&self.lightmap, Load::Clear(CLEAR_BLACK))];
-        begin_rendering(ctx, cmd, self.lightmap.extent, &colors, None);
-        unsafe {
-            ctx.device.cmd_bind_pipeline(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.lightmap_pipeline,
-            );
-        }
-        apply(ctx, cmd, &FULLSCREEN);
-        for (index, (r, lights)) in self
-            .layout
-            .regions
-            .iter()
-            .zip(&self.entity_lights)
-            .enumerate()
-        {
-            if lights.is_empty() {
-                continue;
-            }
-            let mut region = r.region;
-            region.width = r.shape.tiles * r.shape.tile_width;
-            set_region(ctx, cmd, region);
-            for &light in lights {
-                let push = AlphaDrawPush {
-                    entity: index as u32,
-                    light,
-                    ..Default::default()
-                };
-                self.push(ctx, cmd, push);
-                unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
-            }
-        }
-        unsafe { ctx.device.cmd_end_rendering(cmd) };
-        ctx.end_label(cmd);
     }
 
     /// Blends the entities far to near over the lit frame in `targets.hdr`, lit as `mode` says.
@@ -525,31 +415,31 @@ impl AlphaLighting {
         (mode, extent, depth): (AlphaMode, vk::Extent2D, DepthConvention),
     ) {
         ctx.begin_label(cmd, "alpha");
-        self.bind_sets(ctx, cmd, frame_set);
+        unsafe {
+            ctx.device.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline_layout,
+                0,
+                &[frame_set, self.lightmaps.alpha_set(0), self.lightmap_set],
+                &[],
+            );
+        }
         // Forward and probe frames never write the lightmap; the transition still gives the
         // bound (and unread) image the layout its descriptor declares. An atlas no frame has
         // written yet is cleared first, so no read-only layout is entered from UNDEFINED.
-        for image in [&mut self.positions, &mut self.normals, &mut self.lightmap] {
-            if image.state.layout == vk::ImageLayout::UNDEFINED {
-                transition(
-                    ctx,
-                    cmd,
-                    image,
-                    ImageAccess::ColorAttachment,
-                    Contents::Discard,
-                );
-                let colors = [color_attachment(image, Load::Clear(CLEAR_BLACK))];
-                begin_rendering(ctx, cmd, image.extent, &colors, None);
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
-            }
-            transition(
-                ctx,
-                cmd,
-                image,
-                ImageAccess::FragmentSampled,
-                Contents::Keep,
-            );
+        let atlas = &mut self.lightmap;
+        if atlas.state.layout == vk::ImageLayout::UNDEFINED {
+            begin_cleared(ctx, cmd, atlas);
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
         }
+        transition(
+            ctx,
+            cmd,
+            atlas,
+            ImageAccess::FragmentSampled,
+            Contents::Keep,
+        );
         let attachments = (&mut *targets.hdr, &mut *targets.depth_stencil);
         begin_hdr_rendering(ctx, cmd, attachments, extent, Load::Keep, Load::Keep);
         let d = &ctx.device;
@@ -598,90 +488,49 @@ impl AlphaLighting {
         ctx.end_label(cmd);
     }
 
+    /// Frees the alpha pass's own objects; the lightmaps free theirs when dropped.
     pub fn destroy(&mut self, ctx: &Context) {
         let mut parts = Parts {
             images: vec![],
             buffers: vec![],
-            set_layouts: vec![self.alpha_set_layout, self.lightmap_set_layout],
+            set_layouts: vec![self.lightmap_set_layout],
             pipeline_layout: Some(self.pipeline_layout),
             pool: Some(self.pool),
-            pipelines: vec![
-                self.bake_pipeline,
-                self.lightmap_pipeline,
-                self.object_pipeline,
-                self.particle_pipeline,
-            ],
+            pipelines: vec![self.object_pipeline, self.particle_pipeline],
         };
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+        }
         parts.destroy(ctx);
-        for image in [&mut self.positions, &mut self.normals, &mut self.lightmap] {
-            image.destroy(ctx);
-        }
-        for buffer in [
-            &mut self.entities,
-            &mut self.points,
-            &mut self.light_list,
-            &mut self.sprites,
-        ] {
-            buffer.destroy(ctx);
-        }
+        self.lightmap.destroy(ctx);
+        self.sprites.destroy(ctx);
     }
 }
 
-/// Viewport and scissor over one atlas region.
-fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: histencil_alpha::Region) {
-    let viewport = vk::Viewport {
-        x: r.x as f32,
-        y: r.y as f32,
-        width: r.width as f32,
-        height: r.height as f32,
-        min_depth: 0.0,
-        max_depth: 1.0,
-    };
-    let scissor = vk::Rect2D {
-        offset: vk::Offset2D {
-            x: r.x as i32,
-            y: r.y as i32,
-        },
-        extent: vk::Extent2D {
-            width: r.width,
-            height: r.height,
-        },
-    };
-    unsafe {
-        ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
-        ctx.device.cmd_set_scissor(cmd, 0, &[scissor]);
-    }
-}
-
-/// A pool with one alpha set (three storage buffers, two sampled images) and one lightmap set.
-fn create_sets(
+/// A pool with the alpha pass's lightmap set (one sampled image).
+fn create_lightmap_set(
     ctx: &Context,
     parts: &mut Parts,
-    layouts: [vk::DescriptorSetLayout; 2],
-) -> Result<(vk::DescriptorPool, vk::DescriptorSet, vk::DescriptorSet)> {
-    let sizes = [
-        vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::STORAGE_BUFFER)
-            .descriptor_count(3),
-        vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::SAMPLED_IMAGE)
-            .descriptor_count(3),
-    ];
+    layout: vk::DescriptorSetLayout,
+) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
+    let sizes = [vk::DescriptorPoolSize::default()
+        .ty(vk::DescriptorType::SAMPLED_IMAGE)
+        .descriptor_count(1)];
     let info = vk::DescriptorPoolCreateInfo::default()
-        .max_sets(2)
+        .max_sets(1)
         .pool_sizes(&sizes);
     let pool =
         unsafe { ctx.device.create_descriptor_pool(&info, None) }.call("vkCreateDescriptorPool")?;
     ctx.name(pool, "alpha-descriptor-pool");
     parts.pool = Some(pool);
+    let layouts = [layout];
     let alloc = vk::DescriptorSetAllocateInfo::default()
         .descriptor_pool(pool)
         .set_layouts(&layouts);
     let sets =
         unsafe { ctx.device.allocate_descriptor_sets(&alloc) }.call("vkAllocateDescriptorSets")?;
-    ctx.name(sets[0], "alpha-set");
-    ctx.name(sets[1], "alpha-lightmap-set");
-    Ok((pool, sets[0], sets[1]))
+    ctx.name(sets[0], "alpha-lightmap-set");
+    Ok((pool, sets[0]))
 }
 
 fn write_sampled_image(ctx: &Context, set: vk::DescriptorSet, binding: u32, view: vk::ImageView) {

@@ -98,6 +98,20 @@ pub(crate) fn begin_rendering(
     }
 }
 
+/// Discards `image`'s contents and begins rendering into it alone, cleared to black, over its
+/// whole extent.
+pub(crate) fn begin_cleared(ctx: &Context, cmd: vk::CommandBuffer, image: &mut ImageRef) {
+    transition(
+        ctx,
+        cmd,
+        image,
+        ImageAccess::ColorAttachment,
+        Contents::Discard,
+    );
+    let colors = [color_attachment(image, Load::Clear(CLEAR_BLACK))];
+    begin_rendering(ctx, cmd, image.extent, &colors, None);
+}
+
 /// Begins rendering into the HDR target and the depth-stencil target, each cleared or kept as
 /// `hdr` and `depth` say (the forward pass clears both; lighting keeps the G-buffer's depth and
 /// clears HDR once, keeping both when a split pass resumes).

@@ -79,7 +79,7 @@ impl Renderer<'_> {
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            alpha.record_lightmaps(ctx, cmd, scene, meshes, frame_set, alpha_mode);
+            alpha.record_lightmaps(cmd, scene, &view, alpha_mode)?;
             self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
             alpha.record_alpha(
                 ctx,

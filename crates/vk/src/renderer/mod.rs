@@ -96,7 +96,7 @@ pub struct Renderer<'c> {
     lightmap_side: Option<u32>,
     /// Created at the first frame of a scene with alpha entities (and again when the lightmap
     /// resolution changes).
-    alpha: Option<AlphaLighting>,
+    alpha: Option<AlphaLighting<'c>>,
     /// The lighting passes, as an engine records them, into this renderer's targets.
     lighting: DeferredLighting<'c>,
     /// The adaptive technique's costs; `None`: fitted to the talk's figures for the backend.
@@ -375,7 +375,7 @@ impl<'c> Renderer<'c> {
         Ok(self.alpha_lighting()?.map_or(0, |a| a.lightmap_draws()))
     }
 
-    fn alpha_lighting(&mut self) -> Result<Option<&mut AlphaLighting>> {
+    fn alpha_lighting(&mut self) -> Result<Option<&mut AlphaLighting<'c>>> {
         if self.scene.alpha_entity_count() == 0 {
             return Ok(None);
         }

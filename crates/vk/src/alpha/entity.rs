@@ -1,0 +1,133 @@
+//! An engine's alpha entities as [`crate::AlphaLightmaps`] takes them each frame: plain values,
+//! borrowed for the frame. A translucent object brings the mesh whose lightmap UV layout holds
+//! its probes; a particle system brings its particles.
+
+use glam::{Mat4, Vec3};
+use histencil_alpha::{particle_bounds, EntityDesc, EntityKind};
+use histencil_scene::{Material, Mesh, Particle, ParticleLayout};
+
+/// One translucent object or particle system, as lit this frame.
+#[derive(Clone, Copy, Debug)]
+pub struct AlphaEntity<'a> {
+    pub kind: AlphaEntityKind<'a>,
+    /// The BRDF and tint its probes are lit with.
+    pub material: Material,
+    /// Coverage in `[0, 1]`, carried to the record for the alpha shader.
+    pub opacity: f32,
+}
+
+/// What the entity is.
+#[derive(Clone, Copy, Debug)]
+pub enum AlphaEntityKind<'a> {
+    /// A translucent mesh. `probe_mesh` is the mesh in its lightmap UV layout (object space;
+    /// `uv` in `[0, 1]^2`, the layout the alpha shader samples with): one probe per texel it
+    /// covers, baked on the CPU at the region's size ([`histencil_alpha::bake_probes`]).
+    /// `local_bounds` is the object-space box of what is drawn (lights reaching it light the
+    /// entity), `transform` object to world.
+    Object {
+        probe_mesh: &'a Mesh,
+        transform: Mat4,
+        local_bounds: (Vec3, Vec3),
+    },
+    /// A particle system: `particles` are world-space sprites (position, size).
+    Particles {
+        layout: ParticleLayout,
+        particles: &'a [Particle],
+    },
+}
+
+/// The object-space box around `mesh`'s vertices (an empty mesh: the origin).
+pub fn mesh_bounds(mesh: &Mesh) -> (Vec3, Vec3) {
+    let points = mesh.vertices.iter().map(|v| Vec3::from(v.position));
+    let bounds = points.fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
+    if bounds.0.cmple(bounds.1).all() {
+        bounds
+    } else {
+        (Vec3::ZERO, Vec3::ZERO)
+    }
+}
+
+impl AlphaEntity<'_> {
+    /// The world-space box around what the entity draws.
+    pub fn world_bounds(&self) -> (Vec3, Vec3) {
+        match self.kind {
+            AlphaEntityKind::Object {
+                transform,
+                local_bounds: (lo, hi),
+                ..
+            } => {
+                let corners = (0..8).map(|i| {
+                    let pick = |bit: u32, a: f32, b: f32| if i & bit == 0 { a } else { b };
+                    transform.transform_point3(Vec3::new(
+                        pick(1, lo.x, hi.x),
+                        pick(2, lo.y, hi.y),
+                        pick(4, lo.z, hi.z),
+                    ))
+                });
+                corners.fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), p| (lo.min(p), hi.max(p)),
+                )
+            }
+            AlphaEntityKind::Particles { particles, .. } => particle_bounds(particles),
+        }
+    }
+
+    /// The entity's description for [`histencil_alpha::plan_regions`]: its kind and world
+    /// bounds, coverage and side from those.
+    pub fn desc(&self) -> EntityDesc {
+        let kind = match self.kind {
+            AlphaEntityKind::Object { .. } => EntityKind::Surface,
+            AlphaEntityKind::Particles { layout, particles } => EntityKind::Particles {
+                layout,
+                count: u32::try_from(particles.len()).unwrap_or(u32::MAX),
+            },
+        };
+        EntityDesc {
+            kind,
+            bounds: self.world_bounds(),
+            coverage_px: None,
+            side: None,
+        }
+    }
+
+    /// What is wrong with the entity, if anything: an opacity outside `[0, 1]`, a material its
+    /// BRDF refuses, a transform or bounds that are not finite, particles that are not finite
+    /// or not of positive size, or a layout its particles cannot fill.
+    pub fn problem(&self) -> Option<String> {
+        if !(0.0..=1.0).contains(&self.opacity) {
+            return Some(format!("opacity {} is outside [0, 1]", self.opacity));
+        }
+        if let Some(p) = self.material.problem() {
+            return Some(p);
+        }
+        match self.kind {
+            AlphaEntityKind::Object {
+                transform,
+                local_bounds: (lo, hi),
+                ..
+            } => {
+                if !transform.is_finite() || transform.determinant() == 0.0 {
+                    return Some("its transform must be finite and invertible".into());
+                }
+                if !(lo.is_finite() && hi.is_finite()) || lo.cmpgt(hi).any() {
+                    return Some("its bounds must be finite with min <= max".into());
+                }
+            }
+            AlphaEntityKind::Particles { particles, .. } => {
+                if particles
+                    .iter()
+                    .any(|p| !p.position.is_finite() || !p.size.is_finite() || p.size <= 0.0)
+                {
+                    return Some(
+                        "particle positions must be finite and sizes finite and positive".into(),
+                    );
+                }
+            }
+        }
+        histencil_alpha::entity_problem(&self.desc()).map(str::to_owned)
+    }
+}

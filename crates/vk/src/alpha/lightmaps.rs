@@ -1,0 +1,565 @@
+//! The talk's lightmaps for an engine's alpha entities, recorded into its frames:
+//! [`AlphaLightmaps`] lights each entity's region of the caller's lightmap atlas with every light
+//! that reaches it (one additive draw per pair, with the deferred pass's light code), in the
+//! caller's command buffer. The engine plans the regions with
+//! [`histencil_alpha::plan_regions`] and samples the atlas from its own alpha shaders through
+//! `shaders/include/lightmap_sample.glsl`, reading each entity's record from
+//! [`AlphaLightmaps::entity_buffer`].
+//!
+//! Frames in flight work as in [`crate::DeferredLighting`]: each slot has its own buffers and
+//! sets, rewritten when a frame is recorded into it; the buffers grow when a frame needs more.
+
+use super::entity::AlphaEntity;
+use super::gpu::{frame_records, AlphaDrawPush, FrameRecords};
+use crate::access::ImageRef;
+use crate::context::Context;
+use crate::descriptors::{
+    create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers, ALPHA_SET,
+    FRAME_SET, GRAPHICS_STAGES,
+};
+use crate::error::{Error, Result, VkCall};
+use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::passes::begin_cleared;
+use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::resources::Buffer;
+use crate::shaders;
+use crate::state::{apply, FULLSCREEN};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use histencil_alpha::{LightmapLayout, Region, Viewer};
+use histencil_model::ViewDesc;
+use histencil_scene::Light;
+
+/// What an [`AlphaLightmaps`] is made for: fixed for its lifetime.
+#[derive(Clone, Copy, Debug)]
+pub struct AlphaLightmapsDesc {
+    /// The lightmap atlas's format: a colour format the device blends into (HDR radiance;
+    /// `R16G16B16A16_SFLOAT` as histencil's own).
+    pub atlas_format: vk::Format,
+    /// How many frames the caller records before it waits for the oldest (at least 1).
+    pub frames_in_flight: u32,
+}
+
+/// One frame's lightmaps.
+#[derive(Clone, Copy, Debug)]
+pub struct LightmapFrame<'a> {
+    /// Which frame-in-flight slot's buffers and sets this frame uses (`< frames_in_flight`).
+    pub slot: u32,
+    /// The camera: particle probe frames face it, and probes are lit towards it.
+    pub view: &'a ViewDesc,
+    pub lights: &'a [Light],
+    pub entities: &'a [AlphaEntity<'a>],
+    /// The entities' regions, from [`histencil_alpha::plan_regions`] on their
+    /// [`AlphaEntity::desc`]s, in the same order.
+    pub layout: &'a LightmapLayout,
+}
+
+struct Slot {
+    uniforms: Buffer,
+    lights: Buffer,
+    /// Entity records, points, light list, probes: `ALPHA_SET` bindings 0 to 3.
+    storage: [Buffer; 4],
+    frame_set: vk::DescriptorSet,
+    alpha_set: vk::DescriptorSet,
+    /// Per entity, the lights the last frame in this slot draws into its region.
+    entity_lights: Vec<Vec<u32>>,
+}
+
+const STORAGE_NAMES: [&str; 4] = [
+    "alpha-entities",
+    "alpha-points",
+    "alpha-entity-lights",
+    "alpha-probes",
+];
+
+/// Per-entity lightmaps for translucent objects and particle systems, recorded into an engine's
+/// frames.
+///
+/// Per frame, after the engine planned its entities' regions:
+///
+/// ```no_run
+/// use ash::vk;
+/// use histencil_alpha::{plan_regions, Viewer};
+/// use histencil_model::ViewDesc;
+/// use histencil_scene::Light;
+/// use histencil_vk::{AlphaEntity, AlphaLightmaps, ImageRef, LightmapFrame};
+///
+/// fn lightmaps(
+///     lightmaps: &mut AlphaLightmaps,
+///     cmd: vk::CommandBuffer,
+///     slot: u32,
+///     view: &ViewDesc,
+///     lights: &[Light],
+///     entities: &[AlphaEntity],
+///     atlas: &mut ImageRef,
+/// ) -> Result<(), Box<dyn std::error::Error>> {
+///     let descs: Vec<_> = entities.iter().map(AlphaEntity::desc).collect();
+///     let viewer = Viewer::from_view(view).ok_or("a view without a camera")?;
+///     let layout = plan_regions(&descs, &viewer, 720, atlas.extent.width)?;
+///     let frame = LightmapFrame { slot, view, lights, entities, layout: &layout };
+///     // SAFETY: `cmd` records on the lightmaps' device, the atlas state is true, and the last
+///     // frame recorded into `slot` has finished on the GPU.
+///     unsafe { lightmaps.record(cmd, &frame, atlas)? };
+///     // The engine's alpha shaders read `lightmaps.entity_buffer(slot)` and the atlas, once
+///     // its barrier takes the atlas from `atlas.state` to a shader read.
+///     Ok(())
+/// }
+/// ```
+pub struct AlphaLightmaps<'c> {
+    ctx: &'c Context,
+    desc: AlphaLightmapsDesc,
+    /// Frame and alpha set layouts: sets 0 and 1 of the lightmap pass (and of histencil's alpha
+    /// pass).
+    set_layouts: [vk::DescriptorSetLayout; 2],
+    pipeline_layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    pool: vk::DescriptorPool,
+    slots: Vec<Slot>,
+}
+
+impl<'c> AlphaLightmaps<'c> {
+    /// Creates the lightmap pipeline and every slot's buffers and sets. A failure half way
+    /// frees what was made.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] for no frames in flight or a depth-stencil atlas format; Vulkan and
+    /// allocation errors.
+    pub fn new(ctx: &'c Context, desc: &AlphaLightmapsDesc) -> Result<Self> {
+        if desc.frames_in_flight == 0 {
+            return Err(bad("frames_in_flight must be at least 1".into()));
+        }
+        if crate::access::aspect_of(desc.atlas_format) != vk::ImageAspectFlags::COLOR {
+            return Err(bad(format!(
+                "atlas format {:?} is not a colour format",
+                desc.atlas_format
+            )));
+        }
+        let mut this = Self {
+            ctx,
+            desc: *desc,
+            set_layouts: [vk::DescriptorSetLayout::null(); 2],
+            pipeline_layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            pool: vk::DescriptorPool::null(),
+            slots: Vec::new(),
+        };
+        // On an error `this` drops, destroying what exists so far.
+        this.create()?;
+        Ok(this)
+    }
+
+    fn create(&mut self) -> Result<()> {
+        let ctx = self.ctx;
+        self.set_layouts[0] =
+            create_set_layout(ctx, "lightmap-frame-set-layout", FRAME_SET, GRAPHICS_STAGES)?;
+        self.set_layouts[1] =
+            create_set_layout(ctx, "alpha-set-layout", ALPHA_SET, GRAPHICS_STAGES)?;
+        self.pipeline_layout = create_pipeline_layout(
+            ctx,
+            "lightmap-pipeline-layout",
+            &self.set_layouts,
+            GRAPHICS_STAGES,
+            size_of::<AlphaDrawPush>() as u32,
+        )?;
+        let formats = [self.desc.atlas_format];
+        self.pipeline = create_pipeline(
+            ctx,
+            &PipelineDesc {
+                name: "alpha-lightmap-pipeline",
+                vertex: ("fullscreen.vert", shaders::FULLSCREEN_VERT),
+                fragment: Some(("lightmap.frag", shaders::LIGHTMAP_FRAG)),
+                layout: self.pipeline_layout,
+                vertex_input: VertexInput::None,
+                color_formats: &formats,
+                color_writes: true,
+                blend: Blend::Additive,
+                depth_stencil_format: vk::Format::UNDEFINED,
+                depth_clamp: false,
+                specialization: &[],
+            },
+        )?;
+
+        let slots = self.desc.frames_in_flight;
+        let sizes = [
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::UNIFORM_BUFFER)
+                .descriptor_count(slots),
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(slots * (1 + ALPHA_SET.len() as u32)),
+        ];
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(2 * slots)
+            .pool_sizes(&sizes);
+        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
+            .call("vkCreateDescriptorPool")?;
+        ctx.name(self.pool, "lightmap-descriptor-pool");
+        let layouts: Vec<_> = (0..slots).flat_map(|_| self.set_layouts).collect();
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(self.pool)
+            .set_layouts(&layouts);
+        let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+            .call("vkAllocateDescriptorSets")?;
+        for (i, pair) in sets.chunks(2).enumerate() {
+            let (frame_set, alpha_set) = (pair[0], pair[1]);
+            ctx.name(frame_set, &format!("lightmap-frame-set-{i}"));
+            ctx.name(alpha_set, &format!("alpha-set-{i}"));
+            let mut made: Vec<Buffer> = Vec::new();
+            let mut make = |name: String, bytes: u64, usage| -> Result<()> {
+                made.push(Buffer::new(
+                    ctx,
+                    &name,
+                    bytes,
+                    usage,
+                    MemoryLocation::CpuToGpu,
+                )?);
+                Ok(())
+            };
+            let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            let result = make(
+                format!("lightmap-uniforms-{i}"),
+                size_of::<FrameUniforms>() as u64,
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+            )
+            .and_then(|()| make(format!("lightmap-lights-{i}"), 256, storage))
+            .and_then(|()| {
+                STORAGE_NAMES
+                    .iter()
+                    .try_for_each(|name| make(format!("{name}-{i}"), 256, storage))
+            });
+            if let Err(e) = result {
+                for mut b in made {
+                    b.destroy(ctx);
+                }
+                return Err(e);
+            }
+            let mut made = made.into_iter();
+            let mut next = move || made.next().expect("six buffers");
+            let slot = Slot {
+                uniforms: next(),
+                lights: next(),
+                storage: [next(), next(), next(), next()],
+                frame_set,
+                alpha_set,
+                entity_lights: Vec::new(),
+            };
+            write_frame_set(ctx, frame_set, slot.uniforms.handle, slot.lights.handle);
+            write_storage_buffers(ctx, alpha_set, &slot.storage.each_ref().map(|b| b.handle));
+            self.slots.push(slot);
+        }
+        Ok(())
+    }
+
+    /// What these lightmaps were made for.
+    pub fn desc(&self) -> &AlphaLightmapsDesc {
+        &self.desc
+    }
+
+    /// The entity records of the last frame recorded into `slot`
+    /// ([`crate::AlphaEntityRecord`], in entity order): what an engine's alpha shader binds as
+    /// the `AlphaEntity` array of `alpha_entity.glsl` (a storage buffer) to sample the atlas.
+    /// Recording into `slot` again may replace the buffer when it grows, so bind it after.
+    pub fn entity_buffer(&self, slot: u32) -> Option<vk::Buffer> {
+        self.slots.get(slot as usize).map(|s| s.storage[0].handle)
+    }
+
+    /// Lightmap draws the last frame recorded into `slot` made: one per (entity, light that
+    /// reaches its bounds).
+    pub fn draws(&self, slot: u32) -> usize {
+        self.slots
+            .get(slot as usize)
+            .map_or(0, |s| s.entity_lights.iter().map(Vec::len).sum())
+    }
+
+    /// Lights every entity's region of `atlas` for `frame`, after clearing the whole atlas to
+    /// black, and leaves `atlas.state` as a colour attachment just written.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] when the frame does not fit: a slot outside the range, entities that
+    /// [`AlphaEntity::problem`] refuses or that do not match the layout's regions, an atlas of
+    /// another format or smaller than the layout, a view without an invertible camera. Nothing
+    /// is recorded on an error.
+    ///
+    /// # Safety
+    /// - `cmd` is in the recording state, on a queue family with graphics, from the device of
+    ///   the context these lightmaps were made with.
+    /// - `atlas` is live, from that device, with usage `COLOR_ATTACHMENT` (and whatever the
+    ///   engine samples it with), and its `state` is true when `cmd` executes.
+    /// - The GPU has finished every command buffer that recorded into `frame.slot` before;
+    ///   this call rewrites (and may replace) that slot's buffers and descriptor sets.
+    pub unsafe fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightmapFrame,
+        atlas: &mut ImageRef,
+    ) -> Result<()> {
+        self.write_frame(frame, atlas)?;
+        self.record_pass(cmd, frame.slot, frame.layout, atlas);
+        Ok(())
+    }
+
+    /// Checks `frame` and writes its records, lights and uniforms into its slot.
+    pub(crate) fn write_frame(&mut self, frame: &LightmapFrame, atlas: &ImageRef) -> Result<()> {
+        check_frame(&self.desc, frame, atlas)?;
+        let viewer = Viewer::from_view(frame.view)
+            .ok_or_else(|| bad("the view's world-to-view matrix cannot be inverted".into()))?;
+        let e = atlas.extent;
+        let uniforms =
+            FrameUniforms::from_view(frame.view, e.width, e.height, frame.lights.len() as u32)
+                .map_err(|p| bad(p.to_string()))?;
+        let records = frame_records(frame.entities, &frame.layout.regions, &viewer, frame.lights);
+        let ctx = self.ctx;
+        let slot = &mut self.slots[frame.slot as usize];
+        let gpu_lights: Vec<GpuLight> = frame.lights.iter().map(GpuLight::new).collect();
+        let FrameRecords {
+            records,
+            points,
+            probes,
+            light_list,
+            entity_lights,
+        } = records;
+        let bytes: [&[u8]; 4] = [
+            bytemuck::cast_slice(&records),
+            bytemuck::cast_slice(&points),
+            bytemuck::cast_slice(&light_list),
+            bytemuck::cast_slice(&probes),
+        ];
+        let mut grown = fit(
+            ctx,
+            &mut slot.lights,
+            "lightmap-lights",
+            frame.slot,
+            gpu_lights.len() * size_of::<GpuLight>(),
+        )?;
+        if grown {
+            write_frame_set(
+                ctx,
+                slot.frame_set,
+                slot.uniforms.handle,
+                slot.lights.handle,
+            );
+        }
+        grown = false;
+        for ((buffer, name), data) in slot.storage.iter_mut().zip(STORAGE_NAMES).zip(bytes) {
+            grown |= fit(ctx, buffer, name, frame.slot, data.len())?;
+        }
+        if grown {
+            write_storage_buffers(
+                ctx,
+                slot.alpha_set,
+                &slot.storage.each_ref().map(|b| b.handle),
+            );
+        }
+        slot.uniforms.write(bytemuck::bytes_of(&uniforms));
+        slot.lights.write(bytemuck::cast_slice(&gpu_lights));
+        for (buffer, data) in slot.storage.iter_mut().zip(bytes) {
+            buffer.write(data);
+        }
+        slot.entity_lights = entity_lights;
+        Ok(())
+    }
+
+    /// Records the lightmap pass of the frame last written into `slot`: clears `atlas`, then
+    /// one additive draw per (entity, light that reaches it) over the entity's region.
+    pub(crate) fn record_pass(
+        &self,
+        cmd: vk::CommandBuffer,
+        slot: u32,
+        layout: &LightmapLayout,
+        atlas: &mut ImageRef,
+    ) {
+        let ctx = self.ctx;
+        let slot = &self.slots[slot as usize];
+        ctx.begin_label(cmd, "alpha-lightmaps");
+        begin_cleared(ctx, cmd, atlas);
+        let d = &ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline_layout,
+                0,
+                &[slot.frame_set, slot.alpha_set],
+                &[],
+            );
+        }
+        apply(ctx, cmd, &FULLSCREEN);
+        for (index, (r, lights)) in layout.regions.iter().zip(&slot.entity_lights).enumerate() {
+            if lights.is_empty() {
+                continue;
+            }
+            let mut region = r.region;
+            region.width = r.shape.tiles * r.shape.tile_width;
+            set_region(ctx, cmd, region);
+            for &light in lights {
+                let push = AlphaDrawPush {
+                    entity: index as u32,
+                    light,
+                    ..Default::default()
+                };
+                unsafe {
+                    d.cmd_push_constants(
+                        cmd,
+                        self.pipeline_layout,
+                        GRAPHICS_STAGES,
+                        0,
+                        bytemuck::bytes_of(&push),
+                    );
+                    d.cmd_draw(cmd, 3, 1, 0, 0);
+                }
+            }
+        }
+        unsafe { d.cmd_end_rendering(cmd) };
+        ctx.end_label(cmd);
+    }
+
+    /// Sets 0 and 1 of the alpha pipelines (frame, alpha), for histencil's own alpha pass.
+    pub(crate) fn alpha_set_layout(&self) -> vk::DescriptorSetLayout {
+        self.set_layouts[1]
+    }
+
+    /// The alpha set (records, points, light lists, probes) of `slot`'s last frame.
+    pub(crate) fn alpha_set(&self, slot: u32) -> vk::DescriptorSet {
+        self.slots[slot as usize].alpha_set
+    }
+}
+
+impl Drop for AlphaLightmaps<'_> {
+    /// Waits for the device to go idle (teardown only; recording never waits), then frees
+    /// everything, also after a creation that failed half way.
+    fn drop(&mut self) {
+        let ctx = self.ctx;
+        let d = &ctx.device;
+        unsafe {
+            let _ = d.device_wait_idle();
+        }
+        for slot in &mut self.slots {
+            slot.uniforms.destroy(ctx);
+            slot.lights.destroy(ctx);
+            for b in &mut slot.storage {
+                b.destroy(ctx);
+            }
+        }
+        unsafe {
+            d.destroy_pipeline(self.pipeline, None);
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_pipeline_layout(self.pipeline_layout, None);
+            for l in self.set_layouts {
+                d.destroy_descriptor_set_layout(l, None);
+            }
+        }
+    }
+}
+
+/// Makes the storage buffer `buffer` hold at least `bytes` (and never less than 256), replacing it with one of the
+/// next power of two when it is too small. True when it was replaced (its sets need rewriting).
+fn fit(ctx: &Context, buffer: &mut Buffer, name: &str, slot: u32, bytes: usize) -> Result<bool> {
+    let needed = (bytes as u64).max(256);
+    if buffer.size >= needed {
+        return Ok(false);
+    }
+    let grown = Buffer::new(
+        ctx,
+        &format!("{name}-{slot}"),
+        needed.next_power_of_two(),
+        vk::BufferUsageFlags::STORAGE_BUFFER,
+        MemoryLocation::CpuToGpu,
+    )?;
+    let mut old = std::mem::replace(buffer, grown);
+    old.destroy(ctx);
+    Ok(true)
+}
+
+/// Checks one frame against the lightmaps and the atlas: the slot, each entity and its region,
+/// the atlas's format and size.
+fn check_frame(desc: &AlphaLightmapsDesc, frame: &LightmapFrame, atlas: &ImageRef) -> Result<()> {
+    if frame.slot >= desc.frames_in_flight {
+        return Err(bad(format!(
+            "slot {} of {} frames in flight",
+            frame.slot, desc.frames_in_flight
+        )));
+    }
+    if atlas.format != desc.atlas_format {
+        return Err(bad(format!(
+            "the lightmap atlas is {:?}, the lightmaps expect {:?}",
+            atlas.format, desc.atlas_format
+        )));
+    }
+    let (w, h) = frame.layout.atlas.size();
+    let e = atlas.extent;
+    if e.width < w || e.height < h {
+        return Err(bad(format!(
+            "the lightmap atlas is {}x{}, the layout needs {w}x{h}",
+            e.width, e.height
+        )));
+    }
+    let regions = &frame.layout.regions;
+    if regions.len() != frame.entities.len() {
+        return Err(bad(format!(
+            "{} entities and {} lightmap regions",
+            frame.entities.len(),
+            regions.len()
+        )));
+    }
+    for (i, (entity, r)) in frame.entities.iter().zip(regions).enumerate() {
+        if let Some(problem) = entity.problem() {
+            return Err(bad(format!("alpha entity {i}: {problem}")));
+        }
+        let s = r.shape;
+        let width = u64::from(s.tiles) * u64::from(s.tile_width);
+        let fits = s.tiles >= 1
+            && s.tile_width >= 1
+            && s.tile_height >= 1
+            && width <= u64::from(r.region.width)
+            && s.tile_height <= r.region.height
+            && u64::from(r.region.x) + width <= u64::from(e.width)
+            && u64::from(r.region.y) + u64::from(s.tile_height) <= u64::from(e.height);
+        let texels = u64::from(s.tile_width) * u64::from(s.tile_height);
+        let holds_motes = match entity.desc().kind {
+            histencil_alpha::EntityKind::Particles {
+                layout: histencil_scene::ParticleLayout::Dust,
+                count,
+            } => texels >= u64::from(count),
+            _ => true,
+        };
+        if !(fits && holds_motes) {
+            return Err(bad(format!(
+                "alpha entity {i}: its region {:?} ({} tiles of {}x{}) does not fit the atlas or \
+                 its particles",
+                r.region, s.tiles, s.tile_width, s.tile_height
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Viewport and scissor over one atlas region.
+pub(crate) fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: Region) {
+    let viewport = vk::Viewport {
+        x: r.x as f32,
+        y: r.y as f32,
+        width: r.width as f32,
+        height: r.height as f32,
+        min_depth: 0.0,
+        max_depth: 1.0,
+    };
+    let scissor = vk::Rect2D {
+        offset: vk::Offset2D {
+            x: r.x as i32,
+            y: r.y as i32,
+        },
+        extent: vk::Extent2D {
+            width: r.width,
+            height: r.height,
+        },
+    };
+    unsafe {
+        ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+        ctx.device.cmd_set_scissor(cmd, 0, &[scissor]);
+    }
+}
+
+fn bad(message: String) -> Error {
+    Error::BadFrame(message)
+}

@@ -1,0 +1,46 @@
+// An alpha entity's lightmap record, as histencil writes it (one per entity, in the order the
+// entities were given to histencil_vk::AlphaLightmaps): which texels of the lightmap atlas hold
+// its light and how its probes sit in them. An engine binds AlphaLightmaps::entity_buffer as a
+// std430 array of these and samples the atlas through lightmap_sample.glsl.
+// Rust mirror: histencil_vk::AlphaEntityRecord.
+//
+// Self-contained on purpose: an engine's alpha shader needs nothing else from histencil.
+#ifndef ALPHA_ENTITY_GLSL
+#define ALPHA_ENTITY_GLSL
+
+// AlphaEntity.shape.x: how the entity's texels map to probe positions
+// (histencil_vk's ALPHA_KINDS; a unit test holds the two together).
+#define ALPHA_OBJECT 0u
+#define ALPHA_SLICES 1u
+#define ALPHA_DUST 2u
+#define ALPHA_RIBBON 3u
+
+struct AlphaEntity {
+    mat4 model;           // object -> world (identity for particle systems)
+    vec4 tint_opacity;    // rgb tint, w opacity
+    vec4 params;          // xyz the BRDF's packed parameters, w BRDF id
+    uvec4 region;         // xy: the region's first texel in the atlas; zw: one tile's size
+    uvec4 shape;          // x: ALPHA_* kind, y: tiles (slices), z: first point or probe,
+                          // w: point count
+    vec4 centre_radius;   // xyz: probe frame centre (the single probe's point), w: its radius
+    vec4 right_depth;     // xyz: unit right, w: half depth of the slice stack
+    vec4 up;              // xyz: unit up
+    vec4 forward;         // xyz: unit view direction
+    uvec4 light_range;    // x: first index into the entity light list, y: count
+};
+
+// `(u, v, slice)` of the probe nearest P (histencil_alpha::ProbeFrame::locate).
+vec3 frame_locate(AlphaEntity e, vec3 P) {
+    vec3 d = P - e.centre_radius.xyz;
+    float r = e.centre_radius.w;
+    uint n = e.shape.y;
+    float s = 0.0;
+    if (n > 1u) {
+        float half_depth = e.right_depth.w;
+        s = clamp((dot(d, e.forward.xyz) + half_depth) / (2.0 * half_depth) * float(n - 1u),
+                  0.0, float(n - 1u));
+    }
+    return vec3(0.5 + 0.5 * dot(d, e.right_depth.xyz) / r, 0.5 - 0.5 * dot(d, e.up.xyz) / r, s);
+}
+
+#endif
