@@ -4,9 +4,14 @@
 //! fences with two frames in flight. histencil plans each frame on plain data
 //! (`histencil_model::plan_frame`) and records its stencil-masked light volumes into the engine's
 //! command buffer (`histencil_vk::DeferredLighting`), alternating the PS3-like and native
-//! platform behaviours. The last frame of each is compared with histencil's forward reference of
-//! the same state, and the engine's stencil bits are checked to survive lighting.
+//! platform behaviours. Its glass sphere and smoke cloud are lit by histencil's per-entity
+//! lightmaps (`histencil_vk::AlphaLightmaps`, into the engine's own atlas) and drawn by the
+//! engine's own alpha shaders, which sample them through histencil's `lightmap_sample.glsl`. The
+//! last frame of each backend is compared with histencil's forward reference of the same state
+//! (lighting) and with histencil's own lightmap frame (alpha), and the engine's stencil bits are
+//! checked to survive lighting.
 
+mod alpha;
 mod device;
 mod gbuffer;
 mod world;
@@ -15,23 +20,27 @@ use ash::vk;
 use device::{barrier, Buffer, Gpu, Image};
 use gbuffer::{CameraBlock, GBufferPass, DEPTH_FORMAT, ENGINE_MASK};
 use gpu_allocator::MemoryLocation;
+use histencil_alpha::{plan_regions, Viewer};
 use histencil_model::{
     plan_frame, DepthConvention, FarPlane, FlushPolicy, Perspective, PlanInputs, PlanSettings,
     StencilBits, StencilLayout, TechniqueChoice, View, ViewDesc,
 };
 use histencil_vk::{
-    Backend, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame, LightingTargets,
-    Readback, Renderer, Technique, GBUFFER_FORMATS,
+    mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, AlphaMode,
+    Backend, Context, DeferredLighting, FrameDesc, ImageState, LightingDesc, LightingFrame,
+    LightingTargets, LightmapFrame, Readback, Renderer, Technique, GBUFFER_FORMATS,
 };
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-use world::World;
+use world::{AlphaWorld, World};
 
 const WIDTH: u32 = 160;
 const HEIGHT: u32 = 96;
 const FRAMES: usize = 120;
 const IN_FLIGHT: usize = 2;
 const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// The engine's lightmap atlas: what its alpha entities need at this size fits easily.
+const ATLAS_SIDE: u32 = 256;
 
 /// Frame `f`'s platform behaviour: PS3-like and native in turn.
 fn backend(f: usize) -> Backend {
@@ -65,11 +74,15 @@ struct Slot {
     fence: vk::Fence,
     camera: Buffer,
     camera_set: vk::DescriptorSet,
+    /// The engine's alpha set: histencil's entity records for this slot, and the atlas.
+    alpha_set: vk::DescriptorSet,
 }
 
 /// What the last frame of each backend copies back.
 struct Capture {
     frame: usize,
+    /// HDR after lighting, and after the alpha pass.
+    lit: Buffer,
     hdr: Buffer,
     stencil_before: Buffer,
     stencil_after: Buffer,
@@ -132,6 +145,26 @@ fn main() {
         extent,
         U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
     );
+    let mut lightmaps = AlphaLightmaps::new(
+        &ctx,
+        &AlphaLightmapsDesc {
+            atlas_format: HDR_FORMAT,
+            frames_in_flight: IN_FLIGHT as u32,
+        },
+    )
+    .expect("lightmaps");
+    let atlas_image = gpu.image(
+        "lightmap-atlas",
+        HDR_FORMAT,
+        vk::Extent2D {
+            width: ATLAS_SIDE,
+            height: ATLAS_SIDE,
+        },
+        U::COLOR_ATTACHMENT | U::SAMPLED,
+    );
+    let mut atlas = atlas_image.target;
+    let mut alpha_pass = alpha::AlphaPass::new(&gpu, gbuffer_pass.set_layout, IN_FLIGHT);
+    let sphere = world::sphere_mesh();
     let mut targets = LightingTargets {
         gbuffer: [gbuffer[0].target, gbuffer[1].target, gbuffer[2].target],
         depth_stencil: depth.target,
@@ -139,13 +172,20 @@ fn main() {
     };
 
     let d = &gpu.device;
-    let pool_sizes = [vk::DescriptorPoolSize::default()
-        .ty(vk::DescriptorType::UNIFORM_BUFFER)
-        .descriptor_count(IN_FLIGHT as u32)];
+    let sized = |ty| {
+        vk::DescriptorPoolSize::default()
+            .ty(ty)
+            .descriptor_count(IN_FLIGHT as u32)
+    };
+    let pool_sizes = [
+        sized(vk::DescriptorType::UNIFORM_BUFFER),
+        sized(vk::DescriptorType::STORAGE_BUFFER),
+        sized(vk::DescriptorType::SAMPLED_IMAGE),
+    ];
     let descriptor_pool = unsafe {
         d.create_descriptor_pool(
             &vk::DescriptorPoolCreateInfo::default()
-                .max_sets(IN_FLIGHT as u32)
+                .max_sets(2 * IN_FLIGHT as u32)
                 .pool_sizes(&pool_sizes),
             None,
         )
@@ -178,14 +218,15 @@ fn main() {
                 vk::BufferUsageFlags::UNIFORM_BUFFER,
                 MemoryLocation::CpuToGpu,
             );
-            let layouts = [gbuffer_pass.set_layout];
-            let camera_set = d
+            let layouts = [gbuffer_pass.set_layout, alpha_pass.set_layout];
+            let sets = d
                 .allocate_descriptor_sets(
                     &vk::DescriptorSetAllocateInfo::default()
                         .descriptor_pool(descriptor_pool)
                         .set_layouts(&layouts),
                 )
-                .unwrap()[0];
+                .unwrap();
+            let (camera_set, alpha_set) = (sets[0], sets[1]);
             let info = [vk::DescriptorBufferInfo::default()
                 .buffer(camera.buffer)
                 .range(vk::WHOLE_SIZE)];
@@ -200,6 +241,7 @@ fn main() {
                 fence,
                 camera,
                 camera_set,
+                alpha_set,
             }
         })
         .collect();
@@ -215,6 +257,7 @@ fn main() {
     let mut captures: Vec<Capture> = [FRAMES - 2, FRAMES - 1]
         .map(|frame| Capture {
             frame,
+            lit: readback("lit-readback", pixels * 8),
             hdr: readback("hdr-readback", pixels * 8),
             stencil_before: readback("stencil-before", pixels),
             stencil_after: readback("stencil-after", pixels),
@@ -291,6 +334,58 @@ fn main() {
                     &mut targets.depth_stencil,
                     c.stencil_after.buffer,
                 );
+                copy_color(d, slot.cmd, &mut targets.hdr, c.lit.buffer);
+            }
+            // The translucent entities: histencil plans their regions and lights them into the
+            // engine's atlas; the engine draws them with its own shaders.
+            let alpha_world = AlphaWorld::at(f);
+            let entities = [
+                AlphaEntity {
+                    kind: AlphaEntityKind::Object {
+                        probe_mesh: &sphere,
+                        transform: alpha_world.glass_transform,
+                        local_bounds: mesh_bounds(&sphere),
+                    },
+                    material: alpha_world.glass_material,
+                    opacity: alpha_world.glass_opacity,
+                },
+                AlphaEntity {
+                    kind: AlphaEntityKind::Particles {
+                        layout: alpha_world.smoke.layout,
+                        particles: &alpha_world.smoke.particles,
+                    },
+                    material: alpha_world.smoke.material,
+                    opacity: alpha_world.smoke.opacity,
+                },
+            ];
+            let descs: Vec<_> = entities.iter().map(AlphaEntity::desc).collect();
+            let viewer = Viewer::from_view(&view).expect("the engine's camera");
+            let regions =
+                plan_regions(&descs, &viewer, HEIGHT, ATLAS_SIDE).expect("lightmap regions");
+            let slot_index = (f % IN_FLIGHT) as u32;
+            let lightmap_frame = LightmapFrame {
+                slot: slot_index,
+                view: &view,
+                lights: &lights,
+                entities: &entities,
+                layout: &regions,
+            };
+            // SAFETY: as for the lighting; the atlas state is the one the engine tracks.
+            lightmaps
+                .record(slot.cmd, &lightmap_frame, &mut atlas)
+                .expect("lightmaps recorded");
+            let records = lightmaps.entity_buffer(slot_index).expect("the slot");
+            alpha_pass.write_set(d, slot.alpha_set, records, atlas.view);
+            alpha_pass.record(
+                d,
+                slot.cmd,
+                f % IN_FLIGHT,
+                [slot.camera_set, slot.alpha_set],
+                &alpha_world,
+                &mut atlas,
+                (&mut targets.hdr, &mut targets.depth_stencil),
+            );
+            if let Some(c) = capture {
                 copy_color(d, slot.cmd, &mut targets.hdr, c.hdr.buffer);
                 host_barrier(d, slot.cmd);
             }
@@ -309,28 +404,44 @@ fn main() {
     let mut worst = 0u8;
     let mut intact = true;
     let mut renderer_ms = 0.0;
+    let (mut alpha_worst, mut alpha_mean, mut forward_mean) = (0u8, 0.0f64, 0.0f64);
+    let mut alpha_pixels = usize::MAX;
     for c in &captures {
         let scene = world::scene(&world, c.frame);
-        let mut renderer = Renderer::new(&ctx, scene, WIDTH, HEIGHT).expect("reference renderer");
-        let readback = Readback {
+        let hdr_only = Readback {
             hdr: true,
             ..Readback::NONE
         };
-        let forward = renderer
-            .render(Technique::Forward, readback)
-            .expect("forward");
-        let forward = forward.images.hdr.expect("hdr").into_raw();
-        let ours: Vec<f32> = c
-            .hdr
-            .bytes()
-            .chunks_exact(2)
-            .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
-            .collect();
-        for (a, b) in forward.chunks_exact(4).zip(ours.chunks_exact(4)) {
-            for ch in 0..3 {
-                worst = worst.max(tonemap(a[ch]).abs_diff(tonemap(b[ch])));
-            }
-        }
+        let hdr_of = |renderer: &mut Renderer, desc: FrameDesc| {
+            let frame = renderer.render_frame(&desc).expect("reference frame");
+            frame.images.hdr.expect("hdr").into_raw()
+        };
+        // Lighting: the opaque world, forward, against the engine's HDR before its alpha pass.
+        let mut opaque =
+            Renderer::new(&ctx, scene.without_alpha(), WIDTH, HEIGHT).expect("reference renderer");
+        let forward = hdr_of(&mut opaque, FrameDesc::new(Technique::Forward, hdr_only));
+        worst = worst.max(max_difference(&forward, &half_floats(&c.lit)).0);
+        // Alpha: histencil's own lightmap frame of the same state, and the per-pixel reference.
+        let mut renderer = Renderer::new(&ctx, scene, WIDTH, HEIGHT).expect("reference renderer");
+        let with_alpha = |alpha| FrameDesc {
+            alpha,
+            ..FrameDesc::new(Technique::Forward, hdr_only)
+        };
+        let lightmapped = hdr_of(&mut renderer, with_alpha(AlphaMode::Lightmap));
+        let per_pixel = hdr_of(&mut renderer, with_alpha(AlphaMode::Forward));
+        let ours = half_floats(&c.hdr);
+        // The pixels the engine's alpha pass changed: it must have drawn something.
+        let lit = half_floats(&c.lit);
+        let changed = lit
+            .chunks_exact(4)
+            .zip(ours.chunks_exact(4))
+            .filter(|(a, b)| a[..3] != b[..3])
+            .count();
+        alpha_pixels = alpha_pixels.min(changed);
+        let (max, mean) = max_difference(&lightmapped, &ours);
+        alpha_worst = alpha_worst.max(max);
+        alpha_mean += mean / captures.len() as f64;
+        forward_mean += max_difference(&per_pixel, &ours).1 / captures.len() as f64;
         let before = c.stencil_before.bytes();
         let after = c.stencil_after.bytes();
         let marked = before.iter().filter(|s| **s & ENGINE_MASK != 0).count();
@@ -353,11 +464,17 @@ fn main() {
         renderer_ms += timed.elapsed().as_secs_f64() * 1e3 / runs as f64 / captures.len() as f64;
     }
     println!(
+        "alpha: {alpha_pixels} pixels or more drawn; engine frame vs histencil's lightmap frame of \
+         the same state max {alpha_worst}/255 (mean {alpha_mean:.3}); lightmaps vs per-pixel \
+         forward alpha mean {forward_mean:.3}/255 over the frame"
+    );
+    println!(
         "engine: {engine_ms:.1} ms per frame with {IN_FLIGHT} in flight (wall clock, validation on); \
          histencil's Renderer on the same state: {renderer_ms:.1} ms per frame (it waits for each)"
     );
 
     drop(lighting);
+    drop(lightmaps);
     unsafe {
         d.device_wait_idle().unwrap();
         for s in slots.drain(..) {
@@ -368,14 +485,16 @@ fn main() {
         d.destroy_descriptor_pool(descriptor_pool, None);
     }
     for c in captures.drain(..) {
+        gpu.free_buffer(c.lit);
         gpu.free_buffer(c.hdr);
         gpu.free_buffer(c.stencil_before);
         gpu.free_buffer(c.stencil_after);
     }
-    for image in gbuffer.into_iter().chain([depth, hdr]) {
+    for image in gbuffer.into_iter().chain([depth, hdr, atlas_image]) {
         gpu.free_image(image);
     }
     gbuffer_pass.destroy(&gpu);
+    alpha_pass.destroy(&gpu);
     drop(ctx);
     gpu.destroy();
     let messages = device::MESSAGES.load(Ordering::SeqCst);
@@ -384,9 +503,37 @@ fn main() {
          engine stencil bits {}, {messages} validation messages",
         if intact { "intact" } else { "NOT intact" }
     );
-    if worst > 1 || !intact || messages > 0 {
+    let alpha_ok = alpha_worst <= ALPHA_TOLERANCE && alpha_pixels > 0;
+    if worst > 1 || !alpha_ok || !intact || messages > 0 {
         std::process::exit(1);
     }
+}
+
+/// The most the engine's alpha may differ from histencil's lightmap frame, in 8-bit steps: the
+/// two draw the same lightmaps with different depth conventions and shaders.
+const ALPHA_TOLERANCE: u8 = 2;
+
+/// An HDR readback of R16G16B16A16_SFLOAT texels as f32.
+fn half_floats(buffer: &Buffer) -> Vec<f32> {
+    buffer
+        .bytes()
+        .chunks_exact(2)
+        .map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32())
+        .collect()
+}
+
+/// The largest and the mean difference of two RGBA HDR images after tonemapping to 8 bits.
+fn max_difference(a: &[f32], b: &[f32]) -> (u8, f64) {
+    let (mut max, mut sum, mut n) = (0u8, 0u64, 0u64);
+    for (a, b) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        for ch in 0..3 {
+            let d = tonemap(a[ch]).abs_diff(tonemap(b[ch]));
+            max = max.max(d);
+            sum += u64::from(d);
+            n += 1;
+        }
+    }
+    (max, sum as f64 / n.max(1) as f64)
 }
 
 /// histencil's tonemap (exposure 1, Reinhard, sRGB), on the CPU, to 8 bits.

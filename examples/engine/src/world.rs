@@ -1,10 +1,14 @@
-//! The engine's world: a floor and eight boxes in four BRDFs, 64 point lights and a camera, all
-//! animated by frame number. Its own types; `histencil_scene` only for the forward reference.
+//! The engine's world: a floor and eight boxes in four BRDFs, a glass sphere and a smoke cloud
+//! (translucent), 64 point lights and a camera, all animated by frame number. Its own types;
+//! `histencil_scene` for its procedural meshes and particles and for the forward reference.
 
 use glam::{Mat4, Quat, Vec3};
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::Aabb;
-use histencil_scene::{Camera, Light, Material, Object as SceneObject, Scene, Shape};
+use histencil_scene::{
+    uv_sphere, AlphaObject, Camera, Light, Material, Mesh, Object as SceneObject, ParticleLayout,
+    ParticleSystem, Scene, Shape,
+};
 
 pub const LIGHTS: usize = 64;
 
@@ -146,6 +150,65 @@ pub fn camera(frame: usize) -> Camera {
     }
 }
 
+/// The translucent part of the world at one frame: a glass sphere bobbing among the lights and a
+/// cloud of smoke drifting up through them, lit per entity by histencil's lightmaps.
+pub struct AlphaWorld {
+    pub camera: Camera,
+    pub glass_transform: Mat4,
+    pub glass_material: Material,
+    pub glass_opacity: f32,
+    pub smoke: ParticleSystem,
+}
+
+/// The glass sphere's mesh: drawn by the engine's alpha pass, and its UV layout holds the
+/// sphere's light probes.
+pub fn sphere_mesh() -> Mesh {
+    uv_sphere(48, 24)
+}
+
+impl AlphaWorld {
+    pub fn at(frame: usize) -> Self {
+        let t = frame as f32 * 0.05;
+        let glass = histencil_scene::glass_sphere(Vec3::new(0.4, 1.1 + 0.2 * t.sin(), 0.3), 0.55);
+        let mut smoke = histencil_scene::smoke_volume(
+            Vec3::new(-1.6, 0.9 + 0.1 * t, 1.4),
+            0.8,
+            48,
+            ParticleLayout::Slices { count: 4 },
+        );
+        smoke.opacity = 0.35;
+        Self {
+            camera: camera(frame),
+            glass_transform: glass.transform,
+            glass_material: glass.material,
+            glass_opacity: glass.opacity,
+            smoke,
+        }
+    }
+
+    /// Entity 0 (the sphere) and 1 (the smoke), farthest from the camera first.
+    pub fn back_to_front(&self) -> [u32; 2] {
+        let forward = (self.camera.target - self.camera.eye).normalize();
+        let depth = |p: Vec3| (p - self.camera.eye).dot(forward);
+        let (lo, hi) = self.smoke.world_bounds();
+        if depth(self.glass_transform.w_axis.truncate()) >= depth((lo + hi) * 0.5) {
+            [0, 1]
+        } else {
+            [1, 0]
+        }
+    }
+
+    fn glass(&self) -> AlphaObject {
+        AlphaObject {
+            name: "glass".into(),
+            shape: Shape::Sphere,
+            transform: self.glass_transform,
+            material: self.glass_material,
+            opacity: self.glass_opacity,
+        }
+    }
+}
+
 /// The same state as a histencil scene, for histencil's forward reference.
 pub fn scene(world: &World, frame: usize) -> Scene {
     Scene {
@@ -164,8 +227,8 @@ pub fn scene(world: &World, frame: usize) -> Scene {
             })
             .collect(),
         lights: lights(frame),
-        alpha_objects: Vec::new(),
-        particle_systems: Vec::new(),
+        alpha_objects: vec![AlphaWorld::at(frame).glass()],
+        particle_systems: vec![AlphaWorld::at(frame).smoke],
         meshes: Vec::new(),
     }
 }
