@@ -1,0 +1,530 @@
+//! histencil's alpha lightmaps recorded into an engine's frames: the test plays the engine (its
+//! own device, allocator, atlas, command pools and fences, two frames in flight), hands over its
+//! translucent objects and particle systems as plain values each frame, plans their regions on
+//! plain data and records `AlphaLightmaps` into its own command buffers. The same state recorded
+//! through the other slot, after frames that moved the lights and grew every buffer, gives the
+//! same atlas bit for bit; texels outside every region stay black; frames that do not fit are
+//! refused before anything is recorded. Validation with synchronisation validation sees nothing.
+
+use ash::vk;
+use glam::Vec3;
+use histencil_alpha::{plan_regions, EntityRegion, LightmapLayout, Viewer};
+use histencil_scene::{unit_box_bake, uv_sphere, Light, Mesh, ParticleLayout, Scene, Shape};
+use histencil_tests::engine::{Engine, EngineBuffer};
+use histencil_vk::{
+    AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, Context, Error, ImageRef,
+    ImageState, LightmapFrame,
+};
+
+const HEIGHT: u32 = 240;
+const ATLAS: u32 = 512;
+const FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+static NAN_PARTICLE: [histencil_scene::Particle; 1] = [histencil_scene::Particle {
+    position: Vec3::NAN,
+    size: 0.1,
+}];
+
+/// The probe meshes of the scene's shapes, as an engine keeps its meshes.
+struct Meshes {
+    unit_box: Mesh,
+    sphere: Mesh,
+}
+
+fn entities<'a>(scene: &'a Scene, meshes: &'a Meshes) -> Vec<AlphaEntity<'a>> {
+    let objects = scene.alpha_objects.iter().map(|o| AlphaEntity {
+        kind: AlphaEntityKind::Object {
+            probe_mesh: match o.shape {
+                Shape::Box => &meshes.unit_box,
+                _ => &meshes.sphere,
+            },
+            transform: o.transform,
+            local_bounds: (Vec3::NEG_ONE, Vec3::ONE),
+        },
+        material: o.material,
+        opacity: o.opacity,
+    });
+    let systems = scene.particle_systems.iter().map(|s| AlphaEntity {
+        kind: AlphaEntityKind::Particles {
+            layout: s.layout,
+            particles: &s.particles,
+        },
+        material: s.material,
+        opacity: s.opacity,
+    });
+    objects.chain(systems).collect()
+}
+
+/// Every kind of entity: the glass sphere and smoke column of `alpha`, a box, `dust` and
+/// `ribbon`'s systems, `volume`'s slices.
+fn all_kinds() -> Scene {
+    let mut scene = histencil_scene::embedded("alpha").unwrap();
+    for name in ["dust", "ribbon", "volume"] {
+        let other = histencil_scene::embedded(name).unwrap();
+        scene.particle_systems.extend(other.particle_systems);
+        scene.lights.extend(other.lights);
+    }
+    let mut glass_box = scene.alpha_objects[0].clone();
+    glass_box.shape = Shape::Box;
+    glass_box.transform = glam::Mat4::from_translation(Vec3::new(1.0, 1.2, 2.0))
+        * glam::Mat4::from_scale(Vec3::splat(0.4));
+    scene.alpha_objects.push(glass_box);
+    scene
+}
+
+/// The lights at frame `f`: each moved along its own circle.
+fn lights_at(scene: &Scene, f: usize) -> Vec<Light> {
+    scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let angle = 0.9 * f as f32 + i as f32;
+            Light {
+                position: l.position + Vec3::new(angle.cos(), 0.0, angle.sin()) * 0.5,
+                ..*l
+            }
+        })
+        .collect()
+}
+
+fn layout_for(scene: &Scene, entities: &[AlphaEntity]) -> LightmapLayout {
+    let view = scene.camera.view_desc(4.0 / 3.0);
+    let viewer = Viewer::from_view(&view).unwrap();
+    let descs: Vec<_> = entities.iter().map(AlphaEntity::desc).collect();
+    plan_regions(&descs, &viewer, HEIGHT, ATLAS).unwrap()
+}
+
+/// Records one frame of lightmaps into `cmd` (begun here, ended here) and, when `readback` is
+/// given, copies the atlas into it.
+#[allow(clippy::too_many_arguments)]
+unsafe fn record_frame(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    lightmaps: &mut AlphaLightmaps,
+    frame: &LightmapFrame,
+    atlas: &mut ImageRef,
+    readback: Option<&EngineBuffer>,
+) {
+    d.begin_command_buffer(
+        cmd,
+        &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+    )
+    .unwrap();
+    lightmaps.record(cmd, frame, atlas).unwrap();
+    assert_eq!(
+        atlas.state.layout,
+        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
+    );
+    if let Some(buffer) = readback {
+        copy_to_buffer(d, cmd, atlas, buffer.buffer);
+    }
+    d.end_command_buffer(cmd).unwrap();
+}
+
+#[test]
+fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
+    let scene = all_kinds();
+    let meshes = Meshes {
+        unit_box: unit_box_bake(),
+        sphere: uv_sphere(48, 24),
+    };
+    // A smaller first state, so the later frames grow every buffer of both slots.
+    let mut small = scene.clone();
+    small.particle_systems.truncate(1);
+    small.alpha_objects.truncate(1);
+    let engine = Engine::start();
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let mut lightmaps = AlphaLightmaps::new(
+            &ctx,
+            &AlphaLightmapsDesc {
+                atlas_format: FORMAT,
+                frames_in_flight: 2,
+            },
+        )
+        .unwrap();
+        use vk::ImageUsageFlags as U;
+        let extent = vk::Extent2D {
+            width: ATLAS,
+            height: ATLAS,
+        };
+        let atlas_image = engine.image(
+            "atlas",
+            FORMAT,
+            extent,
+            U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
+        );
+        let mut atlas = atlas_image.as_ref(ImageState::UNDEFINED);
+        let bytes = u64::from(ATLAS * ATLAS) * 8;
+        let (first, last) = (engine.readback_buffer(bytes), engine.readback_buffer(bytes));
+        let d = &engine.device;
+        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
+        let slots: Vec<_> = (0..2)
+            .map(|_| {
+                let (pool, cmd) = engine.command_buffer();
+                let signalled =
+                    vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+                (
+                    pool,
+                    cmd,
+                    unsafe { d.create_fence(&signalled, None) }.unwrap(),
+                )
+            })
+            .collect();
+        let view = scene.camera.view_desc(4.0 / 3.0);
+        // Frames 0 and 5 light the same state through slots 0 and 1; between them the lights
+        // move and the entities grow from two to six.
+        let states = [0usize, 1, 2, 3, 4, 0];
+        let mut draws = Vec::new();
+        let mut layouts = Vec::new();
+        for (f, &state) in states.iter().enumerate() {
+            let source = if f == 0 { &small } else { &scene };
+            let entities = entities(source, &meshes);
+            let layout = layout_for(source, &entities);
+            let lights = lights_at(source, state);
+            let slot = f % 2;
+            let (pool, cmd, fence) = slots[slot];
+            let frame = LightmapFrame {
+                slot: slot as u32,
+                view: &view,
+                lights: &lights,
+                entities: &entities,
+                layout: &layout,
+            };
+            let readback = match f {
+                0 => Some(&first),
+                5 => Some(&last),
+                _ => None,
+            };
+            unsafe {
+                d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+                d.reset_fences(&[fence]).unwrap();
+                d.reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
+                    .unwrap();
+                record_frame(d, cmd, &mut lightmaps, &frame, &mut atlas, readback);
+                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+                d.queue_submit2(queue, &[submit], fence).unwrap();
+            }
+            draws.push(lightmaps.draws(slot as u32));
+            layouts.push(layout);
+        }
+        let fences: Vec<_> = slots.iter().map(|s| s.2).collect();
+        unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        assert!(draws.iter().all(|&n| n > 0), "{draws:?}");
+        assert!(
+            draws[1] > draws[0],
+            "the later frames light more: {draws:?}"
+        );
+
+        // Frame 0 (slot 0, two entities) is not frame 5 (slot 1, six); frame 5 against a frame
+        // of the same six entities through slot 0 is the bit-for-bit check.
+        let entities6 = entities(&scene, &meshes);
+        let layout6 = layout_for(&scene, &entities6);
+        let lights0 = lights_at(&scene, 0);
+        let (pool, cmd, fence) = slots[0];
+        let again = engine.readback_buffer(bytes);
+        let frame = LightmapFrame {
+            slot: 0,
+            view: &view,
+            lights: &lights0,
+            entities: &entities6,
+            layout: &layout6,
+        };
+        unsafe {
+            d.reset_fences(&[fence]).unwrap();
+            d.reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
+                .unwrap();
+            record_frame(d, cmd, &mut lightmaps, &frame, &mut atlas, Some(&again));
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], fence).unwrap();
+            d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+        }
+        assert_eq!(
+            again.bytes(),
+            last.bytes(),
+            "the same frame through the other slot"
+        );
+        assert_ne!(first.bytes(), last.bytes());
+
+        // Every lit entity has light in its region; nothing outside the regions is touched.
+        let texels: Vec<[u16; 4]> = last
+            .bytes()
+            .chunks_exact(8)
+            .map(|t| [0, 1, 2, 3].map(|c| u16::from_le_bytes([t[2 * c], t[2 * c + 1]])))
+            .collect();
+        let inside = |r: &EntityRegion, x: u32, y: u32| {
+            x >= r.region.x
+                && x < r.region.x + r.shape.tiles * r.shape.tile_width
+                && y >= r.region.y
+                && y < r.region.y + r.shape.tile_height
+        };
+        let regions = &layouts[5].regions;
+        let mut lit_regions = vec![false; regions.len()];
+        for y in 0..ATLAS {
+            for x in 0..ATLAS {
+                let t = texels[(y * ATLAS + x) as usize];
+                let owner = regions.iter().position(|r| inside(r, x, y));
+                match owner {
+                    Some(i) => lit_regions[i] |= t[..3].iter().any(|c| *c != 0),
+                    None => assert_eq!(t, [0; 4], "texel ({x}, {y}) outside every region"),
+                }
+            }
+        }
+        assert!(lit_regions.iter().all(|l| *l), "{lit_regions:?}");
+
+        drop(lightmaps);
+        unsafe {
+            for (pool, _, fence) in &slots {
+                d.destroy_fence(*fence, None);
+                d.destroy_command_pool(*pool, None);
+            }
+        }
+        engine.free_image(atlas_image);
+        for b in [first, last, again] {
+            engine.free_buffer(b);
+        }
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
+    }
+    engine.destroy().assert_clean();
+}
+
+/// Every frame that does not fit is refused with `BadFrame` before anything is recorded (the
+/// command buffer ends empty and valid), one case per class of mistake.
+#[test]
+fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
+    let scene = all_kinds();
+    let meshes = Meshes {
+        unit_box: unit_box_bake(),
+        sphere: uv_sphere(48, 24),
+    };
+    let engine = Engine::start();
+    {
+        // SAFETY: as above.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        for bad in [
+            AlphaLightmapsDesc {
+                atlas_format: FORMAT,
+                frames_in_flight: 0,
+            },
+            AlphaLightmapsDesc {
+                atlas_format: vk::Format::D32_SFLOAT,
+                frames_in_flight: 1,
+            },
+        ] {
+            let err = AlphaLightmaps::new(&ctx, &bad).err().expect("refused");
+            assert!(matches!(err, Error::BadFrame(_)), "{err}");
+        }
+        let mut lightmaps = AlphaLightmaps::new(
+            &ctx,
+            &AlphaLightmapsDesc {
+                atlas_format: FORMAT,
+                frames_in_flight: 2,
+            },
+        )
+        .unwrap();
+        use vk::ImageUsageFlags as U;
+        let image = |side| {
+            let extent = vk::Extent2D {
+                width: side,
+                height: side,
+            };
+            engine.image("atlas", FORMAT, extent, U::COLOR_ATTACHMENT)
+        };
+        let (atlas_image, small_image) = (image(ATLAS), image(64));
+        let other_format = engine.image(
+            "atlas-f32",
+            vk::Format::R32G32B32A32_SFLOAT,
+            vk::Extent2D {
+                width: ATLAS,
+                height: ATLAS,
+            },
+            U::COLOR_ATTACHMENT,
+        );
+        let entities = entities(&scene, &meshes);
+        let layout = layout_for(&scene, &entities);
+        let view = scene.camera.view_desc(4.0 / 3.0);
+        let frame = LightmapFrame {
+            slot: 0,
+            view: &view,
+            lights: &scene.lights,
+            entities: &entities,
+            layout: &layout,
+        };
+
+        let mut bad_entities: Vec<(&str, Vec<AlphaEntity>)> = Vec::new();
+        let mut with = |what, i: usize, f: &dyn Fn(&mut AlphaEntity)| {
+            let mut e = entities.clone();
+            let before = format!("{:?}", e[i]);
+            f(&mut e[i]);
+            assert_ne!(before, format!("{:?}", e[i]), "{what}: nothing changed");
+            bad_entities.push((what, e));
+        };
+        with("opacity", 0, &|e| e.opacity = 1.5);
+        with("tint", 0, &|e| e.material.tint = Vec3::splat(f32::NAN));
+        with("transform", 0, &|e| {
+            if let AlphaEntityKind::Object { transform, .. } = &mut e.kind {
+                *transform = glam::Mat4::ZERO;
+            }
+        });
+        let system = scene.alpha_objects.len();
+        with("particles", system, &|e| {
+            if let AlphaEntityKind::Particles { particles, .. } = &mut e.kind {
+                *particles = &NAN_PARTICLE;
+            }
+        });
+        with("slices", system, &|e| {
+            if let AlphaEntityKind::Particles { layout, .. } = &mut e.kind {
+                *layout = ParticleLayout::Slices { count: 99 };
+            }
+        });
+        // Dust in a region too small for its motes.
+        let dust = entities
+            .iter()
+            .position(|e| {
+                matches!(
+                    e.kind,
+                    AlphaEntityKind::Particles {
+                        layout: ParticleLayout::Dust,
+                        ..
+                    }
+                )
+            })
+            .unwrap();
+
+        let (pool, cmd) = engine.command_buffer();
+        let d = &engine.device;
+        unsafe {
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+        }
+        let mut refuse = |what: &str, frame: &LightmapFrame, atlas: &mut ImageRef| {
+            let err = unsafe { lightmaps.record(cmd, frame, atlas) }
+                .err()
+                .unwrap_or_else(|| panic!("{what} was recorded"));
+            assert!(matches!(err, Error::BadFrame(_)), "{what}: {err}");
+            assert_eq!(atlas.state, ImageState::UNDEFINED, "{what}: state changed");
+        };
+        let atlas = || atlas_image.as_ref(ImageState::UNDEFINED);
+        refuse("slot", &LightmapFrame { slot: 2, ..frame }, &mut atlas());
+        refuse(
+            "entity count",
+            &LightmapFrame {
+                entities: &entities[1..],
+                ..frame
+            },
+            &mut atlas(),
+        );
+        for (what, bad) in &bad_entities {
+            refuse(
+                what,
+                &LightmapFrame {
+                    entities: bad,
+                    ..frame
+                },
+                &mut atlas(),
+            );
+        }
+        refuse(
+            "atlas size",
+            &frame,
+            &mut small_image.as_ref(ImageState::UNDEFINED),
+        );
+        refuse(
+            "atlas format",
+            &frame,
+            &mut other_format.as_ref(ImageState::UNDEFINED),
+        );
+        let mut outside = layout_for(&scene, &entities);
+        outside.regions[0].region.x = ATLAS - 1;
+        refuse(
+            "region outside the atlas",
+            &LightmapFrame {
+                layout: &outside,
+                ..frame
+            },
+            &mut atlas(),
+        );
+        let mut cramped = layout_for(&scene, &entities);
+        cramped.regions[dust].shape.tile_height = 1;
+        refuse(
+            "dust region",
+            &LightmapFrame {
+                layout: &cramped,
+                ..frame
+            },
+            &mut atlas(),
+        );
+        let mut singular = view;
+        singular.world_to_view = [[0.0; 4]; 4];
+        refuse(
+            "view",
+            &LightmapFrame {
+                view: &singular,
+                ..frame
+            },
+            &mut atlas(),
+        );
+        unsafe {
+            d.end_command_buffer(cmd).unwrap();
+            d.destroy_command_pool(pool, None);
+        }
+        drop(lightmaps);
+        for image in [atlas_image, small_image, other_format] {
+            engine.free_image(image);
+        }
+        assert!(ctx.validation_log().is_empty());
+    }
+    engine.destroy().assert_clean();
+}
+
+unsafe fn copy_to_buffer(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut ImageRef,
+    buffer: vk::Buffer,
+) {
+    let state = ImageState {
+        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        stage: vk::PipelineStageFlags2::COPY,
+        access: vk::AccessFlags2::TRANSFER_READ,
+    };
+    let range = vk::ImageSubresourceRange::default()
+        .aspect_mask(vk::ImageAspectFlags::COLOR)
+        .level_count(1)
+        .layer_count(1);
+    let to_copy = [vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(image.state.stage)
+        .src_access_mask(image.state.access)
+        .dst_stage_mask(state.stage)
+        .dst_access_mask(state.access)
+        .old_layout(image.state.layout)
+        .new_layout(state.layout)
+        .image(image.image)
+        .subresource_range(range)];
+    d.cmd_pipeline_barrier2(
+        cmd,
+        &vk::DependencyInfo::default().image_memory_barriers(&to_copy),
+    );
+    image.state = state;
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .layer_count(1),
+        )
+        .image_extent(vk::Extent3D {
+            width: image.extent.width,
+            height: image.extent.height,
+            depth: 1,
+        });
+    d.cmd_copy_image_to_buffer(cmd, image.image, state.layout, buffer, &[region]);
+    let host = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::COPY)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host));
+}
