@@ -4,7 +4,7 @@
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
-use histencil_vk::{BorrowedDevice, ValidationLog, REQUIREMENTS};
+use histencil_vk::{BorrowedDevice, ImageState, ValidationLog, REQUIREMENTS};
 use std::sync::{Arc, Mutex};
 
 /// The engine's side: what it created, in creation order.
@@ -279,4 +279,80 @@ impl Engine {
             .free(buffer.allocation)
             .expect("free");
     }
+}
+
+/// The engine's barrier from the image's tracked state to `next`, over every aspect.
+///
+/// # Safety
+/// `cmd` is recording on the engine's device and `image.state` is true.
+pub unsafe fn barrier(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut histencil_vk::ImageRef,
+    next: ImageState,
+    discard: bool,
+) {
+    let old = if discard {
+        vk::ImageLayout::UNDEFINED
+    } else {
+        image.state.layout
+    };
+    let b = [vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(image.state.stage)
+        .src_access_mask(image.state.access)
+        .dst_stage_mask(next.stage)
+        .dst_access_mask(next.access)
+        .old_layout(old)
+        .new_layout(next.layout)
+        .image(image.image)
+        .subresource_range(color_range(image))];
+    d.cmd_pipeline_barrier2(
+        cmd,
+        &vk::DependencyInfo::default().image_memory_barriers(&b),
+    );
+    image.state = next;
+}
+
+/// Copies `image` (colour) into `buffer` and makes the copy visible to the host, tracking the
+/// image's state.
+///
+/// # Safety
+/// `cmd` is recording on the engine's device, `image.state` is true, `buffer` is large enough.
+pub unsafe fn copy_to_buffer(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: &mut histencil_vk::ImageRef,
+    buffer: vk::Buffer,
+) {
+    let state = ImageState {
+        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+        stage: vk::PipelineStageFlags2::COPY,
+        access: vk::AccessFlags2::TRANSFER_READ,
+    };
+    barrier(d, cmd, image, state, false);
+    let region = vk::BufferImageCopy::default()
+        .image_subresource(
+            vk::ImageSubresourceLayers::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .layer_count(1),
+        )
+        .image_extent(vk::Extent3D {
+            width: image.extent.width,
+            height: image.extent.height,
+            depth: 1,
+        });
+    d.cmd_copy_image_to_buffer(cmd, image.image, state.layout, buffer, &[region]);
+    let host = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::COPY)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host));
+}
+
+fn color_range(image: &histencil_vk::ImageRef) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange::default()
+        .aspect_mask(image.aspect())
+        .level_count(1)
+        .layer_count(1)
 }

@@ -8,7 +8,7 @@
 use ash::vk;
 use glam::Vec3;
 use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
-use histencil_tests::engine::{Engine, EngineImage};
+use histencil_tests::engine::{barrier, copy_to_buffer, Engine, EngineImage};
 use histencil_vk::{
     Backend, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame, LightingTargets,
     Readback, Renderer, Technique, GBUFFER_FORMATS,
@@ -269,72 +269,11 @@ unsafe fn clear_color(d: &ash::Device, cmd: vk::CommandBuffer, image: &mut histe
     d.cmd_clear_color_image(cmd, image.image, state.layout, &black, &[range]);
 }
 
-unsafe fn copy_to_buffer(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    image: &mut histencil_vk::ImageRef,
-    buffer: vk::Buffer,
-) {
-    let state = ImageState {
-        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-        stage: vk::PipelineStageFlags2::COPY,
-        access: vk::AccessFlags2::TRANSFER_READ,
-    };
-    barrier(d, cmd, image, state, false);
-    let region = vk::BufferImageCopy::default()
-        .image_subresource(
-            vk::ImageSubresourceLayers::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .layer_count(1),
-        )
-        .image_extent(vk::Extent3D {
-            width: image.extent.width,
-            height: image.extent.height,
-            depth: 1,
-        });
-    d.cmd_copy_image_to_buffer(cmd, image.image, state.layout, buffer, &[region]);
-    let host = [vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::COPY)
-        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-    d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host));
-}
-
 fn color_range() -> vk::ImageSubresourceRange {
     vk::ImageSubresourceRange::default()
         .aspect_mask(vk::ImageAspectFlags::COLOR)
         .level_count(1)
         .layer_count(1)
-}
-
-/// The engine's barrier from the image's tracked state to `next`.
-unsafe fn barrier(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    image: &mut histencil_vk::ImageRef,
-    next: ImageState,
-    discard: bool,
-) {
-    let old = if discard {
-        vk::ImageLayout::UNDEFINED
-    } else {
-        image.state.layout
-    };
-    let b = [vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(image.state.stage)
-        .src_access_mask(image.state.access)
-        .dst_stage_mask(next.stage)
-        .dst_access_mask(next.access)
-        .old_layout(old)
-        .new_layout(next.layout)
-        .image(image.image)
-        .subresource_range(color_range())];
-    d.cmd_pipeline_barrier2(
-        cmd,
-        &vk::DependencyInfo::default().image_memory_barriers(&b),
-    );
-    image.state = next;
 }
 
 /// Every description and frame that does not fit is refused with `BadFrame` before anything is

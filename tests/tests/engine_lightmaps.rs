@@ -10,7 +10,7 @@ use ash::vk;
 use glam::Vec3;
 use histencil_alpha::{plan_regions, EntityRegion, LightmapLayout, Viewer};
 use histencil_scene::{unit_box_bake, uv_sphere, Light, Mesh, ParticleLayout, Scene, Shape};
-use histencil_tests::engine::{Engine, EngineBuffer};
+use histencil_tests::engine::{copy_to_buffer, Engine, EngineBuffer};
 use histencil_vk::{
     AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, Context, Error, ImageRef,
     ImageState, LightmapFrame,
@@ -478,53 +478,4 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
         assert!(ctx.validation_log().is_empty());
     }
     engine.destroy().assert_clean();
-}
-
-unsafe fn copy_to_buffer(
-    d: &ash::Device,
-    cmd: vk::CommandBuffer,
-    image: &mut ImageRef,
-    buffer: vk::Buffer,
-) {
-    let state = ImageState {
-        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-        stage: vk::PipelineStageFlags2::COPY,
-        access: vk::AccessFlags2::TRANSFER_READ,
-    };
-    let range = vk::ImageSubresourceRange::default()
-        .aspect_mask(vk::ImageAspectFlags::COLOR)
-        .level_count(1)
-        .layer_count(1);
-    let to_copy = [vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(image.state.stage)
-        .src_access_mask(image.state.access)
-        .dst_stage_mask(state.stage)
-        .dst_access_mask(state.access)
-        .old_layout(image.state.layout)
-        .new_layout(state.layout)
-        .image(image.image)
-        .subresource_range(range)];
-    d.cmd_pipeline_barrier2(
-        cmd,
-        &vk::DependencyInfo::default().image_memory_barriers(&to_copy),
-    );
-    image.state = state;
-    let region = vk::BufferImageCopy::default()
-        .image_subresource(
-            vk::ImageSubresourceLayers::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .layer_count(1),
-        )
-        .image_extent(vk::Extent3D {
-            width: image.extent.width,
-            height: image.extent.height,
-            depth: 1,
-        });
-    d.cmd_copy_image_to_buffer(cmd, image.image, state.layout, buffer, &[region]);
-    let host = [vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::COPY)
-        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-    d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host));
 }
