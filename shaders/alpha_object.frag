@@ -1,6 +1,6 @@
 #version 460
-// A translucent object's fragment, lit as AlphaDraw.mode says (its lightmap, forward per pixel,
-// or the single probe), premultiplied by its opacity for blending over what lies behind.
+// A translucent object's fragment, lit as its pipeline's mode says (its lightmap, forward per
+// pixel, or the single probe), premultiplied by its opacity for blending over what lies behind.
 #include "alpha_lightmap.glsl"
 
 layout(location = 0) in vec3 in_world_position;
@@ -9,16 +9,23 @@ layout(location = 2) in vec2 in_uv;
 
 layout(location = 0) out vec4 out_color;
 
+// How the fragment is lit: forward per pixel, by the single probe, or (neither) from the
+// lightmap. A pipeline per mode, so the lightmap pipeline carries none of the per-pixel
+// reference's code (on a CPU rasteriser the unused branch and its inputs cost as much as the
+// lookup). Booleans, as naga reads no specialisation-constant arithmetic.
+layout(constant_id = 0) const bool LIT_FORWARD = false;
+layout(constant_id = 1) const bool LIT_BY_PROBE = false;
+
 void main() {
     AlphaEntity e = entities[alpha_draw.entity];
     Surface s = alpha_surface(e, in_world_position, normalize(in_world_normal));
     vec3 lit;
-    if (alpha_draw.mode == ALPHA_MODE_FORWARD) {
+    if (LIT_FORWARD) {
         lit = forward_lighting(e, s);
-    } else if (alpha_draw.mode == ALPHA_MODE_PROBE) {
+    } else if (LIT_BY_PROBE) {
         lit = probe_lighting(e, s);
     } else {
-        lit = lightmap_object(lightmap, e, in_uv);
+        lit = lightmap_object(lightmap, lightmap_sampler, e, in_uv);
     }
     float a = e.tint_opacity.w;
     out_color = vec4(lit * a, a);

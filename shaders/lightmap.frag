@@ -32,8 +32,14 @@ void main() {
         P = ribbon_point(e, (float(local.x) + 0.5) / float(e.region.z));
         N = facing_normal(P);
     } else {
-        uint k = uint(local.x) / e.region.z;
-        vec2 in_tile = vec2(uint(local.x) - k * e.region.z, local.y) + 0.5;
+        // Slices: tile k at (k % columns, k / columns) of the region.
+        uvec2 tile = uvec2(local) / e.region.zw;
+        uint k = tile.y * tile_columns(e) + tile.x;
+        if (k >= e.shape.y) {
+            out_color = vec4(0.0);
+            return;
+        }
+        vec2 in_tile = vec2(uvec2(local) - tile * e.region.zw) + 0.5;
         P = frame_probe(e, in_tile / vec2(e.region.zw), k);
         N = facing_normal(P);
     }

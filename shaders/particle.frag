@@ -8,8 +8,16 @@ layout(location = 1) in vec2 in_corner;
 layout(location = 2) flat in uint in_entity;
 layout(location = 3) in float in_param;
 layout(location = 4) flat in float in_mote;
+layout(location = 5) in vec3 in_located;
 
 layout(location = 0) out vec4 out_color;
+
+// How the fragment is lit: forward per pixel, by the single probe, or (neither) from the
+// lightmap. A pipeline per mode, so the lightmap pipeline carries none of the per-pixel
+// reference's code (on a CPU rasteriser the unused branch and its inputs cost as much as the
+// lookup). Booleans, as naga reads no specialisation-constant arithmetic.
+layout(constant_id = 0) const bool LIT_FORWARD = false;
+layout(constant_id = 1) const bool LIT_BY_PROBE = false;
 
 void main() {
     AlphaEntity e = entities[in_entity];
@@ -20,13 +28,14 @@ void main() {
     vec3 P = in_world_position;
     Surface s = alpha_surface(e, P, facing_normal(P));
     vec3 lit;
-    if (alpha_draw.mode == ALPHA_MODE_FORWARD) {
+    if (LIT_FORWARD) {
         lit = forward_lighting(e, s);
-    } else if (alpha_draw.mode == ALPHA_MODE_PROBE) {
+    } else if (LIT_BY_PROBE) {
         lit = probe_lighting(e, s);
     } else {
         // Dust reads its mote's texel (flat: the interpolated copy may round off the index).
-        lit = lightmap_particle(lightmap, e, P, e.shape.x == ALPHA_DUST ? in_mote : in_param);
+        float param = e.shape.x == ALPHA_DUST ? in_mote : in_param;
+        lit = lightmap_particle_at(lightmap, lightmap_sampler, e, in_located, param);
     }
     out_color = vec4(lit * coverage, coverage);
 }

@@ -36,7 +36,7 @@ layout(set = 1, binding = 3, std430) readonly buffer AlphaProbes {
 layout(push_constant) uniform AlphaDraw {
     uint entity; // into `entities`
     uint light;  // into `lights` (lightmap pass)
-    uint mode;   // ALPHA_MODE_* (alpha pass)
+    uint pad0;
     uint pad;
 } alpha_draw;
 

@@ -20,8 +20,8 @@ struct AlphaEntity {
     vec4 tint_opacity;    // rgb tint, w opacity
     vec4 params;          // xyz the BRDF's packed parameters, w BRDF id
     uvec4 region;         // xy: the region's first texel in the atlas; zw: one tile's size
-    uvec4 shape;          // x: ALPHA_* kind, y: tiles (slices), z: first point or probe,
-                          // w: point count
+    uvec4 shape;          // x: ALPHA_* kind, y: tiles (slices), z: first point or probe
+                          // (ALPHA_SLICES: tiles to a row), w: point count
     vec4 centre_radius;   // xyz: probe frame centre (the single probe's point), w: its radius
     vec4 right_depth;     // xyz: unit right, w: half depth of the slice stack
     vec4 up;              // xyz: unit up
@@ -29,18 +29,9 @@ struct AlphaEntity {
     uvec4 light_range;    // x: first index into the entity light list, y: count
 };
 
-// `(u, v, slice)` of the probe nearest P (histencil_alpha::ProbeFrame::locate).
-vec3 frame_locate(AlphaEntity e, vec3 P) {
-    vec3 d = P - e.centre_radius.xyz;
-    float r = e.centre_radius.w;
-    uint n = e.shape.y;
-    float s = 0.0;
-    if (n > 1u) {
-        float half_depth = e.right_depth.w;
-        s = clamp((dot(d, e.forward.xyz) + half_depth) / (2.0 * half_depth) * float(n - 1u),
-                  0.0, float(n - 1u));
-    }
-    return vec3(0.5 + 0.5 * dot(d, e.right_depth.xyz) / r, 0.5 - 0.5 * dot(d, e.up.xyz) / r, s);
+// Tiles to a row of the entity's region: tile k sits at (k % columns, k / columns).
+uint tile_columns(AlphaEntity e) {
+    return e.shape.x == ALPHA_SLICES ? max(e.shape.z, 1u) : 1u;
 }
 
 #endif

@@ -1,8 +1,9 @@
 // Sampling an alpha entity's light from the lightmap atlas, for any alpha shader: histencil's
 // own alpha pass and an engine's. The atlas is the colour image AlphaLightmaps::record lit (bound
-// as a sampled image in SHADER_READ_ONLY_OPTIMAL); the entity is its AlphaEntity record. The
-// result is the radiance towards the viewer that the entity's own BRDF reflects at the probe
-// (the talk's lightmap): multiply by coverage and blend.
+// as a sampled image in SHADER_READ_ONLY_OPTIMAL) with a sampler of linear filtering, no mips and
+// clamp-to-edge addressing; the entity is its AlphaEntity record. The result is the radiance
+// towards the viewer that the entity's own BRDF reflects at the probe (the talk's lightmap):
+// multiply by coverage and blend.
 //
 // Reads are bilinear inside one tile of the entity's region, clamped to the tile, so no texel
 // of a neighbour (or of the guard band) ever leaks in.
@@ -13,45 +14,67 @@
 
 #include "alpha_entity.glsl"
 
-// Tile `tile` of the entity's region at uv in [0, 1]^2 (texel centres at (i + 0.5) / size).
-vec3 lightmap_tile(texture2D atlas, AlphaEntity e, uint tile, vec2 uv) {
+// Tile `tile` of the entity's region at uv in [0, 1]^2 (texel centres at (i + 0.5) / size),
+// filtered by `linear` (bilinear, clamp to edge): the coordinate is clamped to the tile's outer
+// texel centres, so the filter never reaches past the tile.
+vec3 lightmap_tile(texture2D atlas, sampler linear, AlphaEntity e, uint tile, vec2 uv) {
     vec2 size = vec2(e.region.zw);
-    vec2 t = clamp(uv * size - 0.5, vec2(0.0), size - 1.0);
-    ivec2 i0 = ivec2(floor(t));
-    vec2 f = t - vec2(i0);
-    ivec2 i1 = min(i0 + 1, ivec2(e.region.zw) - 1);
-    ivec2 origin = ivec2(e.region.xy) + ivec2(int(tile * e.region.z), 0);
-    vec3 a = texelFetch(atlas, origin + ivec2(i0.x, i0.y), 0).rgb;
-    vec3 b = texelFetch(atlas, origin + ivec2(i1.x, i0.y), 0).rgb;
-    vec3 c = texelFetch(atlas, origin + ivec2(i0.x, i1.y), 0).rgb;
-    vec3 d = texelFetch(atlas, origin + ivec2(i1.x, i1.y), 0).rgb;
-    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+    vec2 t = clamp(uv * size, vec2(0.5), size - 0.5);
+    uint columns = tile_columns(e);
+    uvec2 cell = uvec2(tile % columns, tile / columns);
+    vec2 origin = vec2(e.region.xy + cell * e.region.zw);
+    vec2 atlas_size = vec2(textureSize(sampler2D(atlas, linear), 0));
+    return textureLod(sampler2D(atlas, linear), (origin + t) / atlas_size, 0.0).rgb;
 }
 
 // A translucent object's light at `uv`, its mesh's lightmap UV (the layout it was baked in).
-vec3 lightmap_object(texture2D atlas, AlphaEntity e, vec2 uv) {
-    return lightmap_tile(atlas, e, 0u, uv);
+vec3 lightmap_object(texture2D atlas, sampler linear, AlphaEntity e, vec2 uv) {
+    return lightmap_tile(atlas, linear, e, 0u, uv);
 }
 
-// A particle's light from its system's lightmap. P: the fragment's world position; param: the
-// dust mote's index (flat: an interpolated copy may round off) or the position along a ribbon
-// in [0, 1]; unused for billboards and slices.
-vec3 lightmap_particle(texture2D atlas, AlphaEntity e, vec3 P, float param) {
+// Where a particle system's fragment at world position P sits in its lightmap, before clamping:
+// (u, v, slice), affine in P. Computed per vertex and interpolated, it saves the fragment stage
+// the work (the alpha pass's sprites are flat, so the interpolation is exact).
+vec3 lightmap_locate(AlphaEntity e, vec3 P) {
+    vec3 d = P - e.centre_radius.xyz;
+    float r = e.centre_radius.w;
+    uint n = e.shape.y;
+    float s = 0.0;
+    if (n > 1u) {
+        float half_depth = e.right_depth.w;
+        s = (dot(d, e.forward.xyz) + half_depth) / (2.0 * half_depth) * float(n - 1u);
+    }
+    return vec3(0.5 + 0.5 * dot(d, e.right_depth.xyz) / r, 0.5 - 0.5 * dot(d, e.up.xyz) / r, s);
+}
+
+// A particle's light from its system's lightmap, at `located` (lightmap_locate of the
+// fragment's world position). param: the dust mote's index (flat: an interpolated copy may round
+// off) or the position along a ribbon in [0, 1]; unused for billboards and slices.
+vec3 lightmap_particle_at(texture2D atlas, sampler linear, AlphaEntity e, vec3 located,
+                          float param) {
     uint kind = e.shape.x;
     if (kind == ALPHA_DUST) {
         uint i = uint(param);
         ivec2 texel = ivec2(e.region.xy) + ivec2(int(i % e.region.z), int(i / e.region.z));
-        return texelFetch(atlas, texel, 0).rgb;
+        return texelFetch(sampler2D(atlas, linear), texel, 0).rgb;
     }
     if (kind == ALPHA_RIBBON) {
-        return lightmap_tile(atlas, e, 0u, vec2(param, 0.5));
+        return lightmap_tile(atlas, linear, e, 0u, vec2(param, 0.5));
     }
-    vec3 located = frame_locate(e, P);
-    uint k0 = uint(floor(located.z));
-    uint k1 = min(k0 + 1u, e.shape.y - 1u);
-    vec3 a = lightmap_tile(atlas, e, k0, located.xy);
-    vec3 b = lightmap_tile(atlas, e, k1, located.xy);
-    return mix(a, b, located.z - float(k0));
+    float last = float(e.shape.y - 1u);
+    float s = clamp(located.z, 0.0, last);
+    uint k0 = uint(floor(s));
+    vec3 a = lightmap_tile(atlas, linear, e, k0, located.xy);
+    float f = s - float(k0);
+    if (f == 0.0) {
+        return a;
+    }
+    return mix(a, lightmap_tile(atlas, linear, e, k0 + 1u, located.xy), f);
+}
+
+// A particle's light at world position P (lightmap_locate here, in the fragment stage).
+vec3 lightmap_particle(texture2D atlas, sampler linear, AlphaEntity e, vec3 P, float param) {
+    return lightmap_particle_at(atlas, linear, e, lightmap_locate(e, P), param);
 }
 
 #endif

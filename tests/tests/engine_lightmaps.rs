@@ -8,8 +8,11 @@
 
 use ash::vk;
 use glam::Vec3;
-use histencil_alpha::{plan_regions, EntityRegion, LightmapLayout, Viewer};
-use histencil_scene::{unit_box_bake, uv_sphere, Light, Mesh, ParticleLayout, Scene, Shape};
+use histencil_alpha::{
+    plan_regions, scene_alpha_entities as entities, EntityRegion, LightmapLayout, ProbeMeshes,
+    Viewer,
+};
+use histencil_scene::{Light, ParticleLayout, Scene, Shape};
 use histencil_tests::engine::{copy_to_buffer, Engine, EngineBuffer};
 use histencil_vk::{
     AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, Context, Error, ImageRef,
@@ -23,36 +26,6 @@ static NAN_PARTICLE: [histencil_scene::Particle; 1] = [histencil_scene::Particle
     position: Vec3::NAN,
     size: 0.1,
 }];
-
-/// The probe meshes of the scene's shapes, as an engine keeps its meshes.
-struct Meshes {
-    unit_box: Mesh,
-    sphere: Mesh,
-}
-
-fn entities<'a>(scene: &'a Scene, meshes: &'a Meshes) -> Vec<AlphaEntity<'a>> {
-    let objects = scene.alpha_objects.iter().map(|o| AlphaEntity {
-        kind: AlphaEntityKind::Object {
-            probe_mesh: match o.shape {
-                Shape::Box => &meshes.unit_box,
-                _ => &meshes.sphere,
-            },
-            transform: o.transform,
-            local_bounds: (Vec3::NEG_ONE, Vec3::ONE),
-        },
-        material: o.material,
-        opacity: o.opacity,
-    });
-    let systems = scene.particle_systems.iter().map(|s| AlphaEntity {
-        kind: AlphaEntityKind::Particles {
-            layout: s.layout,
-            particles: &s.particles,
-        },
-        material: s.material,
-        opacity: s.opacity,
-    });
-    objects.chain(systems).collect()
-}
 
 /// Every kind of entity: the glass sphere and smoke column of `alpha`, a box, `dust` and
 /// `ribbon`'s systems, `volume`'s slices.
@@ -124,10 +97,7 @@ unsafe fn record_frame(
 #[test]
 fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
     let scene = all_kinds();
-    let meshes = Meshes {
-        unit_box: unit_box_bake(),
-        sphere: uv_sphere(48, 24),
-    };
+    let meshes = ProbeMeshes::new(&scene);
     // A smaller first state, so the later frames grow every buffer of both slots.
     let mut small = scene.clone();
     small.particle_systems.truncate(1);
@@ -256,10 +226,8 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
             .map(|t| [0, 1, 2, 3].map(|c| u16::from_le_bytes([t[2 * c], t[2 * c + 1]])))
             .collect();
         let inside = |r: &EntityRegion, x: u32, y: u32| {
-            x >= r.region.x
-                && x < r.region.x + r.shape.tiles * r.shape.tile_width
-                && y >= r.region.y
-                && y < r.region.y + r.shape.tile_height
+            let (w, h) = r.shape.size();
+            x >= r.region.x && x < r.region.x + w && y >= r.region.y && y < r.region.y + h
         };
         let regions = &layouts[5].regions;
         let mut lit_regions = vec![false; regions.len()];
@@ -296,10 +264,7 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
 #[test]
 fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
     let scene = all_kinds();
-    let meshes = Meshes {
-        unit_box: unit_box_bake(),
-        sphere: uv_sphere(48, 24),
-    };
+    let meshes = ProbeMeshes::new(&scene);
     let engine = Engine::start();
     {
         // SAFETY: as above.

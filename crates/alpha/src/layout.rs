@@ -6,10 +6,12 @@
 //! coverage on screen if the caller knows better, a forced side), so an engine plans its own
 //! entities the way histencil plans a scene's ([`scene_entities`], [`plan_layout`]).
 
+use crate::entity::{scene_alpha_entities, AlphaEntity, AlphaEntityKind, ProbeMeshes};
+use crate::estimate::{choose_parameters, Parameters};
 use crate::{side_for_coverage, Atlas, AtlasError, Region, MIN_SIDE};
 use glam::{Mat4, Vec3};
 use histencil_model::ViewDesc;
-use histencil_scene::{Camera, ParticleLayout, ParticleSystem, Scene, MAX_SLICES};
+use histencil_scene::{Camera, Light, Particle, ParticleLayout, Scene, MAX_SLICES};
 
 /// An alpha entity of a scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -111,20 +113,38 @@ impl Viewer {
 }
 
 /// How an entity's probes sit in its region: `tiles` tiles of `tile_width x tile_height` texels
-/// side by side (a slice each for sliced systems, one otherwise).
+/// (a slice each for sliced systems, one otherwise), `columns` to a row, row by row: tile `k` at
+/// `(k % columns, k / columns)`. Slices are laid out as square as their count allows, so a stack
+/// of them does not stretch the atlas into a long strip.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RegionShape {
     pub tiles: u32,
+    pub columns: u32,
     pub tile_width: u32,
     pub tile_height: u32,
     /// Whether a full atlas may halve the tiles (not for dust: one texel per mote is the layout).
     pub downgradable: bool,
 }
 
+impl RegionShape {
+    /// Rows of tiles.
+    pub fn rows(&self) -> u32 {
+        self.tiles.div_ceil(self.columns.max(1))
+    }
+
+    /// The texels the tiles span: `(columns * tile_width, rows * tile_height)`.
+    pub fn size(&self) -> (u32, u32) {
+        (
+            self.columns * self.tile_width,
+            self.rows() * self.tile_height,
+        )
+    }
+}
+
 /// An entity's place in the atlas.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EntityRegion {
-    /// The whole region: `shape.tiles` tiles side by side.
+    /// The whole region: its tiles laid out as `shape` says.
     pub region: Region,
     /// The tiles as granted (halved when the atlas was full).
     pub shape: RegionShape,
@@ -161,7 +181,7 @@ pub enum LayoutError {
     #[error("the lightmap atlas is full even at {side}x{side} texels with every region halved down to {min}: {reason}", min = MIN_SIDE)]
     AtlasFull { side: u32, reason: AtlasError },
     #[error("alpha entity {index}: {reason}")]
-    BadEntity { index: usize, reason: &'static str },
+    BadEntity { index: usize, reason: String },
 }
 
 /// Diameter in pixels that a sphere of `radius` at `centre` covers on a `viewport_height`-pixel
@@ -216,8 +236,9 @@ pub fn region_shape(desc: &EntityDesc, viewer: &Viewer, viewport_height: u32) ->
             side_for_coverage(coverage)
         })
     };
-    let square = |tiles, side| RegionShape {
+    let square = |tiles: u32, side| RegionShape {
         tiles,
+        columns: (tiles as f64).sqrt().ceil() as u32,
         tile_width: side,
         tile_height: side,
         downgradable: true,
@@ -225,12 +246,14 @@ pub fn region_shape(desc: &EntityDesc, viewer: &Viewer, viewport_height: u32) ->
     match desc.kind {
         EntityKind::Surface => square(1, side()),
         EntityKind::Particles { layout, count } => match layout {
-            ParticleLayout::Billboard => square(1, side()),
+            // An unresolved Auto is a billboard: `plan_entities` resolves it first.
+            ParticleLayout::Billboard | ParticleLayout::Auto => square(1, side()),
             ParticleLayout::Slices { count } => square(count, side()),
             ParticleLayout::Dust => {
                 let (w, h) = dust_grid(count);
                 RegionShape {
                     tiles: 1,
+                    columns: 1,
                     tile_width: w,
                     tile_height: h,
                     downgradable: false,
@@ -238,6 +261,7 @@ pub fn region_shape(desc: &EntityDesc, viewer: &Viewer, viewport_height: u32) ->
             }
             ParticleLayout::Ribbon => RegionShape {
                 tiles: 1,
+                columns: 1,
                 tile_width: side(),
                 tile_height: 1,
                 downgradable: true,
@@ -253,9 +277,8 @@ pub fn dust_grid(motes: u32) -> (u32, u32) {
 }
 
 /// A ribbon's projected length in pixels: the sum of its segments' projected lengths.
-fn ribbon_length_px(viewer: &Viewer, system: &ParticleSystem, viewport_height: u32) -> f32 {
-    system
-        .particles
+fn ribbon_length_px(viewer: &Viewer, particles: &[Particle], viewport_height: u32) -> f32 {
+    particles
         .windows(2)
         .map(|w| {
             let mid = (w[0].position + w[1].position) * 0.5;
@@ -288,7 +311,7 @@ pub fn scene_entities(
                 EntityKey::System(i) => {
                     let s = &scene.particle_systems[i];
                     let coverage = (s.layout == ParticleLayout::Ribbon)
-                        .then(|| ribbon_length_px(&viewer, s, viewport_height));
+                        .then(|| ribbon_length_px(&viewer, &s.particles, viewport_height));
                     let count = s.particles.len() as u32;
                     let kind = EntityKind::Particles {
                         layout: s.layout,
@@ -329,24 +352,146 @@ pub fn check_forced_side(side: u32) -> Result<(), LayoutError> {
     }
 }
 
-/// Plans `scene`'s lightmap layout ([`plan_regions`] on [`scene_entities`]): regions in
-/// [`entities`] order.
+/// A lightmap plan: the regions, and what each entity was given and why.
+#[derive(Debug)]
+pub struct AlphaPlan {
+    pub layout: LightmapLayout,
+    /// Per entity, in order: its slices and side and the error estimate behind them.
+    pub parameters: Vec<Parameters>,
+}
+
+/// How [`plan_entities`] chooses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChoiceSettings {
+    /// Every region's side, as an author forces it (2..=[`MAX_FORCED_SIDE`]); `None`: chosen.
+    pub forced_side: Option<u32>,
+    /// The estimated mean error (8-bit steps) the choice keeps each entity under.
+    pub target: f32,
+}
+
+impl Default for ChoiceSettings {
+    fn default() -> Self {
+        Self {
+            forced_side: None,
+            target: crate::estimate::DEFAULT_TARGET,
+        }
+    }
+}
+
+/// Plans `entities` seen by `viewer` on a `viewport_height`-pixel view and lit by `lights`:
+/// each one's slices and side from the error estimate ([`choose_parameters`]), then their
+/// regions packed into an atlas of at most `max_side` ([`plan_regions`]). Regions and
+/// parameters come back in entity order.
 ///
 /// # Errors
-/// As [`plan_regions`]; [`LayoutError::BadResolution`] for a forced side outside
-/// 2..=[`MAX_FORCED_SIDE`].
+/// [`LayoutError::BadEntity`] for an entity [`AlphaEntity::problem`] refuses,
+/// [`LayoutError::BadResolution`] for a forced side outside 2..=[`MAX_FORCED_SIDE`], and
+/// [`LayoutError::AtlasFull`] when the regions do not fit even halved.
+pub fn plan_entities(
+    entities: &[AlphaEntity],
+    viewer: &Viewer,
+    lights: &[Light],
+    viewport_height: u32,
+    max_side: u32,
+    settings: &ChoiceSettings,
+) -> Result<AlphaPlan, LayoutError> {
+    if let Some(side) = settings.forced_side {
+        check_forced_side(side)?;
+    }
+    if let Some((index, reason)) = entities
+        .iter()
+        .enumerate()
+        .find_map(|(i, e)| e.problem().map(|r| (i, r)))
+    {
+        return Err(LayoutError::BadEntity { index, reason });
+    }
+    let parameters: Vec<Parameters> = entities
+        .iter()
+        .map(|e| {
+            choose_parameters(
+                e,
+                viewer,
+                lights,
+                viewport_height,
+                settings.forced_side,
+                settings.target,
+            )
+        })
+        .collect();
+    let descs: Vec<EntityDesc> = entities
+        .iter()
+        .zip(&parameters)
+        .map(|(e, p)| resolved_desc(e, p, viewer, viewport_height, settings.forced_side))
+        .collect();
+    let layout = plan_regions(&descs, viewer, viewport_height, max_side)?;
+    Ok(AlphaPlan { layout, parameters })
+}
+
+/// `entity`'s description with its chosen parameters: an automatic system's slices made
+/// explicit, the side fixed (dust keeps its grid; a ribbon its length in pixels unless forced).
+fn resolved_desc(
+    entity: &AlphaEntity,
+    parameters: &Parameters,
+    viewer: &Viewer,
+    viewport_height: u32,
+    forced_side: Option<u32>,
+) -> EntityDesc {
+    let desc = entity.desc();
+    match entity.kind {
+        AlphaEntityKind::Particles { layout, particles } => match layout {
+            ParticleLayout::Dust => desc,
+            ParticleLayout::Ribbon => EntityDesc {
+                coverage_px: Some(ribbon_length_px(viewer, particles, viewport_height)),
+                side: forced_side,
+                ..desc
+            },
+            _ => {
+                let layout = match parameters.slices {
+                    1 => ParticleLayout::Billboard,
+                    count => ParticleLayout::Slices { count },
+                };
+                let count = u32::try_from(particles.len()).unwrap_or(u32::MAX);
+                EntityDesc {
+                    kind: EntityKind::Particles { layout, count },
+                    side: Some(parameters.side),
+                    ..desc
+                }
+            }
+        },
+        AlphaEntityKind::Object { .. } => EntityDesc {
+            side: Some(parameters.side),
+            ..desc
+        },
+    }
+}
+
+/// Plans `scene`'s alpha entities ([`plan_entities`] on [`scene_alpha_entities`], seen by its
+/// camera, lit by its lights); every side forced to `forced_side` if given. Regions and
+/// parameters in [`entities`] order.
+///
+/// # Errors
+/// As [`plan_entities`].
 pub fn plan_layout(
     scene: &Scene,
     viewport_height: u32,
     forced_side: Option<u32>,
     max_side: u32,
-) -> Result<LightmapLayout, LayoutError> {
-    if let Some(side) = forced_side {
-        check_forced_side(side)?;
-    }
-    let descs = scene_entities(scene, viewport_height, forced_side);
+) -> Result<AlphaPlan, LayoutError> {
+    let meshes = ProbeMeshes::new(scene);
+    let entities = scene_alpha_entities(scene, &meshes);
+    let settings = ChoiceSettings {
+        forced_side,
+        ..ChoiceSettings::default()
+    };
     let viewer = Viewer::from_camera(&scene.camera);
-    plan_regions(&descs, &viewer, viewport_height, max_side)
+    plan_entities(
+        &entities,
+        &viewer,
+        &scene.lights,
+        viewport_height,
+        max_side,
+        &settings,
+    )
 }
 
 /// Packs every entity's region into the smallest square atlas from [`START_ATLAS_SIDE`]
@@ -368,6 +513,7 @@ pub fn plan_regions(
         .enumerate()
         .find_map(|(i, d)| entity_problem(d).map(|r| (i, r)))
     {
+        let reason = reason.to_owned();
         return Err(LayoutError::BadEntity { index, reason });
     }
     let shapes: Vec<RegionShape> = descs
@@ -391,19 +537,15 @@ fn pack(shapes: &[RegionShape], side: u32, downgrade: bool) -> Result<LightmapLa
     // Largest first: shelf packing wastes less, and the order (hence the layout) is fixed.
     let mut order: Vec<usize> = (0..shapes.len()).collect();
     order.sort_by_key(|&i| {
-        let s = shapes[i];
-        (
-            std::cmp::Reverse(s.tile_height),
-            std::cmp::Reverse(s.tiles * s.tile_width),
-            i,
-        )
+        let (w, h) = shapes[i].size();
+        (std::cmp::Reverse(h), std::cmp::Reverse(w), i)
     });
     let mut regions = vec![None; shapes.len()];
     for i in order {
         let shape = shapes[i];
-        let (w, h) = (shape.tiles * shape.tile_width, shape.tile_height);
+        let (w, h) = shape.size();
         let allocation = if downgrade && shape.downgradable {
-            // A row of slices can be wider than the whole atlas: halve it until it could fit
+            // A stack of slices can be wider than the whole atlas: halve it until it could fit
             // (the allocation below halves further while there is no room).
             let (mut w, mut h) = (w, h);
             let min_side = MIN_SIDE.min(w.max(h));
@@ -418,8 +560,8 @@ fn pack(shapes: &[RegionShape], side: u32, downgrade: bool) -> Result<LightmapLa
         regions[i] = Some(EntityRegion {
             region,
             shape: RegionShape {
-                tile_width: region.width / shape.tiles,
-                tile_height: region.height,
+                tile_width: region.width / shape.columns,
+                tile_height: region.height / shape.rows(),
                 ..shape
             },
             downgraded: (region.width, region.height) != (w, h),
@@ -446,7 +588,7 @@ mod tests {
     fn every_entity_gets_a_region_and_none_overlap() {
         for name in ["alpha", "dust", "ribbon", "volume", "alpha-many"] {
             let s = scene(name);
-            let layout = plan_layout(&s, 720, None, 4096).unwrap();
+            let layout = plan_layout(&s, 720, None, 4096).unwrap().layout;
             assert_eq!(layout.regions.len(), s.alpha_entity_count(), "{name}");
             for (i, a) in layout.regions.iter().enumerate() {
                 assert!(!a.downgraded);
@@ -466,11 +608,17 @@ mod tests {
             let viewer = Viewer::from_camera(&s.camera);
             region_shape(&scene_entities(s, height, forced)[index], &viewer, height)
         };
-        let s = scene("volume");
+        let mut s = scene("volume");
+        s.particle_systems[0].layout = ParticleLayout::Slices { count: 8 };
         let shape = shape_of(&s, 0, 720, Some(32));
         assert_eq!(
             (shape.tiles, shape.tile_width, shape.tile_height),
             (8, 32, 32)
+        );
+        // Eight slices as a 3 x 3 grid, not a strip.
+        assert_eq!(
+            (shape.columns, shape.rows(), shape.size()),
+            (3, 3, (96, 96))
         );
         let s = scene("dust");
         let shape = shape_of(&s, 0, 720, Some(32));
@@ -488,9 +636,9 @@ mod tests {
     #[test]
     fn the_atlas_grows_then_downgrades_then_fails_clearly() {
         let mut s = scene("alpha-many");
-        let grown = plan_layout(&s, 720, Some(128), 4096).unwrap();
+        let grown = plan_layout(&s, 720, Some(128), 4096).unwrap().layout;
         assert!(grown.atlas.size().0 > START_ATLAS_SIDE);
-        let capped = plan_layout(&s, 720, Some(128), 256).unwrap();
+        let capped = plan_layout(&s, 720, Some(128), 256).unwrap().layout;
         assert!(capped.regions.iter().any(|r| r.downgraded));
         s.particle_systems[0].layout = ParticleLayout::Dust;
         s.particle_systems[0].particles = s.particle_systems[0].particles.repeat(400);
@@ -510,7 +658,8 @@ mod tests {
             s.particle_systems
                 .truncate(usize::from(s.alpha_objects.is_empty()));
             let layout = plan_layout(&s, 720, Some(MAX_FORCED_SIDE), MAX_ATLAS_SIDE)
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
+                .unwrap_or_else(|e| panic!("{name}: {e}"))
+                .layout;
             assert_eq!(layout.regions.len(), 1);
             let r = layout.regions[0];
             assert_eq!(r.downgraded, r.shape.tiles > 1, "{name}: {r:?}");

@@ -10,7 +10,9 @@
 //! - [`Atlas`]: where each entity's region sits, allocated and freed as entities come and go
 //!   (a shelf allocator, etagere), with a guard band against filtering across regions and a
 //!   documented downgrade when the atlas is full;
-//! - [`side_for_coverage`]: how many texels an entity gets from its size on screen;
+//! - [`side_for_coverage`]: how many texels an entity's size on screen can show;
+//! - [`choose_parameters`]: how many slices and texels it needs, from a CPU estimate of the
+//!   lightmap's error against per-pixel lighting;
 //! - [`plan_regions`] (and [`plan_layout`] for a scene): every entity's region shape (a square for objects and billboards, a row
 //!   of slices, a grid of motes, a line of texels for ribbons) packed into an atlas sized to fit;
 //! - [`bake_probes`]: a translucent mesh's probes (position and normal per texel of its region),
@@ -20,6 +22,8 @@
 
 mod atlas;
 mod bake;
+mod entity;
+mod estimate;
 mod layout;
 mod probes;
 mod sizing;
@@ -27,11 +31,15 @@ mod sprites;
 
 pub use atlas::{Allocation, Atlas, AtlasError, Region, RegionId};
 pub use bake::{bake_probes, BakedProbes, Probe};
+pub use entity::{mesh_bounds, scene_alpha_entities, AlphaEntity, AlphaEntityKind, ProbeMeshes};
+pub use estimate::{
+    choose_parameters, coverage_side, estimate, Estimate, ParameterKind, Parameters, DEFAULT_TARGET,
+};
 pub use layout::{
-    bounding_sphere, check_forced_side, dust_grid, entities, entity_problem, plan_layout,
-    plan_regions, projected_diameter, region_shape, scene_entities, EntityDesc, EntityKey,
-    EntityKind, EntityRegion, LayoutError, LightmapLayout, RegionShape, Viewer, ATLAS_PADDING,
-    MAX_ATLAS_SIDE, MAX_FORCED_SIDE, START_ATLAS_SIDE,
+    bounding_sphere, check_forced_side, dust_grid, entities, entity_problem, plan_entities,
+    plan_layout, plan_regions, projected_diameter, region_shape, scene_entities, AlphaPlan,
+    ChoiceSettings, EntityDesc, EntityKey, EntityKind, EntityRegion, LayoutError, LightmapLayout,
+    RegionShape, Viewer, ATLAS_PADDING, MAX_ATLAS_SIDE, MAX_FORCED_SIDE, START_ATLAS_SIDE,
 };
 pub use probes::{back_to_front, camera_axes, fit_frame, particle_bounds, probe_point, ProbeFrame};
 pub use sizing::{side_for_coverage, MAX_SIDE, MIN_SIDE, PIXELS_PER_TEXEL};

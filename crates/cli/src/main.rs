@@ -2,6 +2,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
+use histencil_alpha::ParameterKind;
 use histencil_check::matrix::Platform;
 use histencil_vk::{
     AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, Technique,
@@ -355,16 +356,48 @@ fn print_alpha_error(
     ldr: &image::RgbaImage,
 ) -> Result<()> {
     let mode = desc.alpha;
-    let e = histencil_lab::AlphaReference::render(ctx, renderer, desc.technique)?.error(ldr);
+    let reference = histencil_lab::AlphaReference::render(ctx, renderer, desc.technique)?;
+    let e = reference.error(ldr);
+    let whole = histencil_lab::image_error(ldr, &reference.forward);
     println!(
-        "alpha error against forward ({mode:?}): mean {:.3}/255, max {}/255 over {} pixels",
-        e.mean, e.max, e.pixels
+        "alpha error against forward ({mode:?}): mean {:.3}/255, max {}/255 over {} pixels; \
+         whole frame mean {:.3}/255",
+        e.mean, e.max, e.pixels, whole.mean
     );
     Ok(())
 }
 
-/// Prints the GPU's hi-stencil statistics of one frame next to the simulator's prediction.
+/// Prints each alpha entity's lightmap parameters and the estimate behind them, then the GPU's
+/// hi-stencil statistics of one frame next to the simulator's prediction.
 fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
+    let parameters = renderer.lightmap_parameters()?;
+    let names = renderer.scene().alpha_entity_names();
+    for (p, name) in parameters.iter().zip(names) {
+        let forced = |yes: bool| if yes { " (forced)" } else { "" };
+        let estimated = format!(
+            "estimated error mean {:.2}/255, max {:.0}/255",
+            p.estimate.mean, p.estimate.max
+        );
+        let what = match p.kind {
+            ParameterKind::Surface => format!(
+                "mesh lightmap {0}x{0} texels{1} (coverage allows {2}); {estimated}",
+                p.side,
+                forced(p.forced_side),
+                p.coverage_side
+            ),
+            ParameterKind::Slices => format!(
+                "{} slice(s){} of {2}x{2} texels{3} (coverage allows {4}); {estimated}",
+                p.slices,
+                forced(p.forced_slices),
+                p.side,
+                forced(p.forced_side),
+                p.coverage_side
+            ),
+            ParameterKind::Dust => "one texel per mote".to_owned(),
+            ParameterKind::Ribbon => "texels along it from its length on screen".to_owned(),
+        };
+        println!("alpha entity {name}: {what}");
+    }
     if desc.technique == Technique::Forward {
         bail!("--stats needs a deferred technique: the forward reference has no lighting passes");
     }

@@ -50,6 +50,10 @@ pub enum ParticleLayout {
     /// `count` such quads stacked along the view direction through the system's depth; a
     /// particle interpolates between the two slices around its depth. For thick systems.
     Slices { count: u32 },
+    /// Camera-facing quads as above, as many as the lighting needs: the planner estimates the
+    /// error along the view direction from the lights that reach the system and picks the
+    /// fewest slices that keep it small (one, a billboard, far from every light).
+    Auto,
     /// One texel per mote: the mote's own position is its probe.
     Dust,
     /// The particles are the control points of one ribbon (a camera-facing strip through them,

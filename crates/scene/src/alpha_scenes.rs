@@ -67,7 +67,7 @@ fn smoke_column(base: Vec3, puffs: usize) -> ParticleSystem {
         .collect();
     system(
         "smoke-column",
-        ParticleLayout::Billboard,
+        ParticleLayout::Auto,
         particles,
         Material::lambert(Vec3::splat(0.8)),
     )
@@ -171,10 +171,9 @@ pub(crate) fn add_alpha_entities(name: &str, scene: &mut Scene) -> bool {
         }
         "volume" => {
             let centre = Vec3::new(0.0, 1.8, 3.0);
-            let slices = ParticleLayout::Slices { count: 8 };
             scene
                 .particle_systems
-                .push(smoke_volume(centre, 1.6, 400, slices));
+                .push(smoke_volume(centre, 1.6, 400, ParticleLayout::Auto));
             scene
                 .lights
                 .push(Light::point(centre + Vec3::new(0.3, 0.0, 0.5), 2.2, warm));
@@ -182,7 +181,7 @@ pub(crate) fn add_alpha_entities(name: &str, scene: &mut Scene) -> bool {
         "alpha-many" => {
             for i in 0..8 {
                 let base = Vec3::new(-5.25 + 1.5 * i as f32, 1.8, 2.0 + (i % 2) as f32);
-                let mut s = smoke_volume(base, 0.7, 256, ParticleLayout::Billboard);
+                let mut s = smoke_volume(base, 0.7, 256, ParticleLayout::Auto);
                 s.name = format!("smoke-{i}");
                 scene.particle_systems.push(s);
                 let color = if i % 2 == 0 { warm } else { cool };

@@ -6,6 +6,7 @@ mod alpha_scenes;
 mod embedded;
 mod import;
 mod mesh;
+mod shading;
 mod types;
 
 pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICES};
@@ -16,7 +17,9 @@ pub use import::{
 };
 pub use mesh::{
     light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, Mesh, Vertex, BOX_UV_INSET,
+    SPHERE_DETAIL,
 };
+pub use shading::{range_falloff, shade};
 pub use types::{
     unit_direction, Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape,
     MAX_FAR_OVER_NEAR, MAX_LIGHT_COLOR, MAX_TINT, MAX_WORLD_COORDINATE, MIN_FOV_Y,

@@ -107,6 +107,10 @@ fn box_faces(extent: f32, inset: f32) -> Mesh {
     m
 }
 
+/// The segments around and rings from pole to pole of the scene's sphere shape (drawn, and
+/// baked for lightmaps).
+pub const SPHERE_DETAIL: (u32, u32) = (48, 24);
+
 /// A UV sphere of radius 1 with smooth normals: `segments` around, `rings` from pole to pole.
 pub fn uv_sphere(segments: u32, rings: u32) -> Mesh {
     let mut m = Mesh::default();

@@ -506,6 +506,13 @@ impl Scene {
         self.alpha_objects.len() + self.particle_systems.len()
     }
 
+    /// The alpha entities' names, objects first (the order their lightmaps are planned in).
+    pub fn alpha_entity_names(&self) -> Vec<&str> {
+        let objects = self.alpha_objects.iter().map(|o| o.name.as_str());
+        let systems = self.particle_systems.iter().map(|s| s.name.as_str());
+        objects.chain(systems).collect()
+    }
+
     /// The distinct BRDFs the objects use, sorted by id. Their position in this list is their
     /// stencil slot.
     pub fn brdfs_in_use(&self) -> Vec<BrdfId> {

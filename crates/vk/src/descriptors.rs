@@ -11,6 +11,7 @@ pub enum BindingKind {
     UniformBuffer,
     StorageBuffer,
     SampledImage,
+    Sampler,
 }
 
 impl BindingKind {
@@ -19,6 +20,7 @@ impl BindingKind {
             BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             BindingKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
+            BindingKind::Sampler => vk::DescriptorType::SAMPLER,
         }
     }
 }
@@ -96,7 +98,10 @@ pub const ALPHA_SET: &[BindingDesc] = &[
 ];
 /// Set 2 of the alpha pass (include/alpha_lightmap.glsl): the lightmap atlas. A set of its own
 /// because the lightmap pass renders into it.
-pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "lightmap")];
+pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::SampledImage, "lightmap"),
+    binding(1, BindingKind::Sampler, "lightmap_sampler"),
+];
 
 /// The pipeline layouts: which sets, in order.
 pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET];

@@ -5,7 +5,9 @@ use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
 use ash::vk;
-use histencil_scene::{light_cone, light_sphere, unit_box, uv_sphere, LightKind, Mesh, Shape};
+use histencil_scene::{
+    light_cone, light_sphere, unit_box, uv_sphere, LightKind, Mesh, Shape, SPHERE_DETAIL,
+};
 
 pub struct GpuMesh {
     pub vertices: Buffer,
@@ -107,9 +109,6 @@ impl LightVolumes {
         self.cone.destroy(ctx);
     }
 }
-
-/// The sphere's segments around and rings from pole to pole (drawn, and baked for lightmaps).
-pub(crate) const SPHERE_DETAIL: (u32, u32) = (48, 24);
 
 pub struct Meshes {
     pub unit_box: GpuMesh,

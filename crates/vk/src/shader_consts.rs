@@ -34,7 +34,7 @@ pub const ALPHA_KINDS: [(&str, u32); 4] = [
     ("ALPHA_RIBBON", 3),
 ];
 
-/// GLSL `ALPHA_MODE_*`, in `AlphaDraw.mode`: how the alpha pass lights a fragment.
+/// GLSL `ALPHA_MODE_*`: how the alpha pass lights a fragment (an index of its pipelines).
 pub const ALPHA_MODES: [(&str, u32); 3] = [
     ("ALPHA_MODE_LIGHTMAP", 0),
     ("ALPHA_MODE_FORWARD", 1),

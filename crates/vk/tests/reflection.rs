@@ -17,6 +17,7 @@ fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, S
                 naga::AddressSpace::Storage { .. } => BindingKind::StorageBuffer,
                 naga::AddressSpace::Handle => match module.types[var.ty].inner {
                     naga::TypeInner::Image { .. } => BindingKind::SampledImage,
+                    naga::TypeInner::Sampler { .. } => BindingKind::Sampler,
                     ref other => panic!("{name}: unexpected handle type {other:?}"),
                 },
                 other => panic!("{name}: unexpected address space {other:?}"),

@@ -13,6 +13,7 @@ layout(set = 1, binding = 0, std430) readonly buffer Entities {
     AlphaEntity entities[];
 };
 layout(set = 1, binding = 1) uniform texture2D lightmap_atlas;
+layout(set = 1, binding = 2) uniform sampler lightmap_linear; // bilinear, clamp to edge
 
 layout(push_constant) uniform Draw {
     mat4 model;

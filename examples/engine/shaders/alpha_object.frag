@@ -8,5 +8,5 @@ layout(location = 0) out vec4 out_color;
 void main() {
     AlphaEntity e = entities[draw.entity];
     float a = e.tint_opacity.w;
-    out_color = vec4(lightmap_object(lightmap_atlas, e, in_uv) * a, a);
+    out_color = vec4(lightmap_object(lightmap_atlas, lightmap_linear, e, in_uv) * a, a);
 }

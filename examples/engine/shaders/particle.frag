@@ -2,10 +2,10 @@
 // A soft round sprite lit from its system's lightmap, premultiplied by its coverage.
 #include "alpha.glsl"
 
-layout(location = 0) in vec3 in_world_position;
 layout(location = 1) in vec2 in_corner;
 layout(location = 2) flat in uint in_entity;
 layout(location = 3) in float in_param;
+layout(location = 4) in vec3 in_located;
 
 layout(location = 0) out vec4 out_color;
 
@@ -15,6 +15,6 @@ void main() {
     if (coverage <= 0.0) {
         discard;
     }
-    vec3 lit = lightmap_particle(lightmap_atlas, e, in_world_position, in_param);
+    vec3 lit = lightmap_particle_at(lightmap_atlas, lightmap_linear, e, in_located, in_param);
     out_color = vec4(lit * coverage, coverage);
 }

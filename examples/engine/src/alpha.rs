@@ -30,6 +30,8 @@ pub const SAMPLED: ImageState = ImageState {
 
 pub struct AlphaPass {
     pub set_layout: vk::DescriptorSetLayout,
+    /// How the alpha shaders read the atlas: bilinear, clamp to edge (lightmap_sample.glsl).
+    sampler: vk::Sampler,
     layout: vk::PipelineLayout,
     object_pipeline: vk::Pipeline,
     particle_pipeline: vk::Pipeline,
@@ -48,15 +50,21 @@ impl AlphaPass {
     pub fn new(gpu: &Gpu, camera_layout: vk::DescriptorSetLayout, in_flight: usize) -> Self {
         let d = &gpu.device;
         let fragment = vk::ShaderStageFlags::FRAGMENT;
+        let both = vk::ShaderStageFlags::VERTEX | fragment;
         let bindings = [
             vk::DescriptorSetLayoutBinding::default()
                 .binding(0)
                 .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
                 .descriptor_count(1)
-                .stage_flags(fragment),
+                .stage_flags(both),
             vk::DescriptorSetLayoutBinding::default()
                 .binding(1)
                 .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                .descriptor_count(1)
+                .stage_flags(fragment),
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(2)
+                .descriptor_type(vk::DescriptorType::SAMPLER)
                 .descriptor_count(1)
                 .stage_flags(fragment),
         ];
@@ -133,8 +141,16 @@ impl AlphaPass {
                 )
             })
             .collect();
+        let info = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE);
+        let sampler = unsafe { d.create_sampler(&info, None) }.unwrap();
         Self {
             set_layout,
+            sampler,
             layout,
             object_pipeline,
             particle_pipeline,
@@ -167,6 +183,7 @@ impl AlphaPass {
         let image = [vk::DescriptorImageInfo::default()
             .image_view(atlas)
             .image_layout(SAMPLED.layout)];
+        let sampler = [vk::DescriptorImageInfo::default().sampler(self.sampler)];
         let writes = [
             vk::WriteDescriptorSet::default()
                 .dst_set(set)
@@ -178,6 +195,11 @@ impl AlphaPass {
                 .dst_binding(1)
                 .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
                 .image_info(&image),
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(2)
+                .descriptor_type(vk::DescriptorType::SAMPLER)
+                .image_info(&sampler),
         ];
         unsafe { d.update_descriptor_sets(&writes, &[]) };
     }
@@ -292,6 +314,7 @@ impl AlphaPass {
             gpu.device.destroy_pipeline(self.object_pipeline, None);
             gpu.device.destroy_pipeline(self.particle_pipeline, None);
             gpu.device.destroy_pipeline_layout(self.layout, None);
+            gpu.device.destroy_sampler(self.sampler, None);
             gpu.device
                 .destroy_descriptor_set_layout(self.set_layout, None);
         }

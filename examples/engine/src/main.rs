@@ -20,7 +20,7 @@ use ash::vk;
 use device::{barrier, Buffer, Gpu, Image};
 use gbuffer::{CameraBlock, GBufferPass, DEPTH_FORMAT, ENGINE_MASK};
 use gpu_allocator::MemoryLocation;
-use histencil_alpha::{plan_regions, Viewer};
+use histencil_alpha::{plan_entities, ChoiceSettings, Viewer};
 use histencil_model::{
     plan_frame, DepthConvention, FarPlane, FlushPolicy, Perspective, PlanInputs, PlanSettings,
     StencilBits, StencilLayout, TechniqueChoice, View, ViewDesc,
@@ -181,6 +181,7 @@ fn main() {
         sized(vk::DescriptorType::UNIFORM_BUFFER),
         sized(vk::DescriptorType::STORAGE_BUFFER),
         sized(vk::DescriptorType::SAMPLED_IMAGE),
+        sized(vk::DescriptorType::SAMPLER),
     ];
     let descriptor_pool = unsafe {
         d.create_descriptor_pool(
@@ -358,10 +359,18 @@ fn main() {
                     opacity: alpha_world.smoke.opacity,
                 },
             ];
-            let descs: Vec<_> = entities.iter().map(AlphaEntity::desc).collect();
+            // Each entity's slices and texels from histencil's error estimate, then the atlas.
             let viewer = Viewer::from_view(&view).expect("the engine's camera");
-            let regions =
-                plan_regions(&descs, &viewer, HEIGHT, ATLAS_SIDE).expect("lightmap regions");
+            let plan = plan_entities(
+                &entities,
+                &viewer,
+                &lights,
+                HEIGHT,
+                ATLAS_SIDE,
+                &ChoiceSettings::default(),
+            )
+            .expect("lightmap regions");
+            let regions = plan.layout;
             let slot_index = (f % IN_FLIGHT) as u32;
             let lightmap_frame = LightmapFrame {
                 slot: slot_index,

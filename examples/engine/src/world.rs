@@ -174,7 +174,7 @@ impl AlphaWorld {
             Vec3::new(-1.6, 0.9 + 0.1 * t, 1.4),
             0.8,
             48,
-            ParticleLayout::Slices { count: 4 },
+            ParticleLayout::Auto,
         );
         smoke.opacity = 0.35;
         Self {

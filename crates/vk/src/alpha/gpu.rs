@@ -1,11 +1,11 @@
 //! The alpha passes' GPU records (include/alpha_entity.glsl, alpha.glsl) and how a frame's
 //! entities fill them.
 
-use super::entity::{AlphaEntity, AlphaEntityKind};
 use crate::shader_consts::ALPHA_KINDS;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use histencil_alpha::{bake_probes, fit_frame, EntityRegion, Probe, ProbeFrame, Viewer};
+use histencil_alpha::{AlphaEntity, AlphaEntityKind};
 use histencil_scene::{Light, Material, ParticleLayout};
 
 /// One entity's lightmap record: `AlphaEntity` in `shaders/include/alpha_entity.glsl` (std430,
@@ -18,7 +18,8 @@ pub struct AlphaEntityRecord {
     pub params: [f32; 4],
     /// xy: the region's first texel in the atlas; zw: one tile's size.
     pub region: [u32; 4],
-    /// x: kind, y: tiles, z: first point or probe, w: point count.
+    /// x: kind, y: tiles, z: first point or probe (a sliced system: tiles to a row), w: point
+    /// count.
     pub shape: [u32; 4],
     pub centre_radius: [f32; 4],
     pub right_depth: [f32; 4],
@@ -34,8 +35,7 @@ pub struct AlphaEntityRecord {
 pub struct AlphaDrawPush {
     pub entity: u32,
     pub light: u32,
-    pub mode: u32,
-    pub pad: u32,
+    pub pad: [u32; 2],
 }
 
 fn kind_code(name: &str) -> u32 {
@@ -104,7 +104,9 @@ pub(crate) fn frame_records(
                 let frame = fit_frame(viewer, particles);
                 let first = out.points.len() as u32;
                 let kind = match layout {
-                    ParticleLayout::Billboard | ParticleLayout::Slices { .. } => "ALPHA_SLICES",
+                    ParticleLayout::Billboard
+                    | ParticleLayout::Slices { .. }
+                    | ParticleLayout::Auto => "ALPHA_SLICES",
                     ParticleLayout::Dust => "ALPHA_DUST",
                     ParticleLayout::Ribbon => "ALPHA_RIBBON",
                 };
@@ -116,7 +118,13 @@ pub(crate) fn frame_records(
                     );
                 }
                 let count = particles.len() as u32;
-                let shape = [kind_code(kind), r.shape.tiles, first, count];
+                // Sliced systems index no points: z holds their tiles' columns instead.
+                let z = if kind == "ALPHA_SLICES" {
+                    r.shape.columns
+                } else {
+                    first
+                };
+                let shape = [kind_code(kind), r.shape.tiles, z, count];
                 record(Mat4::IDENTITY, entity, region, shape, &frame)
             }
         };
@@ -159,7 +167,7 @@ fn record(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::alpha::scene_alpha_entities;
+    use histencil_alpha::scene_alpha_entities;
 
     #[test]
     fn records_match_the_glsl_block() {
@@ -177,8 +185,10 @@ mod tests {
             .push(other.particle_systems[0].clone());
         let glass = histencil_scene::embedded("alpha").unwrap();
         scene.alpha_objects.push(glass.alpha_objects[0].clone());
-        let layout = histencil_alpha::plan_layout(&scene, 256, None, 4096).unwrap();
-        let meshes = crate::alpha::ProbeMeshes::new(&scene);
+        let layout = histencil_alpha::plan_layout(&scene, 256, None, 4096)
+            .unwrap()
+            .layout;
+        let meshes = histencil_alpha::ProbeMeshes::new(&scene);
         let entities = scene_alpha_entities(&scene, &meshes);
         let viewer = Viewer::from_camera(&scene.camera);
         let out = frame_records(&entities, &layout.regions, &viewer, &scene.lights);

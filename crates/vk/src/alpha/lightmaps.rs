@@ -9,7 +9,6 @@
 //! Frames in flight work as in [`crate::DeferredLighting`]: each slot has its own buffers and
 //! sets, rewritten when a frame is recorded into it; the buffers grow when a frame needs more.
 
-use super::entity::AlphaEntity;
 use super::gpu::{frame_records, AlphaDrawPush, FrameRecords};
 use crate::access::ImageRef;
 use crate::context::Context;
@@ -26,6 +25,7 @@ use crate::shaders;
 use crate::state::{apply, FULLSCREEN};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
+use histencil_alpha::AlphaEntity;
 use histencil_alpha::{LightmapLayout, Region, Viewer};
 use histencil_model::ViewDesc;
 use histencil_scene::Light;
@@ -390,7 +390,7 @@ impl<'c> AlphaLightmaps<'c> {
                 continue;
             }
             let mut region = r.region;
-            region.width = r.shape.tiles * r.shape.tile_width;
+            (region.width, region.height) = r.shape.size();
             set_region(ctx, cmd, region);
             for &light in lights {
                 let push = AlphaDrawPush {
@@ -507,14 +507,16 @@ fn check_frame(desc: &AlphaLightmapsDesc, frame: &LightmapFrame, atlas: &ImageRe
             return Err(bad(format!("alpha entity {i}: {problem}")));
         }
         let s = r.shape;
-        let width = u64::from(s.tiles) * u64::from(s.tile_width);
+        let width = u64::from(s.columns) * u64::from(s.tile_width);
+        let height = u64::from(s.tiles.div_ceil(s.columns.max(1))) * u64::from(s.tile_height);
         let fits = s.tiles >= 1
+            && (1..=s.tiles).contains(&s.columns)
             && s.tile_width >= 1
             && s.tile_height >= 1
             && width <= u64::from(r.region.width)
-            && s.tile_height <= r.region.height
+            && height <= u64::from(r.region.height)
             && u64::from(r.region.x) + width <= u64::from(e.width)
-            && u64::from(r.region.y) + u64::from(s.tile_height) <= u64::from(e.height);
+            && u64::from(r.region.y) + height <= u64::from(e.height);
         let texels = u64::from(s.tile_width) * u64::from(s.tile_height);
         let holds_motes = match entity.desc().kind {
             histencil_alpha::EntityKind::Particles {
@@ -525,9 +527,9 @@ fn check_frame(desc: &AlphaLightmapsDesc, frame: &LightmapFrame, atlas: &ImageRe
         };
         if !(fits && holds_motes) {
             return Err(bad(format!(
-                "alpha entity {i}: its region {:?} ({} tiles of {}x{}) does not fit the atlas or \
-                 its particles",
-                r.region, s.tiles, s.tile_width, s.tile_height
+                "alpha entity {i}: its region {:?} ({} tiles of {}x{}, {} to a row) does not fit \
+                 the atlas or its particles",
+                r.region, s.tiles, s.tile_width, s.tile_height, s.columns
             )));
         }
     }

@@ -10,12 +10,11 @@
 //! fitted around the system), a mote (dust), or the ribbon's control points, and
 //! `lightmap.frag` computes them per texel.
 
-mod entity;
 mod gpu;
 mod lightmaps;
 
-pub use entity::{mesh_bounds, AlphaEntity, AlphaEntityKind};
 pub use gpu::AlphaEntityRecord;
+pub use histencil_alpha::{mesh_bounds, AlphaEntity, AlphaEntityKind};
 pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 
 use crate::access::{transition, Contents, ImageAccess};
@@ -24,7 +23,7 @@ use crate::descriptors::{
     create_pipeline_layout, create_set_layout, ALPHA_LIGHTMAP_SET, GRAPHICS_STAGES,
 };
 use crate::error::{Result, VkCall};
-use crate::meshes::{Meshes, SPHERE_DETAIL};
+use crate::meshes::Meshes;
 use crate::passes::{begin_cleared, begin_hdr_rendering, Load};
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::{Buffer, Image};
@@ -33,13 +32,13 @@ use crate::shaders;
 use crate::state::{apply, oriented, FULLSCREEN};
 use crate::targets::{Targets, HDR_FORMAT};
 use ash::vk;
-use glam::Vec3;
 use gpu::AlphaDrawPush;
 use histencil_alpha::{
-    back_to_front, plan_layout, sprite_vertices, EntityKey, LightmapLayout, SpriteVertex,
+    back_to_front, plan_layout, scene_alpha_entities, sprite_vertices, AlphaPlan, EntityKey,
+    LightmapLayout, Parameters, ProbeMeshes, SpriteVertex,
 };
 use histencil_model::{CompareOp, CullMode, DepthConvention, DepthState, PassState, ViewDesc};
-use histencil_scene::{unit_box_bake, uv_sphere, Mesh, Scene, Shape};
+use histencil_scene::Scene;
 
 /// How the alpha pass lights translucent objects and particles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -55,6 +54,7 @@ pub enum AlphaMode {
 }
 
 impl AlphaMode {
+    /// The mode's `ALPHA_MODE_*` value: the alpha pipelines' specialisation constant.
     fn code(self) -> u32 {
         let name = match self {
             AlphaMode::Lightmap => "ALPHA_MODE_LIGHTMAP",
@@ -87,62 +87,12 @@ const PARTICLES: PassState = PassState {
     ..ALPHA_OBJECTS
 };
 
-/// The CPU meshes whose UV layouts hold a scene's object probes: the box's bake layout (faces
-/// extended into their gutters), the sphere, the imported meshes.
-pub(crate) struct ProbeMeshes {
-    unit_box: Mesh,
-    sphere: Mesh,
-    imported: Vec<Mesh>,
-}
-
-impl ProbeMeshes {
-    pub(crate) fn new(scene: &Scene) -> Self {
-        Self {
-            unit_box: unit_box_bake(),
-            sphere: uv_sphere(SPHERE_DETAIL.0, SPHERE_DETAIL.1),
-            imported: scene.meshes.clone(),
-        }
-    }
-
-    fn get(&self, shape: Shape) -> &Mesh {
-        match shape {
-            Shape::Box => &self.unit_box,
-            Shape::Sphere => &self.sphere,
-            Shape::Mesh(i) => &self.imported[i as usize],
-        }
-    }
-}
-
-/// `scene`'s alpha entities as an engine would hand them over, in
-/// [`histencil_alpha::entities`] order. Scene shapes fill `[-1, 1]^3`.
-pub(crate) fn scene_alpha_entities<'a>(
-    scene: &'a Scene,
-    meshes: &'a ProbeMeshes,
-) -> Vec<AlphaEntity<'a>> {
-    let objects = scene.alpha_objects.iter().map(|o| AlphaEntity {
-        kind: AlphaEntityKind::Object {
-            probe_mesh: meshes.get(o.shape),
-            transform: o.transform,
-            local_bounds: (Vec3::NEG_ONE, Vec3::ONE),
-        },
-        material: o.material,
-        opacity: o.opacity,
-    });
-    let systems = scene.particle_systems.iter().map(|s| AlphaEntity {
-        kind: AlphaEntityKind::Particles {
-            layout: s.layout,
-            particles: &s.particles,
-        },
-        material: s.material,
-        opacity: s.opacity,
-    });
-    objects.chain(systems).collect()
-}
-
 /// A scene's alpha entities on the GPU: the lightmaps (as an engine records them), the atlas,
 /// the sprites and histencil's alpha pass.
 pub(crate) struct AlphaLighting<'c> {
     layout: LightmapLayout,
+    /// Each entity's slices and side, and the error estimate behind them.
+    parameters: Vec<Parameters>,
     probe_meshes: ProbeMeshes,
     /// Blending order.
     order: Vec<EntityKey>,
@@ -156,8 +106,11 @@ pub(crate) struct AlphaLighting<'c> {
     pipeline_layout: vk::PipelineLayout,
     pool: vk::DescriptorPool,
     lightmap_set: vk::DescriptorSet,
-    object_pipeline: vk::Pipeline,
-    particle_pipeline: vk::Pipeline,
+    /// Bilinear, clamp to edge: how the alpha pass reads the atlas (lightmap_sample.glsl).
+    sampler: vk::Sampler,
+    /// Per [`AlphaMode`] (in `AlphaMode::code` order), the object and particle pipelines,
+    /// made when a frame first uses the mode.
+    pipelines: [Option<[vk::Pipeline; 2]>; 3],
 }
 
 /// The alpha pass's own Vulkan objects, created step by step so a failure part-way destroys what
@@ -169,6 +122,7 @@ struct Parts {
     set_layouts: Vec<vk::DescriptorSetLayout>,
     pipeline_layout: Option<vk::PipelineLayout>,
     pool: Option<vk::DescriptorPool>,
+    sampler: Option<vk::Sampler>,
     pipelines: Vec<vk::Pipeline>,
 }
 
@@ -176,6 +130,9 @@ impl Parts {
     fn destroy(&mut self, ctx: &Context) {
         let d = &ctx.device;
         unsafe {
+            if let Some(s) = self.sampler.take() {
+                d.destroy_sampler(s, None);
+            }
             for p in self.pipelines.drain(..) {
                 d.destroy_pipeline(p, None);
             }
@@ -213,7 +170,7 @@ impl<'c> AlphaLighting<'c> {
         frame_layout: vk::DescriptorSetLayout,
     ) -> Result<Self> {
         let max_side = histencil_alpha::MAX_ATLAS_SIDE.min(ctx.max_image_dimension);
-        let layout = plan_layout(scene, extent.height, forced_side, max_side)?;
+        let plan = plan_layout(scene, extent.height, forced_side, max_side)?;
         let lightmaps = AlphaLightmaps::new(
             ctx,
             &AlphaLightmapsDesc {
@@ -222,7 +179,7 @@ impl<'c> AlphaLighting<'c> {
             },
         )?;
         let mut parts = Parts::default();
-        match Self::create(ctx, scene, layout, lightmaps, frame_layout, &mut parts) {
+        match Self::create(ctx, scene, plan, lightmaps, frame_layout, &mut parts) {
             Ok(built) => Ok(built),
             Err(e) => {
                 parts.destroy(ctx);
@@ -234,7 +191,7 @@ impl<'c> AlphaLighting<'c> {
     fn create(
         ctx: &'c Context,
         scene: &Scene,
-        layout: LightmapLayout,
+        AlphaPlan { layout, parameters }: AlphaPlan,
         lightmaps: AlphaLightmaps<'c>,
         frame_layout: vk::DescriptorSetLayout,
         parts: &mut Parts,
@@ -292,32 +249,9 @@ impl<'c> AlphaLighting<'c> {
         parts.pipeline_layout = Some(pipeline_layout);
         let (pool, lightmap_set) = create_lightmap_set(ctx, parts, lightmap_set_layout)?;
 
-        // The alpha pass: blended over the lit HDR frame, tested against its depth.
-        let hdr = [HDR_FORMAT];
-        let objects_desc = PipelineDesc {
-            name: "alpha-object-pipeline",
-            vertex: ("alpha_object.vert", shaders::ALPHA_OBJECT_VERT),
-            fragment: Some(("alpha_object.frag", shaders::ALPHA_OBJECT_FRAG)),
-            layout: pipeline_layout,
-            vertex_input: VertexInput::PositionNormalUv,
-            color_formats: &hdr,
-            color_writes: true,
-            blend: Blend::PremultipliedOver,
-            depth_stencil_format: ctx.depth_stencil_format,
-            depth_clamp: false,
-            specialization: &[],
-        };
-        let particles_desc = PipelineDesc {
-            name: "alpha-particle-pipeline",
-            vertex: ("particle.vert", shaders::PARTICLE_VERT),
-            fragment: Some(("particle.frag", shaders::PARTICLE_FRAG)),
-            vertex_input: VertexInput::Sprite,
-            ..objects_desc
-        };
-        for desc in [&objects_desc, &particles_desc] {
-            parts.pipelines.push(create_pipeline(ctx, desc)?);
-        }
-        write_sampled_image(ctx, lightmap_set, 0, parts.images[0].view);
+        let sampler = create_sampler(ctx)?;
+        parts.sampler = Some(sampler);
+        write_lightmap_set(ctx, lightmap_set, parts.images[0].view, sampler);
 
         let probe_meshes = ProbeMeshes::new(scene);
         let lightmap_draws = scene_alpha_entities(scene, &probe_meshes)
@@ -334,9 +268,9 @@ impl<'c> AlphaLighting<'c> {
         let order = back_to_front(scene);
         let lightmap = parts.images.pop().expect("the atlas");
         let sprites = parts.buffers.pop().expect("the sprites");
-        let mut pipelines = std::mem::take(&mut parts.pipelines).into_iter();
         let built = Self {
             layout,
+            parameters,
             probe_meshes,
             order,
             sprite_ranges,
@@ -348,8 +282,8 @@ impl<'c> AlphaLighting<'c> {
             pipeline_layout,
             pool,
             lightmap_set,
-            object_pipeline: pipelines.next().expect("objects"),
-            particle_pipeline: pipelines.next().expect("particles"),
+            sampler,
+            pipelines: [None; 3],
         };
         *parts = Parts::default();
         Ok(built)
@@ -358,6 +292,11 @@ impl<'c> AlphaLighting<'c> {
     /// The planned layout: atlas size and each entity's region.
     pub fn layout(&self) -> &LightmapLayout {
         &self.layout
+    }
+
+    /// Each entity's slices and side and the estimate behind them, in entity order.
+    pub fn parameters(&self) -> &[Parameters] {
+        &self.parameters
     }
 
     /// How many lightmap draws a frame makes: one per (entity, light that reaches it).
@@ -402,7 +341,54 @@ impl<'c> AlphaLighting<'c> {
         }
     }
 
+    /// The object and particle pipelines of `mode`, made on first use.
+    fn pipelines(&mut self, ctx: &Context, mode: AlphaMode) -> Result<[vk::Pipeline; 2]> {
+        let slot = mode.code() as usize;
+        if let Some(made) = self.pipelines[slot] {
+            return Ok(made);
+        }
+        // The alpha pass: blended over the lit HDR frame, tested against its depth.
+        let hdr = [HDR_FORMAT];
+        let specialization = [
+            u32::from(mode == AlphaMode::Forward),
+            u32::from(mode == AlphaMode::Probe),
+        ];
+        let objects = PipelineDesc {
+            name: "alpha-object-pipeline",
+            vertex: ("alpha_object.vert", shaders::ALPHA_OBJECT_VERT),
+            fragment: Some(("alpha_object.frag", shaders::ALPHA_OBJECT_FRAG)),
+            layout: self.pipeline_layout,
+            vertex_input: VertexInput::PositionNormalUv,
+            color_formats: &hdr,
+            color_writes: true,
+            blend: Blend::PremultipliedOver,
+            depth_stencil_format: ctx.depth_stencil_format,
+            depth_clamp: false,
+            specialization: &specialization,
+        };
+        let particles = PipelineDesc {
+            name: "alpha-particle-pipeline",
+            vertex: ("particle.vert", shaders::PARTICLE_VERT),
+            fragment: Some(("particle.frag", shaders::PARTICLE_FRAG)),
+            vertex_input: VertexInput::Sprite,
+            ..objects
+        };
+        let object = create_pipeline(ctx, &objects)?;
+        let particle = match create_pipeline(ctx, &particles) {
+            Ok(p) => p,
+            Err(e) => {
+                unsafe { ctx.device.destroy_pipeline(object, None) };
+                return Err(e);
+            }
+        };
+        self.pipelines[slot] = Some([object, particle]);
+        Ok([object, particle])
+    }
+
     /// Blends the entities far to near over the lit frame in `targets.hdr`, lit as `mode` says.
+    ///
+    /// # Errors
+    /// Pipeline creation errors, the first time a mode is used; nothing is recorded then.
     #[allow(clippy::too_many_arguments)]
     pub fn record_alpha(
         &mut self,
@@ -413,7 +399,8 @@ impl<'c> AlphaLighting<'c> {
         targets: &mut Targets,
         frame_set: vk::DescriptorSet,
         (mode, extent, depth): (AlphaMode, vk::Extent2D, DepthConvention),
-    ) {
+    ) -> Result<()> {
+        let [object_pipeline, particle_pipeline] = self.pipelines(ctx, mode)?;
         ctx.begin_label(cmd, "alpha");
         unsafe {
             ctx.device.cmd_bind_descriptor_sets(
@@ -448,16 +435,11 @@ impl<'c> AlphaLighting<'c> {
             match entity {
                 EntityKey::Object(i) => {
                     unsafe {
-                        d.cmd_bind_pipeline(
-                            cmd,
-                            vk::PipelineBindPoint::GRAPHICS,
-                            self.object_pipeline,
-                        );
+                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, object_pipeline);
                     }
                     apply(ctx, cmd, &oriented(ALPHA_OBJECTS, depth));
                     let push = AlphaDrawPush {
                         entity: i as u32,
-                        mode: mode.code(),
                         ..Default::default()
                     };
                     self.push(ctx, cmd, push);
@@ -469,14 +451,13 @@ impl<'c> AlphaLighting<'c> {
                         d.cmd_bind_pipeline(
                             cmd,
                             vk::PipelineBindPoint::GRAPHICS,
-                            self.particle_pipeline,
+                            particle_pipeline,
                         );
                         d.cmd_bind_vertex_buffers(cmd, 0, &[self.sprites.handle], &[0]);
                     }
                     apply(ctx, cmd, &oriented(PARTICLES, depth));
                     let push = AlphaDrawPush {
                         entity: (objects + i) as u32,
-                        mode: mode.code(),
                         ..Default::default()
                     };
                     self.push(ctx, cmd, push);
@@ -486,6 +467,7 @@ impl<'c> AlphaLighting<'c> {
         }
         unsafe { d.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
+        Ok(())
     }
 
     /// Frees the alpha pass's own objects; the lightmaps free theirs when dropped.
@@ -496,7 +478,8 @@ impl<'c> AlphaLighting<'c> {
             set_layouts: vec![self.lightmap_set_layout],
             pipeline_layout: Some(self.pipeline_layout),
             pool: Some(self.pool),
-            pipelines: vec![self.object_pipeline, self.particle_pipeline],
+            sampler: Some(self.sampler),
+            pipelines: self.pipelines.iter().flatten().flatten().copied().collect(),
         };
         unsafe {
             let _ = ctx.device.device_wait_idle();
@@ -507,15 +490,35 @@ impl<'c> AlphaLighting<'c> {
     }
 }
 
-/// A pool with the alpha pass's lightmap set (one sampled image).
+/// The atlas sampler: bilinear, clamp to edge, one mip level.
+fn create_sampler(ctx: &Context) -> Result<vk::Sampler> {
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(vk::Filter::LINEAR)
+        .min_filter(vk::Filter::LINEAR)
+        .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+        .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+        .max_lod(0.0);
+    let sampler = unsafe { ctx.device.create_sampler(&info, None) }.call("vkCreateSampler")?;
+    ctx.name(sampler, "alpha-lightmap-sampler");
+    Ok(sampler)
+}
+
+/// A pool with the alpha pass's lightmap set (the atlas and its sampler).
 fn create_lightmap_set(
     ctx: &Context,
     parts: &mut Parts,
     layout: vk::DescriptorSetLayout,
 ) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
-    let sizes = [vk::DescriptorPoolSize::default()
-        .ty(vk::DescriptorType::SAMPLED_IMAGE)
-        .descriptor_count(1)];
+    let sizes = [
+        vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::SAMPLED_IMAGE)
+            .descriptor_count(1),
+        vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::SAMPLER)
+            .descriptor_count(1),
+    ];
     let info = vk::DescriptorPoolCreateInfo::default()
         .max_sets(1)
         .pool_sizes(&sizes);
@@ -533,14 +536,27 @@ fn create_lightmap_set(
     Ok((pool, sets[0]))
 }
 
-fn write_sampled_image(ctx: &Context, set: vk::DescriptorSet, binding: u32, view: vk::ImageView) {
-    let info = [vk::DescriptorImageInfo::default()
+fn write_lightmap_set(
+    ctx: &Context,
+    set: vk::DescriptorSet,
+    view: vk::ImageView,
+    sampler: vk::Sampler,
+) {
+    let image = [vk::DescriptorImageInfo::default()
         .image_view(view)
         .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)];
-    let write = vk::WriteDescriptorSet::default()
-        .dst_set(set)
-        .dst_binding(binding)
-        .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-        .image_info(&info);
-    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+    let filter = [vk::DescriptorImageInfo::default().sampler(sampler)];
+    let writes = [
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(0)
+            .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+            .image_info(&image),
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(1)
+            .descriptor_type(vk::DescriptorType::SAMPLER)
+            .image_info(&filter),
+    ];
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }

@@ -89,7 +89,7 @@ impl Renderer<'_> {
                 &mut self.targets,
                 frame_set,
                 (alpha_mode, self.extent, depth),
-            );
+            )?;
             self.timestamps.mark(ctx, cmd, "alpha");
         }
         TonemapPass {

@@ -370,6 +370,17 @@ impl<'c> Renderer<'c> {
         Ok(self.alpha_lighting()?.map(|a| a.layout()))
     }
 
+    /// Each alpha entity's lightmap parameters (slices, side) and the error estimate behind
+    /// them, in `histencil_alpha::entities` order; empty for a scene without alpha entities.
+    ///
+    /// # Errors
+    /// [`crate::Error::Lightmap`] when the entities do not fit the atlas.
+    pub fn lightmap_parameters(&mut self) -> Result<Vec<histencil_alpha::Parameters>> {
+        Ok(self
+            .alpha_lighting()?
+            .map_or_else(Vec::new, |a| a.parameters().to_vec()))
+    }
+
     /// Lightmap draws per frame: one per (entity, light that reaches its bounds).
     pub fn lightmap_draws(&mut self) -> Result<usize> {
         Ok(self.alpha_lighting()?.map_or(0, |a| a.lightmap_draws()))

@@ -1,10 +1,14 @@
-//! An engine's alpha entities as [`crate::AlphaLightmaps`] takes them each frame: plain values,
-//! borrowed for the frame. A translucent object brings the mesh whose lightmap UV layout holds
-//! its probes; a particle system brings its particles.
+//! An engine's alpha entities as plain values, borrowed for a frame: what histencil-vk's
+//! `AlphaLightmaps` lights and what the parameter estimate ([`crate::choose_parameters`]) reads.
+//! A translucent object brings the mesh whose lightmap UV layout holds its probes; a particle
+//! system brings its particles. [`ProbeMeshes`] and [`scene_alpha_entities`] give a histencil
+//! scene's entities the same way.
 
+use crate::{particle_bounds, EntityDesc, EntityKind};
 use glam::{Mat4, Vec3};
-use histencil_alpha::{particle_bounds, EntityDesc, EntityKind};
-use histencil_scene::{Material, Mesh, Particle, ParticleLayout};
+use histencil_scene::{
+    unit_box_bake, uv_sphere, Material, Mesh, Particle, ParticleLayout, Scene, Shape, SPHERE_DETAIL,
+};
 
 /// One translucent object or particle system, as lit this frame.
 #[derive(Clone, Copy, Debug)]
@@ -21,7 +25,7 @@ pub struct AlphaEntity<'a> {
 pub enum AlphaEntityKind<'a> {
     /// A translucent mesh. `probe_mesh` is the mesh in its lightmap UV layout (object space;
     /// `uv` in `[0, 1]^2`, the layout the alpha shader samples with): one probe per texel it
-    /// covers, baked on the CPU at the region's size ([`histencil_alpha::bake_probes`]).
+    /// covers, baked on the CPU at the region's size ([`crate::bake_probes`]).
     /// `local_bounds` is the object-space box of what is drawn (lights reaching it light the
     /// entity), `transform` object to world.
     Object {
@@ -76,8 +80,8 @@ impl AlphaEntity<'_> {
         }
     }
 
-    /// The entity's description for [`histencil_alpha::plan_regions`]: its kind and world
-    /// bounds, coverage and side from those.
+    /// The entity's description for [`crate::plan_regions`]: its kind and world bounds,
+    /// coverage and side from those.
     pub fn desc(&self) -> EntityDesc {
         let kind = match self.kind {
             AlphaEntityKind::Object { .. } => EntityKind::Surface,
@@ -128,6 +132,56 @@ impl AlphaEntity<'_> {
                 }
             }
         }
-        histencil_alpha::entity_problem(&self.desc()).map(str::to_owned)
+        crate::entity_problem(&self.desc()).map(str::to_owned)
     }
+}
+
+/// The CPU meshes whose UV layouts hold a scene's object probes: the box's bake layout (faces
+/// extended into their gutters), the sphere, the imported meshes.
+pub struct ProbeMeshes {
+    unit_box: Mesh,
+    sphere: Mesh,
+    imported: Vec<Mesh>,
+}
+
+impl ProbeMeshes {
+    pub fn new(scene: &Scene) -> Self {
+        Self {
+            unit_box: unit_box_bake(),
+            sphere: uv_sphere(SPHERE_DETAIL.0, SPHERE_DETAIL.1),
+            imported: scene.meshes.clone(),
+        }
+    }
+
+    /// The probe mesh of `shape`.
+    pub fn get(&self, shape: Shape) -> &Mesh {
+        match shape {
+            Shape::Box => &self.unit_box,
+            Shape::Sphere => &self.sphere,
+            Shape::Mesh(i) => &self.imported[i as usize],
+        }
+    }
+}
+
+/// `scene`'s alpha entities as an engine would hand them over, in [`crate::entities`] order.
+/// Scene shapes fill `[-1, 1]^3`.
+pub fn scene_alpha_entities<'a>(scene: &'a Scene, meshes: &'a ProbeMeshes) -> Vec<AlphaEntity<'a>> {
+    let objects = scene.alpha_objects.iter().map(|o| AlphaEntity {
+        kind: AlphaEntityKind::Object {
+            probe_mesh: meshes.get(o.shape),
+            transform: o.transform,
+            local_bounds: (Vec3::NEG_ONE, Vec3::ONE),
+        },
+        material: o.material,
+        opacity: o.opacity,
+    });
+    let systems = scene.particle_systems.iter().map(|s| AlphaEntity {
+        kind: AlphaEntityKind::Particles {
+            layout: s.layout,
+            particles: &s.particles,
+        },
+        material: s.material,
+        opacity: s.opacity,
+    });
+    objects.chain(systems).collect()
 }
