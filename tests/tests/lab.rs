@@ -137,6 +137,7 @@ fn sweeps_write_csv_json_and_a_pareto_plot_and_error_falls() {
     let cases = [
         (SweepParam::LutRes, "default", vec![8, 32]),
         (SweepParam::LightmapRes, "alpha", vec![8, 64]),
+        (SweepParam::Slices, "volume", vec![1, 8]),
         (SweepParam::TileSize, "default", vec![4, 16]),
     ];
     for (param, scene, values) in cases {
@@ -153,8 +154,8 @@ fn sweeps_write_csv_json_and_a_pareto_plot_and_error_falls() {
         assert_png(&dir.join("pareto.png"));
         let p = &report.points;
         match param {
-            // Finer tables and lightmaps: less error.
-            SweepParam::LutRes | SweepParam::LightmapRes => {
+            // Finer tables and lightmaps, more slices: less error.
+            SweepParam::LutRes | SweepParam::LightmapRes | SweepParam::Slices => {
                 assert!(p[1].error.mean < p[0].error.mean, "{}: {p:?}", param.name());
             }
             // Smaller tiles: more tile tests, fewer pixels left for the per-pixel test.

@@ -86,6 +86,7 @@ impl SamplingArgs {
 pub enum ParamArg {
     LutRes,
     LightmapRes,
+    Slices,
     TileSize,
 }
 
@@ -94,10 +95,12 @@ pub struct SweepArgs {
     /// The setting to sweep.
     #[arg(long, value_enum)]
     param: ParamArg,
-    /// Values to try (default: lut-res 8..96, lightmap-res 4..128, tile-size 2..64).
+    /// Values to try (default: lut-res 8..96, lightmap-res 4..128, slices 1..32, tile-size
+    /// 2..64).
     #[arg(long, value_delimiter = ',')]
     values: Vec<u32>,
-    /// Scene (default: `default` for lut-res and tile-size, `alpha` for lightmap-res).
+    /// Scene (default: `default` for lut-res and tile-size, `alpha` for lightmap-res, `volume`
+    /// for slices).
     #[arg(long)]
     scene: Option<String>,
     #[command(flatten)]
@@ -206,6 +209,7 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
     let param = match args.param {
         ParamArg::LutRes => SweepParam::LutRes,
         ParamArg::LightmapRes => SweepParam::LightmapRes,
+        ParamArg::Slices => SweepParam::Slices,
         ParamArg::TileSize => SweepParam::TileSize,
     };
     let values = if args.values.is_empty() {

@@ -39,7 +39,7 @@ enum Command {
     /// platform backend, the per-BRDF breakdown, a light-size sweep, each next to its error
     /// against forward; writes report.md, report.json and PNG plots.
     Compare(lab::CompareArgs),
-    /// Speed against error for one setting (lut-res, lightmap-res, tile-size): CSV, JSON and a
+    /// Speed against error for one setting (lut-res, lightmap-res, slices, tile-size): CSV, JSON and a
     /// Pareto plot.
     Sweep(lab::SweepArgs),
     /// Measure this device's per-pass overhead, branch tax and shade cost for the adaptive

@@ -4,6 +4,12 @@
 //!   against forward.
 //! - `lightmap-res`: the alpha entities' lightmap side; lightmap + alpha pass time against the
 //!   error over the pixels the entities cover, against forward-lit alpha.
+//! - `slices`: every camera-facing particle system's slice count (1: a billboard), its side
+//!   still chosen by the estimate; the same times and error.
+//!
+//! The alpha sweeps also report the largest estimated error over the entities
+//! (`estimate_mean`, `histencil_alpha::choose_parameters`), so the estimate can be read against
+//! what was measured.
 //! - `tile-size`: the hi-stencil tile size. The GPU emulation's tile size is a shader constant,
 //!   so this one runs the hi-stencil simulator on the GPU's own captured light footprints (the
 //!   simulator agrees with the GPU at that size, `render --stats`). Culling is exact at every
@@ -16,7 +22,7 @@ use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis};
 use crate::{write_file, AlphaReference, LabError, Result};
-use histencil_scene::Scene;
+use histencil_scene::{ParticleLayout, ParticleSystem, Scene, MAX_SLICES};
 use histencil_vk::{Backend, Context, FlushPolicy, Renderer, Technique};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
@@ -27,6 +33,7 @@ use std::path::{Path, PathBuf};
 pub enum SweepParam {
     LutRes,
     LightmapRes,
+    Slices,
     TileSize,
 }
 
@@ -35,6 +42,7 @@ impl SweepParam {
         match self {
             SweepParam::LutRes => "lut-res",
             SweepParam::LightmapRes => "lightmap-res",
+            SweepParam::Slices => "slices",
             SweepParam::TileSize => "tile-size",
         }
     }
@@ -43,16 +51,19 @@ impl SweepParam {
         match self {
             SweepParam::LutRes => vec![8, 16, 32, 64, 96],
             SweepParam::LightmapRes => vec![4, 8, 16, 32, 64, 128],
+            SweepParam::Slices => vec![1, 2, 4, 8, 16, 32],
             SweepParam::TileSize => vec![2, 4, 8, 16, 32, 64],
         }
     }
 
     /// The embedded scene that exercises the setting: Blinn-Phong up to 256 for the LUT, glass and
-    /// smoke for the lightmaps, tiny to huge lights for the tiles.
+    /// smoke for the lightmaps, a thick smoke ball around a light for the slices, tiny to huge
+    /// lights for the tiles.
     pub fn default_scene(self) -> &'static str {
         match self {
             SweepParam::LutRes | SweepParam::TileSize => "default",
             SweepParam::LightmapRes => "alpha",
+            SweepParam::Slices => "volume",
         }
     }
 
@@ -60,7 +71,9 @@ impl SweepParam {
     fn columns(self) -> (&'static str, &'static str) {
         match self {
             SweepParam::LutRes => ("lighting_ms", "mean error, 8-bit steps"),
-            SweepParam::LightmapRes => ("alpha_ms", "mean error over alpha pixels, 8-bit steps"),
+            SweepParam::LightmapRes | SweepParam::Slices => {
+                ("alpha_ms", "mean error over alpha pixels, 8-bit steps")
+            }
             SweepParam::TileSize => ("tiles_tested", "pixels in unculled tiles"),
         }
     }
@@ -111,7 +124,22 @@ pub fn run_sweep(
             scene.name
         )));
     }
+    if param == SweepParam::Slices && sliceable(&scene).next().is_none() {
+        return Err(LabError::Settings(format!(
+            "scene `{}` has no camera-facing particle systems to slice",
+            scene.name
+        )));
+    }
+    if let Some(bad) = values
+        .iter()
+        .find(|&&n| param == SweepParam::Slices && !(1..=MAX_SLICES).contains(&n))
+    {
+        return Err(LabError::Settings(format!(
+            "{bad} slices: a system has 1 (a billboard) to {MAX_SLICES}"
+        )));
+    }
     let name = scene.name.clone();
+    let original = scene.clone();
     let mut renderer = Renderer::new(ctx, scene, width, height)?;
     let mut points = Vec::new();
     match param {
@@ -149,23 +177,29 @@ pub fn run_sweep(
                 let lit = frame(&mut renderer, technique)?;
                 let masked = reference.error(&lit);
                 let whole = image_error(&lit, &reference.forward);
-                let atlas = renderer
-                    .lightmap_layout()?
-                    .map_or(0, |layout| layout.atlas.size().0);
-                points.push(SweepPoint {
-                    setting: side,
-                    speed,
-                    error: ImageError {
-                        max: f64::from(masked.max),
-                        mean: masked.mean,
-                        flip: whole.flip,
-                    },
-                    extra: vec![
-                        ("alpha_pixels", masked.pixels as f64),
-                        ("atlas_side", f64::from(atlas)),
-                        ("lightmap_draws", renderer.lightmap_draws()? as f64),
-                    ],
-                });
+                points.push(alpha_point(&mut renderer, side, speed, &masked, &whole)?);
+                progress(i + 1, values.len());
+            }
+        }
+        SweepParam::Slices => {
+            let technique = Technique::DEFERRED;
+            let reference = AlphaReference::render(ctx, &mut renderer, technique)?;
+            drop(renderer);
+            for (i, &count) in values.iter().enumerate() {
+                let mut scene = original.clone();
+                for system in sliceable_mut(&mut scene) {
+                    system.layout = match count {
+                        1 => ParticleLayout::Billboard,
+                        count => ParticleLayout::Slices { count },
+                    };
+                }
+                let mut renderer = Renderer::new(ctx, scene, width, height)?;
+                let passes = ["alpha-lightmaps", "alpha"];
+                let speed = time_passes(&mut renderer, technique, &passes, frames)?;
+                let lit = frame(&mut renderer, technique)?;
+                let masked = reference.error(&lit);
+                let whole = image_error(&lit, &reference.forward);
+                points.push(alpha_point(&mut renderer, count, speed, &masked, &whole)?);
                 progress(i + 1, values.len());
             }
         }
@@ -218,6 +252,56 @@ pub fn run_sweep(
         height,
         frames,
         points,
+    })
+}
+
+/// The camera-facing particle systems of `scene` (billboards, slices, automatic): the ones
+/// whose slice count a sweep may set.
+fn sliceable(scene: &Scene) -> impl Iterator<Item = &ParticleSystem> {
+    scene
+        .particle_systems
+        .iter()
+        .filter(|s| !matches!(s.layout, ParticleLayout::Dust | ParticleLayout::Ribbon))
+}
+
+fn sliceable_mut(scene: &mut Scene) -> impl Iterator<Item = &mut ParticleSystem> {
+    scene
+        .particle_systems
+        .iter_mut()
+        .filter(|s| !matches!(s.layout, ParticleLayout::Dust | ParticleLayout::Ribbon))
+}
+
+/// One alpha sweep point: the error over the alpha pixels (FLIP over the whole frame), with the
+/// atlas, the draws and the largest estimated error beside it.
+fn alpha_point(
+    renderer: &mut Renderer,
+    setting: u32,
+    speed: Timing,
+    masked: &histencil_vk::MaskedError,
+    whole: &ImageError,
+) -> Result<SweepPoint> {
+    let atlas = renderer
+        .lightmap_layout()?
+        .map_or(0, |layout| layout.atlas.size().0);
+    let estimate = renderer
+        .lightmap_parameters()?
+        .iter()
+        .map(|p| f64::from(p.estimate.mean))
+        .fold(0.0, f64::max);
+    Ok(SweepPoint {
+        setting,
+        speed,
+        error: ImageError {
+            max: f64::from(masked.max),
+            mean: masked.mean,
+            flip: whole.flip,
+        },
+        extra: vec![
+            ("alpha_pixels", masked.pixels as f64),
+            ("atlas_side", f64::from(atlas)),
+            ("lightmap_draws", renderer.lightmap_draws()? as f64),
+            ("estimate_mean", estimate),
+        ],
     })
 }
 
