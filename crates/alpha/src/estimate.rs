@@ -7,11 +7,11 @@
 //! (the forward reference, through [`histencil_scene::shade`]) against the lightmap's
 //! reconstruction (probes where `lightmap.frag` puts them, bilinear inside a tile and linear
 //! between slices as `lightmap_sample.glsl` reads them). Each sample's error is counted in 8-bit
-//! steps after the tonemap, as if the layer were opaque over black: blending over a background
-//! only brightens the operating point, where the tonemap is flatter, so this overstates what a
-//! single layer shows. (Many layers with errors of one sign add up; the weights of "over" sum to
-//! at most one, so the mean stays a fair guide; `tests/tests/alpha.rs` holds the estimate to the
-//! measured error.)
+//! steps after the tonemap, as if the layer were opaque over black: a translucent layer changes
+//! the frame by its opacity times as much, and the tonemap's difference grows with that factor,
+//! so the opaque layer bounds it. (Layers with errors of one sign add up, but the weights of
+//! "over" sum to at most one.) Measured against `histencil sweep`, the estimate stays above the
+//! error over the alpha pixels at every slice count and side tried (README).
 //!
 //! The choice is the cheapest one whose estimate stays under the target: for a mesh the smallest
 //! side; for a particle system the (slices, side) pair with the fewest texels to light, never
@@ -26,7 +26,7 @@ use histencil_scene::{shade, Light, Material, ParticleLayout, MAX_SLICES};
 use std::collections::HashMap;
 
 /// The default target: the estimated mean error over an entity's samples, in 8-bit steps.
-pub const DEFAULT_TARGET: f32 = 1.0;
+pub const DEFAULT_TARGET: f32 = 2.0;
 
 /// The slice counts tried, fewest first (1 is a billboard).
 const SLICE_COUNTS: [u32; 10] = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32];
@@ -35,8 +35,10 @@ const SLICE_COUNTS: [u32; 10] = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32];
 /// is estimated at it.
 const ESTIMATED_SIDE_LIMIT: u32 = 256;
 
-/// At most this many sample points per entity.
-const MAX_SAMPLES: usize = 256;
+/// At most this many sample points per entity: every sprite of a system of 400 (five points
+/// each). Fewer miss the few sprites next to a light that carry most of the error: at 256 the
+/// estimate fell to half the measured error on `volume`.
+const MAX_SAMPLES: usize = 2048;
 
 /// An estimate of a lightmap's error against per-pixel lighting, in 8-bit steps after the
 /// tonemap: the coverage-weighted mean and the largest over the entity's samples.
@@ -523,9 +525,9 @@ mod tests {
             *layout = ParticleLayout::Auto;
         }
         let viewer = viewer_of(&scene);
-        let lit = choose_parameters(&entities[system], &viewer, &scene.lights, 720, None, 1.0);
+        let lit = choose_parameters(&entities[system], &viewer, &scene.lights, 720, None, 2.0);
         assert!(lit.slices >= 3, "{lit:?}");
-        assert!(lit.estimate.mean <= 1.0, "{lit:?}");
+        assert!(lit.estimate.mean <= 2.0, "{lit:?}");
         // The same system with its lights moved far away: nothing to resolve.
         let far: Vec<Light> = scene
             .lights
