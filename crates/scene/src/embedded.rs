@@ -84,7 +84,7 @@ pub const EMBEDDED: [(&str, &str); 12] = [
     ),
     (
         "volume",
-        "the default room with a thick ball of smoke lit in 8 slices, a point light inside it",
+        "the default room with a thick ball of smoke (slices chosen by the error estimate), a point light inside it",
     ),
     (
         "alpha-many",

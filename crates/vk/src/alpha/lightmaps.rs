@@ -49,8 +49,8 @@ pub struct LightmapFrame<'a> {
     pub view: &'a ViewDesc,
     pub lights: &'a [Light],
     pub entities: &'a [AlphaEntity<'a>],
-    /// The entities' regions, from [`histencil_alpha::plan_regions`] on their
-    /// [`AlphaEntity::desc`]s, in the same order.
+    /// The entities' regions, from [`histencil_alpha::plan_entities`] (or
+    /// [`histencil_alpha::plan_regions`] on their descriptions), in the same order.
     pub layout: &'a LightmapLayout,
 }
 
@@ -79,7 +79,7 @@ const STORAGE_NAMES: [&str; 4] = [
 ///
 /// ```no_run
 /// use ash::vk;
-/// use histencil_alpha::{plan_regions, Viewer};
+/// use histencil_alpha::{plan_entities, ChoiceSettings, Viewer};
 /// use histencil_model::ViewDesc;
 /// use histencil_scene::Light;
 /// use histencil_vk::{AlphaEntity, AlphaLightmaps, ImageRef, LightmapFrame};
@@ -93,9 +93,11 @@ const STORAGE_NAMES: [&str; 4] = [
 ///     entities: &[AlphaEntity],
 ///     atlas: &mut ImageRef,
 /// ) -> Result<(), Box<dyn std::error::Error>> {
-///     let descs: Vec<_> = entities.iter().map(AlphaEntity::desc).collect();
+///     // Each entity's slices and texels from the CPU error estimate, then its region.
 ///     let viewer = Viewer::from_view(view).ok_or("a view without a camera")?;
-///     let layout = plan_regions(&descs, &viewer, 720, atlas.extent.width)?;
+///     let settings = ChoiceSettings::default();
+///     let plan = plan_entities(entities, &viewer, lights, 720, atlas.extent.width, &settings)?;
+///     let layout = plan.layout;
 ///     let frame = LightmapFrame { slot, view, lights, entities, layout: &layout };
 ///     // SAFETY: `cmd` records on the lightmaps' device, the atlas state is true, and the last
 ///     // frame recorded into `slot` has finished on the GPU.
