@@ -10,8 +10,8 @@ use glam::Vec3;
 use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
 use histencil_tests::engine::{barrier, copy_to_buffer, Engine, EngineImage};
 use histencil_vk::{
-    Backend, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame, LightingTargets,
-    Readback, Renderer, Technique, GBUFFER_FORMATS,
+    Backend, BrdfSource, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame,
+    LightingTargets, Readback, Renderer, Technique, GBUFFER_FORMATS,
 };
 
 const WIDTH: u32 = 96;
@@ -181,6 +181,8 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
                     plan: &plan,
                     clear_hdr,
                     timestamps: f == FRAMES - 1,
+                    brdf_source: BrdfSource::Formula,
+                    tile_stats: false,
                 };
                 lighting.record(slot.cmd, &frame, &mut targets).unwrap();
                 if f == FRAMES - 1 {
@@ -375,6 +377,8 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             plan: &plan,
             clear_hdr: true,
             timestamps: false,
+            brdf_source: BrdfSource::Formula,
+            tile_stats: false,
         };
         let reversed = histencil_model::ViewDesc {
             depth: histencil_model::DepthConvention::Reversed,
@@ -486,6 +490,29 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             };
             let err = native_only.record(cmd, &ps3, &mut t).expect_err("refused");
             assert!(err.to_string().contains("hi-stencil"), "{err}");
+            // Statistics need the emulation; the LUT technique needs its tables first.
+            for (what, bad) in [
+                (
+                    "statistics",
+                    LightingFrame {
+                        tile_stats: true,
+                        ..frame
+                    },
+                ),
+                (
+                    "tables",
+                    LightingFrame {
+                        brdf_source: BrdfSource::Table,
+                        ..frame
+                    },
+                ),
+            ] {
+                let err = native_only.record(cmd, &bad, &mut t).expect_err(what);
+                assert!(
+                    matches!(err, histencil_vk::Error::Unsupported(_)),
+                    "{what}: {err}"
+                );
+            }
             native_only
                 .record(cmd, &frame, &mut t)
                 .expect("a native plan");
@@ -504,6 +531,147 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
         for image in gbuffer.into_iter().chain([depth, hdr, small]) {
             engine.free_image(image);
         }
+    }
+    engine.destroy().assert_clean();
+}
+
+/// The LUT technique and the hi-stencil statistics through the engine-facing recording: the
+/// engine lends the renderer's tables, records a PS3-like LUT frame that counts tiles into its
+/// own images, and gets the renderer's frame bit for bit and its statistics exactly.
+#[test]
+fn an_engine_records_the_lut_technique_and_counts_tiles() {
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
+    let engine = Engine::start();
+    let extent = vk::Extent2D {
+        width: WIDTH,
+        height: HEIGHT,
+    };
+    {
+        // SAFETY: as in the frames-in-flight test.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let ds_format = ctx.depth_stencil_format().vk();
+        let mut renderer = Renderer::new(&ctx, scene.clone(), WIDTH, HEIGHT).unwrap();
+        let technique = Technique::Lut {
+            backend: Backend::Ps3,
+            flush: FlushPolicy::Auto,
+        };
+        let plan = renderer.plan(technique).unwrap();
+        let mut lighting = DeferredLighting::new(
+            &ctx,
+            &LightingDesc {
+                layout: *renderer.stencil_layout(),
+                brdfs: renderer.brdfs().to_vec(),
+                extent,
+                depth_stencil_format: ds_format,
+                hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+                frames_in_flight: 1,
+                max_lights: scene.lights.len() as u32,
+                hi_stencil: true,
+            },
+        )
+        .unwrap();
+        // SAFETY: the renderer's tables outlive the one frame below, which is waited for.
+        unsafe { lighting.set_lut_tables(renderer.lut_tables().unwrap()) };
+        use vk::ImageUsageFlags as U;
+        let gbuffer: Vec<EngineImage> = GBUFFER_FORMATS
+            .iter()
+            .map(|f| engine.image("g", *f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+            .collect();
+        let depth = engine.image(
+            "d",
+            ds_format,
+            extent,
+            U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
+        );
+        let hdr_format = vk::Format::R16G16B16A16_SFLOAT;
+        let hdr = engine.image(
+            "h",
+            hdr_format,
+            extent,
+            U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
+        );
+        let readback = engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8);
+        let mut targets = LightingTargets {
+            gbuffer: [0, 1, 2].map(|i| gbuffer[i].as_ref(ImageState::UNDEFINED)),
+            depth_stencil: depth.as_ref(ImageState::UNDEFINED),
+            hdr: hdr.as_ref(ImageState::UNDEFINED),
+        };
+        let view = scene.camera.view_desc(WIDTH as f32 / HEIGHT as f32);
+        // The lights as the renderer validated them (directions unit, ranges capped).
+        let lights = renderer.scene().lights.clone();
+        let frame = LightingFrame {
+            slot: 0,
+            view: &view,
+            lights: &lights,
+            plan: &plan,
+            clear_hdr: true,
+            timestamps: false,
+            brdf_source: BrdfSource::Table,
+            tile_stats: true,
+        };
+        let d = &engine.device;
+        unsafe {
+            let (pool, cmd) = engine.command_buffer();
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            renderer.record_gbuffer(cmd, &mut targets).unwrap();
+            lighting.record(cmd, &frame, &mut targets).unwrap();
+            copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
+            d.end_command_buffer(cmd).unwrap();
+            let queue = d.get_device_queue(engine.queue_family, 0);
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], vk::Fence::null())
+                .unwrap();
+            d.queue_wait_idle(queue).unwrap();
+            d.destroy_command_pool(pool, None);
+        }
+        let ours = hdr_floats(readback.bytes());
+        let stats = lighting.tile_stats(&plan);
+
+        let expected = renderer
+            .render_frame(&histencil_vk::FrameDesc {
+                tile_stats: true,
+                ..histencil_vk::FrameDesc::new(
+                    technique,
+                    Readback {
+                        hdr: true,
+                        ..Readback::NONE
+                    },
+                )
+            })
+            .unwrap();
+        let reference = expected.images.hdr.unwrap().into_raw();
+        let differing = reference
+            .iter()
+            .zip(&ours)
+            .filter(|(e, a)| e.to_bits() != a.to_bits())
+            .count();
+        let examples: Vec<_> = reference
+            .iter()
+            .zip(&ours)
+            .enumerate()
+            .filter(|(_, (e, a))| e.to_bits() != a.to_bits())
+            .take(4)
+            .collect();
+        assert_eq!(
+            differing, 0,
+            "channels differ from the renderer's LUT frame: {examples:?}"
+        );
+        assert!(ours.iter().any(|v| *v > 0.0), "the frame is dark");
+        assert_eq!(Some(stats), expected.tile_stats);
+        assert!(
+            stats.tiles_culled > 0 && stats.fragments_shaded > 0,
+            "{stats:?}"
+        );
+
+        drop(lighting);
+        drop(renderer);
+        for image in gbuffer.into_iter().chain([depth, hdr]) {
+            engine.free_image(image);
+        }
+        engine.free_buffer(readback);
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
     engine.destroy().assert_clean();
 }

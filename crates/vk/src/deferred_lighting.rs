@@ -73,6 +73,13 @@ pub struct LightingFrame<'a> {
     pub clear_hdr: bool,
     /// Write a GPU timestamp after every step ([`DeferredLighting::step_timings`]).
     pub timestamps: bool,
+    /// Where shade passes read each BRDF's value: its formula, or its material's look-up table
+    /// (the talk's LUT technique; [`DeferredLighting::set_lut_tables`] first, and the G-buffer's
+    /// material index names the table).
+    pub brdf_source: BrdfSource,
+    /// Count hi-stencil tiles tested and culled and fragments shaded
+    /// ([`DeferredLighting::tile_stats`]); needs `LightingDesc::hi_stencil`.
+    pub tile_stats: bool,
 }
 
 /// The per-frame-in-flight part: buffers the host writes at record time and the sets that point
@@ -97,7 +104,9 @@ struct Slot {
 ///     ViewDesc,
 /// };
 /// use histencil_scene::Light;
-/// use histencil_vk::{Backend, DeferredLighting, ImageRef, LightingFrame, LightingTargets};
+/// use histencil_vk::{
+///     Backend, BrdfSource, DeferredLighting, ImageRef, LightingFrame, LightingTargets,
+/// };
 ///
 /// /// `gbuffer`, `depth_stencil` and `hdr` carry the states the engine's barriers left.
 /// fn light(
@@ -131,6 +140,8 @@ struct Slot {
 ///         plan: &plan,
 ///         clear_hdr: true,
 ///         timestamps: false,
+///         brdf_source: BrdfSource::Formula,
+///         tile_stats: false,
 ///     };
 ///     // SAFETY: `cmd` is recording on the lighting's device, the images' states are true, and
 ///     // the frame two frames ago (the last one in this slot) has finished on the GPU.
@@ -480,19 +491,7 @@ impl DeferredLighting<'_> {
         frame: &LightingFrame,
         targets: &mut LightingTargets,
     ) -> Result<()> {
-        self.record_with(cmd, frame, targets, false, BrdfSource::Formula)
-    }
-
-    /// [`DeferredLighting::record`] with hi-stencil statistics and the BRDF source, for the
-    /// renderer's lab techniques.
-    pub(crate) fn record_with(
-        &mut self,
-        cmd: vk::CommandBuffer,
-        frame: &LightingFrame,
-        targets: &mut LightingTargets,
-        count_stats: bool,
-        source: BrdfSource,
-    ) -> Result<()> {
+        let (count_stats, source) = (frame.tile_stats, frame.brdf_source);
         check_frame(&self.desc, frame, targets)?;
         if count_stats && !self.desc.hi_stencil {
             return Err(Error::Unsupported(
@@ -557,10 +556,11 @@ impl DeferredLighting<'_> {
         }
     }
 
-    /// The hi-stencil statistics of the last frame recorded with them, once the GPU finished it;
-    /// `flushes` from `plan`. Shared by all slots: for callers that finish a frame before the
-    /// next one counts.
-    pub(crate) fn tile_stats(&self, plan: &FramePlan) -> TileStats {
+    /// The hi-stencil statistics of the last frame recorded with
+    /// [`LightingFrame::tile_stats`], read once the GPU has finished it; `flushes` from that
+    /// frame's `plan`. One set of counters for all slots: a caller counts a frame, waits for it,
+    /// then reads, before the next counting frame.
+    pub fn tile_stats(&self, plan: &FramePlan) -> TileStats {
         let hi = self.hi_stencil.as_ref().expect("made with the lighting");
         TileStats {
             flushes: plan
@@ -572,10 +572,16 @@ impl DeferredLighting<'_> {
         }
     }
 
-    /// Points the LUT set at the tables' buffers (headers, values). The tables must outlive
-    /// every frame recorded with [`BrdfSource::Table`] after this.
-    pub(crate) fn set_lut_tables(&mut self, buffers: &[vk::Buffer; 2]) {
-        write_storage_buffers(self.ctx, self.lut_set, buffers);
+    /// Points the LUT technique at `tables` (one per material, in the order of the G-buffer's
+    /// material indices; [`crate::LutTables::new`]) for the frames recorded with
+    /// [`BrdfSource::Table`] after this.
+    ///
+    /// # Safety
+    /// `tables` outlive every command buffer recorded with [`BrdfSource::Table`] after this
+    /// call, until the GPU has finished them; no command buffer that reads earlier tables is
+    /// still pending (the set is rewritten in place).
+    pub unsafe fn set_lut_tables(&mut self, tables: &crate::LutTables) {
+        write_storage_buffers(self.ctx, self.lut_set, &tables.buffers());
         self.lut_written = true;
     }
 

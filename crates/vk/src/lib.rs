@@ -61,6 +61,7 @@ pub use histencil_model::{CostModel, FlushPolicy, TileStats};
 pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
 pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
+pub use passes::light_pipelines::BrdfSource;
 pub use readback::{FrameImages, Readback};
 pub use renderer::{Frame, Renderer, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};

@@ -27,8 +27,8 @@ use histencil_model::{
 };
 use histencil_vk::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, AlphaMode,
-    Backend, Context, DeferredLighting, FrameDesc, ImageState, LightingDesc, LightingFrame,
-    LightingTargets, LightmapFrame, Readback, Renderer, Technique, GBUFFER_FORMATS,
+    Backend, BrdfSource, Context, DeferredLighting, FrameDesc, ImageState, LightingDesc,
+    LightingFrame, LightingTargets, LightmapFrame, Readback, Renderer, Technique, GBUFFER_FORMATS,
 };
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -322,6 +322,8 @@ fn main() {
                 plan: &plan,
                 clear_hdr: true,
                 timestamps: false,
+                brdf_source: BrdfSource::Formula,
+                tile_stats: false,
             };
             // SAFETY: the command buffer is recording on the engine's device; the images' states
             // are the ones the engine's own barriers left; this slot's last frame has finished.

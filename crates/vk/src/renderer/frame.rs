@@ -68,10 +68,13 @@ impl Renderer<'_> {
                     plan: &plan,
                     clear_hdr: true,
                     timestamps: time_steps,
+                    brdf_source,
+                    tile_stats: count_stats,
                 };
                 let mut targets = self.targets.lighting();
-                self.lighting
-                    .record_with(cmd, &frame, &mut targets, count_stats, brdf_source)?;
+                // SAFETY: `cmd` records on this context's device; the targets' states are the
+                // ones this renderer tracks; it waits for every frame, so slot 0 is free.
+                unsafe { self.lighting.record(cmd, &frame, &mut targets)? };
                 self.targets.lit(&targets);
                 self.timestamps.mark(ctx, cmd, "lighting");
             }

@@ -335,7 +335,9 @@ impl<'c> Renderer<'c> {
                 });
             }
             let tables = LutTables::new(self.ctx, &self.materials, self.lut_resolution)?;
-            self.lighting.set_lut_tables(&tables.buffers());
+            // SAFETY: the renderer keeps the tables until it drops them or bakes new ones, and
+            // it waits for every frame it submits.
+            unsafe { self.lighting.set_lut_tables(&tables) };
             self.lut_tables = Some(tables);
         }
         Ok(self.lut_tables.as_ref().expect("baked above"))
