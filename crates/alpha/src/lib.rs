@@ -25,6 +25,7 @@ mod bake;
 mod entity;
 mod estimate;
 mod layout;
+mod plan;
 mod probes;
 mod sizing;
 mod sprites;
@@ -36,11 +37,12 @@ pub use estimate::{
     choose_parameters, coverage_side, estimate, Estimate, ParameterKind, Parameters, DEFAULT_TARGET,
 };
 pub use layout::{
-    bounding_sphere, check_forced_side, dust_grid, entities, entity_problem, plan_entities,
-    plan_layout, plan_regions, projected_diameter, region_shape, scene_entities, AlphaPlan,
-    ChoiceSettings, EntityDesc, EntityKey, EntityKind, EntityRegion, LayoutError, LightmapLayout,
-    RegionShape, Viewer, ATLAS_PADDING, MAX_ATLAS_SIDE, MAX_FORCED_SIDE, START_ATLAS_SIDE,
+    bounding_sphere, check_forced_side, dust_grid, entities, entity_problem, plan_regions,
+    projected_diameter, region_shape, scene_entities, EntityDesc, EntityKey, EntityKind,
+    EntityRegion, LayoutError, LightmapLayout, RegionShape, Viewer, ATLAS_PADDING, MAX_ATLAS_SIDE,
+    MAX_FORCED_SIDE, START_ATLAS_SIDE,
 };
+pub use plan::{plan_entities, plan_layout, AlphaPlan, ChoiceSettings};
 pub use probes::{back_to_front, camera_axes, fit_frame, particle_bounds, probe_point, ProbeFrame};
 pub use sizing::{side_for_coverage, MAX_SIDE, MIN_SIDE, PIXELS_PER_TEXEL};
 pub use sprites::{sprite_vertices, SpriteVertex};

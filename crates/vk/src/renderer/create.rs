@@ -1,0 +1,213 @@
+//! How a renderer is made and unmade: the scene validated, the layout and materials derived,
+//! every resource created (a failure half way frees what was made), and all of it freed in
+//! order at drop.
+
+use super::{Renderer, DEFAULT_LUT_RESOLUTION};
+use crate::context::Context;
+use crate::deferred_lighting::{DeferredLighting, LightingDesc};
+use crate::descriptors::{DescriptorTargets, Descriptors};
+use crate::error::{Result, VkCall};
+use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::meshes::Meshes;
+use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
+use crate::readback::ReadbackBuffers;
+use crate::resources::Buffer;
+use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
+use crate::timing::Timestamps;
+use ash::vk;
+use histencil_brdf::{Brdf, BrdfId};
+use histencil_model::{StencilBits, StencilLayout};
+use histencil_scene::Scene;
+
+/// The distinct BRDF materials of `scene` in first-use order (the LUT technique's tables) and
+/// each object's index among them.
+fn distinct_materials(scene: &Scene) -> (Vec<Brdf>, Vec<u32>) {
+    let mut materials: Vec<Brdf> = Vec::new();
+    let indices = scene
+        .objects
+        .iter()
+        .map(|o| {
+            let brdf = o.material.brdf;
+            let index = materials
+                .iter()
+                .position(|m| *m == brdf)
+                .unwrap_or_else(|| {
+                    materials.push(brdf);
+                    materials.len() - 1
+                });
+            index as u32
+        })
+        .collect();
+    (materials, indices)
+}
+
+/// The stencil slot of BRDF `id`: its index among the BRDFs in use.
+fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
+    brdfs
+        .iter()
+        .position(|b| *b == id)
+        .expect("brdfs_in_use lists every object's BRDF") as u32
+}
+
+impl<'c> Renderer<'c> {
+    /// Validates the scene and the resolution, then builds everything a frame needs, with the
+    /// talk's stencil layout (culling bit 0, BRDF bits above it).
+    pub fn new(ctx: &'c Context, scene: Scene, width: u32, height: u32) -> Result<Self> {
+        Self::with_stencil_bits(ctx, scene, width, height, None)
+    }
+
+    /// As [`Renderer::new`], with the culling bit and the BRDF field where an engine wants them
+    /// (`None`: the talk's layout).
+    ///
+    /// # Errors
+    /// [`crate::Error::Layout`] when the scene's BRDFs do not fit at those positions, besides the
+    /// errors of [`Renderer::new`].
+    pub fn with_stencil_bits(
+        ctx: &'c Context,
+        mut scene: Scene,
+        width: u32,
+        height: u32,
+        bits: Option<StencilBits>,
+    ) -> Result<Self> {
+        // The resolution first: a scene built for a zero-sized view (a lab wall) would otherwise
+        // take the blame for it.
+        let extent = check_extent(ctx, width, height)?;
+        scene.validate()?;
+        scene.normalise_lights();
+        let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
+        let brdf_count = brdfs.len().max(1) as u32;
+        let stencil_layout = match bits {
+            None => StencilLayout::new(brdf_count, 0)?,
+            Some(bits) => StencilLayout::with_positions(brdf_count, bits)?,
+        };
+        let object_slots = scene
+            .objects
+            .iter()
+            .map(|o| slot_of(&brdfs, o.material.brdf.id()))
+            .collect();
+        let (materials, object_materials) = distinct_materials(&scene);
+
+        let lighting = DeferredLighting::new(
+            ctx,
+            &LightingDesc {
+                layout: stencil_layout,
+                brdfs: brdfs.clone(),
+                extent,
+                depth_stencil_format: ctx.depth_stencil_format,
+                hdr_format: HDR_FORMAT,
+                frames_in_flight: 1,
+                max_lights: scene.lights.len() as u32,
+                hi_stencil: true,
+            },
+        )?;
+        let targets = Targets::new(ctx, extent)?;
+        let meshes = Meshes::new(ctx, &scene.meshes)?;
+        let uniforms = FrameUniforms::new(&scene.camera, width, height, scene.lights.len() as u32);
+        let frame_uniforms = Buffer::with_data(
+            ctx,
+            "frame-uniforms",
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            bytemuck::bytes_of(&uniforms),
+        )?;
+        let gpu_lights: Vec<GpuLight> = scene.lights.iter().map(GpuLight::new).collect();
+        let lights = Buffer::with_data(
+            ctx,
+            "scene-lights",
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            bytemuck::cast_slice(&gpu_lights),
+        )?;
+        let descriptors = Descriptors::new(
+            ctx,
+            &DescriptorTargets {
+                frame_uniforms: frame_uniforms.handle,
+                lights: lights.handle,
+                hdr_view: targets.hdr.view,
+            },
+        )?;
+        let pipelines = Pipelines::new(
+            ctx,
+            &PipelineLayouts {
+                mesh: descriptors.mesh_pipeline_layout,
+                lighting: lighting.pipeline_layout(),
+                tonemap: descriptors.tonemap_pipeline_layout,
+            },
+            &TargetFormats {
+                gbuffer: GBUFFER_FORMATS,
+                hdr: HDR_FORMAT,
+                ldr: LDR_FORMAT,
+                depth_stencil: ctx.depth_stencil_format,
+            },
+        )?;
+        let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
+        let command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
+            .call("vkCreateCommandPool")?;
+        ctx.name(command_pool, "frame-command-pool");
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(command_pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        let cmd = unsafe { ctx.device.allocate_command_buffers(&alloc) }
+            .call("vkAllocateCommandBuffers")?[0];
+        ctx.name(cmd, "frame-commands");
+        let fence = unsafe {
+            ctx.device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+        }
+        .call("vkCreateFence")?;
+        ctx.name(fence, "frame-fence");
+        let timestamps = Timestamps::new(ctx)?;
+        let readback = ReadbackBuffers::new(ctx, extent)?;
+        Ok(Self {
+            ctx,
+            scene,
+            stencil_layout,
+            brdfs,
+            object_slots,
+            materials,
+            object_materials,
+            lut_resolution: DEFAULT_LUT_RESOLUTION,
+            lut_tables: None,
+            lightmap_side: None,
+            alpha: None,
+            lighting,
+            cost_model: None,
+            extent,
+            targets,
+            meshes,
+            frame_uniforms,
+            lights,
+            descriptors,
+            pipelines,
+            command_pool,
+            cmd,
+            fence,
+            timestamps,
+            readback,
+        })
+    }
+}
+
+impl Drop for Renderer<'_> {
+    fn drop(&mut self) {
+        let ctx = self.ctx;
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+            ctx.device.destroy_fence(self.fence, None);
+            ctx.device.destroy_command_pool(self.command_pool, None);
+        }
+        self.timestamps.destroy(ctx);
+        self.readback.destroy(ctx);
+        self.pipelines.destroy(ctx);
+        if let Some(t) = self.lut_tables.as_mut() {
+            t.destroy(ctx);
+        }
+        if let Some(a) = self.alpha.as_mut() {
+            a.destroy(ctx);
+        }
+        self.descriptors.destroy(ctx);
+        self.lights.destroy(ctx);
+        self.frame_uniforms.destroy(ctx);
+        self.meshes.destroy(ctx);
+        self.targets.destroy(ctx);
+    }
+}

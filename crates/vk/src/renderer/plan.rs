@@ -1,0 +1,85 @@
+//! What a renderer frame is planned with: the camera as a view in the frame's depth convention,
+//! the planner's inputs from the scene, and the uniforms of the mesh and alpha passes.
+
+use super::Renderer;
+use crate::error::Result;
+use crate::gpu_types::FrameUniforms;
+use crate::technique::Technique;
+use histencil_model::{
+    plan_frame, DepthConvention, FarPlane, FramePlan, LightShape, Perspective, PlanError,
+    PlanInputs, View, ViewDesc,
+};
+
+impl Renderer<'_> {
+    /// The lighting plan of a frame, from histencil-model's planner on the scene's plain inputs:
+    /// each light that touches an object and that the camera can see, classified against the
+    /// camera, with the BRDF slots it touches ([`FramePlan::lights`] says which scene light each
+    /// planned light is).
+    pub fn plan(&self, technique: Technique) -> Result<FramePlan> {
+        self.plan_in(technique, &self.view_desc())
+    }
+
+    pub(super) fn plan_in(&self, technique: Technique, view: &ViewDesc) -> Result<FramePlan> {
+        let Some(settings) = technique.plan_settings(|backend| self.cost_model(backend)) else {
+            return Ok(FramePlan::empty(view.depth));
+        };
+        let view = View::new(view).map_err(PlanError::from)?;
+        let shapes: Vec<LightShape> = self.scene.lights.iter().map(|l| l.shape()).collect();
+        let brdf_bounds = self.scene.brdf_bounds(&self.brdfs);
+        let inputs = PlanInputs {
+            lights: &shapes,
+            brdf_bounds: &brdf_bounds,
+            view: &view,
+        };
+        Ok(plan_frame(&self.stencil_layout, &inputs, &settings)?)
+    }
+
+    /// The camera as the planner and the lighting take it, with standard depth and its own far
+    /// plane.
+    pub(super) fn view_desc(&self) -> ViewDesc {
+        let aspect = self.extent.width as f32 / self.extent.height as f32;
+        self.scene.camera.view_desc(aspect)
+    }
+
+    /// The camera with depth stored as `depth` says, its far plane at infinity if asked.
+    pub(super) fn view_desc_in(&self, depth: DepthConvention, infinite_far: bool) -> ViewDesc {
+        if depth == DepthConvention::Standard && !infinite_far {
+            return self.view_desc();
+        }
+        let c = &self.scene.camera;
+        Perspective {
+            eye: c.eye.into(),
+            target: c.target.into(),
+            up: c.up.into(),
+            fov_y_radians: c.fov_y_radians,
+            aspect: self.extent.width as f32 / self.extent.height as f32,
+            near: c.near,
+            far: if infinite_far {
+                FarPlane::Infinite
+            } else {
+                FarPlane::Finite(c.far)
+            },
+            depth,
+        }
+        .desc()
+    }
+
+    /// The mesh and alpha passes' uniforms for `view`: the camera's own (the forward reference's
+    /// eye and rays stay as they always were), with the projection and far depth of `view`.
+    pub(super) fn uniforms(&self, view: &ViewDesc) -> Result<FrameUniforms> {
+        let (w, h) = (self.extent.width, self.extent.height);
+        let lights = self.scene.lights.len() as u32;
+        let camera = FrameUniforms::new(&self.scene.camera, w, h, lights);
+        if *view == self.view_desc() {
+            return Ok(camera);
+        }
+        let projected = FrameUniforms::from_view(view, w, h, lights)
+            .map_err(|p| crate::Error::BadFrame(p.to_string()))?;
+        Ok(FrameUniforms {
+            proj: projected.proj,
+            view_proj: projected.view_proj,
+            settings: projected.settings,
+            ..camera
+        })
+    }
+}
