@@ -7,7 +7,8 @@
 use crate::{particle_bounds, EntityDesc, EntityKind};
 use glam::{Mat4, Vec3};
 use histencil_scene::{
-    unit_box_bake, uv_sphere, Material, Mesh, Particle, ParticleLayout, Scene, Shape, SPHERE_DETAIL,
+    unit_box_bake, uv_sphere, Light, Material, Mesh, Particle, ParticleLayout, Scene, Shape,
+    SPHERE_DETAIL,
 };
 
 /// One translucent object or particle system, as lit this frame.
@@ -78,6 +79,15 @@ impl AlphaEntity<'_> {
             }
             AlphaEntityKind::Particles { particles, .. } => particle_bounds(particles),
         }
+    }
+
+    /// The indices of the `lights` whose range reaches the entity's bounds: the only ones that
+    /// light it (one lightmap draw each).
+    pub fn lights_reaching(&self, lights: &[Light]) -> Vec<u32> {
+        let (lo, hi) = self.world_bounds();
+        (0..lights.len() as u32)
+            .filter(|&l| lights[l as usize].reaches_box(lo, hi))
+            .collect()
     }
 
     /// The entity's description for [`crate::plan_regions`]: its kind and world bounds,

@@ -113,11 +113,10 @@ struct Sample {
 
 /// The lights whose range reaches the entity's bounds: the only ones that light it.
 fn reaching(entity: &AlphaEntity, lights: &[Light]) -> Vec<Light> {
-    let (lo, hi) = entity.world_bounds();
-    lights
-        .iter()
-        .filter(|l| l.reaches_box(lo, hi))
-        .copied()
+    entity
+        .lights_reaching(lights)
+        .into_iter()
+        .map(|l| lights[l as usize])
         .collect()
 }
 

@@ -69,10 +69,7 @@ pub(crate) fn frame_records(
 ) -> FrameRecords {
     let mut out = FrameRecords::default();
     for (entity, r) in entities.iter().zip(regions) {
-        let (lo, hi) = entity.world_bounds();
-        let reaching: Vec<u32> = (0..lights.len() as u32)
-            .filter(|&l| lights[l as usize].reaches_box(lo, hi))
-            .collect();
+        let reaching = entity.lights_reaching(lights);
         let region = [
             r.region.x,
             r.region.y,

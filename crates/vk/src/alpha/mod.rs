@@ -256,14 +256,7 @@ impl<'c> AlphaLighting<'c> {
         let probe_meshes = ProbeMeshes::new(scene);
         let lightmap_draws = scene_alpha_entities(scene, &probe_meshes)
             .iter()
-            .map(|e| {
-                let (lo, hi) = e.world_bounds();
-                scene
-                    .lights
-                    .iter()
-                    .filter(|l| l.reaches_box(lo, hi))
-                    .count()
-            })
+            .map(|e| e.lights_reaching(&scene.lights).len())
             .sum();
         let order = back_to_front(scene);
         let lightmap = parts.images.pop().expect("the atlas");
