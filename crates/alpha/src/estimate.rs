@@ -315,6 +315,104 @@ fn sides_up_to(max: u32) -> impl Iterator<Item = u32> {
     })
 }
 
+/// What an estimate replays for one entity, set up once: its sample points and their lighting,
+/// and how its lightmap reconstructs them.
+enum Replay<'a> {
+    /// A mesh: probes baked from its UV layout, carried to the world by its transform.
+    Surface {
+        mesh: &'a histencil_scene::Mesh,
+        samples: Vec<Sample>,
+        shade_at: Box<dyn Fn(Vec3, Vec3) -> Vec3 + 'a>,
+        to_world: Box<dyn Fn(Vec3, Vec3) -> (Vec3, Vec3) + 'a>,
+    },
+    /// Camera-facing slices around a particle system.
+    Sliced {
+        samples: Vec<Sample>,
+        frame: ProbeFrame,
+        shade_at: Box<dyn Fn(Vec3) -> Vec3 + 'a>,
+    },
+    /// Dust and ribbons: nothing to choose.
+    Nothing,
+}
+
+impl<'a> Replay<'a> {
+    /// The replay of `entity` seen by `viewer`, lit by `lights` (those that reach it) with
+    /// `material`; a mesh's samples from a bake `fine` texels a side.
+    fn new<'e: 'a>(
+        entity: &AlphaEntity<'e>,
+        viewer: &Viewer,
+        lights: &'a [Light],
+        material: &'a Material,
+        fine: u32,
+    ) -> Self {
+        let eye = viewer.eye;
+        match entity.kind {
+            AlphaEntityKind::Object {
+                probe_mesh,
+                transform,
+                ..
+            } => {
+                let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
+                let shade_at = Box::new(move |p, n| shade(lights, material, p, n, eye));
+                let to_world = Box::new(move |p, n: Vec3| {
+                    (
+                        transform.transform_point3(p),
+                        (normal_matrix * n).try_normalize().unwrap_or(Vec3::Z),
+                    )
+                });
+                let samples = object_samples(probe_mesh, fine, eye, &shade_at, &to_world);
+                Replay::Surface {
+                    mesh: probe_mesh,
+                    samples,
+                    shade_at,
+                    to_world,
+                }
+            }
+            AlphaEntityKind::Particles { layout, particles } => match layout {
+                ParticleLayout::Dust | ParticleLayout::Ribbon => Replay::Nothing,
+                _ => {
+                    let shade_at =
+                        Box::new(move |p: Vec3| shade(lights, material, p, facing(eye, p), eye));
+                    Replay::Sliced {
+                        samples: particle_samples(particles, viewer, &shade_at),
+                        frame: fit_frame(viewer, particles),
+                        shade_at,
+                    }
+                }
+            },
+        }
+    }
+
+    /// The estimate at `slices x side` (a mesh ignores `slices`; beyond
+    /// [`ESTIMATED_SIDE_LIMIT`] texels the estimate there stands for it, as more texels never
+    /// raise the error, so a forced huge side costs no huge bake).
+    fn estimate(&self, slices: u32, side: u32) -> Estimate {
+        match self {
+            Replay::Surface {
+                mesh,
+                samples,
+                shade_at,
+                to_world,
+            } => {
+                let side = side.min(ESTIMATED_SIDE_LIMIT);
+                object_estimate(samples, mesh, side, shade_at, to_world)
+            }
+            Replay::Sliced {
+                samples,
+                frame,
+                shade_at,
+            } => sliced_estimate(samples, frame, (slices.max(1), side), shade_at),
+            Replay::Nothing => Estimate::default(),
+        }
+    }
+}
+
+/// The bake a mesh's samples come from: twice as fine as the largest side tried, within
+/// 64..=[`ESTIMATED_SIDE_LIMIT`].
+fn fine_side(largest: u32) -> u32 {
+    (2 * largest.min(ESTIMATED_SIDE_LIMIT)).clamp(64, ESTIMATED_SIDE_LIMIT)
+}
+
 /// The estimated error of `entity`'s lightmap at `slices x side`, lit by `lights` and seen by
 /// `viewer`. Dust and ribbons have nothing to choose and estimate to zero.
 pub fn estimate(
@@ -326,55 +424,8 @@ pub fn estimate(
 ) -> Estimate {
     let lights = reaching(entity, lights);
     let material = entity.material;
-    let eye = viewer.eye;
-    match entity.kind {
-        AlphaEntityKind::Object {
-            probe_mesh,
-            transform,
-            ..
-        } => {
-            let (shade_at, to_world) = object_shading(&lights, &material, eye, transform);
-            // Beyond 256 texels the estimate at 256 stands for it (more texels never raise the
-            // error), so a forced huge side costs no huge bake here.
-            let side = side.min(ESTIMATED_SIDE_LIMIT);
-            let fine = (2 * side).clamp(64, ESTIMATED_SIDE_LIMIT);
-            let samples = object_samples(probe_mesh, fine, eye, &shade_at, &to_world);
-            object_estimate(&samples, probe_mesh, side, &shade_at, &to_world)
-        }
-        AlphaEntityKind::Particles { layout, particles } => match layout {
-            ParticleLayout::Dust | ParticleLayout::Ribbon => Estimate::default(),
-            _ => {
-                let shade_at = |p: Vec3| shade(&lights, &material, p, facing(eye, p), eye);
-                let samples = particle_samples(particles, viewer, &shade_at);
-                let frame = fit_frame(viewer, particles);
-                sliced_estimate(&samples, &frame, (slices.max(1), side), &shade_at)
-            }
-        },
-    }
-}
-
-type ObjectShading<'a> = (
-    Box<dyn Fn(Vec3, Vec3) -> Vec3 + 'a>,
-    Box<dyn Fn(Vec3, Vec3) -> (Vec3, Vec3) + 'a>,
-);
-
-/// How an object's probes are lit (at a world position and normal) and carried to the world.
-fn object_shading<'a>(
-    lights: &'a [Light],
-    material: &'a Material,
-    eye: Vec3,
-    transform: glam::Mat4,
-) -> ObjectShading<'a> {
-    let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
-    (
-        Box::new(move |p, n| shade(lights, material, p, n, eye)),
-        Box::new(move |p, n| {
-            (
-                transform.transform_point3(p),
-                (normal_matrix * n).try_normalize().unwrap_or(Vec3::Z),
-            )
-        }),
-    )
+    let replay = Replay::new(entity, viewer, &lights, &material, fine_side(side));
+    replay.estimate(slices, side)
 }
 
 /// The cheapest parameters whose estimate stays under `target` (8-bit steps, mean), within
@@ -391,21 +442,6 @@ pub fn choose_parameters(
     let coverage = coverage_side(entity, viewer, viewport_height);
     let lights = reaching(entity, lights);
     let material = entity.material;
-    let eye = viewer.eye;
-    let pick_side = |estimate_at: &mut dyn FnMut(u32) -> Estimate| match forced_side {
-        Some(side) => (side, estimate_at(side)),
-        None => {
-            let mut last = None;
-            for side in sides_up_to(coverage) {
-                let e = estimate_at(side);
-                last = Some((side, e));
-                if e.mean <= target {
-                    break;
-                }
-            }
-            last.expect("at least one side")
-        }
-    };
     let base = Parameters {
         kind: ParameterKind::Surface,
         slices: 1,
@@ -415,91 +451,87 @@ pub fn choose_parameters(
         forced_slices: true,
         forced_side: forced_side.is_some(),
     };
-    match entity.kind {
-        AlphaEntityKind::Object {
-            probe_mesh,
-            transform,
-            ..
-        } => {
-            let (shade_at, to_world) = object_shading(&lights, &material, eye, transform);
-            let fine = (2 * coverage).clamp(64, ESTIMATED_SIDE_LIMIT);
-            let samples = object_samples(probe_mesh, fine, eye, &shade_at, &to_world);
-            let (side, estimate) = pick_side(&mut |side| {
-                let side_estimated = side.min(ESTIMATED_SIDE_LIMIT);
-                object_estimate(&samples, probe_mesh, side_estimated, &shade_at, &to_world)
-            });
-            Parameters {
-                side,
-                estimate,
-                ..base
+    let forced_slices = match entity.kind {
+        AlphaEntityKind::Object { .. } => Some(1),
+        AlphaEntityKind::Particles { layout, .. } => match layout {
+            ParticleLayout::Dust => {
+                return Parameters {
+                    kind: ParameterKind::Dust,
+                    ..base
+                }
+            }
+            ParticleLayout::Ribbon => {
+                return Parameters {
+                    kind: ParameterKind::Ribbon,
+                    ..base
+                }
+            }
+            ParticleLayout::Billboard => Some(1),
+            ParticleLayout::Slices { count } => Some(count),
+            ParticleLayout::Auto => None,
+        },
+    };
+    let replay = Replay::new(entity, viewer, &lights, &material, fine_side(coverage));
+    let sides: Vec<u32> = match forced_side {
+        Some(side) => vec![side],
+        None => sides_up_to(coverage).collect(),
+    };
+    if let Replay::Surface { .. } = replay {
+        // The smallest side under the target; failing that, the largest tried.
+        let mut last = None;
+        for &side in &sides {
+            let e = replay.estimate(1, side);
+            last = Some((side, e));
+            if e.mean <= target {
+                break;
             }
         }
-        AlphaEntityKind::Particles { layout, particles } => {
-            let forced = match layout {
-                ParticleLayout::Dust => {
-                    return Parameters {
-                        kind: ParameterKind::Dust,
-                        ..base
-                    }
-                }
-                ParticleLayout::Ribbon => {
-                    return Parameters {
-                        kind: ParameterKind::Ribbon,
-                        ..base
-                    }
-                }
-                ParticleLayout::Billboard => Some(1),
-                ParticleLayout::Slices { count } => Some(count),
-                ParticleLayout::Auto => None,
-            };
-            let shade_at = |p: Vec3| shade(&lights, &material, p, facing(eye, p), eye);
-            let samples = particle_samples(particles, viewer, &shade_at);
-            let frame = fit_frame(viewer, particles);
-            let counts: Vec<u32> = match forced {
-                Some(n) => vec![n],
-                None => SLICE_COUNTS
-                    .into_iter()
-                    .filter(|&n| n <= MAX_SLICES)
-                    .collect(),
-            };
-            // The cheapest (slices x side^2 texels to light) pair under the target; failing
-            // that, the most accurate one tried.
-            let mut best: Option<(u64, u32, u32, Estimate)> = None;
-            let mut fallback: Option<(u32, u32, Estimate)> = None;
-            for &n in &counts {
-                let sides: Vec<u32> = match forced_side {
-                    Some(side) => vec![side],
-                    None => sides_up_to(coverage).collect(),
-                };
-                for side in sides {
-                    let cost = u64::from(n) * u64::from(side) * u64::from(side);
-                    if best.is_some_and(|b| b.0 <= cost) {
-                        break;
-                    }
-                    let e = sliced_estimate(&samples, &frame, (n, side), &shade_at);
-                    if fallback.is_none_or(|f| e.mean < f.2.mean) {
-                        fallback = Some((n, side, e));
-                    }
-                    if e.mean <= target {
-                        best = Some((cost, n, side, e));
-                        break;
-                    }
-                }
+        let (side, estimate) = last.expect("at least one side");
+        return Parameters {
+            side,
+            estimate,
+            ..base
+        };
+    }
+    let counts: Vec<u32> = match forced_slices {
+        Some(n) => vec![n],
+        None => SLICE_COUNTS
+            .into_iter()
+            .filter(|&n| n <= MAX_SLICES)
+            .collect(),
+    };
+    // The cheapest (slices x side^2 texels to light) pair under the target; failing that, the
+    // most accurate one tried.
+    let mut best: Option<(u64, u32, u32, Estimate)> = None;
+    let mut fallback: Option<(u32, u32, Estimate)> = None;
+    for &n in &counts {
+        for &side in &sides {
+            let cost = u64::from(n) * u64::from(side) * u64::from(side);
+            if best.is_some_and(|b| b.0 <= cost) {
+                break;
             }
-            let (slices, side, estimate) = match (best, fallback) {
-                (Some((_, n, side, e)), _) => (n, side, e),
-                (None, Some(f)) => f,
-                (None, None) => unreachable!("at least one pair is tried"),
-            };
-            Parameters {
-                kind: ParameterKind::Slices,
-                slices,
-                side,
-                estimate,
-                forced_slices: forced.is_some(),
-                ..base
+            let e = replay.estimate(n, side);
+            if fallback.is_none_or(|f| e.mean < f.2.mean) {
+                fallback = Some((n, side, e));
+            }
+            if e.mean <= target {
+                best = Some((cost, n, side, e));
+                break;
             }
         }
+    }
+    let (slices, side, estimate) = match (best, fallback) {
+        (Some((_, n, side, e)), _) => (n, side, e),
+        (None, Some(f)) => f,
+        (None, None) => unreachable!("at least one pair is tried"),
+    };
+    Parameters {
+        kind: ParameterKind::Slices,
+        slices,
+        side,
+        estimate,
+        forced_slices: forced_slices.is_some(),
+        ..base
     }
 }
 
