@@ -4,12 +4,11 @@
 //! clamp). Running `histencil_model::Simulator` on them predicts the GPU frame exactly: its
 //! final stencil and its hi-stencil statistics (`tests/tests/hi_stencil.rs` holds it to that).
 
-use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
 use crate::meshes::LightVolumes;
-use crate::passes::{begin_rendering, color_attachment, Load};
+use crate::passes::begin_cleared;
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::{Buffer, Image};
@@ -117,21 +116,13 @@ impl FootprintCapture {
     ) {
         ctx.begin_label(cmd, &format!("capture-footprint-{}", light.0));
         for (face, cull) in [CullMode::Back, CullMode::Front].into_iter().enumerate() {
-            let image = &mut self.faces[face];
-            transition(
-                ctx,
-                cmd,
-                image,
-                ImageAccess::ColorAttachment,
-                Contents::Discard,
-            );
             let clear = vk::ClearValue {
                 color: vk::ClearColorValue {
                     float32: [NO_FACE; 4],
                 },
             };
-            let colors = [color_attachment(image, Load::Clear(clear))];
-            begin_rendering(ctx, cmd, self.extent, &colors, None);
+            let image = &mut self.faces[face];
+            begin_cleared(ctx, cmd, image, clear);
             let push = LightDrawPush {
                 light_index: light.0,
                 ..Default::default()

@@ -18,7 +18,7 @@ use crate::descriptors::{
 };
 use crate::error::{Error, Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
-use crate::passes::begin_cleared;
+use crate::passes::{begin_cleared, CLEAR_BLACK};
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::Buffer;
 use crate::shaders;
@@ -373,7 +373,7 @@ impl<'c> AlphaLightmaps<'c> {
         let ctx = self.ctx;
         let slot = &self.slots[slot as usize];
         ctx.begin_label(cmd, "alpha-lightmaps");
-        begin_cleared(ctx, cmd, atlas);
+        begin_cleared(ctx, cmd, atlas, CLEAR_BLACK);
         let d = &ctx.device;
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);

@@ -24,7 +24,7 @@ use crate::descriptors::{
 };
 use crate::error::{Result, VkCall};
 use crate::meshes::Meshes;
-use crate::passes::{begin_cleared, begin_hdr_rendering, Load};
+use crate::passes::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::{Buffer, Image};
 use crate::shader_consts::ALPHA_MODES;
@@ -410,7 +410,7 @@ impl<'c> AlphaLighting<'c> {
         // written yet is cleared first, so no read-only layout is entered from UNDEFINED.
         let atlas = &mut self.lightmap;
         if atlas.state.layout == vk::ImageLayout::UNDEFINED {
-            begin_cleared(ctx, cmd, atlas);
+            begin_cleared(ctx, cmd, atlas, CLEAR_BLACK);
             unsafe { ctx.device.cmd_end_rendering(cmd) };
         }
         transition(

@@ -98,9 +98,14 @@ pub(crate) fn begin_rendering(
     }
 }
 
-/// Discards `image`'s contents and begins rendering into it alone, cleared to black, over its
+/// Discards `image`'s contents and begins rendering into it alone, cleared to `clear`, over its
 /// whole extent.
-pub(crate) fn begin_cleared(ctx: &Context, cmd: vk::CommandBuffer, image: &mut ImageRef) {
+pub(crate) fn begin_cleared(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    image: &mut ImageRef,
+    clear: vk::ClearValue,
+) {
     transition(
         ctx,
         cmd,
@@ -108,7 +113,7 @@ pub(crate) fn begin_cleared(ctx: &Context, cmd: vk::CommandBuffer, image: &mut I
         ImageAccess::ColorAttachment,
         Contents::Discard,
     );
-    let colors = [color_attachment(image, Load::Clear(CLEAR_BLACK))];
+    let colors = [color_attachment(image, Load::Clear(clear))];
     begin_rendering(ctx, cmd, image.extent, &colors, None);
 }
 
