@@ -3,8 +3,7 @@
 //! `AlphaLightmaps` lit earlier in the same command buffer. The engine binds the records
 //! (`AlphaLightmaps::entity_buffer`) and the atlas in a set of its own.
 
-use crate::device::{barrier, Buffer, Gpu};
-use crate::gbuffer::DEPTH_FORMAT;
+use crate::device::{barrier, graphics_pipeline, Buffer, Gpu, GpuMesh, PipelineSpec};
 use crate::world::AlphaWorld;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -35,15 +34,9 @@ pub struct AlphaPass {
     layout: vk::PipelineLayout,
     object_pipeline: vk::Pipeline,
     particle_pipeline: vk::Pipeline,
-    sphere_vertices: Buffer,
-    sphere_indices: Buffer,
-    index_count: u32,
+    sphere: GpuMesh,
     /// Per frame in flight: the sprites it draws.
     sprites: Vec<Buffer>,
-}
-
-fn spirv(bytes: &[u8]) -> Vec<u32> {
-    ash::util::read_spv(&mut std::io::Cursor::new(bytes)).expect("SPIR-V")
 }
 
 impl AlphaPass {
@@ -92,7 +85,7 @@ impl AlphaPass {
         let f32x2 = vk::Format::R32G32_SFLOAT;
         // histencil_scene's vertex: position, normal, uv (32 bytes); lit from the lightmap, the
         // object needs no normal.
-        let object_pipeline = pipeline(
+        let object_pipeline = blended_pipeline(
             d,
             layout,
             (
@@ -102,7 +95,7 @@ impl AlphaPass {
             (32, &[(f32x3, 0), (f32x2, 24)]),
             vk::CullModeFlags::BACK,
         );
-        let particle_pipeline = pipeline(
+        let particle_pipeline = blended_pipeline(
             d,
             layout,
             (
@@ -120,17 +113,6 @@ impl AlphaPass {
             ),
             vk::CullModeFlags::NONE,
         );
-        let mesh = crate::world::sphere_mesh();
-        let floats: Vec<f32> = mesh
-            .vertices
-            .iter()
-            .flat_map(|v| [v.position.as_slice(), &v.normal, &v.uv].concat())
-            .collect();
-        let upload = |name, bytes: &[u8], usage| {
-            let mut b = gpu.buffer(name, bytes.len() as u64, usage, MemoryLocation::CpuToGpu);
-            b.write(bytes);
-            b
-        };
         let sprites = (0..in_flight)
             .map(|i| {
                 gpu.buffer(
@@ -154,17 +136,7 @@ impl AlphaPass {
             layout,
             object_pipeline,
             particle_pipeline,
-            sphere_vertices: upload(
-                "sphere-vertices",
-                bytemuck::cast_slice(&floats),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-            ),
-            sphere_indices: upload(
-                "sphere-indices",
-                bytemuck::cast_slice(&mesh.indices),
-                vk::BufferUsageFlags::INDEX_BUFFER,
-            ),
-            index_count: mesh.indices.len() as u32,
+            sphere: gpu.mesh("sphere", &crate::world::sphere_mesh()),
             sprites,
         }
     }
@@ -281,14 +253,7 @@ impl AlphaPass {
                         pad: [0; 3],
                     };
                     d.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&push));
-                    d.cmd_bind_vertex_buffers(cmd, 0, &[self.sphere_vertices.buffer], &[0]);
-                    d.cmd_bind_index_buffer(
-                        cmd,
-                        self.sphere_indices.buffer,
-                        0,
-                        vk::IndexType::UINT32,
-                    );
-                    d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+                    self.sphere.draw(d, cmd);
                 } else {
                     d.cmd_bind_pipeline(
                         cmd,
@@ -318,8 +283,7 @@ impl AlphaPass {
             gpu.device
                 .destroy_descriptor_set_layout(self.set_layout, None);
         }
-        gpu.free_buffer(self.sphere_vertices);
-        gpu.free_buffer(self.sphere_indices);
+        gpu.free_mesh(self.sphere);
         for b in self.sprites {
             gpu.free_buffer(b);
         }
@@ -328,58 +292,13 @@ impl AlphaPass {
 
 /// A blended pipeline over the HDR target: premultiplied "over", depth tested (reversed Z:
 /// nearer or equal passes), not written.
-fn pipeline(
+fn blended_pipeline(
     d: &ash::Device,
     layout: vk::PipelineLayout,
-    (vert, frag): (&[u8], &[u8]),
-    (stride, attributes): (u32, &[(vk::Format, u32)]),
+    shaders: (&[u8], &[u8]),
+    vertex: (u32, &[(vk::Format, u32)]),
     cull: vk::CullModeFlags,
 ) -> vk::Pipeline {
-    let module = |bytes: &[u8]| {
-        let code = spirv(bytes);
-        unsafe { d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None) }
-            .unwrap()
-    };
-    let (vert, frag) = (module(vert), module(frag));
-    let stages = [
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::VERTEX)
-            .module(vert)
-            .name(c"main"),
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::FRAGMENT)
-            .module(frag)
-            .name(c"main"),
-    ];
-    let bindings = [vk::VertexInputBindingDescription::default().stride(stride)];
-    let attributes: Vec<_> = attributes
-        .iter()
-        .enumerate()
-        .map(|(location, (format, offset))| {
-            vk::VertexInputAttributeDescription::default()
-                .location(location as u32)
-                .format(*format)
-                .offset(*offset)
-        })
-        .collect();
-    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-        .vertex_binding_descriptions(&bindings)
-        .vertex_attribute_descriptions(&attributes);
-    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-        .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-    let viewport = vk::PipelineViewportStateCreateInfo::default()
-        .viewport_count(1)
-        .scissor_count(1);
-    let raster = vk::PipelineRasterizationStateCreateInfo::default()
-        .cull_mode(cull)
-        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-        .line_width(1.0);
-    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-        .depth_test_enable(true)
-        .depth_write_enable(false)
-        .depth_compare_op(vk::CompareOp::GREATER_OR_EQUAL);
     let over = vk::BlendFactor::ONE_MINUS_SRC_ALPHA;
     let blend = [vk::PipelineColorBlendAttachmentState::default()
         .blend_enable(true)
@@ -390,32 +309,20 @@ fn pipeline(
         .dst_alpha_blend_factor(over)
         .alpha_blend_op(vk::BlendOp::ADD)
         .color_write_mask(vk::ColorComponentFlags::RGBA)];
-    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
-    let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
-    let formats = [vk::Format::R16G16B16A16_SFLOAT];
-    let mut rendering = vk::PipelineRenderingCreateInfo::default()
-        .color_attachment_formats(&formats)
-        .depth_attachment_format(DEPTH_FORMAT)
-        .stencil_attachment_format(DEPTH_FORMAT);
-    let info = vk::GraphicsPipelineCreateInfo::default()
-        .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&assembly)
-        .viewport_state(&viewport)
-        .rasterization_state(&raster)
-        .multisample_state(&multisample)
-        .depth_stencil_state(&depth)
-        .color_blend_state(&blend)
-        .dynamic_state(&dynamic)
-        .layout(layout)
-        .push_next(&mut rendering);
-    let pipeline = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
-        .map_err(|(_, e)| e)
-        .unwrap()[0];
-    unsafe {
-        d.destroy_shader_module(vert, None);
-        d.destroy_shader_module(frag, None);
-    }
-    pipeline
+    graphics_pipeline(
+        d,
+        layout,
+        &PipelineSpec {
+            shaders,
+            vertex,
+            cull,
+            depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default()
+                .depth_test_enable(true)
+                .depth_write_enable(false)
+                .depth_compare_op(vk::CompareOp::GREATER_OR_EQUAL),
+            blend: &blend,
+            color_formats: &[vk::Format::R16G16B16A16_SFLOAT],
+            dynamic: &[],
+        },
+    )
 }

@@ -337,3 +337,157 @@ pub fn barrier(
     };
     image.state = next;
 }
+
+/// A mesh in the engine's vertex and index buffers (histencil_scene's vertex: position, normal,
+/// uv; 32 bytes), drawn with one indexed call.
+pub struct GpuMesh {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub index_count: u32,
+}
+
+impl GpuMesh {
+    pub fn draw(&self, d: &ash::Device, cmd: vk::CommandBuffer) {
+        unsafe {
+            d.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.buffer], &[0]);
+            d.cmd_bind_index_buffer(cmd, self.indices.buffer, 0, vk::IndexType::UINT32);
+            d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+        }
+    }
+}
+
+impl Gpu {
+    /// Uploads `mesh` into host-visible vertex and index buffers named after `name`.
+    pub fn mesh(&self, name: &str, mesh: &histencil_scene::Mesh) -> GpuMesh {
+        let floats: Vec<f32> = mesh
+            .vertices
+            .iter()
+            .flat_map(|v| [v.position.as_slice(), &v.normal, &v.uv].concat())
+            .collect();
+        let upload = |what: &str, bytes: &[u8], usage| {
+            let mut b = self.buffer(
+                &format!("{name}-{what}"),
+                bytes.len() as u64,
+                usage,
+                MemoryLocation::CpuToGpu,
+            );
+            b.write(bytes);
+            b
+        };
+        GpuMesh {
+            vertices: upload(
+                "vertices",
+                bytemuck::cast_slice(&floats),
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+            ),
+            indices: upload(
+                "indices",
+                bytemuck::cast_slice(&mesh.indices),
+                vk::BufferUsageFlags::INDEX_BUFFER,
+            ),
+            index_count: mesh.indices.len() as u32,
+        }
+    }
+
+    pub fn free_mesh(&self, mesh: GpuMesh) {
+        self.free_buffer(mesh.vertices);
+        self.free_buffer(mesh.indices);
+    }
+}
+
+/// What differs between the engine's graphics pipelines; the rest is shared: triangle lists,
+/// counter-clockwise front faces, one sample, dynamic viewport and scissor, dynamic rendering
+/// with the engine's depth-stencil format.
+pub struct PipelineSpec<'a> {
+    /// Vertex and fragment SPIR-V.
+    pub shaders: (&'a [u8], &'a [u8]),
+    /// The vertex stride and each attribute's format and offset, at locations 0, 1, ...
+    pub vertex: (u32, &'a [(vk::Format, u32)]),
+    pub cull: vk::CullModeFlags,
+    pub depth_stencil: vk::PipelineDepthStencilStateCreateInfo<'a>,
+    /// One per colour attachment.
+    pub blend: &'a [vk::PipelineColorBlendAttachmentState],
+    pub color_formats: &'a [vk::Format],
+    /// Dynamic state besides viewport and scissor.
+    pub dynamic: &'a [vk::DynamicState],
+}
+
+/// Creates a graphics pipeline of `layout` as `spec` says.
+pub fn graphics_pipeline(
+    d: &ash::Device,
+    layout: vk::PipelineLayout,
+    spec: &PipelineSpec,
+) -> vk::Pipeline {
+    let module = |bytes: &[u8]| {
+        let code = ash::util::read_spv(&mut std::io::Cursor::new(bytes)).expect("SPIR-V");
+        unsafe { d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None) }
+            .unwrap()
+    };
+    let (vert, frag) = (module(spec.shaders.0), module(spec.shaders.1));
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::VERTEX)
+            .module(vert)
+            .name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::FRAGMENT)
+            .module(frag)
+            .name(c"main"),
+    ];
+    let (stride, attributes) = spec.vertex;
+    let bindings = [vk::VertexInputBindingDescription::default().stride(stride)];
+    let attributes: Vec<_> = attributes
+        .iter()
+        .enumerate()
+        .map(|(location, (format, offset))| {
+            vk::VertexInputAttributeDescription::default()
+                .location(location as u32)
+                .format(*format)
+                .offset(*offset)
+        })
+        .collect();
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+        .vertex_binding_descriptions(&bindings)
+        .vertex_attribute_descriptions(&attributes);
+    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+        .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default()
+        .viewport_count(1)
+        .scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .cull_mode(spec.cull)
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0);
+    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(spec.blend);
+    let dynamic: Vec<_> = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR]
+        .into_iter()
+        .chain(spec.dynamic.iter().copied())
+        .collect();
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(spec.color_formats)
+        .depth_attachment_format(crate::gbuffer::DEPTH_FORMAT)
+        .stencil_attachment_format(crate::gbuffer::DEPTH_FORMAT);
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .depth_stencil_state(&spec.depth_stencil)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .push_next(&mut rendering);
+    let pipeline = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
+        .map_err(|(_, e)| e)
+        .unwrap()[0];
+    unsafe {
+        d.destroy_shader_module(vert, None);
+        d.destroy_shader_module(frag, None);
+    }
+    pipeline
+}

@@ -2,7 +2,7 @@
 //! `gbuffer_write.glsl`), reversed-Z depth, and each draw's stencil: the BRDF slot where
 //! histencil's layout puts it, the engine's own bits where the engine keeps them.
 
-use crate::device::{barrier, Buffer, Gpu};
+use crate::device::{barrier, graphics_pipeline, Gpu, GpuMesh, PipelineSpec};
 use crate::world::World;
 use ash::vk;
 use histencil_model::StencilLayout;
@@ -28,17 +28,11 @@ struct DrawPush {
     brdf: [f32; 4],
 }
 
-fn spirv(bytes: &[u8]) -> Vec<u32> {
-    ash::util::read_spv(&mut std::io::Cursor::new(bytes)).expect("SPIR-V")
-}
-
 pub struct GBufferPass {
     pub set_layout: vk::DescriptorSetLayout,
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
-    box_vertices: Buffer,
-    box_indices: Buffer,
-    index_count: u32,
+    unit_box: GpuMesh,
 }
 
 impl GBufferPass {
@@ -69,139 +63,45 @@ impl GBufferPass {
             )
         }
         .unwrap();
-        let module = |bytes: &[u8]| {
-            let code = spirv(bytes);
-            unsafe {
-                d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&code), None)
-            }
-            .unwrap()
-        };
-        let vert = module(include_bytes!(concat!(
-            env!("OUT_DIR"),
-            "/gbuffer.vert.spv"
-        )));
-        let frag = module(include_bytes!(concat!(
-            env!("OUT_DIR"),
-            "/gbuffer.frag.spv"
-        )));
-        let stages = [
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::VERTEX)
-                .module(vert)
-                .name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(frag)
-                .name(c"main"),
-        ];
-        // histencil_scene's vertex: position, normal, uv (32 bytes).
-        let bindings = [vk::VertexInputBindingDescription::default().stride(32)];
-        let attributes = [
-            vk::VertexInputAttributeDescription::default()
-                .location(0)
-                .format(vk::Format::R32G32B32_SFLOAT),
-            vk::VertexInputAttributeDescription::default()
-                .location(1)
-                .format(vk::Format::R32G32B32_SFLOAT)
-                .offset(12),
-        ];
-        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
-            .vertex_binding_descriptions(&bindings)
-            .vertex_attribute_descriptions(&attributes);
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
-        let raster = vk::PipelineRasterizationStateCreateInfo::default()
-            .cull_mode(vk::CullModeFlags::BACK)
-            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-            .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let stencil = vk::StencilOpState::default()
             .compare_op(vk::CompareOp::ALWAYS)
             .pass_op(vk::StencilOp::REPLACE)
             .compare_mask(0xFF);
-        // Reversed Z: nearer is greater.
-        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(true)
-            .depth_write_enable(true)
-            .depth_compare_op(vk::CompareOp::GREATER)
-            .stencil_test_enable(true)
-            .front(stencil)
-            .back(stencil);
+        let f32x3 = vk::Format::R32G32B32_SFLOAT;
         let blend = [vk::PipelineColorBlendAttachmentState::default()
             .color_write_mask(vk::ColorComponentFlags::RGBA); 3];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
-        let dynamic = [
-            vk::DynamicState::VIEWPORT,
-            vk::DynamicState::SCISSOR,
-            vk::DynamicState::STENCIL_REFERENCE,
-            vk::DynamicState::STENCIL_WRITE_MASK,
-        ];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
-        let mut rendering = vk::PipelineRenderingCreateInfo::default()
-            .color_attachment_formats(&GBUFFER_FORMATS)
-            .depth_attachment_format(DEPTH_FORMAT)
-            .stencil_attachment_format(DEPTH_FORMAT);
-        let info = vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
-            .vertex_input_state(&vertex_input)
-            .input_assembly_state(&assembly)
-            .viewport_state(&viewport)
-            .rasterization_state(&raster)
-            .multisample_state(&multisample)
-            .depth_stencil_state(&depth)
-            .color_blend_state(&blend)
-            .dynamic_state(&dynamic)
-            .layout(layout)
-            .push_next(&mut rendering);
-        let pipeline =
-            unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
-                .map_err(|(_, e)| e)
-                .unwrap()[0];
-        unsafe {
-            d.destroy_shader_module(vert, None);
-            d.destroy_shader_module(frag, None);
-        }
-        let mesh = histencil_scene::unit_box();
-        let vertex_bytes: Vec<u8> = mesh
-            .vertices
-            .iter()
-            .flat_map(|v| {
-                bytemuck::cast_slice::<f32, u8>(&[v.position, v.normal].concat())
-                    .to_vec()
-                    .into_iter()
-                    .chain(bytemuck::cast_slice::<f32, u8>(&v.uv).to_vec())
-            })
-            .collect();
-        let index_bytes: &[u8] = bytemuck::cast_slice(&mesh.indices);
-        let upload = |name, bytes: &[u8], usage| {
-            let mut b = gpu.buffer(
-                name,
-                bytes.len() as u64,
-                usage,
-                gpu_allocator::MemoryLocation::CpuToGpu,
-            );
-            b.write(bytes);
-            b
-        };
+        let pipeline = graphics_pipeline(
+            d,
+            layout,
+            &PipelineSpec {
+                shaders: (
+                    include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer.vert.spv")),
+                    include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer.frag.spv")),
+                ),
+                // histencil_scene's vertex: position, normal, uv (32 bytes).
+                vertex: (32, &[(f32x3, 0), (f32x3, 12)]),
+                cull: vk::CullModeFlags::BACK,
+                // Reversed Z: nearer is greater.
+                depth_stencil: vk::PipelineDepthStencilStateCreateInfo::default()
+                    .depth_test_enable(true)
+                    .depth_write_enable(true)
+                    .depth_compare_op(vk::CompareOp::GREATER)
+                    .stencil_test_enable(true)
+                    .front(stencil)
+                    .back(stencil),
+                blend: &blend,
+                color_formats: &GBUFFER_FORMATS,
+                dynamic: &[
+                    vk::DynamicState::STENCIL_REFERENCE,
+                    vk::DynamicState::STENCIL_WRITE_MASK,
+                ],
+            },
+        );
         Self {
             set_layout,
             layout,
             pipeline,
-            box_vertices: upload(
-                "box-vertices",
-                &vertex_bytes,
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-            ),
-            box_indices: upload(
-                "box-indices",
-                index_bytes,
-                vk::BufferUsageFlags::INDEX_BUFFER,
-            ),
-            index_count: mesh.indices.len() as u32,
+            unit_box: gpu.mesh("box", &histencil_scene::unit_box()),
         }
     }
 
@@ -295,8 +195,6 @@ impl GBufferPass {
                 &[camera_set],
                 &[],
             );
-            d.cmd_bind_vertex_buffers(cmd, 0, &[self.box_vertices.buffer], &[0]);
-            d.cmd_bind_index_buffer(cmd, self.box_indices.buffer, 0, vk::IndexType::UINT32);
             for (i, object) in world.objects.iter().enumerate() {
                 let (reference, mask) = gbuffer_stencil_reference(layout, world.slot(object))
                     .expect("every object's slot is in the layout");
@@ -320,7 +218,7 @@ impl GBufferPass {
                     0,
                     bytemuck::bytes_of(&push),
                 );
-                d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+                self.unit_box.draw(d, cmd);
             }
             d.cmd_end_rendering(cmd);
         }
@@ -333,7 +231,6 @@ impl GBufferPass {
             gpu.device
                 .destroy_descriptor_set_layout(self.set_layout, None);
         }
-        gpu.free_buffer(self.box_vertices);
-        gpu.free_buffer(self.box_indices);
+        gpu.free_mesh(self.unit_box);
     }
 }
