@@ -356,3 +356,52 @@ fn color_range(image: &histencil_vk::ImageRef) -> vk::ImageSubresourceRange {
         .level_count(1)
         .layer_count(1)
 }
+
+/// The images an engine lights into: the G-buffer in `GBUFFER_FORMATS`, depth-stencil and an
+/// RGBA16F HDR image, with the contract's usages plus copies out (and the HDR image's clear).
+pub struct EngineTargets {
+    pub gbuffer: Vec<EngineImage>,
+    pub depth: EngineImage,
+    pub hdr: EngineImage,
+}
+
+impl Engine {
+    /// Lighting targets of `extent`, depth-stencil in `depth_format`.
+    pub fn lighting_targets(
+        &self,
+        extent: vk::Extent2D,
+        depth_format: vk::Format,
+    ) -> EngineTargets {
+        use vk::ImageUsageFlags as U;
+        let names = ["albedo", "normal-depth", "material"];
+        let gbuffer = names
+            .iter()
+            .zip(histencil_vk::GBUFFER_FORMATS)
+            .map(|(n, f)| self.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+            .collect();
+        let depth_usage = U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC;
+        let hdr_usage = U::COLOR_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC;
+        EngineTargets {
+            gbuffer,
+            depth: self.image("depth", depth_format, extent, depth_usage),
+            hdr: self.image("hdr", vk::Format::R16G16B16A16_SFLOAT, extent, hdr_usage),
+        }
+    }
+}
+
+impl EngineTargets {
+    /// As histencil sees them, before anything touched them.
+    pub fn refs(&self) -> histencil_vk::LightingTargets {
+        histencil_vk::LightingTargets {
+            gbuffer: [0, 1, 2].map(|i| self.gbuffer[i].as_ref(ImageState::UNDEFINED)),
+            depth_stencil: self.depth.as_ref(ImageState::UNDEFINED),
+            hdr: self.hdr.as_ref(ImageState::UNDEFINED),
+        }
+    }
+
+    pub fn free(self, engine: &Engine) {
+        for image in self.gbuffer.into_iter().chain([self.depth, self.hdr]) {
+            engine.free_image(image);
+        }
+    }
+}

@@ -8,10 +8,10 @@
 use ash::vk;
 use glam::Vec3;
 use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
-use histencil_tests::engine::{barrier, copy_to_buffer, Engine, EngineImage};
+use histencil_tests::engine::{barrier, copy_to_buffer, Engine};
 use histencil_vk::{
     Backend, BrdfSource, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame,
-    LightingTargets, Readback, Renderer, Technique, GBUFFER_FORMATS,
+    LightingTargets, Readback, Renderer, Technique,
 };
 
 const WIDTH: u32 = 96;
@@ -99,28 +99,9 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
         .unwrap();
 
         // The engine's images: its own usages (a superset of the contract's).
-        use vk::ImageUsageFlags as U;
-        let names = ["albedo", "normal-depth", "material"];
-        let gbuffer: Vec<EngineImage> = names
-            .iter()
-            .zip(GBUFFER_FORMATS)
-            .map(|(n, f)| engine.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
-            .collect();
-        let depth = engine.image(
-            "depth",
-            ds_format,
-            extent,
-            U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
-        );
-        let hdr_format = vk::Format::R16G16B16A16_SFLOAT;
-        let hdr_usage = U::COLOR_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC;
-        let hdr = engine.image("hdr", hdr_format, extent, hdr_usage);
+        let images = engine.lighting_targets(extent, ds_format);
         let readback = engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8);
-        let mut targets = LightingTargets {
-            gbuffer: [0, 1, 2].map(|i| gbuffer[i].as_ref(ImageState::UNDEFINED)),
-            depth_stencil: depth.as_ref(ImageState::UNDEFINED),
-            hdr: hdr.as_ref(ImageState::UNDEFINED),
-        };
+        let mut targets = images.refs();
 
         let d = &engine.device;
         let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
@@ -249,9 +230,7 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
                 d.destroy_command_pool(s.pool, None);
             }
         }
-        for image in gbuffer.into_iter().chain([depth, hdr]) {
-            engine.free_image(image);
-        }
+        images.free(&engine);
         engine.free_buffer(readback);
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
@@ -331,28 +310,17 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
         }
 
         let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();
-        use vk::ImageUsageFlags as U;
-        let gbuffer: Vec<EngineImage> = GBUFFER_FORMATS
-            .iter()
-            .map(|f| engine.image("g", *f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
-            .collect();
-        let depth = engine.image("d", ds_format, extent, U::DEPTH_STENCIL_ATTACHMENT);
-        let hdr_format = vk::Format::R16G16B16A16_SFLOAT;
-        let hdr = engine.image("h", hdr_format, extent, U::COLOR_ATTACHMENT);
+        let images = engine.lighting_targets(extent, ds_format);
         let small = engine.image(
             "s",
-            hdr_format,
+            vk::Format::R16G16B16A16_SFLOAT,
             vk::Extent2D {
                 width: 8,
                 height: 8,
             },
-            U::COLOR_ATTACHMENT,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT,
         );
-        let targets = LightingTargets {
-            gbuffer: [0, 1, 2].map(|i| gbuffer[i].as_ref(ImageState::UNDEFINED)),
-            depth_stencil: depth.as_ref(ImageState::UNDEFINED),
-            hdr: hdr.as_ref(ImageState::UNDEFINED),
-        };
+        let targets = images.refs();
         let view = scene.camera.view_desc(2.0);
         let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
         let bounds = scene.brdf_bounds(renderer.brdfs());
@@ -528,9 +496,8 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
         drop(native_only);
         drop(lighting);
         drop(renderer);
-        for image in gbuffer.into_iter().chain([depth, hdr, small]) {
-            engine.free_image(image);
-        }
+        images.free(&engine);
+        engine.free_image(small);
     }
     engine.destroy().assert_clean();
 }
@@ -572,30 +539,9 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
         .unwrap();
         // SAFETY: the renderer's tables outlive the one frame below, which is waited for.
         unsafe { lighting.set_lut_tables(renderer.lut_tables().unwrap()) };
-        use vk::ImageUsageFlags as U;
-        let gbuffer: Vec<EngineImage> = GBUFFER_FORMATS
-            .iter()
-            .map(|f| engine.image("g", *f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
-            .collect();
-        let depth = engine.image(
-            "d",
-            ds_format,
-            extent,
-            U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
-        );
-        let hdr_format = vk::Format::R16G16B16A16_SFLOAT;
-        let hdr = engine.image(
-            "h",
-            hdr_format,
-            extent,
-            U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
-        );
+        let images = engine.lighting_targets(extent, ds_format);
         let readback = engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8);
-        let mut targets = LightingTargets {
-            gbuffer: [0, 1, 2].map(|i| gbuffer[i].as_ref(ImageState::UNDEFINED)),
-            depth_stencil: depth.as_ref(ImageState::UNDEFINED),
-            hdr: hdr.as_ref(ImageState::UNDEFINED),
-        };
+        let mut targets = images.refs();
         let view = scene.camera.view_desc(WIDTH as f32 / HEIGHT as f32);
         // The lights as the renderer validated them (directions unit, ranges capped).
         let lights = renderer.scene().lights.clone();
@@ -667,9 +613,7 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
 
         drop(lighting);
         drop(renderer);
-        for image in gbuffer.into_iter().chain([depth, hdr]) {
-            engine.free_image(image);
-        }
+        images.free(&engine);
         engine.free_buffer(readback);
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
