@@ -4,7 +4,7 @@
 //!
 //! The planner works on plain values ([`EntityDesc`]: what an entity is, its world bounds, its
 //! coverage on screen if the caller knows better, a forced side), so an engine plans its own
-//! entities the way histencil plans a scene's ([`scene_entities`], [`crate::plan_layout`]).
+//! entities the way histencil plans a scene's ([`crate::plan_layout`]).
 
 use crate::{side_for_coverage, Atlas, AtlasError, Region, MIN_SIDE};
 use glam::{Mat4, Vec3};
@@ -297,41 +297,6 @@ pub fn entities(scene: &Scene) -> impl Iterator<Item = EntityKey> {
         .chain((0..scene.particle_systems.len()).map(EntityKey::System))
 }
 
-/// The descriptions of `scene`'s alpha entities in [`entities`] order, seen from its camera at
-/// `viewport_height` pixels, every side forced to `forced_side` if given.
-pub fn scene_entities(
-    scene: &Scene,
-    viewport_height: u32,
-    forced_side: Option<u32>,
-) -> Vec<EntityDesc> {
-    let viewer = Viewer::from_camera(&scene.camera);
-    entities(scene)
-        .map(|key| {
-            let bounds = key.world_bounds(scene);
-            let (kind, coverage_px) = match key {
-                EntityKey::Object(_) => (EntityKind::Surface, None),
-                EntityKey::System(i) => {
-                    let s = &scene.particle_systems[i];
-                    let coverage = (s.layout == ParticleLayout::Ribbon)
-                        .then(|| ribbon_length_px(&viewer, &s.particles, viewport_height));
-                    let count = s.particles.len() as u32;
-                    let kind = EntityKind::Particles {
-                        layout: s.layout,
-                        count,
-                    };
-                    (kind, coverage)
-                }
-            };
-            EntityDesc {
-                kind,
-                bounds,
-                coverage_px,
-                side: forced_side,
-            }
-        })
-        .collect()
-}
-
 /// Largest atlas side a renderer tries before regions are halved: 4096^2 RGBA16F texels are
 /// 128 MiB, and every Vulkan 1.3 device allows 4096-texel images.
 pub const MAX_ATLAS_SIDE: u32 = 4096;
@@ -466,7 +431,12 @@ mod tests {
     fn region_shapes_follow_the_layouts() {
         let shape_of = |s: &Scene, index: usize, height: u32, forced: Option<u32>| {
             let viewer = Viewer::from_camera(&s.camera);
-            region_shape(&scene_entities(s, height, forced)[index], &viewer, height)
+            let meshes = crate::ProbeMeshes::new(s);
+            let desc = EntityDesc {
+                side: forced,
+                ..crate::scene_alpha_entities(s, &meshes)[index].desc()
+            };
+            region_shape(&desc, &viewer, height)
         };
         let mut s = scene("volume");
         s.particle_systems[0].layout = ParticleLayout::Slices { count: 8 };

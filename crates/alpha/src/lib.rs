@@ -38,9 +38,9 @@ pub use estimate::{
 };
 pub use layout::{
     bounding_sphere, check_forced_side, dust_grid, entities, entity_problem, plan_regions,
-    projected_diameter, region_shape, scene_entities, EntityDesc, EntityKey, EntityKind,
-    EntityRegion, LayoutError, LightmapLayout, RegionShape, Viewer, ATLAS_PADDING, MAX_ATLAS_SIDE,
-    MAX_FORCED_SIDE, START_ATLAS_SIDE,
+    projected_diameter, region_shape, EntityDesc, EntityKey, EntityKind, EntityRegion, LayoutError,
+    LightmapLayout, RegionShape, Viewer, ATLAS_PADDING, MAX_ATLAS_SIDE, MAX_FORCED_SIDE,
+    START_ATLAS_SIDE,
 };
 pub use plan::{plan_entities, plan_layout, AlphaPlan, ChoiceSettings};
 pub use probes::{back_to_front, camera_axes, fit_frame, particle_bounds, probe_point, ProbeFrame};
