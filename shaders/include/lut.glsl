@@ -64,7 +64,8 @@ bool lut_coordinates(LutTable table, vec3 N, vec3 T, vec3 V, vec3 L, out vec3 u)
         if (!brdf_normalize(N, n) || !brdf_normalize(V, v) || !brdf_normalize(L, l)) {
             return false;
         }
-        if (dot(n, l) <= 0.0 || dot(n, v) < 0.0) {
+        float n_dot_v;
+        if (dot(n, l) <= 0.0 || !brdf_above_horizon(n, v, n_dot_v)) {
             return false;
         }
         vec3 lp, vp;

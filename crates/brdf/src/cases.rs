@@ -154,6 +154,10 @@ pub fn hard_directions() -> Vec<(String, [V3<f64>; 4])> {
             [N, T, with_cos(cos, 0.5), with_cos(cos, 0.5 + 3.0)],
         ));
     }
+    // Shading normals put the view below the horizon along silhouettes; opposite the normal it
+    // has no azimuth.
+    out.push(("n.v=-0.3".into(), [N, T, with_cos(-0.3, 0.5), l]));
+    out.push(("v==-n".into(), [N, T, N.map(|x| -x), l]));
     out.push(("l==v".into(), [N, T, l, l]));
     out.push(("l==-v".into(), [N, T, l.map(|x| -x), l]));
     out.push(("l==n".into(), [N, T, v, N]));

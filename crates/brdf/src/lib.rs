@@ -6,8 +6,10 @@
 //! unit irradiance perpendicular to the light. So Lambert is `rho / pi * max(N.L, 0)`.
 //! - All vectors point away from the surface and need not be normalized; denormal-scale and huge
 //!   inputs are rescaled before normalising. A zero (or non-finite) vector gives 0.
-//! - Surface BRDFs (Lambert, Blinn-Phong, Oren-Nayar, GGX): `N.L <= 0` or `N.V < 0` gives 0;
-//!   `N.V == 0` with `N.L > 0` gives the finite limit.
+//! - Surface BRDFs (Lambert, Blinn-Phong, Oren-Nayar, GGX): `N.L <= 0` gives 0; a view below
+//!   the horizon (`N.V < 0`, which shading normals give along silhouettes) is evaluated as the
+//!   grazing view of the same azimuth, so the value is continuous there; `N.V == 0` with
+//!   `N.L > 0` gives the finite limit.
 //! - Kajiya-Kay ignores N and is not gated; a zero tangent gives 0.
 //! - Penner skin is not gated (light wraps past the terminator) and ignores V.
 //! - GGX clamps alpha to [`GGX_MIN_ALPHA`]; `pow(0, 0)` is 1 everywhere (GLSL leaves it undefined,

@@ -22,7 +22,7 @@
 
 use crate::cases::{halton, sphere_point};
 use crate::model::Brdf;
-use crate::vector::{angle_between, dot, normalize, scale, sub, V3};
+use crate::vector::{above_horizon, angle_between, dot, normalize, scale, sub, V3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// The geometric axes a table is sampled over (see the module doc).
@@ -87,8 +87,8 @@ impl LutAxes {
     }
 
     /// The table coordinates (each in [0, 1]) of a shading point, or `None` where the model
-    /// gives 0 without looking anything up (zero vectors; `N.L <= 0` or `N.V < 0` for the
-    /// surface models, as their gate says). `curvature_per_mm` is only read by skin.
+    /// gives 0 without looking anything up (zero vectors; `N.L <= 0` for the surface models, as
+    /// their gate says; a view below the horizon is looked up as grazing, as they evaluate it). `curvature_per_mm` is only read by skin.
     pub fn coordinates(
         self,
         [n, t, v, l]: [V3<f64>; 4],
@@ -102,9 +102,10 @@ impl LutAxes {
             }
             LutAxes::Isotropic => {
                 let (n, v, l) = (normalize(n)?, normalize(v)?, normalize(l)?);
-                if dot(n, l) <= 0.0 || dot(n, v) < 0.0 {
+                if dot(n, l) <= 0.0 {
                     return None;
                 }
+                let (v, _) = above_horizon(n, v)?;
                 let in_plane = |d: V3<f64>| normalize(sub(d, scale(n, dot(n, d))));
                 let phi = match (in_plane(l), in_plane(v)) {
                     (Some(lp), Some(vp)) => angle_between(lp, vp),

@@ -77,6 +77,16 @@ pub(crate) fn pow_safe<R: Real>(x: R, e: R) -> R {
     }
 }
 
+/// A unit view `v` moved onto the horizon of the unit normal `n` where it lies below it, with
+/// its cosine (0 there): see `models::surface::lit`.
+pub(crate) fn above_horizon<R: Real>(n: V3<R>, v: V3<R>) -> Option<(V3<R>, R)> {
+    let n_dot_v = dot(n, v).min(R::one());
+    if n_dot_v >= R::zero() {
+        return Some((v, n_dot_v));
+    }
+    Some((normalize(sub(v, scale(n, n_dot_v)))?, R::zero()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

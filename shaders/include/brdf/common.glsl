@@ -34,6 +34,21 @@ float brdf_pow(float x, float e) {
     return pow(x, e);
 }
 
+// Moves the unit view `v` onto the horizon of the unit normal `n` where it lies below it (N.V < 0,
+// which interpolated shading normals give along silhouettes), with its cosine, 0 there: the
+// surface BRDFs stay continuous in V at the horizon, so forward and deferred, an ulp apart, cannot
+// differ by a whole grazing value on silhouette pixels. False only for v = -n, which has no azimuth. As above_horizon in
+// crates/brdf/src/vector.rs.
+bool brdf_above_horizon(vec3 n, inout vec3 v, out float n_dot_v) {
+    n_dot_v = min(dot(n, v), 1.0);
+    if (n_dot_v >= 0.0) {
+        return true;
+    }
+    bool ok = brdf_normalize(v - n * n_dot_v, v);
+    n_dot_v = 0.0;
+    return ok;
+}
+
 float brdf_sin_from_cos(float c) {
     return sqrt(max(1.0 - c * c, 0.0));
 }

@@ -20,8 +20,7 @@ bool brdf_lit(vec3 N, vec3 V, vec3 L, out BrdfLit s) {
         return false;
     }
     s.n_dot_l = min(dot(s.n, s.l), 1.0);
-    s.n_dot_v = min(dot(s.n, s.v), 1.0);
-    return s.n_dot_l > 0.0 && s.n_dot_v >= 0.0;
+    return s.n_dot_l > 0.0 && brdf_above_horizon(s.n, s.v, s.n_dot_v);
 }
 
 float brdf_lambert(float rho, vec3 N, vec3 L) {

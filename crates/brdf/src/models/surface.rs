@@ -1,7 +1,7 @@
 //! Lambert, normalized Blinn-Phong, Oren-Nayar (full and qualitative) and GGX: the surface
-//! BRDFs, gated by `N.L > 0` and `N.V >= 0`.
+//! BRDFs, gated by `N.L > 0`, with a view below the horizon taken as grazing (see `lit`).
 
-use crate::vector::{add, c, cross, dot, normalize, pow_safe, scale, sub, Real, V3};
+use crate::vector::{above_horizon, add, c, cross, dot, normalize, pow_safe, scale, sub, Real, V3};
 
 /// Unit directions and cosines of a lit surface point, or `None` when it is not lit.
 pub(crate) struct Lit<R: Real> {
@@ -12,12 +12,21 @@ pub(crate) struct Lit<R: Real> {
     pub n_dot_v: R,
 }
 
-/// Normalises and gates: `None` for zero vectors, `N.L <= 0` or `N.V < 0`.
+/// Normalises and gates: `None` for zero vectors or `N.L <= 0`. A view below the horizon
+/// (`N.V < 0`, which interpolated shading normals give on visible front faces along
+/// silhouettes) is taken as the grazing view of the same azimuth: `V` projected onto the tangent
+/// plane, `N.V = 0`. That keeps every surface BRDF continuous in `V` at the horizon. A gate there
+/// (0 below, the whole grazing value above) would let two computations an ulp apart, forward's
+/// interpolated position and deferred's reconstructed one, differ by that whole value on a
+/// silhouette pixel. Only `V = -N` exactly, with no azimuth, gives `None`.
 pub(crate) fn lit<R: Real>(n: V3<R>, v: V3<R>, l: V3<R>) -> Option<Lit<R>> {
     let (n, v, l) = (normalize(n)?, normalize(v)?, normalize(l)?);
     let n_dot_l = dot(n, l).min(R::one());
-    let n_dot_v = dot(n, v).min(R::one());
-    (n_dot_l > R::zero() && n_dot_v >= R::zero()).then_some(Lit {
+    if n_dot_l <= R::zero() {
+        return None;
+    }
+    let (v, n_dot_v) = above_horizon(n, v)?;
+    Some(Lit {
         n,
         v,
         l,
