@@ -4,6 +4,7 @@
 
 use anyhow::Result;
 use histencil_check::{CheckOptions, CheckScene, InjectedFault, Outcome};
+use histencil_scene::DefaultLights;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -54,7 +55,7 @@ fn usage(e: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(2)
 }
 
-pub fn check(args: &CheckArgs) -> ExitCode {
+pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     let names = if args.scenes.is_empty() {
         histencil_scene::EMBEDDED
             .iter()
@@ -65,7 +66,7 @@ pub fn check(args: &CheckArgs) -> ExitCode {
     };
     let mut scenes = Vec::new();
     for name in names {
-        match crate::load_scene_arg(&name) {
+        match crate::load_scene_arg(&name, lights) {
             Ok(scene) => scenes.push(CheckScene { name, scene }),
             Err(e) => return usage(e),
         }

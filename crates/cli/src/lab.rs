@@ -3,6 +3,7 @@
 use crate::on_device;
 use anyhow::{bail, Result};
 use histencil_lab::{CompareSettings, SweepParam};
+use histencil_scene::DefaultLights;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
@@ -173,7 +174,7 @@ fn steady_llvmpipe() {
     }
 }
 
-pub fn compare(args: &CompareArgs) -> Result<()> {
+pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     steady_llvmpipe();
     histencil_vk::check_output_dir(&args.out)?;
     if let Some(bad) = args
@@ -188,7 +189,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
         CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
     settings.target_ci = sampling.target;
     settings.budget = sampling.budget;
-    settings.scene = crate::load_scene_arg(&args.scene)?;
+    settings.scene = crate::load_scene_arg(&args.scene, lights)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;
     let report = on_device(args.run.validate, |ctx| {
@@ -203,7 +204,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
-pub fn sweep(args: &SweepArgs) -> Result<()> {
+pub fn sweep(args: &SweepArgs, lights: DefaultLights) -> Result<()> {
     steady_llvmpipe();
     histencil_vk::check_output_dir(&args.out)?;
     let param = match args.param {
@@ -217,7 +218,10 @@ pub fn sweep(args: &SweepArgs) -> Result<()> {
     } else {
         args.values.clone()
     };
-    let scene = crate::load_scene_arg(args.scene.as_deref().unwrap_or(param.default_scene()))?;
+    let scene = crate::load_scene_arg(
+        args.scene.as_deref().unwrap_or(param.default_scene()),
+        lights,
+    )?;
     let report = on_device(args.run.validate, |ctx| {
         let bar = progress_bar(Some(values.len() as u64));
         bar.set_message(format!("{} on {}", param.name(), scene.name));
@@ -275,10 +279,10 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     Ok(())
 }
 
-pub fn demo(args: &DemoArgs) -> Result<()> {
+pub fn demo(args: &DemoArgs, lights: DefaultLights) -> Result<()> {
     histencil_vk::check_output_file(&args.out)?;
     let settings = histencil_lab::DemoSettings {
-        scene: crate::load_scene_arg(&args.scene)?,
+        scene: crate::load_scene_arg(&args.scene, lights)?,
         width: args.run.width,
         height: args.run.height,
         frames: args.run.frames as usize,

@@ -4,6 +4,7 @@ use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
 use histencil_alpha::ParameterKind;
 use histencil_check::matrix::Platform;
+use histencil_scene::{with_default_lights, DefaultLights};
 use histencil_vk::{
     AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, Technique,
 };
@@ -24,6 +25,10 @@ mod lab;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Render a scene without lights unlit (black) instead of lighting it with the default rig
+    /// (a key directional light from the camera's upper left and a dim fill from the right).
+    #[arg(long, global = true)]
+    no_default_lights: bool,
 }
 
 #[derive(Subcommand)]
@@ -33,8 +38,9 @@ enum Command {
     /// A short tour of the talk: stencil on the 360-like, PS3-like and native backends next to
     /// branching and forward, with times, errors and hi-stencil statistics, and a contact sheet.
     Demo(lab::DemoArgs),
-    /// List the embedded scenes: name, BRDFs in use, lights, alpha entities, description.
-    Scenes,
+    /// List the embedded scenes, then any glTF files given: name, BRDFs in use, lights, alpha
+    /// entities, description (which says when the default rig lights a scene).
+    Scenes(ScenesArgs),
     /// The talk's table on this device: lighting time with 1, 2, 3 BRDFs per technique and
     /// platform backend, the per-BRDF breakdown, a light-size sweep, each next to its error
     /// against forward; writes report.md, report.json and PNG plots.
@@ -54,6 +60,12 @@ enum Command {
     /// Print the error of the BRDF look-up tables against resolution and the error the G-buffer
     /// encodings add (markdown), both against the f64 reference.
     BrdfReport(BrdfReportArgs),
+}
+
+#[derive(clap::Args)]
+struct ScenesArgs {
+    /// `.gltf` / `.glb` files to list after the embedded scenes.
+    files: Vec<String>,
 }
 
 #[derive(clap::Args)]
@@ -259,11 +271,18 @@ fn parse_byte(text: &str) -> Result<u8, String> {
     parsed.map_err(|_| format!("`{text}` is not a byte (0-255 or 0x00-0xFF)"))
 }
 
-/// The scene `--scene` names, with a warning on stderr when it has no lights: its image is
-/// black (every technique lights only), which is correct but looks like a failure.
-pub(crate) fn load_scene_arg(spec: &str) -> Result<histencil_scene::Scene> {
-    let scene = histencil_scene::load_scene(spec)?;
-    if scene.lights.is_empty() {
+/// The scene `--scene` names. A scene without lights gets the default rig unless `lights` is
+/// `Off`, announced on stderr; left unlit it gets a warning, since its black image is correct
+/// but looks like a failure.
+pub(crate) fn load_scene_arg(spec: &str, lights: DefaultLights) -> Result<histencil_scene::Scene> {
+    let (scene, rigged) = with_default_lights(histencil_scene::load_scene(spec)?, lights);
+    if rigged {
+        eprintln!(
+            "histencil: scene `{spec}` has no lights: lit by the default rig (a key directional \
+             light from the camera's upper left, a dim fill from the right); \
+             --no-default-lights renders it unlit"
+        );
+    } else if scene.lights.is_empty() {
         eprintln!(
             "histencil: warning: scene `{spec}` has no lights, so every technique renders it \
              black (glTF lights come from KHR_lights_punctual)"
@@ -272,8 +291,8 @@ pub(crate) fn load_scene_arg(spec: &str) -> Result<histencil_scene::Scene> {
     Ok(scene)
 }
 
-fn render(args: &RenderArgs) -> Result<()> {
-    let scene = load_scene_arg(&args.scene)?;
+fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
+    let scene = load_scene_arg(&args.scene, lights)?;
     let costs = lab::read_costs_arg(args.costs.as_deref())?;
     for path in [
         Some(&args.out),
@@ -492,16 +511,33 @@ fn brdf_report(args: &BrdfReportArgs) -> Result<()> {
     Ok(())
 }
 
-fn scenes() {
-    for (name, description) in histencil_scene::EMBEDDED {
-        let scene = histencil_scene::embedded(name).expect("embedded scenes exist");
+fn scenes(args: &ScenesArgs, lights: DefaultLights) -> Result<()> {
+    let row = |name: &str, scene: &histencil_scene::Scene, description: &str| {
         println!(
             "{name}\t{}\t{}\t{}\t{description}",
             scene.brdfs_in_use().len(),
             scene.lights.len(),
             scene.alpha_entity_count()
         );
+    };
+    for (name, description) in histencil_scene::EMBEDDED {
+        let scene = histencil_scene::embedded(name).expect("embedded scenes exist");
+        row(name, &scene, description);
     }
+    for file in &args.files {
+        let loaded = histencil_scene::load_scene(file)?;
+        let (scene, rigged) = with_default_lights(loaded, lights);
+        let description = match (rigged, scene.lights.is_empty()) {
+            (true, _) => format!(
+                "{}; no lights of its own: lit by the default rig",
+                scene.description
+            ),
+            (false, true) => format!("{}; no lights: renders black", scene.description),
+            (false, false) => scene.description.clone(),
+        };
+        row(&scene.name, &scene, &description);
+    }
+    Ok(())
 }
 
 fn main() -> ExitCode {
@@ -525,16 +561,18 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let lights = if cli.no_default_lights {
+        DefaultLights::Off
+    } else {
+        DefaultLights::IfNone
+    };
     let result = match &cli.command {
-        Command::Check(args) => return check::check(args),
-        Command::Render(args) => render(args),
-        Command::Scenes => {
-            scenes();
-            Ok(())
-        }
-        Command::Compare(args) => lab::compare(args),
-        Command::Demo(args) => lab::demo(args),
-        Command::Sweep(args) => lab::sweep(args),
+        Command::Check(args) => return check::check(args, lights),
+        Command::Render(args) => render(args, lights),
+        Command::Scenes(args) => scenes(args, lights),
+        Command::Compare(args) => lab::compare(args, lights),
+        Command::Demo(args) => lab::demo(args, lights),
+        Command::Sweep(args) => lab::sweep(args, lights),
         Command::Calibrate(args) => lab::calibrate(args),
         Command::BrdfEval(args) => brdf_eval(args),
         Command::BrdfReport(args) => brdf_report(args),

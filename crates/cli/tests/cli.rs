@@ -384,9 +384,10 @@ fn brdf_eval_takes_directions_of_any_finite_length_on_both_devices() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// A glTF without lights renders (black, correctly) and says why on stderr.
+/// A glTF without lights (most of the Khronos samples) is lit by the default rig, announced on
+/// stderr and in `scenes`; `--no-default-lights` renders it black, with a warning.
 #[test]
-fn a_scene_without_lights_is_announced() {
+fn a_scene_without_lights_gets_the_default_rig() {
     let dir = std::env::temp_dir().join(format!("histencil-no-lights-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // One triangle: 3 positions (36 bytes) as a base64 data URI.
@@ -412,23 +413,46 @@ fn a_scene_without_lights_is_announced() {
     );
     let path = dir.join("dark.gltf");
     std::fs::write(&path, gltf).unwrap();
-    let out = dir.join("dark.png");
-    let (ok, _, stderr) = histencil(&[
-        "render",
-        "--scene",
-        path.to_str().unwrap(),
-        "--width",
-        "8",
-        "--height",
-        "8",
-        "--frames",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stderr}");
+    let scene = path.to_str().unwrap();
+    let render = |out: &std::path::Path, extra: &[&str]| {
+        let mut args = vec!["render", "--scene", scene, "--width", "8", "--height", "8"];
+        args.extend([
+            "--frames",
+            "1",
+            "--validate",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        args.extend(extra);
+        let (ok, _, stderr) = histencil(&args);
+        assert!(ok, "{stderr}");
+        let lit = image::open(out).unwrap().into_rgba8();
+        let brightest = lit
+            .pixels()
+            .map(|p| p.0[..3].iter().copied().max().unwrap())
+            .max();
+        (brightest.unwrap(), stderr)
+    };
+    // By default the rig lights it, and says so.
+    let (brightest, stderr) = render(&dir.join("rig.png"), &[]);
+    assert!(stderr.contains("lit by the default rig"), "{stderr}");
+    assert!(brightest > 64, "the triangle is lit: {brightest}");
+    // Without the rig it is black, with a warning.
+    let (brightest, stderr) = render(&dir.join("dark.png"), &["--no-default-lights"]);
     assert!(stderr.contains("has no lights"), "{stderr}");
-    assert!(out.exists());
+    assert_eq!(brightest, 0);
+    // `scenes` lists the file with the rig's two lights and says where they come from.
+    let (ok, stdout, stderr) = histencil(&["scenes", scene]);
+    assert!(ok, "{stderr}");
+    let row = stdout.lines().last().unwrap();
+    let columns: Vec<&str> = row.split('\t').collect();
+    assert_eq!(columns[..4], ["dark", "1", "2", "0"], "{row}");
+    assert!(columns[4].ends_with("lit by the default rig"), "{row}");
+    let (ok, stdout, _) = histencil(&["scenes", "--no-default-lights", scene]);
+    assert!(
+        ok && stdout.lines().last().unwrap().contains("\t0\t0\t"),
+        "{stdout}"
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -5,6 +5,7 @@ mod alpha;
 mod alpha_scenes;
 mod embedded;
 mod import;
+mod light_rig;
 mod mesh;
 mod shading;
 mod types;
@@ -14,6 +15,9 @@ pub use alpha_scenes::{glass_sphere, smoke_volume};
 pub use embedded::{embedded, embedded_names, EMBEDDED};
 pub use import::{
     import_gltf, load_gltf, load_scene, material_from_gltf, ImportError, MaterialError,
+};
+pub use light_rig::{
+    default_light_rig, with_default_lights, DefaultLights, FILL_SHARE, KEY_RADIANCE,
 };
 pub use mesh::{
     light_cone, light_sphere, unit_box, unit_box_bake, uv_sphere, Mesh, Vertex, BOX_UV_INSET,
