@@ -12,12 +12,14 @@ layout(location = 5) in vec3 in_located;
 
 layout(location = 0) out vec4 out_color;
 
-// How the fragment is lit: forward per pixel, by the single probe, or (neither) from the
-// lightmap. A pipeline per mode, so the lightmap pipeline carries none of the per-pixel
+// How the fragment is lit: forward per pixel, by the single probe, through the direction map, or
+// (none) from the lightmap. A pipeline per mode, so the lightmap pipeline carries none of the per-pixel
 // reference's code (on a CPU rasteriser the unused branch and its inputs cost as much as the
 // lookup). Booleans, as naga reads no specialisation-constant arithmetic.
 layout(constant_id = 0) const bool LIT_FORWARD = false;
 layout(constant_id = 1) const bool LIT_BY_PROBE = false;
+// From the atlas's incident light and the direction map, with the fragment's own BRDF.
+layout(constant_id = 2) const bool LIT_DIRECTIONAL = false;
 
 void main() {
     AlphaEntity e = entities[in_entity];
@@ -36,6 +38,11 @@ void main() {
         // Dust reads its mote's texel (flat: the interpolated copy may round off the index).
         float param = e.shape.x == ALPHA_DUST ? in_mote : in_param;
         lit = lightmap_particle_at(lightmap, lightmap_sampler, e, in_located, param);
+        if (LIT_DIRECTIONAL) {
+            vec4 direction =
+                lightmap_particle_at_rgba(direction_map, lightmap_sampler, e, in_located, param);
+            lit = directional_lighting(s, normalize(frame.eye.xyz - P), lit, direction);
+        }
     }
     out_color = vec4(lit * coverage, coverage);
 }

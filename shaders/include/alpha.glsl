@@ -8,6 +8,7 @@
 
 #include "light.glsl"
 #include "alpha_entity.glsl"
+#include "lightmap_sample.glsl"
 
 layout(set = 1, binding = 0, std430) readonly buffer AlphaEntities {
     AlphaEntity entities[];
@@ -75,6 +76,67 @@ vec3 ribbon_point(AlphaEntity e, float t) {
     vec3 a = points[e.shape.z + i].xyz;
     vec3 b = points[e.shape.z + i + 1u].xyz;
     return mix(a, b, x - float(i));
+}
+
+// The probe of the lightmap texel at `local` (texel coordinates inside the entity's region): its
+// world position P and normal N. False for a texel that holds no probe (outside the mesh's UV
+// layout, past the last mote, past the last slice).
+bool lightmap_probe(AlphaEntity e, ivec2 local, out vec3 P, out vec3 N) {
+    P = vec3(0.0);
+    N = vec3(0.0, 0.0, 1.0);
+    uint kind = e.shape.x;
+    if (kind == ALPHA_OBJECT) {
+        AlphaProbe probe = probes[e.shape.z + uint(local.y) * e.region.z + uint(local.x)];
+        if (probe.position.w == 0.0) {
+            return false;
+        }
+        P = (e.model * vec4(probe.position.xyz, 1.0)).xyz;
+        N = normalize(transpose(inverse(mat3(e.model))) * probe.normal.xyz);
+        return true;
+    }
+    if (kind == ALPHA_DUST) {
+        uint i = uint(local.y) * e.region.z + uint(local.x);
+        if (i >= e.shape.w) {
+            return false;
+        }
+        P = points[e.shape.z + i].xyz;
+    } else if (kind == ALPHA_RIBBON) {
+        P = ribbon_point(e, (float(local.x) + 0.5) / float(e.region.z));
+    } else {
+        // Slices: tile k at (k % columns, k / columns) of the region.
+        uvec2 tile = uvec2(local) / e.region.zw;
+        uint k = tile.y * tile_columns(e) + tile.x;
+        if (k >= e.shape.y) {
+            return false;
+        }
+        vec2 in_tile = vec2(uvec2(local) - tile * e.region.zw) + 0.5;
+        P = frame_probe(e, in_tile / vec2(e.region.zw), k);
+    }
+    N = facing_normal(P);
+    return true;
+}
+
+// The BRDF without its cosine, f_r(N, V, L): evaluate_brdf divided by N.L (0 behind N).
+vec3 brdf_without_cosine(Surface s, vec3 V, vec3 L) {
+    float c = dot(s.normal, L);
+    return c > 0.0 ? evaluate_brdf(s, s.brdf, V, L) / c : vec3(0.0);
+}
+
+// The light a direction-mapped entity reflects towards V at surface s (its own normal and
+// BRDF): `irradiance` is the atlas's (the sum of incident * N.L at the probe), `direction` the
+// direction map's (sum of w L, sum of w) there (lightmap_direction in lightmap_sample.glsl
+// decodes it). irradiance * f_r(L) is exact for one light, and for any number on a Lambert
+// surface (f_r is constant); the share of the light that one direction does not explain (lights
+// on several sides) is taken as arriving along the normal.
+vec3 directional_lighting(Surface s, vec3 V, vec3 irradiance, vec4 direction) {
+    vec3 L;
+    float directionality;
+    if (!lightmap_direction(direction, L, directionality)) {
+        return vec3(0.0);
+    }
+    vec3 along = brdf_without_cosine(s, V, L);
+    vec3 spread = brdf_without_cosine(s, V, s.normal);
+    return irradiance * mix(spread, along, directionality);
 }
 
 // Every light's contribution at surface s (the forward reference), over the entity's light

@@ -1,5 +1,5 @@
-// The lightmap atlas in histencil's own alpha pass: set 2, sampled through lightmap_sample.glsl
-// with a linear clamp-to-edge sampler.
+// The lightmap atlas (and direction map) in histencil's own alpha pass: set 2, sampled through
+// lightmap_sample.glsl with a linear clamp-to-edge sampler.
 #ifndef ALPHA_LIGHTMAP_GLSL
 #define ALPHA_LIGHTMAP_GLSL
 
@@ -8,5 +8,7 @@
 
 layout(set = 2, binding = 0) uniform texture2D lightmap;
 layout(set = 2, binding = 1) uniform sampler lightmap_sampler;
+// The direction map of directional frames (lightmap_directional.frag); bound in every mode.
+layout(set = 2, binding = 2) uniform texture2D direction_map;
 
 #endif

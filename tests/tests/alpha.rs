@@ -2,6 +2,7 @@
 //! and the classic single light probe, on the embedded alpha scenes and on scenes built here.
 
 use glam::Vec3;
+use histencil_brdf::Brdf;
 use histencil_scene::{glass_sphere, Light, ParticleLayout, Scene};
 use histencil_tests::{output_dir, with_validated_context};
 use histencil_vk::{masked_error, AlphaMode, Context, FrameDesc, Readback, Renderer, Technique};
@@ -93,6 +94,52 @@ fn lightmap_error_falls_with_resolution_and_is_small_at_the_default() {
         assert!(
             default_error.0 <= 2.0,
             "default lightmap mean error {default_error:?} > 2/255"
+        );
+    });
+}
+
+/// With one light the direction map loses nothing but interpolation, and the fragment evaluates
+/// the sphere's sharp Blinn-Phong lobe with its own normal, where a plain lightmap interpolates
+/// the lobe between texels: below the plain lightmap's error at every side. (Under many lights
+/// one direction stands for all of them; the README measures where that loses.)
+#[test]
+fn the_direction_map_follows_a_sharp_highlight_under_one_light() {
+    with_validated_context(|ctx| {
+        let mut scene = sphere_near_a_light();
+        // The light alone, reaching past the sphere so that the frame behind it is lit too.
+        let mut light = *scene.lights.last().unwrap();
+        light.radius = 8.0;
+        scene.lights = vec![light];
+        let sphere = scene.alpha_objects.last_mut().unwrap();
+        sphere.material.brdf = Brdf::BlinnPhong { exponent: 200.0 };
+        let background = frame(ctx, &scene.without_alpha(), AlphaMode::Forward, None);
+        let forward = frame(ctx, &scene, AlphaMode::Forward, None);
+        let mut rows = Vec::new();
+        for side in [Some(16), Some(32), Some(64), None] {
+            let plain = frame(ctx, &scene, AlphaMode::Lightmap, side);
+            let directional = frame(ctx, &scene, AlphaMode::Directional, side);
+            rows.push((
+                side,
+                alpha_error(&plain, &forward, &background),
+                alpha_error(&directional, &forward, &background),
+            ));
+            if side.is_none() {
+                save("highlight-lightmap", &plain);
+                save("highlight-directional", &directional);
+            }
+        }
+        save("highlight-forward", &forward);
+        eprintln!("side, (plain mean, max), (directional mean, max): {rows:?}");
+        for (side, plain, directional) in &rows {
+            assert!(
+                directional.0 < plain.0 / 1.5,
+                "side {side:?}: directional {directional:?} not well below plain {plain:?}"
+            );
+        }
+        let (_, _, default) = rows.last().unwrap();
+        assert!(
+            default.0 <= 1.0,
+            "directional at the default side: {default:?}"
         );
     });
 }

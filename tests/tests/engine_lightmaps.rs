@@ -13,7 +13,7 @@ use histencil_alpha::{
     Viewer,
 };
 use histencil_scene::{Light, ParticleLayout, Scene, Shape};
-use histencil_tests::engine::{copy_to_buffer, Engine, EngineBuffer};
+use histencil_tests::engine::{copy_to_buffer, Engine, EngineBuffer, EngineImage};
 use histencil_vk::{
     AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, Context, Error, ImageRef,
     ImageState, LightmapFrame,
@@ -111,6 +111,7 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
             &AlphaLightmapsDesc {
                 atlas_format: FORMAT,
                 frames_in_flight: 2,
+                direction_format: None,
             },
         )
         .unwrap();
@@ -261,6 +262,162 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
 
 /// Every frame that does not fit is refused with `BadFrame` before anything is recorded (the
 /// command buffer ends empty and valid), one case per class of mistake.
+/// A direction map recorded into an engine's images: at every dust mote (a probe whose position
+/// the test knows) under one light, the atlas holds the light's irradiance through the mote's
+/// normal (it faces the camera) and the map its direction with weight; everywhere, no weight
+/// without irradiance, directions no longer than their weight, nothing outside the regions.
+#[test]
+fn an_engine_records_a_direction_map() {
+    let mut scene = all_kinds();
+    let meshes = ProbeMeshes::new(&scene);
+    let dust_index = scene
+        .particle_systems
+        .iter()
+        .position(|p| p.layout == ParticleLayout::Dust)
+        .unwrap();
+    let motes = scene.particle_systems[dust_index].particles.clone();
+    let centre = motes.iter().map(|p| p.position).sum::<Vec3>() / motes.len() as f32;
+    scene.lights = vec![Light::point(
+        centre + Vec3::new(0.4, 1.2, 0.6),
+        20.0,
+        Vec3::new(2.0, 1.5, 1.0),
+    )];
+    let light = scene.lights[0];
+    let engine = Engine::start();
+    {
+        // SAFETY: as above.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let mut lightmaps = AlphaLightmaps::new(
+            &ctx,
+            &AlphaLightmapsDesc {
+                atlas_format: FORMAT,
+                frames_in_flight: 1,
+                direction_format: Some(FORMAT),
+            },
+        )
+        .unwrap();
+        use vk::ImageUsageFlags as U;
+        let extent = vk::Extent2D {
+            width: ATLAS,
+            height: ATLAS,
+        };
+        let usage = U::COLOR_ATTACHMENT | U::TRANSFER_SRC;
+        let atlas_image = engine.image("atlas", FORMAT, extent, usage);
+        let direction_image = engine.image("direction-map", FORMAT, extent, usage);
+        let bytes = u64::from(ATLAS * ATLAS) * 8;
+        let (atlas_bytes, direction_bytes) =
+            (engine.readback_buffer(bytes), engine.readback_buffer(bytes));
+        let entities = entities(&scene, &meshes);
+        let layout = layout_for(&scene, &entities);
+        let view = scene.camera.view_desc(4.0 / 3.0);
+        let frame = LightmapFrame {
+            slot: 0,
+            view: &view,
+            lights: &scene.lights,
+            entities: &entities,
+            layout: &layout,
+        };
+        let d = &engine.device;
+        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
+        let (pool, cmd) = engine.command_buffer();
+        let mut atlas = atlas_image.as_ref(ImageState::UNDEFINED);
+        let mut direction = direction_image.as_ref(ImageState::UNDEFINED);
+        unsafe {
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            lightmaps
+                .record_directional(cmd, &frame, &mut atlas, &mut direction)
+                .unwrap();
+            copy_to_buffer(d, cmd, &mut atlas, atlas_bytes.buffer);
+            copy_to_buffer(d, cmd, &mut direction, direction_bytes.buffer);
+            d.end_command_buffer(cmd).unwrap();
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], vk::Fence::null())
+                .unwrap();
+            d.queue_wait_idle(queue).unwrap();
+        }
+        let texels = |buffer: &EngineBuffer| -> Vec<[f32; 4]> {
+            buffer
+                .bytes()
+                .chunks_exact(8)
+                .map(|t| {
+                    [0, 1, 2, 3]
+                        .map(|c| half::f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32())
+                })
+                .collect()
+        };
+        let (irradiance, directions) = (texels(&atlas_bytes), texels(&direction_bytes));
+
+        let region = &layout.regions[scene.alpha_objects.len() + dust_index];
+        let width = region.shape.tile_width;
+        let mut checked = 0;
+        for (i, mote) in motes.iter().enumerate() {
+            let (x, y) = (
+                region.region.x + i as u32 % width,
+                region.region.y + i as u32 / width,
+            );
+            let at = (y * ATLAS + x) as usize;
+            let (incident, l) = light.incident(mote.position).unwrap();
+            let n_dot_l = (scene.camera.eye - mote.position).normalize().dot(l);
+            let [dx, dy, dz, w] = directions[at];
+            if n_dot_l <= 1e-3 {
+                continue;
+            }
+            let expected = incident * n_dot_l;
+            let got = Vec3::from_slice(&irradiance[at][..3]);
+            assert!(
+                (got - expected).abs().max_element() <= 2e-3 * expected.max_element().max(1.0),
+                "mote {i}: irradiance {got} against {expected}"
+            );
+            let dominant = Vec3::new(dx, dy, dz) / w;
+            assert!(
+                (dominant - l).length() <= 3e-3,
+                "mote {i}: direction {dominant} against {l}"
+            );
+            checked += 1;
+        }
+        assert!(
+            checked > motes.len() / 2,
+            "{checked} of {} motes lit",
+            motes.len()
+        );
+
+        let inside = |r: &EntityRegion, x: u32, y: u32| {
+            let (w, h) = r.shape.size();
+            x >= r.region.x && x < r.region.x + w && y >= r.region.y && y < r.region.y + h
+        };
+        for y in 0..ATLAS {
+            for x in 0..ATLAS {
+                let at = (y * ATLAS + x) as usize;
+                let ([r, g, b, _], [dx, dy, dz, w]) = (irradiance[at], directions[at]);
+                if !layout.regions.iter().any(|r| inside(r, x, y)) {
+                    assert_eq!([r, g, b, w], [0.0; 4], "({x}, {y}) outside every region");
+                }
+                assert_eq!(
+                    w > 0.0,
+                    r + g + b > 0.0,
+                    "({x}, {y}): weight {w}, light {r} {g} {b}"
+                );
+                let length = Vec3::new(dx, dy, dz).length();
+                assert!(
+                    length <= w * 1.002 + 1e-6,
+                    "({x}, {y}): |sum w L| {length} > {w}"
+                );
+            }
+        }
+
+        drop(lightmaps);
+        unsafe { d.destroy_command_pool(pool, None) };
+        engine.free_image(atlas_image);
+        engine.free_image(direction_image);
+        engine.free_buffer(atlas_bytes);
+        engine.free_buffer(direction_bytes);
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
+    }
+    engine.destroy().assert_clean();
+}
+
 #[test]
 fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
     let scene = all_kinds();
@@ -273,10 +430,17 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
             AlphaLightmapsDesc {
                 atlas_format: FORMAT,
                 frames_in_flight: 0,
+                direction_format: None,
             },
             AlphaLightmapsDesc {
                 atlas_format: vk::Format::D32_SFLOAT,
                 frames_in_flight: 1,
+                direction_format: None,
+            },
+            AlphaLightmapsDesc {
+                atlas_format: FORMAT,
+                frames_in_flight: 1,
+                direction_format: Some(vk::Format::D32_SFLOAT),
             },
         ] {
             let err = AlphaLightmaps::new(&ctx, &bad).err().expect("refused");
@@ -287,6 +451,7 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
             &AlphaLightmapsDesc {
                 atlas_format: FORMAT,
                 frames_in_flight: 2,
+                direction_format: None,
             },
         )
         .unwrap();
@@ -432,6 +597,35 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
             },
             &mut atlas(),
         );
+        // A direction map these lightmaps were not made for, or one that does not match.
+        let refuse_directional = |what: &str,
+                                  lightmaps: &mut AlphaLightmaps,
+                                  direction: &EngineImage| {
+            let mut direction = direction.as_ref(ImageState::UNDEFINED);
+            let err =
+                unsafe { lightmaps.record_directional(cmd, &frame, &mut atlas(), &mut direction) }
+                    .err()
+                    .unwrap_or_else(|| panic!("{what} was recorded"));
+            assert!(matches!(err, Error::BadFrame(_)), "{what}: {err}");
+            assert_eq!(
+                direction.state,
+                ImageState::UNDEFINED,
+                "{what}: state changed"
+            );
+        };
+        refuse_directional("no direction format", &mut lightmaps, &atlas_image);
+        let mut directional = AlphaLightmaps::new(
+            &ctx,
+            &AlphaLightmapsDesc {
+                atlas_format: FORMAT,
+                frames_in_flight: 1,
+                direction_format: Some(FORMAT),
+            },
+        )
+        .unwrap();
+        refuse_directional("direction format", &mut directional, &other_format);
+        refuse_directional("direction extent", &mut directional, &small_image);
+        drop(directional);
         unsafe {
             d.end_command_buffer(cmd).unwrap();
             d.destroy_command_pool(pool, None);

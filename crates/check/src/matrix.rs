@@ -126,6 +126,7 @@ pub fn alpha_name(mode: AlphaMode) -> &'static str {
         AlphaMode::Lightmap => "lightmap",
         AlphaMode::Forward => "forward",
         AlphaMode::Probe => "probe",
+        AlphaMode::Directional => "directional",
     }
 }
 
@@ -352,7 +353,11 @@ pub fn cases(
         alpha,
     };
     if needs.has_alpha {
-        for alpha in [AlphaMode::Lightmap, AlphaMode::Probe] {
+        for alpha in [
+            AlphaMode::Lightmap,
+            AlphaMode::Directional,
+            AlphaMode::Probe,
+        ] {
             let config = talk(Platform::X360, FlushPolicy::Auto, 0, alpha);
             out.push(case(Some(config), Expect::Alpha));
         }
@@ -462,13 +467,14 @@ mod tests {
             .filter_map(|c| c.config)
             .all(|c| c.pattern == 0));
         assert_eq!(crowded.len(), 1 + lighting + 2);
-        // Alpha scenes: the lighting matrix lit forward (exact), plus lightmap and probe.
+        // Alpha scenes: the lighting matrix lit forward (exact), plus lightmap, directional and
+        // probe.
         let alpha = SceneNeeds {
             has_alpha: true,
             ..ROOM
         };
         let alpha = cases(alpha, DepthStencilFormat::D32S8, (257, 129));
-        assert_eq!(alpha.len(), room.len() + 2);
+        assert_eq!(alpha.len(), room.len() + 3);
         let modes: HashSet<_> = alpha
             .iter()
             .filter(|c| c.expect == Expect::Alpha)
@@ -476,7 +482,11 @@ mod tests {
             .collect();
         assert_eq!(
             modes,
-            HashSet::from([AlphaMode::Lightmap, AlphaMode::Probe])
+            HashSet::from([
+                AlphaMode::Lightmap,
+                AlphaMode::Directional,
+                AlphaMode::Probe
+            ])
         );
     }
 

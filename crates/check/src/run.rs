@@ -446,7 +446,7 @@ impl Group<'_> {
             images.brdf_ids.expect("asked for"),
         );
         let alpha_bound = match config.alpha {
-            AlphaMode::Lightmap => ALPHA_LIGHTMAP,
+            AlphaMode::Lightmap | AlphaMode::Directional => ALPHA_LIGHTMAP,
             _ => ALPHA_PROBE,
         };
         let alpha = (case.expect == Expect::Alpha)

@@ -124,8 +124,9 @@ struct RenderArgs {
     #[arg(long, default_value_t = histencil_vk::DEFAULT_LUT_RESOLUTION)]
     lut_resolution: u32,
     /// How translucent objects and particles are lit: `lightmap` (the talk's per-entity GPU
-    /// lightmaps), `forward` (every light per pixel: the reference), `probe` (every light at one
-    /// point per entity: the classic CPU light probe).
+    /// lightmaps), `directional` (lightmaps of incident light with a light-direction map, each
+    /// fragment evaluating its own BRDF), `forward` (every light per pixel: the reference),
+    /// `probe` (every light at one point per entity: the classic CPU light probe).
     #[arg(long, value_enum, default_value = "lightmap")]
     alpha: AlphaArg,
     /// Lightmap side in texels for every alpha entity (2..=4094: one region and its guard band
@@ -189,6 +190,7 @@ enum AlphaArg {
     Lightmap,
     Forward,
     Probe,
+    Directional,
 }
 
 impl AlphaArg {
@@ -197,6 +199,7 @@ impl AlphaArg {
             AlphaArg::Lightmap => AlphaMode::Lightmap,
             AlphaArg::Forward => AlphaMode::Forward,
             AlphaArg::Probe => AlphaMode::Probe,
+            AlphaArg::Directional => AlphaMode::Directional,
         }
     }
 }

@@ -101,6 +101,7 @@ pub const ALPHA_SET: &[BindingDesc] = &[
 pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[
     binding(0, BindingKind::SampledImage, "lightmap"),
     binding(1, BindingKind::Sampler, "lightmap_sampler"),
+    binding(2, BindingKind::SampledImage, "direction_map"),
 ];
 
 /// The pipeline layouts: which sets, in order.
@@ -132,6 +133,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
     ("lut_eval.comp", LUT_EVAL_LAYOUT),
     ("lightmap.frag", LIGHTMAP_LAYOUT),
+    ("lightmap_directional.frag", LIGHTMAP_LAYOUT),
     ("alpha_object.vert", ALPHA_LAYOUT),
     ("alpha_object.frag", ALPHA_LAYOUT),
     ("particle.vert", ALPHA_LAYOUT),

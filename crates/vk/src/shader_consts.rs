@@ -35,8 +35,9 @@ pub const ALPHA_KINDS: [(&str, u32); 4] = [
 ];
 
 /// GLSL `ALPHA_MODE_*`: how the alpha pass lights a fragment (an index of its pipelines).
-pub const ALPHA_MODES: [(&str, u32); 3] = [
+pub const ALPHA_MODES: [(&str, u32); 4] = [
     ("ALPHA_MODE_LIGHTMAP", 0),
     ("ALPHA_MODE_FORWARD", 1),
     ("ALPHA_MODE_PROBE", 2),
+    ("ALPHA_MODE_DIRECTIONAL", 3),
 ];

@@ -150,6 +150,7 @@ fn main() {
         &AlphaLightmapsDesc {
             atlas_format: HDR_FORMAT,
             frames_in_flight: IN_FLIGHT as u32,
+            direction_format: None,
         },
     )
     .expect("lightmaps");

@@ -18,7 +18,7 @@ use crate::descriptors::{
 };
 use crate::error::{Error, Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
-use crate::passes::{begin_cleared, CLEAR_BLACK};
+use crate::passes::{begin_all_cleared, CLEAR_BLACK};
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::Buffer;
 use crate::shaders;
@@ -38,6 +38,10 @@ pub struct AlphaLightmapsDesc {
     pub atlas_format: vk::Format,
     /// How many frames the caller records before it waits for the oldest (at least 1).
     pub frames_in_flight: u32,
+    /// With a format, [`AlphaLightmaps::record_directional`] also lights a direction map of
+    /// this format (four channels, blendable, as the atlas: `R16G16B16A16_SFLOAT` as
+    /// histencil's own); `None` makes only plain lightmaps.
+    pub direction_format: Option<vk::Format>,
 }
 
 /// One frame's lightmaps.
@@ -115,6 +119,9 @@ pub struct AlphaLightmaps<'c> {
     set_layouts: [vk::DescriptorSetLayout; 2],
     pipeline_layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
+    /// Lights the atlas with incident light and the direction map (lightmap_directional.frag),
+    /// when the desc has a direction format.
+    directional_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
 }
@@ -130,11 +137,17 @@ impl<'c> AlphaLightmaps<'c> {
         if desc.frames_in_flight == 0 {
             return Err(bad("frames_in_flight must be at least 1".into()));
         }
-        if crate::access::aspect_of(desc.atlas_format) != vk::ImageAspectFlags::COLOR {
-            return Err(bad(format!(
-                "atlas format {:?} is not a colour format",
-                desc.atlas_format
-            )));
+        for (what, format) in [
+            ("atlas", Some(desc.atlas_format)),
+            ("direction map", desc.direction_format),
+        ] {
+            if let Some(format) = format {
+                if crate::access::aspect_of(format) != vk::ImageAspectFlags::COLOR {
+                    return Err(bad(format!(
+                        "{what} format {format:?} is not a colour format"
+                    )));
+                }
+            }
         }
         let mut this = Self {
             ctx,
@@ -142,6 +155,7 @@ impl<'c> AlphaLightmaps<'c> {
             set_layouts: [vk::DescriptorSetLayout::null(); 2],
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            directional_pipeline: vk::Pipeline::null(),
             pool: vk::DescriptorPool::null(),
             slots: Vec::new(),
         };
@@ -164,22 +178,35 @@ impl<'c> AlphaLightmaps<'c> {
             size_of::<AlphaDrawPush>() as u32,
         )?;
         let formats = [self.desc.atlas_format];
-        self.pipeline = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "alpha-lightmap-pipeline",
-                vertex: ("fullscreen.vert", shaders::FULLSCREEN_VERT),
-                fragment: Some(("lightmap.frag", shaders::LIGHTMAP_FRAG)),
-                layout: self.pipeline_layout,
-                vertex_input: VertexInput::None,
-                color_formats: &formats,
-                color_writes: true,
-                blend: Blend::Additive,
-                depth_stencil_format: vk::Format::UNDEFINED,
-                depth_clamp: false,
-                specialization: &[],
-            },
-        )?;
+        let plain = PipelineDesc {
+            name: "alpha-lightmap-pipeline",
+            vertex: ("fullscreen.vert", shaders::FULLSCREEN_VERT),
+            fragment: Some(("lightmap.frag", shaders::LIGHTMAP_FRAG)),
+            layout: self.pipeline_layout,
+            vertex_input: VertexInput::None,
+            color_formats: &formats,
+            color_writes: true,
+            blend: Blend::Additive,
+            depth_stencil_format: vk::Format::UNDEFINED,
+            depth_clamp: false,
+            specialization: &[],
+        };
+        self.pipeline = create_pipeline(ctx, &plain)?;
+        if let Some(direction_format) = self.desc.direction_format {
+            let formats = [self.desc.atlas_format, direction_format];
+            self.directional_pipeline = create_pipeline(
+                ctx,
+                &PipelineDesc {
+                    name: "alpha-lightmap-directional-pipeline",
+                    fragment: Some((
+                        "lightmap_directional.frag",
+                        shaders::LIGHTMAP_DIRECTIONAL_FRAG,
+                    )),
+                    color_formats: &formats,
+                    ..plain
+                },
+            )?;
+        }
 
         let slots = self.desc.frames_in_flight;
         let sizes = [
@@ -296,7 +323,36 @@ impl<'c> AlphaLightmaps<'c> {
         atlas: &mut ImageRef,
     ) -> Result<()> {
         self.write_frame(frame, atlas)?;
-        self.record_pass(cmd, frame.slot, frame.layout, atlas);
+        self.record_pass(cmd, frame.slot, frame.layout, atlas, None);
+        Ok(())
+    }
+
+    /// Lights every entity's region of `atlas` with the irradiance at each probe (the sum of
+    /// `incident * N.L` over the lights in front of its normal; no BRDF), and of `direction` with
+    /// the irradiance-weighted sum of their directions (xyz: the sum of `w L`, w: the sum of `w`,
+    /// `w` the irradiance's luminance), after clearing both to black;
+    /// leaves both states as colour attachments just written. The engine's alpha shader reads
+    /// both at the same coordinates (`lightmap_sample.glsl`: `lightmap_direction`) and evaluates
+    /// its own BRDF with its own normal and view along the dominant direction: what plain
+    /// lightmaps cannot do for normal-mapped or sharply specular entities, at the price of one
+    /// direction for all the lights reaching a texel.
+    ///
+    /// # Errors
+    /// As [`Self::record`]; also [`Error::BadFrame`] when these lightmaps were made without a
+    /// direction format, or `direction` differs from it or from the atlas's extent.
+    ///
+    /// # Safety
+    /// As [`Self::record`], for `direction` as for `atlas`.
+    pub unsafe fn record_directional(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightmapFrame,
+        atlas: &mut ImageRef,
+        direction: &mut ImageRef,
+    ) -> Result<()> {
+        check_direction(&self.desc, atlas, direction)?;
+        self.write_frame(frame, atlas)?;
+        self.record_pass(cmd, frame.slot, frame.layout, atlas, Some(direction));
         Ok(())
     }
 
@@ -361,22 +417,34 @@ impl<'c> AlphaLightmaps<'c> {
         Ok(())
     }
 
-    /// Records the lightmap pass of the frame last written into `slot`: clears `atlas`, then
-    /// one additive draw per (entity, light that reaches it) over the entity's region.
+    /// Records the lightmap pass of the frame last written into `slot`: clears `atlas` (and
+    /// `direction`, which makes it the directional pass), then one additive draw per (entity,
+    /// light that reaches it) over the entity's region.
     pub(crate) fn record_pass(
         &self,
         cmd: vk::CommandBuffer,
         slot: u32,
         layout: &LightmapLayout,
         atlas: &mut ImageRef,
+        direction: Option<&mut ImageRef>,
     ) {
         let ctx = self.ctx;
         let slot = &self.slots[slot as usize];
-        ctx.begin_label(cmd, "alpha-lightmaps");
-        begin_cleared(ctx, cmd, atlas, CLEAR_BLACK);
+        let pipeline = match direction {
+            Some(direction) => {
+                ctx.begin_label(cmd, "alpha-lightmaps-directional");
+                begin_all_cleared(ctx, cmd, &mut [atlas, direction], CLEAR_BLACK);
+                self.directional_pipeline
+            }
+            None => {
+                ctx.begin_label(cmd, "alpha-lightmaps");
+                begin_all_cleared(ctx, cmd, &mut [atlas], CLEAR_BLACK);
+                self.pipeline
+            }
+        };
         let d = &ctx.device;
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
             d.cmd_bind_descriptor_sets(
                 cmd,
                 vk::PipelineBindPoint::GRAPHICS,
@@ -445,6 +513,7 @@ impl Drop for AlphaLightmaps<'_> {
         }
         unsafe {
             d.destroy_pipeline(self.pipeline, None);
+            d.destroy_pipeline(self.directional_pipeline, None);
             d.destroy_descriptor_pool(self.pool, None);
             d.destroy_pipeline_layout(self.pipeline_layout, None);
             for l in self.set_layouts {
@@ -471,6 +540,35 @@ fn fit(ctx: &Context, buffer: &mut Buffer, name: &str, slot: u32, bytes: usize) 
     let mut old = std::mem::replace(buffer, grown);
     old.destroy(ctx);
     Ok(true)
+}
+
+/// A direction map fits when these lightmaps make one, in their format, at the atlas's extent.
+fn check_direction(
+    desc: &AlphaLightmapsDesc,
+    atlas: &ImageRef,
+    direction: &ImageRef,
+) -> Result<()> {
+    let Some(format) = desc.direction_format else {
+        return Err(bad(
+            "these lightmaps were made without a direction format (AlphaLightmapsDesc)".into(),
+        ));
+    };
+    if direction.format != format {
+        return Err(bad(format!(
+            "the direction map is {:?}, these lightmaps make {format:?}",
+            direction.format
+        )));
+    }
+    if direction.extent != atlas.extent {
+        return Err(bad(format!(
+            "the direction map is {}x{}, the atlas {}x{}",
+            direction.extent.width,
+            direction.extent.height,
+            atlas.extent.width,
+            atlas.extent.height
+        )));
+    }
+    Ok(())
 }
 
 /// Checks one frame against the lightmaps and the atlas: the slot, each entity and its region,

@@ -51,6 +51,10 @@ pub enum AlphaMode {
     /// The classic alternative: every light evaluated at one point per entity (what a CPU light
     /// probe stores), applied with the fragment's normal and view direction.
     Probe,
+    /// The talk's first improvement: lightmaps of the light arriving at each probe with a
+    /// second atlas of its dominant direction, so each fragment evaluates its own BRDF with its
+    /// own normal and view ([`AlphaLightmaps::record_directional`]).
+    Directional,
 }
 
 impl AlphaMode {
@@ -60,6 +64,7 @@ impl AlphaMode {
             AlphaMode::Lightmap => "ALPHA_MODE_LIGHTMAP",
             AlphaMode::Forward => "ALPHA_MODE_FORWARD",
             AlphaMode::Probe => "ALPHA_MODE_PROBE",
+            AlphaMode::Directional => "ALPHA_MODE_DIRECTIONAL",
         };
         ALPHA_MODES
             .iter()
@@ -101,6 +106,8 @@ pub(crate) struct AlphaLighting<'c> {
     lightmap_draws: usize,
     lightmaps: AlphaLightmaps<'c>,
     lightmap: Image,
+    /// The direction map of directional frames, as large as the atlas.
+    direction_map: Image,
     sprites: Buffer,
     lightmap_set_layout: vk::DescriptorSetLayout,
     pipeline_layout: vk::PipelineLayout,
@@ -110,7 +117,7 @@ pub(crate) struct AlphaLighting<'c> {
     sampler: vk::Sampler,
     /// Per [`AlphaMode`] (in `AlphaMode::code` order), the object and particle pipelines,
     /// made when a frame first uses the mode.
-    pipelines: [Option<[vk::Pipeline; 2]>; 3],
+    pipelines: [Option<[vk::Pipeline; 2]>; 4],
 }
 
 /// The alpha pass's own Vulkan objects, created step by step so a failure part-way destroys what
@@ -176,6 +183,7 @@ impl<'c> AlphaLighting<'c> {
             &AlphaLightmapsDesc {
                 atlas_format: LIGHTMAP_FORMAT,
                 frames_in_flight: 1,
+                direction_format: Some(LIGHTMAP_FORMAT),
             },
         )?;
         let mut parts = Parts::default();
@@ -202,13 +210,15 @@ impl<'c> AlphaLighting<'c> {
             height: h,
         };
         use vk::ImageUsageFlags as U;
-        parts.images.push(Image::new(
-            ctx,
-            "alpha-lightmap-atlas",
-            LIGHTMAP_FORMAT,
-            extent,
-            U::COLOR_ATTACHMENT | U::SAMPLED,
-        )?);
+        for name in ["alpha-lightmap-atlas", "alpha-direction-map"] {
+            parts.images.push(Image::new(
+                ctx,
+                name,
+                LIGHTMAP_FORMAT,
+                extent,
+                U::COLOR_ATTACHMENT | U::SAMPLED,
+            )?);
+        }
 
         let mut sprites: Vec<SpriteVertex> = Vec::new();
         let mut sprite_ranges = Vec::new();
@@ -251,7 +261,12 @@ impl<'c> AlphaLighting<'c> {
 
         let sampler = create_sampler(ctx)?;
         parts.sampler = Some(sampler);
-        write_lightmap_set(ctx, lightmap_set, parts.images[0].view, sampler);
+        write_lightmap_set(
+            ctx,
+            lightmap_set,
+            [parts.images[0].view, parts.images[1].view],
+            sampler,
+        );
 
         let probe_meshes = ProbeMeshes::new(scene);
         let lightmap_draws = scene_alpha_entities(scene, &probe_meshes)
@@ -259,6 +274,7 @@ impl<'c> AlphaLighting<'c> {
             .map(|e| e.lights_reaching(&scene.lights).len())
             .sum();
         let order = back_to_front(scene);
+        let direction_map = parts.images.pop().expect("the direction map");
         let lightmap = parts.images.pop().expect("the atlas");
         let sprites = parts.buffers.pop().expect("the sprites");
         let built = Self {
@@ -270,13 +286,14 @@ impl<'c> AlphaLighting<'c> {
             lightmap_draws,
             lightmaps,
             lightmap,
+            direction_map,
             sprites,
             lightmap_set_layout,
             pipeline_layout,
             pool,
             lightmap_set,
             sampler,
-            pipelines: [None; 3],
+            pipelines: [None; 4],
         };
         *parts = Parts::default();
         Ok(built)
@@ -297,8 +314,8 @@ impl<'c> AlphaLighting<'c> {
         self.lightmap_draws
     }
 
-    /// Writes the frame's entity records (every mode reads them) and, in lightmap mode, records
-    /// the lightmap pass into `cmd`, as an engine would.
+    /// Writes the frame's entity records (every mode reads them) and, in the lightmap modes,
+    /// records the lightmap pass into `cmd`, as an engine would.
     pub fn record_lightmaps(
         &mut self,
         cmd: vk::CommandBuffer,
@@ -315,10 +332,13 @@ impl<'c> AlphaLighting<'c> {
             layout: &self.layout,
         };
         self.lightmaps.write_frame(&frame, &self.lightmap)?;
-        if mode == AlphaMode::Lightmap {
-            self.lightmaps
-                .record_pass(cmd, 0, &self.layout, &mut self.lightmap);
-        }
+        let direction = match mode {
+            AlphaMode::Lightmap => None,
+            AlphaMode::Directional => Some(&mut *self.direction_map),
+            AlphaMode::Forward | AlphaMode::Probe => return Ok(()),
+        };
+        self.lightmaps
+            .record_pass(cmd, 0, &self.layout, &mut self.lightmap, direction);
         Ok(())
     }
 
@@ -345,6 +365,7 @@ impl<'c> AlphaLighting<'c> {
         let specialization = [
             u32::from(mode == AlphaMode::Forward),
             u32::from(mode == AlphaMode::Probe),
+            u32::from(mode == AlphaMode::Directional),
         ];
         let objects = PipelineDesc {
             name: "alpha-object-pipeline",
@@ -405,21 +426,23 @@ impl<'c> AlphaLighting<'c> {
                 &[],
             );
         }
-        // Forward and probe frames never write the lightmap; the transition still gives the
-        // bound (and unread) image the layout its descriptor declares. An atlas no frame has
-        // written yet is cleared first, so no read-only layout is entered from UNDEFINED.
-        let atlas = &mut self.lightmap;
-        if atlas.state.layout == vk::ImageLayout::UNDEFINED {
-            begin_cleared(ctx, cmd, atlas, CLEAR_BLACK);
-            unsafe { ctx.device.cmd_end_rendering(cmd) };
+        // Forward and probe frames never write the atlas, nor plain lightmap frames the
+        // direction map; the transition still gives each bound (and unread) image the layout its
+        // descriptor declares. An image no frame has written yet is cleared first, so no
+        // read-only layout is entered from UNDEFINED.
+        for image in [&mut self.lightmap, &mut self.direction_map] {
+            if image.state.layout == vk::ImageLayout::UNDEFINED {
+                begin_cleared(ctx, cmd, image, CLEAR_BLACK);
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            }
+            transition(
+                ctx,
+                cmd,
+                image,
+                ImageAccess::FragmentSampled,
+                Contents::Keep,
+            );
         }
-        transition(
-            ctx,
-            cmd,
-            atlas,
-            ImageAccess::FragmentSampled,
-            Contents::Keep,
-        );
         let attachments = (&mut *targets.hdr, &mut *targets.depth_stencil);
         begin_hdr_rendering(ctx, cmd, attachments, extent, Load::Keep, Load::Keep);
         let d = &ctx.device;
@@ -479,6 +502,7 @@ impl<'c> AlphaLighting<'c> {
         }
         parts.destroy(ctx);
         self.lightmap.destroy(ctx);
+        self.direction_map.destroy(ctx);
         self.sprites.destroy(ctx);
     }
 }
@@ -507,7 +531,7 @@ fn create_lightmap_set(
     let sizes = [
         vk::DescriptorPoolSize::default()
             .ty(vk::DescriptorType::SAMPLED_IMAGE)
-            .descriptor_count(1),
+            .descriptor_count(2),
         vk::DescriptorPoolSize::default()
             .ty(vk::DescriptorType::SAMPLER)
             .descriptor_count(1),
@@ -532,24 +556,27 @@ fn create_lightmap_set(
 fn write_lightmap_set(
     ctx: &Context,
     set: vk::DescriptorSet,
-    view: vk::ImageView,
+    [atlas, direction_map]: [vk::ImageView; 2],
     sampler: vk::Sampler,
 ) {
-    let image = [vk::DescriptorImageInfo::default()
-        .image_view(view)
-        .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)];
+    let image = |view| {
+        [vk::DescriptorImageInfo::default()
+            .image_view(view)
+            .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
+    };
+    let (atlas, direction_map) = (image(atlas), image(direction_map));
     let filter = [vk::DescriptorImageInfo::default().sampler(sampler)];
+    let write = |binding, ty, info| {
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(binding)
+            .descriptor_type(ty)
+            .image_info(info)
+    };
     let writes = [
-        vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(0)
-            .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-            .image_info(&image),
-        vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(1)
-            .descriptor_type(vk::DescriptorType::SAMPLER)
-            .image_info(&filter),
+        write(0, vk::DescriptorType::SAMPLED_IMAGE, &atlas),
+        write(1, vk::DescriptorType::SAMPLER, &filter),
+        write(2, vk::DescriptorType::SAMPLED_IMAGE, &direction_map),
     ];
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }

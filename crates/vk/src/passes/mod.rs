@@ -106,15 +106,31 @@ pub(crate) fn begin_cleared(
     image: &mut ImageRef,
     clear: vk::ClearValue,
 ) {
-    transition(
-        ctx,
-        cmd,
-        image,
-        ImageAccess::ColorAttachment,
-        Contents::Discard,
-    );
-    let colors = [color_attachment(image, Load::Clear(clear))];
-    begin_rendering(ctx, cmd, image.extent, &colors, None);
+    begin_all_cleared(ctx, cmd, &mut [image], clear);
+}
+
+/// Discards the contents of `images` (colour images of one extent, attachments 0, 1, ... in
+/// order) and begins rendering into them, each cleared to `clear`.
+pub(crate) fn begin_all_cleared(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    images: &mut [&mut ImageRef],
+    clear: vk::ClearValue,
+) {
+    for image in images.iter_mut() {
+        transition(
+            ctx,
+            cmd,
+            image,
+            ImageAccess::ColorAttachment,
+            Contents::Discard,
+        );
+    }
+    let colors: Vec<_> = images
+        .iter()
+        .map(|image| color_attachment(image, Load::Clear(clear)))
+        .collect();
+    begin_rendering(ctx, cmd, images[0].extent, &colors, None);
 }
 
 /// Begins rendering into the HDR target and the depth-stencil target, each cleared or kept as
