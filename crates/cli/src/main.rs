@@ -544,6 +544,12 @@ fn scenes(args: &ScenesArgs, lights: DefaultLights) -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    // A closed stdout (`histencil check --list | head`) ends the process quietly, as it does
+    // any Unix filter, instead of making every print a panic: Rust ignores SIGPIPE by default.
+    // SAFETY: restoring a signal's default disposition before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {

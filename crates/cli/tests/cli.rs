@@ -384,6 +384,31 @@ fn brdf_eval_takes_directions_of_any_finite_length_on_both_devices() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A reader that stops early (`histencil check --list | head -1`) ends the listing quietly, as
+/// with any Unix filter: no panic on the closed pipe.
+#[test]
+fn a_closed_stdout_ends_a_listing_without_a_panic() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    for args in [&["check", "--list"][..], &["scenes"][..]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_histencil"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("run histencil");
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut first)
+            .unwrap();
+        // The reader is dropped here: the rest of the listing meets a closed pipe.
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!first.is_empty(), "{args:?}: nothing listed");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
+
 /// A glTF without lights (most of the Khronos samples) is lit by the default rig, announced on
 /// stderr and in `scenes`; `--no-default-lights` renders it black, with a warning.
 #[test]
