@@ -7,8 +7,8 @@
 #include "lightmap_sample.glsl"
 
 layout(set = 2, binding = 0) uniform texture2D lightmap;
-layout(set = 2, binding = 1) uniform sampler lightmap_sampler;
 // The direction map of directional frames (lightmap_directional.frag); bound in every mode.
-layout(set = 2, binding = 2) uniform texture2D direction_map;
+layout(set = 2, binding = 1) uniform texture2D direction_map;
+layout(set = 2, binding = 2) uniform sampler lightmap_sampler;
 
 #endif

@@ -100,8 +100,8 @@ pub const ALPHA_SET: &[BindingDesc] = &[
 /// because the lightmap pass renders into it.
 pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[
     binding(0, BindingKind::SampledImage, "lightmap"),
-    binding(1, BindingKind::Sampler, "lightmap_sampler"),
-    binding(2, BindingKind::SampledImage, "direction_map"),
+    binding(1, BindingKind::SampledImage, "direction_map"),
+    binding(2, BindingKind::Sampler, "lightmap_sampler"),
 ];
 
 /// The pipeline layouts: which sets, in order.

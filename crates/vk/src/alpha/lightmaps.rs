@@ -119,7 +119,7 @@ pub struct AlphaLightmaps<'c> {
     set_layouts: [vk::DescriptorSetLayout; 2],
     pipeline_layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
-    /// Lights the atlas with incident light and the direction map (lightmap_directional.frag),
+    /// Lights the atlas with irradiance and the direction map (lightmap_directional.frag),
     /// when the desc has a direction format.
     directional_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,

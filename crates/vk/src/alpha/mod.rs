@@ -20,7 +20,8 @@ pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
 use crate::descriptors::{
-    create_pipeline_layout, create_set_layout, ALPHA_LIGHTMAP_SET, GRAPHICS_STAGES,
+    create_pipeline_layout, create_set_layout, write_sampled_images, ALPHA_LIGHTMAP_SET,
+    GRAPHICS_STAGES,
 };
 use crate::error::{Result, VkCall};
 use crate::meshes::Meshes;
@@ -522,7 +523,7 @@ fn create_sampler(ctx: &Context) -> Result<vk::Sampler> {
     Ok(sampler)
 }
 
-/// A pool with the alpha pass's lightmap set (the atlas and its sampler).
+/// A pool with the alpha pass's lightmap set (the atlas, the direction map, their sampler).
 fn create_lightmap_set(
     ctx: &Context,
     parts: &mut Parts,
@@ -553,30 +554,20 @@ fn create_lightmap_set(
     Ok((pool, sets[0]))
 }
 
+/// The atlas and the direction map at bindings 0 and 1, the sampler at 2
+/// (include/alpha_lightmap.glsl).
 fn write_lightmap_set(
     ctx: &Context,
     set: vk::DescriptorSet,
-    [atlas, direction_map]: [vk::ImageView; 2],
+    images: [vk::ImageView; 2],
     sampler: vk::Sampler,
 ) {
-    let image = |view| {
-        [vk::DescriptorImageInfo::default()
-            .image_view(view)
-            .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
-    };
-    let (atlas, direction_map) = (image(atlas), image(direction_map));
+    write_sampled_images(ctx, set, &images);
     let filter = [vk::DescriptorImageInfo::default().sampler(sampler)];
-    let write = |binding, ty, info| {
-        vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(binding)
-            .descriptor_type(ty)
-            .image_info(info)
-    };
-    let writes = [
-        write(0, vk::DescriptorType::SAMPLED_IMAGE, &atlas),
-        write(1, vk::DescriptorType::SAMPLER, &filter),
-        write(2, vk::DescriptorType::SAMPLED_IMAGE, &direction_map),
-    ];
-    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    let write = vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(2)
+        .descriptor_type(vk::DescriptorType::SAMPLER)
+        .image_info(&filter);
+    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
 }
