@@ -115,8 +115,8 @@ fn unit(theta: f64, phi: f64) -> V3<f64> {
     ]
 }
 
-/// A direction with the given cosine to +Z, in azimuth `phi`.
-fn with_cos(cos: f64, phi: f64) -> V3<f64> {
+/// A unit direction with the given cosine to +Z (the cases' normal), in azimuth `phi`.
+pub fn with_cos(cos: f64, phi: f64) -> V3<f64> {
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
     [sin * phi.cos(), sin * phi.sin(), cos]
 }
