@@ -1,17 +1,22 @@
 #version 460
 // Forward reference: every fragment evaluates its own BRDF for every light, with the same light
-// code as the deferred pass. Ground truth for every error figure.
+// code as the deferred pass and the same textured surface as the G-buffer pass. Ground truth for
+// every error figure.
 #include "light.glsl"
-#include "draw.glsl"
+#include "material.glsl"
 
 layout(location = 0) in vec3 in_world_position;
 layout(location = 1) in vec3 in_world_normal;
 layout(location = 2) in float in_linear_depth;
+layout(location = 3) in vec4 in_uv;
+layout(location = 4) in vec4 in_world_tangent;
+layout(location = 5) in vec4 in_color;
 
 layout(location = 0) out vec4 out_color;
 
 void main() {
-    Surface s = surface_from_draw(in_world_position, in_world_normal);
+    Surface s = surface_from_material(in_world_position, in_world_normal, in_uv,
+                                      in_world_tangent, in_color);
     vec3 sum = vec3(0.0);
     for (uint i = 0; i < frame.counts.x; ++i) {
         sum += shade_light(lights[i], s);

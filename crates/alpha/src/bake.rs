@@ -176,11 +176,7 @@ mod tests {
     /// the top-left rule, so the pair covers exactly the texels of the square.
     #[test]
     fn shared_edges_cover_each_texel_once() {
-        let v = |x: f32, y: f32| Vertex {
-            position: [x, y, 0.0],
-            normal: [0.0, 0.0, 1.0],
-            uv: [x, y],
-        };
+        let v = |x: f32, y: f32| Vertex::new([x, y, 0.0], [0.0, 0.0, 1.0], [x, y]);
         let mesh = Mesh {
             vertices: vec![v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)],
             indices: vec![0, 1, 2, 0, 2, 3],
@@ -212,11 +208,7 @@ mod tests {
 
     #[test]
     fn broken_triangles_cover_nothing() {
-        let v = |u: f32| Vertex {
-            position: [u, 0.0, 0.0],
-            normal: [0.0, 0.0, 1.0],
-            uv: [u, u],
-        };
+        let v = |u: f32| Vertex::new([u, 0.0, 0.0], [0.0, 0.0, 1.0], [u, u]);
         let degenerate = Mesh {
             vertices: vec![v(0.0), v(0.5), v(1.0), v(f32::NAN)],
             indices: vec![0, 1, 2, 0, 1, 3, 0, 1, 99],

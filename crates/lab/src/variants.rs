@@ -107,6 +107,7 @@ pub fn light_size_scene(coverage: f64, aspect: f32) -> Scene {
         alpha_objects: vec![],
         particle_systems: vec![],
         meshes: vec![],
+        images: Vec::new(),
     }
 }
 

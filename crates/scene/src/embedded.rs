@@ -337,6 +337,7 @@ fn room(name: &str, description: String, models: &[BrdfId]) -> Scene {
         alpha_objects: vec![],
         particle_systems: vec![],
         meshes: vec![],
+        images: Vec::new(),
     }
 }
 

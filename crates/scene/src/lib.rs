@@ -8,6 +8,7 @@ mod import;
 mod light_rig;
 mod mesh;
 mod shading;
+mod texture;
 mod types;
 
 pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICES};
@@ -15,6 +16,7 @@ pub use alpha_scenes::{glass_sphere, smoke_volume};
 pub use embedded::{embedded, embedded_names, EMBEDDED};
 pub use import::{
     import_gltf, load_gltf, load_scene, material_from_gltf, ImportError, MaterialError,
+    MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES,
 };
 pub use light_rig::{
     default_light_rig, with_default_lights, DefaultLights, FILL_SHARE, KEY_RADIANCE,
@@ -24,6 +26,10 @@ pub use mesh::{
     SPHERE_DETAIL,
 };
 pub use shading::{range_falloff, shade};
+pub use texture::{
+    textured_brdf, uv_transform, Filter, MaterialMaps, Sampler, TextureImage, TextureRef,
+    UvTransform, Wrap, MAX_TEXTURE_SIDE, UV_IDENTITY,
+};
 pub use types::{
     unit_direction, Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape,
     MAX_FAR_OVER_NEAR, MAX_LIGHT_COLOR, MAX_TINT, MAX_WORLD_COORDINATE, MIN_FOV_Y,

@@ -4,14 +4,37 @@
 
 use std::f32::consts::{PI, TAU};
 
-/// A vertex: object-space position and normal, and its place in the shape's lightmap layout
-/// (`uv` in `[0, 1]^2`; zero on light volumes, which have no lightmap).
+/// A vertex: object-space position and normal, its texture coordinates, tangent and colour.
+///
+/// `uv` is glTF's `TEXCOORD_0`: where the material's textures are read, and for an alpha object
+/// its place in the lightmap layout (then in `[0, 1]^2`); the built-in shapes put their lightmap
+/// layout there, light volumes zero. `uv1` is `TEXCOORD_1`. `tangent` is glTF's `TANGENT`
+/// (xyz along +u in object space, w = +-1 the bitangent's sign, `cross(normal, tangent.xyz) * w`),
+/// zero where the mesh has no normal-mapped material. `color` is `COLOR_0` as linear RGBA, which
+/// multiplies the material's tint; white by default.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
     pub uv: [f32; 2],
+    pub uv1: [f32; 2],
+    pub tangent: [f32; 4],
+    pub color: [f32; 4],
+}
+
+impl Vertex {
+    /// A vertex with no second texture coordinate, no tangent and a white colour.
+    pub const fn new(position: [f32; 3], normal: [f32; 3], uv: [f32; 2]) -> Self {
+        Self {
+            position,
+            normal,
+            uv,
+            uv1: [0.0; 2],
+            tangent: [0.0; 4],
+            color: [1.0; 4],
+        }
+    }
 }
 
 /// An indexed triangle list.
@@ -30,11 +53,7 @@ impl Mesh {
     ) {
         let base = self.vertices.len() as u32;
         for (position, uv) in corners.into_iter().zip(uvs) {
-            self.vertices.push(Vertex {
-                position,
-                normal,
-                uv,
-            });
+            self.vertices.push(Vertex::new(position, normal, uv));
         }
         self.indices
             .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
@@ -123,11 +142,8 @@ pub fn uv_sphere(segments: u32, rings: u32) -> Mesh {
                 theta.cos(),
                 -theta.sin() * phi.sin(),
             ];
-            m.vertices.push(Vertex {
-                position: p,
-                normal: p,
-                uv: [s as f32 / segments as f32, r as f32 / rings as f32],
-            });
+            let uv = [s as f32 / segments as f32, r as f32 / rings as f32];
+            m.vertices.push(Vertex::new(p, p, uv));
         }
     }
     let row = segments + 1;
@@ -168,23 +184,14 @@ pub fn light_cone(sides: u32) -> Mesh {
         let a = TAU * i as f32 / sides as f32;
         [r * a.cos(), r * a.sin(), 1.0001]
     };
-    m.vertices.push(Vertex {
-        position: [0.0; 3],
-        normal: [0.0, 0.0, -1.0],
-        uv: [0.0; 2],
-    });
+    m.vertices
+        .push(Vertex::new([0.0; 3], [0.0, 0.0, -1.0], [0.0; 2]));
     let cap_center = m.vertices.len() as u32;
-    m.vertices.push(Vertex {
-        position: [0.0, 0.0, 1.0001],
-        normal: [0.0, 0.0, 1.0],
-        uv: [0.0; 2],
-    });
+    m.vertices
+        .push(Vertex::new([0.0, 0.0, 1.0001], [0.0, 0.0, 1.0], [0.0; 2]));
     for i in 0..sides {
-        m.vertices.push(Vertex {
-            position: ring(i),
-            normal: [0.0, 0.0, 1.0],
-            uv: [0.0; 2],
-        });
+        m.vertices
+            .push(Vertex::new(ring(i), [0.0, 0.0, 1.0], [0.0; 2]));
     }
     for i in 0..sides {
         let a = 2 + i;

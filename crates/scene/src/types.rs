@@ -1,4 +1,5 @@
 use crate::alpha::{alpha_problem, transformed_unit_cube};
+use crate::texture::{MaterialMaps, TextureImage, TextureRef};
 use crate::{AlphaObject, Mesh, ParticleSystem};
 use glam::{Mat4, Vec3};
 use histencil_brdf::{Brdf, BrdfId};
@@ -18,6 +19,8 @@ pub struct Scene {
     pub particle_systems: Vec<ParticleSystem>,
     /// Imported triangle meshes, referenced by [`Shape::Mesh`]; empty for the embedded scenes.
     pub meshes: Vec<Mesh>,
+    /// Decoded images, referenced by the materials' maps ([`TextureRef::image`]).
+    pub images: Vec<TextureImage>,
 }
 
 /// A perspective camera. The aspect ratio comes from the render target.
@@ -81,19 +84,27 @@ impl Object {
     }
 }
 
-/// A surface: a BRDF model with its parameters (as `histencil-brdf` defines them) and a tint.
-/// The outgoing radiance is `tint * brdf(N, T, V, L) * incident`; Kajiya-Kay's fibre tangent is
-/// the world +Y axis projected onto the surface (see `shaders/include/light.glsl`).
+/// A surface: a BRDF model with its parameters (as `histencil-brdf` defines them), a tint, and
+/// optionally texture maps that vary both over the surface ([`MaterialMaps`]). The outgoing
+/// radiance is `tint * brdf(N, T, V, L) * incident`; Kajiya-Kay's fibre tangent is the world +Y
+/// axis projected onto the surface (see `shaders/include/light.glsl`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
     pub brdf: Brdf,
     /// Linear RGB multiplier in `[0, 1]` per channel: the surface's colour.
     pub tint: Vec3,
+    /// Texture maps; opaque objects read them, alpha entities do not (yet).
+    pub maps: MaterialMaps,
 }
 
 impl Material {
+    /// An untextured material.
     pub fn new(brdf: Brdf, tint: Vec3) -> Self {
-        Self { brdf, tint }
+        Self {
+            brdf,
+            tint,
+            maps: MaterialMaps::default(),
+        }
     }
 
     /// A Lambertian surface of diffuse albedo `albedo`.
@@ -191,6 +202,12 @@ pub enum SceneError {
     },
     #[error("mesh {index}: {problem}")]
     BadMesh { index: usize, problem: &'static str },
+    #[error("image {index} (`{name}`) {problem}")]
+    BadImage {
+        index: usize,
+        name: String,
+        problem: String,
+    },
     #[error("camera: {0}")]
     BadCamera(String),
     #[error("{kind} {index} (`{name}`): {problem}")]
@@ -250,6 +267,38 @@ pub(crate) fn material_problem(m: &Material) -> Option<String> {
     }
 }
 
+/// What is wrong with a material's maps given the scene's `images`, if anything: an image index
+/// out of range, a texture coordinate set other than 0 or 1, a transform or normal scale that
+/// is not finite.
+fn maps_problem(maps: &MaterialMaps, images: &[TextureImage]) -> Option<String> {
+    if !maps.normal_scale.is_finite() {
+        return Some("normal map scale must be finite".into());
+    }
+    let names = ["base colour", "normal", "metallic-roughness"];
+    maps.refs().iter().zip(names).find_map(|(map, name)| {
+        map.and_then(|m| texture_ref_problem(&m, images.len()))
+            .map(|p| format!("{name} map: {p}"))
+    })
+}
+
+fn texture_ref_problem(map: &TextureRef, images: usize) -> Option<String> {
+    if map.image as usize >= images {
+        Some(format!(
+            "image {} does not exist ({images} images)",
+            map.image
+        ))
+    } else if map.texcoord > 1 {
+        Some(format!(
+            "TEXCOORD_{} is not read (0 and 1 are)",
+            map.texcoord
+        ))
+    } else if !map.transform.iter().flatten().all(|x| x.is_finite()) {
+        Some("texture transform must be finite".into())
+    } else {
+        None
+    }
+}
+
 /// Whether every coordinate of the box lies within [`MAX_WORLD_COORDINATE`].
 fn inside_world((lo, hi): (Vec3, Vec3)) -> bool {
     let limit = Vec3::splat(MAX_WORLD_COORDINATE);
@@ -300,8 +349,20 @@ fn mesh_problem(mesh: &Mesh) -> Option<&'static str> {
     if !mesh.vertices.iter().all(unit) {
         return Some("normals must be unit length");
     }
-    if !mesh.vertices.iter().flat_map(|v| v.uv).all(f32::is_finite) {
-        return Some("uvs must be finite");
+    let attributes = |v: &crate::Vertex| {
+        let mut all = v.uv.into_iter().chain(v.uv1).chain(v.tangent);
+        all.all(f32::is_finite)
+    };
+    if !mesh.vertices.iter().all(attributes) {
+        return Some("texture coordinates and tangents must be finite");
+    }
+    let colour = |v: &crate::Vertex| {
+        v.color
+            .iter()
+            .all(|c| c.is_finite() && (0.0..=MAX_TINT).contains(c))
+    };
+    if !mesh.vertices.iter().all(colour) {
+        return Some("vertex colours must be finite and in [0, MAX_TINT]");
     }
     None
 }
@@ -396,12 +457,22 @@ impl Scene {
                 return Err(SceneError::BadMesh { index, problem });
             }
         }
+        for (index, image) in self.images.iter().enumerate() {
+            if let Some(problem) = image.problem() {
+                return Err(SceneError::BadImage {
+                    index,
+                    name: image.name.clone(),
+                    problem,
+                });
+            }
+        }
         for (index, o) in self.objects.iter().enumerate() {
             let problem = self
                 .shape_problem(o.shape)
                 .or_else(|| transform_problem(&o.transform))
                 .or_else(|| outside_world_problem(o.world_bounds()))
-                .or_else(|| material_problem(&o.material));
+                .or_else(|| material_problem(&o.material))
+                .or_else(|| maps_problem(&o.material.maps, &self.images));
             if let Some(problem) = problem {
                 return Err(SceneError::BadObject {
                     index,

@@ -7,10 +7,11 @@ use crate::context::Context;
 use crate::descriptors::{
     create_pipeline_layout, create_set_layout, create_storage_buffer_set, BindingDesc,
 };
-use crate::error::{Result, VkCall};
+use crate::error::Result;
 use crate::pipelines::create_compute_pipeline;
 use crate::readback::host_readable;
 use crate::resources::Buffer;
+use crate::upload::submit_once;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
@@ -148,63 +149,19 @@ impl CaseKernel {
     }
 
     fn dispatch(&self, ctx: &Context, buffers: &[vk::Buffer], count: u32) -> Result<()> {
-        let d = &ctx.device;
         let (pool, set) =
             create_storage_buffer_set(ctx, self.name, self.compute.set_layout, buffers)?;
-        let command_pool = unsafe {
-            d.create_command_pool(
-                &vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family),
-                None,
-            )
-        };
-        let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) };
-        let recorded = (|| -> Result<()> {
-            let command_pool = command_pool.call("vkCreateCommandPool")?;
-            ctx.name(command_pool, &format!("{}-command-pool", self.name));
-            let fence = fence.call("vkCreateFence")?;
-            ctx.name(fence, &format!("{}-fence", self.name));
-            let cmd = unsafe {
-                d.allocate_command_buffers(
-                    &vk::CommandBufferAllocateInfo::default()
-                        .command_pool(command_pool)
-                        .command_buffer_count(1),
-                )
-            }
-            .call("vkAllocateCommandBuffers")?[0];
-            ctx.name(cmd, &format!("{}-commands", self.name));
+        let recorded = submit_once(ctx, self.name, |cmd| {
+            // Host writes to the inputs are visible at submit; only the results need a
+            // barrier, towards the host read after the fence.
+            self.compute.bind(ctx, cmd, set, &count.to_le_bytes());
             unsafe {
-                d.begin_command_buffer(
-                    cmd,
-                    &vk::CommandBufferBeginInfo::default()
-                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-                .call("vkBeginCommandBuffer")?;
-                ctx.begin_label(cmd, self.name);
-                // Host writes to the inputs are visible at submit; only the results need a
-                // barrier, towards the host read after the fence.
-                self.compute.bind(ctx, cmd, set, &count.to_le_bytes());
-                d.cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1);
-                host_readable(ctx, cmd, vk::PipelineStageFlags2::COMPUTE_SHADER);
-                ctx.end_label(cmd);
-                d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
-                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-                d.queue_submit2(ctx.queue, &[submit], fence)
-                    .call("vkQueueSubmit2")?;
-                d.wait_for_fences(&[fence], true, u64::MAX)
-                    .call("vkWaitForFences")?;
-            }
-            Ok(())
-        })();
-        unsafe {
-            if let Ok(fence) = fence {
-                d.destroy_fence(fence, None);
-            }
-            if let Ok(command_pool) = command_pool {
-                d.destroy_command_pool(command_pool, None);
-            }
-            d.destroy_descriptor_pool(pool, None);
-        }
+                ctx.device
+                    .cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1)
+            };
+            host_readable(ctx, cmd, vk::PipelineStageFlags2::COMPUTE_SHADER);
+        });
+        unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
         recorded
     }
 

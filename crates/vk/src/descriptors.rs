@@ -46,6 +46,17 @@ pub const FRAME_SET: &[BindingDesc] = &[
     binding(0, BindingKind::UniformBuffer, "frame"),
     binding(1, BindingKind::StorageBuffer, "lights"),
 ];
+/// Set 1 of the mesh pipelines (include/material.glsl): a material's map record, its three
+/// maps and their samplers.
+pub const MATERIAL_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::UniformBuffer, "material_maps"),
+    binding(1, BindingKind::SampledImage, "map_base_color"),
+    binding(2, BindingKind::SampledImage, "map_normal"),
+    binding(3, BindingKind::SampledImage, "map_metallic_roughness"),
+    binding(4, BindingKind::Sampler, "sampler_base_color"),
+    binding(5, BindingKind::Sampler, "sampler_normal"),
+    binding(6, BindingKind::Sampler, "sampler_metallic_roughness"),
+];
 /// Set 1 of the deferred light pipelines (include/gbuffer.glsl).
 pub const GBUFFER_SET: &[BindingDesc] = &[
     binding(0, BindingKind::SampledImage, "gbuffer_albedo"),
@@ -105,7 +116,7 @@ pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[
 ];
 
 /// The pipeline layouts: which sets, in order.
-pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET];
+pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, MATERIAL_SET];
 pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET, LUT_SET];
 pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
 pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
@@ -304,6 +315,8 @@ fn write_in_order<'a, T>(
 pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
     pub tonemap_layout: vk::DescriptorSetLayout,
+    /// Set 1 of the mesh pipelines; the sets are the materials' (`materials.rs`).
+    pub material_layout: vk::DescriptorSetLayout,
     pub mesh_pipeline_layout: vk::PipelineLayout,
     pub tonemap_pipeline_layout: vk::PipelineLayout,
     pool: vk::DescriptorPool,
@@ -343,10 +356,12 @@ impl Descriptors {
         let set_layout = |name, set| create_set_layout(ctx, name, set, GRAPHICS_STAGES);
         let frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
         let tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
+        let material_layout = set_layout("material-set-layout", MATERIAL_SET)?;
         let pipeline_layout = |name, sets: &[vk::DescriptorSetLayout]| {
             create_pipeline_layout(ctx, name, sets, GRAPHICS_STAGES, PUSH_CONSTANT_BYTES)
         };
-        let mesh_pipeline_layout = pipeline_layout("mesh-pipeline-layout", &[frame_layout])?;
+        let mesh_pipeline_layout =
+            pipeline_layout("mesh-pipeline-layout", &[frame_layout, material_layout])?;
         let tonemap_pipeline_layout =
             pipeline_layout("tonemap-pipeline-layout", &[frame_layout, tonemap_layout])?;
 
@@ -380,6 +395,7 @@ impl Descriptors {
         let d = Self {
             frame_layout,
             tonemap_layout,
+            material_layout,
             mesh_pipeline_layout,
             tonemap_pipeline_layout,
             pool,
@@ -401,7 +417,7 @@ impl Descriptors {
             for l in [self.mesh_pipeline_layout, self.tonemap_pipeline_layout] {
                 ctx.device.destroy_pipeline_layout(l, None);
             }
-            for l in [self.frame_layout, self.tonemap_layout] {
+            for l in [self.frame_layout, self.tonemap_layout, self.material_layout] {
                 ctx.device.destroy_descriptor_set_layout(l, None);
             }
         }

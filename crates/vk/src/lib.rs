@@ -23,6 +23,7 @@ pub mod gpu_types;
 mod hi_stencil;
 mod image_error;
 mod lut;
+mod materials;
 mod meshes;
 mod output;
 pub mod passes;
@@ -37,6 +38,7 @@ mod targets;
 mod technique;
 pub use targets::{check_extent, GBUFFER_FORMATS};
 mod timing;
+mod upload;
 
 /// The compiled SPIR-V of every shader module (built by build.rs, never checked in).
 pub mod shaders {
@@ -60,6 +62,10 @@ pub use gpu_types::ProjectionError;
 pub use histencil_model::{CostModel, FlushPolicy, TileStats};
 pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
+pub use materials::{
+    mip_chain, plan_materials, srgb_to_linear, GpuMaterials, MaterialPlan, MaterialRecord, SetPlan,
+    TextureKey,
+};
 pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
 pub use passes::light_pipelines::BrdfSource;
 pub use readback::{FrameImages, Readback};

@@ -4,7 +4,9 @@
 use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
+use crate::upload::{upload, BufferUpload};
 use ash::vk;
+use gpu_allocator::MemoryLocation;
 use histencil_scene::{
     light_cone, light_sphere, unit_box, uv_sphere, LightKind, Mesh, Shape, SPHERE_DETAIL,
 };
@@ -16,32 +18,25 @@ pub struct GpuMesh {
 }
 
 impl GpuMesh {
-    pub(crate) fn new(ctx: &Context, name: &str, mesh: &Mesh) -> Result<Self> {
-        let vertex_bytes: Vec<u8> = mesh
-            .vertices
-            .iter()
-            .flat_map(|v| {
-                v.position
-                    .iter()
-                    .chain(&v.normal)
-                    .chain(&v.uv)
-                    .flat_map(|f| f.to_ne_bytes())
-            })
-            .collect();
-        let index_bytes: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
-        let mut vertices = Buffer::with_data(
-            ctx,
-            &format!("{name}-vertices"),
+    /// Device-local vertex and index buffers sized for `mesh`, not yet filled.
+    fn allocate(ctx: &Context, name: &str, mesh: &Mesh) -> Result<Self> {
+        let buffer = |what: &str, bytes: usize, usage| {
+            Buffer::new(
+                ctx,
+                &format!("{name}-{what}"),
+                bytes as u64,
+                usage | vk::BufferUsageFlags::TRANSFER_DST,
+                MemoryLocation::GpuOnly,
+            )
+        };
+        let vertex_bytes = std::mem::size_of_val(mesh.vertices.as_slice());
+        let mut vertices = buffer(
+            "vertices",
+            vertex_bytes,
             vk::BufferUsageFlags::VERTEX_BUFFER,
-            &vertex_bytes,
         )?;
-        let indices = Buffer::with_data(
-            ctx,
-            &format!("{name}-indices"),
-            vk::BufferUsageFlags::INDEX_BUFFER,
-            &index_bytes,
-        );
-        match indices {
+        let index_bytes = std::mem::size_of_val(mesh.indices.as_slice());
+        match buffer("indices", index_bytes, vk::BufferUsageFlags::INDEX_BUFFER) {
             Ok(indices) => Ok(Self {
                 vertices,
                 indices,
@@ -49,6 +44,54 @@ impl GpuMesh {
             }),
             Err(e) => {
                 vertices.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// `meshes` in device-local memory, filled through one staging upload named `name`. A
+    /// failure half way frees what was made.
+    pub(crate) fn upload_all(
+        ctx: &Context,
+        name: &str,
+        meshes: &[(String, &Mesh)],
+    ) -> Result<Vec<Self>> {
+        let mut made: Vec<GpuMesh> = Vec::with_capacity(meshes.len());
+        let free = |made: Vec<GpuMesh>| {
+            for mut m in made {
+                m.destroy(ctx);
+            }
+        };
+        for (mesh_name, mesh) in meshes {
+            match GpuMesh::allocate(ctx, mesh_name, mesh) {
+                Ok(m) => made.push(m),
+                Err(e) => {
+                    free(made);
+                    return Err(e);
+                }
+            }
+        }
+        let bytes: Vec<(Vec<u8>, Vec<u8>)> = meshes.iter().map(|(_, m)| mesh_bytes(m)).collect();
+        let uploads: Vec<BufferUpload> = made
+            .iter()
+            .zip(&bytes)
+            .flat_map(|(gpu, (vertices, indices))| {
+                [
+                    BufferUpload {
+                        dst: gpu.vertices.handle,
+                        bytes: vertices,
+                    },
+                    BufferUpload {
+                        dst: gpu.indices.handle,
+                        bytes: indices,
+                    },
+                ]
+            })
+            .collect();
+        match upload(ctx, name, &uploads, &[]) {
+            Ok(()) => Ok(made),
+            Err(e) => {
+                free(made);
                 Err(e)
             }
         }
@@ -72,6 +115,27 @@ impl GpuMesh {
     }
 }
 
+/// The vertex buffer's bytes (every `Vertex` field, in order, as `VertexInput::Mesh` reads
+/// them) and the index buffer's.
+fn mesh_bytes(mesh: &Mesh) -> (Vec<u8>, Vec<u8>) {
+    let vertices = mesh
+        .vertices
+        .iter()
+        .flat_map(|v| {
+            v.position
+                .iter()
+                .chain(&v.normal)
+                .chain(&v.uv)
+                .chain(&v.uv1)
+                .chain(&v.tangent)
+                .chain(&v.color)
+                .flat_map(|f| f.to_ne_bytes())
+        })
+        .collect();
+    let indices = mesh.indices.iter().flat_map(|i| i.to_ne_bytes()).collect();
+    (vertices, indices)
+}
+
 /// Light-volume tessellation: enough that the circumscribed mesh stays close to the sphere / cone.
 pub const SPHERE_SEGMENTS: u32 = 24;
 pub const SPHERE_RINGS: u32 = 12;
@@ -86,14 +150,17 @@ pub struct LightVolumes {
 impl LightVolumes {
     pub fn new(ctx: &Context) -> Result<Self> {
         let sphere = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
-        let mut sphere = GpuMesh::new(ctx, "light-sphere-mesh", &sphere)?;
-        match GpuMesh::new(ctx, "light-cone-mesh", &light_cone(CONE_SIDES)) {
-            Ok(cone) => Ok(Self { sphere, cone }),
-            Err(e) => {
-                sphere.destroy(ctx);
-                Err(e)
-            }
-        }
+        let cone = light_cone(CONE_SIDES);
+        let named = [
+            ("light-sphere-mesh".to_owned(), &sphere),
+            ("light-cone-mesh".to_owned(), &cone),
+        ];
+        let mut made = GpuMesh::upload_all(ctx, "light-volume-upload", &named)?.into_iter();
+        let mut next = || made.next().expect("two light volumes");
+        Ok(Self {
+            sphere: next(),
+            cone: next(),
+        })
     }
 
     /// Draws the volume of a light of `kind` (the vertex shader places it).
@@ -125,19 +192,8 @@ impl Meshes {
         let builtin_names = ["box-mesh", "sphere-mesh"].map(String::from);
         let imported_names = (0..imported.len()).map(|i| format!("imported-mesh-{i}"));
         let names = builtin_names.into_iter().chain(imported_names);
-        let mut made: Vec<GpuMesh> = Vec::new();
-        for (name, mesh) in names.zip(builtin.iter().chain(imported)) {
-            match GpuMesh::new(ctx, &name, mesh) {
-                Ok(m) => made.push(m),
-                Err(e) => {
-                    for mut m in made {
-                        m.destroy(ctx);
-                    }
-                    return Err(e);
-                }
-            }
-        }
-        let mut made = made.into_iter();
+        let named: Vec<(String, &Mesh)> = names.zip(builtin.iter().chain(imported)).collect();
+        let mut made = GpuMesh::upload_all(ctx, "mesh-upload", &named)?.into_iter();
         let mut next = || made.next().expect("two built-in meshes");
         let (unit_box, sphere) = (next(), next());
         Ok(Self {

@@ -15,8 +15,9 @@ pub enum VertexInput {
     None,
     /// Position only (light volumes; `scene::Vertex`).
     Position,
-    /// Position and normal (meshes; `scene::Vertex`).
-    PositionNormal,
+    /// Every attribute of `scene::Vertex`: position, normal, both texture coordinate sets,
+    /// tangent and colour (the textured mesh passes).
+    Mesh,
     /// Position, normal and lightmap uv (alpha meshes; `scene::Vertex`).
     PositionNormalUv,
     /// `histencil_alpha::SpriteVertex`: position, corner, entity, param.
@@ -103,6 +104,15 @@ pub const DYNAMIC_STATES: [vk::DynamicState; 11] = [
     vk::DynamicState::STENCIL_REFERENCE,
 ];
 
+// The offsets `VertexInput::Mesh` reads `scene::Vertex` at.
+const _: () = {
+    use histencil_scene::Vertex;
+    assert!(std::mem::offset_of!(Vertex, uv1) == 32);
+    assert!(std::mem::offset_of!(Vertex, tangent) == 40);
+    assert!(std::mem::offset_of!(Vertex, color) == 56);
+    assert!(size_of::<Vertex>() == 72);
+};
+
 /// The vertex stride and attributes (locations 0, 1, ...) of `input`.
 fn vertex_attributes(input: VertexInput) -> (u32, Vec<vk::VertexInputAttributeDescription>) {
     use vk::Format as F;
@@ -112,9 +122,16 @@ fn vertex_attributes(input: VertexInput) -> (u32, Vec<vk::VertexInputAttributeDe
             size_of::<histencil_scene::Vertex>(),
             &[(F::R32G32B32_SFLOAT, 0)],
         ),
-        VertexInput::PositionNormal => (
+        VertexInput::Mesh => (
             size_of::<histencil_scene::Vertex>(),
-            &[(F::R32G32B32_SFLOAT, 0), (F::R32G32B32_SFLOAT, 12)],
+            &[
+                (F::R32G32B32_SFLOAT, 0),
+                (F::R32G32B32_SFLOAT, 12),
+                (F::R32G32_SFLOAT, 24),
+                (F::R32G32_SFLOAT, 32),
+                (F::R32G32B32A32_SFLOAT, 40),
+                (F::R32G32B32A32_SFLOAT, 56),
+            ],
         ),
         VertexInput::PositionNormalUv => (
             size_of::<histencil_scene::Vertex>(),
@@ -320,7 +337,7 @@ impl Pipelines {
                 name: "gbuffer-pipeline",
                 fragment: Some(("gbuffer.frag", shaders::GBUFFER_FRAG)),
                 layout: layouts.mesh,
-                vertex_input: VertexInput::PositionNormal,
+                vertex_input: VertexInput::Mesh,
                 color_formats: &formats.gbuffer,
                 ..base
             },
@@ -331,7 +348,7 @@ impl Pipelines {
                 name: "forward-pipeline",
                 fragment: Some(("forward.frag", shaders::FORWARD_FRAG)),
                 layout: layouts.mesh,
-                vertex_input: VertexInput::PositionNormal,
+                vertex_input: VertexInput::Mesh,
                 ..base
             },
         )?;

@@ -172,6 +172,19 @@ impl Image {
         extent: vk::Extent2D,
         usage: vk::ImageUsageFlags,
     ) -> Result<Self> {
+        Self::with_mips(ctx, name, format, extent, usage, 1)
+    }
+
+    /// An image of `mip_levels` levels, its view over all of them (a texture). Its
+    /// [`ImageRef`] state describes every level.
+    pub fn with_mips(
+        ctx: &Context,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+        mip_levels: u32,
+    ) -> Result<Self> {
         let aspect = crate::access::aspect_of(format);
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
@@ -181,7 +194,7 @@ impl Image {
                 height: extent.height,
                 depth: 1,
             })
-            .mip_levels(1)
+            .mip_levels(mip_levels)
             .array_layers(1)
             .samples(vk::SampleCountFlags::TYPE_1)
             .tiling(vk::ImageTiling::OPTIMAL)
@@ -203,7 +216,7 @@ impl Image {
             .image(handle)
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
-            .subresource_range(subresource_range(aspect));
+            .subresource_range(subresource_range(aspect).level_count(mip_levels));
         let view = unsafe {
             ctx.device
                 .bind_image_memory(handle, allocation.memory(), allocation.offset())

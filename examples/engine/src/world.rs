@@ -237,5 +237,6 @@ pub fn scene(world: &World, frame: usize) -> Scene {
         alpha_objects: vec![AlphaWorld::at(frame).glass()],
         particle_systems: vec![AlphaWorld::at(frame).smoke],
         meshes: Vec::new(),
+        images: Vec::new(),
     }
 }

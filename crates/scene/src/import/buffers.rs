@@ -37,7 +37,7 @@ pub(super) fn load_buffers(
             Source::Bin => blob
                 .take()
                 .ok_or_else(|| bad("refers to the GLB binary chunk, which is missing".into()))?,
-            Source::Uri(uri) => read_uri(uri, base_dir, length).map_err(bad)?,
+            Source::Uri(uri) => read_uri(uri, base_dir, ReadLimit::Exactly(length)).map_err(bad)?,
         };
         if (data.len() as u64) < length {
             return Err(bad(format!(
@@ -52,14 +52,27 @@ pub(super) fn load_buffers(
     Ok(out)
 }
 
-fn read_uri(uri: &str, base_dir: Option<&Path>, length: u64) -> Result<Vec<u8>, String> {
+/// The bytes `uri` names: a base64 `data:` URI, or a regular file inside `base_dir` read under
+/// `limit`.
+pub(super) fn read_uri(
+    uri: &str,
+    base_dir: Option<&Path>,
+    limit: ReadLimit,
+) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) = rest
             .split_once(";base64,")
             .ok_or("only base64 `data:` URIs are supported")?;
-        return base64::engine::general_purpose::STANDARD
+        let bytes = base64::engine::general_purpose::STANDARD
             .decode(payload)
-            .map_err(|e| format!("bad base64 in data URI: {e}"));
+            .map_err(|e| format!("bad base64 in data URI: {e}"))?;
+        return match limit {
+            ReadLimit::AtMost(n) if bytes.len() as u64 > n => Err(format!(
+                "the data URI holds {} bytes, more than the {n} an import may read",
+                bytes.len()
+            )),
+            _ => Ok(bytes),
+        };
     }
     if uri.contains("://") {
         return Err(format!(
@@ -70,7 +83,7 @@ fn read_uri(uri: &str, base_dir: Option<&Path>, length: u64) -> Result<Vec<u8>, 
         format!("`{uri}` is an external file, but the glTF was not read from a file")
     })?;
     let path = confined_path(dir, &percent_decode(uri))?;
-    read_regular_file(&path, ReadLimit::Exactly(length))
+    read_regular_file(&path, limit)
 }
 
 /// `relative` inside `dir`, or why not. The policy for every file a glTF names (buffers now,
@@ -239,12 +252,20 @@ mod tests {
     #[test]
     fn data_uris() {
         assert_eq!(
-            read_uri("data:application/octet-stream;base64,AAEC", None, 3).unwrap(),
+            read_uri(
+                "data:application/octet-stream;base64,AAEC",
+                None,
+                ReadLimit::Exactly(3)
+            )
+            .unwrap(),
             vec![0, 1, 2]
         );
-        assert!(read_uri("data:text/plain,abc", None, 3).is_err());
-        assert!(read_uri("http://example.com/a.bin", None, 3).is_err());
-        assert!(read_uri("a.bin", None, 3)
+        assert!(read_uri("data:text/plain,abc", None, ReadLimit::Exactly(3)).is_err());
+        assert!(read_uri("data:a;base64,AAEC", None, ReadLimit::AtMost(2))
+            .unwrap_err()
+            .contains("more than the 2"));
+        assert!(read_uri("http://example.com/a.bin", None, ReadLimit::Exactly(3)).is_err());
+        assert!(read_uri("a.bin", None, ReadLimit::Exactly(3))
             .unwrap_err()
             .contains("not read from a file"));
     }
@@ -295,7 +316,7 @@ mod tests {
         ];
         for (uri, why) in refused {
             let start = std::time::Instant::now();
-            let err = read_uri(uri, Some(&dir), 4).unwrap_err();
+            let err = read_uri(uri, Some(&dir), ReadLimit::Exactly(4)).unwrap_err();
             assert!(err.contains(why), "`{uri}`: {err}");
             assert!(
                 start.elapsed().as_secs() < 5,
@@ -310,9 +331,13 @@ mod tests {
             "sub/../ok.bin",
             "ok%2Ebin",
         ] {
-            assert_eq!(read_uri(uri, Some(&dir), 4).unwrap(), vec![7; 4], "{uri}");
+            assert_eq!(
+                read_uri(uri, Some(&dir), ReadLimit::Exactly(4)).unwrap(),
+                vec![7; 4],
+                "{uri}"
+            );
         }
-        let err = read_uri("ok.bin", Some(&dir), 17).unwrap_err();
+        let err = read_uri("ok.bin", Some(&dir), ReadLimit::Exactly(17)).unwrap_err();
         assert!(
             err.contains("holds 16 bytes but byteLength declares 17"),
             "{err}"

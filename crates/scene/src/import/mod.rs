@@ -17,16 +17,20 @@
 //! panic: truncated files, missing or short buffers, accessors past their views, unknown BRDFs.
 
 mod buffers;
+mod images;
 mod material;
+mod tangents;
 mod uv_layout;
 
 use buffers::ReadLimit;
 pub use buffers::MAX_IMPORT_BYTES;
+pub use images::{MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES};
 
 pub use material::{material_from_gltf, MaterialError};
 
 use crate::{
-    AlphaObject, Camera, Light, LightKind, Mesh, Object, Scene, SceneError, Shape, Vertex,
+    AlphaObject, Camera, Light, LightKind, MaterialMaps, Mesh, Object, Scene, SceneError, Shape,
+    Vertex,
 };
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -57,6 +61,13 @@ pub enum ImportError {
         index: usize,
         name: String,
         problem: MaterialError,
+    },
+    /// An image that cannot be read or decoded: `problem` says why.
+    #[error("image {index} (`{name}`) {problem}")]
+    Image {
+        index: usize,
+        name: String,
+        problem: String,
     },
     #[error("light {index} (`{name}`): {problem}")]
     Light {
@@ -121,7 +132,9 @@ pub fn import_gltf(
             alpha_objects: vec![],
             particle_systems: vec![],
             meshes: vec![],
+            images: Vec::new(),
         },
+        images: images::Images::new(&gltf.document, &buffers, base_dir),
         mesh_slots: HashMap::new(),
         camera: None,
     };
@@ -146,6 +159,7 @@ pub fn import_gltf(
 struct Importer<'a> {
     buffers: &'a [Vec<u8>],
     scene: Scene,
+    images: images::Images<'a>,
     /// `(mesh, primitive, mirrored)` to its index in `scene.meshes`: a mesh used by several
     /// nodes is stored once per winding.
     mesh_slots: HashMap<(usize, usize, bool), (u32, Mat4)>,
@@ -205,11 +219,20 @@ impl Importer<'_> {
                 problem,
             })?;
             let blend = gltf_material.alpha_mode() == gltf::material::AlphaMode::Blend;
+            let mut material = material;
+            // Alpha entities are lit per entity from their lightmaps and do not read maps.
+            if !blend {
+                material.maps = self.material_maps(&gltf_material)?;
+            }
+            let needs = Needs {
+                lightmap_uv: blend,
+                tangents_from: material.maps.normal.map(|n| n.texcoord),
+            };
             let key = (mesh.index(), primitive.index(), mirrored);
             let (slot, fit) = match self.mesh_slots.get(&key) {
                 Some(found) => *found,
                 None => {
-                    let (fitted, fit) = read_primitive(self.buffers, &primitive, mirrored, blend)
+                    let (fitted, fit) = read_primitive(self.buffers, &primitive, mirrored, needs)
                         .map_err(|p| {
                         mesh_error(format!("primitive {}: {p}", primitive.index()))
                     })?;
@@ -247,12 +270,60 @@ impl Importer<'_> {
     }
 }
 
+impl Importer<'_> {
+    /// The material's texture maps, their images decoded into the scene on first use.
+    fn material_maps(&mut self, m: &gltf::Material) -> Result<MaterialMaps, ImportError> {
+        let images = &mut self.scene.images;
+        let pbr = m.pbr_metallic_roughness();
+        let mut maps = MaterialMaps {
+            normal_scale: 1.0,
+            ..MaterialMaps::default()
+        };
+        let mut info = |info: Option<gltf::texture::Info>| -> Result<_, ImportError> {
+            info.map(|i| {
+                let transform = i.texture_transform().map(|t| {
+                    serde_json::json!({
+                        "offset": t.offset(), "rotation": t.rotation(), "scale": t.scale(),
+                        "texCoord": t.tex_coord(),
+                    })
+                });
+                self.images
+                    .texture_ref(images, &i.texture(), i.tex_coord(), transform.as_ref())
+            })
+            .transpose()
+        };
+        maps.base_color = info(pbr.base_color_texture())?;
+        maps.metallic_roughness = info(pbr.metallic_roughness_texture())?;
+        if let Some(normal) = m.normal_texture() {
+            let transform = normal.extension_value("KHR_texture_transform");
+            maps.normal = Some(self.images.texture_ref(
+                images,
+                &normal.texture(),
+                normal.tex_coord(),
+                transform,
+            )?);
+            maps.normal_scale = normal.scale();
+        }
+        Ok(maps)
+    }
+}
+
+/// What a primitive's vertices must carry beyond positions and normals.
+#[derive(Clone, Copy, Debug)]
+struct Needs {
+    /// `TEXCOORD_0` as a lightmap layout (an alpha object's).
+    lightmap_uv: bool,
+    /// Tangents, generated from this texture coordinate set when the file has none (a
+    /// normal-mapped material's).
+    tangents_from: Option<u32>,
+}
+
 /// The primitive's triangles fitted into `[-1, 1]^3`, and the transform that undoes the fit.
 fn read_primitive(
     buffers: &[Vec<u8>],
     primitive: &gltf::Primitive,
     mirrored: bool,
-    needs_uv: bool,
+    needs: Needs,
 ) -> Result<(Mesh, Mat4), String> {
     if primitive.mode() != gltf::mesh::Mode::Triangles {
         return Err(format!(
@@ -267,6 +338,9 @@ fn read_primitive(
         Some(positions_accessor.clone()),
         primitive.get(&gltf::Semantic::Normals),
         primitive.get(&gltf::Semantic::TexCoords(0)),
+        primitive.get(&gltf::Semantic::TexCoords(1)),
+        primitive.get(&gltf::Semantic::Tangents),
+        primitive.get(&gltf::Semantic::Colors(0)),
         primitive.indices(),
     ];
     for accessor in checked.iter().flatten() {
@@ -281,9 +355,22 @@ fn read_primitive(
     if let Some(normals) = primitive.get(&gltf::Semantic::Normals) {
         check_attribute_type("NORMAL", &normals, &[DataType::F32], Dimensions::Vec3)?;
     }
-    if let Some(uvs) = primitive.get(&gltf::Semantic::TexCoords(0)) {
-        let types = [DataType::F32, DataType::U8, DataType::U16];
-        check_attribute_type("TEXCOORD_0", &uvs, &types, Dimensions::Vec2)?;
+    let normalised = [DataType::F32, DataType::U8, DataType::U16];
+    for set in 0..2 {
+        if let Some(uvs) = primitive.get(&gltf::Semantic::TexCoords(set)) {
+            let semantic = format!("TEXCOORD_{set}");
+            check_attribute_type(&semantic, &uvs, &normalised, Dimensions::Vec2)?;
+        }
+    }
+    if let Some(tangents) = primitive.get(&gltf::Semantic::Tangents) {
+        check_attribute_type("TANGENT", &tangents, &[DataType::F32], Dimensions::Vec4)?;
+    }
+    if let Some(colors) = primitive.get(&gltf::Semantic::Colors(0)) {
+        let dimensions = match colors.dimensions() {
+            Dimensions::Vec3 => Dimensions::Vec3,
+            _ => Dimensions::Vec4,
+        };
+        check_attribute_type("COLOR_0", &colors, &normalised, dimensions)?;
     }
     if let Some(indices) = primitive.indices() {
         let types = [DataType::U8, DataType::U16, DataType::U32];
@@ -308,14 +395,23 @@ fn read_primitive(
     if indices.iter().any(|&i| i as usize >= positions.len()) {
         return Err("an index is out of range".into());
     }
+    let count = positions.len();
+    let same_count = |name: &str, len: Option<usize>| match len {
+        Some(len) if len != count => Err(format!("{name} and POSITION counts differ")),
+        _ => Ok(()),
+    };
     let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
-    if needs_uv {
+    let uvs1: Option<Vec<[f32; 2]>> = reader.read_tex_coords(1).map(|t| t.into_f32().collect());
+    let colors: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|c| c.into_rgba_f32().collect());
+    let tangents: Option<Vec<[f32; 4]>> = reader.read_tangents().map(Iterator::collect);
+    same_count("TEXCOORD_0", uvs.as_ref().map(Vec::len))?;
+    same_count("TEXCOORD_1", uvs1.as_ref().map(Vec::len))?;
+    same_count("COLOR_0", colors.as_ref().map(Vec::len))?;
+    same_count("TANGENT", tangents.as_ref().map(Vec::len))?;
+    if needs.lightmap_uv {
         let uvs = uvs
             .as_ref()
             .ok_or("an alphaMode BLEND primitive needs TEXCOORD_0 for its lightmap")?;
-        if uvs.len() != positions.len() {
-            return Err("TEXCOORD_0 and POSITION counts differ".into());
-        }
         let points: Vec<[f32; 3]> = positions.iter().map(|p| p.to_array()).collect();
         if let Some(problem) = uv_layout::layout_problem(&points, &indices, uvs) {
             return Err(format!("alphaMode BLEND: {problem}"));
@@ -324,11 +420,18 @@ fn read_primitive(
     let normals: Option<Vec<Vec3>> = reader
         .read_normals()
         .map(|n| n.map(|n| Vec3::from(n).normalize_or(Vec3::Y)).collect());
-    let uv_of = |i: usize| {
-        uvs.as_ref()
-            .and_then(|u| u.get(i).copied())
-            .unwrap_or_default()
-    };
+    if let Some(set) = needs.tangents_from {
+        let has = if set == 0 {
+            uvs.is_some()
+        } else {
+            uvs1.is_some()
+        };
+        if tangents.is_none() && !has {
+            return Err(format!(
+                "its normal map reads TEXCOORD_{set}, which it lacks (tangents come from it)"
+            ));
+        }
+    }
     let (lo, hi) = positions
         .iter()
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
@@ -338,13 +441,26 @@ fn read_primitive(
     // A flat mesh (a plane) keeps a sliver of thickness so the fit stays invertible.
     let half = ((hi - lo) * 0.5).max(Vec3::splat(((hi - lo).max_element() * 5e-4).max(1e-6)));
     let fit = |p: Vec3| ((p - centre) / half).clamp(Vec3::splat(-1.0), Vec3::splat(1.0));
-    // Normals transform by the inverse transpose of the fit's `1 / half` scale.
+    // Normals transform by the inverse transpose of the fit's `1 / half` scale, tangents (in
+    // the surface) by the fit itself.
     let fit_normal = |n: Vec3| (n * half).normalize_or(Vec3::Y);
+    let fit_tangent = |t: [f32; 4]| {
+        let xyz = (Vec3::new(t[0], t[1], t[2]) / half).normalize_or_zero();
+        xyz.extend(if t[3] < 0.0 { -1.0 } else { 1.0 }).to_array()
+    };
+    let vertex = |i: usize, normal: Vec3| Vertex {
+        position: fit(positions[i]).to_array(),
+        normal: normal.to_array(),
+        uv: uvs.as_ref().map_or([0.0; 2], |u| u[i]),
+        uv1: uvs1.as_ref().map_or([0.0; 2], |u| u[i]),
+        tangent: tangents.as_ref().map_or([0.0; 4], |t| fit_tangent(t[i])),
+        color: colors.as_ref().map_or([1.0; 4], |c| c[i]),
+    };
     let mut mesh = Mesh::default();
     match normals {
         Some(normals) if normals.len() == positions.len() => {
             mesh.vertices = (0..positions.len())
-                .map(|i| vertex(fit(positions[i]), fit_normal(normals[i]), uv_of(i)))
+                .map(|i| vertex(i, fit_normal(normals[i])))
                 .collect();
             mesh.indices = std::mem::take(&mut indices);
         }
@@ -355,11 +471,19 @@ fn read_primitive(
                 let n = fit_normal((b - a).cross(c - a).normalize_or(Vec3::Y));
                 for &i in t {
                     mesh.indices.push(mesh.vertices.len() as u32);
-                    mesh.vertices
-                        .push(vertex(fit(positions[i as usize]), n, uv_of(i as usize)));
+                    mesh.vertices.push(vertex(i as usize, n));
                 }
             }
         }
+    }
+    if let (Some(set), None) = (needs.tangents_from, &tangents) {
+        // In the file's own space and winding, as the normal map was baked.
+        let unfit = tangents::Space {
+            position: &|p: [f32; 3]| (Vec3::from(p) * half + centre).to_array(),
+            normal: &|n: [f32; 3]| (Vec3::from(n) / half).normalize_or(Vec3::Y).to_array(),
+            tangent: &fit_tangent,
+        };
+        tangents::generate(&mut mesh, set, &unfit)?;
     }
     if mirrored {
         // A mirroring transform flips the winding on screen; flipping it here restores it.
@@ -410,14 +534,6 @@ fn check_attribute_type(
             ""
         }
     ))
-}
-
-fn vertex(position: Vec3, normal: Vec3, uv: [f32; 2]) -> Vertex {
-    Vertex {
-        position: position.to_array(),
-        normal: normal.to_array(),
-        uv,
-    }
 }
 
 fn import_light(

@@ -140,7 +140,7 @@ fn record(
     shape: [u32; 4],
     frame: &ProbeFrame,
 ) -> AlphaEntityRecord {
-    let Material { brdf, tint } = entity.material;
+    let Material { brdf, tint, .. } = entity.material;
     let p = brdf.packed_params();
     AlphaEntityRecord {
         model: model.to_cols_array_2d(),

@@ -22,6 +22,8 @@ pub struct GeometryPass<'a> {
     pub pipeline: vk::Pipeline,
     pub pipeline_layout: vk::PipelineLayout,
     pub frame_set: vk::DescriptorSet,
+    /// Each object's material set (set 1: its texture maps), in `Scene::objects` order.
+    pub material_sets: &'a [vk::DescriptorSet],
     pub extent: vk::Extent2D,
     /// Each object's material index (its LUT table), stored in the G-buffer.
     pub material_indices: &'a [u32],
@@ -64,6 +66,18 @@ impl GeometryPass<'_> {
         }
         for (i, object) in self.scene.objects.iter().enumerate() {
             apply(self.ctx, self.cmd, &state_of(i));
+            if i == 0 || self.material_sets[i] != self.material_sets[i - 1] {
+                unsafe {
+                    d.cmd_bind_descriptor_sets(
+                        self.cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        self.pipeline_layout,
+                        1,
+                        &[self.material_sets[i]],
+                        &[],
+                    );
+                }
+            }
             let push = DrawPush::new(object.transform, &object.material, self.material_indices[i]);
             unsafe {
                 d.cmd_push_constants(

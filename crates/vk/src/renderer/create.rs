@@ -8,6 +8,7 @@ use crate::deferred_lighting::{DeferredLighting, LightingDesc};
 use crate::descriptors::{DescriptorTargets, Descriptors};
 use crate::error::{Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::materials::GpuMaterials;
 use crate::meshes::Meshes;
 use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::ReadbackBuffers;
@@ -73,6 +74,7 @@ impl<'c> Renderer<'c> {
         // take the blame for it.
         let extent = check_extent(ctx, width, height)?;
         scene.validate()?;
+        crate::materials::check_images(ctx, &scene)?;
         scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
         let brdf_count = brdfs.len().max(1) as u32;
@@ -124,6 +126,7 @@ impl<'c> Renderer<'c> {
                 hdr_view: targets.hdr.view,
             },
         )?;
+        let maps = GpuMaterials::new(ctx, &scene, descriptors.material_layout)?;
         let pipelines = Pipelines::new(
             ctx,
             &PipelineLayouts {
@@ -174,6 +177,7 @@ impl<'c> Renderer<'c> {
             extent,
             targets,
             meshes,
+            maps,
             frame_uniforms,
             lights,
             descriptors,
@@ -204,6 +208,7 @@ impl Drop for Renderer<'_> {
         if let Some(a) = self.alpha.as_mut() {
             a.destroy(ctx);
         }
+        self.maps.destroy(ctx);
         self.descriptors.destroy(ctx);
         self.lights.destroy(ctx);
         self.frame_uniforms.destroy(ctx);

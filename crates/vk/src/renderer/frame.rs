@@ -189,6 +189,7 @@ impl Renderer<'_> {
             },
             pipeline_layout: self.descriptors.mesh_pipeline_layout,
             frame_set: self.descriptors.frame_set,
+            material_sets: &self.maps.object_sets,
             extent: self.extent,
             material_indices: &self.object_materials,
             depth,

@@ -14,6 +14,7 @@ use crate::deferred_lighting::DeferredLighting;
 use crate::descriptors::Descriptors;
 use crate::error::Result;
 use crate::lut::LutTables;
+use crate::materials::GpuMaterials;
 use crate::meshes::Meshes;
 use crate::pipelines::Pipelines;
 use crate::readback::{FrameImages, ReadbackBuffers};
@@ -73,6 +74,8 @@ pub struct Renderer<'c> {
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
+    /// The objects' texture maps (set 1 of the mesh passes).
+    maps: GpuMaterials,
     frame_uniforms: Buffer,
     lights: Buffer,
     descriptors: Descriptors,

@@ -1,0 +1,227 @@
+//! Work done once at creation: a command buffer recorded, submitted and waited for
+//! ([`submit_once`]), and the uploads that use it. Vertex, index and texture data goes through
+//! one staging buffer into device-local memory ([`upload`]); the staging memory is freed
+//! before the function returns.
+
+use crate::context::Context;
+use crate::error::{Result, VkCall};
+use crate::resources::Buffer;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// Records `record` into a fresh command buffer named after `name`, submits it and waits for
+/// it. The pool and the fence are freed whatever happens.
+pub(crate) fn submit_once(
+    ctx: &Context,
+    name: &str,
+    record: impl FnOnce(vk::CommandBuffer),
+) -> Result<()> {
+    let d = &ctx.device;
+    let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
+    let command_pool = unsafe { d.create_command_pool(&pool_info, None) };
+    let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) };
+    let done = (|| -> Result<()> {
+        let command_pool = command_pool.call("vkCreateCommandPool")?;
+        ctx.name(command_pool, &format!("{name}-command-pool"));
+        let fence = fence.call("vkCreateFence")?;
+        ctx.name(fence, &format!("{name}-fence"));
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(command_pool)
+            .command_buffer_count(1);
+        let cmd =
+            unsafe { d.allocate_command_buffers(&alloc) }.call("vkAllocateCommandBuffers")?[0];
+        ctx.name(cmd, &format!("{name}-commands"));
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        unsafe { d.begin_command_buffer(cmd, &begin) }.call("vkBeginCommandBuffer")?;
+        ctx.begin_label(cmd, name);
+        record(cmd);
+        ctx.end_label(cmd);
+        unsafe {
+            d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(ctx.queue, &[submit], fence)
+                .call("vkQueueSubmit2")?;
+            // Creation waits for its own one-off work, as buffer creation does; frames never
+            // come through here.
+            d.wait_for_fences(&[fence], true, u64::MAX)
+                .call("vkWaitForFences")
+        }
+    })();
+    unsafe {
+        if let Ok(fence) = fence {
+            d.destroy_fence(fence, None);
+        }
+        if let Ok(command_pool) = command_pool {
+            d.destroy_command_pool(command_pool, None);
+        }
+    }
+    done
+}
+
+/// Bytes for a device-local buffer.
+pub(crate) struct BufferUpload<'a> {
+    pub dst: vk::Buffer,
+    pub bytes: &'a [u8],
+}
+
+/// Every mip level of a colour image, tightly packed RGBA8 (4 bytes a texel), level 0 first.
+/// The image is in `UNDEFINED` layout before and `SHADER_READ_ONLY_OPTIMAL` after, visible to
+/// fragment shaders.
+pub(crate) struct ImageUpload<'a> {
+    pub dst: vk::Image,
+    pub levels: &'a [(vk::Extent2D, Vec<u8>)],
+}
+
+/// Copies every upload through one staging buffer named `{name}-staging`, in one submission.
+/// Afterwards buffers are readable as vertices, indices, uniforms and storage by any later
+/// submission, and images are sampled by fragment shaders.
+pub(crate) fn upload(
+    ctx: &Context,
+    name: &str,
+    buffers: &[BufferUpload],
+    images: &[ImageUpload],
+) -> Result<()> {
+    // Offsets: every chunk starts 16-byte aligned (image copies need a multiple of the texel
+    // size, 4; buffer copies nothing).
+    let align = |x: u64| x.next_multiple_of(16);
+    let chunks = buffers.iter().map(|b| b.bytes).chain(
+        images
+            .iter()
+            .flat_map(|i| i.levels.iter().map(|(_, l)| l.as_slice())),
+    );
+    let mut offsets = Vec::new();
+    let mut total = 0u64;
+    for chunk in chunks.clone() {
+        offsets.push(total);
+        total = align(total + chunk.len() as u64);
+    }
+    if total == 0 {
+        return Ok(());
+    }
+    let mut staging = Buffer::new(
+        ctx,
+        &format!("{name}-staging"),
+        total,
+        vk::BufferUsageFlags::TRANSFER_SRC,
+        MemoryLocation::CpuToGpu,
+    )?;
+    let mut bytes = vec![0u8; total as usize];
+    for (chunk, &offset) in chunks.zip(&offsets) {
+        bytes[offset as usize..offset as usize + chunk.len()].copy_from_slice(chunk);
+    }
+    staging.write(&bytes);
+    drop(bytes);
+    let src = staging.handle;
+    let done = submit_once(ctx, name, |cmd| {
+        let d = &ctx.device;
+        let mut offsets = offsets.iter();
+        for b in buffers {
+            let offset = *offsets.next().expect("one offset per chunk");
+            if !b.bytes.is_empty() {
+                let region = vk::BufferCopy::default()
+                    .src_offset(offset)
+                    .size(b.bytes.len() as u64);
+                unsafe { d.cmd_copy_buffer(cmd, src, b.dst, &[region]) };
+            }
+        }
+        let whole = |levels: u32| {
+            vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                .level_count(levels)
+                .layer_count(1)
+        };
+        let to_transfer: Vec<_> = images
+            .iter()
+            .map(|i| {
+                vk::ImageMemoryBarrier2::default()
+                    .dst_stage_mask(vk::PipelineStageFlags2::COPY)
+                    .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                    .old_layout(vk::ImageLayout::UNDEFINED)
+                    .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+                    .image(i.dst)
+                    .subresource_range(whole(i.levels.len() as u32))
+            })
+            .collect();
+        unsafe {
+            d.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_transfer),
+            )
+        };
+        for image in images {
+            let regions: Vec<_> = image
+                .levels
+                .iter()
+                .enumerate()
+                .map(|(level, (extent, _))| {
+                    let offset = *offsets.next().expect("one offset per chunk");
+                    vk::BufferImageCopy::default()
+                        .buffer_offset(offset)
+                        .image_subresource(
+                            vk::ImageSubresourceLayers::default()
+                                .aspect_mask(vk::ImageAspectFlags::COLOR)
+                                .mip_level(level as u32)
+                                .layer_count(1),
+                        )
+                        .image_extent(vk::Extent3D {
+                            width: extent.width,
+                            height: extent.height,
+                            depth: 1,
+                        })
+                })
+                .collect();
+            unsafe {
+                d.cmd_copy_buffer_to_image(
+                    cmd,
+                    src,
+                    image.dst,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &regions,
+                )
+            };
+        }
+        let to_shader: Vec<_> = images
+            .iter()
+            .map(|i| {
+                vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                    .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                    .dst_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
+                    .dst_access_mask(vk::AccessFlags2::SHADER_SAMPLED_READ)
+                    .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
+                    .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
+                    .image(i.dst)
+                    .subresource_range(whole(i.levels.len() as u32))
+            })
+            .collect();
+        // Later submissions' reads of the buffers wait for the copies through this barrier
+        // (submission order carries the execution dependency on).
+        let buffer_reads = [vk::MemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::COPY)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(
+                vk::PipelineStageFlags2::VERTEX_INPUT
+                    | vk::PipelineStageFlags2::VERTEX_SHADER
+                    | vk::PipelineStageFlags2::FRAGMENT_SHADER
+                    | vk::PipelineStageFlags2::COMPUTE_SHADER,
+            )
+            .dst_access_mask(
+                vk::AccessFlags2::VERTEX_ATTRIBUTE_READ
+                    | vk::AccessFlags2::INDEX_READ
+                    | vk::AccessFlags2::UNIFORM_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_READ,
+            )];
+        unsafe {
+            d.cmd_pipeline_barrier2(
+                cmd,
+                &vk::DependencyInfo::default()
+                    .memory_barriers(&buffer_reads)
+                    .image_memory_barriers(&to_shader),
+            )
+        };
+    });
+    staging.destroy(ctx);
+    done
+}
