@@ -174,3 +174,96 @@ pub fn write(name: &str, doc: &Value, bin: &[u8]) -> PathBuf {
     std::fs::write(&path, serde_json::to_vec_pretty(doc).unwrap()).unwrap();
     path
 }
+
+/// PNG bytes of a `side` x `side` RGBA image whose texel `(x, y)` is `f(x, y)`.
+pub fn png(side: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Vec<u8> {
+    let image = image::RgbaImage::from_fn(side, side, |x, y| image::Rgba(f(x, y)));
+    let mut out = std::io::Cursor::new(Vec::new());
+    image
+        .write_to(&mut out, image::ImageFormat::Png)
+        .expect("encode a PNG in memory");
+    out.into_inner()
+}
+
+/// The test scene with textures as glTF ships them, one image per way a glTF holds one:
+/// the floor's base colour is a checkerboard in an external `checker.png` (repeated 4 times
+/// by `KHR_texture_transform`, nearest-filtered through a sampler), its normal map a ripple
+/// in a `data:` URI (tangents generated), its metallic-roughness a gradient in a buffer view;
+/// the box has vertex colours (`COLOR_0`). Returns the document, its buffer and the external
+/// image's bytes.
+pub fn textured_gltf() -> (Value, Vec<u8>, Vec<u8>) {
+    use base64::Engine as _;
+    let (mut doc, bin) = test_gltf("blinn_phong");
+    let mut bin = Bin {
+        bytes: bin,
+        views: serde_json::from_value(doc["bufferViews"].clone()).unwrap(),
+        accessors: serde_json::from_value(doc["accessors"].clone()).unwrap(),
+    };
+    let checker = png(32, |x, y| {
+        if (x / 4 + y / 4) % 2 == 0 {
+            [240, 230, 210, 255]
+        } else {
+            [70, 100, 170, 255]
+        }
+    });
+    let ripple = png(32, |x, _| {
+        let slope = (x as f32 * 0.6).sin() * 0.5;
+        let n = [slope, 0.0, 1.0];
+        let len = (n[0] * n[0] + 1.0f32).sqrt();
+        let c = |v: f32| ((v / len * 0.5 + 0.5) * 255.0).round() as u8;
+        [c(n[0]), c(n[1]), c(n[2]), 255]
+    });
+    let gradient = png(16, |x, _| [0, (60 + x * 12) as u8, 0, 255]);
+    // The gradient's bytes in a buffer view of its own (4-byte aligned, as views should be).
+    while !bin.bytes.len().is_multiple_of(4) {
+        bin.bytes.push(0);
+    }
+    bin.views
+        .push(json!({"buffer": 0, "byteOffset": bin.bytes.len(), "byteLength": gradient.len()}));
+    let gradient_view = bin.views.len() - 1;
+    bin.bytes.extend(&gradient);
+    // Vertex colours on the cube: one per vertex, warm above and cool below.
+    let cube_accessor = doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+        .as_u64()
+        .unwrap() as usize;
+    let count = doc["accessors"][cube_accessor]["count"].as_u64().unwrap() as usize;
+    let colors: Vec<f32> = (0..count)
+        .flat_map(|i| {
+            if i % 2 == 0 {
+                [1.0, 0.7, 0.4, 1.0]
+            } else {
+                [0.5, 0.8, 1.0, 1.0]
+            }
+        })
+        .collect();
+    let color_accessor = bin.push(
+        colors.iter().flat_map(|f| f.to_le_bytes()).collect(),
+        json!({"componentType": 5126, "count": count, "type": "VEC4"}),
+    );
+    doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = json!(color_accessor);
+    doc["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_texture_transform"]);
+    doc["images"] = json!([
+        {"uri": "checker.png"},
+        {"uri": format!("data:image/png;base64,{}",
+                        base64::engine::general_purpose::STANDARD.encode(&ripple))},
+        {"bufferView": gradient_view, "mimeType": "image/png", "name": "gradient"}
+    ]);
+    doc["samplers"] = json!([{"magFilter": 9728, "minFilter": 9986}]);
+    doc["textures"] = json!([
+        {"source": 0, "sampler": 0}, {"source": 1}, {"source": 2}
+    ]);
+    doc["materials"][0] = json!({
+        "name": "floor", "extras": {"brdf": "ggx", "alpha": 0.4, "f0": 0.5, "f90": 1.0},
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+            "baseColorTexture": {"index": 0, "extensions": {
+                "KHR_texture_transform": {"scale": [4.0, 4.0]}}},
+            "metallicRoughnessTexture": {"index": 2}
+        },
+        "normalTexture": {"index": 1, "scale": 0.8}
+    });
+    doc["bufferViews"] = json!(bin.views);
+    doc["accessors"] = json!(bin.accessors);
+    doc["buffers"][0]["byteLength"] = json!(bin.bytes.len());
+    (doc, bin.bytes, checker)
+}

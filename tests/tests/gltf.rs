@@ -106,3 +106,76 @@ fn the_committed_check_scene_is_the_test_scene() {
     assert_eq!(scene.brdfs_in_use().len(), 2);
     assert_eq!(scene.alpha_objects.len(), 1);
 }
+
+/// A sparse accessor (glTF's "these elements differ from the base") as the floor's `POSITION`:
+/// with a base view, and without one (zeros); its substitutions land where its indices say.
+/// Indices that do not rise, or point past the count, are refused with the accessor named.
+#[test]
+fn sparse_positions_import_and_bad_ones_are_refused() {
+    // Raise the floor quad's corner 2 to y = 0.5, as a sparse substitution of one element.
+    let sparse_doc = |indices: &[u32], base_view: bool| {
+        let (mut doc, mut bin) = test_gltf("blinn_phong");
+        let floor_positions = doc["meshes"][1]["primitives"][0]["attributes"]["POSITION"]
+            .as_u64()
+            .unwrap() as usize;
+        let index_offset = bin.len();
+        bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+        let value_offset = bin.len();
+        for _ in indices {
+            bin.extend([1.0f32, 0.5, -1.0].iter().flat_map(|f| f.to_le_bytes()));
+        }
+        let views = doc["bufferViews"].as_array_mut().unwrap();
+        views.push(json!({"buffer": 0, "byteOffset": index_offset,
+                          "byteLength": indices.len() * 4}));
+        views.push(json!({"buffer": 0, "byteOffset": value_offset,
+                          "byteLength": indices.len() * 12}));
+        let (iv, vv) = (views.len() - 2, views.len() - 1);
+        let accessor = &mut doc["accessors"][floor_positions];
+        accessor["sparse"] = json!({"count": indices.len(),
+            "indices": {"bufferView": iv, "componentType": 5125},
+            "values": {"bufferView": vv}});
+        accessor["max"] = json!([1.0, 0.5, 1.0]);
+        if !base_view {
+            accessor.as_object_mut().unwrap().remove("bufferView");
+        }
+        doc["buffers"][0]["byteLength"] = json!(bin.len());
+        (doc, bin)
+    };
+    for base_view in [true, false] {
+        let (doc, bin) = sparse_doc(&[2], base_view);
+        let path = write(&format!("sparse-{base_view}"), &doc, &bin);
+        let scene = load_scene(path.to_str().unwrap()).expect("a sparse accessor imports");
+        let floor = scene
+            .objects
+            .iter()
+            .find(|o| o.name.starts_with("floor"))
+            .unwrap();
+        let Shape::Mesh(mesh) = floor.shape else {
+            unreachable!()
+        };
+        let world: Vec<glam::Vec3> = scene.meshes[mesh as usize]
+            .vertices
+            .iter()
+            .map(|v| floor.transform.transform_point3(v.position.into()))
+            .collect();
+        let raised = world.iter().filter(|p| (p.y - 0.5).abs() < 1e-4).count();
+        // The quad has no normals, so each triangle has its own corners: corner 2 is in both.
+        assert_eq!(raised, 2, "base view {base_view}: {world:?}");
+        let (lo, hi) = world.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+            (lo.min(p.y), hi.max(p.y))
+        });
+        assert!(lo.abs() < 1e-4 && (hi - 0.5).abs() < 1e-4, "{lo} {hi}");
+    }
+    for (name, indices) in [("unsorted", &[3u32, 1][..]), ("past-count", &[4][..])] {
+        let (doc, bin) = sparse_doc(indices, true);
+        let path = write(&format!("sparse-{name}"), &doc, &bin);
+        let Err(err) = load_scene(path.to_str().unwrap()) else {
+            panic!("{name}: imported");
+        };
+        assert!(
+            err.to_string()
+                .contains("must rise strictly and stay below"),
+            "{name}: {err}"
+        );
+    }
+}

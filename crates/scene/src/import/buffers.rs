@@ -202,15 +202,82 @@ fn percent_decode(uri: &str) -> String {
 }
 
 /// Checks that every element `accessor` addresses lies inside its buffer view, and the view
-/// inside its buffer (whose data length [`load_buffers`] checked).
-pub(super) fn check_accessor(accessor: &gltf::Accessor) -> Result<(), String> {
+/// inside its buffer (whose data length [`load_buffers`] checked). A sparse accessor's base
+/// view is optional (zeros without one); its indices and values must lie inside their views,
+/// and its indices must rise strictly and stay below the accessor's count, as glTF requires
+/// (the reader would otherwise skip or misplace substitutions silently).
+pub(super) fn check_accessor(accessor: &gltf::Accessor, buffers: &[Vec<u8>]) -> Result<(), String> {
     let which = format!("accessor {}", accessor.index());
-    if accessor.sparse().is_some() {
-        return Err(format!("{which}: sparse accessors are not supported"));
+    let element = accessor.size();
+    if accessor.count() == 0 {
+        return Err(format!("{which}: count must be at least 1"));
     }
-    let view = accessor
-        .view()
-        .ok_or_else(|| format!("{which}: has no buffer view"))?;
+    match accessor.view() {
+        Some(view) => check_elements(&which, &view, accessor.offset(), accessor.count(), element)?,
+        None if accessor.sparse().is_some() => {}
+        None => return Err(format!("{which}: has no buffer view")),
+    }
+    let Some(sparse) = accessor.sparse() else {
+        return Ok(());
+    };
+    let count = sparse.count();
+    if count == 0 || count > accessor.count() {
+        return Err(format!(
+            "{which}: sparse count {count} must be 1 to the accessor's count {}",
+            accessor.count()
+        ));
+    }
+    let indices = sparse.indices();
+    let index_size = indices.index_type().size();
+    let which_indices = format!("{which} sparse indices");
+    check_elements(
+        &which_indices,
+        &indices.view(),
+        indices.offset(),
+        count,
+        index_size,
+    )?;
+    let values = sparse.values();
+    let which_values = format!("{which} sparse values");
+    check_elements(
+        &which_values,
+        &values.view(),
+        values.offset(),
+        count,
+        element,
+    )?;
+    let view = indices.view();
+    let data = &buffers[view.buffer().index()];
+    let stride = view.stride().unwrap_or(index_size).max(index_size);
+    let mut previous: Option<u64> = None;
+    for k in 0..count {
+        let at = view.offset() + indices.offset() + k * stride;
+        let bytes = &data[at..at + index_size];
+        let index = bytes
+            .iter()
+            .rev()
+            .fold(0u64, |v, b| (v << 8) | u64::from(*b));
+        if previous.is_some_and(|p| index <= p) || index >= accessor.count() as u64 {
+            return Err(format!(
+                "{which_indices}: index {index} (entry {k}) must rise strictly and stay below \
+                 the count {}",
+                accessor.count()
+            ));
+        }
+        previous = Some(index);
+    }
+    Ok(())
+}
+
+/// `count` elements of `element` bytes from `offset` in `view` lie inside the view, and the
+/// view inside its buffer.
+fn check_elements(
+    which: &str,
+    view: &gltf::buffer::View,
+    offset: usize,
+    count: usize,
+    element: usize,
+) -> Result<(), String> {
     let buffer_end = view.offset().checked_add(view.length());
     if buffer_end.is_none_or(|end| end > view.buffer().length()) {
         return Err(format!(
@@ -219,19 +286,17 @@ pub(super) fn check_accessor(accessor: &gltf::Accessor) -> Result<(), String> {
             view.buffer().index()
         ));
     }
-    let element = accessor.size();
     let stride = view.stride().unwrap_or(element).max(element);
-    let needed = match accessor.count() {
+    let needed = match count {
         0 => Some(0),
         n => (n - 1)
             .checked_mul(stride)
             .and_then(|x| x.checked_add(element))
-            .and_then(|x| x.checked_add(accessor.offset())),
+            .and_then(|x| x.checked_add(offset)),
     };
     if needed.is_none_or(|needed| needed > view.length()) {
         return Err(format!(
-            "{which}: {} elements run past the end of buffer view {}",
-            accessor.count(),
+            "{which}: {count} elements run past the end of buffer view {}",
             view.index()
         ));
     }

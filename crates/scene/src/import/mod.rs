@@ -224,8 +224,15 @@ impl Importer<'_> {
             if !blend {
                 material.maps = self.material_maps(&gltf_material)?;
             }
+            let mut texcoords = [false; 2];
+            for map in material.maps.refs().into_iter().flatten() {
+                if let Some(set) = texcoords.get_mut(map.texcoord as usize) {
+                    *set = true;
+                }
+            }
             let needs = Needs {
                 lightmap_uv: blend,
+                texcoords,
                 tangents_from: material.maps.normal.map(|n| n.texcoord),
             };
             let key = (mesh.index(), primitive.index(), mirrored);
@@ -282,10 +289,13 @@ impl Importer<'_> {
         let mut info = |info: Option<gltf::texture::Info>| -> Result<_, ImportError> {
             info.map(|i| {
                 let transform = i.texture_transform().map(|t| {
-                    serde_json::json!({
+                    let mut json = serde_json::json!({
                         "offset": t.offset(), "rotation": t.rotation(), "scale": t.scale(),
-                        "texCoord": t.tex_coord(),
-                    })
+                    });
+                    if let Some(set) = t.tex_coord() {
+                        json["texCoord"] = set.into();
+                    }
+                    json
                 });
                 self.images
                     .texture_ref(images, &i.texture(), i.tex_coord(), transform.as_ref())
@@ -313,6 +323,8 @@ impl Importer<'_> {
 struct Needs {
     /// `TEXCOORD_0` as a lightmap layout (an alpha object's).
     lightmap_uv: bool,
+    /// The texture coordinate sets the material's maps read.
+    texcoords: [bool; 2],
     /// Tangents, generated from this texture coordinate set when the file has none (a
     /// normal-mapped material's).
     tangents_from: Option<u32>,
@@ -344,7 +356,7 @@ fn read_primitive(
         primitive.indices(),
     ];
     for accessor in checked.iter().flatten() {
-        buffers::check_accessor(accessor)?;
+        buffers::check_accessor(accessor, buffers)?;
     }
     check_attribute_type(
         "POSITION",
@@ -420,15 +432,10 @@ fn read_primitive(
     let normals: Option<Vec<Vec3>> = reader
         .read_normals()
         .map(|n| n.map(|n| Vec3::from(n).normalize_or(Vec3::Y)).collect());
-    if let Some(set) = needs.tangents_from {
-        let has = if set == 0 {
-            uvs.is_some()
-        } else {
-            uvs1.is_some()
-        };
-        if tangents.is_none() && !has {
+    for (set, has) in [uvs.is_some(), uvs1.is_some()].into_iter().enumerate() {
+        if needs.texcoords[set] && !has {
             return Err(format!(
-                "its normal map reads TEXCOORD_{set}, which it lacks (tangents come from it)"
+                "its material's textures read TEXCOORD_{set}, which it lacks"
             ));
         }
     }
