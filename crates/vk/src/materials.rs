@@ -271,7 +271,7 @@ impl GpuMaterials {
     /// pipelines' set 1). A failure half way frees what was made.
     ///
     /// # Errors
-    /// An image larger than the device allows ([`check_images`]), and Vulkan or allocation
+    /// An image larger than the device allows (`check_images`), and Vulkan or allocation
     /// failures.
     pub fn new(ctx: &Context, scene: &Scene, layout: vk::DescriptorSetLayout) -> Result<Self> {
         check_images(ctx, scene)?;
