@@ -28,10 +28,8 @@ impl TextureImage {
     /// of the wrong length.
     pub fn problem(&self) -> Option<String> {
         let (w, h) = (self.width, self.height);
-        if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
-            return Some(format!(
-                "is {w}x{h}; sides must be 1 to {MAX_TEXTURE_SIDE} texels"
-            ));
+        if let Some(problem) = side_problem(w, h) {
+            return Some(problem);
         }
         let expected = u64::from(w) * u64::from(h) * 4;
         (self.rgba8.len() as u64 != expected).then(|| {
@@ -41,6 +39,14 @@ impl TextureImage {
             )
         })
     }
+}
+
+/// What is wrong with an image of `width` x `height` texels, if anything: a zero side or one
+/// over [`MAX_TEXTURE_SIDE`]. The importer asks before it decodes, the scene after.
+pub(crate) fn side_problem(width: u32, height: u32) -> Option<String> {
+    let ok = |s: u32| (1..=MAX_TEXTURE_SIDE).contains(&s);
+    (!ok(width) || !ok(height))
+        .then(|| format!("is {width}x{height}; sides must be 1 to {MAX_TEXTURE_SIDE} texels"))
 }
 
 /// How texture coordinates outside `[0, 1]` wrap (glTF's `wrapS` / `wrapT`).
