@@ -4,7 +4,9 @@
 
 use super::buffers::{read_uri, ReadLimit};
 use super::ImportError;
-use crate::{uv_transform, Filter, Sampler, TextureImage, TextureRef, Wrap, MAX_TEXTURE_SIDE};
+use crate::{
+    uv_transform, Filter, Sampler, TextureImage, TextureRef, UvTransform, Wrap, MAX_TEXTURE_SIDE,
+};
 use gltf::texture::{MagFilter, MinFilter, WrappingMode};
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -42,29 +44,25 @@ impl<'a> Images<'a> {
     }
 
     /// The reference a material's texture info makes: its image decoded into `images` (once),
-    /// its sampler, its texture coordinate set and `KHR_texture_transform` (`transform`, the
-    /// extension's raw JSON, whose `texCoord` overrides `tex_coord`).
+    /// its sampler, and `placement`, its uv transform and texture coordinate set (or why the
+    /// texture's `KHR_texture_transform` was refused).
     pub(super) fn texture_ref(
         &mut self,
         images: &mut Vec<TextureImage>,
         texture: &gltf::Texture,
-        tex_coord: u32,
-        transform: Option<&serde_json::Value>,
+        placement: Result<(UvTransform, u32), String>,
     ) -> Result<TextureRef, ImportError> {
         let image = self.image(images, &texture.source())?;
-        let (transform, tex_coord) = match transform {
-            None => (crate::UV_IDENTITY, tex_coord),
-            Some(value) => parse_transform(value, tex_coord).map_err(|problem| {
-                ImportError::Structure(format!(
-                    "texture {}: KHR_texture_transform {problem}",
-                    texture.index()
-                ))
-            })?,
-        };
+        let (transform, texcoord) = placement.map_err(|problem| {
+            ImportError::Structure(format!(
+                "texture {}: KHR_texture_transform {problem}",
+                texture.index()
+            ))
+        })?;
         Ok(TextureRef {
             image,
             sampler: sampler(&texture.sampler()),
-            texcoord: tex_coord,
+            texcoord,
             transform,
         })
     }
@@ -155,11 +153,8 @@ pub(super) fn decode(
     let (width, height) = reader
         .into_dimensions()
         .map_err(|e| format!("has a corrupt header: {e}"))?;
-    let side_ok = |s: u32| (1..=MAX_TEXTURE_SIDE).contains(&s);
-    if !side_ok(width) || !side_ok(height) {
-        return Err(format!(
-            "is {width}x{height}; sides must be 1 to {MAX_TEXTURE_SIDE} texels"
-        ));
+    if let Some(problem) = crate::texture::side_problem(width, height) {
+        return Err(problem);
     }
     let rgba_bytes = u64::from(width) * u64::from(height) * 4;
     if rgba_bytes > budget {
@@ -209,11 +204,12 @@ fn sampler(s: &gltf::texture::Sampler) -> Sampler {
 }
 
 /// `KHR_texture_transform`'s JSON object as a matrix, and the texture coordinate set (its
-/// `texCoord` when present, else `tex_coord`).
-fn parse_transform(
+/// `texCoord` when present, else `tex_coord`): for the normal texture, whose extension the
+/// `gltf` crate leaves as raw JSON.
+pub(super) fn parse_transform(
     value: &serde_json::Value,
     tex_coord: u32,
-) -> Result<(crate::UvTransform, u32), String> {
+) -> Result<(UvTransform, u32), String> {
     let object = value.as_object().ok_or("is not a JSON object")?;
     let number = |key: &str, default: f32| -> Result<f32, String> {
         match object.get(key) {

@@ -29,8 +29,8 @@ pub use images::{MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES};
 pub use material::{material_from_gltf, MaterialError};
 
 use crate::{
-    AlphaObject, Camera, Light, LightKind, MaterialMaps, Mesh, Object, Scene, SceneError, Shape,
-    Vertex,
+    uv_transform, AlphaObject, Camera, Light, LightKind, MaterialMaps, Mesh, Object, Scene,
+    SceneError, Shape, Vertex, UV_IDENTITY,
 };
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -288,30 +288,29 @@ impl Importer<'_> {
         };
         let mut info = |info: Option<gltf::texture::Info>| -> Result<_, ImportError> {
             info.map(|i| {
-                let transform = i.texture_transform().map(|t| {
-                    let mut json = serde_json::json!({
-                        "offset": t.offset(), "rotation": t.rotation(), "scale": t.scale(),
-                    });
-                    if let Some(set) = t.tex_coord() {
-                        json["texCoord"] = set.into();
-                    }
-                    json
-                });
-                self.images
-                    .texture_ref(images, &i.texture(), i.tex_coord(), transform.as_ref())
+                let placement = match i.texture_transform() {
+                    None => (UV_IDENTITY, i.tex_coord()),
+                    Some(t) => (
+                        uv_transform(t.offset(), t.rotation(), t.scale()),
+                        t.tex_coord().unwrap_or(i.tex_coord()),
+                    ),
+                };
+                self.images.texture_ref(images, &i.texture(), Ok(placement))
             })
             .transpose()
         };
         maps.base_color = info(pbr.base_color_texture())?;
         maps.metallic_roughness = info(pbr.metallic_roughness_texture())?;
         if let Some(normal) = m.normal_texture() {
-            let transform = normal.extension_value("KHR_texture_transform");
-            maps.normal = Some(self.images.texture_ref(
-                images,
-                &normal.texture(),
-                normal.tex_coord(),
-                transform,
-            )?);
+            let set = normal.tex_coord();
+            let placement = match normal.extension_value("KHR_texture_transform") {
+                None => Ok((UV_IDENTITY, set)),
+                Some(value) => images::parse_transform(value, set),
+            };
+            maps.normal = Some(
+                self.images
+                    .texture_ref(images, &normal.texture(), placement)?,
+            );
             maps.normal_scale = normal.scale();
         }
         Ok(maps)
