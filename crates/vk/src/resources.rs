@@ -118,12 +118,20 @@ impl Buffer {
     /// # Panics
     /// If the buffer is not host visible or `bytes` is longer than it: caller bugs.
     pub fn write(&mut self, bytes: &[u8]) {
+        self.write_at(0, bytes);
+    }
+
+    /// Copies `bytes` into a host-visible buffer from byte `offset`.
+    ///
+    /// # Panics
+    /// If the buffer is not host visible or `bytes` runs past its end: caller bugs.
+    pub fn write_at(&mut self, offset: usize, bytes: &[u8]) {
         let slice = self
             .allocation
             .as_mut()
             .and_then(|a| a.mapped_slice_mut())
             .expect("buffer is host visible");
-        slice[..bytes.len()].copy_from_slice(bytes);
+        slice[offset..offset + bytes.len()].copy_from_slice(bytes);
     }
 
     /// The contents of a host-visible buffer.

@@ -107,12 +107,10 @@ pub(crate) fn upload(
         vk::BufferUsageFlags::TRANSFER_SRC,
         MemoryLocation::CpuToGpu,
     )?;
-    let mut bytes = vec![0u8; total as usize];
+    // Straight into the mapped staging memory: no second copy of every byte on the heap.
     for (chunk, &offset) in chunks.zip(&offsets) {
-        bytes[offset as usize..offset as usize + chunk.len()].copy_from_slice(chunk);
+        staging.write_at(offset as usize, chunk);
     }
-    staging.write(&bytes);
-    drop(bytes);
     let src = staging.handle;
     let done = submit_once(ctx, name, |cmd| {
         let d = &ctx.device;
