@@ -447,18 +447,6 @@ impl GpuMaterials {
         Ok(())
     }
 
-    /// Bytes of texture memory the materials hold (every level, RGBA8).
-    pub fn texture_bytes(&self) -> u64 {
-        self.textures
-            .iter()
-            .map(|t| {
-                let (w, h) = (u64::from(t.extent.width), u64::from(t.extent.height));
-                // A full mip chain adds a third.
-                w * h * 4 * 4 / 3
-            })
-            .sum()
-    }
-
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);
