@@ -109,6 +109,7 @@ impl Engine {
             allocator: self.allocator.clone(),
             debug_utils: true,
             depth_stencil: None,
+            memory_budget: None,
         }
     }
 

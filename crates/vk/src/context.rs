@@ -9,6 +9,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::{CStr, CString};
 use std::mem::ManuallyDrop;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -59,6 +60,10 @@ pub struct ContextDesc {
     /// [`DepthStencilFormat::ALL`] the device can attach. A requested format the device lacks
     /// is [`Error::MissingFormat`].
     pub depth_stencil: Option<DepthStencilFormat>,
+    /// The most device memory, in bytes, histencil's objects may hold at once; `None`: no
+    /// limit but the device's. An allocation past it fails with [`Error::Allocation`], as one
+    /// past the device's memory would.
+    pub memory_budget: Option<u64>,
 }
 
 impl ContextDesc {
@@ -88,6 +93,8 @@ pub struct BorrowedDevice {
     pub debug_utils: bool,
     /// As [`ContextDesc::depth_stencil`].
     pub depth_stencil: Option<DepthStencilFormat>,
+    /// As [`ContextDesc::memory_budget`]: the share of the engine's memory histencil may take.
+    pub memory_budget: Option<u64>,
 }
 
 /// One Vulkan device and what hangs off it. Dropping an owned context waits for the device, frees
@@ -113,6 +120,56 @@ pub struct Context {
     pub(crate) timestamp_period_ns: f64,
     pub(crate) max_image_dimension: u32,
     pub(crate) max_storage_buffer_range: u32,
+    pub(crate) memory: MemoryAccount,
+}
+
+/// The device memory histencil's allocations hold, against the budget the context was given.
+#[derive(Debug, Default)]
+pub(crate) struct MemoryAccount {
+    budget: Option<u64>,
+    in_use: AtomicU64,
+    peak: AtomicU64,
+}
+
+impl MemoryAccount {
+    fn new(budget: Option<u64>) -> Self {
+        Self {
+            budget,
+            in_use: AtomicU64::new(0),
+            peak: AtomicU64::new(0),
+        }
+    }
+
+    /// Counts `bytes` more as held, or says why not: they would pass the budget.
+    pub fn reserve(&self, bytes: u64) -> std::result::Result<(), String> {
+        let mut held = self.in_use.load(Ordering::Relaxed);
+        loop {
+            let after = held.saturating_add(bytes);
+            if let Some(budget) = self.budget.filter(|&b| after > b) {
+                return Err(format!(
+                    "{bytes} bytes would pass the context's memory budget of {budget} bytes \
+                     ({held} held)"
+                ));
+            }
+            match self.in_use.compare_exchange_weak(
+                held,
+                after,
+                Ordering::Relaxed,
+                Ordering::Relaxed,
+            ) {
+                Ok(_) => {
+                    self.peak.fetch_max(after, Ordering::Relaxed);
+                    return Ok(());
+                }
+                Err(now) => held = now,
+            }
+        }
+    }
+
+    /// Counts `bytes` as no longer held.
+    pub fn release(&self, bytes: u64) {
+        self.in_use.fetch_sub(bytes, Ordering::Relaxed);
+    }
 }
 
 /// The format `wanted` names, or the first the device has; [`Error::MissingFormat`] when the
@@ -320,6 +377,7 @@ impl Context {
             timestamp_period_ns: f64::from(limits.timestamp_period),
             max_image_dimension: limits.max_image_dimension2_d,
             max_storage_buffer_range: limits.max_storage_buffer_range,
+            memory: MemoryAccount::new(desc.memory_budget),
         };
         ctx.name(ctx.device.handle(), "histencil-device");
         ctx.name(ctx.queue, "graphics-queue");
@@ -354,6 +412,7 @@ impl Context {
             allocator,
             debug_utils,
             depth_stencil,
+            memory_budget,
         } = lent;
         // SAFETY: the caller's promise that `physical_device` belongs to `instance`.
         let missing = unsafe { REQUIREMENTS.missing(&instance, physical_device) };
@@ -397,6 +456,7 @@ impl Context {
             timestamp_period_ns: f64::from(props.limits.timestamp_period),
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            memory: MemoryAccount::new(memory_budget),
         })
     }
 
@@ -462,6 +522,23 @@ impl Context {
     /// The name of the device in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
     pub fn device_name(&self) -> &str {
         &self.device_name
+    }
+
+    /// The bytes of device memory histencil's objects on this context hold now (what every
+    /// renderer, lighting and lightmap made with it has allocated and not yet freed).
+    pub fn memory_in_use(&self) -> u64 {
+        self.memory.in_use.load(Ordering::Relaxed)
+    }
+
+    /// The most device memory histencil's objects on this context have held at once, staging
+    /// buffers included: the budget a workload needs.
+    pub fn memory_peak(&self) -> u64 {
+        self.memory.peak.load(Ordering::Relaxed)
+    }
+
+    /// The budget [`ContextDesc::memory_budget`] or [`BorrowedDevice::memory_budget`] set.
+    pub fn memory_budget(&self) -> Option<u64> {
+        self.memory.budget
     }
 
     /// The depth-stencil format every renderer on this context uses.

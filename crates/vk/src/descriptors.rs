@@ -4,6 +4,7 @@
 use crate::context::Context;
 use crate::error::{Result, VkCall};
 use crate::gpu_types::PUSH_CONSTANT_BYTES;
+use crate::teardown::build;
 use ash::vk;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -312,6 +313,7 @@ fn write_in_order<'a, T>(
 
 /// The renderer's own set layouts, pipeline layouts, pool and sets: the mesh passes' and the
 /// tonemap's (the lighting has its own, `deferred_lighting.rs`).
+#[derive(Default)]
 pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
     pub tonemap_layout: vk::DescriptorSetLayout,
@@ -352,56 +354,46 @@ pub struct DescriptorTargets {
 }
 
 impl Descriptors {
+    /// The layouts, pool and sets, written for `targets`; a failure half way frees what was
+    /// made.
     pub fn new(ctx: &Context, targets: &DescriptorTargets) -> Result<Self> {
         let set_layout = |name, set| create_set_layout(ctx, name, set, GRAPHICS_STAGES);
-        let frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
-        let tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
-        let material_layout = set_layout("material-set-layout", MATERIAL_SET)?;
         let pipeline_layout = |name, sets: &[vk::DescriptorSetLayout]| {
             create_pipeline_layout(ctx, name, sets, GRAPHICS_STAGES, PUSH_CONSTANT_BYTES)
         };
-        let mesh_pipeline_layout =
-            pipeline_layout("mesh-pipeline-layout", &[frame_layout, material_layout])?;
-        let tonemap_pipeline_layout =
-            pipeline_layout("tonemap-pipeline-layout", &[frame_layout, tonemap_layout])?;
-
-        let sizes = [
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::UNIFORM_BUFFER)
-                .descriptor_count(1),
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1),
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::SAMPLED_IMAGE)
-                .descriptor_count(1),
-        ];
-        let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(2)
-            .pool_sizes(&sizes);
-        let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
-            .call("vkCreateDescriptorPool")?;
-        ctx.name(pool, "frame-descriptor-pool");
-        let layouts = [frame_layout, tonemap_layout];
-        let alloc = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(pool)
-            .set_layouts(&layouts);
-        let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
-            .call("vkAllocateDescriptorSets")?;
-        let names = ["frame-set", "tonemap-set"];
-        for (set, name) in sets.iter().zip(names) {
-            ctx.name(*set, name);
-        }
-        let d = Self {
-            frame_layout,
-            tonemap_layout,
-            material_layout,
-            mesh_pipeline_layout,
-            tonemap_pipeline_layout,
-            pool,
-            frame_set: sets[0],
-            tonemap_set: sets[1],
-        };
+        let d = build(ctx, |d: &mut Self| {
+            d.frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
+            d.tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
+            d.material_layout = set_layout("material-set-layout", MATERIAL_SET)?;
+            d.mesh_pipeline_layout =
+                pipeline_layout("mesh-pipeline-layout", &[d.frame_layout, d.material_layout])?;
+            d.tonemap_pipeline_layout = pipeline_layout(
+                "tonemap-pipeline-layout",
+                &[d.frame_layout, d.tonemap_layout],
+            )?;
+            let sizes = [
+                (vk::DescriptorType::UNIFORM_BUFFER, 1),
+                (vk::DescriptorType::STORAGE_BUFFER, 1),
+                (vk::DescriptorType::SAMPLED_IMAGE, 1),
+            ]
+            .map(|(ty, n)| vk::DescriptorPoolSize::default().ty(ty).descriptor_count(n));
+            let pool_info = vk::DescriptorPoolCreateInfo::default()
+                .max_sets(2)
+                .pool_sizes(&sizes);
+            d.pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
+                .call("vkCreateDescriptorPool")?;
+            ctx.name(d.pool, "frame-descriptor-pool");
+            let layouts = [d.frame_layout, d.tonemap_layout];
+            let alloc = vk::DescriptorSetAllocateInfo::default()
+                .descriptor_pool(d.pool)
+                .set_layouts(&layouts);
+            let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+                .call("vkAllocateDescriptorSets")?;
+            (d.frame_set, d.tonemap_set) = (sets[0], sets[1]);
+            ctx.name(d.frame_set, "frame-set");
+            ctx.name(d.tonemap_set, "tonemap-set");
+            Ok(())
+        })?;
         d.write(ctx, targets);
         Ok(d)
     }
@@ -421,5 +413,8 @@ impl Descriptors {
                 ctx.device.destroy_descriptor_set_layout(l, None);
             }
         }
+        *self = Self::default();
     }
 }
+
+crate::teardown::destroy_by_method!(Descriptors);

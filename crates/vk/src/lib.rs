@@ -35,6 +35,7 @@ mod resources;
 mod shader_consts;
 pub mod state;
 mod targets;
+mod teardown;
 mod technique;
 pub use targets::{check_extent, GBUFFER_FORMATS};
 mod timing;

@@ -465,6 +465,8 @@ impl GpuMaterials {
     }
 }
 
+crate::teardown::destroy_by_method!(GpuMaterials);
+
 #[cfg(test)]
 mod tests {
     use super::*;

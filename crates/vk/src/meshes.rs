@@ -221,6 +221,8 @@ impl Meshes {
     }
 }
 
+crate::teardown::destroy_by_method!(Meshes);
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,6 +5,7 @@
 use crate::context::Context;
 use crate::error::{Result, VkCall};
 use crate::shaders;
+use crate::teardown::build;
 use ash::vk;
 use std::io::Cursor;
 
@@ -293,6 +294,7 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
 }
 
 /// The renderer's fixed pipelines (light pipelines are created per plan: `passes::lighting`).
+#[derive(Default)]
 pub struct Pipelines {
     pub gbuffer: vk::Pipeline,
     pub forward: vk::Pipeline,
@@ -331,45 +333,43 @@ impl Pipelines {
             depth_clamp: false,
             specialization: &[],
         };
-        let gbuffer = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "gbuffer-pipeline",
-                fragment: Some(("gbuffer.frag", shaders::GBUFFER_FRAG)),
-                layout: layouts.mesh,
-                vertex_input: VertexInput::Mesh,
-                color_formats: &formats.gbuffer,
-                ..base
-            },
-        )?;
-        let forward = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "forward-pipeline",
-                fragment: Some(("forward.frag", shaders::FORWARD_FRAG)),
-                layout: layouts.mesh,
-                vertex_input: VertexInput::Mesh,
-                ..base
-            },
-        )?;
         let ldr = [formats.ldr];
-        let tonemap = create_pipeline(
-            ctx,
-            &PipelineDesc {
-                name: "tonemap-pipeline",
-                vertex: fullscreen_vert,
-                fragment: Some(("tonemap.frag", shaders::TONEMAP_FRAG)),
-                layout: layouts.tonemap,
-                vertex_input: VertexInput::None,
-                color_formats: &ldr,
-                depth_stencil_format: vk::Format::UNDEFINED,
-                ..base
-            },
-        )?;
-        Ok(Self {
-            gbuffer,
-            forward,
-            tonemap,
+        build(ctx, |p: &mut Self| {
+            p.gbuffer = create_pipeline(
+                ctx,
+                &PipelineDesc {
+                    name: "gbuffer-pipeline",
+                    fragment: Some(("gbuffer.frag", shaders::GBUFFER_FRAG)),
+                    layout: layouts.mesh,
+                    vertex_input: VertexInput::Mesh,
+                    color_formats: &formats.gbuffer,
+                    ..base
+                },
+            )?;
+            p.forward = create_pipeline(
+                ctx,
+                &PipelineDesc {
+                    name: "forward-pipeline",
+                    fragment: Some(("forward.frag", shaders::FORWARD_FRAG)),
+                    layout: layouts.mesh,
+                    vertex_input: VertexInput::Mesh,
+                    ..base
+                },
+            )?;
+            p.tonemap = create_pipeline(
+                ctx,
+                &PipelineDesc {
+                    name: "tonemap-pipeline",
+                    vertex: fullscreen_vert,
+                    fragment: Some(("tonemap.frag", shaders::TONEMAP_FRAG)),
+                    layout: layouts.tonemap,
+                    vertex_input: VertexInput::None,
+                    color_formats: &ldr,
+                    depth_stencil_format: vk::Format::UNDEFINED,
+                    ..base
+                },
+            )?;
+            Ok(())
         })
     }
 
@@ -377,5 +377,8 @@ impl Pipelines {
         for p in [self.gbuffer, self.forward, self.tonemap] {
             unsafe { ctx.device.destroy_pipeline(p, None) };
         }
+        *self = Self::default();
     }
 }
+
+crate::teardown::destroy_by_method!(Pipelines);

@@ -6,6 +6,7 @@ use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
 use crate::targets::Targets;
+use crate::teardown::build;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use image::{GrayImage, Rgba32FImage, RgbaImage};
@@ -100,6 +101,7 @@ pub(crate) fn host_readable(ctx: &Context, cmd: vk::CommandBuffer, stage: vk::Pi
     };
 }
 
+#[derive(Default)]
 pub(crate) struct ReadbackBuffers {
     extent: vk::Extent2D,
     ldr: Buffer,
@@ -112,12 +114,13 @@ impl ReadbackBuffers {
     pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
         let pixels = u64::from(extent.width) * u64::from(extent.height);
         let buffer = |name, bytes_per_pixel| Buffer::readback(ctx, name, pixels * bytes_per_pixel);
-        Ok(Self {
-            extent,
-            ldr: buffer("ldr-readback", 4)?,
-            hdr: buffer("hdr-readback", 8)?,
-            stencil: buffer("stencil-readback", 1)?,
-            material: buffer("gbuffer-material-readback", 16)?,
+        build(ctx, |r: &mut Self| {
+            r.extent = extent;
+            r.ldr = buffer("ldr-readback", 4)?;
+            r.hdr = buffer("hdr-readback", 8)?;
+            r.stencil = buffer("stencil-readback", 1)?;
+            r.material = buffer("gbuffer-material-readback", 16)?;
+            Ok(())
         })
     }
 
@@ -196,3 +199,5 @@ impl ReadbackBuffers {
         self.material.destroy(ctx);
     }
 }
+
+crate::teardown::destroy_by_method!(ReadbackBuffers);

@@ -1,6 +1,6 @@
 //! Buffers and images with their gpu-allocator memory, both named after the resource. They are
-//! destroyed explicitly with the context (`destroy`), never by `Drop`, so teardown order stays in
-//! the owner's hands.
+//! destroyed explicitly with the context (`destroy`), never by `Drop` (see `teardown`); their
+//! empty values (`Default`) hold null handles, which `destroy` accepts.
 
 use crate::access::{subresource_range, ImageRef, ImageState};
 use crate::context::Context;
@@ -16,7 +16,14 @@ fn allocate(
     location: MemoryLocation,
     linear: bool,
 ) -> Result<Allocation> {
-    ctx.allocator
+    ctx.memory
+        .reserve(requirements.size)
+        .map_err(|message| Error::Allocation {
+            name: name.to_owned(),
+            message,
+        })?;
+    let made = ctx
+        .allocator
         .lock()
         .unwrap()
         .allocate(&AllocationCreateDesc {
@@ -29,10 +36,15 @@ fn allocate(
         .map_err(|e| Error::Allocation {
             name: name.to_owned(),
             message: e.to_string(),
-        })
+        });
+    if made.is_err() {
+        ctx.memory.release(requirements.size);
+    }
+    made
 }
 
 fn free(ctx: &Context, allocation: Allocation) {
+    ctx.memory.release(allocation.size());
     // Freeing only fails for allocations this allocator did not make: a bug, not a runtime state.
     ctx.allocator
         .lock()
@@ -42,6 +54,7 @@ fn free(ctx: &Context, allocation: Allocation) {
 }
 
 /// A buffer and its memory.
+#[derive(Default)]
 pub struct Buffer {
     pub handle: vk::Buffer,
     pub size: vk::DeviceSize,
@@ -72,16 +85,18 @@ impl Buffer {
                 return Err(e);
             }
         };
-        unsafe {
-            ctx.device
-                .bind_buffer_memory(handle, allocation.memory(), allocation.offset())
-        }
-        .call("vkBindBufferMemory")?;
-        Ok(Self {
+        let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
+        let mut made = Self {
             handle,
             size,
             allocation: Some(allocation),
-        })
+        };
+        let bound = unsafe { ctx.device.bind_buffer_memory(handle, memory, offset) };
+        if let Err(e) = bound.call("vkBindBufferMemory") {
+            made.destroy(ctx);
+            return Err(e);
+        }
+        Ok(made)
     }
 
     /// A host-readable buffer that copies write into.
@@ -144,8 +159,10 @@ impl Buffer {
         &slice[..self.size as usize]
     }
 
+    /// Frees the buffer and its memory; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe { ctx.device.destroy_buffer(self.handle, None) };
+        self.handle = vk::Buffer::null();
         if let Some(a) = self.allocation.take() {
             free(ctx, a);
         }
@@ -256,16 +273,37 @@ impl Image {
         })
     }
 
+    /// Frees the image, its view and its memory; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_image_view(self.target.view, None);
             ctx.device.destroy_image(self.target.image, None);
         }
+        self.target.view = vk::ImageView::null();
+        self.target.image = vk::Image::null();
         if let Some(a) = self.allocation.take() {
             free(ctx, a);
         }
     }
 }
+
+/// No image yet: null handles.
+impl Default for Image {
+    fn default() -> Self {
+        Self {
+            target: ImageRef {
+                image: vk::Image::null(),
+                view: vk::ImageView::null(),
+                format: vk::Format::UNDEFINED,
+                extent: vk::Extent2D::default(),
+                state: ImageState::UNDEFINED,
+            },
+            allocation: None,
+        }
+    }
+}
+
+crate::teardown::destroy_by_method!(Buffer, Image);
 
 #[cfg(test)]
 mod tests {

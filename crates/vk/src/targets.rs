@@ -5,6 +5,7 @@ use crate::access::LightingTargets;
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::resources::Image;
+use crate::teardown::build;
 use ash::vk;
 
 /// The G-buffer's formats, in binding order: albedo, normal-depth, material
@@ -18,6 +19,7 @@ pub const GBUFFER_FORMATS: [vk::Format; 3] = [
 pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 
+#[derive(Default)]
 pub struct Targets {
     pub gbuffer: [Image; 3],
     pub depth_stencil: Image,
@@ -45,38 +47,37 @@ pub fn check_extent(ctx: &Context, width: u32, height: u32) -> Result<vk::Extent
 }
 
 impl Targets {
+    /// Every target at `extent`; a failure half way frees the targets made so far.
     pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
         use vk::ImageUsageFlags as U;
         let gbuffer_usage = U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC;
         let names = ["gbuffer-albedo", "gbuffer-normal-depth", "gbuffer-material"];
-        let mut gbuffer = Vec::new();
-        for (name, format) in names.into_iter().zip(GBUFFER_FORMATS) {
-            gbuffer.push(Image::new(ctx, name, format, extent, gbuffer_usage)?);
-        }
-        let gbuffer: [Image; 3] = gbuffer.try_into().ok().expect("three G-buffer targets");
-        Ok(Self {
-            gbuffer,
-            depth_stencil: Image::new(
+        build(ctx, |t: &mut Self| {
+            for ((slot, name), format) in t.gbuffer.iter_mut().zip(names).zip(GBUFFER_FORMATS) {
+                *slot = Image::new(ctx, name, format, extent, gbuffer_usage)?;
+            }
+            t.depth_stencil = Image::new(
                 ctx,
                 "depth-stencil",
                 ctx.depth_stencil_format,
                 extent,
                 U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
-            )?,
-            hdr: Image::new(
+            )?;
+            t.hdr = Image::new(
                 ctx,
                 "hdr-color",
                 HDR_FORMAT,
                 extent,
                 U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC,
-            )?,
-            ldr: Image::new(
+            )?;
+            t.ldr = Image::new(
                 ctx,
                 "ldr-color",
                 LDR_FORMAT,
                 extent,
                 U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
-            )?,
+            )?;
+            Ok(())
         })
     }
 
@@ -107,3 +108,5 @@ impl Targets {
         self.ldr.destroy(ctx);
     }
 }
+
+crate::teardown::destroy_by_method!(Targets);

@@ -185,6 +185,7 @@ impl Timestamps {
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+        self.pool = vk::QueryPool::null();
     }
 }
 
@@ -261,6 +262,8 @@ impl StepTimer {
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
     }
 }
+
+crate::teardown::destroy_by_method!(Timestamps);
 
 #[cfg(test)]
 mod tests {

@@ -151,6 +151,8 @@ impl Gpu {
             allocator: self.allocator.clone(),
             debug_utils: true,
             depth_stencil: Some(DepthStencilFormat::D32S8),
+            // The most of this engine's memory histencil's lighting and lightmaps may hold.
+            memory_budget: Some(256 << 20),
         }
     }
 

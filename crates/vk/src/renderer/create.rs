@@ -14,6 +14,7 @@ use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
 use crate::readback::ReadbackBuffers;
 use crate::resources::Buffer;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
+use crate::teardown::{build, Destroy, Owned};
 use crate::timing::Timestamps;
 use ash::vk;
 use histencil_brdf::{Brdf, BrdfId};
@@ -102,64 +103,69 @@ impl<'c> Renderer<'c> {
                 hi_stencil: true,
             },
         )?;
-        let targets = Targets::new(ctx, extent)?;
-        let meshes = Meshes::new(ctx, &scene.meshes)?;
+        // Each part is destroyed if a later one fails; `keep` hands it to the renderer.
+        let targets = Owned::new(ctx, Targets::new(ctx, extent)?);
+        let meshes = Owned::new(ctx, Meshes::new(ctx, &scene.meshes)?);
         let uniforms = FrameUniforms::new(&scene.camera, width, height, scene.lights.len() as u32);
-        let frame_uniforms = Buffer::with_data(
+        let frame_uniforms = Owned::new(
             ctx,
-            "frame-uniforms",
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-            bytemuck::bytes_of(&uniforms),
-        )?;
+            Buffer::with_data(
+                ctx,
+                "frame-uniforms",
+                vk::BufferUsageFlags::UNIFORM_BUFFER,
+                bytemuck::bytes_of(&uniforms),
+            )?,
+        );
         let gpu_lights: Vec<GpuLight> = scene.lights.iter().map(GpuLight::new).collect();
-        let lights = Buffer::with_data(
+        let lights = Owned::new(
             ctx,
-            "scene-lights",
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            bytemuck::cast_slice(&gpu_lights),
-        )?;
-        let descriptors = Descriptors::new(
+            Buffer::with_data(
+                ctx,
+                "scene-lights",
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                bytemuck::cast_slice(&gpu_lights),
+            )?,
+        );
+        let descriptors = Owned::new(
             ctx,
-            &DescriptorTargets {
-                frame_uniforms: frame_uniforms.handle,
-                lights: lights.handle,
-                hdr_view: targets.hdr.view,
-            },
-        )?;
-        let maps = GpuMaterials::new(ctx, &scene, descriptors.material_layout)?;
-        let pipelines = Pipelines::new(
+            Descriptors::new(
+                ctx,
+                &DescriptorTargets {
+                    frame_uniforms: frame_uniforms.handle,
+                    lights: lights.handle,
+                    hdr_view: targets.hdr.view,
+                },
+            )?,
+        );
+        let maps = Owned::new(
             ctx,
-            &PipelineLayouts {
-                mesh: descriptors.mesh_pipeline_layout,
-                lighting: lighting.pipeline_layout(),
-                tonemap: descriptors.tonemap_pipeline_layout,
-            },
-            &TargetFormats {
-                gbuffer: GBUFFER_FORMATS,
-                hdr: HDR_FORMAT,
-                ldr: LDR_FORMAT,
-                depth_stencil: ctx.depth_stencil_format,
-            },
-        )?;
-        let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
-        let command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
-            .call("vkCreateCommandPool")?;
-        ctx.name(command_pool, "frame-command-pool");
-        let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(command_pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        let cmd = unsafe { ctx.device.allocate_command_buffers(&alloc) }
-            .call("vkAllocateCommandBuffers")?[0];
-        ctx.name(cmd, "frame-commands");
-        let fence = unsafe {
-            ctx.device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-        }
-        .call("vkCreateFence")?;
-        ctx.name(fence, "frame-fence");
-        let timestamps = Timestamps::new(ctx)?;
+            GpuMaterials::new(ctx, &scene, descriptors.material_layout)?,
+        );
+        let pipelines = Owned::new(
+            ctx,
+            Pipelines::new(
+                ctx,
+                &PipelineLayouts {
+                    mesh: descriptors.mesh_pipeline_layout,
+                    lighting: lighting.pipeline_layout(),
+                    tonemap: descriptors.tonemap_pipeline_layout,
+                },
+                &TargetFormats {
+                    gbuffer: GBUFFER_FORMATS,
+                    hdr: HDR_FORMAT,
+                    ldr: LDR_FORMAT,
+                    depth_stencil: ctx.depth_stencil_format,
+                },
+            )?,
+        );
+        let submission = Owned::new(ctx, FrameSubmission::new(ctx)?);
+        let timestamps = Owned::new(ctx, Timestamps::new(ctx)?);
         let readback = ReadbackBuffers::new(ctx, extent)?;
+        let FrameSubmission {
+            command_pool,
+            cmd,
+            fence,
+        } = submission.keep();
         Ok(Self {
             ctx,
             scene,
@@ -175,19 +181,63 @@ impl<'c> Renderer<'c> {
             lighting,
             cost_model: None,
             extent,
-            targets,
-            meshes,
-            maps,
-            frame_uniforms,
-            lights,
-            descriptors,
-            pipelines,
+            targets: targets.keep(),
+            meshes: meshes.keep(),
+            maps: maps.keep(),
+            frame_uniforms: frame_uniforms.keep(),
+            lights: lights.keep(),
+            descriptors: descriptors.keep(),
+            pipelines: pipelines.keep(),
             command_pool,
             cmd,
             fence,
-            timestamps,
+            timestamps: timestamps.keep(),
             readback,
         })
+    }
+}
+
+/// The renderer's own submission: one command buffer, re-recorded each frame, and its fence.
+#[derive(Default)]
+struct FrameSubmission {
+    command_pool: vk::CommandPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+impl FrameSubmission {
+    fn new(ctx: &Context) -> Result<Self> {
+        build(ctx, |s: &mut Self| {
+            let pool_info =
+                vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
+            s.command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
+                .call("vkCreateCommandPool")?;
+            ctx.name(s.command_pool, "frame-command-pool");
+            let alloc = vk::CommandBufferAllocateInfo::default()
+                .command_pool(s.command_pool)
+                .level(vk::CommandBufferLevel::PRIMARY)
+                .command_buffer_count(1);
+            s.cmd = unsafe { ctx.device.allocate_command_buffers(&alloc) }
+                .call("vkAllocateCommandBuffers")?[0];
+            ctx.name(s.cmd, "frame-commands");
+            s.fence = unsafe {
+                ctx.device
+                    .create_fence(&vk::FenceCreateInfo::default(), None)
+            }
+            .call("vkCreateFence")?;
+            ctx.name(s.fence, "frame-fence");
+            Ok(())
+        })
+    }
+}
+
+impl Destroy for FrameSubmission {
+    fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_fence(self.fence, None);
+            ctx.device.destroy_command_pool(self.command_pool, None);
+        }
+        *self = Self::default();
     }
 }
 

@@ -1,0 +1,82 @@
+//! How what histencil makes is freed, also when making it fails half way.
+//!
+//! Resources are destroyed explicitly with the context (`destroy`), never by `Drop`, so
+//! teardown order stays in the owner's hands. Two helpers keep a failed creation from leaking
+//! what its earlier steps made:
+//! - [`build`] fills a value in place from its empty state, one step at a time, and destroys it
+//!   when a step fails. It works because every `destroy` accepts a value only partly made:
+//!   Vulkan's destroy calls take null handles, and an empty `Vec` frees nothing.
+//! - [`Owned`] holds one finished part of a larger whole (a renderer's targets, its meshes) until
+//!   the whole is made; dropped before [`Owned::keep`], it destroys its part.
+
+use crate::context::Context;
+use crate::error::Result;
+
+/// A value made of Vulkan objects and allocations that frees them all. It must accept being
+/// destroyed twice, and when only some of its parts exist.
+pub(crate) trait Destroy {
+    fn destroy(&mut self, ctx: &Context);
+}
+
+/// Makes a `T` by running `steps` on its empty value. When a step fails, what the earlier ones
+/// made is destroyed before the error is returned.
+pub(crate) fn build<T: Default + Destroy>(
+    ctx: &Context,
+    steps: impl FnOnce(&mut T) -> Result<()>,
+) -> Result<T> {
+    let mut made = T::default();
+    match steps(&mut made) {
+        Ok(()) => Ok(made),
+        Err(e) => {
+            made.destroy(ctx);
+            Err(e)
+        }
+    }
+}
+
+/// One finished part of something still being made: destroyed on drop unless kept.
+pub(crate) struct Owned<'c, T: Destroy> {
+    ctx: &'c Context,
+    value: Option<T>,
+}
+
+impl<'c, T: Destroy> Owned<'c, T> {
+    pub fn new(ctx: &'c Context, value: T) -> Self {
+        Self {
+            ctx,
+            value: Some(value),
+        }
+    }
+
+    /// The part, now the caller's to destroy.
+    pub fn keep(mut self) -> T {
+        self.value.take().expect("kept once")
+    }
+}
+
+impl<T: Destroy> std::ops::Deref for Owned<'_, T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        self.value.as_ref().expect("not yet kept")
+    }
+}
+
+impl<T: Destroy> Drop for Owned<'_, T> {
+    fn drop(&mut self) {
+        if let Some(v) = self.value.as_mut() {
+            v.destroy(self.ctx);
+        }
+    }
+}
+
+/// Implements [`Destroy`] by the types' own `destroy(&mut self, &Context)`.
+macro_rules! destroy_by_method {
+    ($($t:ty),* $(,)?) => {
+        $(impl $crate::teardown::Destroy for $t {
+            fn destroy(&mut self, ctx: &$crate::context::Context) {
+                <$t>::destroy(self, ctx)
+            }
+        })*
+    };
+}
+pub(crate) use destroy_by_method;
