@@ -246,6 +246,9 @@ pub struct SceneNeeds {
     /// The preserved stencil bits its layout leaves (`StencilLayout::preserved_mask`).
     pub preserved_mask: u8,
     pub has_alpha: bool,
+    /// The LUT technique can light it: no material's parameters vary per texel
+    /// (`Material::parameters_vary`), which a table per material cannot follow.
+    pub lut: bool,
 }
 
 impl SceneNeeds {
@@ -257,6 +260,7 @@ impl SceneNeeds {
         Ok(Self {
             preserved_mask: layout.preserved_mask(),
             has_alpha: scene.alpha_entity_count() > 0,
+            lut: !scene.objects.iter().any(|o| o.material.parameters_vary()),
         })
     }
 }
@@ -337,6 +341,9 @@ pub fn cases(
     let mut out = vec![case(None, Expect::Reference)];
     for &pattern in patterns {
         for config in lighting_configs(pattern, exact_alpha) {
+            if config.lighting == Lighting::Lut && !needs.lut {
+                continue;
+            }
             let expect = if config.lighting == Lighting::Lut {
                 Expect::Lut
             } else {
@@ -407,6 +414,7 @@ mod tests {
     const ROOM: SceneNeeds = SceneNeeds {
         preserved_mask: 0xFC,
         has_alpha: false,
+        lut: true,
     };
 
     #[test]
@@ -416,6 +424,7 @@ mod tests {
             SceneNeeds {
                 preserved_mask: 0xF0,
                 has_alpha: true,
+                lut: true,
             },
         ] {
             let mut seen = HashSet::new();
@@ -459,7 +468,7 @@ mod tests {
         // A layout whose BRDF bits reach bit 5 leaves no room for 0xA0.
         let crowded = SceneNeeds {
             preserved_mask: 0xC0,
-            has_alpha: false,
+            ..ROOM
         };
         let crowded = cases(crowded, DepthStencilFormat::D32S8, (257, 129));
         assert!(crowded
@@ -475,6 +484,14 @@ mod tests {
         };
         let alpha = cases(alpha, DepthStencilFormat::D32S8, (257, 129));
         assert_eq!(alpha.len(), room.len() + 3);
+        // Per-texel BRDF parameters: no LUT cases (7 per pattern), everything else kept.
+        let textured = SceneNeeds { lut: false, ..ROOM };
+        let textured = cases(textured, DepthStencilFormat::D32S8, (257, 129));
+        assert_eq!(textured.len(), room.len() - 2 * 7);
+        assert!(textured
+            .iter()
+            .filter_map(|c| c.config)
+            .all(|c| c.lighting != Lighting::Lut));
         let modes: HashSet<_> = alpha
             .iter()
             .filter(|c| c.expect == Expect::Alpha)

@@ -348,6 +348,7 @@ mod tests {
         let needs = SceneNeeds {
             preserved_mask: 0xFC,
             has_alpha: false,
+            lut: true,
         };
         let all = cases(needs, DepthStencilFormat::D32S8, (7, 5));
         let result = |case: crate::matrix::Case, outcome| CaseResult {

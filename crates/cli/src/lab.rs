@@ -134,6 +134,18 @@ pub struct DemoArgs {
     out: PathBuf,
 }
 
+#[derive(clap::Args)]
+pub struct ScaleArgs {
+    /// An embedded scene or a `.gltf` / `.glb` file.
+    #[arg(long, default_value = "town")]
+    scene: String,
+    #[command(flatten)]
+    run: RunArgs,
+    /// The report (markdown).
+    #[arg(long, default_value = "out/scale.md")]
+    out: PathBuf,
+}
+
 /// A spinner with a message, or a bar when the number of steps is known.
 fn progress_bar(steps: Option<u64>) -> ProgressBar {
     match steps {
@@ -276,6 +288,29 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
                 x * 100.0
             ))
     );
+    Ok(())
+}
+
+pub fn scale(args: &ScaleArgs, lights: DefaultLights) -> Result<()> {
+    histencil_vk::check_output_file(&args.out)?;
+    let start = std::time::Instant::now();
+    let scene = crate::load_scene_arg(&args.scene, lights)?;
+    let settings = histencil_lab::ScaleSettings {
+        scene,
+        load_ms: start.elapsed().as_secs_f64() * 1e3,
+        width: args.run.width,
+        height: args.run.height,
+        rounds: args.run.frames as usize,
+    };
+    let report = on_device(args.run.validate, |ctx| {
+        Ok(with_spinner(|step| {
+            histencil_lab::run_scale(ctx, settings, step)
+        })?)
+    })?;
+    let markdown = format!("# `{}` at scale\n\n{}", args.scene, report.markdown());
+    histencil_vk::write_atomically(&args.out, markdown.as_bytes())?;
+    print!("{markdown}");
+    println!("\nwrote {}", args.out.display());
     Ok(())
 }
 

@@ -45,6 +45,10 @@ enum Command {
     /// platform backend, the per-BRDF breakdown, a light-size sweep, each next to its error
     /// against forward; writes report.md, report.json and PNG plots.
     Compare(lab::CompareArgs),
+    /// A scene at scale (default: the generated `town`): load time and device memory, then
+    /// G-buffer, lighting and frame time of stencil (native, PS3-like) and branching next to
+    /// forward, each with its error; writes a markdown report.
+    Scale(lab::ScaleArgs),
     /// Speed against error for one setting (lut-res, lightmap-res, slices, tile-size): CSV, JSON and a
     /// Pareto plot.
     Sweep(lab::SweepArgs),
@@ -581,6 +585,7 @@ fn main() -> ExitCode {
         Command::Scenes(args) => scenes(args, lights),
         Command::Compare(args) => lab::compare(args, lights),
         Command::Demo(args) => lab::demo(args, lights),
+        Command::Scale(args) => lab::scale(args, lights),
         Command::Sweep(args) => lab::sweep(args, lights),
         Command::Calibrate(args) => lab::calibrate(args),
         Command::BrdfEval(args) => brdf_eval(args),

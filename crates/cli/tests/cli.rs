@@ -515,3 +515,42 @@ fn demo_prints_the_tour_and_writes_the_contact_sheet_under_validation() {
     assert_eq!(image.width(), 4 * (48 + 6) + 6);
     assert_eq!(image.height(), 2 * (32 + 30 + 6) + 6);
 }
+
+#[test]
+fn scale_reports_the_town_under_validation() {
+    let dir = std::env::temp_dir().join("histencil-cli-scale");
+    let _ = std::fs::remove_dir_all(&dir);
+    let report = dir.join("scale.md");
+    let (ok, stdout, stderr) = histencil(&[
+        "scale",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--frames",
+        "2",
+        "--validate",
+        "--out",
+        report.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let written = std::fs::read_to_string(&report).expect("the report");
+    assert!(stdout.contains(&written), "{stdout}");
+    assert!(written.contains("247808 triangles"), "{written}");
+    assert!(written.contains("25 materials, 256 lights"), "{written}");
+    // Every technique is within one 8-bit step of forward.
+    for row in ["stencil, native", "stencil, PS3-like", "branching, native"] {
+        let line = written
+            .lines()
+            .find(|l| l.starts_with(&format!("| {row} |")))
+            .unwrap_or_else(|| panic!("{row}: {written}"));
+        let error = line.rsplit('|').nth(1).unwrap().trim();
+        let max: f64 = error.split(" / ").next().unwrap().parse().unwrap();
+        assert!(max <= 1.0, "{line}");
+    }
+    assert!(
+        written.contains("Lighting time over branching's"),
+        "{written}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -10,6 +10,8 @@
 //! - [`demo`]: a short tour of the talk on one scene (`histencil demo`, `tools/demo`): the
 //!   techniques and backends side by side with their times, errors and hi-stencil statistics,
 //!   and a contact sheet of the frames, the stencil byte and the talk's failures.
+//! - [`scale`]: a scene at scale: its load time and device memory, and G-buffer, lighting and
+//!   frame time of stencil (native, PS3-like) and branching, each with its error.
 //! - [`calibrate()`]: this device's per-pass overhead, branch tax and shade cost, the
 //!   [`CostModel`](histencil_vk::CostModel) that the adaptive technique chooses with.
 
@@ -21,6 +23,7 @@ pub mod demo;
 mod image_error;
 mod measure;
 mod plot;
+pub mod scale;
 pub mod stats;
 pub mod sweep;
 mod variants;
@@ -31,6 +34,7 @@ pub use compare::{run_compare, CompareReport, CompareSettings, MAX_ROUNDS};
 pub use demo::{run_demo, DemoReport, DemoSettings};
 pub use image_error::{image_error, ImageError};
 pub use measure::Timing;
+pub use scale::{run_scale, ScaleReport, ScaleSettings};
 pub use sweep::{run_sweep, SweepParam, SweepReport};
 pub use variants::{light_size_scene, with_brdf_count};
 

@@ -39,7 +39,7 @@ fn material(id: BrdfId, variant: usize, tint: Vec3) -> Material {
 }
 
 /// `(name, description)` of every embedded scene.
-pub const EMBEDDED: [(&str, &str); 12] = [
+pub const EMBEDDED: [(&str, &str); 13] = [
     (
         "default",
         "procedural room: 2 BRDFs, 36 point lights from tiny to huge, 3 spots, 1 directional",
@@ -90,6 +90,10 @@ pub const EMBEDDED: [(&str, &str); 12] = [
         "alpha-many",
         "the default room with 8 smoke systems x 256 particles, each with a light of its own",
     ),
+    (
+        "town",
+        "a generated town at a real scene's scale: 248k triangles, 25 textured materials (base colour, normal, metallic-roughness) in 4 BRDFs, 224 point and 32 spot lights",
+    ),
 ];
 
 pub fn embedded_names() -> impl Iterator<Item = &'static str> {
@@ -106,6 +110,9 @@ pub fn embedded(name: &str) -> Result<Scene, SceneError> {
             name: name.to_owned(),
             known: embedded_names().collect::<Vec<_>>().join(", "),
         })?;
+    if name == "town" {
+        return Ok(crate::town::town(name, description));
+    }
     let models: &[BrdfId] = match name {
         "brdfs-1" => &[BrdfId::Lambert],
         "brdfs-3" => &[BrdfId::Lambert, BrdfId::OrenNayarFull, BrdfId::Ggx],
@@ -155,10 +162,10 @@ pub fn embedded(name: &str) -> Result<Scene, SceneError> {
 }
 
 /// A tiny deterministic generator (SplitMix64), so scenes never depend on a crate's RNG stream.
-struct SplitMix(u64);
+pub(crate) struct SplitMix(pub(crate) u64);
 
 impl SplitMix {
-    fn next_f32(&mut self) -> f32 {
+    pub(crate) fn next_f32(&mut self) -> f32 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -167,7 +174,7 @@ impl SplitMix {
         (z >> 40) as f32 / (1u64 << 24) as f32
     }
 
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+    pub(crate) fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.next_f32()
     }
 }
@@ -358,7 +365,11 @@ mod tests {
                 .filter(|l| l.kind == LightKind::Point)
                 .count();
             // Every room keeps its 36 point lights, except the one built to have only huge ones.
-            let expected = if name == "huge-lights" { 8 } else { 32 };
+            let expected = match name {
+                "huge-lights" => 8,
+                "town" => 224,
+                _ => 32,
+            };
             assert!(points >= expected, "{name}: {points} point lights");
         }
     }

@@ -9,6 +9,7 @@ mod light_rig;
 mod mesh;
 mod shading;
 mod texture;
+mod town;
 mod types;
 
 pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICES};
@@ -30,6 +31,7 @@ pub use texture::{
     textured_brdf, uv_transform, Filter, MaterialMaps, Sampler, TextureImage, TextureRef,
     UvTransform, Wrap, MAX_TEXTURE_SIDE, UV_IDENTITY,
 };
+pub use town::{TOWN_LIGHTS, TOWN_MATERIALS};
 pub use types::{
     unit_direction, Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape,
     MAX_FAR_OVER_NEAR, MAX_LIGHT_COLOR, MAX_TINT, MAX_WORLD_COORDINATE, MIN_FOV_Y,

@@ -111,6 +111,16 @@ impl Material {
     pub fn lambert(albedo: Vec3) -> Self {
         Self::new(Brdf::Lambert { rho: 1.0 }, albedo)
     }
+
+    /// Whether the BRDF's parameters change from texel to texel: a metallic-roughness map on a
+    /// model [`crate::textured_brdf`] scales (GGX, Blinn-Phong, Oren-Nayar). A table per
+    /// material (the LUT technique's) cannot follow such a surface.
+    pub fn parameters_vary(&self) -> bool {
+        self.maps.metallic_roughness.is_some()
+            && [(0.5, 0.0), (1.0, 0.5)]
+                .iter()
+                .any(|&(g, b)| crate::textured_brdf(self.brdf, g, b) != self.brdf)
+    }
 }
 
 /// The kind of a light and its kind-specific parameters.

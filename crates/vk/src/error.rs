@@ -36,6 +36,13 @@ pub enum Error {
          {limit} bytes: lower the LUT resolution"
     )]
     LutTooLarge { bytes: u64, limit: u64 },
+    /// The LUT technique on a scene whose BRDF parameters vary per texel.
+    #[error(
+        "the LUT technique tabulates each material's own BRDF parameters, and object `{object}`'s \
+         metallic-roughness map changes its {brdf} parameters per texel, which no table per \
+         material follows: light this scene with stencil, branching or adaptive"
+    )]
+    LutTexturedParameters { object: String, brdf: &'static str },
     #[error(transparent)]
     Lightmap(#[from] histencil_alpha::LayoutError),
     #[error("{count} distinct materials; the G-buffer indexes at most {max}")]

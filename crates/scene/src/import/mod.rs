@@ -19,7 +19,7 @@
 mod buffers;
 mod images;
 mod material;
-mod tangents;
+pub(crate) mod tangents;
 mod uv_layout;
 
 use buffers::ReadLimit;

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 /// How the mesh's fitted vertices map back to the file's own space, where tangents are made,
 /// and how a tangent made there maps into the fitted mesh.
-pub(super) struct Space<'a> {
+pub(crate) struct Space<'a> {
     pub position: &'a dyn Fn([f32; 3]) -> [f32; 3],
     pub normal: &'a dyn Fn([f32; 3]) -> [f32; 3],
     pub tangent: &'a dyn Fn([f32; 4]) -> [f32; 4],
@@ -63,7 +63,7 @@ impl mikktspace::Geometry for Corners<'_> {
 /// agree share a vertex again. A corner the algorithm leaves without a usable tangent (a
 /// triangle with no UV area) gets one perpendicular to its normal, so the shader never
 /// normalises zero.
-pub(super) fn generate(mesh: &mut Mesh, uv_set: u32, space: &Space) -> Result<(), String> {
+pub(crate) fn generate(mesh: &mut Mesh, uv_set: u32, space: &Space) -> Result<(), String> {
     let corners = mesh.indices.len();
     let mut geometry = Corners {
         mesh,

@@ -160,10 +160,23 @@ impl<'c> Renderer<'c> {
     /// (by table index: the scene's distinct BRDF materials in first-use order).
     ///
     /// # Errors
+    /// [`crate::Error::LutTexturedParameters`] when an object's metallic-roughness map changes
+    /// its BRDF's parameters per texel ([`histencil_scene::Material::parameters_vary`]),
     /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
     /// [`LutTables::new`].
     pub fn lut_tables(&mut self) -> Result<&LutTables> {
         if self.lut_tables.is_none() {
+            if let Some(o) = self
+                .scene
+                .objects
+                .iter()
+                .find(|o| o.material.parameters_vary())
+            {
+                return Err(crate::Error::LutTexturedParameters {
+                    object: o.name.clone(),
+                    brdf: o.material.brdf.id().name(),
+                });
+            }
             if self.materials.len() > MAX_MATERIALS {
                 return Err(crate::Error::TooManyMaterials {
                     count: self.materials.len(),
