@@ -1,7 +1,7 @@
 #version 460
 // Forward reference: every fragment evaluates its own BRDF for every light, with the same light
 // code as the deferred pass and the same textured surface as the G-buffer pass. Ground truth for
-// every error figure.
+// every error figure. Emitted light is added once, before the lights.
 #include "light.glsl"
 #include "material.glsl"
 
@@ -17,7 +17,7 @@ layout(location = 0) out vec4 out_color;
 void main() {
     Surface s = surface_from_material(in_world_position, in_world_normal, in_uv,
                                       in_world_tangent, in_color);
-    vec3 sum = vec3(0.0);
+    vec3 sum = material_emissive(in_uv);
     for (uint i = 0; i < frame.counts.x; ++i) {
         sum += shade_light(lights[i], s);
     }

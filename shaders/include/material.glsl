@@ -12,20 +12,25 @@
 #define MAP_BASE_COLOR 0
 #define MAP_NORMAL 1
 #define MAP_METALLIC_ROUGHNESS 2
+#define MAP_EMISSIVE 3
 
 layout(set = 1, binding = 0, std140) uniform MaterialMaps {
     // Per map, two rows (a, b, c) of its KHR_texture_transform: u' = a u + b v + c; the first
     // row's w is the texture coordinate set (0 or 1).
-    vec4 transform[6];
+    vec4 transform[8];
     // x: 1 where the normal map is read; y: the normal map's scale.
     vec4 normal_map;
+    // rgb: the radiance the surface emits, times the emissive map.
+    vec4 emissive;
 } material_maps;
 layout(set = 1, binding = 1) uniform texture2D map_base_color;
 layout(set = 1, binding = 2) uniform texture2D map_normal;
 layout(set = 1, binding = 3) uniform texture2D map_metallic_roughness;
-layout(set = 1, binding = 4) uniform sampler sampler_base_color;
-layout(set = 1, binding = 5) uniform sampler sampler_normal;
-layout(set = 1, binding = 6) uniform sampler sampler_metallic_roughness;
+layout(set = 1, binding = 4) uniform texture2D map_emissive;
+layout(set = 1, binding = 5) uniform sampler sampler_base_color;
+layout(set = 1, binding = 6) uniform sampler sampler_normal;
+layout(set = 1, binding = 7) uniform sampler sampler_metallic_roughness;
+layout(set = 1, binding = 8) uniform sampler sampler_emissive;
 
 // The map's texture coordinates: its set of `uv` (xy TEXCOORD_0, zw TEXCOORD_1), transformed.
 vec2 material_map_uv(int map, vec4 uv) {
@@ -92,6 +97,13 @@ Surface surface_from_material(vec3 world_position, vec3 world_normal, vec4 uv,
         }
     }
     return s;
+}
+
+// The radiance the draw's surface emits at `uv`: added once per pixel, not per light.
+vec3 material_emissive(vec4 uv) {
+    vec3 map = texture(sampler2D(map_emissive, sampler_emissive),
+                       material_map_uv(MAP_EMISSIVE, uv)).rgb;
+    return material_maps.emissive.rgb * map;
 }
 
 #endif

@@ -164,3 +164,61 @@ fn bad_images_are_refused_naming_the_image() {
         }
     }
 }
+
+/// `emissiveFactor` times `KHR_materials_emissive_strength`, with its `emissiveTexture`, is
+/// what the material emits; the textured scene with it renders within 1/255 of forward and
+/// brighter than without; a negative or non-finite emission is refused, naming the object.
+#[test]
+fn emission_imports_with_its_strength_and_map() {
+    let emissive = |factor: Value, strength: Value| {
+        move |doc: &mut Value| {
+            let m = &mut doc["materials"][0];
+            m["emissiveFactor"] = factor;
+            m["emissiveTexture"] = json!({"index": 0});
+            m["extensions"] =
+                json!({"KHR_materials_emissive_strength": {"emissiveStrength": strength}});
+            doc["extensionsUsed"]
+                .as_array_mut()
+                .unwrap()
+                .push(json!("KHR_materials_emissive_strength"));
+        }
+    };
+    let path = write_textured("emissive", emissive(json!([0.5, 0.25, 0.125]), json!(4.0)));
+    let scene = load_scene(path.to_str().unwrap()).expect("the emissive glTF imports");
+    let floor = scene
+        .objects
+        .iter()
+        .find(|o| o.name.starts_with("floor"))
+        .unwrap();
+    assert_eq!(floor.material.emissive, glam::Vec3::new(2.0, 1.0, 0.5));
+    assert!(floor.material.maps.emissive.is_some());
+    let plain = load_scene(write_textured("not-emissive", |_| {}).to_str().unwrap()).unwrap();
+    with_validated_context(|ctx| {
+        let frame = |scene: &histencil_scene::Scene, t| {
+            let mut r = Renderer::new(ctx, scene.clone(), 96, 96).unwrap();
+            r.render(t, LDR).unwrap().images.ldr.unwrap()
+        };
+        let forward = frame(&scene, Technique::Forward);
+        let unlit = frame(&plain, Technique::Forward);
+        let brighter = forward
+            .pixels()
+            .zip(unlit.pixels())
+            .filter(|(a, b)| a.0[0] > b.0[0])
+            .count();
+        assert!(brighter > 96 * 96 / 4, "{brighter} pixels brighter");
+        let stencil = Technique::Stencil {
+            backend: Backend::Ps3,
+            flush: FlushPolicy::Auto,
+        };
+        assert_close("gltf-emissive", &frame(&scene, stencil), &forward, 1);
+    });
+    for (factor, strength) in [
+        (json!([0.5, -0.25, 0.0]), json!(1.0)),
+        (json!([0.5, 0.25, 0.0]), json!(1e38)),
+    ] {
+        let path = write_textured("bad-emissive", emissive(factor, strength));
+        let err = load_scene(path.to_str().unwrap()).expect_err("refused");
+        let message = err.to_string();
+        assert!(message.contains("emissive"), "{message}");
+    }
+}

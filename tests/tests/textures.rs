@@ -307,3 +307,66 @@ fn textured_surfaces_light_the_same_in_every_exact_technique() {
         }
     });
 }
+
+/// Emission is added once per pixel: with no lights, the HDR frame of every technique is the
+/// emitted radiance times the emissive map's texel (decoded from sRGB), and with lights it is
+/// that plus the lit surface, the deferred techniques within 1/255 of forward.
+#[test]
+fn emission_is_added_once_and_read_from_its_map() {
+    let texel = [180, 90, 30, 255];
+    let mut material = Material::new(Brdf::Lambert { rho: 1.0 }, Vec3::splat(0.5));
+    material.emissive = Vec3::new(0.4, 0.6, 0.8);
+    material.maps.emissive = Some(TextureRef::new(0));
+    let mesh = square(Vec3::Y, uvs(0.5, 0.5), uvs(0.0, 0.0), [1.0; 4]);
+    let lit = scene(mesh, material, vec![solid("ember", texel)]);
+    let dark = Scene {
+        lights: vec![],
+        ..lit.clone()
+    };
+    let expected = material.emissive
+        * Vec3::new(
+            srgb_to_linear(texel[0]),
+            srgb_to_linear(texel[1]),
+            srgb_to_linear(texel[2]),
+        );
+    let flush = FlushPolicy::Auto;
+    let techniques = [
+        Technique::Forward,
+        Technique::Stencil {
+            backend: Backend::Ps3,
+            flush,
+        },
+        Technique::Branching {
+            backend: Backend::Native,
+            flush,
+        },
+    ];
+    with_validated_context(|ctx| {
+        let hdr = Readback {
+            hdr: true,
+            ..Readback::NONE
+        };
+        let mut renderer = Renderer::new(ctx, dark, SIZE, SIZE).unwrap();
+        let mut reference = None;
+        for technique in techniques {
+            let image = renderer.render(technique, hdr).unwrap().images.hdr.unwrap();
+            let centre = image.get_pixel(SIZE / 2, SIZE / 2).0;
+            // The device's sRGB decode is good to about 2 % at the darkest channel.
+            for c in 0..3 {
+                assert!(
+                    (centre[c] - expected[c]).abs() <= 0.02 * expected[c] + 1e-4,
+                    "{technique:?}: {centre:?} against {expected}"
+                );
+            }
+            // Every technique emits exactly what forward does, once.
+            let forward = *reference.get_or_insert(centre);
+            assert_eq!(centre, forward, "{technique:?}");
+        }
+        let mut renderer = Renderer::new(ctx, lit, SIZE, SIZE).unwrap();
+        let mut frame = |t| renderer.render(t, LDR).unwrap().images.ldr.unwrap();
+        let forward = frame(Technique::Forward);
+        for technique in &techniques[1..] {
+            assert_close("emissive-lit", &frame(*technique), &forward, 1);
+        }
+    });
+}

@@ -29,7 +29,7 @@ pub use mesh::{
 pub use shading::{range_falloff, shade};
 pub use texture::{
     textured_brdf, uv_transform, Filter, MaterialMaps, Sampler, TextureImage, TextureRef,
-    UvTransform, Wrap, MAX_TEXTURE_SIDE, UV_IDENTITY,
+    UvTransform, Wrap, MAP_COUNT, MAX_TEXTURE_SIDE, UV_IDENTITY,
 };
 pub use town::{TOWN_LIGHTS, TOWN_MATERIALS};
 pub use types::{

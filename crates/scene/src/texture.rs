@@ -141,6 +141,8 @@ impl TextureRef {
 ///   `cross(N, T) * w` and normal. Needs tangents, which the importer reads or generates.
 /// - `metallic_roughness` (linear): green is roughness, blue metalness, each a factor in
 ///   `[0, 1]` on the BRDF's parameters as [`textured_brdf`] says.
+/// - `emissive` (sRGB): its RGB multiplies the material's emitted radiance
+///   ([`crate::Material::emissive`]), which is added once per pixel, not per light.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct MaterialMaps {
     pub base_color: Option<TextureRef>,
@@ -148,12 +150,27 @@ pub struct MaterialMaps {
     /// glTF's `normalTexture.scale`.
     pub normal_scale: f32,
     pub metallic_roughness: Option<TextureRef>,
+    pub emissive: Option<TextureRef>,
 }
 
+/// How many maps a material has ([`MaterialMaps::refs`]).
+pub const MAP_COUNT: usize = 4;
+
 impl MaterialMaps {
-    /// The maps, in the order the GPU binds them (base colour, normal, metallic-roughness).
-    pub fn refs(&self) -> [Option<TextureRef>; 3] {
-        [self.base_color, self.normal, self.metallic_roughness]
+    /// The maps, in the order the GPU binds them (base colour, normal, metallic-roughness,
+    /// emissive).
+    pub fn refs(&self) -> [Option<TextureRef>; MAP_COUNT] {
+        [
+            self.base_color,
+            self.normal,
+            self.metallic_roughness,
+            self.emissive,
+        ]
+    }
+
+    /// Whether map `i` of [`MaterialMaps::refs`] holds colour, stored as sRGB.
+    pub fn is_srgb(i: usize) -> bool {
+        i == 0 || i == 3
     }
 
     pub fn is_empty(&self) -> bool {

@@ -1,6 +1,6 @@
 //! `town`: a generated scene at the scale deferred renderers are judged at (a Sponza's worth):
 //! about 250k triangles, 25 textured materials (base colour, normal and metallic-roughness
-//! maps) in four BRDFs, and 256 point and spot lights. Everything is made here, from fixed
+//! maps, three of them emissive) in four BRDFs, and 256 point and spot lights. Everything is made here, from fixed
 //! seeds, so the scene is the same on every machine and needs no asset download.
 
 use crate::embedded::SplitMix;
@@ -136,6 +136,7 @@ fn textured_material(m: usize, images: &mut Vec<TextureImage>) -> Material {
     )
     .clamp(Vec3::splat(0.1), Vec3::ONE);
     let height = |x: u32, y: u32| pattern(m % 5, x, y);
+    let glows = m % 8 == 5;
     let first = images.len() as u32;
     images.push(map(m, "base", |x, y| {
         let v = 0.45 + 0.55 * height(x, y);
@@ -161,7 +162,10 @@ fn textured_material(m: usize, images: &mut Vec<TextureImage>) -> Material {
             normal: Some(TextureRef::new(first + 1)),
             normal_scale: 1.0,
             metallic_roughness: Some(TextureRef::new(first + 2)),
+            // Every eighth material glows through its base colour pattern.
+            emissive: glows.then(|| TextureRef::new(first)),
         },
+        emissive: if glows { tint * 0.8 } else { Vec3::ZERO },
         ..Material::new(brdf, tint)
     }
 }

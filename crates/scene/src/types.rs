@@ -95,16 +95,26 @@ pub struct Material {
     pub tint: Vec3,
     /// Texture maps; opaque objects read them, alpha entities do not (yet).
     pub maps: MaterialMaps,
+    /// Linear RGB radiance the surface emits (glTF's `emissiveFactor` times
+    /// `KHR_materials_emissive_strength`), times the emissive map where there is one. It is
+    /// added once per pixel, whatever the lights; alpha entities do not emit (yet).
+    pub emissive: Vec3,
 }
 
 impl Material {
-    /// An untextured material.
+    /// An untextured material that emits nothing.
     pub fn new(brdf: Brdf, tint: Vec3) -> Self {
         Self {
             brdf,
             tint,
             maps: MaterialMaps::default(),
+            emissive: Vec3::ZERO,
         }
+    }
+
+    /// Whether the surface emits anything.
+    pub fn emits(&self) -> bool {
+        self.emissive != Vec3::ZERO
     }
 
     /// A Lambertian surface of diffuse albedo `albedo`.
@@ -272,6 +282,14 @@ pub(crate) fn material_problem(m: &Material) -> Option<String> {
             "tint must be finite, in [0, {MAX_TINT}] per channel, got {}",
             m.tint
         ))
+    } else if !finite3(m.emissive)
+        || m.emissive.min_element() < 0.0
+        || m.emissive.max_element() > MAX_LIGHT_COLOR
+    {
+        Some(format!(
+            "emissive must be finite, in [0, {MAX_LIGHT_COLOR:e}] per channel, got {}",
+            m.emissive
+        ))
     } else {
         m.brdf.check().err().map(|e| e.to_string())
     }
@@ -284,7 +302,7 @@ fn maps_problem(maps: &MaterialMaps, images: &[TextureImage]) -> Option<String> 
     if !maps.normal_scale.is_finite() {
         return Some("normal map scale must be finite".into());
     }
-    let names = ["base colour", "normal", "metallic-roughness"];
+    let names = ["base colour", "normal", "metallic-roughness", "emissive"];
     maps.refs().iter().zip(names).find_map(|(map, name)| {
         map.and_then(|m| texture_ref_problem(&m, images.len()))
             .map(|p| format!("{name} map: {p}"))

@@ -54,9 +54,11 @@ pub const MATERIAL_SET: &[BindingDesc] = &[
     binding(1, BindingKind::SampledImage, "map_base_color"),
     binding(2, BindingKind::SampledImage, "map_normal"),
     binding(3, BindingKind::SampledImage, "map_metallic_roughness"),
-    binding(4, BindingKind::Sampler, "sampler_base_color"),
-    binding(5, BindingKind::Sampler, "sampler_normal"),
-    binding(6, BindingKind::Sampler, "sampler_metallic_roughness"),
+    binding(4, BindingKind::SampledImage, "map_emissive"),
+    binding(5, BindingKind::Sampler, "sampler_base_color"),
+    binding(6, BindingKind::Sampler, "sampler_normal"),
+    binding(7, BindingKind::Sampler, "sampler_metallic_roughness"),
+    binding(8, BindingKind::Sampler, "sampler_emissive"),
 ];
 /// Set 1 of the deferred light pipelines (include/gbuffer.glsl).
 pub const GBUFFER_SET: &[BindingDesc] = &[
@@ -132,6 +134,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("mesh.vert", MESH_LAYOUT),
     ("gbuffer.frag", MESH_LAYOUT),
     ("forward.frag", MESH_LAYOUT),
+    ("emissive.frag", MESH_LAYOUT),
     ("light_volume.vert", LIGHTING_LAYOUT),
     ("deferred_light.frag", LIGHTING_LAYOUT),
     ("lut_light.frag", LIGHTING_LAYOUT),

@@ -10,22 +10,25 @@ use crate::resources::{Buffer, Image};
 use crate::upload::{upload, BufferUpload, ImageUpload};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
 use gpu_allocator::MemoryLocation;
-use histencil_scene::{Filter, MaterialMaps, Sampler, Scene, TextureImage, Wrap};
+use histencil_scene::{Filter, MaterialMaps, Sampler, Scene, TextureImage, Wrap, MAP_COUNT};
 
 /// `MaterialMaps` in include/material.glsl (std140).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct MaterialRecord {
     /// Per map two rows of its uv transform; the first row's w is its texture coordinate set.
-    pub transform: [[f32; 4]; 6],
+    pub transform: [[f32; 4]; 2 * MAP_COUNT],
     /// x: 1 where the normal map is read; y: its scale.
     pub normal_map: [f32; 4],
+    /// rgb: the radiance the surface emits (times the emissive map).
+    pub emissive: [f32; 4],
 }
 
 impl MaterialRecord {
-    pub fn new(maps: &MaterialMaps) -> Self {
-        let mut transform = [[0.0; 4]; 6];
+    pub fn new(maps: &MaterialMaps, emissive: Vec3) -> Self {
+        let mut transform = [[0.0; 4]; 2 * MAP_COUNT];
         for (i, map) in maps.refs().iter().enumerate() {
             let (m, set) = map.map_or((histencil_scene::UV_IDENTITY, 0), |m| {
                 (m.transform, m.texcoord)
@@ -40,6 +43,7 @@ impl MaterialRecord {
         Self {
             transform,
             normal_map,
+            emissive: emissive.extend(0.0).to_array(),
         }
     }
 }
@@ -55,13 +59,14 @@ pub struct TextureKey {
     pub srgb: bool,
 }
 
-/// One descriptor set: its record and, per map, the texture and sampler slots it binds (slot 0
-/// is the white texel and the default sampler).
+/// One descriptor set: its record (maps and emitted radiance) and, per map, the texture and
+/// sampler slots it binds (slot 0 is the white texel and the default sampler).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SetPlan {
     pub maps: MaterialMaps,
-    pub textures: [usize; 3],
-    pub samplers: [usize; 3],
+    pub emissive: Vec3,
+    pub textures: [usize; MAP_COUNT],
+    pub samplers: [usize; MAP_COUNT],
 }
 
 /// What the scene's materials need on the GPU, computed without it.
@@ -91,26 +96,32 @@ pub fn plan_materials(scene: &Scene) -> MaterialPlan {
         samplers: vec![],
         sets: vec![SetPlan {
             maps: MaterialMaps::default(),
-            textures: [0; 3],
-            samplers: [0; 3],
+            emissive: Vec3::ZERO,
+            textures: [0; MAP_COUNT],
+            samplers: [0; MAP_COUNT],
         }],
         object_sets: vec![],
     };
     for object in &scene.objects {
-        let maps = object.material.maps;
-        let set = match plan.sets.iter().position(|s| s.maps == maps) {
+        let (maps, emissive) = (object.material.maps, object.material.emissive);
+        let set = match plan
+            .sets
+            .iter()
+            .position(|s| s.maps == maps && s.emissive == emissive)
+        {
             Some(set) => set,
             None => {
                 let mut set = SetPlan {
                     maps,
-                    textures: [0; 3],
-                    samplers: [0; 3],
+                    emissive,
+                    textures: [0; MAP_COUNT],
+                    samplers: [0; MAP_COUNT],
                 };
                 for (i, map) in maps.refs().iter().enumerate() {
                     if let Some(map) = map {
                         let key = TextureKey {
                             image: map.image,
-                            srgb: i == 0,
+                            srgb: MaterialMaps::is_srgb(i),
                         };
                         set.textures[i] = slot(&mut plan.textures, key);
                         set.samplers[i] = slot(&mut plan.samplers, map.sampler);
@@ -348,7 +359,7 @@ impl GpuMaterials {
             .iter()
             .zip(record_bytes.chunks_exact_mut(RECORD_STRIDE as usize))
         {
-            let record = MaterialRecord::new(&set.maps);
+            let record = MaterialRecord::new(&set.maps, set.emissive);
             chunk[..size_of::<MaterialRecord>()].copy_from_slice(bytemuck::bytes_of(&record));
         }
         let records = self.records.insert(Buffer::new(
@@ -387,8 +398,8 @@ impl GpuMaterials {
         let count = plan.sets.len() as u32;
         let sizes = [
             (vk::DescriptorType::UNIFORM_BUFFER, count),
-            (vk::DescriptorType::SAMPLED_IMAGE, 3 * count),
-            (vk::DescriptorType::SAMPLER, 3 * count),
+            (vk::DescriptorType::SAMPLED_IMAGE, MAP_COUNT as u32 * count),
+            (vk::DescriptorType::SAMPLER, MAP_COUNT as u32 * count),
         ]
         .map(|(ty, n)| vk::DescriptorPoolSize::default().ty(ty).descriptor_count(n));
         let pool_info = vk::DescriptorPoolCreateInfo::default()
@@ -436,7 +447,7 @@ impl GpuMaterials {
                 writes.push(
                     vk::WriteDescriptorSet::default()
                         .dst_set(*set)
-                        .dst_binding(4 + k as u32)
+                        .dst_binding(1 + (MAP_COUNT + k) as u32)
                         .descriptor_type(vk::DescriptorType::SAMPLER)
                         .image_info(info),
                 );
@@ -534,7 +545,7 @@ mod tests {
             ]
         );
         assert_eq!(plan.samplers.len(), 1);
-        assert_eq!(plan.sets[1].textures, [1, 0, 2]);
-        assert_eq!(plan.sets[1].samplers, [1, 0, 1]);
+        assert_eq!(plan.sets[1].textures, [1, 0, 2, 0]);
+        assert_eq!(plan.sets[1].samplers, [1, 0, 1, 0]);
     }
 }

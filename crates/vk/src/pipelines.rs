@@ -298,6 +298,8 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
 pub struct Pipelines {
     pub gbuffer: vk::Pipeline,
     pub forward: vk::Pipeline,
+    /// Emitted radiance into the HDR target after the G-buffer pass (equal depth).
+    pub emissive: vk::Pipeline,
     pub tonemap: vk::Pipeline,
 }
 
@@ -356,6 +358,16 @@ impl Pipelines {
                     ..base
                 },
             )?;
+            p.emissive = create_pipeline(
+                ctx,
+                &PipelineDesc {
+                    name: "emissive-pipeline",
+                    fragment: Some(("emissive.frag", shaders::EMISSIVE_FRAG)),
+                    layout: layouts.mesh,
+                    vertex_input: VertexInput::Mesh,
+                    ..base
+                },
+            )?;
             p.tonemap = create_pipeline(
                 ctx,
                 &PipelineDesc {
@@ -374,7 +386,7 @@ impl Pipelines {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for p in [self.gbuffer, self.forward, self.tonemap] {
+        for p in [self.gbuffer, self.forward, self.emissive, self.tonemap] {
             unsafe { ctx.device.destroy_pipeline(p, None) };
         }
         *self = Self::default();

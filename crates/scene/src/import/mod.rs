@@ -220,9 +220,12 @@ impl Importer<'_> {
             })?;
             let blend = gltf_material.alpha_mode() == gltf::material::AlphaMode::Blend;
             let mut material = material;
-            // Alpha entities are lit per entity from their lightmaps and do not read maps.
+            // Alpha entities are lit per entity from their lightmaps and do not read maps or
+            // emit.
             if !blend {
-                material.maps = self.material_maps(&gltf_material)?;
+                let strength = gltf_material.emissive_strength().unwrap_or(1.0);
+                material.emissive = Vec3::from(gltf_material.emissive_factor()) * strength;
+                material.maps = self.material_maps(&gltf_material, material.emits())?;
             }
             let mut texcoords = [false; 2];
             for map in material.maps.refs().into_iter().flatten() {
@@ -279,7 +282,13 @@ impl Importer<'_> {
 
 impl Importer<'_> {
     /// The material's texture maps, their images decoded into the scene on first use.
-    fn material_maps(&mut self, m: &gltf::Material) -> Result<MaterialMaps, ImportError> {
+    /// The emissive map is read only where the material `emits` (the map multiplies its
+    /// factor).
+    fn material_maps(
+        &mut self,
+        m: &gltf::Material,
+        emits: bool,
+    ) -> Result<MaterialMaps, ImportError> {
         let images = &mut self.scene.images;
         let pbr = m.pbr_metallic_roughness();
         let mut maps = MaterialMaps {
@@ -301,6 +310,9 @@ impl Importer<'_> {
         };
         maps.base_color = info(pbr.base_color_texture())?;
         maps.metallic_roughness = info(pbr.metallic_roughness_texture())?;
+        if emits {
+            maps.emissive = info(m.emissive_texture())?;
+        }
         if let Some(normal) = m.normal_texture() {
             let set = normal.tex_coord();
             let placement = match normal.extension_value("KHR_texture_transform") {

@@ -11,7 +11,9 @@ use crate::gpu_types::DrawPush;
 use crate::meshes::Meshes;
 use crate::state::{apply, oriented, with_stencil, OPAQUE};
 use ash::vk;
-use histencil_model::{DepthConvention, FaceStencil, PassState, StencilLayout, StencilOp};
+use histencil_model::{
+    CompareOp, DepthConvention, DepthState, FaceStencil, PassState, StencilLayout, StencilOp,
+};
 use histencil_scene::Scene;
 
 pub struct GeometryPass<'a> {
@@ -51,7 +53,9 @@ pub fn gbuffer_stencil(
 }
 
 impl GeometryPass<'_> {
-    fn draw_objects(&self, state_of: impl Fn(usize) -> PassState) {
+    /// Draws the objects `state_of` gives a state, each with its material set and push
+    /// constants.
+    fn draw_objects(&self, state_of: impl Fn(usize) -> Option<PassState>) {
         let d = &self.ctx.device;
         unsafe {
             d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
@@ -64,9 +68,12 @@ impl GeometryPass<'_> {
                 &[],
             );
         }
+        let mut bound = None;
         for (i, object) in self.scene.objects.iter().enumerate() {
-            apply(self.ctx, self.cmd, &state_of(i));
-            if i == 0 || self.material_sets[i] != self.material_sets[i - 1] {
+            let Some(state) = state_of(i) else { continue };
+            apply(self.ctx, self.cmd, &state);
+            if bound != Some(self.material_sets[i]) {
+                bound = Some(self.material_sets[i]);
                 unsafe {
                     d.cmd_bind_descriptor_sets(
                         self.cmd,
@@ -134,33 +141,70 @@ impl GeometryPass<'_> {
         let clear = Load::Clear(clear_depth_stencil(self.depth));
         let ds = depth_stencil_attachment(&targets.depth_stencil, clear);
         begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
-        self.draw_objects(
-            |i| match gbuffer_stencil(layout, slots[i], preserved_pattern) {
+        self.draw_objects(|i| {
+            Some(match gbuffer_stencil(layout, slots[i], preserved_pattern) {
                 Some(s) => with_stencil(oriented(OPAQUE, self.depth), s),
                 None => oriented(OPAQUE, self.depth),
-            },
-        );
+            })
+        });
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }
 
     /// The forward reference: lit HDR colour straight from the meshes.
     pub fn record_forward(&self, targets: &mut LightingTargets) {
+        let depth = Load::Clear(clear_depth_stencil(self.depth));
+        self.record_into_hdr(targets, "forward", depth, |_| {
+            Some(oriented(OPAQUE, self.depth))
+        });
+    }
+
+    /// After the G-buffer pass (whose depth it reads): clears the HDR target and writes the
+    /// radiance of every emitting object where that object is the visible surface (depth at or
+    /// in front of the stored one: the same vertex stage computes it again, and no driver
+    /// decorates `gl_Position` invariant without complaint; nothing written but colour), so
+    /// the light passes add onto it and emission counts once.
+    pub fn record_emissive(&self, targets: &mut LightingTargets) {
+        let visible = oriented(VISIBLE_AGAIN, self.depth);
+        self.record_into_hdr(targets, "emissive", Load::Keep, |i| {
+            self.scene.objects[i].material.emits().then_some(visible)
+        });
+    }
+
+    /// A pass labelled `label` into the cleared HDR target and the depth-stencil (`depth`:
+    /// cleared or kept), drawing the objects `state_of` gives a state.
+    fn record_into_hdr(
+        &self,
+        targets: &mut LightingTargets,
+        label: &str,
+        depth: Load,
+        state_of: impl Fn(usize) -> Option<PassState>,
+    ) {
         let (ctx, cmd) = (self.ctx, self.cmd);
-        ctx.begin_label(cmd, "forward");
+        ctx.begin_label(cmd, label);
         begin_hdr_rendering(
             ctx,
             cmd,
             (&mut targets.hdr, &mut targets.depth_stencil),
             self.extent,
             Load::Clear(CLEAR_BLACK),
-            Load::Clear(clear_depth_stencil(self.depth)),
+            depth,
         );
-        self.draw_objects(|_| oriented(OPAQUE, self.depth));
+        self.draw_objects(state_of);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }
 }
+
+/// The visible surface again: depth at or in front of what the G-buffer pass wrote, nothing
+/// written but colour.
+const VISIBLE_AGAIN: PassState = PassState {
+    depth: DepthState {
+        compare: Some(CompareOp::LessOrEqual),
+        write: false,
+    },
+    ..OPAQUE
+};
 
 #[cfg(test)]
 mod tests {

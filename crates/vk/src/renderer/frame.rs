@@ -60,13 +60,21 @@ impl Renderer<'_> {
             }
             _ => {
                 self.record_geometry(false, desc);
+                // Emitted light goes into the HDR target once; the lighting adds onto it.
+                let emits = self.scene.objects.iter().any(|o| o.material.emits());
+                if emits {
+                    let mut targets = self.targets.lighting();
+                    self.geometry_pass(cmd, self.pipelines.emissive, desc.depth)
+                        .record_emissive(&mut targets);
+                    self.targets.lit(&targets);
+                }
                 self.timestamps.mark(ctx, cmd, "gbuffer");
                 let frame = LightingFrame {
                     slot: 0,
                     view: &view,
                     lights: &self.scene.lights,
                     plan: &plan,
-                    clear_hdr: true,
+                    clear_hdr: !emits,
                     timestamps: time_steps,
                     brdf_source,
                     tile_stats: count_stats,
@@ -162,7 +170,7 @@ impl Renderer<'_> {
         let cmd = self.cmd;
         let mut targets = self.targets.lighting();
         if forward {
-            self.geometry_pass(cmd, true, desc.depth)
+            self.geometry_pass(cmd, self.pipelines.forward, desc.depth)
                 .record_forward(&mut targets);
         } else {
             let (depth, pattern) = (desc.depth, desc.preserved_pattern);
@@ -171,10 +179,12 @@ impl Renderer<'_> {
         self.targets.lit(&targets);
     }
 
+    /// The mesh pass drawing the scene's objects with `pipeline` (G-buffer, forward or
+    /// emissive).
     fn geometry_pass(
         &self,
         cmd: vk::CommandBuffer,
-        forward: bool,
+        pipeline: vk::Pipeline,
         depth: DepthConvention,
     ) -> GeometryPass<'_> {
         GeometryPass {
@@ -182,11 +192,7 @@ impl Renderer<'_> {
             cmd,
             scene: &self.scene,
             meshes: &self.meshes,
-            pipeline: if forward {
-                self.pipelines.forward
-            } else {
-                self.pipelines.gbuffer
-            },
+            pipeline,
             pipeline_layout: self.descriptors.mesh_pipeline_layout,
             frame_set: self.descriptors.frame_set,
             material_sets: &self.maps.object_sets,
@@ -203,12 +209,13 @@ impl Renderer<'_> {
         depth: DepthConvention,
         preserved_pattern: u8,
     ) {
-        self.geometry_pass(cmd, false, depth).record_gbuffer(
-            targets,
-            &self.stencil_layout,
-            &self.object_slots,
-            preserved_pattern,
-        );
+        self.geometry_pass(cmd, self.pipelines.gbuffer, depth)
+            .record_gbuffer(
+                targets,
+                &self.stencil_layout,
+                &self.object_slots,
+                preserved_pattern,
+            );
     }
 
     /// Records histencil's G-buffer pass of the scene (its camera, its objects) into another
