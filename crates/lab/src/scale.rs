@@ -11,7 +11,7 @@
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, Timing, WARM_UP_FRAMES};
 use crate::Result;
-use histencil_scene::{Scene, Shape};
+use histencil_scene::{unit_box, uv_sphere, Material, Mesh, Scene, Shape, SPHERE_DETAIL};
 use histencil_vk::{Backend, Context, FlushPolicy, FrameDesc, Renderer, Technique};
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -40,23 +40,25 @@ pub struct SceneSize {
 
 impl SceneSize {
     pub fn of(scene: &Scene) -> Self {
+        // The built-in shapes' triangles, from the meshes the renderer draws for them.
+        let (s, r) = SPHERE_DETAIL;
+        let builtin = |m: Mesh| m.indices.len() / 3;
+        let (cube, sphere) = (builtin(unit_box()), builtin(uv_sphere(s, r)));
         let triangles = scene
             .objects
             .iter()
             .map(|o| match o.shape {
                 Shape::Mesh(i) => scene.meshes[i as usize].indices.len() / 3,
-                Shape::Box => 12,
-                Shape::Sphere => {
-                    let (s, r) = histencil_scene::SPHERE_DETAIL;
-                    (s * (2 * r - 2)) as usize
-                }
+                Shape::Box => cube,
+                Shape::Sphere => sphere,
             })
             .sum();
-        let materials: std::collections::HashSet<String> = scene
-            .objects
-            .iter()
-            .map(|o| format!("{:?}", o.material))
-            .collect();
+        let mut materials: Vec<&Material> = Vec::new();
+        for o in &scene.objects {
+            if !materials.contains(&&o.material) {
+                materials.push(&o.material);
+            }
+        }
         let mesh_bytes: usize = scene
             .meshes
             .iter()
@@ -139,6 +141,7 @@ pub fn run_scale(
     step: &mut dyn FnMut(&str),
 ) -> Result<ScaleReport> {
     let size = SceneSize::of(&settings.scene);
+    let rounds = settings.rounds.max(1);
     step("creating the renderer");
     let before = ctx.memory_in_use();
     let start = Instant::now();
@@ -157,12 +160,8 @@ pub fn run_scale(
     }
     // samples[technique] = (gbuffer, lighting, frame) per round.
     let mut samples = vec![(Vec::new(), Vec::new(), Vec::new()); techniques.len()];
-    for round in 0..settings.rounds.max(1) {
-        step(&format!(
-            "round {} of {}",
-            round + 1,
-            settings.rounds.max(1)
-        ));
+    for round in 0..rounds {
+        step(&format!("round {} of {rounds}", round + 1));
         for ((_, technique), s) in techniques.iter().zip(&mut samples) {
             let t = renderer.render_frame(&FrameDesc::from(*technique))?.timings;
             let pass = |name| t.pass_ms(name).unwrap_or(0.0);
@@ -206,7 +205,7 @@ pub fn run_scale(
         device: ctx.device_name().to_owned(),
         width: settings.width,
         height: settings.height,
-        rounds: settings.rounds.max(1),
+        rounds,
         size,
         load_ms: settings.load_ms,
         create_ms,

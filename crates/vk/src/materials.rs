@@ -7,6 +7,7 @@
 use crate::context::Context;
 use crate::error::{Error, Result, VkCall};
 use crate::resources::{Buffer, Image};
+use crate::teardown::build;
 use crate::upload::{upload, BufferUpload, ImageUpload};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -268,6 +269,7 @@ fn sampler_info(s: &Sampler) -> vk::SamplerCreateInfo<'static> {
 }
 
 /// The scene's materials on the GPU. [`GpuMaterials::object_sets`] is each object's set 1.
+#[derive(Default)]
 pub struct GpuMaterials {
     textures: Vec<Image>,
     samplers: Vec<vk::Sampler>,
@@ -287,20 +289,7 @@ impl GpuMaterials {
     pub fn new(ctx: &Context, scene: &Scene, layout: vk::DescriptorSetLayout) -> Result<Self> {
         check_images(ctx, scene)?;
         let plan = plan_materials(scene);
-        let mut made = Self {
-            textures: vec![],
-            samplers: vec![],
-            records: None,
-            pool: vk::DescriptorPool::null(),
-            object_sets: vec![],
-        };
-        match made.fill(ctx, scene, &plan, layout) {
-            Ok(()) => Ok(made),
-            Err(e) => {
-                made.destroy(ctx);
-                Err(e)
-            }
-        }
+        build(ctx, |made: &mut Self| made.fill(ctx, scene, &plan, layout))
     }
 
     fn fill(

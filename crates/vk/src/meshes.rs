@@ -4,6 +4,7 @@
 use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
+use crate::teardown::build;
 use crate::upload::{upload, BufferUpload};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -11,6 +12,7 @@ use histencil_scene::{
     light_cone, light_sphere, unit_box, uv_sphere, LightKind, Mesh, Shape, SPHERE_DETAIL,
 };
 
+#[derive(Default)]
 pub struct GpuMesh {
     pub vertices: Buffer,
     pub indices: Buffer,
@@ -29,24 +31,18 @@ impl GpuMesh {
                 MemoryLocation::GpuOnly,
             )
         };
-        let vertex_bytes = std::mem::size_of_val(mesh.vertices.as_slice());
-        let mut vertices = buffer(
-            "vertices",
-            vertex_bytes,
-            vk::BufferUsageFlags::VERTEX_BUFFER,
-        )?;
-        let index_bytes = std::mem::size_of_val(mesh.indices.as_slice());
-        match buffer("indices", index_bytes, vk::BufferUsageFlags::INDEX_BUFFER) {
-            Ok(indices) => Ok(Self {
-                vertices,
-                indices,
-                index_count: mesh.indices.len() as u32,
-            }),
-            Err(e) => {
-                vertices.destroy(ctx);
-                Err(e)
-            }
-        }
+        build(ctx, |m: &mut Self| {
+            let vertex_bytes = std::mem::size_of_val(mesh.vertices.as_slice());
+            m.vertices = buffer(
+                "vertices",
+                vertex_bytes,
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+            )?;
+            let index_bytes = std::mem::size_of_val(mesh.indices.as_slice());
+            m.indices = buffer("indices", index_bytes, vk::BufferUsageFlags::INDEX_BUFFER)?;
+            m.index_count = mesh.indices.len() as u32;
+            Ok(())
+        })
     }
 
     /// `meshes` in device-local memory, filled through one staging upload named `name`. A
@@ -56,45 +52,30 @@ impl GpuMesh {
         name: &str,
         meshes: &[(String, &Mesh)],
     ) -> Result<Vec<Self>> {
-        let mut made: Vec<GpuMesh> = Vec::with_capacity(meshes.len());
-        let free = |made: Vec<GpuMesh>| {
-            for mut m in made {
-                m.destroy(ctx);
+        build(ctx, |made: &mut Vec<GpuMesh>| {
+            for (mesh_name, mesh) in meshes {
+                made.push(GpuMesh::allocate(ctx, mesh_name, mesh)?);
             }
-        };
-        for (mesh_name, mesh) in meshes {
-            match GpuMesh::allocate(ctx, mesh_name, mesh) {
-                Ok(m) => made.push(m),
-                Err(e) => {
-                    free(made);
-                    return Err(e);
-                }
-            }
-        }
-        let bytes: Vec<(Vec<u8>, Vec<u8>)> = meshes.iter().map(|(_, m)| mesh_bytes(m)).collect();
-        let uploads: Vec<BufferUpload> = made
-            .iter()
-            .zip(&bytes)
-            .flat_map(|(gpu, (vertices, indices))| {
-                [
-                    BufferUpload {
-                        dst: gpu.vertices.handle,
-                        bytes: vertices,
-                    },
-                    BufferUpload {
-                        dst: gpu.indices.handle,
-                        bytes: indices,
-                    },
-                ]
-            })
-            .collect();
-        match upload(ctx, name, &uploads, &[]) {
-            Ok(()) => Ok(made),
-            Err(e) => {
-                free(made);
-                Err(e)
-            }
-        }
+            let bytes: Vec<(Vec<u8>, Vec<u8>)> =
+                meshes.iter().map(|(_, m)| mesh_bytes(m)).collect();
+            let uploads: Vec<BufferUpload> = made
+                .iter()
+                .zip(&bytes)
+                .flat_map(|(gpu, (vertices, indices))| {
+                    [
+                        BufferUpload {
+                            dst: gpu.vertices.handle,
+                            bytes: vertices,
+                        },
+                        BufferUpload {
+                            dst: gpu.indices.handle,
+                            bytes: indices,
+                        },
+                    ]
+                })
+                .collect();
+            upload(ctx, name, &uploads, &[])
+        })
     }
 
     /// Binds and draws the whole mesh.
@@ -222,6 +203,8 @@ impl Meshes {
 }
 
 crate::teardown::destroy_by_method!(Meshes);
+
+crate::teardown::destroy_by_method!(GpuMesh);
 
 #[cfg(test)]
 mod tests {

@@ -18,6 +18,16 @@ pub(crate) trait Destroy {
     fn destroy(&mut self, ctx: &Context);
 }
 
+/// Several parts made one after another: each is destroyed.
+impl<T: Destroy> Destroy for Vec<T> {
+    fn destroy(&mut self, ctx: &Context) {
+        for part in self.iter_mut() {
+            part.destroy(ctx);
+        }
+        self.clear();
+    }
+}
+
 /// Makes a `T` by running `steps` on its empty value. When a step fails, what the earlier ones
 /// made is destroyed before the error is returned.
 pub(crate) fn build<T: Default + Destroy>(
