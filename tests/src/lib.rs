@@ -5,7 +5,7 @@ pub mod engine;
 pub mod gltf_builder;
 
 use histencil_scene::Scene;
-use histencil_vk::{Context, ContextDesc, Frame, Readback, Renderer, Technique};
+use histencil_vk::{Context, ContextDesc, Frame, Readback, Renderer, Shading};
 use image::RgbaImage;
 use std::path::PathBuf;
 
@@ -31,12 +31,12 @@ pub fn with_validated_context<T>(body: impl FnOnce(&Context) -> T) -> T {
 pub fn render(
     ctx: &Context,
     scene: &Scene,
-    technique: Technique,
+    shading: impl Into<Shading>,
     size: u32,
     readback: Readback,
 ) -> Frame {
     let mut renderer = Renderer::new(ctx, scene.clone(), size, size).expect("renderer");
-    renderer.render(technique, readback).expect("frame")
+    renderer.render(shading, readback).expect("frame")
 }
 
 /// Per-channel absolute differences of two 8-bit images.

@@ -5,7 +5,9 @@ use glam::Vec3;
 use histencil_brdf::Brdf;
 use histencil_scene::{glass_sphere, Light, ParticleLayout, Scene};
 use histencil_tests::{output_dir, with_validated_context};
-use histencil_vk::{masked_error, AlphaMode, Context, FrameDesc, Readback, Renderer, Technique};
+use histencil_vk::{
+    masked_error, AlphaMode, Context, FrameDesc, Readback, Renderer, Shading, Technique,
+};
 use image::RgbaImage;
 
 const SIZE: u32 = 192;
@@ -23,7 +25,7 @@ fn frame(ctx: &Context, scene: &Scene, mode: AlphaMode, side: Option<u32>) -> Rg
     };
     let desc = FrameDesc {
         alpha: mode,
-        ..FrameDesc::new(Technique::Forward, readback)
+        ..FrameDesc::new(Shading::Forward, readback)
     };
     let frame = renderer.render_frame(&desc).expect("frame");
     frame.images.ldr.expect("ldr")
@@ -267,7 +269,7 @@ fn lightmap_frames_are_deterministic_and_deferred_matches_forward_behind_them() 
             .unwrap();
         assert!(a == b, "two lightmap frames differ");
         let forward = renderer
-            .render(Technique::Forward, ldr)
+            .render(Shading::Forward, ldr)
             .unwrap()
             .images
             .ldr

@@ -106,7 +106,7 @@ fn accessor_mutations() -> Vec<(String, serde_json::Value)> {
 #[test]
 fn hostile_gltf_values_are_refused_or_rendered_exactly() {
     use histencil_tests::gltf_builder::{test_gltf, write};
-    use histencil_vk::{Backend, FlushPolicy, Readback, Technique};
+    use histencil_vk::{Backend, FlushPolicy, Readback, Shading, Technique};
     let (doc, bin) = test_gltf("blinn_phong");
     let mut cases: Vec<(String, serde_json::Value)> = vec![];
     for site in SITES {
@@ -156,14 +156,14 @@ fn hostile_gltf_values_are_refused_or_rendered_exactly() {
                     continue;
                 }
             };
-            let mut frame = |t| {
+            let mut frame = |t: Shading| {
                 let frame = renderer
                     .render(t, ldr)
                     .unwrap_or_else(|e| panic!("{what}: {e}"));
                 frame.images.ldr.unwrap()
             };
-            let deferred = frame(stencil);
-            let forward = frame(Technique::Forward);
+            let deferred = frame(stencil.into());
+            let forward = frame(Shading::Forward);
             let d = histencil_tests::diff(&deferred, &forward);
             if d.max > 1 {
                 wrong.push(format!("{what}: stencil {d:?} off forward"));
@@ -183,7 +183,7 @@ fn hostile_gltf_values_are_refused_or_rendered_exactly() {
 /// the range is capped where its window is already 1 everywhere in the scene.
 #[test]
 fn huge_light_ranges_render_as_forward_does() {
-    use histencil_vk::{Backend, FlushPolicy, Readback, Technique};
+    use histencil_vk::{Backend, FlushPolicy, Readback, Shading, Technique};
     let mut scene = histencil_scene::embedded("default").unwrap();
     for light in scene.lights.iter_mut().filter(|l| l.is_local()) {
         light.radius = f32::MAX;
@@ -194,12 +194,12 @@ fn huge_light_ranges_render_as_forward_does() {
     };
     with_validated_context(|ctx| {
         let mut renderer = Renderer::new(ctx, scene, 48, 48).unwrap();
-        let mut frame = |t| renderer.render(t, ldr).unwrap().images.ldr.unwrap();
-        let forward = frame(Technique::Forward);
+        let mut frame = |t: Shading| renderer.render(t, ldr).unwrap().images.ldr.unwrap();
+        let forward = frame(Shading::Forward);
         assert!(histencil_tests::lit_fraction(&forward) > 0.5);
         for backend in [Backend::Native, Backend::Ps3] {
             let flush = FlushPolicy::Auto;
-            let deferred = frame(Technique::Stencil { backend, flush });
+            let deferred = frame(Technique::Stencil { backend, flush }.into());
             histencil_tests::assert_close("huge-ranges", &deferred, &forward, 1);
         }
     });

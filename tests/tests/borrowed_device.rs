@@ -7,7 +7,7 @@
 
 use histencil_tests::engine::Engine;
 use histencil_tests::{render, with_validated_context};
-use histencil_vk::{Backend, Context, FlushPolicy, Readback, Technique};
+use histencil_vk::{Backend, Context, FlushPolicy, Readback, Shading, Technique};
 
 const SIZE: u32 = 96;
 
@@ -15,11 +15,12 @@ const SIZE: u32 = 96;
 fn an_engines_device_renders_what_histencils_own_renders() {
     let scene = histencil_scene::embedded("default").unwrap();
     let techniques = [
-        Technique::Forward,
+        Shading::Forward,
         Technique::Stencil {
             backend: Backend::Ps3,
             flush: FlushPolicy::Auto,
-        },
+        }
+        .into(),
     ];
     let owned: Vec<_> = with_validated_context(|ctx| {
         assert!(ctx.owns_device());

@@ -7,7 +7,7 @@
 
 use histencil_model::DepthConvention;
 use histencil_tests::{diff, with_validated_context};
-use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique};
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 64;
@@ -15,26 +15,30 @@ const HEIGHT: u32 = 64;
 #[test]
 fn reversed_z_and_infinite_far_light_what_standard_depth_lights() {
     let techniques = [
-        Technique::Forward,
+        Shading::Forward,
         Technique::Stencil {
             backend: Backend::Ps3,
             flush: FlushPolicy::Auto,
-        },
+        }
+        .into(),
         Technique::Stencil {
             backend: Backend::Native,
             flush: FlushPolicy::Auto,
-        },
+        }
+        .into(),
         Technique::Stencil {
             backend: Backend::X360 {
                 zero_preserved: true,
                 save_restore: true,
             },
             flush: FlushPolicy::Auto,
-        },
+        }
+        .into(),
         Technique::Branching {
             backend: Backend::Native,
             flush: FlushPolicy::Auto,
-        },
+        }
+        .into(),
     ];
     with_validated_context(|ctx| {
         for name in ["brdfs-3", "near-far", "inside", "alpha"] {
@@ -77,7 +81,7 @@ fn reversed_z_and_infinite_far_light_what_standard_depth_lights() {
                     let d = diff(expected.ldr.as_ref().unwrap(), frame.ldr.as_ref().unwrap());
                     let what = format!("{name} {technique:?} {what}");
                     assert!(d.max <= 1, "{what}: {d:?}");
-                    if technique != Technique::Forward {
+                    if technique != Shading::Forward {
                         assert!(frame.stencil == expected.stencil, "{what}: stencil differs");
                     }
                 }

@@ -6,7 +6,7 @@
 use histencil_scene::{load_scene, ImportError, MaterialError, Shape};
 use histencil_tests::gltf_builder::{committed_scene_path, self_contained, test_gltf, write};
 use histencil_tests::{assert_close, lit_fraction, output_dir, with_validated_context};
-use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Shading, Technique};
 use serde_json::json;
 
 #[test]
@@ -33,9 +33,9 @@ fn a_gltf_with_two_brdfs_renders_and_matches_forward() {
             },
             flush: FlushPolicy::Auto,
         };
-        let frame = |r: &mut Renderer, t| r.render(t, ldr).unwrap().images.ldr.unwrap();
-        let deferred = frame(&mut renderer, stencil);
-        let forward = frame(&mut renderer, Technique::Forward);
+        let frame = |r: &mut Renderer, t: Shading| r.render(t, ldr).unwrap().images.ldr.unwrap();
+        let deferred = frame(&mut renderer, stencil.into());
+        let forward = frame(&mut renderer, Shading::Forward);
         assert!(lit_fraction(&forward) > 0.3, "the scene is lit");
         assert_close("gltf-stencil-vs-forward", &deferred, &forward, 1);
     });

@@ -5,7 +5,7 @@
 use histencil_scene::{load_scene, Filter, ImportError};
 use histencil_tests::gltf_builder::{png, textured_gltf, write};
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Shading, Technique};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
@@ -60,25 +60,28 @@ fn a_textured_gltf_imports_every_kind_of_image_and_matches_forward() {
     with_validated_context(|ctx| {
         let plain = Renderer::new(ctx, plain, 128, 128)
             .unwrap()
-            .render(Technique::Forward, LDR)
+            .render(Shading::Forward, LDR)
             .unwrap()
             .images
             .ldr
             .unwrap();
         let mut r = Renderer::new(ctx, scene, 128, 128).unwrap();
         let mut frame = |t| r.render(t, LDR).unwrap().images.ldr.unwrap();
-        let forward = frame(Technique::Forward);
+        let forward = frame(Shading::Forward);
         assert!(lit_fraction(&forward) > 0.3);
         assert!(diff(&forward, &plain).max > 64, "the textures show");
         for backend in [Backend::Ps3, Backend::Native] {
             let flush = FlushPolicy::Auto;
-            let stencil = frame(Technique::Stencil { backend, flush });
+            let stencil = frame(Technique::Stencil { backend, flush }.into());
             assert_close("gltf-textured-stencil", &stencil, &forward, 1);
         }
-        let branching = frame(Technique::Branching {
-            backend: Backend::Native,
-            flush: FlushPolicy::Auto,
-        });
+        let branching = frame(
+            Technique::Branching {
+                backend: Backend::Native,
+                flush: FlushPolicy::Auto,
+            }
+            .into(),
+        );
         assert_close("gltf-textured-branching", &branching, &forward, 1);
     });
 }
@@ -198,8 +201,8 @@ fn emission_imports_with_its_strength_and_map() {
             let mut r = Renderer::new(ctx, scene.clone(), 96, 96).unwrap();
             r.render(t, LDR).unwrap().images.ldr.unwrap()
         };
-        let forward = frame(&scene, Technique::Forward);
-        let unlit = frame(&plain, Technique::Forward);
+        let forward = frame(&scene, Shading::Forward);
+        let unlit = frame(&plain, Shading::Forward);
         let brighter = forward
             .pixels()
             .zip(unlit.pixels())
@@ -210,7 +213,7 @@ fn emission_imports_with_its_strength_and_map() {
             backend: Backend::Ps3,
             flush: FlushPolicy::Auto,
         };
-        assert_close("gltf-emissive", &frame(&scene, stencil), &forward, 1);
+        assert_close("gltf-emissive", &frame(&scene, stencil.into()), &forward, 1);
     });
     for (factor, strength) in [
         (json!([0.5, -0.25, 0.0]), json!(1.0)),

@@ -8,7 +8,7 @@
 //! "Exact" below means within 1/255 of the forward reference, like every deferred technique.
 
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique};
 use image::RgbaImage;
 
 const SIZE: u32 = 160;
@@ -22,11 +22,11 @@ fn x360(zero_preserved: bool, save_restore: bool) -> Backend {
     }
 }
 
-/// The LDR frame of `technique` with `pattern` in the engine's stencil bits.
-fn image(renderer: &mut Renderer, technique: Technique, pattern: u8) -> RgbaImage {
+/// The LDR frame of `shading` with `pattern` in the engine's stencil bits.
+fn image(renderer: &mut Renderer, shading: impl Into<Shading>, pattern: u8) -> RgbaImage {
     let desc = FrameDesc {
         preserved_pattern: pattern,
-        ..FrameDesc::new(technique, Readback::ALL)
+        ..FrameDesc::new(shading, Readback::ALL)
     };
     renderer
         .render_frame(&desc)
@@ -58,7 +58,7 @@ fn x360_without_zeroing_loses_lights_on_preserved_bits_and_the_fixes_restore_the
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-            let forward = image(&mut renderer, Technique::Forward, 0);
+            let forward = image(&mut renderer, Shading::Forward, 0);
             assert!(
                 lit_fraction(&forward) > 0.5,
                 "{name}: reference mostly black"
@@ -93,7 +93,7 @@ fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-            let forward = image(&mut renderer, Technique::Forward, 0);
+            let forward = image(&mut renderer, Shading::Forward, 0);
             for backend in [Backend::Ps3, x360(true, false)] {
                 let label = format!("{name} {backend:?}");
                 let never = image(&mut renderer, stencil(backend, FlushPolicy::Never), 0);
@@ -115,7 +115,7 @@ fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
 /// The GPU frame does what the CPU simulator predicts from the GPU's own inputs (G-buffer depth
 /// and stencil, rasterised light footprints, the plan): the same stencil after lighting, so the
 /// 360-like backend zeroes preserved bits exactly where the model says, and the same tile
-/// statistics, so tiles are marked, flushed and culled exactly as the model says.
+/// statistics, so tiles are marked, flushed and culled exactly as the model says. A forward frame has nothing to simulate and is refused.
 #[test]
 fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
     let auto = FlushPolicy::Auto;
@@ -148,6 +148,11 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
+            // The forward reference has no stencil plan to simulate: refused, not guessed.
+            assert!(matches!(
+                renderer.simulator_inputs(Shading::Forward),
+                Err(histencil_vk::Error::Unsupported(_))
+            ));
             for (label, technique) in cases {
                 let desc = FrameDesc {
                     preserved_pattern: PATTERN,

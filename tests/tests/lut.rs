@@ -8,7 +8,7 @@ use histencil_brdf::{Brdf, BrdfId, V3};
 use histencil_scene::{Light, LightKind, Scene};
 use histencil_tests::{diff, with_validated_context};
 use histencil_vk::{
-    Backend, Error, FlushPolicy, LutEvaluator, LutTables, Readback, Renderer, Technique,
+    Backend, Error, FlushPolicy, LutEvaluator, LutTables, Readback, Renderer, Shading, Technique,
 };
 use image::Rgba32FImage;
 
@@ -184,7 +184,7 @@ fn frame_error_stays_within_the_tables_and_falls_with_resolution() {
             stencil: false,
             brdf_ids: true,
         };
-        let forward = renderer.render(Technique::Forward, readback).unwrap();
+        let forward = renderer.render(Shading::Forward, readback).unwrap();
         let deferred = renderer.render(Technique::DEFERRED, readback).unwrap();
         let ids = deferred.images.brdf_ids.unwrap();
         let forward_hdr = forward.images.hdr.unwrap();

@@ -10,7 +10,7 @@
 //! order. So the sums round identically. The test asserts it.
 
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, CostModel, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, CostModel, FlushPolicy, Readback, Renderer, Shading, Technique};
 
 const SIZE: u32 = 160;
 const TOLERANCE: u8 = 1;
@@ -60,7 +60,7 @@ fn check(scene_name: &str) {
     with_validated_context(|ctx| {
         let mut renderer = Renderer::new(ctx, scene, SIZE, SIZE).expect("renderer");
         let forward = renderer
-            .render(Technique::Forward, Readback::ALL)
+            .render(Shading::Forward, Readback::ALL)
             .expect("forward")
             .images
             .ldr

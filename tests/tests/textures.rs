@@ -11,7 +11,7 @@ use histencil_scene::{
     Shape, TextureImage, TextureRef, Vertex, Wrap,
 };
 use histencil_tests::{assert_close, lit_fraction, with_validated_context};
-use histencil_vk::{srgb_to_linear, Backend, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{srgb_to_linear, Backend, FlushPolicy, Readback, Renderer, Shading, Technique};
 use image::RgbaImage;
 
 const SIZE: u32 = 96;
@@ -96,11 +96,7 @@ const LDR: Readback = Readback {
 fn forward(scene: &Scene) -> RgbaImage {
     with_validated_context(|ctx| {
         let mut r = Renderer::new(ctx, scene.clone(), SIZE, SIZE).unwrap();
-        r.render(Technique::Forward, LDR)
-            .unwrap()
-            .images
-            .ldr
-            .unwrap()
+        r.render(Shading::Forward, LDR).unwrap().images.ldr.unwrap()
     })
 }
 
@@ -281,7 +277,7 @@ fn textured_surfaces_light_the_same_in_every_exact_technique() {
     with_validated_context(|ctx| {
         let mut r = Renderer::new(ctx, textured, SIZE, SIZE).unwrap();
         let mut frame = |t| r.render(t, LDR).unwrap().images.ldr.unwrap();
-        let reference = frame(Technique::Forward);
+        let reference = frame(Shading::Forward);
         assert!(histencil_tests::diff(&reference, &untextured).max > 64);
         let techniques = [
             (
@@ -302,7 +298,7 @@ fn textured_surfaces_light_the_same_in_every_exact_technique() {
             ),
         ];
         for (name, technique) in techniques {
-            let image = frame(technique);
+            let image = frame(technique.into());
             assert_close(&format!("textured-{name}"), &image, &reference, 1);
         }
     });
@@ -331,15 +327,17 @@ fn emission_is_added_once_and_read_from_its_map() {
         );
     let flush = FlushPolicy::Auto;
     let techniques = [
-        Technique::Forward,
+        Shading::Forward,
         Technique::Stencil {
             backend: Backend::Ps3,
             flush,
-        },
+        }
+        .into(),
         Technique::Branching {
             backend: Backend::Native,
             flush,
-        },
+        }
+        .into(),
     ];
     with_validated_context(|ctx| {
         let hdr = Readback {
@@ -364,7 +362,7 @@ fn emission_is_added_once_and_read_from_its_map() {
         }
         let mut renderer = Renderer::new(ctx, lit, SIZE, SIZE).unwrap();
         let mut frame = |t| renderer.render(t, LDR).unwrap().images.ldr.unwrap();
-        let forward = frame(Technique::Forward);
+        let forward = frame(Shading::Forward);
         for technique in &techniques[1..] {
             assert_close("emissive-lit", &frame(*technique), &forward, 1);
         }

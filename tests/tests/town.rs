@@ -5,7 +5,7 @@
 
 use histencil_scene::{embedded, TOWN_LIGHTS};
 use histencil_tests::{assert_close, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, Error, FlushPolicy, Readback, Renderer, Technique};
+use histencil_vk::{Backend, Error, FlushPolicy, Readback, Renderer, Shading, Technique};
 
 const WIDTH: u32 = 128;
 const HEIGHT: u32 = 72;
@@ -28,7 +28,7 @@ fn town_matches_forward_within_one_step() {
                 .ldr
                 .expect("asked for")
         };
-        let forward = frame(Technique::Forward);
+        let forward = frame(Shading::Forward);
         assert!(lit_fraction(&forward) > 0.5, "the town is mostly lit");
         let flush = FlushPolicy::Auto;
         for (name, technique) in [
@@ -54,7 +54,12 @@ fn town_matches_forward_within_one_step() {
                 },
             ),
         ] {
-            assert_close(&format!("town-{name}"), &frame(technique), &forward, 1);
+            assert_close(
+                &format!("town-{name}"),
+                &frame(technique.into()),
+                &forward,
+                1,
+            );
         }
         // Its roughness maps vary the BRDF parameters per texel: the LUT technique, whose
         // tables are per material, says so instead of rendering the wrong lobes.

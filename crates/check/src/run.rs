@@ -7,7 +7,7 @@ use crate::matrix::{self, Case, Config, Expect, KnownWrong, Platform, SceneNeeds
 use histencil_model::FlushPolicy;
 use histencil_scene::Scene;
 use histencil_vk::{
-    AlphaMode, Context, ContextDesc, DepthStencilFormat, FrameDesc, Readback, Renderer,
+    AlphaMode, Context, ContextDesc, DepthStencilFormat, FrameDesc, Readback, Renderer, Shading,
     SimulatorInputs, Technique, ValidationLog, ValidationMessage,
 };
 use image::{GrayImage, RgbaImage};
@@ -364,7 +364,7 @@ impl Group<'_> {
         let forward = |renderer: &mut Renderer| -> histencil_vk::Result<RgbaImage> {
             let forward = FrameDesc {
                 alpha: AlphaMode::Forward,
-                ..FrameDesc::new(Technique::Forward, IMAGES)
+                ..FrameDesc::new(Shading::Forward, IMAGES)
             };
             let frame = renderer.render_frame(&forward)?;
             Ok(frame.images.ldr.expect("asked for"))

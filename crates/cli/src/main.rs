@@ -6,7 +6,7 @@ use histencil_alpha::ParameterKind;
 use histencil_check::matrix::Platform;
 use histencil_scene::{with_default_lights, DefaultLights};
 use histencil_vk::{
-    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, Technique,
+    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -225,7 +225,7 @@ enum FlushArg {
 }
 
 impl RenderArgs {
-    fn technique(&self) -> Technique {
+    fn shading(&self) -> Shading {
         // The check's platform vocabulary names the same five backends.
         let backend = match self.backend {
             BackendArg::X360 => Platform::X360,
@@ -241,12 +241,12 @@ impl RenderArgs {
             FlushArg::Never => FlushPolicy::Never,
         };
         match self.technique {
-            TechniqueArg::Stencil => Technique::Stencil { backend, flush },
-            TechniqueArg::Branching => Technique::Branching { backend, flush },
-            TechniqueArg::Adaptive => Technique::Adaptive { backend, flush },
-            TechniqueArg::Lut => Technique::Lut { backend, flush },
-            TechniqueArg::Deferred => Technique::DEFERRED,
-            TechniqueArg::Forward => Technique::Forward,
+            TechniqueArg::Stencil => Technique::Stencil { backend, flush }.into(),
+            TechniqueArg::Branching => Technique::Branching { backend, flush }.into(),
+            TechniqueArg::Adaptive => Technique::Adaptive { backend, flush }.into(),
+            TechniqueArg::Lut => Technique::Lut { backend, flush }.into(),
+            TechniqueArg::Deferred => Technique::DEFERRED.into(),
+            TechniqueArg::Forward => Shading::Forward,
         }
     }
 }
@@ -312,7 +312,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
         histencil_vk::check_output_file(path)?;
     }
     on_device(args.validate, |ctx| {
-        let technique = args.technique();
+        let shading = args.shading();
         let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
         renderer.set_cost_model(costs);
         renderer.set_lut_resolution(args.lut_resolution)?;
@@ -326,7 +326,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
         let desc = FrameDesc {
             preserved_pattern: args.preserved_pattern,
             alpha: args.alpha.mode(),
-            ..FrameDesc::new(technique, readback)
+            ..FrameDesc::new(shading, readback)
         };
         if args.stats {
             print_stats(&mut renderer, &desc)?;
@@ -363,7 +363,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             args.frames.max(1),
             args.width,
             args.height,
-            technique,
+            shading,
             ctx.device_name()
         );
         if let Some(lighting) = &timings.lighting {
@@ -382,7 +382,7 @@ fn print_alpha_error(
     ldr: &image::RgbaImage,
 ) -> Result<()> {
     let mode = desc.alpha;
-    let reference = histencil_lab::AlphaReference::render(ctx, renderer, desc.technique)?;
+    let reference = histencil_lab::AlphaReference::render(ctx, renderer, desc.shading)?;
     let e = reference.error(ldr);
     let whole = histencil_lab::image_error(ldr, &reference.forward);
     println!(
@@ -424,7 +424,7 @@ fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
         };
         println!("alpha entity {name}: {what}");
     }
-    if desc.technique == Technique::Forward {
+    if desc.shading == Shading::Forward {
         bail!("--stats needs a deferred technique: the forward reference has no lighting passes");
     }
     let inputs = renderer.simulator_inputs(*desc)?;

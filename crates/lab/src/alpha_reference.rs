@@ -2,7 +2,7 @@
 
 use crate::measure::frame;
 use crate::Result;
-use histencil_vk::{masked_error, AlphaMode, Context, FrameDesc, MaskedError, Renderer, Technique};
+use histencil_vk::{masked_error, AlphaMode, Context, FrameDesc, MaskedError, Renderer, Shading};
 use image::RgbaImage;
 
 /// The frame with forward-lit alpha entities (the reference), and the scene without them: where
@@ -13,16 +13,21 @@ pub struct AlphaReference {
 }
 
 impl AlphaReference {
-    /// Renders both with `technique` for the opaque scene.
-    pub fn render(ctx: &Context, renderer: &mut Renderer, technique: Technique) -> Result<Self> {
+    /// Renders both with `shading` for the opaque scene.
+    pub fn render(
+        ctx: &Context,
+        renderer: &mut Renderer,
+        shading: impl Into<Shading>,
+    ) -> Result<Self> {
+        let shading = shading.into();
         let forward_alpha = FrameDesc {
             alpha: AlphaMode::Forward,
-            ..technique.into()
+            ..shading.into()
         };
         let forward = frame(renderer, forward_alpha)?;
         let (w, h) = forward.dimensions();
         let mut without = Renderer::new(ctx, renderer.scene().without_alpha(), w, h)?;
-        let background = frame(&mut without, technique)?;
+        let background = frame(&mut without, shading)?;
         Ok(Self {
             forward,
             background,

@@ -11,7 +11,7 @@ use crate::measure::{frame, time_passes, Timing};
 use crate::Result;
 use histencil_scene::Scene;
 use histencil_vk::{
-    Backend, Context, FlushPolicy, FrameDesc, Readback, Renderer, Technique, TileStats,
+    Backend, Context, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique, TileStats,
 };
 use image::{RgbImage, RgbaImage};
 use std::fmt::Write as _;
@@ -31,7 +31,7 @@ pub struct DemoSettings {
 /// One row of the demo's table.
 pub struct DemoRow {
     pub label: &'static str,
-    pub technique: Technique,
+    pub shading: Shading,
     /// Lighting (or, for forward, the forward pass) over the timed frames.
     pub time: Timing,
     /// `None` for the reference itself.
@@ -69,14 +69,14 @@ fn stencil(backend: Backend, flush: FlushPolicy) -> Technique {
 }
 
 /// The rows, in the table's order.
-fn configurations() -> [(&'static str, Technique); 6] {
+fn configurations() -> [(&'static str, Shading); 6] {
     let auto = FlushPolicy::Auto;
     [
-        ("forward (reference)", Technique::Forward),
-        ("branching, native", Technique::DEFERRED),
-        ("stencil, native", stencil(Backend::Native, auto)),
-        ("stencil, PS3-like", stencil(Backend::Ps3, auto)),
-        ("stencil, 360-like (zeroing)", stencil(X360, auto)),
+        ("forward (reference)", Shading::Forward),
+        ("branching, native", Technique::DEFERRED.into()),
+        ("stencil, native", stencil(Backend::Native, auto).into()),
+        ("stencil, PS3-like", stencil(Backend::Ps3, auto).into()),
+        ("stencil, 360-like (zeroing)", stencil(X360, auto).into()),
         (
             "stencil, 360-like (save/restore)",
             stencil(
@@ -85,7 +85,8 @@ fn configurations() -> [(&'static str, Technique); 6] {
                     save_restore: true,
                 },
                 auto,
-            ),
+            )
+            .into(),
         ),
     ]
 }
@@ -105,16 +106,15 @@ pub fn run_demo(
     };
     let mut frames: Vec<(RgbaImage, Option<StencilView>)> = Vec::new();
     let mut rows = Vec::new();
-    for (label, technique) in configurations() {
+    for (label, shading) in configurations() {
         step(label);
-        let pass = if technique == Technique::Forward {
-            "forward"
-        } else {
-            "lighting"
+        let pass = match shading {
+            Shading::Forward => "forward",
+            Shading::Deferred(_) => "lighting",
         };
         let desc = FrameDesc {
             preserved_pattern: DEMO_PATTERN,
-            ..FrameDesc::new(technique, all)
+            ..FrameDesc::new(shading, all)
         };
         let time = time_passes(&mut renderer, desc, &[pass], settings.frames)?;
         let images = renderer.render_frame(&desc)?.images;
@@ -134,8 +134,8 @@ pub fn run_demo(
                     .count();
                 (kept, surfaces.count() - kept)
             });
-        let tiles = match technique {
-            Technique::Stencil { backend, .. } if backend != Backend::Native => {
+        let tiles = match shading {
+            Shading::Deferred(Technique::Stencil { backend, .. }) if backend != Backend::Native => {
                 let counted = FrameDesc {
                     tile_stats: true,
                     readback: Readback::NONE,
@@ -147,11 +147,11 @@ pub fn run_demo(
         };
         rows.push(DemoRow {
             label,
-            technique,
+            shading,
             time,
             error,
             tiles,
-            preserved: preserved.filter(|_| technique != Technique::Forward),
+            preserved: preserved.filter(|_| shading != Shading::Forward),
         });
         let surfaces = images
             .brdf_ids
@@ -162,16 +162,16 @@ pub fn run_demo(
     let no_zeroing = frame(&mut renderer, stencil(X360_NO_ZEROING, FlushPolicy::Auto))?;
     let never = frame(&mut renderer, stencil(Backend::Ps3, FlushPolicy::Never))?;
     // Rows by technique, not by their place in the table.
-    let row = |technique: Technique| {
+    let row = |shading: Shading| {
         rows.iter()
-            .position(|r| r.technique == technique)
+            .position(|r| r.shading == shading)
             .expect("every technique shown is a row")
     };
     let (x360_row, ps3_row) = (
-        row(stencil(X360, FlushPolicy::Auto)),
-        row(stencil(Backend::Ps3, FlushPolicy::Auto)),
+        row(stencil(X360, FlushPolicy::Auto).into()),
+        row(stencil(Backend::Ps3, FlushPolicy::Auto).into()),
     );
-    let forward = frames[row(Technique::Forward)].0.clone();
+    let forward = frames[row(Shading::Forward)].0.clone();
     let x360 = frames[x360_row].0.clone();
     let (ps3, ps3_stencil) = frames[ps3_row].clone();
     let (ps3_stencil, surfaces) = ps3_stencil.expect("asked for");

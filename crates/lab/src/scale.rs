@@ -12,7 +12,7 @@ use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, Timing, WARM_UP_FRAMES};
 use crate::Result;
 use histencil_scene::{unit_box, uv_sphere, Material, Mesh, Scene, Shape, SPHERE_DETAIL};
-use histencil_vk::{Backend, Context, FlushPolicy, FrameDesc, Renderer, Technique};
+use histencil_vk::{Backend, Context, FlushPolicy, FrameDesc, Renderer, Shading, Technique};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -79,7 +79,7 @@ impl SceneSize {
 /// One technique's figures.
 pub struct ScaleRow {
     pub label: &'static str,
-    pub technique: Technique,
+    pub shading: Shading,
     pub gbuffer: Timing,
     pub lighting: Timing,
     /// Every pass of the frame, tonemap included.
@@ -106,30 +106,33 @@ pub struct ScaleReport {
     pub ratios: Vec<(&'static str, Timing)>,
 }
 
-fn techniques() -> [(&'static str, Technique); 4] {
+fn techniques() -> [(&'static str, Shading); 4] {
     let flush = FlushPolicy::Auto;
     [
-        ("forward (reference)", Technique::Forward),
+        ("forward (reference)", Shading::Forward),
         (
             "stencil, native",
             Technique::Stencil {
                 backend: Backend::Native,
                 flush,
-            },
+            }
+            .into(),
         ),
         (
             "stencil, PS3-like",
             Technique::Stencil {
                 backend: Backend::Ps3,
                 flush,
-            },
+            }
+            .into(),
         ),
         (
             "branching, native",
             Technique::Branching {
                 backend: Backend::Native,
                 flush,
-            },
+            }
+            .into(),
         ),
     ]
 }
@@ -165,7 +168,7 @@ pub fn run_scale(
         for ((_, technique), s) in techniques.iter().zip(&mut samples) {
             let t = renderer.render_frame(&FrameDesc::from(*technique))?.timings;
             let pass = |name| t.pass_ms(name).unwrap_or(0.0);
-            let lighting = if *technique == Technique::Forward {
+            let lighting = if *technique == Shading::Forward {
                 pass("forward")
             } else {
                 pass("lighting")
@@ -194,7 +197,7 @@ pub fn run_scale(
         .enumerate()
         .map(|(i, (((label, technique), (g, l, f)), image))| ScaleRow {
             label,
-            technique: *technique,
+            shading: *technique,
             gbuffer: Timing::from_samples(g),
             lighting: Timing::from_samples(l),
             frame: Timing::from_samples(f),
@@ -259,7 +262,7 @@ impl ScaleReport {
                 format!("{:.0} / {:.4}", e.max, e.mean)
             });
             // Forward draws no G-buffer.
-            let gbuffer = if r.technique == Technique::Forward {
+            let gbuffer = if r.shading == Shading::Forward {
                 "-".to_owned()
             } else {
                 t(&r.gbuffer)

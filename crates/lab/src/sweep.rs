@@ -23,7 +23,7 @@ use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis};
 use crate::{write_file, AlphaReference, LabError, Result};
 use histencil_scene::{ParticleLayout, ParticleSystem, Scene, MAX_SLICES};
-use histencil_vk::{Backend, Context, FlushPolicy, Renderer, Technique};
+use histencil_vk::{Backend, Context, FlushPolicy, Renderer, Shading, Technique};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -144,7 +144,7 @@ pub fn run_sweep(
     let mut points = Vec::new();
     match param {
         SweepParam::LutRes => {
-            let reference = frame(&mut renderer, Technique::Forward)?;
+            let reference = frame(&mut renderer, Shading::Forward)?;
             let lut = Technique::Lut {
                 backend: Backend::Native,
                 flush: FlushPolicy::Auto,

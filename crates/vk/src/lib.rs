@@ -72,5 +72,5 @@ pub use passes::light_pipelines::BrdfSource;
 pub use readback::{FrameImages, Readback};
 pub use renderer::{Frame, Renderer, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
-pub use technique::{Backend, FrameDesc, Technique};
+pub use technique::{Backend, FrameDesc, Shading, Technique};
 pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown};

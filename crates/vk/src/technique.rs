@@ -1,5 +1,6 @@
-//! What a renderer frame is: its lighting technique (the talk's, and the ones it is compared
-//! with), the platform behaviour the plan follows, and the frame description that carries them.
+//! What a renderer frame is: forward or deferred, the deferred frame's lighting technique (the
+//! talk's, and the ones it is compared with), the platform behaviour the plan follows, and the
+//! frame description that carries them.
 
 use crate::alpha::AlphaMode;
 use crate::passes::light_pipelines::BrdfSource;
@@ -41,11 +42,36 @@ impl Backend {
     }
 }
 
-/// How the frame is lit.
+/// What a frame draws: the forward reference, or a G-buffer lit by a deferred technique. Forward
+/// is a frame of its own (no G-buffer, no stencil, no lighting plan), not one more lighting
+/// technique: what only deferred frames have hangs off [`Shading::Deferred`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shading {
+    /// The forward reference: every object lit by every light per pixel, in one pass.
+    Forward,
+    /// The G-buffer pass, then the lighting passes of a technique.
+    Deferred(Technique),
+}
+
+impl From<Technique> for Shading {
+    fn from(technique: Technique) -> Self {
+        Shading::Deferred(technique)
+    }
+}
+
+impl Shading {
+    /// The deferred frame's lighting technique; `None` for the forward frame.
+    pub fn technique(self) -> Option<Technique> {
+        match self {
+            Shading::Forward => None,
+            Shading::Deferred(technique) => Some(technique),
+        }
+    }
+}
+
+/// How a deferred frame's G-buffer is lit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Technique {
-    /// The forward reference: every object lit by every light per pixel.
-    Forward,
     /// The talk's technique: each light volume drawn once per BRDF it touches, masked by the
     /// BRDF id in the stencil, with one shader per BRDF.
     Stencil {
@@ -79,14 +105,10 @@ impl Technique {
         flush: FlushPolicy::Auto,
     };
 
-    /// What the planner is asked for; `None` for the forward frame, which has no lighting
-    /// passes. `costs` gives the adaptive technique's cost model for a backend.
-    pub(crate) fn plan_settings(
-        self,
-        costs: impl FnOnce(Backend) -> CostModel,
-    ) -> Option<PlanSettings> {
+    /// What the planner is asked for. `costs` gives the adaptive technique's cost model for a
+    /// backend.
+    pub(crate) fn plan_settings(self, costs: impl FnOnce(Backend) -> CostModel) -> PlanSettings {
         let (technique, backend, flush) = match self {
-            Technique::Forward => return None,
             Technique::Stencil { backend, flush } => (TechniqueChoice::Stencil, backend, flush),
             Technique::Branching { backend, flush } => (TechniqueChoice::Branching, backend, flush),
             Technique::Adaptive { backend, flush } => {
@@ -95,11 +117,11 @@ impl Technique {
             // Planned as branching: one draw per light, whatever the pixel's BRDF.
             Technique::Lut { backend, flush } => (TechniqueChoice::Branching, backend, flush),
         };
-        Some(PlanSettings {
+        PlanSettings {
             technique,
             caps: backend.platform().caps(),
             flush,
-        })
+        }
     }
 
     pub(crate) fn brdf_source(self) -> BrdfSource {
@@ -115,7 +137,7 @@ impl Technique {
 /// resolution, lightmap sides) or is calibration (the cost model).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameDesc {
-    pub technique: Technique,
+    pub shading: Shading,
     /// Which images to copy back.
     pub readback: Readback,
     /// Which end of depth is near in the renderer's depth buffer: its G-buffer, forward and
@@ -137,20 +159,28 @@ pub struct FrameDesc {
     pub tile_stats: bool,
 }
 
-/// A technique's frame with everything else at its default and nothing read back (what timing
-/// loops take).
+/// A technique's deferred frame with everything else at its default and nothing read back (what
+/// timing loops take).
 impl From<Technique> for FrameDesc {
     fn from(technique: Technique) -> Self {
         FrameDesc::new(technique, Readback::NONE)
     }
 }
 
+/// A forward or deferred frame with everything else at its default and nothing read back.
+impl From<Shading> for FrameDesc {
+    fn from(shading: Shading) -> Self {
+        FrameDesc::new(shading, Readback::NONE)
+    }
+}
+
 impl FrameDesc {
-    /// `technique`'s frame with standard depth and the camera's far plane, alpha lightmaps, no
-    /// preserved pattern, no step timing or statistics.
-    pub fn new(technique: Technique, readback: Readback) -> Self {
+    /// The frame of `shading` (a [`Technique`] for a deferred frame, or [`Shading::Forward`])
+    /// with standard depth and the camera's far plane, alpha lightmaps, no preserved pattern, no
+    /// step timing or statistics.
+    pub fn new(shading: impl Into<Shading>, readback: Readback) -> Self {
         Self {
-            technique,
+            shading: shading.into(),
             readback,
             depth: DepthConvention::Standard,
             infinite_far: false,

@@ -28,7 +28,8 @@ use histencil_model::{
 use histencil_vk::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, AlphaMode,
     Backend, BrdfSource, Context, DeferredLighting, FrameDesc, ImageState, LightingDesc,
-    LightingFrame, LightingTargets, LightmapFrame, Readback, Renderer, Technique, GBUFFER_FORMATS,
+    LightingFrame, LightingTargets, LightmapFrame, Readback, Renderer, Shading, Technique,
+    GBUFFER_FORMATS,
 };
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -431,13 +432,13 @@ fn main() {
         // Lighting: the opaque world, forward, against the engine's HDR before its alpha pass.
         let mut opaque =
             Renderer::new(&ctx, scene.without_alpha(), WIDTH, HEIGHT).expect("reference renderer");
-        let forward = hdr_of(&mut opaque, FrameDesc::new(Technique::Forward, hdr_only));
+        let forward = hdr_of(&mut opaque, FrameDesc::new(Shading::Forward, hdr_only));
         worst = worst.max(max_difference(&forward, &half_floats(&c.lit)).0);
         // Alpha: histencil's own lightmap frame of the same state, and the per-pixel reference.
         let mut renderer = Renderer::new(&ctx, scene, WIDTH, HEIGHT).expect("reference renderer");
         let with_alpha = |alpha| FrameDesc {
             alpha,
-            ..FrameDesc::new(Technique::Forward, hdr_only)
+            ..FrameDesc::new(Shading::Forward, hdr_only)
         };
         let lightmapped = hdr_of(&mut renderer, with_alpha(AlphaMode::Lightmap));
         let per_pixel = hdr_of(&mut renderer, with_alpha(AlphaMode::Forward));

@@ -10,7 +10,7 @@ use crate::variants::{light_size_scene, with_brdf_count};
 use crate::Result;
 use histencil_scene::Scene;
 use histencil_vk::{
-    Backend, Context, CostModel, FlushPolicy, FrameDesc, Readback, Renderer, Technique,
+    Backend, Context, CostModel, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique,
 };
 
 /// What a comparison run measures.
@@ -368,7 +368,7 @@ pub fn run_compare(
         let mut renderer = new_renderer(with_brdf_count(&settings.scene, brdfs))?;
         costs.get_or_insert(renderer.cost_model(Backend::Native));
         progress(&format!("{brdfs} BRDF(s): forward reference and errors"));
-        let reference = frame(&mut renderer, Technique::Forward)?;
+        let reference = frame(&mut renderer, Shading::Forward)?;
         let mut errors = Vec::new();
         for (_, technique) in &rows_spec {
             errors.push(image_error(&frame(&mut renderer, *technique)?, &reference));
@@ -431,7 +431,7 @@ pub fn run_compare(
         let scene = light_size_scene(coverage, aspect);
         let lights = scene.lights.len();
         let mut renderer = new_renderer(scene)?;
-        let reference = frame(&mut renderer, Technique::Forward)?;
+        let reference = frame(&mut renderer, Shading::Forward)?;
         let mut error = ImageError::default();
         for technique in size_techniques() {
             error = error.worst(image_error(&frame(&mut renderer, technique)?, &reference));

@@ -1,6 +1,6 @@
-//! One renderer frame: its passes in order (G-buffer or forward, lighting through
-//! `DeferredLighting`, alpha lightmaps and the alpha pass, tonemap, readback), submitted and
-//! waited for.
+//! One renderer frame: its passes in order (the forward pass, or the G-buffer, emission and
+//! lighting through `DeferredLighting`; then alpha lightmaps and the alpha pass, tonemap,
+//! readback), submitted and waited for.
 
 use super::{Frame, Renderer};
 use crate::access::LightingTargets;
@@ -11,86 +11,45 @@ use crate::passes::light_pipelines::BrdfSource;
 use crate::passes::tonemap::TonemapPass;
 use crate::readback::Readback;
 use crate::targets::GBUFFER_FORMATS;
-use crate::technique::{FrameDesc, Technique};
+use crate::technique::{FrameDesc, Shading, Technique};
 use crate::timing::FrameTimings;
 use ash::vk;
-use histencil_model::DepthConvention;
+use histencil_model::{DepthConvention, FramePlan, ViewDesc};
 
 impl Renderer<'_> {
-    /// Renders one frame and waits for it. `readback` says which images to copy back.
-    pub fn render(&mut self, technique: Technique, readback: Readback) -> Result<Frame> {
-        self.render_frame(&FrameDesc::new(technique, readback))
+    /// Renders one frame and waits for it: the forward reference ([`Shading::Forward`]) or a
+    /// [`Technique`]'s deferred frame. `readback` says which images to copy back.
+    pub fn render(&mut self, shading: impl Into<Shading>, readback: Readback) -> Result<Frame> {
+        self.render_frame(&FrameDesc::new(shading, readback))
     }
 
     /// Renders the frame `desc` describes and waits for it.
     pub fn render_frame(&mut self, desc: &FrameDesc) -> Result<Frame> {
-        let FrameDesc {
-            technique,
-            readback,
-            depth,
-            infinite_far,
-            alpha: alpha_mode,
-            preserved_pattern: _,
-            pass_timing,
-            tile_stats,
-        } = *desc;
-        // Only the deferred path has a G-buffer to read BRDF ids from.
-        let readback = Readback {
-            brdf_ids: readback.brdf_ids && technique != Technique::Forward,
-            ..readback
-        };
         let ctx = self.ctx;
-        let view = self.view_desc_in(depth, infinite_far);
+        let view = self.view_desc_in(desc.depth, desc.infinite_far);
         self.frame_uniforms
             .write(bytemuck::bytes_of(&self.uniforms(&view)?));
-        let plan = self.plan_in(technique, &view)?;
-        let count_stats = tile_stats && technique != Technique::Forward;
-        let brdf_source = technique.brdf_source();
-        if brdf_source == BrdfSource::Table {
-            self.lut_tables()?;
-        }
         self.alpha_lighting()?;
-        let time_steps = pass_timing && technique != Technique::Forward;
+        let deferred = match desc.shading {
+            Shading::Forward => None,
+            Shading::Deferred(technique) => {
+                let plan = self.plan_in(technique, &view)?;
+                if technique.brdf_source() == BrdfSource::Table {
+                    self.lut_tables()?;
+                }
+                Some((technique, plan))
+            }
+        };
         let cmd = self.begin_commands()?;
         self.timestamps.begin_frame(ctx, cmd);
-        match technique {
-            Technique::Forward => {
-                self.record_geometry(true, desc);
-                self.timestamps.mark(ctx, cmd, "forward");
-            }
-            _ => {
-                self.record_geometry(false, desc);
-                // Emitted light goes into the HDR target once; the lighting adds onto it.
-                let emits = self.scene.objects.iter().any(|o| o.material.emits());
-                if emits {
-                    let mut targets = self.targets.lighting();
-                    self.geometry_pass(cmd, self.pipelines.emissive, desc.depth)
-                        .record_emissive(&mut targets);
-                    self.targets.lit(&targets);
-                }
-                self.timestamps.mark(ctx, cmd, "gbuffer");
-                let frame = LightingFrame {
-                    slot: 0,
-                    view: &view,
-                    lights: &self.scene.lights,
-                    plan: &plan,
-                    clear_hdr: !emits,
-                    timestamps: time_steps,
-                    brdf_source,
-                    tile_stats: count_stats,
-                };
-                let mut targets = self.targets.lighting();
-                // SAFETY: `cmd` records on this context's device; the targets' states are the
-                // ones this renderer tracks; it waits for every frame, so slot 0 is free.
-                unsafe { self.lighting.record(cmd, &frame, &mut targets)? };
-                self.targets.lit(&targets);
-                self.timestamps.mark(ctx, cmd, "lighting");
-            }
+        match &deferred {
+            None => self.record_forward_pass(desc),
+            Some((technique, plan)) => self.record_deferred(desc, *technique, &view, plan)?,
         }
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            alpha.record_lightmaps(cmd, scene, &view, alpha_mode)?;
+            alpha.record_lightmaps(cmd, scene, &view, desc.alpha)?;
             self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
             alpha.record_alpha(
                 ctx,
@@ -99,7 +58,7 @@ impl Renderer<'_> {
                 meshes,
                 &mut self.targets,
                 frame_set,
-                (alpha_mode, self.extent, depth),
+                (desc.alpha, self.extent, desc.depth),
             )?;
             self.timestamps.mark(ctx, cmd, "alpha");
         }
@@ -113,19 +72,76 @@ impl Renderer<'_> {
         }
         .record(&mut self.targets);
         self.timestamps.mark(ctx, cmd, "tonemap");
+        // Only the deferred frame has a G-buffer to read BRDF ids from.
+        let readback = Readback {
+            brdf_ids: desc.readback.brdf_ids && deferred.is_some(),
+            ..desc.readback
+        };
         self.readback.record(ctx, cmd, &mut self.targets, readback);
         self.submit_and_wait()?;
         let mut timings = self.timestamps.read(ctx)?;
-        if time_steps {
+        if desc.pass_timing && deferred.is_some() {
             timings.lighting = self.lighting.step_timings(0)?;
         }
         let images = self.readback.read(readback)?;
-        let tile_stats = count_stats.then(|| self.lighting.tile_stats(&plan));
+        let tile_stats = match &deferred {
+            Some((_, plan)) if desc.tile_stats => Some(self.lighting.tile_stats(plan)),
+            _ => None,
+        };
         Ok(Frame {
             timings,
             images,
             tile_stats,
         })
+    }
+
+    /// The forward frame's one pass: every object lit by every light into the HDR target.
+    fn record_forward_pass(&mut self, desc: &FrameDesc) {
+        let (ctx, cmd) = (self.ctx, self.cmd);
+        let mut targets = self.targets.lighting();
+        self.geometry_pass(cmd, self.pipelines.forward, desc.depth)
+            .record_forward(&mut targets);
+        self.targets.lit(&targets);
+        self.timestamps.mark(ctx, cmd, "forward");
+    }
+
+    /// The deferred frame's passes: the G-buffer, emission into the HDR target, and the
+    /// lighting of `plan` through [`crate::DeferredLighting`].
+    fn record_deferred(
+        &mut self,
+        desc: &FrameDesc,
+        technique: Technique,
+        view: &ViewDesc,
+        plan: &FramePlan,
+    ) -> Result<()> {
+        let (ctx, cmd) = (self.ctx, self.cmd);
+        self.record_gbuffer_pass(desc);
+        // Emitted light goes into the HDR target once; the lighting adds onto it.
+        let emits = self.scene.objects.iter().any(|o| o.material.emits());
+        if emits {
+            let mut targets = self.targets.lighting();
+            self.geometry_pass(cmd, self.pipelines.emissive, desc.depth)
+                .record_emissive(&mut targets);
+            self.targets.lit(&targets);
+        }
+        self.timestamps.mark(ctx, cmd, "gbuffer");
+        let frame = LightingFrame {
+            slot: 0,
+            view,
+            lights: &self.scene.lights,
+            plan,
+            clear_hdr: !emits,
+            timestamps: desc.pass_timing,
+            brdf_source: technique.brdf_source(),
+            tile_stats: desc.tile_stats,
+        };
+        let mut targets = self.targets.lighting();
+        // SAFETY: `cmd` records on this context's device; the targets' states are the ones this
+        // renderer tracks; it waits for every frame, so slot 0 is free.
+        unsafe { self.lighting.record(cmd, &frame, &mut targets)? };
+        self.targets.lit(&targets);
+        self.timestamps.mark(ctx, cmd, "lighting");
+        Ok(())
     }
 
     /// Resets the frame's command pool (its one command buffer; resetting pools, not single
@@ -165,17 +181,12 @@ impl Renderer<'_> {
         Ok(())
     }
 
-    /// Records the forward pass or the G-buffer pass into the renderer's targets.
-    pub(super) fn record_geometry(&mut self, forward: bool, desc: &FrameDesc) {
+    /// Records the G-buffer pass into the renderer's targets.
+    pub(super) fn record_gbuffer_pass(&mut self, desc: &FrameDesc) {
         let cmd = self.cmd;
         let mut targets = self.targets.lighting();
-        if forward {
-            self.geometry_pass(cmd, self.pipelines.forward, desc.depth)
-                .record_forward(&mut targets);
-        } else {
-            let (depth, pattern) = (desc.depth, desc.preserved_pattern);
-            self.record_gbuffer_into(cmd, &mut targets, depth, pattern);
-        }
+        let (depth, pattern) = (desc.depth, desc.preserved_pattern);
+        self.record_gbuffer_into(cmd, &mut targets, depth, pattern);
         self.targets.lit(&targets);
     }
 

@@ -20,9 +20,7 @@ impl Renderer<'_> {
     }
 
     pub(super) fn plan_in(&self, technique: Technique, view: &ViewDesc) -> Result<FramePlan> {
-        let Some(settings) = technique.plan_settings(|backend| self.cost_model(backend)) else {
-            return Ok(FramePlan::empty(view.depth));
-        };
+        let settings = technique.plan_settings(|backend| self.cost_model(backend));
         let view = View::new(view).map_err(PlanError::from)?;
         let shapes: Vec<LightShape> = self.scene.lights.iter().map(|l| l.shape()).collect();
         let brdf_bounds = self.scene.brdf_bounds(&self.brdfs);

@@ -11,7 +11,7 @@ use ash::vk;
 use histencil_model::{DepthConvention, Footprint, SoftTarget};
 
 impl Renderer<'_> {
-    /// The CPU simulator's inputs for `technique`'s frame, captured from the GPU: the G-buffer
+    /// The CPU simulator's inputs for the deferred frame `desc`, captured from the GPU: the G-buffer
     /// pass's depth and stencil, the plan, and each planned light's footprint as rasterised.
     /// `histencil_model::Simulator` run on them predicts the stencil and the hi-stencil
     /// statistics ([`super::Frame::tile_stats`]) the GPU frame produces.
@@ -26,8 +26,13 @@ impl Renderer<'_> {
                 "simulator inputs of a frame with reversed depth or an infinite far plane",
             ));
         }
+        let Some(technique) = desc.shading.technique() else {
+            return Err(crate::Error::Unsupported(
+                "simulator inputs of a forward frame, which has no stencil to simulate",
+            ));
+        };
         let ctx = self.ctx;
-        let plan = self.plan(desc.technique)?;
+        let plan = self.plan(technique)?;
         let layout = self.lighting.pipeline_layout();
         let mut capture = FootprintCapture::new(ctx, layout, self.extent)?;
         let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
@@ -35,7 +40,7 @@ impl Renderer<'_> {
         let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
         let result = (|| {
             let cmd = self.begin_commands()?;
-            self.record_geometry(false, desc);
+            self.record_gbuffer_pass(desc);
             let image = &mut self.targets.depth_stencil;
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
             copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
