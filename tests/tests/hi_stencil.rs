@@ -7,6 +7,7 @@
 //!
 //! "Exact" below means within 1/255 of the forward reference, like every deferred technique.
 
+use histencil_model::DepthConvention;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique};
 use image::RgbaImage;
@@ -159,24 +160,67 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
                     tile_stats: true,
                     ..FrameDesc::new(technique, Readback::ALL)
                 };
-                let inputs = renderer.simulator_inputs(desc).expect("inputs");
-                let (sim, predicted) = inputs.predict();
-                let frame = renderer.render_frame(&desc).expect("frame");
-                let stats = frame.tile_stats.expect("statistics were asked for");
-                println!("{name} {label}: {stats:?}");
-                assert!(stats.tiles_tested > 0, "{name} {label}: nothing tested");
-                assert_eq!(stats, sim.stats, "{name} {label}: tile statistics");
-                let stencil = frame.images.stencil.unwrap().into_raw();
-                let wrong = stencil
-                    .iter()
-                    .zip(&predicted.stencil)
-                    .filter(|(a, b)| a != b)
-                    .count();
-                assert_eq!(
-                    wrong, 0,
-                    "{name} {label}: stencil differs at {wrong} pixels"
-                );
+                assert_simulated(&mut renderer, &desc, &format!("{name} {label}"));
             }
         });
     }
+}
+
+/// Reversed Z and an infinite far plane are simulated as the GPU renders them: the capture
+/// projects depths and light volumes in the frame's convention.
+#[test]
+fn reversed_and_infinite_far_frames_equal_the_simulators() {
+    let auto = FlushPolicy::Auto;
+    let cases = [
+        ("ps3", stencil(Backend::Ps3, auto)),
+        ("x360", stencil(x360(true, false), auto)),
+        ("ps3-flush-never", stencil(Backend::Ps3, FlushPolicy::Never)),
+        (
+            "x360-flush-always",
+            stencil(x360(true, false), FlushPolicy::Always),
+        ),
+    ];
+    let conventions = [
+        ("reversed", DepthConvention::Reversed, false),
+        ("reversed-infinite", DepthConvention::Reversed, true),
+        ("infinite", DepthConvention::Standard, true),
+    ];
+    for name in ["default", "near-far", "inside"] {
+        let scene = histencil_scene::embedded(name).unwrap();
+        with_validated_context(|ctx| {
+            let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
+            for (label, technique) in cases {
+                for (depth_label, depth, infinite_far) in conventions {
+                    let desc = FrameDesc {
+                        preserved_pattern: PATTERN,
+                        tile_stats: true,
+                        depth,
+                        infinite_far,
+                        ..FrameDesc::new(technique, Readback::ALL)
+                    };
+                    let what = format!("{name} {label} {depth_label}");
+                    assert_simulated(&mut renderer, &desc, &what);
+                }
+            }
+        });
+    }
+}
+
+/// Asserts that the GPU frame `desc` leaves the stencil and the tile statistics that the
+/// simulator predicts from the GPU's own inputs.
+fn assert_simulated(renderer: &mut Renderer, desc: &FrameDesc, what: &str) {
+    let inputs = renderer.simulator_inputs(*desc).expect("inputs");
+    let (sim, predicted) = inputs.predict();
+    let frame = renderer.render_frame(desc).expect("frame");
+    let stats = frame.tile_stats.expect("statistics were asked for");
+    println!("{what}: {stats:?}");
+    assert!(stats.tiles_tested > 0, "{what}: nothing tested");
+    assert_eq!(stats, sim.stats, "{what}: tile statistics");
+    let stencil = frame.images.stencil.unwrap().into_raw();
+    let wrong = stencil
+        .iter()
+        .zip(&predicted.stencil)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(wrong, 0, "{what}: stencil differs at {wrong} pixels");
 }

@@ -16,8 +16,8 @@ use crate::shaders;
 use crate::state::apply;
 use ash::vk;
 use histencil_model::{
-    CullMode, DepthState, Footprint, FramePlan, PassState, SimResult, Simulator, SoftTarget, Span,
-    StencilLayout,
+    CullMode, DepthConvention, DepthState, Footprint, FramePlan, PassState, SimResult, Simulator,
+    SoftTarget, Span, StencilLayout,
 };
 use histencil_scene::Light;
 
@@ -164,8 +164,9 @@ impl FootprintCapture {
         ctx.end_label(cmd);
     }
 
-    /// The footprint of the last recorded light, once the commands have completed.
-    pub fn footprint(&self) -> Result<Footprint> {
+    /// The footprint of the last recorded light, once the commands have completed, its depths
+    /// in `depth`'s convention (the one the frame uniforms projected the volume with).
+    pub fn footprint(&self, depth: DepthConvention) -> Result<Footprint> {
         let [front, back] = &self.readback;
         let front: &[f32] = bytemuck::cast_slice(front.read());
         let back: &[f32] = bytemuck::cast_slice(back.read());
@@ -188,7 +189,7 @@ impl FootprintCapture {
         let rect = bounds.map_or((0, 0, 0, 0), |(x0, y0, x1, y1)| {
             (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
         });
-        Ok(Footprint::from_fn(rect, |x, y| {
+        Ok(Footprint::from_fn_in(depth, rect, |x, y| {
             let i = (y * width + x) as usize;
             (back[i] != NO_FACE).then(|| Span {
                 front: (front[i] != NO_FACE).then_some(front[i]),

@@ -8,7 +8,7 @@ use crate::resources::Buffer;
 use crate::shader_consts::HI_STENCIL_TILE;
 use crate::technique::FrameDesc;
 use ash::vk;
-use histencil_model::{DepthConvention, Footprint, SoftTarget};
+use histencil_model::{Footprint, SoftTarget};
 
 impl Renderer<'_> {
     /// The CPU simulator's inputs for the deferred frame `desc`, captured from the GPU: the G-buffer
@@ -16,23 +16,27 @@ impl Renderer<'_> {
     /// `histencil_model::Simulator` run on them predicts the stencil and the hi-stencil
     /// statistics ([`super::Frame::tile_stats`]) the GPU frame produces.
     ///
+    /// Every depth convention the frame can have is captured as the frame renders it: depths
+    /// and footprints in the frame's convention (reversed Z stores far as 0), its far plane
+    /// finite or at infinity.
+    ///
     /// # Errors
-    /// [`crate::Error::Unsupported`] without a 32-bit float depth buffer (the simulator compares
-    /// f32 depths), besides the errors of [`Renderer::plan`] and of Vulkan calls.
+    /// [`crate::Error::Unsupported`] for a forward frame (it has no stencil plan) and without a
+    /// 32-bit float depth buffer (the simulator compares f32 depths), besides the errors of
+    /// [`Renderer::plan`] and of Vulkan calls.
     pub fn simulator_inputs(&mut self, desc: impl Into<FrameDesc>) -> Result<SimulatorInputs> {
         let desc = &desc.into();
-        if desc.depth != DepthConvention::Standard || desc.infinite_far {
-            return Err(crate::Error::Unsupported(
-                "simulator inputs of a frame with reversed depth or an infinite far plane",
-            ));
-        }
         let Some(technique) = desc.shading.technique() else {
             return Err(crate::Error::Unsupported(
                 "simulator inputs of a forward frame, which has no stencil to simulate",
             ));
         };
         let ctx = self.ctx;
-        let plan = self.plan(technique)?;
+        // The G-buffer pass and the captured volumes project with the frame's own view.
+        let view = self.view_desc_in(desc.depth, desc.infinite_far);
+        self.frame_uniforms
+            .write(bytemuck::bytes_of(&self.uniforms(&view)?));
+        let plan = self.plan_in(technique, &view)?;
         let layout = self.lighting.pipeline_layout();
         let mut capture = FootprintCapture::new(ctx, layout, self.extent)?;
         let pixels = u64::from(self.extent.width) * u64::from(self.extent.height);
@@ -56,7 +60,8 @@ impl Renderer<'_> {
             for (planned, light) in plan.lights.iter().enumerate() {
                 let index = light.input as u32;
                 if plan.is_full_screen(planned) {
-                    footprints.push(Footprint::full_screen(target.width, target.height));
+                    let full = Footprint::full_screen(target.width, target.height);
+                    footprints.push(full.in_convention(desc.depth));
                     continue;
                 }
                 let cmd = self.begin_commands()?;
@@ -73,7 +78,7 @@ impl Renderer<'_> {
                 let light = &self.scene.lights[index as usize];
                 capture.record(ctx, cmd, layout, self.lighting.volumes(), (index, light));
                 self.submit_and_wait()?;
-                footprints.push(capture.footprint()?);
+                footprints.push(capture.footprint(desc.depth)?);
             }
             Ok(SimulatorInputs {
                 layout: self.stencil_layout,
