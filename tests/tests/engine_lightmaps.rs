@@ -16,7 +16,7 @@ use histencil_scene::{Light, ParticleLayout, Scene, Shape};
 use histencil_tests::engine::{copy_to_buffer, Engine, EngineBuffer, EngineImage};
 use histencil_vk::{
     AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, Context, Error, ImageRef,
-    ImageState, LightmapFrame,
+    ImageState, LightmapFrame, LightmapTimings,
 };
 
 const HEIGHT: u32 = 240;
@@ -162,6 +162,8 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
                 lights: &lights,
                 entities: &entities,
                 layout: &layout,
+                // Slot 1's frames are timed, slot 0's are not.
+                timestamps: slot == 1,
             };
             let readback = match f {
                 0 => Some(&first),
@@ -183,6 +185,8 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
         }
         let fences: Vec<_> = slots.iter().map(|s| s.2).collect();
         unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        assert_eq!(lightmaps.timings(0).unwrap(), None, "slot 0 was not timed");
+        assert_timed(&lightmaps.timings(1).unwrap().expect("slot 1 was timed"), 6);
         assert!(draws.iter().all(|&n| n > 0), "{draws:?}");
         assert!(
             draws[1] > draws[0],
@@ -202,6 +206,8 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
             lights: &lights0,
             entities: &entities6,
             layout: &layout6,
+            // Timestamps change no texel.
+            timestamps: true,
         };
         unsafe {
             d.reset_fences(&[fence]).unwrap();
@@ -218,6 +224,7 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
             last.bytes(),
             "the same frame through the other slot"
         );
+        assert_timed(&lightmaps.timings(0).unwrap().expect("timed"), 6);
         assert_ne!(first.bytes(), last.bytes());
 
         // Every lit entity has light in its region; nothing outside the regions is touched.
@@ -316,6 +323,7 @@ fn an_engine_records_a_direction_map() {
             lights: &scene.lights,
             entities: &entities,
             layout: &layout,
+            timestamps: true,
         };
         let d = &engine.device;
         let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
@@ -337,6 +345,8 @@ fn an_engine_records_a_direction_map() {
                 .unwrap();
             d.queue_wait_idle(queue).unwrap();
         }
+        let entity_count = entities.len() as u32;
+        assert_timed(&lightmaps.timings(0).unwrap().expect("timed"), entity_count);
         let texels = |buffer: &EngineBuffer| -> Vec<[f32; 4]> {
             buffer
                 .bytes()
@@ -482,6 +492,7 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
             lights: &scene.lights,
             entities: &entities,
             layout: &layout,
+            timestamps: false,
         };
 
         let mut bad_entities: Vec<(&str, Vec<AlphaEntity>)> = Vec::new();
@@ -637,4 +648,16 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
         assert!(ctx.validation_log().is_empty());
     }
     engine.destroy().assert_clean();
+}
+
+/// Timings of a frame of `entities` entities: the clear and each lit entity once, in order.
+fn assert_timed(t: &LightmapTimings, entities: u32) {
+    assert!(t.clear_ms.is_finite() && t.clear_ms >= 0.0, "{t:?}");
+    assert!(!t.per_entity.is_empty(), "{t:?}");
+    assert!(t.per_entity.windows(2).all(|w| w[0].0 < w[1].0), "{t:?}");
+    assert!(t
+        .per_entity
+        .iter()
+        .all(|&(e, ms)| e < entities && ms.is_finite() && ms >= 0.0));
+    assert!(t.total_ms() >= t.clear_ms);
 }

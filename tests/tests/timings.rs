@@ -99,3 +99,35 @@ fn lights_draw_once_per_brdf_they_touch() {
         assert!(plan.lights.len() <= scene.lights.len());
     });
 }
+
+/// The alpha lightmap pass is timed per entity when asked for, and only when a lightmap pass
+/// was recorded.
+#[test]
+fn lightmaps_are_timed_per_entity() {
+    use histencil_vk::AlphaMode;
+    let scene = histencil_scene::embedded("alpha").unwrap();
+    let entities = scene.alpha_entity_names().len() as u32;
+    with_validated_context(|ctx| {
+        let mut renderer = Renderer::new(ctx, scene, 96, 96).expect("renderer");
+        let desc = |alpha, pass_timing| FrameDesc {
+            alpha,
+            pass_timing,
+            ..STENCIL.into()
+        };
+        for mode in [AlphaMode::Lightmap, AlphaMode::Directional] {
+            let timings = renderer.render_frame(&desc(mode, true)).unwrap().timings;
+            let lightmaps = timings.lightmaps.expect("lightmaps timed");
+            assert!(lightmaps.clear_ms.is_finite() && lightmaps.clear_ms >= 0.0);
+            assert!(!lightmaps.per_entity.is_empty());
+            assert!(lightmaps
+                .per_entity
+                .iter()
+                .all(|&(e, ms)| e < entities && ms.is_finite() && ms >= 0.0));
+        }
+        let untimed = renderer.render_frame(&desc(AlphaMode::Lightmap, false));
+        assert!(untimed.unwrap().timings.lightmaps.is_none());
+        // Forward-lit alpha records no lightmap pass, so there is nothing to time.
+        let forward = renderer.render_frame(&desc(AlphaMode::Forward, true));
+        assert!(forward.unwrap().timings.lightmaps.is_none());
+    });
+}

@@ -369,6 +369,17 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
         if let Some(lighting) = &timings.lighting {
             print!("{}", describe_breakdown(lighting));
         }
+        if let Some(lightmaps) = &timings.lightmaps {
+            let names = renderer.scene().alpha_entity_names();
+            println!(
+                "alpha lightmaps (median): clear {:.3} ms",
+                lightmaps.clear_ms
+            );
+            for &(entity, ms) in &lightmaps.per_entity {
+                let name = names.get(entity as usize).copied().unwrap_or("?");
+                println!("  entity {name:24} {ms:8.3} ms");
+            }
+        }
         Ok(())
     })
 }

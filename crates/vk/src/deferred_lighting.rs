@@ -516,7 +516,8 @@ impl DeferredLighting<'_> {
                 if let Some(mut old) = slot.timer.take() {
                     old.destroy(ctx);
                 }
-                slot.timer = Some(StepTimer::new(ctx, needed.next_power_of_two())?);
+                let capacity = needed.next_power_of_two();
+                slot.timer = Some(StepTimer::new(ctx, "lighting-step-timestamps", capacity)?);
             }
         }
         slot.uniforms.write(bytemuck::bytes_of(&uniforms));

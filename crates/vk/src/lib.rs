@@ -73,4 +73,4 @@ pub use readback::{FrameImages, Readback};
 pub use renderer::{Frame, Renderer, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
 pub use technique::{Backend, FrameDesc, Shading, Technique};
-pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown};
+pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown, LightmapTimings};

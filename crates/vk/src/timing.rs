@@ -13,6 +13,38 @@ pub struct FrameTimings {
     /// The lighting pass broken down by the talk's pass groups, when asked for
     /// (`FrameDesc::pass_timing`).
     pub lighting: Option<LightingBreakdown>,
+    /// The alpha lightmap pass per entity, when asked for and the frame lights its alpha
+    /// entities with lightmaps.
+    pub lightmaps: Option<LightmapTimings>,
+}
+
+/// The lightmap pass of one frame: clearing the atlas, then each entity's draws (one per light
+/// that reaches it), so an engine sees what each of its alpha entities costs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LightmapTimings {
+    /// Beginning the pass, which clears the atlas (and the direction map).
+    pub clear_ms: f64,
+    /// `(entity index, ms)` for every entity some light reaches, in entity order.
+    pub per_entity: Vec<(u32, f64)>,
+}
+
+impl LightmapTimings {
+    /// Per-step durations `(group, entity, ms)` as [`StepTimer`] reads them: the `clear` step,
+    /// then one `entity` step per entity drawn.
+    fn from_steps(steps: &[(String, Option<u32>, f64)]) -> Self {
+        let mut out = Self::default();
+        for (_, entity, ms) in steps {
+            match entity {
+                Some(e) => add_to(&mut out.per_entity, e, *ms),
+                None => out.clear_ms += ms,
+            }
+        }
+        out
+    }
+
+    pub fn total_ms(&self) -> f64 {
+        self.clear_ms + self.per_entity.iter().map(|e| e.1).sum::<f64>()
+    }
 }
 
 /// Lighting time by pass group (`setup`, `mask-<brdf>`, `shade-<brdf>`, `cleanup`,
@@ -66,7 +98,24 @@ impl FrameTimings {
                 breakdowns.iter().map(|b| &b.per_light),
             ),
         });
-        FrameTimings { passes, lighting }
+        let lightmaps: Vec<&LightmapTimings> =
+            frames.iter().filter_map(|f| f.lightmaps.as_ref()).collect();
+        let lightmaps = (lightmaps.len() == frames.len()).then(|| {
+            let mut clears: Vec<f64> = lightmaps.iter().map(|l| l.clear_ms).collect();
+            clears.sort_by(f64::total_cmp);
+            LightmapTimings {
+                clear_ms: median_of_sorted(&clears),
+                per_entity: median_per_key(
+                    &lightmaps[0].per_entity,
+                    lightmaps.iter().map(|l| &l.per_entity),
+                ),
+            }
+        });
+        FrameTimings {
+            passes,
+            lighting,
+            lightmaps,
+        }
     }
 }
 
@@ -179,7 +228,7 @@ impl Timestamps {
             .collect();
         Ok(FrameTimings {
             passes,
-            lighting: None,
+            ..FrameTimings::default()
         })
     }
 
@@ -199,8 +248,8 @@ pub(crate) struct StepTimer {
 }
 
 impl StepTimer {
-    pub fn new(ctx: &Context, capacity: u32) -> Result<Self> {
-        let pool = timestamp_pool(ctx, "lighting-step-timestamps", capacity)?;
+    pub fn new(ctx: &Context, name: &str, capacity: u32) -> Result<Self> {
+        let pool = timestamp_pool(ctx, name, capacity)?;
         Ok(Self {
             pool,
             capacity,
@@ -236,15 +285,23 @@ impl StepTimer {
         light: Option<u32>,
     ) {
         let index = self.steps.len() as u32 + 1;
-        assert!(
-            index < self.capacity,
-            "more lighting steps than the timer holds"
-        );
+        assert!(index < self.capacity, "more steps than the timer holds");
         write_timestamp(ctx, cmd, self.pool, index);
         self.steps.push((group, light));
     }
 
+    /// The lighting steps' times by pass group and light.
     pub fn read(&self, ctx: &Context) -> Result<LightingBreakdown> {
+        Ok(LightingBreakdown::from_steps(&self.read_steps(ctx)?))
+    }
+
+    /// The lightmap steps' times: the clear, then per entity.
+    pub fn read_lightmaps(&self, ctx: &Context) -> Result<LightmapTimings> {
+        Ok(LightmapTimings::from_steps(&self.read_steps(ctx)?))
+    }
+
+    /// `(group, light or entity, ms)` per step, waiting for the queries.
+    fn read_steps(&self, ctx: &Context) -> Result<Vec<(String, Option<u32>, f64)>> {
         let ticks = read_ticks(ctx, self.pool, self.steps.len() + 1)?;
         let steps: Vec<(String, Option<u32>, f64)> = self
             .steps
@@ -255,7 +312,7 @@ impl StepTimer {
                 (group.clone(), *light, ms)
             })
             .collect();
-        Ok(LightingBreakdown::from_steps(&steps))
+        Ok(steps)
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -273,7 +330,7 @@ mod tests {
     fn median_per_pass() {
         let f = |a, b| FrameTimings {
             passes: vec![("gbuffer", a), ("lighting", b)],
-            lighting: None,
+            ..FrameTimings::default()
         };
         let m = FrameTimings::median(&[f(1.0, 9.0), f(3.0, 1.0), f(2.0, 5.0)]);
         assert_eq!(m, f(2.0, 5.0));

@@ -382,6 +382,7 @@ fn main() {
                 lights: &lights,
                 entities: &entities,
                 layout: &regions,
+                timestamps: false,
             };
             // SAFETY: as for the lighting; the atlas state is the one the engine tracks.
             lightmaps

@@ -23,6 +23,7 @@ use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::Buffer;
 use crate::shaders;
 use crate::state::{apply, FULLSCREEN};
+use crate::timing::{LightmapTimings, StepTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_alpha::AlphaEntity;
@@ -56,6 +57,10 @@ pub struct LightmapFrame<'a> {
     /// The entities' regions, from [`histencil_alpha::plan_entities`] (or
     /// [`histencil_alpha::plan_regions`] on their descriptions), in the same order.
     pub layout: &'a LightmapLayout,
+    /// Write a GPU timestamp after the clear and after each entity's draws
+    /// ([`AlphaLightmaps::timings`]). Opt-in: on some drivers a timestamp between draws
+    /// serialises them.
+    pub timestamps: bool,
 }
 
 struct Slot {
@@ -67,6 +72,9 @@ struct Slot {
     alpha_set: vk::DescriptorSet,
     /// Per entity, the lights the last frame in this slot draws into its region.
     entity_lights: Vec<Vec<u32>>,
+    /// Timestamps of the last frame in this slot, when it asked for them; grown as needed.
+    timer: Option<StepTimer>,
+    timed: bool,
 }
 
 const STORAGE_NAMES: [&str; 4] = [
@@ -102,7 +110,7 @@ const STORAGE_NAMES: [&str; 4] = [
 ///     let settings = ChoiceSettings::default();
 ///     let plan = plan_entities(entities, &viewer, lights, 720, atlas.extent.width, &settings)?;
 ///     let layout = plan.layout;
-///     let frame = LightmapFrame { slot, view, lights, entities, layout: &layout };
+///     let frame = LightmapFrame { slot, view, lights, entities, layout: &layout, timestamps: false };
 ///     // SAFETY: `cmd` records on the lightmaps' device, the atlas state is true, and the last
 ///     // frame recorded into `slot` has finished on the GPU.
 ///     unsafe { lightmaps.record(cmd, &frame, atlas)? };
@@ -271,6 +279,8 @@ impl<'c> AlphaLightmaps<'c> {
                 frame_set,
                 alpha_set,
                 entity_lights: Vec::new(),
+                timer: None,
+                timed: false,
             };
             write_frame_set(ctx, frame_set, slot.uniforms.handle, slot.lights.handle);
             write_storage_buffers(ctx, alpha_set, &slot.storage.each_ref().map(|b| b.handle));
@@ -290,6 +300,22 @@ impl<'c> AlphaLightmaps<'c> {
     /// Recording into `slot` again may replace the buffer when it grows, so bind it after.
     pub fn entity_buffer(&self, slot: u32) -> Option<vk::Buffer> {
         self.slots.get(slot as usize).map(|s| s.storage[0].handle)
+    }
+
+    /// The GPU times of the last frame recorded into `slot`, once the GPU has finished it:
+    /// `None` when that frame asked for no timestamps. Waits for the query results.
+    ///
+    /// # Errors
+    /// Vulkan errors reading the queries.
+    pub fn timings(&self, slot: u32) -> Result<Option<LightmapTimings>> {
+        match self.slots.get(slot as usize) {
+            Some(Slot {
+                timer: Some(timer),
+                timed: true,
+                ..
+            }) => Ok(Some(timer.read_lightmaps(self.ctx)?)),
+            _ => Ok(None),
+        }
     }
 
     /// Lightmap draws the last frame recorded into `slot` made: one per (entity, light that
@@ -413,6 +439,19 @@ impl<'c> AlphaLightmaps<'c> {
         for (buffer, data) in slot.storage.iter_mut().zip(bytes) {
             buffer.write(data);
         }
+        slot.timed = frame.timestamps;
+        if frame.timestamps {
+            // A start mark, the clear, then one mark per entity at most.
+            let needed = frame.entities.len() as u32 + 2;
+            if slot.timer.as_ref().is_none_or(|t| t.capacity() < needed) {
+                if let Some(mut old) = slot.timer.take() {
+                    old.destroy(ctx);
+                }
+                let name = format!("lightmap-timestamps-{}", frame.slot);
+                let capacity = needed.next_power_of_two();
+                slot.timer = Some(StepTimer::new(ctx, &name, capacity)?);
+            }
+        }
         slot.entity_lights = entity_lights;
         Ok(())
     }
@@ -421,7 +460,7 @@ impl<'c> AlphaLightmaps<'c> {
     /// `direction`, which makes it the directional pass), then one additive draw per (entity,
     /// light that reaches it) over the entity's region.
     pub(crate) fn record_pass(
-        &self,
+        &mut self,
         cmd: vk::CommandBuffer,
         slot: u32,
         layout: &LightmapLayout,
@@ -429,7 +468,13 @@ impl<'c> AlphaLightmaps<'c> {
         direction: Option<&mut ImageRef>,
     ) {
         let ctx = self.ctx;
-        let slot = &self.slots[slot as usize];
+        let slot = &mut self.slots[slot as usize];
+        // Queries are reset outside rendering, as Vulkan requires.
+        let mut timer = slot.timer.as_mut().filter(|_| slot.timed);
+        if let Some(t) = timer.as_deref_mut() {
+            t.reset(ctx, cmd);
+            t.start(ctx, cmd);
+        }
         let pipeline = match direction {
             Some(direction) => {
                 ctx.begin_label(cmd, "alpha-lightmaps-directional");
@@ -455,6 +500,9 @@ impl<'c> AlphaLightmaps<'c> {
             );
         }
         apply(ctx, cmd, &FULLSCREEN);
+        if let Some(t) = timer.as_deref_mut() {
+            t.mark(ctx, cmd, "clear".to_owned(), None);
+        }
         for (index, (r, lights)) in layout.regions.iter().zip(&slot.entity_lights).enumerate() {
             if lights.is_empty() {
                 continue;
@@ -478,6 +526,9 @@ impl<'c> AlphaLightmaps<'c> {
                     );
                     d.cmd_draw(cmd, 3, 1, 0, 0);
                 }
+            }
+            if let Some(t) = timer.as_deref_mut() {
+                t.mark(ctx, cmd, "entity".to_owned(), Some(index as u32));
             }
         }
         unsafe { d.cmd_end_rendering(cmd) };
@@ -509,6 +560,9 @@ impl Drop for AlphaLightmaps<'_> {
             slot.lights.destroy(ctx);
             for b in &mut slot.storage {
                 b.destroy(ctx);
+            }
+            if let Some(t) = slot.timer.as_mut() {
+                t.destroy(ctx);
             }
         }
         unsafe {

@@ -32,6 +32,7 @@ use crate::shader_consts::ALPHA_MODES;
 use crate::shaders;
 use crate::state::{apply, oriented, FULLSCREEN};
 use crate::targets::{Targets, HDR_FORMAT};
+use crate::timing::LightmapTimings;
 use ash::vk;
 use gpu::AlphaDrawPush;
 use histencil_alpha::{
@@ -316,21 +317,26 @@ impl<'c> AlphaLighting<'c> {
     }
 
     /// Writes the frame's entity records (every mode reads them) and, in the lightmap modes,
-    /// records the lightmap pass into `cmd`, as an engine would.
+    /// records the lightmap pass into `cmd`, as an engine would, with timestamps if asked
+    /// ([`Self::lightmap_timings`]).
     pub fn record_lightmaps(
         &mut self,
         cmd: vk::CommandBuffer,
         scene: &Scene,
         view: &ViewDesc,
         mode: AlphaMode,
+        timestamps: bool,
     ) -> Result<()> {
         let entities = scene_alpha_entities(scene, &self.probe_meshes);
+        let lit = matches!(mode, AlphaMode::Lightmap | AlphaMode::Directional);
         let frame = LightmapFrame {
             slot: 0,
             view,
             lights: &scene.lights,
             entities: &entities,
             layout: &self.layout,
+            // Only a recorded pass writes its queries.
+            timestamps: timestamps && lit,
         };
         self.lightmaps.write_frame(&frame, &self.lightmap)?;
         let direction = match mode {
@@ -341,6 +347,12 @@ impl<'c> AlphaLighting<'c> {
         self.lightmaps
             .record_pass(cmd, 0, &self.layout, &mut self.lightmap, direction);
         Ok(())
+    }
+
+    /// The lightmap pass's GPU times of the last frame, once it has finished: `None` unless
+    /// it recorded lightmaps with timestamps.
+    pub fn lightmap_timings(&self) -> Result<Option<LightmapTimings>> {
+        self.lightmaps.timings(0)
     }
 
     fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, push: AlphaDrawPush) {

@@ -49,7 +49,7 @@ impl Renderer<'_> {
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            alpha.record_lightmaps(cmd, scene, &view, desc.alpha)?;
+            alpha.record_lightmaps(cmd, scene, &view, desc.alpha, desc.pass_timing)?;
             self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
             alpha.record_alpha(
                 ctx,
@@ -82,6 +82,9 @@ impl Renderer<'_> {
         let mut timings = self.timestamps.read(ctx)?;
         if desc.pass_timing && deferred.is_some() {
             timings.lighting = self.lighting.step_timings(0)?;
+        }
+        if let Some(alpha) = self.alpha.as_ref().filter(|_| desc.pass_timing) {
+            timings.lightmaps = alpha.lightmap_timings()?;
         }
         let images = self.readback.read(readback)?;
         let tile_stats = match &deferred {
