@@ -314,19 +314,75 @@ fn write_in_order<'a, T>(
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 
-/// The renderer's own set layouts, pipeline layouts, pool and sets: the mesh passes' and the
-/// tonemap's (the lighting has its own, `deferred_lighting.rs`).
+/// The renderer's frame set (set 0 of its mesh, alpha and tonemap passes): its layout, pool
+/// and the one set, pointing at the frame's uniforms and lights. Each pass owns the rest of
+/// its layout (`passes/`); the lighting has its own (`deferred_lighting.rs`).
 #[derive(Default)]
 pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
-    pub tonemap_layout: vk::DescriptorSetLayout,
-    /// Set 1 of the mesh pipelines; the sets are the materials' (`materials.rs`).
-    pub material_layout: vk::DescriptorSetLayout,
-    pub mesh_pipeline_layout: vk::PipelineLayout,
-    pub tonemap_pipeline_layout: vk::PipelineLayout,
     pool: vk::DescriptorPool,
     pub frame_set: vk::DescriptorSet,
-    pub tonemap_set: vk::DescriptorSet,
+}
+
+/// A pool holding one set of `layout` (whose bindings need `sizes`), and that set, named
+/// `name` (the pool `name-pool`). Nothing is left behind on an error.
+pub(crate) fn one_set(
+    ctx: &Context,
+    name: &str,
+    layout: vk::DescriptorSetLayout,
+    sizes: &[(vk::DescriptorType, u32)],
+) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
+    let sizes: Vec<_> = sizes
+        .iter()
+        .map(|&(ty, n)| vk::DescriptorPoolSize::default().ty(ty).descriptor_count(n))
+        .collect();
+    let pool_info = vk::DescriptorPoolCreateInfo::default()
+        .max_sets(1)
+        .pool_sizes(&sizes);
+    let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
+        .call("vkCreateDescriptorPool")?;
+    ctx.name(pool, &format!("{name}-pool"));
+    let layouts = [layout];
+    let alloc = vk::DescriptorSetAllocateInfo::default()
+        .descriptor_pool(pool)
+        .set_layouts(&layouts);
+    match unsafe { ctx.device.allocate_descriptor_sets(&alloc) }.call("vkAllocateDescriptorSets") {
+        Ok(sets) => {
+            ctx.name(sets[0], name);
+            Ok((pool, sets[0]))
+        }
+        Err(e) => {
+            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+            Err(e)
+        }
+    }
+}
+
+/// The layouts of a renderer pass whose set 0 is the frame set and set 1 its own `set`: that
+/// set's layout (`name-set-layout`) and the pipeline layout (`name-pipeline-layout`), with the
+/// graphics push constants. Nothing is left behind on an error.
+pub(crate) fn pass_layouts(
+    ctx: &Context,
+    name: &str,
+    frame_layout: vk::DescriptorSetLayout,
+    set: &[BindingDesc],
+) -> Result<(vk::DescriptorSetLayout, vk::PipelineLayout)> {
+    let own = create_set_layout(ctx, &format!("{name}-set-layout"), set, GRAPHICS_STAGES)?;
+    let sets = [frame_layout, own];
+    let layout_name = format!("{name}-pipeline-layout");
+    match create_pipeline_layout(
+        ctx,
+        &layout_name,
+        &sets,
+        GRAPHICS_STAGES,
+        PUSH_CONSTANT_BYTES,
+    ) {
+        Ok(layout) => Ok((own, layout)),
+        Err(e) => {
+            unsafe { ctx.device.destroy_descriptor_set_layout(own, None) };
+            Err(e)
+        }
+    }
 }
 
 /// A named pipeline layout: `sets` in order, and `push_constant_bytes` visible to `stages`.
@@ -349,72 +405,29 @@ pub(crate) fn create_pipeline_layout(
     Ok(layout)
 }
 
-/// What the sets point at.
-pub struct DescriptorTargets {
-    pub frame_uniforms: vk::Buffer,
-    pub lights: vk::Buffer,
-    pub hdr_view: vk::ImageView,
-}
-
 impl Descriptors {
-    /// The layouts, pool and sets, written for `targets`; a failure half way frees what was
-    /// made.
-    pub fn new(ctx: &Context, targets: &DescriptorTargets) -> Result<Self> {
-        let set_layout = |name, set| create_set_layout(ctx, name, set, GRAPHICS_STAGES);
-        let pipeline_layout = |name, sets: &[vk::DescriptorSetLayout]| {
-            create_pipeline_layout(ctx, name, sets, GRAPHICS_STAGES, PUSH_CONSTANT_BYTES)
-        };
+    /// The layout, pool and set, written for the frame's uniform and light buffers; a failure
+    /// half way frees what was made.
+    pub fn new(ctx: &Context, frame_uniforms: vk::Buffer, lights: vk::Buffer) -> Result<Self> {
         let d = build(ctx, |d: &mut Self| {
-            d.frame_layout = set_layout("frame-set-layout", FRAME_SET)?;
-            d.tonemap_layout = set_layout("tonemap-set-layout", TONEMAP_SET)?;
-            d.material_layout = set_layout("material-set-layout", MATERIAL_SET)?;
-            d.mesh_pipeline_layout =
-                pipeline_layout("mesh-pipeline-layout", &[d.frame_layout, d.material_layout])?;
-            d.tonemap_pipeline_layout = pipeline_layout(
-                "tonemap-pipeline-layout",
-                &[d.frame_layout, d.tonemap_layout],
-            )?;
+            d.frame_layout =
+                create_set_layout(ctx, "frame-set-layout", FRAME_SET, GRAPHICS_STAGES)?;
             let sizes = [
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
                 (vk::DescriptorType::STORAGE_BUFFER, 1),
-                (vk::DescriptorType::SAMPLED_IMAGE, 1),
-            ]
-            .map(|(ty, n)| vk::DescriptorPoolSize::default().ty(ty).descriptor_count(n));
-            let pool_info = vk::DescriptorPoolCreateInfo::default()
-                .max_sets(2)
-                .pool_sizes(&sizes);
-            d.pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
-                .call("vkCreateDescriptorPool")?;
-            ctx.name(d.pool, "frame-descriptor-pool");
-            let layouts = [d.frame_layout, d.tonemap_layout];
-            let alloc = vk::DescriptorSetAllocateInfo::default()
-                .descriptor_pool(d.pool)
-                .set_layouts(&layouts);
-            let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
-                .call("vkAllocateDescriptorSets")?;
-            (d.frame_set, d.tonemap_set) = (sets[0], sets[1]);
-            ctx.name(d.frame_set, "frame-set");
-            ctx.name(d.tonemap_set, "tonemap-set");
+            ];
+            (d.pool, d.frame_set) = one_set(ctx, "frame-set", d.frame_layout, &sizes)?;
             Ok(())
         })?;
-        d.write(ctx, targets);
+        write_frame_set(ctx, d.frame_set, frame_uniforms, lights);
         Ok(d)
-    }
-
-    fn write(&self, ctx: &Context, t: &DescriptorTargets) {
-        write_frame_set(ctx, self.frame_set, t.frame_uniforms, t.lights);
-        write_sampled_images(ctx, self.tonemap_set, &[t.hdr_view]);
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);
-            for l in [self.mesh_pipeline_layout, self.tonemap_pipeline_layout] {
-                ctx.device.destroy_pipeline_layout(l, None);
-            }
-            for l in [self.frame_layout, self.tonemap_layout, self.material_layout] {
-                ctx.device.destroy_descriptor_set_layout(l, None);
-            }
+            ctx.device
+                .destroy_descriptor_set_layout(self.frame_layout, None);
         }
         *self = Self::default();
     }

@@ -94,6 +94,18 @@ const PARTICLES: PassState = PassState {
     ..ALPHA_OBJECTS
 };
 
+/// What histencil's alpha pass draws in one frame.
+#[derive(Clone, Copy)]
+pub(crate) struct AlphaInputs<'a> {
+    pub scene: &'a Scene,
+    pub meshes: &'a Meshes,
+    /// Set 0: the frame's uniforms and lights.
+    pub frame_set: vk::DescriptorSet,
+    pub mode: AlphaMode,
+    pub extent: vk::Extent2D,
+    pub depth: DepthConvention,
+}
+
 /// A scene's alpha entities on the GPU: the lightmaps (as an engine records them), the atlas,
 /// the sprites and histencil's alpha pass.
 pub(crate) struct AlphaLighting<'c> {
@@ -412,21 +424,26 @@ impl<'c> AlphaLighting<'c> {
         Ok([object, particle])
     }
 
-    /// Blends the entities far to near over the lit frame in `targets.hdr`, lit as `mode` says.
+    /// Blends the entities far to near over the lit frame in `targets.hdr`, lit as
+    /// `inputs.mode` says.
     ///
     /// # Errors
     /// Pipeline creation errors, the first time a mode is used; nothing is recorded then.
-    #[allow(clippy::too_many_arguments)]
     pub fn record_alpha(
         &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
-        scene: &Scene,
-        meshes: &Meshes,
+        inputs: &AlphaInputs,
         targets: &mut Targets,
-        frame_set: vk::DescriptorSet,
-        (mode, extent, depth): (AlphaMode, vk::Extent2D, DepthConvention),
     ) -> Result<()> {
+        let AlphaInputs {
+            scene,
+            meshes,
+            frame_set,
+            mode,
+            extent,
+            depth,
+        } = *inputs;
         let [object_pipeline, particle_pipeline] = self.pipelines(ctx, mode)?;
         ctx.begin_label(cmd, "alpha");
         unsafe {

@@ -1,5 +1,6 @@
-//! The mesh passes: the G-buffer pass (surface attributes, BRDF id into the stencil BRDF bits) and
-//! the forward reference (every object lit by every light, per pixel).
+//! The mesh passes: the G-buffer pass (surface attributes, BRDF id into the stencil BRDF bits),
+//! the forward reference (every object lit by every light, per pixel) and the emission after
+//! the G-buffer pass. [`MeshPasses`] owns their pipelines; each frame they draw [`MeshInputs`].
 
 use super::{
     begin_hdr_rendering, begin_rendering, clear_depth_stencil, color_attachment,
@@ -7,30 +8,61 @@ use super::{
 };
 use crate::access::{transition, Contents, ImageAccess, LightingTargets};
 use crate::context::Context;
+use crate::descriptors::{pass_layouts, MATERIAL_SET};
+use crate::error::Result;
 use crate::gpu_types::DrawPush;
 use crate::meshes::Meshes;
+use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::shaders;
 use crate::state::{apply, oriented, with_stencil, OPAQUE};
+use crate::teardown::build;
 use ash::vk;
 use histencil_model::{
     CompareOp, DepthConvention, DepthState, FaceStencil, PassState, StencilLayout, StencilOp,
 };
 use histencil_scene::Scene;
 
-pub struct GeometryPass<'a> {
-    pub ctx: &'a Context,
-    pub cmd: vk::CommandBuffer,
+/// The mesh passes, made once: the G-buffer, forward and emission pipelines, their pipeline
+/// layout (set 0 the frame, set 1 an object's material) and the material set layout.
+#[derive(Default)]
+pub struct MeshPasses {
+    /// Set 1 of the mesh pipelines; the sets are the materials' (`materials.rs`).
+    pub material_layout: vk::DescriptorSetLayout,
+    pipeline_layout: vk::PipelineLayout,
+    gbuffer: vk::Pipeline,
+    forward: vk::Pipeline,
+    /// Emitted radiance into the HDR target after the G-buffer pass (equal depth).
+    emissive: vk::Pipeline,
+}
+
+/// The formats the mesh passes render to.
+pub struct MeshFormats {
+    pub gbuffer: [vk::Format; 3],
+    pub hdr: vk::Format,
+    pub depth_stencil: vk::Format,
+}
+
+/// What the mesh passes draw in one frame.
+pub struct MeshInputs<'a> {
     pub scene: &'a Scene,
     pub meshes: &'a Meshes,
-    pub pipeline: vk::Pipeline,
-    pub pipeline_layout: vk::PipelineLayout,
     pub frame_set: vk::DescriptorSet,
     /// Each object's material set (set 1: its texture maps), in `Scene::objects` order.
     pub material_sets: &'a [vk::DescriptorSet],
-    pub extent: vk::Extent2D,
     /// Each object's material index (its LUT table), stored in the G-buffer.
     pub material_indices: &'a [u32],
+    pub extent: vk::Extent2D,
     /// Which end of depth is near: the depth test and the clear follow it.
     pub depth: DepthConvention,
+}
+
+/// What the G-buffer pass writes into the stencil: each object's BRDF slot into the layout's
+/// BRDF bits, the engine's pattern into its preserved bits.
+pub struct GbufferStencil<'a> {
+    pub layout: &'a StencilLayout,
+    /// Each object's BRDF slot, in `Scene::objects` order.
+    pub slots: &'a [u32],
+    pub preserved_pattern: u8,
 }
 
 /// The stencil state with which the G-buffer pass writes `slot` (a BRDF's index among those in
@@ -52,62 +84,82 @@ pub fn gbuffer_stencil(
     ))
 }
 
-impl GeometryPass<'_> {
-    /// Draws the objects `state_of` gives a state, each with its material set and push
-    /// constants.
-    fn draw_objects(&self, state_of: impl Fn(usize) -> Option<PassState>) {
-        let d = &self.ctx.device;
-        unsafe {
-            d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-            d.cmd_bind_descriptor_sets(
-                self.cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline_layout,
-                0,
-                &[self.frame_set],
-                &[],
-            );
-        }
-        let mut bound = None;
-        for (i, object) in self.scene.objects.iter().enumerate() {
-            let Some(state) = state_of(i) else { continue };
-            apply(self.ctx, self.cmd, &state);
-            if bound != Some(self.material_sets[i]) {
-                bound = Some(self.material_sets[i]);
-                unsafe {
-                    d.cmd_bind_descriptor_sets(
-                        self.cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        self.pipeline_layout,
-                        1,
-                        &[self.material_sets[i]],
-                        &[],
-                    );
-                }
-            }
-            let push = DrawPush::new(object.transform, &object.material, self.material_indices[i]);
-            unsafe {
-                d.cmd_push_constants(
-                    self.cmd,
-                    self.pipeline_layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    bytemuck::bytes_of(&push),
-                );
-            }
-            self.meshes.shape(object.shape).draw(self.ctx, self.cmd);
+impl MeshPasses {
+    /// The pipelines and layouts; a failure half way frees what was made.
+    pub fn new(
+        ctx: &Context,
+        frame_layout: vk::DescriptorSetLayout,
+        formats: &MeshFormats,
+    ) -> Result<Self> {
+        build(ctx, |p: &mut Self| {
+            (p.material_layout, p.pipeline_layout) =
+                pass_layouts(ctx, "mesh", frame_layout, MATERIAL_SET)?;
+            let hdr = [formats.hdr];
+            let base = PipelineDesc {
+                name: "",
+                vertex: ("mesh.vert", shaders::MESH_VERT),
+                fragment: None,
+                layout: p.pipeline_layout,
+                vertex_input: VertexInput::Mesh,
+                color_formats: &hdr,
+                color_writes: true,
+                blend: Blend::Off,
+                depth_stencil_format: formats.depth_stencil,
+                depth_clamp: false,
+                specialization: &[],
+            };
+            let fragment = |name, spirv| PipelineDesc {
+                name,
+                fragment: Some(spirv),
+                ..base
+            };
+            p.gbuffer = create_pipeline(
+                ctx,
+                &PipelineDesc {
+                    color_formats: &formats.gbuffer,
+                    ..fragment("gbuffer-pipeline", ("gbuffer.frag", shaders::GBUFFER_FRAG))
+                },
+            )?;
+            p.forward = create_pipeline(
+                ctx,
+                &fragment("forward-pipeline", ("forward.frag", shaders::FORWARD_FRAG)),
+            )?;
+            p.emissive = create_pipeline(
+                ctx,
+                &fragment(
+                    "emissive-pipeline",
+                    ("emissive.frag", shaders::EMISSIVE_FRAG),
+                ),
+            )?;
+            Ok(())
+        })
+    }
+
+    fn draw<'a>(
+        &self,
+        ctx: &'a Context,
+        cmd: vk::CommandBuffer,
+        pipeline: vk::Pipeline,
+        inputs: &'a MeshInputs<'a>,
+    ) -> Draw<'a> {
+        Draw {
+            ctx,
+            cmd,
+            pipeline,
+            pipeline_layout: self.pipeline_layout,
+            inputs,
         }
     }
 
     /// Writes the G-buffer and each draw's BRDF slot into the stencil BRDF bits.
     pub fn record_gbuffer(
         &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        inputs: &MeshInputs,
+        stencil: &GbufferStencil,
         targets: &mut LightingTargets,
-        layout: &StencilLayout,
-        slots: &[u32],
-        preserved_pattern: u8,
     ) {
-        let (ctx, cmd) = (self.ctx, self.cmd);
         ctx.begin_label(cmd, "gbuffer");
         for image in targets.gbuffer.iter_mut() {
             transition(
@@ -138,13 +190,19 @@ impl GeometryPass<'_> {
             .zip(clears)
             .map(|(i, clear)| color_attachment(i, Load::Clear(clear)))
             .collect();
-        let clear = Load::Clear(clear_depth_stencil(self.depth));
+        let depth = inputs.depth;
+        let clear = Load::Clear(clear_depth_stencil(depth));
         let ds = depth_stencil_attachment(&targets.depth_stencil, clear);
-        begin_rendering(ctx, cmd, self.extent, &colors, Some(&ds));
-        self.draw_objects(|i| {
+        begin_rendering(ctx, cmd, inputs.extent, &colors, Some(&ds));
+        let GbufferStencil {
+            layout,
+            slots,
+            preserved_pattern,
+        } = *stencil;
+        self.draw(ctx, cmd, self.gbuffer, inputs).objects(|i| {
             Some(match gbuffer_stencil(layout, slots[i], preserved_pattern) {
-                Some(s) => with_stencil(oriented(OPAQUE, self.depth), s),
-                None => oriented(OPAQUE, self.depth),
+                Some(s) => with_stencil(oriented(OPAQUE, depth), s),
+                None => oriented(OPAQUE, depth),
             })
         });
         unsafe { ctx.device.cmd_end_rendering(cmd) };
@@ -152,11 +210,17 @@ impl GeometryPass<'_> {
     }
 
     /// The forward reference: lit HDR colour straight from the meshes.
-    pub fn record_forward(&self, targets: &mut LightingTargets) {
-        let depth = Load::Clear(clear_depth_stencil(self.depth));
-        self.record_into_hdr(targets, "forward", depth, |_| {
-            Some(oriented(OPAQUE, self.depth))
-        });
+    pub fn record_forward(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        inputs: &MeshInputs,
+        targets: &mut LightingTargets,
+    ) {
+        let depth = Load::Clear(clear_depth_stencil(inputs.depth));
+        let opaque = oriented(OPAQUE, inputs.depth);
+        self.draw(ctx, cmd, self.forward, inputs)
+            .hdr_pass(targets, "forward", depth, |_| Some(opaque));
     }
 
     /// After the G-buffer pass (whose depth it reads): clears the HDR target and writes the
@@ -164,16 +228,101 @@ impl GeometryPass<'_> {
     /// in front of the stored one: the same vertex stage computes it again, and no driver
     /// decorates `gl_Position` invariant without complaint; nothing written but colour), so
     /// the light passes add onto it and emission counts once.
-    pub fn record_emissive(&self, targets: &mut LightingTargets) {
-        let visible = oriented(VISIBLE_AGAIN, self.depth);
-        self.record_into_hdr(targets, "emissive", Load::Keep, |i| {
-            self.scene.objects[i].material.emits().then_some(visible)
-        });
+    pub fn record_emissive(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        inputs: &MeshInputs,
+        targets: &mut LightingTargets,
+    ) {
+        let visible = oriented(VISIBLE_AGAIN, inputs.depth);
+        let objects = &inputs.scene.objects;
+        self.draw(ctx, cmd, self.emissive, inputs)
+            .hdr_pass(targets, "emissive", Load::Keep, |i| {
+                objects[i].material.emits().then_some(visible)
+            });
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            for p in [self.gbuffer, self.forward, self.emissive] {
+                ctx.device.destroy_pipeline(p, None);
+            }
+            ctx.device
+                .destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.material_layout, None);
+        }
+        *self = Self::default();
+    }
+}
+
+crate::teardown::destroy_by_method!(MeshPasses);
+
+/// One mesh pass being recorded: a pipeline and the frame's inputs.
+struct Draw<'a> {
+    ctx: &'a Context,
+    cmd: vk::CommandBuffer,
+    pipeline: vk::Pipeline,
+    pipeline_layout: vk::PipelineLayout,
+    inputs: &'a MeshInputs<'a>,
+}
+
+impl Draw<'_> {
+    /// Draws the objects `state_of` gives a state, each with its material set and push
+    /// constants.
+    fn objects(&self, state_of: impl Fn(usize) -> Option<PassState>) {
+        let (d, cmd, inputs) = (&self.ctx.device, self.cmd, self.inputs);
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                self.pipeline_layout,
+                0,
+                &[inputs.frame_set],
+                &[],
+            );
+        }
+        let mut bound = None;
+        for (i, object) in inputs.scene.objects.iter().enumerate() {
+            let Some(state) = state_of(i) else { continue };
+            apply(self.ctx, cmd, &state);
+            let set = inputs.material_sets[i];
+            if bound != Some(set) {
+                bound = Some(set);
+                unsafe {
+                    d.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        self.pipeline_layout,
+                        1,
+                        &[set],
+                        &[],
+                    );
+                }
+            }
+            let push = DrawPush::new(
+                object.transform,
+                &object.material,
+                inputs.material_indices[i],
+            );
+            unsafe {
+                d.cmd_push_constants(
+                    cmd,
+                    self.pipeline_layout,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+            }
+            inputs.meshes.shape(object.shape).draw(self.ctx, cmd);
+        }
     }
 
     /// A pass labelled `label` into the cleared HDR target and the depth-stencil (`depth`:
     /// cleared or kept), drawing the objects `state_of` gives a state.
-    fn record_into_hdr(
+    fn hdr_pass(
         &self,
         targets: &mut LightingTargets,
         label: &str,
@@ -186,11 +335,11 @@ impl GeometryPass<'_> {
             ctx,
             cmd,
             (&mut targets.hdr, &mut targets.depth_stencil),
-            self.extent,
+            self.inputs.extent,
             Load::Clear(CLEAR_BLACK),
             depth,
         );
-        self.draw_objects(state_of);
+        self.objects(state_of);
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }

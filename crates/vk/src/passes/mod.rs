@@ -1,5 +1,11 @@
-//! One file per pass. Each pass takes its inputs as one small struct and records into a command
-//! buffer inside its own debug label.
+//! One file per pass, one convention for all of them: a pass is an object made once that owns
+//! its pipelines and the layouts and sets only it uses (`MeshPasses`, `Tonemap`, and outside
+//! this folder `DeferredLighting`, `AlphaLightmaps` and the renderer's alpha pass), freed with
+//! `destroy` (a creation that fails half way frees what it made); each frame it records from
+//! one inputs struct (`MeshInputs`, `TonemapInputs`, `LightingFrame`, `LightmapFrame`,
+//! `AlphaInputs`) into the caller's command buffer, inside its own debug label. The lighting's
+//! per-frame recording (`lighting.rs`) and the light pipelines it creates per plan
+//! (`light_pipelines.rs`) live here and belong to `DeferredLighting`.
 
 pub mod geometry;
 pub mod light_pipelines;

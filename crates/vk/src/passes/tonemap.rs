@@ -1,24 +1,80 @@
-//! HDR -> 8-bit display colour.
+//! HDR -> 8-bit display colour. [`Tonemap`] owns its pipeline and the set that samples the
+//! renderer's HDR target; each frame it reads [`TonemapInputs`].
 
 use super::{begin_rendering, color_attachment, Load, CLEAR_BLACK};
 use crate::access::{transition, Contents, ImageAccess};
 use crate::context::Context;
+use crate::descriptors::{one_set, pass_layouts, write_sampled_images, TONEMAP_SET};
+use crate::error::Result;
+use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::shaders;
 use crate::state::{apply, FULLSCREEN};
 use crate::targets::Targets;
+use crate::teardown::build;
 use ash::vk;
 
-pub struct TonemapPass<'a> {
-    pub ctx: &'a Context,
-    pub cmd: vk::CommandBuffer,
-    pub pipeline: vk::Pipeline,
-    pub pipeline_layout: vk::PipelineLayout,
-    pub sets: [vk::DescriptorSet; 2],
+/// The tonemap pass, made once for one HDR target.
+#[derive(Default)]
+pub struct Tonemap {
+    set_layout: vk::DescriptorSetLayout,
+    pipeline_layout: vk::PipelineLayout,
+    pool: vk::DescriptorPool,
+    /// Samples the HDR target.
+    set: vk::DescriptorSet,
+    pipeline: vk::Pipeline,
+}
+
+/// What the tonemap pass reads in one frame besides the HDR target.
+pub struct TonemapInputs {
+    /// Set 0: the frame's uniforms (exposure).
+    pub frame_set: vk::DescriptorSet,
     pub extent: vk::Extent2D,
 }
 
-impl TonemapPass<'_> {
-    pub fn record(&self, targets: &mut Targets) {
-        let (ctx, cmd) = (self.ctx, self.cmd);
+impl Tonemap {
+    /// The pipeline writing `ldr_format` and the set sampling `hdr_view`; a failure half way
+    /// frees what was made.
+    pub fn new(
+        ctx: &Context,
+        frame_layout: vk::DescriptorSetLayout,
+        ldr_format: vk::Format,
+        hdr_view: vk::ImageView,
+    ) -> Result<Self> {
+        build(ctx, |t: &mut Self| {
+            (t.set_layout, t.pipeline_layout) =
+                pass_layouts(ctx, "tonemap", frame_layout, TONEMAP_SET)?;
+            let sizes = [(vk::DescriptorType::SAMPLED_IMAGE, 1)];
+            (t.pool, t.set) = one_set(ctx, "tonemap-set", t.set_layout, &sizes)?;
+            write_sampled_images(ctx, t.set, &[hdr_view]);
+            let ldr = [ldr_format];
+            t.pipeline = create_pipeline(
+                ctx,
+                &PipelineDesc {
+                    name: "tonemap-pipeline",
+                    vertex: ("fullscreen.vert", shaders::FULLSCREEN_VERT),
+                    fragment: Some(("tonemap.frag", shaders::TONEMAP_FRAG)),
+                    layout: t.pipeline_layout,
+                    vertex_input: VertexInput::None,
+                    color_formats: &ldr,
+                    color_writes: true,
+                    blend: Blend::Off,
+                    depth_stencil_format: vk::Format::UNDEFINED,
+                    depth_clamp: false,
+                    specialization: &[],
+                },
+            )?;
+            Ok(())
+        })
+    }
+
+    /// Tonemaps `targets.hdr` into `targets.ldr`.
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        inputs: &TonemapInputs,
+        targets: &mut Targets,
+    ) {
         ctx.begin_label(cmd, "tonemap");
         transition(
             ctx,
@@ -37,7 +93,7 @@ impl TonemapPass<'_> {
         begin_rendering(
             ctx,
             cmd,
-            self.extent,
+            inputs.extent,
             &[color_attachment(&targets.ldr, Load::Clear(CLEAR_BLACK))],
             None,
         );
@@ -49,7 +105,7 @@ impl TonemapPass<'_> {
                 vk::PipelineBindPoint::GRAPHICS,
                 self.pipeline_layout,
                 0,
-                &self.sets,
+                &[inputs.frame_set, self.set],
                 &[],
             );
             apply(ctx, cmd, &FULLSCREEN);
@@ -58,4 +114,18 @@ impl TonemapPass<'_> {
         }
         ctx.end_label(cmd);
     }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            ctx.device
+                .destroy_pipeline_layout(self.pipeline_layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+        }
+        *self = Self::default();
+    }
 }
+
+crate::teardown::destroy_by_method!(Tonemap);

@@ -5,12 +5,13 @@
 use super::{Renderer, DEFAULT_LUT_RESOLUTION};
 use crate::context::Context;
 use crate::deferred_lighting::{DeferredLighting, LightingDesc};
-use crate::descriptors::{DescriptorTargets, Descriptors};
+use crate::descriptors::Descriptors;
 use crate::error::{Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
 use crate::materials::GpuMaterials;
 use crate::meshes::Meshes;
-use crate::pipelines::{PipelineLayouts, Pipelines, TargetFormats};
+use crate::passes::geometry::{MeshFormats, MeshPasses};
+use crate::passes::tonemap::Tonemap;
 use crate::readback::ReadbackBuffers;
 use crate::resources::Buffer;
 use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
@@ -128,35 +129,22 @@ impl<'c> Renderer<'c> {
         );
         let descriptors = Owned::new(
             ctx,
-            Descriptors::new(
-                ctx,
-                &DescriptorTargets {
-                    frame_uniforms: frame_uniforms.handle,
-                    lights: lights.handle,
-                    hdr_view: targets.hdr.view,
-                },
-            )?,
+            Descriptors::new(ctx, frame_uniforms.handle, lights.handle)?,
         );
+        let frame_layout = descriptors.frame_layout;
+        let formats = MeshFormats {
+            gbuffer: GBUFFER_FORMATS,
+            hdr: HDR_FORMAT,
+            depth_stencil: ctx.depth_stencil_format,
+        };
+        let mesh_passes = Owned::new(ctx, MeshPasses::new(ctx, frame_layout, &formats)?);
         let maps = Owned::new(
             ctx,
-            GpuMaterials::new(ctx, &scene, descriptors.material_layout)?,
+            GpuMaterials::new(ctx, &scene, mesh_passes.material_layout)?,
         );
-        let pipelines = Owned::new(
+        let tonemap = Owned::new(
             ctx,
-            Pipelines::new(
-                ctx,
-                &PipelineLayouts {
-                    mesh: descriptors.mesh_pipeline_layout,
-                    lighting: lighting.pipeline_layout(),
-                    tonemap: descriptors.tonemap_pipeline_layout,
-                },
-                &TargetFormats {
-                    gbuffer: GBUFFER_FORMATS,
-                    hdr: HDR_FORMAT,
-                    ldr: LDR_FORMAT,
-                    depth_stencil: ctx.depth_stencil_format,
-                },
-            )?,
+            Tonemap::new(ctx, frame_layout, LDR_FORMAT, targets.hdr.view)?,
         );
         let submission = Owned::new(ctx, FrameSubmission::new(ctx)?);
         let timestamps = Owned::new(ctx, Timestamps::new(ctx)?);
@@ -187,7 +175,8 @@ impl<'c> Renderer<'c> {
             frame_uniforms: frame_uniforms.keep(),
             lights: lights.keep(),
             descriptors: descriptors.keep(),
-            pipelines: pipelines.keep(),
+            mesh_passes: mesh_passes.keep(),
+            tonemap: tonemap.keep(),
             command_pool,
             cmd,
             fence,
@@ -251,7 +240,7 @@ impl Drop for Renderer<'_> {
         }
         self.timestamps.destroy(ctx);
         self.readback.destroy(ctx);
-        self.pipelines.destroy(ctx);
+        self.tonemap.destroy(ctx);
         if let Some(t) = self.lut_tables.as_mut() {
             t.destroy(ctx);
         }
@@ -259,6 +248,7 @@ impl Drop for Renderer<'_> {
             a.destroy(ctx);
         }
         self.maps.destroy(ctx);
+        self.mesh_passes.destroy(ctx);
         self.descriptors.destroy(ctx);
         self.lights.destroy(ctx);
         self.frame_uniforms.destroy(ctx);

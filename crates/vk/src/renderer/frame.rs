@@ -4,11 +4,12 @@
 
 use super::{Frame, Renderer};
 use crate::access::LightingTargets;
+use crate::alpha::AlphaInputs;
 use crate::deferred_lighting::LightingFrame;
 use crate::error::{Result, VkCall};
-use crate::passes::geometry::GeometryPass;
+use crate::passes::geometry::{GbufferStencil, MeshInputs};
 use crate::passes::light_pipelines::BrdfSource;
-use crate::passes::tonemap::TonemapPass;
+use crate::passes::tonemap::TonemapInputs;
 use crate::readback::Readback;
 use crate::targets::GBUFFER_FORMATS;
 use crate::technique::{FrameDesc, Shading, Technique};
@@ -51,26 +52,22 @@ impl Renderer<'_> {
             let (scene, meshes) = (&self.scene, &self.meshes);
             alpha.record_lightmaps(cmd, scene, &view, desc.alpha, desc.pass_timing)?;
             self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
-            alpha.record_alpha(
-                ctx,
-                cmd,
+            let inputs = AlphaInputs {
                 scene,
                 meshes,
-                &mut self.targets,
                 frame_set,
-                (desc.alpha, self.extent, desc.depth),
-            )?;
+                mode: desc.alpha,
+                extent: self.extent,
+                depth: desc.depth,
+            };
+            alpha.record_alpha(ctx, cmd, &inputs, &mut self.targets)?;
             self.timestamps.mark(ctx, cmd, "alpha");
         }
-        TonemapPass {
-            ctx,
-            cmd,
-            pipeline: self.pipelines.tonemap,
-            pipeline_layout: self.descriptors.tonemap_pipeline_layout,
-            sets: [self.descriptors.frame_set, self.descriptors.tonemap_set],
+        let inputs = TonemapInputs {
+            frame_set: self.descriptors.frame_set,
             extent: self.extent,
-        }
-        .record(&mut self.targets);
+        };
+        self.tonemap.record(ctx, cmd, &inputs, &mut self.targets);
         self.timestamps.mark(ctx, cmd, "tonemap");
         // Only the deferred frame has a G-buffer to read BRDF ids from.
         let readback = Readback {
@@ -102,8 +99,9 @@ impl Renderer<'_> {
     fn record_forward_pass(&mut self, desc: &FrameDesc) {
         let (ctx, cmd) = (self.ctx, self.cmd);
         let mut targets = self.targets.lighting();
-        self.geometry_pass(cmd, self.pipelines.forward, desc.depth)
-            .record_forward(&mut targets);
+        let inputs = self.mesh_inputs(desc.depth);
+        self.mesh_passes
+            .record_forward(ctx, cmd, &inputs, &mut targets);
         self.targets.lit(&targets);
         self.timestamps.mark(ctx, cmd, "forward");
     }
@@ -123,8 +121,9 @@ impl Renderer<'_> {
         let emits = self.scene.objects.iter().any(|o| o.material.emits());
         if emits {
             let mut targets = self.targets.lighting();
-            self.geometry_pass(cmd, self.pipelines.emissive, desc.depth)
-                .record_emissive(&mut targets);
+            let inputs = self.mesh_inputs(desc.depth);
+            self.mesh_passes
+                .record_emissive(ctx, cmd, &inputs, &mut targets);
             self.targets.lit(&targets);
         }
         self.timestamps.mark(ctx, cmd, "gbuffer");
@@ -193,25 +192,15 @@ impl Renderer<'_> {
         self.targets.lit(&targets);
     }
 
-    /// The mesh pass drawing the scene's objects with `pipeline` (G-buffer, forward or
-    /// emissive).
-    fn geometry_pass(
-        &self,
-        cmd: vk::CommandBuffer,
-        pipeline: vk::Pipeline,
-        depth: DepthConvention,
-    ) -> GeometryPass<'_> {
-        GeometryPass {
-            ctx: self.ctx,
-            cmd,
+    /// What the mesh passes draw this frame: the scene's objects with their materials.
+    fn mesh_inputs(&self, depth: DepthConvention) -> MeshInputs<'_> {
+        MeshInputs {
             scene: &self.scene,
             meshes: &self.meshes,
-            pipeline,
-            pipeline_layout: self.descriptors.mesh_pipeline_layout,
             frame_set: self.descriptors.frame_set,
             material_sets: &self.maps.object_sets,
-            extent: self.extent,
             material_indices: &self.object_materials,
+            extent: self.extent,
             depth,
         }
     }
@@ -223,13 +212,14 @@ impl Renderer<'_> {
         depth: DepthConvention,
         preserved_pattern: u8,
     ) {
-        self.geometry_pass(cmd, self.pipelines.gbuffer, depth)
-            .record_gbuffer(
-                targets,
-                &self.stencil_layout,
-                &self.object_slots,
-                preserved_pattern,
-            );
+        let stencil = GbufferStencil {
+            layout: &self.stencil_layout,
+            slots: &self.object_slots,
+            preserved_pattern,
+        };
+        let inputs = self.mesh_inputs(depth);
+        self.mesh_passes
+            .record_gbuffer(self.ctx, cmd, &inputs, &stencil, targets);
     }
 
     /// Records histencil's G-buffer pass of the scene (its camera, its objects) into another

@@ -16,7 +16,8 @@ use crate::error::Result;
 use crate::lut::LutTables;
 use crate::materials::GpuMaterials;
 use crate::meshes::Meshes;
-use crate::pipelines::Pipelines;
+use crate::passes::geometry::MeshPasses;
+use crate::passes::tonemap::Tonemap;
 use crate::readback::{FrameImages, ReadbackBuffers};
 use crate::resources::Buffer;
 use crate::targets::Targets;
@@ -78,8 +79,10 @@ pub struct Renderer<'c> {
     maps: GpuMaterials,
     frame_uniforms: Buffer,
     lights: Buffer,
+    /// The frame set (set 0 of the mesh, alpha and tonemap passes).
     descriptors: Descriptors,
-    pipelines: Pipelines,
+    mesh_passes: MeshPasses,
+    tonemap: Tonemap,
     command_pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
