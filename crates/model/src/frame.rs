@@ -78,15 +78,6 @@ pub struct FramePlan {
 }
 
 impl FramePlan {
-    /// A plan that draws nothing (the forward frame has no lighting passes).
-    pub fn empty(depth: DepthConvention) -> Self {
-        Self {
-            depth,
-            lights: Vec::new(),
-            steps: Vec::new(),
-        }
-    }
-
     /// Plans every light in order, then inserts flushes and the save / restore steps.
     pub fn build(
         layout: &StencilLayout,

@@ -28,7 +28,7 @@ use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelin
 use crate::passes::lighting::LightingPass;
 use crate::resources::Buffer;
 use crate::targets::GBUFFER_FORMATS;
-use crate::timing::{LightingBreakdown, StepTimer};
+use crate::timing::{LightingBreakdown, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_brdf::BrdfId;
@@ -89,7 +89,7 @@ struct Slot {
     lights: Buffer,
     frame_set: vk::DescriptorSet,
     gbuffer_set: vk::DescriptorSet,
-    timer: Option<StepTimer>,
+    timer: SlotTimer,
 }
 
 /// The lighting passes of the talk, recorded into an engine's frames.
@@ -317,7 +317,7 @@ impl<'c> DeferredLighting<'c> {
                 lights,
                 frame_set,
                 gbuffer_set,
-                timer: None,
+                timer: SlotTimer::default(),
             });
         }
         Ok(())
@@ -510,16 +510,9 @@ impl DeferredLighting<'_> {
         self.prepare_for(frame.plan, count_stats, source)?;
         let ctx = self.ctx;
         let slot = &mut self.slots[frame.slot as usize];
-        if frame.timestamps {
-            let needed = frame.plan.steps.len() as u32 + 1;
-            if slot.timer.as_ref().is_none_or(|t| t.capacity() < needed) {
-                if let Some(mut old) = slot.timer.take() {
-                    old.destroy(ctx);
-                }
-                let capacity = needed.next_power_of_two();
-                slot.timer = Some(StepTimer::new(ctx, "lighting-step-timestamps", capacity)?);
-            }
-        }
+        let steps = frame.plan.steps.len() as u32;
+        let name = "lighting-step-timestamps";
+        slot.timer.prepare(ctx, name, frame.timestamps, steps)?;
         slot.uniforms.write(bytemuck::bytes_of(&uniforms));
         let gpu_lights: Vec<GpuLight> = frame.lights.iter().map(GpuLight::new).collect();
         slot.lights.write(bytemuck::cast_slice(&gpu_lights));
@@ -543,7 +536,7 @@ impl DeferredLighting<'_> {
             count_stats,
             clear_hdr: frame.clear_hdr,
         };
-        let timer = slot.timer.as_mut().filter(|_| frame.timestamps);
+        let timer = slot.timer.active();
         let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
         pass.record(targets, hi_stencil, timer)
     }
@@ -551,7 +544,7 @@ impl DeferredLighting<'_> {
     /// The per-step GPU times of the last frame recorded into `slot` with timestamps, once the
     /// GPU has finished it (`None` when that frame had none). Waits for the query results.
     pub fn step_timings(&self, slot: u32) -> Result<Option<LightingBreakdown>> {
-        match self.slots.get(slot as usize).and_then(|s| s.timer.as_ref()) {
+        match self.slots.get(slot as usize).and_then(|s| s.timer.last()) {
             Some(t) => Ok(Some(t.read(self.ctx)?)),
             None => Ok(None),
         }
@@ -608,9 +601,7 @@ impl Drop for DeferredLighting<'_> {
         for slot in &mut self.slots {
             slot.uniforms.destroy(ctx);
             slot.lights.destroy(ctx);
-            if let Some(t) = slot.timer.as_mut() {
-                t.destroy(ctx);
-            }
+            slot.timer.destroy(ctx);
         }
         if let Some(h) = self.hi_stencil.as_mut() {
             h.destroy(ctx);

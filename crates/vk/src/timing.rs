@@ -320,6 +320,53 @@ impl StepTimer {
     }
 }
 
+/// A frame-in-flight slot's step timer: made, or made again larger, when a frame recorded into
+/// the slot asks for timestamps, and read only when the slot's last frame did, so an untimed
+/// frame never reports the times of an earlier one.
+#[derive(Default)]
+pub(crate) struct SlotTimer {
+    timer: Option<StepTimer>,
+    /// Whether the last frame recorded into the slot writes the timer's queries.
+    timed: bool,
+}
+
+impl SlotTimer {
+    /// Readies the slot for its next frame: timed (`timed`) with up to `steps` marks after the
+    /// start mark, or untimed. A failure leaves the slot untimed.
+    pub fn prepare(&mut self, ctx: &Context, name: &str, timed: bool, steps: u32) -> Result<()> {
+        self.timed = false;
+        if !timed {
+            return Ok(());
+        }
+        let needed = steps + 1;
+        if self.timer.as_ref().is_none_or(|t| t.capacity() < needed) {
+            if let Some(mut old) = self.timer.take() {
+                old.destroy(ctx);
+            }
+            self.timer = Some(StepTimer::new(ctx, name, needed.next_power_of_two())?);
+        }
+        self.timed = true;
+        Ok(())
+    }
+
+    /// The timer the frame being recorded writes, if it is timed.
+    pub fn active(&mut self) -> Option<&mut StepTimer> {
+        self.timer.as_mut().filter(|_| self.timed)
+    }
+
+    /// The timer the slot's last frame wrote, if it was timed.
+    pub fn last(&self) -> Option<&StepTimer> {
+        self.timer.as_ref().filter(|_| self.timed)
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        if let Some(t) = self.timer.as_mut() {
+            t.destroy(ctx);
+        }
+        *self = Self::default();
+    }
+}
+
 crate::teardown::destroy_by_method!(Timestamps);
 
 #[cfg(test)]

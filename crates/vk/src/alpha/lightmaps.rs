@@ -23,7 +23,7 @@ use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::Buffer;
 use crate::shaders;
 use crate::state::{apply, FULLSCREEN};
-use crate::timing::{LightmapTimings, StepTimer};
+use crate::timing::{LightmapTimings, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_alpha::AlphaEntity;
@@ -72,9 +72,8 @@ struct Slot {
     alpha_set: vk::DescriptorSet,
     /// Per entity, the lights the last frame in this slot draws into its region.
     entity_lights: Vec<Vec<u32>>,
-    /// Timestamps of the last frame in this slot, when it asked for them; grown as needed.
-    timer: Option<StepTimer>,
-    timed: bool,
+    /// Timestamps of the last frame in this slot, when it asked for them.
+    timer: SlotTimer,
 }
 
 const STORAGE_NAMES: [&str; 4] = [
@@ -279,8 +278,7 @@ impl<'c> AlphaLightmaps<'c> {
                 frame_set,
                 alpha_set,
                 entity_lights: Vec::new(),
-                timer: None,
-                timed: false,
+                timer: SlotTimer::default(),
             };
             write_frame_set(ctx, frame_set, slot.uniforms.handle, slot.lights.handle);
             write_storage_buffers(ctx, alpha_set, &slot.storage.each_ref().map(|b| b.handle));
@@ -308,13 +306,9 @@ impl<'c> AlphaLightmaps<'c> {
     /// # Errors
     /// Vulkan errors reading the queries.
     pub fn timings(&self, slot: u32) -> Result<Option<LightmapTimings>> {
-        match self.slots.get(slot as usize) {
-            Some(Slot {
-                timer: Some(timer),
-                timed: true,
-                ..
-            }) => Ok(Some(timer.read_lightmaps(self.ctx)?)),
-            _ => Ok(None),
+        match self.slots.get(slot as usize).and_then(|s| s.timer.last()) {
+            Some(timer) => Ok(Some(timer.read_lightmaps(self.ctx)?)),
+            None => Ok(None),
         }
     }
 
@@ -439,19 +433,10 @@ impl<'c> AlphaLightmaps<'c> {
         for (buffer, data) in slot.storage.iter_mut().zip(bytes) {
             buffer.write(data);
         }
-        slot.timed = frame.timestamps;
-        if frame.timestamps {
-            // A start mark, the clear, then one mark per entity at most.
-            let needed = frame.entities.len() as u32 + 2;
-            if slot.timer.as_ref().is_none_or(|t| t.capacity() < needed) {
-                if let Some(mut old) = slot.timer.take() {
-                    old.destroy(ctx);
-                }
-                let name = format!("lightmap-timestamps-{}", frame.slot);
-                let capacity = needed.next_power_of_two();
-                slot.timer = Some(StepTimer::new(ctx, &name, capacity)?);
-            }
-        }
+        // A clear mark, then one mark per entity at most.
+        let steps = frame.entities.len() as u32 + 1;
+        let name = "lightmap-timestamps";
+        slot.timer.prepare(ctx, name, frame.timestamps, steps)?;
         slot.entity_lights = entity_lights;
         Ok(())
     }
@@ -470,7 +455,7 @@ impl<'c> AlphaLightmaps<'c> {
         let ctx = self.ctx;
         let slot = &mut self.slots[slot as usize];
         // Queries are reset outside rendering, as Vulkan requires.
-        let mut timer = slot.timer.as_mut().filter(|_| slot.timed);
+        let mut timer = slot.timer.active();
         if let Some(t) = timer.as_deref_mut() {
             t.reset(ctx, cmd);
             t.start(ctx, cmd);
@@ -561,9 +546,7 @@ impl Drop for AlphaLightmaps<'_> {
             for b in &mut slot.storage {
                 b.destroy(ctx);
             }
-            if let Some(t) = slot.timer.as_mut() {
-                t.destroy(ctx);
-            }
+            slot.timer.destroy(ctx);
         }
         unsafe {
             d.destroy_pipeline(self.pipeline, None);

@@ -27,9 +27,7 @@ impl Renderer<'_> {
     /// Renders the frame `desc` describes and waits for it.
     pub fn render_frame(&mut self, desc: &FrameDesc) -> Result<Frame> {
         let ctx = self.ctx;
-        let view = self.view_desc_in(desc.depth, desc.infinite_far);
-        self.frame_uniforms
-            .write(bytemuck::bytes_of(&self.uniforms(&view)?));
+        let view = self.frame_view(desc)?;
         self.alpha_lighting()?;
         let deferred = match desc.shading {
             Shading::Forward => None,

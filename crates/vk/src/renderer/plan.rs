@@ -4,7 +4,7 @@
 use super::Renderer;
 use crate::error::Result;
 use crate::gpu_types::FrameUniforms;
-use crate::technique::Technique;
+use crate::technique::{FrameDesc, Technique};
 use histencil_model::{
     plan_frame, DepthConvention, FarPlane, FramePlan, LightShape, Perspective, PlanError,
     PlanInputs, View, ViewDesc,
@@ -60,6 +60,16 @@ impl Renderer<'_> {
             depth,
         }
         .desc()
+    }
+
+    /// The view of the frame `desc` (its depth convention and far plane), written into the
+    /// frame uniforms that the mesh passes, the alpha pass and the simulator's captured light
+    /// volumes project with.
+    pub(super) fn frame_view(&mut self, desc: &FrameDesc) -> Result<ViewDesc> {
+        let view = self.view_desc_in(desc.depth, desc.infinite_far);
+        self.frame_uniforms
+            .write(bytemuck::bytes_of(&self.uniforms(&view)?));
+        Ok(view)
     }
 
     /// The mesh and alpha passes' uniforms for `view`: the camera's own (the forward reference's

@@ -33,9 +33,7 @@ impl Renderer<'_> {
         };
         let ctx = self.ctx;
         // The G-buffer pass and the captured volumes project with the frame's own view.
-        let view = self.view_desc_in(desc.depth, desc.infinite_far);
-        self.frame_uniforms
-            .write(bytemuck::bytes_of(&self.uniforms(&view)?));
+        let view = self.frame_view(desc)?;
         let plan = self.plan_in(technique, &view)?;
         let layout = self.lighting.pipeline_layout();
         let mut capture = FootprintCapture::new(ctx, layout, self.extent)?;
