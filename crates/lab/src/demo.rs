@@ -108,10 +108,7 @@ pub fn run_demo(
     let mut rows = Vec::new();
     for (label, shading) in configurations() {
         step(label);
-        let pass = match shading {
-            Shading::Forward => "forward",
-            Shading::Deferred(_) => "lighting",
-        };
+        let pass = shading.lighting_pass();
         let desc = FrameDesc {
             preserved_pattern: DEMO_PATTERN,
             ..FrameDesc::new(shading, all)

@@ -165,16 +165,11 @@ pub fn run_scale(
     let mut samples = vec![(Vec::new(), Vec::new(), Vec::new()); techniques.len()];
     for round in 0..rounds {
         step(&format!("round {} of {rounds}", round + 1));
-        for ((_, technique), s) in techniques.iter().zip(&mut samples) {
-            let t = renderer.render_frame(&FrameDesc::from(*technique))?.timings;
+        for (&(_, shading), s) in techniques.iter().zip(&mut samples) {
+            let t = renderer.render_frame(&FrameDesc::from(shading))?.timings;
             let pass = |name| t.pass_ms(name).unwrap_or(0.0);
-            let lighting = if *technique == Shading::Forward {
-                pass("forward")
-            } else {
-                pass("lighting")
-            };
             s.0.push(pass("gbuffer"));
-            s.1.push(lighting);
+            s.1.push(pass(shading.lighting_pass()));
             s.2.push(t.total_ms());
         }
     }

@@ -67,6 +67,15 @@ impl Shading {
             Shading::Deferred(technique) => Some(technique),
         }
     }
+
+    /// The timed pass that lights the frame ([`crate::FrameTimings::pass_ms`]): `forward`, or
+    /// `lighting` after the G-buffer.
+    pub fn lighting_pass(self) -> &'static str {
+        match self {
+            Shading::Forward => "forward",
+            Shading::Deferred(_) => "lighting",
+        }
+    }
 }
 
 /// How a deferred frame's G-buffer is lit.

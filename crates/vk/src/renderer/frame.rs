@@ -101,7 +101,8 @@ impl Renderer<'_> {
         self.mesh_passes
             .record_forward(ctx, cmd, &inputs, &mut targets);
         self.targets.lit(&targets);
-        self.timestamps.mark(ctx, cmd, "forward");
+        self.timestamps
+            .mark(ctx, cmd, Shading::Forward.lighting_pass());
     }
 
     /// The deferred frame's passes: the G-buffer, emission into the HDR target, and the
@@ -140,7 +141,7 @@ impl Renderer<'_> {
         // renderer tracks; it waits for every frame, so slot 0 is free.
         unsafe { self.lighting.record(cmd, &frame, &mut targets)? };
         self.targets.lit(&targets);
-        self.timestamps.mark(ctx, cmd, "lighting");
+        self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
         Ok(())
     }
 
