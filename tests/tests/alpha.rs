@@ -6,7 +6,8 @@ use histencil_brdf::Brdf;
 use histencil_scene::{glass_sphere, Light, ParticleLayout, Scene};
 use histencil_tests::{output_dir, with_validated_context};
 use histencil_vk::{
-    masked_error, AlphaMode, Context, FrameDesc, Readback, Renderer, Shading, Technique,
+    masked_error, AlphaMode, Context, FrameDesc, Readback, Renderer, RendererDesc, Shading,
+    Technique,
 };
 use image::RgbaImage;
 
@@ -15,10 +16,11 @@ const SIZE: u32 = 192;
 /// One frame of `scene` lit by the forward reference, its alpha entities as `mode` says with
 /// lightmaps of `side` texels (`None`: from coverage).
 fn frame(ctx: &Context, scene: &Scene, mode: AlphaMode, side: Option<u32>) -> RgbaImage {
-    let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-    renderer
-        .set_lightmap_resolution(side)
-        .expect("lightmap side");
+    let desc = RendererDesc {
+        lightmap_side: side,
+        ..RendererDesc::new(SIZE, SIZE)
+    };
+    let mut renderer = Renderer::with_desc(ctx, scene.clone(), &desc).expect("renderer");
     let readback = Readback {
         ldr: true,
         ..Readback::NONE
@@ -283,10 +285,21 @@ fn lightmap_frames_are_deterministic_and_deferred_matches_forward_behind_them() 
 fn bad_lightmap_resolutions_are_clear_errors() {
     with_validated_context(|ctx| {
         let scene = histencil_scene::embedded("alpha").unwrap();
-        let mut renderer = Renderer::new(ctx, scene, 64, 64).unwrap();
+        let held = ctx.memory_in_use();
         for side in [0, 1, 4097] {
-            let err = renderer.set_lightmap_resolution(Some(side)).unwrap_err();
+            let desc = RendererDesc {
+                lightmap_side: Some(side),
+                ..RendererDesc::new(64, 64)
+            };
+            let Err(err) = Renderer::with_desc(ctx, scene.clone(), &desc) else {
+                panic!("a renderer with {side}-texel lightmaps");
+            };
             assert!(err.to_string().contains("lightmap resolution"), "{err}");
+            assert_eq!(
+                ctx.memory_in_use(),
+                held,
+                "refused before anything was made"
+            );
         }
     });
 }

@@ -7,7 +7,7 @@
 use histencil_lab::stats::Sampling;
 use histencil_lab::{calibrate, read_costs, run_compare, run_sweep, CompareSettings, SweepParam};
 use histencil_tests::{output_dir, with_validated_context};
-use histencil_vk::{Backend, Renderer};
+use histencil_vk::{Backend, Renderer, RendererDesc};
 use serde_json::Value;
 use std::path::Path;
 
@@ -199,10 +199,14 @@ fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
     assert_eq!(read, c);
     with_validated_context(|ctx| {
         let scene = histencil_scene::embedded("brdfs-3").unwrap();
-        let mut renderer = Renderer::new(ctx, scene, 32, 32).unwrap();
-        assert_ne!(renderer.cost_model(Backend::Native), read);
-        renderer.set_cost_model(Some(read));
-        assert_eq!(renderer.cost_model(Backend::Native), read);
+        let talks = Renderer::new(ctx, scene.clone(), 32, 32).unwrap();
+        assert_ne!(talks.cost_model(Backend::Native), read);
+        let desc = RendererDesc {
+            cost_model: Some(read),
+            ..RendererDesc::new(32, 32)
+        };
+        let calibrated = Renderer::with_desc(ctx, scene, &desc).unwrap();
+        assert_eq!(calibrated.cost_model(Backend::Native), read);
     });
 }
 

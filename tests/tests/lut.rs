@@ -8,7 +8,8 @@ use histencil_brdf::{Brdf, BrdfId, V3};
 use histencil_scene::{Light, LightKind, Scene};
 use histencil_tests::{diff, with_validated_context};
 use histencil_vk::{
-    Backend, Error, FlushPolicy, LutEvaluator, LutTables, Readback, Renderer, Shading, Technique,
+    Backend, Error, FlushPolicy, LutEvaluator, LutTables, Readback, Renderer, RendererDesc,
+    Shading, Technique,
 };
 use image::Rgba32FImage;
 
@@ -184,6 +185,13 @@ fn frame_error_stays_within_the_tables_and_falls_with_resolution() {
             stencil: false,
             brdf_ids: true,
         };
+        let at = |lut_resolution| {
+            let desc = RendererDesc {
+                lut_resolution,
+                ..RendererDesc::new(SIZE, SIZE)
+            };
+            Renderer::with_desc(ctx, scene.clone(), &desc).expect("renderer")
+        };
         let forward = renderer.render(Shading::Forward, readback).unwrap();
         let deferred = renderer.render(Technique::DEFERRED, readback).unwrap();
         let ids = deferred.images.brdf_ids.unwrap();
@@ -191,7 +199,7 @@ fn frame_error_stays_within_the_tables_and_falls_with_resolution() {
         let forward_ldr = forward.images.ldr.unwrap();
         let mut means = Vec::new();
         for resolution in [4, 8, 16, 32, 64] {
-            renderer.set_lut_resolution(resolution).unwrap();
+            let mut renderer = at(resolution);
             let frame = renderer.render(LUT, readback).unwrap();
             let bounds = per_model_bounds(&scene, renderer.lut_tables().unwrap().luts());
             let (ratio, mean) = against_prediction(
@@ -225,8 +233,11 @@ fn lut_equals_forward_where_tables_are_exact() {
     // Lambert-only room is the branching frame up to rounding.
     let scene = histencil_scene::embedded("brdfs-1").unwrap();
     with_validated_context(|ctx| {
-        let mut renderer = Renderer::new(ctx, scene, 96, 96).expect("renderer");
-        renderer.set_lut_resolution(2).unwrap();
+        let desc = RendererDesc {
+            lut_resolution: 2,
+            ..RendererDesc::new(96, 96)
+        };
+        let mut renderer = Renderer::with_desc(ctx, scene, &desc).expect("renderer");
         let branching = renderer.render(Technique::DEFERRED, Readback::ALL).unwrap();
         let lut = renderer.render(LUT, Readback::ALL).unwrap();
         let d = diff(
@@ -241,13 +252,25 @@ fn lut_equals_forward_where_tables_are_exact() {
 fn bad_resolutions_are_clear_errors() {
     let scene = histencil_scene::embedded("brdfs-1").unwrap();
     with_validated_context(|ctx| {
-        let mut renderer = Renderer::new(ctx, scene, 32, 32).expect("renderer");
+        let held = ctx.memory_in_use();
         for bad in [0, 1, 513] {
-            let e = renderer.set_lut_resolution(bad).unwrap_err();
+            let desc = RendererDesc {
+                lut_resolution: bad,
+                ..RendererDesc::new(32, 32)
+            };
+            let Err(e) = Renderer::with_desc(ctx, scene.clone(), &desc) else {
+                panic!("a renderer with {bad}-point tables");
+            };
             assert!(matches!(e, Error::Lut(_)), "{e}");
             assert!(e.to_string().contains(&bad.to_string()), "{e}");
+            // Refused before anything was made.
+            assert_eq!(ctx.memory_in_use(), held);
         }
-        // The renderer still works at its previous resolution.
+        let desc = RendererDesc {
+            lut_resolution: 8,
+            ..RendererDesc::new(32, 32)
+        };
+        let mut renderer = Renderer::with_desc(ctx, scene, &desc).expect("renderer");
         renderer.render(LUT, Readback::NONE).expect("frame");
     });
 }

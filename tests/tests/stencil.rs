@@ -6,7 +6,7 @@
 
 use histencil_model::StencilBits;
 use histencil_tests::with_validated_context;
-use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Technique};
+use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, RendererDesc, Technique};
 
 const SIZE: u32 = 128;
 const PATTERN: u8 = 0xA0;
@@ -152,9 +152,12 @@ fn engine_bit_positions_light_the_same_image_and_keep_the_engines_bits() {
         let scene = histencil_scene::embedded(name).unwrap();
         with_validated_context(|ctx| {
             let mut talks = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
-            let mut engine =
-                Renderer::with_stencil_bits(ctx, scene.clone(), SIZE, SIZE, Some(bits))
-                    .expect("renderer at the engine's bits");
+            let desc = RendererDesc {
+                stencil_bits: Some(bits),
+                ..RendererDesc::new(SIZE, SIZE)
+            };
+            let mut engine = Renderer::with_desc(ctx, scene.clone(), &desc)
+                .expect("renderer at the engine's bits");
             let layout = *engine.stencil_layout();
             assert_eq!(
                 (layout.culling_mask(), layout.engine_mask()),

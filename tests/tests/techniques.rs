@@ -10,7 +10,9 @@
 //! order. So the sums round identically. The test asserts it.
 
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, CostModel, FlushPolicy, Readback, Renderer, Shading, Technique};
+use histencil_vk::{
+    Backend, CostModel, FlushPolicy, Readback, Renderer, RendererDesc, Shading, Technique,
+};
 
 const SIZE: u32 = 160;
 const TOLERANCE: u8 = 1;
@@ -156,8 +158,14 @@ fn volumes_crossing_near_and_far_planes() {
 fn adaptive_chooses_what_the_cost_model_says() {
     let scene = histencil_scene::embedded("brdfs-3").unwrap();
     with_validated_context(|ctx| {
-        let mut renderer = Renderer::new(ctx, scene, SIZE, SIZE).expect("renderer");
         let (backend, flush) = (Backend::Ps3, FlushPolicy::Auto);
+        let with_costs = |costs| {
+            let desc = RendererDesc {
+                cost_model: Some(costs),
+                ..RendererDesc::new(SIZE, SIZE)
+            };
+            Renderer::with_desc(ctx, scene.clone(), &desc).expect("renderer")
+        };
         let plan = |renderer: &Renderer, technique| renderer.plan(technique).expect("plan");
         let adaptive = Technique::Adaptive { backend, flush };
         let free_stencil = CostModel {
@@ -167,7 +175,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             shade_ms: 1.0,
             interval: None,
         };
-        renderer.set_cost_model(Some(free_stencil));
+        let renderer = with_costs(free_stencil);
         assert_eq!(
             plan(&renderer, adaptive),
             plan(&renderer, Technique::Stencil { backend, flush })
@@ -179,7 +187,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             shade_ms: 1.0,
             interval: None,
         };
-        renderer.set_cost_model(Some(free_branching));
+        let renderer = with_costs(free_branching);
         assert_eq!(
             plan(&renderer, adaptive),
             plan(&renderer, Technique::Branching { backend, flush })

@@ -6,7 +6,8 @@ use histencil_alpha::ParameterKind;
 use histencil_check::matrix::Platform;
 use histencil_scene::{with_default_lights, DefaultLights};
 use histencil_vk::{
-    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique,
+    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, RendererDesc,
+    Shading, Technique,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -313,10 +314,13 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
     }
     on_device(args.validate, |ctx| {
         let shading = args.shading();
-        let mut renderer = Renderer::new(ctx, scene, args.width, args.height)?;
-        renderer.set_cost_model(costs);
-        renderer.set_lut_resolution(args.lut_resolution)?;
-        renderer.set_lightmap_resolution(args.lightmap_resolution)?;
+        let desc = RendererDesc {
+            lut_resolution: args.lut_resolution,
+            lightmap_side: args.lightmap_resolution,
+            cost_model: costs,
+            ..RendererDesc::new(args.width, args.height)
+        };
+        let mut renderer = Renderer::with_desc(ctx, scene, &desc)?;
         let readback = Readback {
             ldr: true,
             hdr: args.hdr.is_some(),

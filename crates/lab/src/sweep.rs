@@ -23,7 +23,7 @@ use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis};
 use crate::{write_file, AlphaReference, LabError, Result};
 use histencil_scene::{ParticleLayout, ParticleSystem, Scene, MAX_SLICES};
-use histencil_vk::{Backend, Context, FlushPolicy, Renderer, Shading, Technique};
+use histencil_vk::{Backend, Context, FlushPolicy, Renderer, RendererDesc, Shading, Technique};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -150,7 +150,11 @@ pub fn run_sweep(
                 flush: FlushPolicy::Auto,
             };
             for (i, &res) in values.iter().enumerate() {
-                renderer.set_lut_resolution(res)?;
+                let desc = RendererDesc {
+                    lut_resolution: res,
+                    ..RendererDesc::new(width, height)
+                };
+                let mut renderer = Renderer::with_desc(ctx, original.clone(), &desc)?;
                 let speed = time_lighting(&mut renderer, lut, frames)?;
                 let error = image_error(&frame(&mut renderer, lut)?, &reference);
                 let bytes = renderer.lut_tables()?.size_bytes();
@@ -167,7 +171,11 @@ pub fn run_sweep(
             let technique = Technique::DEFERRED;
             let reference = AlphaReference::render(ctx, &mut renderer, technique)?;
             for (i, &side) in values.iter().enumerate() {
-                renderer.set_lightmap_resolution(Some(side))?;
+                let desc = RendererDesc {
+                    lightmap_side: Some(side),
+                    ..RendererDesc::new(width, height)
+                };
+                let mut renderer = Renderer::with_desc(ctx, original.clone(), &desc)?;
                 let speed = time_passes(
                     &mut renderer,
                     technique,

@@ -37,7 +37,6 @@ pub mod state;
 mod targets;
 mod teardown;
 mod technique;
-pub use targets::{check_extent, GBUFFER_FORMATS};
 mod timing;
 mod upload;
 
@@ -70,7 +69,8 @@ pub use materials::{
 pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
 pub use passes::light_pipelines::BrdfSource;
 pub use readback::{FrameImages, Readback};
-pub use renderer::{Frame, Renderer, DEFAULT_LUT_RESOLUTION};
+pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
+pub use targets::{check_extent, GBUFFER_FORMATS};
 pub use technique::{Backend, FrameDesc, Shading, Technique};
 pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown, LightmapTimings};

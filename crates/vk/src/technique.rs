@@ -99,7 +99,7 @@ pub enum Technique {
         flush: FlushPolicy,
     },
     /// The talk's third option: one draw per light, as branching, with every BRDF read from its
-    /// material's look-up table ([`crate::Renderer::set_lut_resolution`]) instead of its formula.
+    /// material's look-up table ([`crate::RendererDesc::lut_resolution`]) instead of its formula.
     /// Approximate: its error against forward falls with the table resolution.
     Lut {
         backend: Backend,

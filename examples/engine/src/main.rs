@@ -567,6 +567,10 @@ const TRANSFER_READ: ImageState = ImageState {
     access: vk::AccessFlags2::TRANSFER_READ,
 };
 
+/// Copies the stencil aspect of `image` into `buffer` (one byte per pixel).
+///
+/// # Safety
+/// As [`copy`].
 unsafe fn copy_stencil(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
@@ -576,6 +580,10 @@ unsafe fn copy_stencil(
     copy(d, cmd, image, vk::ImageAspectFlags::STENCIL, buffer);
 }
 
+/// Copies the colour aspect of `image` into `buffer`.
+///
+/// # Safety
+/// As [`copy`].
 unsafe fn copy_color(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
@@ -585,6 +593,11 @@ unsafe fn copy_color(
     copy(d, cmd, image, vk::ImageAspectFlags::COLOR, buffer);
 }
 
+/// Barriers `image` to a transfer read and copies its `aspect` into `buffer`.
+///
+/// # Safety
+/// `cmd` is recording, outside a render pass, on `d`; `image.state` is true when `cmd` executes;
+/// `buffer` is live, has `TRANSFER_DST` usage and holds the whole aspect.
 unsafe fn copy(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
@@ -607,6 +620,10 @@ unsafe fn copy(
     d.cmd_copy_image_to_buffer(cmd, image.image, TRANSFER_READ.layout, buffer, &[region]);
 }
 
+/// Makes the copies recorded before it visible to the host once `cmd` has finished.
+///
+/// # Safety
+/// `cmd` is recording, outside a render pass, on `d`.
 unsafe fn host_barrier(d: &ash::Device, cmd: vk::CommandBuffer) {
     let b = [vk::MemoryBarrier2::default()
         .src_stage_mask(vk::PipelineStageFlags2::COPY)

@@ -10,7 +10,8 @@ use crate::variants::{light_size_scene, with_brdf_count};
 use crate::Result;
 use histencil_scene::Scene;
 use histencil_vk::{
-    Backend, Context, CostModel, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique,
+    Backend, Context, CostModel, FlushPolicy, FrameDesc, Readback, Renderer, RendererDesc, Shading,
+    Technique,
 };
 
 /// What a comparison run measures.
@@ -346,9 +347,11 @@ pub fn run_compare(
     }
     let (w, h, frames) = (settings.width, settings.height, settings.frames);
     let new_renderer = |scene: Scene| -> Result<Renderer> {
-        let mut r = Renderer::new(ctx, scene, w, h)?;
-        r.set_cost_model(settings.costs);
-        Ok(r)
+        let desc = RendererDesc {
+            cost_model: settings.costs,
+            ..RendererDesc::new(w, h)
+        };
+        Ok(Renderer::with_desc(ctx, scene, &desc)?)
     };
     let rows_spec = table_rows();
     let mut rows: Vec<Row> = rows_spec

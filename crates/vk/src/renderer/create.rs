@@ -2,7 +2,7 @@
 //! every resource created (a failure half way frees what was made), and all of it freed in
 //! order at drop.
 
-use super::{Renderer, DEFAULT_LUT_RESOLUTION};
+use super::{Renderer, RendererDesc};
 use crate::context::Context;
 use crate::deferred_lighting::{DeferredLighting, LightingDesc};
 use crate::descriptors::Descriptors;
@@ -18,8 +18,9 @@ use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FOR
 use crate::teardown::{build, Destroy, Owned};
 use crate::timing::Timestamps;
 use ash::vk;
+use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
-use histencil_model::{StencilBits, StencilLayout};
+use histencil_model::StencilLayout;
 use histencil_scene::Scene;
 
 /// The distinct BRDF materials of `scene` in first-use order (the LUT technique's tables) and
@@ -54,33 +55,35 @@ fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
 
 impl<'c> Renderer<'c> {
     /// Validates the scene and the resolution, then builds everything a frame needs, with the
-    /// talk's stencil layout (culling bit 0, BRDF bits above it).
+    /// defaults of [`RendererDesc::new`].
     pub fn new(ctx: &'c Context, scene: Scene, width: u32, height: u32) -> Result<Self> {
-        Self::with_stencil_bits(ctx, scene, width, height, None)
+        Self::with_desc(ctx, scene, &RendererDesc::new(width, height))
     }
 
-    /// As [`Renderer::new`], with the culling bit and the BRDF field where an engine wants them
-    /// (`None`: the talk's layout).
+    /// Validates `desc` and the scene, then builds everything a frame needs.
     ///
     /// # Errors
-    /// [`crate::Error::Layout`] when the scene's BRDFs do not fit at those positions, besides the
-    /// errors of [`Renderer::new`].
-    pub fn with_stencil_bits(
-        ctx: &'c Context,
-        mut scene: Scene,
-        width: u32,
-        height: u32,
-        bits: Option<StencilBits>,
-    ) -> Result<Self> {
+    /// Before anything is made: [`crate::Error::BadResolution`] for a size the device cannot
+    /// render, [`crate::Error::Lut`] for a table resolution outside
+    /// `2..=`[`Lut::MAX_RESOLUTION`], [`crate::Error::Lightmap`] for a lightmap side outside
+    /// `2..=`[`histencil_alpha::MAX_FORCED_SIDE`], the scene's own errors, and
+    /// [`crate::Error::Layout`] when its BRDFs do not fit the stencil bits. Then any error of
+    /// making the resources, after freeing what was made.
+    pub fn with_desc(ctx: &'c Context, mut scene: Scene, desc: &RendererDesc) -> Result<Self> {
+        let (width, height) = (desc.width, desc.height);
         // The resolution first: a scene built for a zero-sized view (a lab wall) would otherwise
         // take the blame for it.
         let extent = check_extent(ctx, width, height)?;
+        Lut::check_resolution(desc.lut_resolution)?;
+        if let Some(side) = desc.lightmap_side {
+            histencil_alpha::check_forced_side(side)?;
+        }
         scene.validate()?;
         crate::materials::check_images(ctx, &scene)?;
         scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
         let brdf_count = brdfs.len().max(1) as u32;
-        let stencil_layout = match bits {
+        let stencil_layout = match desc.stencil_bits {
             None => StencilLayout::new(brdf_count, 0)?,
             Some(bits) => StencilLayout::with_positions(brdf_count, bits)?,
         };
@@ -162,12 +165,12 @@ impl<'c> Renderer<'c> {
             object_slots,
             materials,
             object_materials,
-            lut_resolution: DEFAULT_LUT_RESOLUTION,
+            lut_resolution: desc.lut_resolution,
             lut_tables: None,
-            lightmap_side: None,
+            lightmap_side: desc.lightmap_side,
             alpha: None,
             lighting,
-            cost_model: None,
+            cost_model: desc.cost_model,
             extent,
             targets: targets.keep(),
             meshes: meshes.keep(),

@@ -1,5 +1,5 @@
 //! The renderer: owns a scene's GPU resources and records / submits whole frames. This file
-//! holds what it owns and how it is configured; `create.rs` how it is made and freed,
+//! holds what it owns and what it is built with (`RendererDesc`); `create.rs` how it is made and freed,
 //! `plan.rs` how a frame is planned, `frame.rs` the order of a frame's passes, `simulator.rs`
 //! what the CPU simulator is given.
 
@@ -24,12 +24,11 @@ use crate::targets::Targets;
 use crate::technique::Backend;
 use crate::timing::{FrameTimings, Timestamps};
 use ash::vk;
-use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
-use histencil_model::{CostModel, StencilLayout, TalkFigures, TileStats};
+use histencil_model::{CostModel, StencilBits, StencilLayout, TalkFigures, TileStats};
 use histencil_scene::Scene;
 
-/// The LUT technique's table resolution until [`Renderer::set_lut_resolution`] says otherwise:
+/// The LUT technique's table resolution unless [`RendererDesc::lut_resolution`] says otherwise:
 /// the `brdf-report` tables put the broad lobes within about 1e-3 of their formula at 32
 /// points per axis (the sharp ones need more, see the README), at 384 KiB per 3D table.
 pub const DEFAULT_LUT_RESOLUTION: u32 = 32;
@@ -48,6 +47,48 @@ pub struct Frame {
     pub tile_stats: Option<TileStats>,
 }
 
+/// What a [`Renderer`] is built with: its resolution, where its stencil bits sit, and what it
+/// bakes (LUT tables, lightmap sizes) or chooses with (the adaptive technique's costs).
+///
+/// These are fixed for a renderer's life, as an engine's pipelines and tables are: a frame
+/// never depends on a setting some earlier caller left behind, and a comparison of two
+/// settings is two renderers (making one costs the scene's uploads). What changes per frame is
+/// in [`crate::FrameDesc`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RendererDesc {
+    pub width: u32,
+    pub height: u32,
+    /// The culling bit and the BRDF field where an engine wants them; `None`: the talk's
+    /// layout (culling bit 0, BRDF bits above it).
+    pub stencil_bits: Option<StencilBits>,
+    /// The LUT technique's table resolution (grid points per axis,
+    /// `2..=`[`histencil_brdf::lut::Lut::MAX_RESOLUTION`]).
+    pub lut_resolution: u32,
+    /// Every alpha entity's lightmap side in texels (a ribbon's texels along it; dust keeps
+    /// one texel per mote), `2..=`[`histencil_alpha::MAX_FORCED_SIDE`]; `None`: each sized
+    /// from its screen coverage (`histencil_alpha::side_for_coverage`).
+    pub lightmap_side: Option<u32>,
+    /// The costs [`crate::Technique::Adaptive`] chooses with, e.g. calibrated on this device.
+    /// `None`: the talk's measurements fitted by [`CostModel::from_talk`] (360 figures for the
+    /// 360-like backend, PS3 figures otherwise) with an assumed 5 us per extra draw.
+    pub cost_model: Option<CostModel>,
+}
+
+impl RendererDesc {
+    /// `width` x `height` with the talk's stencil layout, [`DEFAULT_LUT_RESOLUTION`], lightmaps
+    /// sized from coverage and the talk's costs.
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            stencil_bits: None,
+            lut_resolution: DEFAULT_LUT_RESOLUTION,
+            lightmap_side: None,
+            cost_model: None,
+        }
+    }
+}
+
 /// A scene ready to render at one resolution.
 pub struct Renderer<'c> {
     ctx: &'c Context,
@@ -61,12 +102,11 @@ pub struct Renderer<'c> {
     materials: Vec<Brdf>,
     object_materials: Vec<u32>,
     lut_resolution: u32,
-    /// Baked when the LUT technique first renders at `lut_resolution`.
+    /// Baked when the LUT technique first renders.
     lut_tables: Option<LutTables>,
     /// Lightmap region side for every entity; `None`: from screen coverage.
     lightmap_side: Option<u32>,
-    /// Created at the first frame of a scene with alpha entities (and again when the lightmap
-    /// resolution changes).
+    /// Created at the first frame of a scene with alpha entities.
     alpha: Option<AlphaLighting<'c>>,
     /// The lighting passes, as an engine records them, into this renderer's targets.
     lighting: DeferredLighting<'c>,
@@ -121,13 +161,6 @@ impl<'c> Renderer<'c> {
             .collect()
     }
 
-    /// The costs [`crate::Technique::Adaptive`] chooses with, e.g. calibrated on this device. Without
-    /// them it uses the talk's measurements fitted by [`CostModel::from_talk`] (360 figures for
-    /// the 360-like backend, PS3 figures otherwise) with an assumed 5 us per extra draw.
-    pub fn set_cost_model(&mut self, costs: Option<CostModel>) {
-        self.cost_model = costs;
-    }
-
     /// The costs the adaptive technique uses with `backend`.
     pub fn cost_model(&self, backend: Backend) -> CostModel {
         self.cost_model.unwrap_or_else(|| {
@@ -139,22 +172,7 @@ impl<'c> Renderer<'c> {
         })
     }
 
-    /// Sets the LUT technique's table resolution (grid points per axis); the tables are baked
-    /// again on the next LUT frame.
-    ///
-    /// # Errors
-    /// [`crate::Error::Lut`] outside `2..=`[`Lut::MAX_RESOLUTION`].
-    pub fn set_lut_resolution(&mut self, resolution: u32) -> Result<()> {
-        Lut::check_resolution(resolution)?;
-        if resolution != self.lut_resolution {
-            if let Some(mut old) = self.lut_tables.take() {
-                old.destroy(self.ctx);
-            }
-            self.lut_resolution = resolution;
-        }
-        Ok(())
-    }
-
+    /// The LUT technique's table resolution ([`RendererDesc::lut_resolution`]).
     pub fn lut_resolution(&self) -> u32 {
         self.lut_resolution
     }
@@ -193,26 +211,6 @@ impl<'c> Renderer<'c> {
             self.lut_tables = Some(tables);
         }
         Ok(self.lut_tables.as_ref().expect("baked above"))
-    }
-
-    /// Gives every alpha entity's lightmap `side` texels a side (a ribbon `side` texels along
-    /// it; dust keeps one texel per mote); `None` sizes them from screen coverage
-    /// (`histencil_alpha::side_for_coverage`). The atlas is laid out again on the next frame.
-    ///
-    /// # Errors
-    /// [`crate::Error::Lightmap`] for a side outside 2..=[`histencil_alpha::MAX_FORCED_SIDE`]
-    /// (the renderer keeps its setting).
-    pub fn set_lightmap_resolution(&mut self, side: Option<u32>) -> Result<()> {
-        if let Some(s) = side {
-            histencil_alpha::check_forced_side(s)?;
-        }
-        if side != self.lightmap_side {
-            if let Some(mut old) = self.alpha.take() {
-                old.destroy(self.ctx);
-            }
-            self.lightmap_side = side;
-        }
-        Ok(())
     }
 
     /// The alpha entities' lightmap layout (atlas size, each entity's region), planned on first
