@@ -495,6 +495,8 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             d.queue_wait_idle(queue).unwrap();
             d.destroy_command_pool(pool, None);
         }
+        // No emulation, no counters: no statistics rather than zeros.
+        assert_eq!(native_only.tile_stats(frame.plan), None);
         drop(native_only);
         drop(lighting);
         drop(renderer);
@@ -575,7 +577,7 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
             d.destroy_command_pool(pool, None);
         }
         let ours = hdr_floats(readback.bytes());
-        let stats = lighting.tile_stats(&plan);
+        let stats = lighting.tile_stats(&plan).expect("made with hi-stencil");
 
         let expected = renderer
             .render_frame(&histencil_vk::FrameDesc {

@@ -553,17 +553,21 @@ impl DeferredLighting<'_> {
     /// The hi-stencil statistics of the last frame recorded with
     /// [`LightingFrame::tile_stats`], read once the GPU has finished it; `flushes` from that
     /// frame's `plan`. One set of counters for all slots: a caller counts a frame, waits for it,
-    /// then reads, before the next counting frame.
-    pub fn tile_stats(&self, plan: &FramePlan) -> TileStats {
-        let hi = self.hi_stencil.as_ref().expect("made with the lighting");
-        TileStats {
+    /// then reads, before the next counting frame. `None` for a lighting made without
+    /// [`LightingDesc::hi_stencil`], which has no counters (and refuses counting frames).
+    pub fn tile_stats(&self, plan: &FramePlan) -> Option<TileStats> {
+        if !self.desc.hi_stencil {
+            return None;
+        }
+        let hi = self.hi_stencil.as_ref()?;
+        Some(TileStats {
             flushes: plan
                 .steps
                 .iter()
                 .filter(|s| matches!(s, Step::FlushHiStencil))
                 .count() as u64,
             ..hi.read_stats()
-        }
+        })
     }
 
     /// Points the LUT technique at `tables` (one per material, in the order of the G-buffer's

@@ -83,7 +83,7 @@ impl Renderer<'_> {
         }
         let images = self.readback.read(readback)?;
         let tile_stats = match &deferred {
-            Some((_, plan)) if desc.tile_stats => Some(self.lighting.tile_stats(plan)),
+            Some((_, plan)) if desc.tile_stats => self.lighting.tile_stats(plan),
             _ => None,
         };
         Ok(Frame {
