@@ -102,6 +102,36 @@ pub struct SweepReport {
     pub points: Vec<SweepPoint>,
 }
 
+/// Every value of `values` in `param`'s range, so that a sweep refuses a bad value before it
+/// renders anything rather than after the good ones before it.
+///
+/// # Errors
+/// [`LabError::Settings`] (slices, tile sizes) or the renderer's own error (LUT resolution,
+/// lightmap side) naming the first value out of range.
+pub fn check_values(param: SweepParam, values: &[u32], width: u32, height: u32) -> Result<()> {
+    for &value in values {
+        match param {
+            SweepParam::LutRes => histencil_brdf::lut::Lut::check_resolution(value)
+                .map_err(histencil_vk::Error::from)?,
+            SweepParam::LightmapRes => {
+                histencil_alpha::check_forced_side(value).map_err(histencil_vk::Error::from)?
+            }
+            SweepParam::Slices if !(1..=MAX_SLICES).contains(&value) => {
+                return Err(LabError::Settings(format!(
+                    "{value} slices: a system has 1 (a billboard) to {MAX_SLICES}"
+                )))
+            }
+            SweepParam::TileSize if value == 0 || value > width.max(height) => {
+                return Err(LabError::Settings(format!(
+                    "tile size {value} must be between 1 and the frame's larger side"
+                )))
+            }
+            SweepParam::Slices | SweepParam::TileSize => {}
+        }
+    }
+    Ok(())
+}
+
 /// Measures `scene` at every value; `progress(done, total)` after each.
 #[allow(clippy::too_many_arguments)]
 pub fn run_sweep(
@@ -130,14 +160,7 @@ pub fn run_sweep(
             scene.name
         )));
     }
-    if let Some(bad) = values
-        .iter()
-        .find(|&&n| param == SweepParam::Slices && !(1..=MAX_SLICES).contains(&n))
-    {
-        return Err(LabError::Settings(format!(
-            "{bad} slices: a system has 1 (a billboard) to {MAX_SLICES}"
-        )));
-    }
+    check_values(param, values, width, height)?;
     let name = scene.name.clone();
     let original = scene.clone();
     let mut renderer = Renderer::new(ctx, scene, width, height)?;
@@ -221,11 +244,6 @@ pub fn run_sweep(
             };
             let mut inputs = renderer.simulator_inputs(technique)?;
             for (i, &tile) in values.iter().enumerate() {
-                if tile == 0 || tile > width.max(height) {
-                    return Err(LabError::Settings(format!(
-                        "tile size {tile} must be between 1 and the frame's larger side"
-                    )));
-                }
                 inputs.tile_size = tile;
                 let stats = inputs.predict().0.stats;
                 let tested = stats.tiles_tested as f64;
@@ -416,5 +434,35 @@ impl SweepReport {
                          "frames": self.frames, "warm_up_frames": WARM_UP_FRAMES},
             "points": points,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each setting's range, at both ends and past them, and a bad value anywhere in the list
+    /// (not only the first) refuses the whole sweep.
+    #[test]
+    fn values_outside_each_settings_range_are_refused_up_front() {
+        let (w, h) = (160, 90);
+        let cases = [
+            (
+                SweepParam::LutRes,
+                2,
+                histencil_brdf::lut::Lut::MAX_RESOLUTION,
+            ),
+            (SweepParam::LightmapRes, 2, histencil_alpha::MAX_FORCED_SIDE),
+            (SweepParam::Slices, 1, MAX_SLICES),
+            (SweepParam::TileSize, 1, w.max(h)),
+        ];
+        for (param, lo, hi) in cases {
+            check_values(param, &[lo, hi], w, h).unwrap_or_else(|e| panic!("{param:?}: {e}"));
+            for bad in [lo - 1, hi + 1, u32::MAX] {
+                let err = check_values(param, &[lo, hi, bad], w, h)
+                    .expect_err(&format!("{param:?} {bad}"));
+                assert!(err.to_string().contains(&bad.to_string()), "{err}");
+            }
+        }
     }
 }
