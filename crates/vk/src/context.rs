@@ -401,7 +401,13 @@ impl Context {
     /// - `allocator` was created for `device`;
     /// - `debug_utils` is true only if `VK_EXT_debug_utils` is enabled on `instance`;
     /// - while histencil's owned-device tools ([`crate::Renderer`]) submit to `queue` and wait,
-    ///   nothing else uses that queue (Vulkan requires queues to be externally synchronised).
+    ///   nothing else uses that queue (Vulkan requires queues to be externally synchronised);
+    /// - while a [`crate::DeferredLighting`] or [`crate::AlphaLightmaps`] that has recorded, or a
+    ///   [`crate::LutTables`], is dropped, nothing else uses any queue of the device: dropping
+    ///   waits for the device to go idle. Their `unsafe fn destroy` frees without that wait.
+    ///
+    /// The engine-facing parts submit nothing themselves: making, recording and reading them
+    /// never touches a queue.
     pub unsafe fn from_raw(lent: BorrowedDevice) -> Result<Self> {
         let BorrowedDevice {
             instance,

@@ -28,6 +28,7 @@ use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelin
 use crate::passes::lighting::LightingPass;
 use crate::resources::Buffer;
 use crate::targets::GBUFFER_FORMATS;
+use crate::teardown::InFlight;
 use crate::timing::{LightingBreakdown, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -165,6 +166,7 @@ pub struct DeferredLighting<'c> {
     hi_stencil: Option<HiStencilSurface>,
     volumes: Option<LightVolumes>,
     pipelines: LightPipelines,
+    in_flight: InFlight,
 }
 
 /// The stencil reference with which an engine's G-buffer pass writes BRDF slot `slot`, and the
@@ -201,6 +203,7 @@ impl<'c> DeferredLighting<'c> {
             slots: Vec::new(),
             hi_stencil: None,
             volumes: None,
+            in_flight: InFlight::default(),
             pipelines: LightPipelines::new(
                 vk::PipelineLayout::null(),
                 desc.hdr_format,
@@ -537,6 +540,7 @@ impl DeferredLighting<'_> {
             clear_hdr: frame.clear_hdr,
         };
         let timer = slot.timer.active();
+        self.in_flight.mark();
         let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
         pass.record(targets, hi_stencil, timer)
     }
@@ -570,6 +574,17 @@ impl DeferredLighting<'_> {
         })
     }
 
+    /// Frees everything now, without the device-wide wait that dropping does once this has
+    /// recorded (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
+    /// device): an engine that submits from other threads frees through this, once its own
+    /// fences say the GPU is done.
+    ///
+    /// # Safety
+    /// The GPU has finished every command buffer recorded with this lighting.
+    pub unsafe fn destroy(mut self) {
+        self.in_flight.clear();
+    }
+
     /// Points the LUT technique at `tables` (one per material, in the order of the G-buffer's
     /// material indices; [`crate::LutTables::new`]) for the frames recorded with
     /// [`BrdfSource::Table`] after this.
@@ -593,14 +608,13 @@ impl DeferredLighting<'_> {
 }
 
 impl Drop for DeferredLighting<'_> {
-    /// Waits for the device to go idle (teardown only; recording never waits), then frees
+    /// Once this has recorded, waits for the device to go idle (so nothing else may use any
+    /// of its queues meanwhile; [`DeferredLighting::destroy`] does not wait), then frees
     /// everything, also after a creation that failed half way.
     fn drop(&mut self) {
         let ctx = self.ctx;
         let d = &ctx.device;
-        unsafe {
-            let _ = d.device_wait_idle();
-        }
+        self.in_flight.wait(ctx);
         self.pipelines.destroy(ctx);
         for slot in &mut self.slots {
             slot.uniforms.destroy(ctx);

@@ -9,6 +9,7 @@ use crate::descriptors::LUT_EVAL_SET;
 use crate::error::{Error, Result};
 use crate::resources::Buffer;
 use crate::shaders;
+use crate::teardown::InFlight;
 use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, V3};
@@ -25,21 +26,24 @@ struct GpuLutTable {
 }
 
 /// One table per material, baked at one resolution and uploaded.
-pub struct LutTables {
+pub struct LutTables<'c> {
+    ctx: &'c Context,
     luts: Vec<Lut>,
     resolution: u32,
     headers: Buffer,
     values: Buffer,
+    /// From the start: any lighting may bind the tables ([`crate::DeferredLighting::set_lut_tables`]).
+    in_flight: InFlight,
 }
 
-impl LutTables {
+impl<'c> LutTables<'c> {
     /// Bakes a table of `resolution` points per axis for each of `materials` (a material's
     /// index here is its table index) and uploads them.
     ///
     /// # Errors
     /// [`Error::Lut`] for a resolution histencil-brdf refuses, [`Error::LutTooLarge`] when the
     /// values exceed the device's storage-buffer range, and allocation errors.
-    pub fn new(ctx: &Context, materials: &[Brdf], resolution: u32) -> Result<Self> {
+    pub fn new(ctx: &'c Context, materials: &[Brdf], resolution: u32) -> Result<Self> {
         let luts = materials
             .iter()
             .map(|b| Lut::bake(*b, resolution))
@@ -71,11 +75,15 @@ impl LutTables {
                     return Err(e);
                 }
             };
+        let mut in_flight = InFlight::default();
+        in_flight.mark();
         Ok(Self {
+            ctx,
             luts,
             resolution,
             headers,
             values,
+            in_flight,
         })
     }
 
@@ -98,9 +106,26 @@ impl LutTables {
         [self.headers.handle, self.values.handle]
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
-        self.headers.destroy(ctx);
-        self.values.destroy(ctx);
+    /// Frees the tables now, without the device-wide wait that dropping does
+    /// (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the device): an
+    /// engine that submits from other threads frees through this, once its own fences say the
+    /// GPU is done.
+    ///
+    /// # Safety
+    /// The GPU has finished every command buffer recorded with a lighting pointed at these
+    /// tables.
+    pub unsafe fn destroy(mut self) {
+        self.in_flight.clear();
+    }
+}
+
+impl Drop for LutTables<'_> {
+    /// Waits for the device to go idle (so nothing else may use any of its queues meanwhile;
+    /// [`LutTables::destroy`] does not wait), then frees the tables.
+    fn drop(&mut self) {
+        self.in_flight.wait(self.ctx);
+        self.headers.destroy(self.ctx);
+        self.values.destroy(self.ctx);
     }
 }
 

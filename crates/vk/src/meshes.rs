@@ -4,7 +4,7 @@
 use crate::context::Context;
 use crate::error::Result;
 use crate::resources::Buffer;
-use crate::teardown::build;
+use crate::teardown::{build, Owned};
 use crate::upload::{upload, BufferUpload};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -78,6 +78,20 @@ impl GpuMesh {
         })
     }
 
+    /// `mesh` in host-visible memory, written through its mapping: no submission, so no use of
+    /// the queue. A failure half way frees what was made.
+    fn host_visible(ctx: &Context, name: &str, mesh: &Mesh) -> Result<Self> {
+        let (vertices, indices) = mesh_bytes(mesh);
+        build(ctx, |m: &mut Self| {
+            let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+            m.vertices = Buffer::with_data(ctx, &format!("{name}-vertices"), usage, &vertices)?;
+            let usage = vk::BufferUsageFlags::INDEX_BUFFER;
+            m.indices = Buffer::with_data(ctx, &format!("{name}-indices"), usage, &indices)?;
+            m.index_count = mesh.indices.len() as u32;
+            Ok(())
+        })
+    }
+
     /// Binds and draws the whole mesh.
     pub(crate) fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {
         unsafe {
@@ -123,6 +137,10 @@ pub const SPHERE_RINGS: u32 = 12;
 pub const CONE_SIDES: u32 = 24;
 
 /// The light volumes: a sphere circumscribing a point light's range, a cone a spot light's.
+///
+/// They live in host-visible memory, written through its mapping rather than uploaded, so that
+/// making a [`crate::DeferredLighting`] on an engine's device submits nothing to the engine's
+/// queue (a few hundred vertices: what a draw reads of them stays in the GPU's caches).
 pub struct LightVolumes {
     pub sphere: GpuMesh,
     pub cone: GpuMesh,
@@ -132,15 +150,15 @@ impl LightVolumes {
     pub fn new(ctx: &Context) -> Result<Self> {
         let sphere = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
         let cone = light_cone(CONE_SIDES);
-        let named = [
-            ("light-sphere-mesh".to_owned(), &sphere),
-            ("light-cone-mesh".to_owned(), &cone),
-        ];
-        let mut made = GpuMesh::upload_all(ctx, "light-volume-upload", &named)?.into_iter();
-        let mut next = || made.next().expect("two light volumes");
+        // The sphere is freed if the cone fails.
+        let sphere = Owned::new(
+            ctx,
+            GpuMesh::host_visible(ctx, "light-sphere-mesh", &sphere)?,
+        );
+        let cone = GpuMesh::host_visible(ctx, "light-cone-mesh", &cone)?;
         Ok(Self {
-            sphere: next(),
-            cone: next(),
+            sphere: sphere.keep(),
+            cone,
         })
     }
 

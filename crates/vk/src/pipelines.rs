@@ -1,6 +1,7 @@
 //! Graphics pipelines. Everything that changes between the talk's light passes (cull mode, depth
-//! and stencil state) is dynamic state set per draw from a [`crate::state::DrawState`]; pipelines
-//! differ only in shaders, attachments, blending and colour writes.
+//! and stencil state) is dynamic state set per draw from the model's pass state
+//! ([`crate::state::apply`]); pipelines differ only in shaders, attachments, blending and
+//! colour writes.
 
 use crate::context::Context;
 use crate::error::{Result, VkCall};

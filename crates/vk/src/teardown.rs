@@ -1,7 +1,8 @@
 //! How what histencil makes is freed, also when making it fails half way.
 //!
 //! Resources are destroyed explicitly with the context (`destroy`), never by `Drop`, so
-//! teardown order stays in the owner's hands. Two helpers keep a failed creation from leaking
+//! teardown order stays in the owner's hands; only the objects an engine holds (which keep
+//! their context) free theirs on `Drop`, waiting first as [`InFlight`] says. Two helpers keep a failed creation from leaking
 //! what its earlier steps made:
 //! - [`build`] fills a value in place from its empty state, one step at a time, and destroys it
 //!   when a step fails. It works because every `destroy` accepts a value only partly made:
@@ -90,3 +91,35 @@ macro_rules! destroy_by_method {
     };
 }
 pub(crate) use destroy_by_method;
+
+/// Whether an engine-facing object ([`crate::DeferredLighting`], [`crate::AlphaLightmaps`],
+/// [`crate::LutTables`]) may still be in use by the GPU when it is dropped: from its first
+/// recording (tables: from their making, as any lighting may bind them) until its owner frees
+/// it through its `unsafe fn destroy`, which promises the GPU is done.
+///
+/// Dropping an object in use waits for the device to go idle first. Vulkan counts that wait
+/// as a use of every queue of the device, which an engine submitting from other threads cannot
+/// allow; an object never recorded, or freed through `destroy`, does not wait.
+#[derive(Default)]
+pub(crate) struct InFlight(bool);
+
+impl InFlight {
+    pub fn mark(&mut self) {
+        self.0 = true;
+    }
+
+    pub fn clear(&mut self) {
+        self.0 = false;
+    }
+
+    /// Waits for the device to go idle if the object may still be in use.
+    pub fn wait(&self, ctx: &Context) {
+        if self.0 {
+            // SAFETY: a device wait; the queues' external synchronisation is the Drop's
+            // documented condition.
+            unsafe {
+                let _ = ctx.device.device_wait_idle();
+            }
+        }
+    }
+}

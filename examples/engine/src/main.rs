@@ -487,10 +487,13 @@ fn main() {
          histencil's Renderer on the same state: {renderer_ms:.1} ms per frame (it waits for each)"
     );
 
-    drop(lighting);
-    drop(lightmaps);
     unsafe {
-        d.device_wait_idle().unwrap();
+        let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
+        d.wait_for_fences(&fences, true, u64::MAX).unwrap();
+        // The GPU is done with every frame: histencil's parts are freed without the
+        // device-wide wait that dropping them would do.
+        lighting.destroy();
+        lightmaps.destroy();
         for s in slots.drain(..) {
             d.destroy_fence(s.fence, None);
             d.destroy_command_pool(s.pool, None);

@@ -23,6 +23,7 @@ use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::resources::Buffer;
 use crate::shaders;
 use crate::state::{apply, FULLSCREEN};
+use crate::teardown::InFlight;
 use crate::timing::{LightmapTimings, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -131,6 +132,7 @@ pub struct AlphaLightmaps<'c> {
     directional_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
+    in_flight: InFlight,
 }
 
 impl<'c> AlphaLightmaps<'c> {
@@ -165,6 +167,7 @@ impl<'c> AlphaLightmaps<'c> {
             directional_pipeline: vk::Pipeline::null(),
             pool: vk::DescriptorPool::null(),
             slots: Vec::new(),
+            in_flight: InFlight::default(),
         };
         // On an error `this` drops, destroying what exists so far.
         this.create()?;
@@ -285,6 +288,18 @@ impl<'c> AlphaLightmaps<'c> {
             self.slots.push(slot);
         }
         Ok(())
+    }
+
+    /// Frees everything now, without the device-wide wait that dropping does once these have
+    /// recorded (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
+    /// device): an engine that submits from other threads frees through this, once its own
+    /// fences say the GPU is done.
+    ///
+    /// # Safety
+    /// The GPU has finished every command buffer recorded with these lightmaps, and every draw
+    /// of yours that read an [`Self::entity_buffer`].
+    pub unsafe fn destroy(mut self) {
+        self.in_flight.clear();
     }
 
     /// What these lightmaps were made for.
@@ -453,6 +468,7 @@ impl<'c> AlphaLightmaps<'c> {
         direction: Option<&mut ImageRef>,
     ) {
         let ctx = self.ctx;
+        self.in_flight.mark();
         let slot = &mut self.slots[slot as usize];
         // Queries are reset outside rendering, as Vulkan requires.
         let mut timer = slot.timer.active();
@@ -532,14 +548,13 @@ impl<'c> AlphaLightmaps<'c> {
 }
 
 impl Drop for AlphaLightmaps<'_> {
-    /// Waits for the device to go idle (teardown only; recording never waits), then frees
+    /// Once these have recorded, waits for the device to go idle (so nothing else may use any
+    /// of its queues meanwhile; [`AlphaLightmaps::destroy`] does not wait), then frees
     /// everything, also after a creation that failed half way.
     fn drop(&mut self) {
         let ctx = self.ctx;
         let d = &ctx.device;
-        unsafe {
-            let _ = d.device_wait_idle();
-        }
+        self.in_flight.wait(ctx);
         for slot in &mut self.slots {
             slot.uniforms.destroy(ctx);
             slot.lights.destroy(ctx);

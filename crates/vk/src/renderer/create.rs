@@ -244,8 +244,9 @@ impl Drop for Renderer<'_> {
         self.timestamps.destroy(ctx);
         self.readback.destroy(ctx);
         self.tonemap.destroy(ctx);
-        if let Some(t) = self.lut_tables.as_mut() {
-            t.destroy(ctx);
+        if let Some(t) = self.lut_tables.take() {
+            // SAFETY: the device is idle (above).
+            unsafe { t.destroy() };
         }
         if let Some(a) = self.alpha.as_mut() {
             a.destroy(ctx);

@@ -103,7 +103,7 @@ pub struct Renderer<'c> {
     object_materials: Vec<u32>,
     lut_resolution: u32,
     /// Baked when the LUT technique first renders.
-    lut_tables: Option<LutTables>,
+    lut_tables: Option<LutTables<'c>>,
     /// Lightmap region side for every entity; `None`: from screen coverage.
     lightmap_side: Option<u32>,
     /// Created at the first frame of a scene with alpha entities.
@@ -185,7 +185,7 @@ impl<'c> Renderer<'c> {
     /// its BRDF's parameters per texel ([`histencil_scene::Material::parameters_vary`]),
     /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
     /// [`LutTables::new`].
-    pub fn lut_tables(&mut self) -> Result<&LutTables> {
+    pub fn lut_tables(&mut self) -> Result<&LutTables<'c>> {
         if self.lut_tables.is_none() {
             if let Some(o) = self
                 .scene
