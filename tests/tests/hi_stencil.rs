@@ -116,7 +116,8 @@ fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
 /// The GPU frame does what the CPU simulator predicts from the GPU's own inputs (G-buffer depth
 /// and stencil, rasterised light footprints, the plan): the same stencil after lighting, so the
 /// 360-like backend zeroes preserved bits exactly where the model says, and the same tile
-/// statistics, so tiles are marked, flushed and culled exactly as the model says. A forward frame has nothing to simulate and is refused.
+/// statistics, so tiles are marked, flushed and culled exactly as the model says. A forward
+/// frame has nothing to simulate and is refused.
 #[test]
 fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
     let auto = FlushPolicy::Auto;

@@ -168,6 +168,8 @@ pub fn run_sweep(
     match param {
         SweepParam::LutRes => {
             let reference = frame(&mut renderer, Shading::Forward)?;
+            // Each point has a renderer of its own.
+            drop(renderer);
             let lut = Technique::Lut {
                 backend: Backend::Native,
                 flush: FlushPolicy::Auto,
@@ -193,6 +195,7 @@ pub fn run_sweep(
         SweepParam::LightmapRes => {
             let technique = Technique::DEFERRED;
             let reference = AlphaReference::render(ctx, &mut renderer, technique)?;
+            drop(renderer);
             for (i, &side) in values.iter().enumerate() {
                 let desc = RendererDesc {
                     lightmap_side: Some(side),

@@ -1,7 +1,7 @@
 //! The renderer: owns a scene's GPU resources and records / submits whole frames. This file
-//! holds what it owns and what it is built with (`RendererDesc`); `create.rs` how it is made and freed,
-//! `plan.rs` how a frame is planned, `frame.rs` the order of a frame's passes, `simulator.rs`
-//! what the CPU simulator is given.
+//! holds what it owns and what it is built with (`RendererDesc`); `create.rs` how it is made
+//! and freed, `plan.rs` how a frame is planned, `frame.rs` the order of a frame's passes,
+//! `simulator.rs` what the CPU simulator is given.
 
 mod create;
 mod frame;
@@ -101,17 +101,14 @@ pub struct Renderer<'c> {
     /// The distinct BRDF materials (one LUT table each) and each object's index among them.
     materials: Vec<Brdf>,
     object_materials: Vec<u32>,
-    lut_resolution: u32,
+    /// What it was built with: the LUT resolution, lightmap side and costs are read from here.
+    desc: RendererDesc,
     /// Baked when the LUT technique first renders.
     lut_tables: Option<LutTables<'c>>,
-    /// Lightmap region side for every entity; `None`: from screen coverage.
-    lightmap_side: Option<u32>,
     /// Created at the first frame of a scene with alpha entities.
     alpha: Option<AlphaLighting<'c>>,
     /// The lighting passes, as an engine records them, into this renderer's targets.
     lighting: DeferredLighting<'c>,
-    /// The adaptive technique's costs; `None`: fitted to the talk's figures for the backend.
-    cost_model: Option<CostModel>,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -163,7 +160,7 @@ impl<'c> Renderer<'c> {
 
     /// The costs the adaptive technique uses with `backend`.
     pub fn cost_model(&self, backend: Backend) -> CostModel {
-        self.cost_model.unwrap_or_else(|| {
+        self.desc.cost_model.unwrap_or_else(|| {
             let figures = match backend {
                 Backend::X360 { .. } => TalkFigures::X360,
                 Backend::Ps3 | Backend::Native => TalkFigures::PS3,
@@ -174,7 +171,7 @@ impl<'c> Renderer<'c> {
 
     /// The LUT technique's table resolution ([`RendererDesc::lut_resolution`]).
     pub fn lut_resolution(&self) -> u32 {
-        self.lut_resolution
+        self.desc.lut_resolution
     }
 
     /// The LUT technique's tables at the current resolution, baked and uploaded on first use
@@ -204,7 +201,7 @@ impl<'c> Renderer<'c> {
                     max: MAX_MATERIALS,
                 });
             }
-            let tables = LutTables::new(self.ctx, &self.materials, self.lut_resolution)?;
+            let tables = LutTables::new(self.ctx, &self.materials, self.desc.lut_resolution)?;
             // SAFETY: the renderer keeps the tables until it drops them or bakes new ones, and
             // it waits for every frame it submits.
             unsafe { self.lighting.set_lut_tables(&tables) };
@@ -247,7 +244,7 @@ impl<'c> Renderer<'c> {
                 self.ctx,
                 &self.scene,
                 self.extent,
-                self.lightmap_side,
+                self.desc.lightmap_side,
                 self.descriptors.frame_layout,
             )?);
         }

@@ -11,8 +11,9 @@ use ash::vk;
 use histencil_model::{Footprint, SoftTarget};
 
 impl Renderer<'_> {
-    /// The CPU simulator's inputs for the deferred frame `desc`, captured from the GPU: the G-buffer
-    /// pass's depth and stencil, the plan, and each planned light's footprint as rasterised.
+    /// The CPU simulator's inputs for the deferred frame `desc`, captured from the GPU: the
+    /// G-buffer pass's depth and stencil, the plan, and each planned light's footprint as
+    /// rasterised.
     /// `histencil_model::Simulator` run on them predicts the stencil and the hi-stencil
     /// statistics ([`super::Frame::tile_stats`]) the GPU frame produces.
     ///
