@@ -18,11 +18,15 @@ pub struct Engine {
     pub device: ash::Device,
     pub allocator: Arc<Mutex<Allocator>>,
     pub log: Arc<ValidationLog>,
+    /// Held until the instance is destroyed ([`crate::instance_turn`]); the last field, so it
+    /// is released after everything else.
+    _turn: std::sync::MutexGuard<'static, ()>,
 }
 
 impl Engine {
     /// Creates the instance, messenger, device and allocator.
     pub fn start() -> Self {
+        let turn = crate::instance_turn();
         let entry = unsafe { ash::Entry::load() }.expect("Vulkan loader");
         let log = Arc::new(ValidationLog::default());
         let app = vk::ApplicationInfo::default().api_version(REQUIREMENTS.api_version);
@@ -96,6 +100,7 @@ impl Engine {
             device,
             allocator: Arc::new(Mutex::new(allocator)),
             log,
+            _turn: turn,
         }
     }
 

@@ -8,6 +8,7 @@ use histencil_scene::Scene;
 use histencil_vk::{Context, ContextDesc, Frame, Readback, Renderer, Shading};
 use image::RgbaImage;
 use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// Where failing comparisons write their images.
 pub fn output_dir() -> PathBuf {
@@ -16,9 +17,25 @@ pub fn output_dir() -> PathBuf {
     dir
 }
 
+/// This test process's turn to hold a Vulkan instance with the validation layer: one at a time.
+///
+/// The test harness runs a file's tests on parallel threads, each with its own instance. The
+/// validation layer of Debian 12 (1.3.239) now and then crashed in that case, inside the layer
+/// (a SIGSEGV in `libVkLayer_khronos_validation.so`, once through a null function pointer)
+/// with no message before, in tests that pass alone every time: the layer's own global state
+/// is not safe against instances made and destroyed concurrently (as in Vulkan-Profiles #414).
+/// lavapipe already spreads one frame over every core, so taking turns costs little. A test
+/// that panics gives its turn back (a poisoned lock is still a turn).
+pub fn instance_turn() -> MutexGuard<'static, ()> {
+    static TURN: Mutex<()> = Mutex::new(());
+    TURN.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
 /// Runs `body` with a validated context, then drops the context (the validation layer reports
-/// leaked objects at device destruction) and fails on any validation message.
+/// leaked objects at device destruction) and fails on any validation message. Holds
+/// [`instance_turn`] throughout.
 pub fn with_validated_context<T>(body: impl FnOnce(&Context) -> T) -> T {
+    let _turn = instance_turn();
     let ctx = Context::new(ContextDesc::validated()).expect("a Vulkan 1.3 device with validation");
     let log = ctx.validation_log();
     let result = body(&ctx);

@@ -31,6 +31,7 @@ enum Outcome {
 /// Makes a renderer of `scene` on a context with `budget` and renders every technique; the
 /// memory in use once the renderer is gone, and where it stopped. Any validation message fails.
 fn attempt(scene: &histencil_scene::Scene, budget: Option<u64>) -> (Outcome, u64, u64) {
+    let _turn = histencil_tests::instance_turn();
     let ctx = Context::new(ContextDesc {
         memory_budget: budget,
         ..ContextDesc::validated()
