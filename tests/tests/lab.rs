@@ -274,3 +274,34 @@ fn compare_verdicts_do_not_flip_under_background_load() {
         }
     }
 }
+
+/// The demo's contact sheet shows the talk's failures: each failure frame visibly differs from
+/// its fix (mean over the tile above 5/255), and each fix is within 1/255 of forward. The first
+/// failure once equalled its fix because the demo rendered it without engine bits to mis-test.
+#[test]
+fn the_demo_shows_each_failure_next_to_a_fix_that_matches_forward() {
+    let settings = histencil_lab::DemoSettings {
+        scene: histencil_scene::embedded("default").unwrap(),
+        width: 320,
+        height: 180,
+        frames: 1,
+    };
+    let report =
+        with_validated_context(|ctx| histencil_lab::run_demo(ctx, settings, &mut |_| {}).unwrap());
+    assert_eq!(report.failures.len(), 2);
+    for pair in &report.failures {
+        let ((failure_caption, failure), (fix_caption, fix)) = (&pair.failure, &pair.fix);
+        let shown = histencil_lab::image_error(failure, fix);
+        assert!(
+            shown.mean > 5.0,
+            "`{failure_caption}` differs from `{fix_caption}` by a mean of only {:.2}/255",
+            shown.mean
+        );
+        let fixed = histencil_lab::image_error(fix, &report.forward);
+        assert!(
+            fixed.max <= 1.0,
+            "`{fix_caption}` is {}/255 from forward",
+            fixed.max
+        );
+    }
+}

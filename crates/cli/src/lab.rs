@@ -4,6 +4,7 @@ use crate::on_device;
 use anyhow::{bail, Result};
 use histencil_lab::{CompareSettings, SweepParam};
 use histencil_scene::DefaultLights;
+use histencil_vk::ImageKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
@@ -129,7 +130,7 @@ pub struct DemoArgs {
     scene: String,
     #[command(flatten)]
     run: RunArgs,
-    /// The contact sheet (PNG).
+    /// The contact sheet, in the format its extension names (`.png`, `.jpg` or `.jpeg`).
     #[arg(long, default_value = "out/demo.png")]
     out: PathBuf,
 }
@@ -315,7 +316,7 @@ pub fn scale(args: &ScaleArgs, lights: DefaultLights) -> Result<()> {
 }
 
 pub fn demo(args: &DemoArgs, lights: DefaultLights) -> Result<()> {
-    histencil_vk::check_output_file(&args.out)?;
+    histencil_vk::check_image_output(&args.out, ImageKind::Colour)?;
     let settings = histencil_lab::DemoSettings {
         scene: crate::load_scene_arg(&args.scene, lights)?,
         width: args.run.width,
@@ -327,7 +328,8 @@ pub fn demo(args: &DemoArgs, lights: DefaultLights) -> Result<()> {
             histencil_lab::run_demo(ctx, settings, step)
         })?)
     })?;
-    histencil_vk::save_png(&report.sheet, &args.out)?;
+    let sheet = image::DynamicImage::from(report.sheet.clone());
+    histencil_vk::save_image_as(&sheet, &args.out, ImageKind::Colour)?;
     println!("The talk on `{}`:\n", args.scene);
     print!("{}", report.table());
     println!(

@@ -6,9 +6,10 @@ use histencil_alpha::ParameterKind;
 use histencil_check::matrix::Platform;
 use histencil_scene::{with_default_lights, DefaultLights};
 use histencil_vk::{
-    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, Readback, Renderer, RendererDesc,
-    Shading, Technique,
+    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, ImageKind, Readback, Renderer,
+    RendererDesc, Shading, Technique,
 };
+use image::DynamicImage;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -162,13 +163,15 @@ struct RenderArgs {
     width: u32,
     #[arg(long, default_value_t = 720)]
     height: u32,
-    /// Tonemapped PNG output.
+    /// The tonemapped frame, in the format its extension names: `.png`, or `.jpg` / `.jpeg`
+    /// (lossy, no alpha). Any other extension is refused before rendering.
     #[arg(long, default_value = "out/render.png")]
     out: PathBuf,
-    /// Linear HDR output (OpenEXR).
+    /// The linear HDR frame, as OpenEXR (the name must end in `.exr`).
     #[arg(long)]
     hdr: Option<PathBuf>,
-    /// The raw stencil byte of every pixel after lighting, as an 8-bit grey PNG.
+    /// The raw stencil byte of every pixel after lighting, as an 8-bit grey PNG (`.png` only:
+    /// JPEG would change the values).
     #[arg(long)]
     dump_stencil: Option<PathBuf>,
     /// Frames to time after the written one; the median is printed.
@@ -302,15 +305,15 @@ pub(crate) fn load_scene_arg(spec: &str, lights: DefaultLights) -> Result<histen
 fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
     let scene = load_scene_arg(&args.scene, lights)?;
     let costs = lab::read_costs_arg(args.costs.as_deref())?;
-    for path in [
-        Some(&args.out),
-        args.hdr.as_ref(),
-        args.dump_stencil.as_ref(),
-    ]
-    .into_iter()
-    .flatten()
-    {
-        histencil_vk::check_output_file(path)?;
+    let outputs = [
+        (Some(&args.out), ImageKind::Colour),
+        (args.hdr.as_ref(), ImageKind::Hdr),
+        (args.dump_stencil.as_ref(), ImageKind::Exact),
+    ];
+    for (path, kind) in outputs {
+        if let Some(path) = path {
+            histencil_vk::check_image_output(path, kind)?;
+        }
     }
     on_device(args.validate, |ctx| {
         let shading = args.shading();
@@ -340,15 +343,29 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             let ldr = images.ldr.as_ref().expect("requested");
             print_alpha_error(ctx, &mut renderer, &desc, ldr)?;
         }
-        histencil_vk::save_png(images.ldr.as_ref().expect("requested"), &args.out)?;
-        println!("wrote {}", args.out.display());
-        if let (Some(path), Some(hdr)) = (&args.hdr, &images.hdr) {
-            histencil_vk::save_exr(hdr, path)?;
-            println!("wrote {}", path.display());
-        }
-        if let (Some(path), Some(stencil)) = (&args.dump_stencil, &images.stencil) {
-            histencil_vk::save_png(stencil, path)?;
-            println!("wrote {}", path.display());
+        let ldr = images.ldr.clone().expect("requested");
+        let written = [
+            (
+                Some(&args.out),
+                Some(DynamicImage::from(ldr)),
+                ImageKind::Colour,
+            ),
+            (
+                args.hdr.as_ref(),
+                images.hdr.clone().map(DynamicImage::from),
+                ImageKind::Hdr,
+            ),
+            (
+                args.dump_stencil.as_ref(),
+                images.stencil.clone().map(DynamicImage::from),
+                ImageKind::Exact,
+            ),
+        ];
+        for (path, image, kind) in written {
+            if let (Some(path), Some(image)) = (path, image) {
+                histencil_vk::save_image_as(&image, path, kind)?;
+                println!("wrote {}", path.display());
+            }
         }
         let timed = FrameDesc {
             pass_timing: args.timings,

@@ -90,6 +90,47 @@ fn bad_arguments_are_one_line_errors() {
     );
 }
 
+/// Every image a command writes is in the format its name says: an extension it cannot write is
+/// refused before rendering, naming the path, and nothing is written; JPEG is written as JPEG.
+#[test]
+fn images_are_written_in_the_format_their_name_says_or_refused_before_rendering() {
+    let dir = std::env::temp_dir().join(format!("histencil-cli-formats-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let at = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let small = ["--width", "32", "--height", "24", "--frames", "1"];
+    let refused: [(&[&str], &str); 6] = [
+        (
+            &["render", "--out", &at("x.exr")],
+            "name it .png, .jpg, .jpeg",
+        ),
+        (&["render", "--out", &at("x.tiff")], "`.tiff`"),
+        (&["render", "--out", &at("x")], "has no extension"),
+        (&["render", "--hdr", &at("x.png")], "name it .exr"),
+        (
+            &["render", "--dump-stencil", &at("s.jpg")],
+            "JPEG would change them",
+        ),
+        (
+            &["demo", "--out", &at("sheet.exr")],
+            "name it .png, .jpg, .jpeg",
+        ),
+    ];
+    for (args, needle) in refused {
+        assert_one_line_error(&[args, &small].concat(), needle);
+    }
+    assert!(!dir.exists(), "a refused run created {}", dir.display());
+    let jpeg = at("frame.JPG");
+    let (ok, stdout, stderr) = histencil(&[&["render", "--out", &jpeg][..], &small].concat());
+    assert!(ok, "{stdout}\n{stderr}");
+    let bytes = std::fs::read(&jpeg).unwrap();
+    assert_eq!(
+        image::guess_format(&bytes).unwrap(),
+        image::ImageFormat::Jpeg
+    );
+    assert_eq!(image::load_from_memory(&bytes).unwrap().width(), 32);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn brdf_report_prints_both_tables() {
     let (ok, stdout, stderr) =

@@ -50,6 +50,18 @@ pub struct DemoReport {
     pub rows: Vec<DemoRow>,
     /// The contact sheet (`out/demo.png`).
     pub sheet: RgbImage,
+    /// The forward reference, full size.
+    pub forward: RgbaImage,
+    /// The talk's failures beside their fixes, full size, as the sheet's second row shows them.
+    pub failures: Vec<FailureAndFix>,
+}
+
+/// One of the talk's failures and the frame its fix gives, each with its caption on the sheet.
+/// The failure must be visible (it differs from the fix) and the fix must match forward: the
+/// demo is only a tour of the talk while both hold, so a test holds them.
+pub struct FailureAndFix {
+    pub failure: (String, RgbaImage),
+    pub fix: (String, RgbaImage),
 }
 
 /// A frame's stencil after lighting and which of its pixels hold a surface.
@@ -156,8 +168,18 @@ pub fn run_demo(
         frames.push((ldr, images.stencil.zip(surfaces)));
     }
     step("the talk's failures");
-    let no_zeroing = frame(&mut renderer, stencil(X360_NO_ZEROING, FlushPolicy::Auto))?;
-    let never = frame(&mut renderer, stencil(Backend::Ps3, FlushPolicy::Never))?;
+    // The failures are rendered with the engine's bits that the table's rows carry: without
+    // them the 360-like backend has nothing in the preserved bits to mis-test, and its failure
+    // frame equals its fix.
+    let failure = |renderer: &mut Renderer, technique: Technique| {
+        let desc = FrameDesc {
+            preserved_pattern: DEMO_PATTERN,
+            ..FrameDesc::from(Shading::from(technique))
+        };
+        frame(renderer, desc)
+    };
+    let no_zeroing = failure(&mut renderer, stencil(X360_NO_ZEROING, FlushPolicy::Auto))?;
+    let never = failure(&mut renderer, stencil(Backend::Ps3, FlushPolicy::Never))?;
     // Rows by technique, not by their place in the table.
     let row = |shading: Shading| {
         rows.iter()
@@ -173,7 +195,17 @@ pub fn run_demo(
     let (ps3, ps3_stencil) = frames[ps3_row].clone();
     let (ps3_stencil, surfaces) = ps3_stencil.expect("asked for");
     let max_difference = rows[x360_row].error.map_or(0.0, |e| e.max);
-    let tiles = vec![
+    let failures = vec![
+        FailureAndFix {
+            failure: ("FAIL 360-like without zeroing".to_owned(), no_zeroing),
+            fix: ("fix: zeroing as lights draw".to_owned(), x360.clone()),
+        },
+        FailureAndFix {
+            failure: ("FAIL PS3-like, no hi-stencil flush".to_owned(), never),
+            fix: ("fix: flush before each test".to_owned(), ps3),
+        },
+    ];
+    let mut tiles = vec![
         ("forward (reference)".to_owned(), forward.clone()),
         ("stencil technique, 360-like".to_owned(), x360.clone()),
         (
@@ -184,11 +216,11 @@ pub fn run_demo(
             "PS3-like stencil: G BRDF id, B engine bits, R culling".to_owned(),
             stencil_colours(&ps3_stencil, &layout, &surfaces),
         ),
-        ("FAIL 360-like without zeroing".to_owned(), no_zeroing),
-        ("fix: zeroing as lights draw".to_owned(), x360),
-        ("FAIL PS3-like, no hi-stencil flush".to_owned(), never),
-        ("fix: flush before each test".to_owned(), ps3),
     ];
+    for pair in &failures {
+        tiles.push(pair.failure.clone());
+        tiles.push(pair.fix.clone());
+    }
     Ok(DemoReport {
         device: ctx.device_name().to_owned(),
         width: settings.width,
@@ -196,6 +228,8 @@ pub fn run_demo(
         frames: settings.frames,
         rows,
         sheet: contact_sheet(&halved(tiles), 4),
+        forward,
+        failures,
     })
 }
 

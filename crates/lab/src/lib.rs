@@ -31,7 +31,7 @@ mod variants;
 pub use alpha_reference::AlphaReference;
 pub use calibrate::{calibrate, read_costs, Calibration};
 pub use compare::{run_compare, CompareReport, CompareSettings, MAX_ROUNDS};
-pub use demo::{run_demo, DemoReport, DemoSettings};
+pub use demo::{run_demo, DemoReport, DemoSettings, FailureAndFix};
 pub use image_error::{image_error, ImageError};
 pub use measure::Timing;
 pub use scale::{run_scale, ScaleReport, ScaleSettings};

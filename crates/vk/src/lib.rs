@@ -66,7 +66,10 @@ pub use materials::{
     mip_chain, plan_materials, srgb_to_linear, GpuMaterials, MaterialPlan, MaterialRecord, SetPlan,
     TextureKey,
 };
-pub use output::{check_output_dir, check_output_file, save_exr, save_png, write_atomically};
+pub use output::{
+    check_image_output, check_output_dir, check_output_file, image_format, save_image_as, save_png,
+    write_atomically, ImageKind,
+};
 pub use passes::light_pipelines::BrdfSource;
 pub use readback::{FrameImages, Readback};
 pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
