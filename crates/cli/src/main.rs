@@ -510,20 +510,20 @@ fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
     histencil_vk::check_output_file(&args.out)?;
     let input = std::fs::File::open(&args.cases)
         .with_context(|| format!("cannot read {}", args.cases.display()))?;
-    let (rows, errors) =
-        brdf_eval::parse_cases(input).with_context(|| format!("in {}", args.cases.display()))?;
+    let (rows, errors) = histencil_brdf::eval_csv::parse_cases(input)
+        .with_context(|| format!("in {}", args.cases.display()))?;
     for e in &errors {
         eprintln!("histencil: {}: {e}", args.cases.display());
     }
     let (values, as_f32) = match args.device {
-        Device::Cpu => (brdf_eval::evaluate_cpu(&rows), false),
+        Device::Cpu => (histencil_brdf::eval_csv::evaluate_cpu(&rows), false),
         Device::Gpu => (
             on_device(args.validate, |ctx| brdf_eval::evaluate_gpu(ctx, &rows))?,
             true,
         ),
     };
     let mut out = Vec::new();
-    brdf_eval::write_results(&mut out, &rows, &values, as_f32)?;
+    histencil_brdf::eval_csv::write_results(&mut out, &rows, &values, as_f32)?;
     histencil_vk::write_atomically(&args.out, &out)?;
     println!("wrote {} ({} rows)", args.out.display(), rows.len());
     if !errors.is_empty() {

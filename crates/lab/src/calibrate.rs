@@ -19,6 +19,7 @@ use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::stats::{median_interval, sample, Interval, Sampled, Sampling};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::{LabError, Result};
+use histencil_model::COST_FIELDS;
 use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Renderer, Technique};
 use serde_json::{json, Value};
 use std::path::Path;
@@ -166,22 +167,6 @@ pub fn calibrate(
     })
 }
 
-const FIELDS: [&str; 4] = [
-    "pass_overhead_ms",
-    "stencil_per_brdf_ms",
-    "branch_tax_per_brdf_ms",
-    "shade_ms",
-];
-
-fn fields(c: &CostModel) -> [f64; 4] {
-    [
-        c.pass_overhead_ms,
-        c.stencil_per_brdf_ms,
-        c.branch_tax_per_brdf_ms,
-        c.shade_ms,
-    ]
-}
-
 impl Calibration {
     /// The costs at the top level (what [`read_costs`] reads), then the device, the settings and
     /// the measurements.
@@ -197,11 +182,11 @@ impl Calibration {
             "sampling": {"rounds": self.sampled.rounds, "stopped": self.sampled.stop.word(),
                          "seconds": self.sampled.seconds},
         });
-        for (name, value) in FIELDS.iter().zip(fields(&self.costs)) {
+        for (name, value) in COST_FIELDS.iter().zip(self.costs.fields()) {
             out[*name] = json!(value);
         }
         if let Some(iv) = self.costs.interval {
-            let intervals: serde_json::Map<String, Value> = FIELDS
+            let intervals: serde_json::Map<String, Value> = COST_FIELDS
                 .iter()
                 .zip(iv)
                 .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
@@ -219,55 +204,14 @@ impl Calibration {
     }
 }
 
-/// Reads the costs a calibration wrote (`pass_overhead_ms`, `stencil_per_brdf_ms`,
-/// `branch_tax_per_brdf_ms`, `shade_ms`: finite, non-negative milliseconds).
+/// Reads the costs a calibration wrote ([`CostModel::from_json`]), naming the file in errors.
 pub fn read_costs(path: &Path) -> Result<CostModel> {
     let bad = |problem: String| LabError::Costs {
         path: path.display().to_string(),
         problem,
     };
     let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
-    let value: Value = serde_json::from_str(&text).map_err(|e| bad(format!("not JSON: {e}")))?;
-    let mut v = [0.0; 4];
-    for (out, name) in v.iter_mut().zip(FIELDS) {
-        *out = value
-            .get(name)
-            .and_then(Value::as_f64)
-            .filter(|x| x.is_finite() && *x >= 0.0)
-            .ok_or_else(|| bad(format!("`{name}` must be a finite, non-negative number")))?;
-    }
-    // Intervals are optional (costs written by hand have none); when present each is a
-    // `[lo, hi]` pair around its cost.
-    let interval = match value.get("intervals") {
-        None | Some(Value::Null) => None,
-        Some(iv) => {
-            let mut out = [(0.0, 0.0); 4];
-            for ((slot, name), cost) in out.iter_mut().zip(FIELDS).zip(v) {
-                let pair = iv
-                    .get(name)
-                    .and_then(Value::as_array)
-                    .filter(|p| p.len() == 2)
-                    .and_then(|p| Some((p[0].as_f64()?, p[1].as_f64()?)))
-                    .filter(|(lo, hi)| {
-                        lo.is_finite() && hi.is_finite() && *lo >= 0.0 && lo <= &cost && cost <= *hi
-                    })
-                    .ok_or_else(|| {
-                        bad(format!(
-                            "`intervals.{name}` must be [lo, hi], finite, with lo <= {name} <= hi"
-                        ))
-                    })?;
-                *slot = pair;
-            }
-            Some(out)
-        }
-    };
-    Ok(CostModel {
-        pass_overhead_ms: v[0],
-        stencil_per_brdf_ms: v[1],
-        branch_tax_per_brdf_ms: v[2],
-        shade_ms: v[3],
-        interval,
-    })
+    CostModel::from_json(&text).map_err(|e| bad(e.to_string()))
 }
 
 #[cfg(test)]

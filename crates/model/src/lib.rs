@@ -44,6 +44,7 @@
 
 mod backend;
 mod chooser;
+mod costs_json;
 mod footprint;
 mod frame;
 mod layout;
@@ -57,6 +58,7 @@ mod view;
 
 pub use backend::{Native, PlatformBackend, PlatformCaps, Ps3Like, X360Like};
 pub use chooser::{CostModel, TalkFigures};
+pub use costs_json::{CostsError, COST_FIELDS};
 pub use footprint::{Footprint, Span};
 pub use frame::{
     insert_flushes, write_test_dependencies, FlushPolicy, FramePlan, PlannedLight, Step,

@@ -1,0 +1,5 @@
+//! The `gltf` fuzz target ([`histencil_fuzz::gltf`]).
+
+fn main() {
+    histencil_fuzz::run(histencil_fuzz::gltf);
+}
