@@ -17,6 +17,7 @@
 //! panic: truncated files, missing or short buffers, accessors past their views, unknown BRDFs.
 
 mod buffers;
+mod document;
 mod images;
 mod material;
 pub(crate) mod tangents;
@@ -24,6 +25,7 @@ mod uv_layout;
 
 use buffers::ReadLimit;
 pub use buffers::MAX_IMPORT_BYTES;
+pub use document::SUPPORTED_REQUIRED_EXTENSIONS;
 pub use images::{MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES};
 
 pub use material::{material_from_gltf, MaterialError};
@@ -46,6 +48,13 @@ pub enum ImportError {
     Io { path: String, problem: String },
     #[error("not a valid glTF file: {0}")]
     Parse(String),
+    /// A valid file that needs an extension histencil does not read.
+    #[error(
+        "the file requires the glTF extension `{0}`, which histencil does not support \
+         (supported: {supported})",
+        supported = document::SUPPORTED_REQUIRED_EXTENSIONS.join(", ")
+    )]
+    UnsupportedExtension(String),
     #[error("buffer {index}: {problem}")]
     Buffer { index: usize, problem: String },
     #[error("mesh {index} (`{name}`): {problem}")]
@@ -119,7 +128,7 @@ pub fn import_gltf(
     base_dir: Option<&Path>,
     name: &str,
 ) -> Result<Scene, ImportError> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| ImportError::Parse(e.to_string()))?;
+    let gltf = document::parse(bytes)?;
     let buffers = buffers::load_buffers(&gltf.document, gltf.blob, base_dir)?;
     let mut importer = Importer {
         buffers: &buffers,
