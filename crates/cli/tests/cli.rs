@@ -131,6 +131,41 @@ fn images_are_written_in_the_format_their_name_says_or_refused_before_rendering(
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A scene named by its bare file name is read from the current folder, with its external
+/// buffer and image (the fuzz seed that names them, beside them in a folder of its own).
+#[test]
+fn a_bare_scene_file_name_is_found_in_the_current_folder() {
+    let fuzz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
+    let dir = std::env::temp_dir().join(format!("histencil-bare-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for file in [
+        "assets/tri.bin",
+        "assets/px.png",
+        "corpus/gltf/external.gltf",
+    ] {
+        let from = fuzz.join(file);
+        std::fs::copy(&from, dir.join(from.file_name().unwrap())).unwrap();
+    }
+    let run = Command::new(env!("CARGO_BIN_EXE_histencil"))
+        .current_dir(&dir)
+        .args([
+            "render",
+            "--scene",
+            "external.gltf",
+            "--width",
+            "32",
+            "--height",
+            "24",
+        ])
+        .args(["--frames", "1", "--out", "frame.png"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(dir.join("frame.png").is_file());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn brdf_report_prints_both_tables() {
     let (ok, stdout, stderr) =

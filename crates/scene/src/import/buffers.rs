@@ -100,6 +100,12 @@ pub(super) fn confined_path(dir: &Path, relative: &str) -> Result<PathBuf, Strin
             "`{relative}` is an absolute path; a glTF may only name files inside its own folder"
         ));
     }
+    // A bare file name's folder (`Path::parent` of `scene.gltf` is ``) is the current one.
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
     let root = dir
         .canonicalize()
         .map_err(|e| format!("cannot resolve the glTF's folder {}: {e}", dir.display()))?;
@@ -306,6 +312,15 @@ fn check_elements(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_bare_file_names_folder_is_the_current_one() {
+        // Tests run in the crate's folder.
+        let here = Path::new("Cargo.toml").canonicalize().unwrap();
+        assert_eq!(confined_path(Path::new(""), "Cargo.toml"), Ok(here));
+        let outside = confined_path(Path::new(""), "../../Cargo.toml").unwrap_err();
+        assert!(outside.contains("outside the glTF's folder"), "{outside}");
+    }
 
     #[test]
     fn percent_decoding() {
