@@ -1,0 +1,78 @@
+//! The Khronos sample models in `../shared/gltf-sample-models` (read there, never copied into
+//! the repository), where what a correct import gives can be checked without a picture.
+//! Where the folder is absent the tests say so and check nothing.
+
+use histencil_scene::{import_gltf, Scene};
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+fn models() -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/gltf-sample-models");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("SKIPPED: no sample models at {}", dir.display());
+        None
+    }
+}
+
+/// Imports `model/file` after `edit` changed its JSON.
+fn import_edited(model: &str, file: &str, edit: impl Fn(&mut serde_json::Value)) -> Scene {
+    let dir = models().expect("checked by the caller").join(model);
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join(file)).unwrap()).unwrap();
+    edit(&mut json);
+    import_gltf(&serde_json::to_vec(&json).unwrap(), Some(&dir), model).unwrap()
+}
+
+/// Tangents histencil generates (MikkTSpace) have the handedness of the tangents the model's
+/// exporter wrote: NormalTangentMirrorTest imported with its `TANGENT` attributes and without
+/// them gives, at every vertex both have, the same sign `w` and nearly the same direction.
+#[test]
+fn generated_tangents_have_the_handedness_of_supplied_ones() {
+    if models().is_none() {
+        return;
+    }
+    let model = "NormalTangentMirrorTest";
+    let file = "NormalTangentMirrorTest.gltf";
+    let supplied = import_edited(model, file, |_| {});
+    let generated = import_edited(model, file, |json| {
+        for mesh in json["meshes"].as_array_mut().unwrap() {
+            for primitive in mesh["primitives"].as_array_mut().unwrap() {
+                primitive["attributes"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("TANGENT");
+            }
+        }
+    });
+    assert_eq!(supplied.meshes.len(), generated.meshes.len());
+    let (mut compared, mut flipped, mut worst_cos) = (0, 0, 1.0f32);
+    for (a, b) in supplied.meshes.iter().zip(&generated.meshes) {
+        let key = |v: &histencil_scene::Vertex| {
+            let bits = |x: &[f32]| x.iter().map(|c| c.to_bits()).collect::<Vec<_>>();
+            (bits(&v.position), bits(&v.normal), bits(&v.uv))
+        };
+        let made: HashMap<_, _> = b.vertices.iter().map(|v| (key(v), v.tangent)).collect();
+        for v in &a.vertices {
+            let Some(t) = made.get(&key(v)) else {
+                continue;
+            };
+            compared += 1;
+            if t[3] != v.tangent[3] {
+                flipped += 1;
+            }
+            let cos: f32 = t[..3].iter().zip(&v.tangent[..3]).map(|(x, y)| x * y).sum();
+            worst_cos = worst_cos.min(cos);
+        }
+    }
+    assert!(compared > 1000, "only {compared} vertices matched");
+    assert_eq!(
+        flipped, 0,
+        "{flipped} of {compared} generated tangents flipped"
+    );
+    assert!(
+        worst_cos > 0.9,
+        "a generated tangent is {worst_cos} (cosine) from its supplied one"
+    );
+}
