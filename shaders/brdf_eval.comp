@@ -1,5 +1,6 @@
 #version 460
-// Evaluates BRDF cases with the GLSL spelling, for the comparison against the f64 reference
+// Evaluates BRDF cases with the GLSL spelling, in parts (tinted RGB, white), for the comparison
+// against the f64 reference
 // (histencil brdf-eval --device gpu, and crates/vk/tests/brdf_gpu.rs).
 // Rust mirror of the structs: crates/vk/src/brdf_eval.rs (GpuBrdfCase).
 
@@ -34,5 +35,6 @@ void main() {
         return;
     }
     BrdfCase c = cases[i];
-    results[i] = vec4(brdf_eval(c.model.x, c.params, c.n.xyz, c.t.xyz, c.v.xyz, c.l.xyz), 0.0);
+    BrdfParts parts = brdf_eval_parts(c.model.x, c.params, c.n.xyz, c.t.xyz, c.v.xyz, c.l.xyz);
+    results[i] = vec4(parts.tinted, parts.white);
 }

@@ -48,7 +48,7 @@ vec3 fibre_tangent(vec3 N) {
 // Outgoing radiance towards V for unit light of direction L, by BRDF model `model` with the
 // surface's parameters.
 vec3 evaluate_brdf(Surface s, uint model, vec3 V, vec3 L) {
-    return s.tint * brdf_eval(model, s.params, s.normal, fibre_tangent(s.normal), V, L);
+    return brdf_eval_tinted(model, s.params, s.tint, s.normal, fibre_tangent(s.normal), V, L);
 }
 
 // One light's contribution to one surface point seen from the camera, by BRDF `model` (the

@@ -61,6 +61,10 @@ vec4 material_textured_params(uint model, vec4 p, float roughness, float metalli
     case BRDF_OREN_NAYAR_QUALITATIVE:
         p.y = p.y * r;
         break;
+    case BRDF_GLTF_METAL_ROUGH:
+        p.x = p.x * r * r;
+        p.y = p.y * m;
+        break;
     }
     return p;
 }

@@ -8,8 +8,8 @@ use histencil_brdf::cases::{
 use histencil_tests::with_validated_context;
 use histencil_vk::BrdfEvaluator;
 
-/// Every case evaluated by the GLSL spelling, under validation.
-fn on_gpu(cases: &[Case]) -> Vec<[f64; 3]> {
+/// Every case evaluated by the GLSL spelling, under validation, in parts (tinted RGB, white).
+fn on_gpu(cases: &[Case]) -> Vec<[f64; 4]> {
     let values = with_validated_context(|ctx| {
         let mut evaluator = BrdfEvaluator::new(ctx).expect("BRDF evaluator");
         let input: Vec<_> = cases.iter().map(|c| (c.brdf, c.dirs_f32())).collect();
@@ -17,7 +17,10 @@ fn on_gpu(cases: &[Case]) -> Vec<[f64; 3]> {
         evaluator.destroy(ctx);
         values
     });
-    values.into_iter().map(|v| v.map(f64::from)).collect()
+    values
+        .into_iter()
+        .map(|v| v.channels().map(f64::from))
+        .collect()
 }
 
 #[test]

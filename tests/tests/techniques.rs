@@ -9,6 +9,7 @@
 //! the branching one reads the same id from the G-buffer), and lights are blended in the same
 //! order. So the sums round identically. The test asserts it.
 
+use histencil_brdf::BrdfId;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{
     Backend, CostModel, FlushPolicy, Readback, Renderer, RendererDesc, Shading, Technique,
@@ -61,6 +62,10 @@ fn check(scene_name: &str) {
     let scene = histencil_scene::embedded(scene_name).unwrap();
     with_validated_context(|ctx| {
         let mut renderer = Renderer::new(ctx, scene, SIZE, SIZE).expect("renderer");
+        let tabulable = renderer
+            .brdfs()
+            .iter()
+            .all(|b| *b != BrdfId::GltfMetalRough);
         let forward = renderer
             .render(Shading::Forward, Readback::ALL)
             .expect("forward")
@@ -95,12 +100,28 @@ fn check(scene_name: &str) {
             images.push((label, against_forward(label, technique, TOLERANCE).0));
         }
         // The LUT technique is approximate: its own tolerance, at the default resolution, with
-        // hi-stencil (ps3) and without (native).
-        for (label, backend) in [("lut-native", Backend::Native), ("lut-ps3", Backend::Ps3)] {
-            let flush = FlushPolicy::Auto;
-            let technique = Technique::Lut { backend, flush };
-            let (_, d) = against_forward(label, technique, LUT_TOLERANCE);
+        // hi-stencil (ps3) and without (native). It has no table for glTF's metallic-roughness
+        // BRDF, and says so.
+        let luts =
+            [("lut-native", Backend::Native), ("lut-ps3", Backend::Ps3)].map(|(label, backend)| {
+                (
+                    label,
+                    Technique::Lut {
+                        backend,
+                        flush: FlushPolicy::Auto,
+                    },
+                )
+            });
+        for (label, technique) in luts.iter().filter(|_| tabulable) {
+            let (_, d) = against_forward(label, *technique, LUT_TOLERANCE);
             assert!(d.mean <= LUT_MEAN_TOLERANCE, "{scene_name} {label}: {d:?}");
+        }
+        for (label, technique) in luts.iter().filter(|_| !tabulable) {
+            let refused = renderer.render(*technique, Readback::ALL).err();
+            assert!(
+                matches!(refused, Some(histencil_vk::Error::LutUntabulable { .. })),
+                "{scene_name} {label}: {refused:?}"
+            );
         }
         let (_, branching) = &images[0];
         for (label, image) in &images[1..] {
@@ -140,6 +161,12 @@ fn three_brdfs() {
 #[test]
 fn six_brdfs() {
     check("brdfs-6");
+}
+
+/// glTF's metallic-roughness BRDF beside skin, hair and cloth: the talk's multi-BRDF case.
+#[test]
+fn gltf_metal_rough_beside_the_talks_brdfs() {
+    check("pbr-mixed");
 }
 
 #[test]

@@ -51,6 +51,11 @@ pub fn ordinary_brdfs() -> Vec<Brdf> {
         ks: 0.6,
         p: 30.0,
     });
+    for alpha in [0.05, 0.3, 0.8] {
+        for metallic in [0.0, 0.5, 1.0] {
+            out.push(Brdf::GltfMetalRough { alpha, metallic });
+        }
+    }
     out
 }
 
@@ -83,6 +88,11 @@ pub fn extreme_brdfs() -> Vec<Brdf> {
             rho: 1.0,
             curvature_per_mm,
         });
+    }
+    for alpha in [0.0, 1e-4, 1.0] {
+        for metallic in [0.0, 1.0] {
+            out.push(Brdf::GltfMetalRough { alpha, metallic });
+        }
     }
     out
 }
@@ -237,8 +247,9 @@ pub fn ordinary_error(actual: f64, reference: f64) -> f64 {
 }
 
 /// The worst error of each model over `cases`: `(model, error, label of the case)`. `actual[i]`
-/// is case `i` as evaluated by the spelling under test, against the f64 reference; skin
-/// compares its three channels, scalar models their one value. Prints one line per model,
+/// is case `i` as evaluated by the spelling under test, its [`crate::Parts::channels`] (tinted
+/// RGB, white), against the f64 reference; skin compares its three tinted channels, scalar
+/// models their one, and a model with a white part that too. Prints one line per model,
 /// prefixed by `spelling`, for the report.
 ///
 /// # Panics
@@ -246,14 +257,15 @@ pub fn ordinary_error(actual: f64, reference: f64) -> f64 {
 pub fn worst_per_model(
     spelling: &str,
     cases: &[Case],
-    actual: &[[f64; 3]],
+    actual: &[[f64; 4]],
     error: fn(f64, f64) -> f64,
 ) -> Vec<(&'static str, f64, String)> {
     let mut out: Vec<(&'static str, f64, String)> = vec![];
     for (case, value) in cases.iter().zip(actual) {
-        let reference = case.brdf.reference(case.dirs);
-        let channels = if case.brdf.is_rgb() { 3 } else { 1 };
-        for k in 0..channels {
+        let reference = case.brdf.reference_parts(case.dirs).channels();
+        let tinted = if case.brdf.is_rgb() { 0..3 } else { 0..1 };
+        let white = if case.brdf.is_tabulable() { 3..3 } else { 3..4 };
+        for k in tinted.chain(white) {
             assert!(
                 reference[k].is_finite(),
                 "reference not finite: {}",

@@ -145,6 +145,10 @@ impl ParamEncoding {
                 f0: s(f0, linear),
                 f90: s(f90, linear),
             },
+            Brdf::GltfMetalRough { alpha, metallic } => Brdf::GltfMetalRough {
+                alpha: s(alpha, roughness),
+                metallic: s(metallic, linear),
+            },
             Brdf::KajiyaKay { kd, ks, p } => Brdf::KajiyaKay {
                 kd: s(kd, linear),
                 ks: s(ks, linear),

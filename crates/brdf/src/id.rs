@@ -19,11 +19,14 @@ pub enum BrdfId {
     KajiyaKay,
     /// Penner's pre-integrated skin.
     PennerSkin,
+    /// glTF 2.0's metallic-roughness BRDF (the specification's Appendix B): Lambert diffuse
+    /// and GGX specular by Fresnel for the dielectric part, base-tinted GGX for the metal part.
+    GltfMetalRough,
 }
 
 impl BrdfId {
     /// Every BRDF, in index order.
-    pub const ALL: [BrdfId; 7] = [
+    pub const ALL: [BrdfId; 8] = [
         BrdfId::Lambert,
         BrdfId::BlinnPhong,
         BrdfId::OrenNayarFull,
@@ -31,6 +34,7 @@ impl BrdfId {
         BrdfId::Ggx,
         BrdfId::KajiyaKay,
         BrdfId::PennerSkin,
+        BrdfId::GltfMetalRough,
     ];
 
     /// The stable numeric id used by the G-buffer and the shaders.
@@ -53,6 +57,7 @@ impl BrdfId {
             BrdfId::Ggx => "ggx",
             BrdfId::KajiyaKay => "kajiya_kay",
             BrdfId::PennerSkin => "penner_skin",
+            BrdfId::GltfMetalRough => "gltf_metal_rough",
         }
     }
 

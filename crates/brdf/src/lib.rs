@@ -37,6 +37,6 @@ mod models;
 mod vector;
 
 pub use id::{BrdfId, UnknownBrdf};
-pub use model::{ranges, Brdf, BrdfError, Range, MODEL_NAMES};
+pub use model::{ranges, Brdf, BrdfError, Parts, Range, MODEL_NAMES};
 pub use models::*;
 pub use vector::{normalize, Real, V3};

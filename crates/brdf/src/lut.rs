@@ -72,7 +72,8 @@ impl LutAxes {
             Brdf::BlinnPhong { .. }
             | Brdf::OrenNayarFull { .. }
             | Brdf::OrenNayarQualitative { .. }
-            | Brdf::Ggx { .. } => LutAxes::Isotropic,
+            | Brdf::Ggx { .. }
+            | Brdf::GltfMetalRough { .. } => LutAxes::Isotropic,
             Brdf::KajiyaKay { .. } => LutAxes::Fibre,
             Brdf::PennerSkin { .. } => LutAxes::SkinCurvature,
         }
@@ -176,6 +177,13 @@ impl LutAxes {
 pub enum LutError {
     #[error("LUT resolution {0} is out of range (2..={max})", max = Lut::MAX_RESOLUTION)]
     Resolution(u32),
+    /// A table holds `f / tint`, which the shader multiplies by the pixel's tint; a model with a
+    /// white part ([`crate::Parts`]) is not the tint times anything a table could hold.
+    #[error(
+        "no look-up table for {0}: its value is not the tint times a function of the angles \
+         (its dielectric specular is white)"
+    )]
+    Untabulable(&'static str),
 }
 
 /// A baked table for one material.
@@ -205,6 +213,9 @@ impl Lut {
     /// Samples `brdf` (its f64 reference) at `resolution` points per axis.
     pub fn bake(brdf: Brdf, resolution: u32) -> Result<Self, LutError> {
         Self::check_resolution(resolution)?;
+        if !brdf.is_tabulable() {
+            return Err(LutError::Untabulable(brdf.name()));
+        }
         let axes = LutAxes::of(&brdf);
         let dims = axes.dimensions();
         let r = resolution as usize;

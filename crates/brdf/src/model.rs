@@ -6,6 +6,40 @@ use crate::models;
 use crate::vector::{c, Real, V3};
 use serde_json::{Map, Value};
 
+/// A BRDF's value in two parts: `f_r * cos(theta_L) = tint * tinted + white`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Parts<R> {
+    pub tinted: [R; 3],
+    pub white: R,
+}
+
+impl<R: Real> Parts<R> {
+    /// The value for a white surface.
+    pub fn at_white(self) -> [R; 3] {
+        self.tinted.map(|x| x + self.white)
+    }
+
+    /// The value for a surface of colour `tint`. With no white part this is exactly
+    /// `tint * tinted`, as the talk's models always were.
+    pub fn tinted_by(self, tint: [R; 3]) -> [R; 3] {
+        let mut out = [R::zero(); 3];
+        for ((o, t), x) in out.iter_mut().zip(tint).zip(self.tinted) {
+            *o = if self.white == R::zero() {
+                t * x
+            } else {
+                t * x + self.white
+            };
+        }
+        out
+    }
+
+    /// The four channels compared between spellings: tinted RGB, then white.
+    pub fn channels(self) -> [R; 4] {
+        let [r, g, b] = self.tinted;
+        [r, g, b, self.white]
+    }
+}
+
 /// A BRDF model and its parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Brdf {
@@ -38,11 +72,17 @@ pub enum Brdf {
         rho: f64,
         curvature_per_mm: f64,
     },
+    /// glTF's metallic-roughness BRDF; `alpha` is roughness squared. Its base colour is the
+    /// surface's tint, which it does not simply scale ([`Brdf::eval_parts`]).
+    GltfMetalRough {
+        alpha: f64,
+        metallic: f64,
+    },
 }
 
 /// Names accepted by [`Brdf::parse`], in id order ([`BrdfId::ALL`]).
-pub const MODEL_NAMES: [&str; 7] = {
-    let mut names = [""; 7];
+pub const MODEL_NAMES: [&str; 8] = {
+    let mut names = [""; 8];
     let mut i = 0;
     while i < names.len() {
         names[i] = BrdfId::ALL[i].name();
@@ -259,6 +299,22 @@ impl Brdf {
                     curvature_per_mm,
                 }
             }
+            "gltf_metal_rough" => {
+                // glTF's names: `roughness` (perceptual, squared to alpha) and `metallic`.
+                let p = p(&["alpha", "roughness", "metallic"])?;
+                let alpha = p
+                    .one_of(
+                        ("alpha", ROUGHNESS),
+                        ("roughness", ROUGHNESS),
+                        "`alpha` or `roughness`",
+                    )?
+                    .unwrap_or_else(|roughness| roughness * roughness);
+                Brdf::GltfMetalRough {
+                    alpha,
+                    // glTF's default metallicFactor.
+                    metallic: p.optional("metallic", UNIT)?.unwrap_or(1.0),
+                }
+            }
             _ => unreachable!("every name in MODEL_NAMES is handled"),
         })
     }
@@ -287,6 +343,9 @@ impl Brdf {
                 ("rho", rho, RHO),
                 ("curvature_per_mm", curvature_per_mm, CURVATURE_PER_MM),
             ],
+            Brdf::GltfMetalRough { alpha, metallic } => {
+                vec![("alpha", alpha, ROUGHNESS), ("metallic", metallic, UNIT)]
+            }
         }
     }
 
@@ -319,6 +378,7 @@ impl Brdf {
             Brdf::Ggx { .. } => BrdfId::Ggx,
             Brdf::KajiyaKay { .. } => BrdfId::KajiyaKay,
             Brdf::PennerSkin { .. } => BrdfId::PennerSkin,
+            Brdf::GltfMetalRough { .. } => BrdfId::GltfMetalRough,
         }
     }
 
@@ -329,6 +389,12 @@ impl Brdf {
 
     pub fn name(&self) -> &'static str {
         MODEL_NAMES[self.model_index() as usize]
+    }
+
+    /// Whether the value is the tint times a function of the angles (no white part), which a
+    /// look-up table of `f / tint` can hold: every model but glTF's metallic-roughness.
+    pub fn is_tabulable(&self) -> bool {
+        !matches!(self, Brdf::GltfMetalRough { .. })
     }
 
     /// Only skin is coloured; every other model returns one value.
@@ -350,12 +416,16 @@ impl Brdf {
                 rho,
                 curvature_per_mm,
             } => [rho, curvature_per_mm, 0.0, 0.0],
+            Brdf::GltfMetalRough { alpha, metallic } => [alpha, metallic, 0.0, 0.0],
         }
     }
 
-    /// `f_r * cos(theta_L)` in precision `R`; scalar models repeat their value in all three
-    /// channels. `skin_panels` sets the skin integral's accuracy.
-    pub fn eval<R: Real>(&self, [n, t, v, l]: [V3<R>; 4], skin_panels: u32) -> [R; 3] {
+    /// `f_r * cos(theta_L)` in two parts, `tint * tinted + white`, in precision `R`: the
+    /// talk's models scale with the surface's tint and have no white part; glTF's
+    /// metallic-roughness BRDF is affine in its base colour (a dielectric's specular is white).
+    /// Scalar models repeat their value in all three channels. `skin_panels` sets the skin
+    /// integral's accuracy.
+    pub fn eval_parts<R: Real>(&self, [n, t, v, l]: [V3<R>; 4], skin_panels: u32) -> Parts<R> {
         let p = self.packed_params().map(c::<R>);
         let scalar = match self {
             Brdf::Lambert { .. } => models::lambert(p[0], n, l),
@@ -367,10 +437,45 @@ impl Brdf {
             Brdf::Ggx { .. } => models::ggx(p[0], p[1], p[2], n, v, l),
             Brdf::KajiyaKay { .. } => models::kajiya_kay(p[0], p[1], p[2], t, v, l),
             Brdf::PennerSkin { .. } => {
-                return models::penner_skin(p[0], p[1], n, l, skin_panels);
+                return Parts {
+                    tinted: models::penner_skin(p[0], p[1], n, l, skin_panels),
+                    white: R::zero(),
+                };
+            }
+            Brdf::GltfMetalRough { .. } => {
+                let (tinted, white) = models::gltf_metal_rough(p[0], p[1], n, v, l);
+                return Parts {
+                    tinted: [tinted; 3],
+                    white,
+                };
             }
         };
-        [scalar; 3]
+        Parts {
+            tinted: [scalar; 3],
+            white: R::zero(),
+        }
+    }
+
+    /// `f_r * cos(theta_L)` of a white surface (tint 1), in precision `R`: for the talk's models
+    /// the value per unit tint. Scalar models repeat their value in all three channels.
+    pub fn eval<R: Real>(&self, dirs: [V3<R>; 4], skin_panels: u32) -> [R; 3] {
+        self.eval_parts(dirs, skin_panels).at_white()
+    }
+
+    /// `f_r * cos(theta_L)` of a surface of colour `tint`: what a light's radiance is multiplied
+    /// by (`brdf_eval_tinted` in GLSL).
+    pub fn eval_tinted<R: Real>(&self, tint: [R; 3], dirs: [V3<R>; 4], skin_panels: u32) -> [R; 3] {
+        self.eval_parts(dirs, skin_panels).tinted_by(tint)
+    }
+
+    /// The f64 reference of [`Brdf::eval_parts`].
+    pub fn reference_parts(&self, dirs: [V3<f64>; 4]) -> Parts<f64> {
+        self.eval_parts(dirs, models::REFERENCE_PANELS)
+    }
+
+    /// The f32 spelling of [`Brdf::eval_parts`], as the GPU computes it.
+    pub fn shipping_parts(&self, dirs: [V3<f32>; 4]) -> Parts<f32> {
+        self.eval_parts(dirs, models::SHIPPING_PANELS)
     }
 
     /// The f64 reference.
@@ -417,9 +522,31 @@ mod tests {
                 "ggx" => json!({"alpha": 0.1}),
                 "kajiya_kay" => json!({"kd": 0.5, "ks": 0.5, "p": 40}),
                 "penner_skin" => json!({"rho": 1, "curvature_per_mm": 0.5}),
+                "gltf_metal_rough" => json!({"roughness": 0.5}),
                 _ => json!({"rho": 1, "sigma": 0.3}),
             };
             assert_eq!(parse(name, params).unwrap().model_index() as usize, i);
+        }
+        // glTF's names and defaults: roughness is perceptual, metallic defaults to 1.
+        assert_eq!(
+            parse("gltf_metal_rough", json!({"roughness": 0.5})).unwrap(),
+            Brdf::GltfMetalRough {
+                alpha: 0.25,
+                metallic: 1.0
+            }
+        );
+        assert_eq!(
+            parse("gltf_metal_rough", json!({"alpha": 0.3, "metallic": 0})).unwrap(),
+            Brdf::GltfMetalRough {
+                alpha: 0.3,
+                metallic: 0.0
+            }
+        );
+        for ambiguous in [json!({}), json!({"alpha": 0.1, "roughness": 0.1})] {
+            let err = parse("gltf_metal_rough", ambiguous)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("`alpha` or `roughness`"), "{err}");
         }
     }
 
@@ -452,6 +579,7 @@ mod tests {
             "ggx" => json!({"alpha": 0.1, "f0": 0.04, "f90": 1}),
             "kajiya_kay" => json!({"kd": 0.5, "ks": 0.5, "p": 40}),
             "penner_skin" => json!({"rho": 1, "curvature_per_mm": 0.5}),
+            "gltf_metal_rough" => json!({"alpha": 0.1, "metallic": 0.5}),
             _ => json!({"rho": 1, "sigma": 0.3}),
         };
         for name in MODEL_NAMES {
@@ -518,7 +646,10 @@ mod tests {
             (Brdf::BlinnPhong { exponent }, "n") => *exponent = x,
             (Brdf::OrenNayarFull { sigma, .. }, "sigma")
             | (Brdf::OrenNayarQualitative { sigma, .. }, "sigma") => *sigma = x,
-            (Brdf::Ggx { alpha, .. }, "alpha") => *alpha = x,
+            (Brdf::Ggx { alpha, .. }, "alpha") | (Brdf::GltfMetalRough { alpha, .. }, "alpha") => {
+                *alpha = x
+            }
+            (Brdf::GltfMetalRough { metallic, .. }, "metallic") => *metallic = x,
             (Brdf::Ggx { f0, .. }, "f0") => *f0 = x,
             (Brdf::Ggx { f90, .. }, "f90") => *f90 = x,
             (Brdf::KajiyaKay { kd, .. }, "kd") => *kd = x,

@@ -8,11 +8,16 @@ use histencil_brdf::cases::{
 use histencil_brdf::{skin_diffusion, Brdf, REFERENCE_PANELS, SHIPPING_PANELS};
 use std::f64::consts::PI;
 
-/// Every case evaluated by the f32 spelling.
-fn in_f32(cases: &[Case]) -> Vec<[f64; 3]> {
+/// Every case evaluated by the f32 spelling, in parts (tinted RGB, white).
+fn in_f32(cases: &[Case]) -> Vec<[f64; 4]> {
     cases
         .iter()
-        .map(|c| c.brdf.shipping(c.dirs_f32()).map(f64::from))
+        .map(|c| {
+            c.brdf
+                .shipping_parts(c.dirs_f32())
+                .channels()
+                .map(f64::from)
+        })
         .collect()
 }
 
@@ -227,4 +232,125 @@ fn skin_limits_and_convergence() {
             }
         }
     }
+}
+
+/// glTF 2.0 Appendix B transcribed on its own, formula by formula, in plain f64 (with its
+/// `fresnel_mix` at IOR 1.5 and `conductor_fresnel`): the independent reference that
+/// `gltf_metal_rough` is held to, for coloured base colours, both parts at once.
+fn appendix_b(base: [f64; 3], metallic: f64, roughness: f64, v: [f64; 3], l: [f64; 3]) -> [f64; 3] {
+    let norm = |a: [f64; 3]| {
+        let len = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        a.map(|x| x / len)
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (v, l) = (norm(v), norm(l));
+    let n = [0.0, 0.0, 1.0];
+    let h = norm([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
+    let alpha = roughness * roughness;
+    let a2 = alpha * alpha;
+    let (n_dot_l, n_dot_v, n_dot_h, v_dot_h) = (dot(n, l), dot(n, v), dot(n, h), dot(v, h));
+    let d = a2 / (PI * (n_dot_h * n_dot_h * (a2 - 1.0) + 1.0).powi(2));
+    let vis = 1.0
+        / ((n_dot_l.abs() + (a2 + (1.0 - a2) * n_dot_l * n_dot_l).sqrt())
+            * (n_dot_v.abs() + (a2 + (1.0 - a2) * n_dot_v * n_dot_v).sqrt()));
+    let specular_brdf = vis * d;
+    let weight = (1.0 - v_dot_h.abs()).powi(5);
+    let f0 = ((1.0 - 1.5f64) / (1.0 + 1.5)).powi(2);
+    let mut out = [0.0; 3];
+    for (o, bc) in out.iter_mut().zip(base) {
+        let diffuse_brdf = bc / PI;
+        let metal_brdf = specular_brdf * (bc + (1.0 - bc) * weight);
+        let fresnel = f0 + (1.0 - f0) * weight;
+        let dielectric_brdf = diffuse_brdf * (1.0 - fresnel) + specular_brdf * fresnel;
+        *o = (dielectric_brdf * (1.0 - metallic) + metal_brdf * metallic) * n_dot_l;
+    }
+    out
+}
+
+#[test]
+fn gltf_metal_rough_is_the_specifications_brdf() {
+    let n = [0.0, 0.0, 1.0];
+    let t = [1.0, 0.0, 0.0];
+    let mut compared = 0;
+    for roughness in [0.05, 0.3, 0.7, 1.0] {
+        for metallic in [0.0, 0.25, 1.0] {
+            let brdf = Brdf::GltfMetalRough {
+                alpha: roughness * roughness,
+                metallic,
+            };
+            for base in [[1.0, 1.0, 1.0], [0.9, 0.4, 0.05], [0.0, 0.0, 0.0]] {
+                for i in 1..40 {
+                    let l = histencil_brdf::cases::sphere_point(
+                        histencil_brdf::cases::halton(i, 2),
+                        histencil_brdf::cases::halton(i, 3),
+                    );
+                    let v = histencil_brdf::cases::sphere_point(
+                        histencil_brdf::cases::halton(i, 5),
+                        histencil_brdf::cases::halton(i, 7),
+                    );
+                    let (l, v) = (l.map(|x| x * 1.0), [v[0], v[1], v[2].abs()]);
+                    if l[2] <= 1e-3 || v[2] <= 1e-3 {
+                        continue;
+                    }
+                    let ours = brdf.eval_tinted(base, [n, t, v, l], REFERENCE_PANELS);
+                    let spec = appendix_b(base, metallic, roughness, v, l);
+                    for (a, b) in ours.iter().zip(spec) {
+                        assert!(
+                            (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+                            "{brdf:?} base {base:?} v {v:?} l {l:?}: {a} vs {b}"
+                        );
+                    }
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert!(compared > 500, "{compared}");
+    // At normal incidence by hand: D = 1 / (pi a^2), the visibility 1/4, no Fresnel weight.
+    let (alpha, metallic) = (0.09, 0.4);
+    let brdf = Brdf::GltfMetalRough { alpha, metallic };
+    let parts = brdf.reference_parts([n, t, n, n]);
+    let specular = 1.0 / (4.0 * PI * alpha * alpha);
+    let tinted = (1.0 - metallic) * 0.96 / PI + metallic * specular;
+    let white = (1.0 - metallic) * 0.04 * specular;
+    assert!(
+        (parts.tinted[0] - tinted).abs() < 1e-12 * tinted,
+        "{parts:?}"
+    );
+    assert!((parts.white - white).abs() < 1e-12 * white, "{parts:?}");
+}
+
+#[test]
+fn gltf_metal_rough_albedo_is_bounded_and_it_is_reciprocal() {
+    let n = [0.0, 0.0, 1.0];
+    let t = [1.0, 0.0, 0.0];
+    // Sharper lobes than alpha 0.1 need a finer grid than the albedo integral's.
+    for alpha in [0.1, 0.4, 1.0] {
+        for metallic in [0.0, 1.0] {
+            let brdf = Brdf::GltfMetalRough { alpha, metallic };
+            for theta_v in [0.0, 0.7, 1.4] {
+                let a = albedo(&brdf, theta_v);
+                println!("{brdf:?} theta_v {theta_v}: albedo {a:.5}");
+                // A metal reflects at most everything (single scattering loses energy at high
+                // roughness: 0.31 at alpha 1). The specification's dielectric is not energy
+                // conserving at grazing view: it weights diffuse by 1 - F(V.H) per light
+                // direction, not by what the specular lobe leaves, and reflects up to 1.2065
+                // (alpha 0.1, theta_v 1.4) here; held to that measure plus 0.3 %.
+                let bound = if metallic == 1.0 { 1.0 + 1e-3 } else { 1.21 };
+                assert!(a <= bound, "{brdf:?} at theta_v {theta_v}: albedo {a}");
+            }
+            for (a, b) in [
+                ([0.3, 0.1, 0.9], [-0.4, 0.5, 0.6]),
+                ([0.9, 0.0, 0.2], [0.0, 0.1, 1.0]),
+            ] {
+                let f_ab = brdf.reference([n, t, a, b])[0] / (b[2] / norm(b));
+                let f_ba = brdf.reference([n, t, b, a])[0] / (a[2] / norm(a));
+                assert!((f_ab - f_ba).abs() <= 1e-12 * f_ab.max(1.0), "{brdf:?}");
+            }
+        }
+    }
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }

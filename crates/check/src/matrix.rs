@@ -247,7 +247,8 @@ pub struct SceneNeeds {
     pub preserved_mask: u8,
     pub has_alpha: bool,
     /// The LUT technique can light it: no material's parameters vary per texel
-    /// (`Material::parameters_vary`), which a table per material cannot follow.
+    /// (`Material::parameters_vary`), which a table per material cannot follow, and every BRDF
+    /// is its tint times a table (`Brdf::is_tabulable`; not glTF's metallic-roughness).
     pub lut: bool,
 }
 
@@ -260,7 +261,10 @@ impl SceneNeeds {
         Ok(Self {
             preserved_mask: layout.preserved_mask(),
             has_alpha: scene.alpha_entity_count() > 0,
-            lut: !scene.objects.iter().any(|o| o.material.parameters_vary()),
+            lut: !scene
+                .objects
+                .iter()
+                .any(|o| o.material.parameters_vary() || !o.material.brdf.is_tabulable()),
         })
     }
 }

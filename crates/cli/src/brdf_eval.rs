@@ -14,5 +14,9 @@ pub fn evaluate_gpu(ctx: &histencil_vk::Context, rows: &[Row]) -> Result<Vec<[f6
     let input: Vec<_> = rows.iter().map(|r| (r.brdf, r.dirs.map(unit))).collect();
     let values = evaluator.evaluate(ctx, &input);
     evaluator.destroy(ctx);
-    Ok(values?.into_iter().map(|v| v.map(f64::from)).collect())
+    // The case file's value is a white surface's.
+    Ok(values?
+        .into_iter()
+        .map(|v| v.at_white().map(f64::from))
+        .collect())
 }

@@ -34,12 +34,17 @@ fn material(id: BrdfId, variant: usize, tint: Vec3) -> Material {
             rho: 0.85,
             curvature_per_mm: [0.3, 1.0][variant % 2],
         },
+        // A rough dielectric and a polished metal.
+        BrdfId::GltfMetalRough => Brdf::GltfMetalRough {
+            alpha: [0.36, 0.04][variant % 2],
+            metallic: [0.0, 1.0][variant % 2],
+        },
     };
     Material::new(brdf, tint)
 }
 
 /// `(name, description)` of every embedded scene.
-pub const EMBEDDED: [(&str, &str); 13] = [
+pub const EMBEDDED: [(&str, &str); 14] = [
     (
         "default",
         "procedural room: 2 BRDFs, 36 point lights from tiny to huge, 3 spots, 1 directional",
@@ -56,6 +61,11 @@ pub const EMBEDDED: [(&str, &str); 13] = [
         "brdfs-6",
         "the default room with all six BRDFs: Lambert, Blinn-Phong, Oren-Nayar, GGX, \
          Kajiya-Kay, Penner skin",
+    ),
+    (
+        "pbr-mixed",
+        "the default room with glTF's metallic-roughness BRDF (a rough dielectric, a polished \
+         metal) beside Penner skin, Kajiya-Kay hair and Oren-Nayar cloth",
     ),
     (
         "huge-lights",
@@ -117,6 +127,12 @@ pub fn embedded(name: &str) -> Result<Scene, SceneError> {
         "brdfs-1" => &[BrdfId::Lambert],
         "brdfs-3" => &[BrdfId::Lambert, BrdfId::OrenNayarFull, BrdfId::Ggx],
         "huge-lights" => &[BrdfId::Lambert, BrdfId::BlinnPhong, BrdfId::OrenNayarFull],
+        "pbr-mixed" => &[
+            BrdfId::GltfMetalRough,
+            BrdfId::PennerSkin,
+            BrdfId::KajiyaKay,
+            BrdfId::OrenNayarFull,
+        ],
         "brdfs-6" => &[
             BrdfId::Lambert,
             BrdfId::BlinnPhong,

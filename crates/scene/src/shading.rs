@@ -60,11 +60,12 @@ pub fn shade(lights: &[Light], material: &Material, p: Vec3, n: Vec3, eye: Vec3)
     let mut sum = Vec3::ZERO;
     for light in lights {
         if let Some((incident, l)) = light.incident(p) {
-            let f = material.brdf.eval(
+            let f = material.brdf.eval_tinted(
+                material.tint.to_array(),
                 [n.to_array(), t.to_array(), v.to_array(), l.to_array()],
                 SHIPPING_PANELS,
             );
-            sum += incident * material.tint * Vec3::from(f);
+            sum += incident * Vec3::from(f);
         }
     }
     sum

@@ -192,6 +192,8 @@ const MAX_TEXTURED_EXPONENT: f64 = 1e4;
 /// - Blinn-Phong: the exponent of the Beckmann-equivalent roughness scaled the same way,
 ///   `(n + 2) / roughness^4 - 2` (from `n = 2 / alpha^2 - 2`), at most 1e4.
 /// - Oren-Nayar (both forms): `sigma * roughness`.
+/// - glTF's metallic-roughness: as glTF defines it, `alpha * roughness^2` and
+///   `metallic * metallic texel`.
 /// - Lambert, Kajiya-Kay, Penner skin: unchanged (no roughness; fibre and skin parameters are
 ///   not what the texture describes).
 ///
@@ -225,6 +227,12 @@ pub fn textured_brdf(brdf: Brdf, roughness: f32, metallic: f32) -> Brdf {
         Brdf::OrenNayarQualitative { rho, sigma } => Brdf::OrenNayarQualitative {
             rho,
             sigma: sigma * r,
+        },
+        // glTF's own rule: the texel's green times roughnessFactor (alpha is its square), its
+        // blue times metallicFactor.
+        Brdf::GltfMetalRough { alpha, metallic } => Brdf::GltfMetalRough {
+            alpha: alpha * r * r,
+            metallic: metallic * m,
         },
         other => other,
     }

@@ -86,7 +86,9 @@ impl Object {
 
 /// A surface: a BRDF model with its parameters (as `histencil-brdf` defines them), a tint, and
 /// optionally texture maps that vary both over the surface ([`MaterialMaps`]). The outgoing
-/// radiance is `tint * brdf(N, T, V, L) * incident`; Kajiya-Kay's fibre tangent is the world +Y
+/// radiance is `brdf.eval_tinted(tint, N, T, V, L) * incident`: `tint * brdf(N, T, V, L)` for
+/// the talk's models, and for glTF's metallic-roughness `tint` is the base colour, with a white
+/// dielectric specular ([`histencil_brdf::Parts`]); Kajiya-Kay's fibre tangent is the world +Y
 /// axis projected onto the surface (see `shaders/include/light.glsl`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {

@@ -6,7 +6,7 @@ use crate::context::Context;
 use crate::descriptors::BRDF_EVAL_SET;
 use crate::error::Result;
 use crate::shaders;
-use histencil_brdf::{Brdf, V3};
+use histencil_brdf::{Brdf, Parts, V3};
 
 /// std430 mirror of `BrdfCase` in `shaders/brdf_eval.comp`.
 #[repr(C)]
@@ -36,8 +36,13 @@ impl BrdfEvaluator {
         Ok(Self { kernel })
     }
 
-    /// `f_r * cos(theta_L)` of each case, RGB (scalar models repeat their value).
-    pub fn evaluate(&self, ctx: &Context, cases: &[(Brdf, [V3<f32>; 4])]) -> Result<Vec<[f32; 3]>> {
+    /// `f_r * cos(theta_L)` of each case in its two parts, `tint * tinted + white`
+    /// ([`histencil_brdf::Parts`]; scalar models repeat their value in the tinted channels).
+    pub fn evaluate(
+        &self,
+        ctx: &Context,
+        cases: &[(Brdf, [V3<f32>; 4])],
+    ) -> Result<Vec<Parts<f32>>> {
         let gpu: Vec<GpuBrdfCase> = cases
             .iter()
             .map(|(brdf, [n, t, v, l])| GpuBrdfCase {
@@ -49,8 +54,16 @@ impl BrdfEvaluator {
                 l: pad(*l),
             })
             .collect();
-        self.kernel
-            .run(ctx, bytemuck::cast_slice(&gpu), gpu.len() as u32, &[])
+        let values = self
+            .kernel
+            .run(ctx, bytemuck::cast_slice(&gpu), gpu.len() as u32, &[])?;
+        Ok(values
+            .into_iter()
+            .map(|[r, g, b, white]| Parts {
+                tinted: [r, g, b],
+                white,
+            })
+            .collect())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -116,7 +116,7 @@ impl CaseKernel {
         cases: &[u8],
         count: u32,
         extra: &[vk::Buffer],
-    ) -> Result<Vec<[f32; 3]>> {
+    ) -> Result<Vec<[f32; 4]>> {
         if count == 0 {
             return Ok(Vec::new());
         }
@@ -140,7 +140,7 @@ impl CaseKernel {
         let values = self.dispatch(ctx, &buffers, count).map(|()| {
             bytemuck::cast_slice::<u8, f32>(output.read())
                 .chunks_exact(4)
-                .map(|c| [c[0], c[1], c[2]])
+                .map(|c| [c[0], c[1], c[2], c[3]])
                 .collect()
         });
         input.destroy(ctx);

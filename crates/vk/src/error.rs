@@ -43,6 +43,12 @@ pub enum Error {
          material follows: light this scene with stencil, branching or adaptive"
     )]
     LutTexturedParameters { object: String, brdf: &'static str },
+    #[error(
+        "the LUT technique tabulates each material's BRDF divided by its tint, and object \
+         `{object}`'s {brdf} is not its tint times a function of the angles (its dielectric \
+         specular is white): light this scene with stencil, branching or adaptive"
+    )]
+    LutUntabulable { object: String, brdf: &'static str },
     #[error(transparent)]
     Lightmap(#[from] histencil_alpha::LayoutError),
     #[error("{count} distinct materials; the G-buffer indexes at most {max}")]

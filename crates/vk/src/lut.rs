@@ -181,12 +181,13 @@ impl LutEvaluator {
                 }
             })
             .collect();
-        self.kernel.run(
+        let values = self.kernel.run(
             ctx,
             bytemuck::cast_slice(&gpu),
             gpu.len() as u32,
             &tables.buffers(),
-        )
+        )?;
+        Ok(values.into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -6,7 +6,17 @@
 #include "brdf/surface.glsl"
 #include "brdf/fibre.glsl"
 #include "brdf/skin.glsl"
+#include "brdf/gltf.glsl"
 
+// A BRDF's value in two parts, f * N.L = tint * tinted + white (histencil_brdf::Parts): the
+// talk's models scale with the tint and have no white part; glTF's metallic-roughness BRDF is
+// affine in its base colour.
+struct BrdfParts {
+    vec3 tinted;
+    float white;
+};
+
+// The value of a white surface (tint 1): for the talk's models, the value per unit tint.
 vec3 brdf_eval(uint model, vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {
     switch (model) {
     case BRDF_LAMBERT:
@@ -23,8 +33,30 @@ vec3 brdf_eval(uint model, vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {
         return vec3(brdf_kajiya_kay(p.x, p.y, p.z, T, V, L));
     case BRDF_PENNER_SKIN:
         return brdf_penner_skin(p.x, p.y, N, L);
+    case BRDF_GLTF_METAL_ROUGH: {
+        vec2 g = brdf_gltf_metal_rough(p.x, p.y, N, V, L);
+        return vec3(g.x + g.y);
+    }
     }
     return vec3(0.0);
+}
+
+BrdfParts brdf_eval_parts(uint model, vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {
+    if (model == BRDF_GLTF_METAL_ROUGH) {
+        vec2 g = brdf_gltf_metal_rough(p.x, p.y, N, V, L);
+        return BrdfParts(vec3(g.x), g.y);
+    }
+    return BrdfParts(brdf_eval(model, p, N, T, V, L), 0.0);
+}
+
+// The value for a surface of colour `tint`: what a light's radiance is multiplied by. For the
+// talk's models exactly tint * brdf_eval, as it always was.
+vec3 brdf_eval_tinted(uint model, vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L) {
+    if (model == BRDF_GLTF_METAL_ROUGH) {
+        vec2 g = brdf_gltf_metal_rough(p.x, p.y, N, V, L);
+        return tint * g.x + g.y;
+    }
+    return tint * brdf_eval(model, p, N, T, V, L);
 }
 
 #endif

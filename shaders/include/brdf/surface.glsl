@@ -106,18 +106,25 @@ float brdf_oren_nayar_qualitative(float rho, float sigma, vec3 N, vec3 V, vec3 L
         * (big_a * s.n_dot_l + big_b * max(a.cos_phi, 0.0) * a.sin_alpha * a.cos_i_tan_beta);
 }
 
+// GGX / Trowbridge-Reitz D with alpha clamped to [GGX_MIN_ALPHA, 1] (returned squared in a2);
+// 1 - (N.H)^2 is formed as |N x H|^2 against cancellation.
+float brdf_ggx_d(float alpha, vec3 n, vec3 h, out float a2) {
+    float a = clamp(alpha, GGX_MIN_ALPHA, 1.0);
+    a2 = a * a;
+    float n_dot_h = clamp(dot(n, h), 0.0, 1.0);
+    vec3 n_cross_h = cross(n, h);
+    float d_denominator = n_dot_h * n_dot_h * a2 + dot(n_cross_h, n_cross_h);
+    return a2 * INV_PI / (d_denominator * d_denominator);
+}
+
 float brdf_ggx(float alpha, float f0, float f90, vec3 N, vec3 V, vec3 L) {
     BrdfLit s;
     vec3 h;
     if (!brdf_lit(N, V, L, s) || !brdf_normalize(s.l + s.v, h)) {
         return 0.0;
     }
-    float a = clamp(alpha, GGX_MIN_ALPHA, 1.0);
-    float a2 = a * a;
-    float n_dot_h = clamp(dot(s.n, h), 0.0, 1.0);
-    vec3 n_cross_h = cross(s.n, h);
-    float d_denominator = n_dot_h * n_dot_h * a2 + dot(n_cross_h, n_cross_h);
-    float d = a2 * INV_PI / (d_denominator * d_denominator);
+    float a2;
+    float d = brdf_ggx_d(alpha, s.n, h, a2);
     float nl = s.n_dot_l;
     float nv = s.n_dot_v;
     float vis = 0.5 / (nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2));

@@ -151,8 +151,20 @@ pub fn oren_nayar_qualitative<R: Real>(rho: R, sigma: R, n: V3<R>, v: V3<R>, l: 
 /// peak (`1 / (pi alpha^2)`) loses f32 precision. Both spellings clamp to it.
 pub const GGX_MIN_ALPHA: f64 = 1e-3;
 
+/// GGX / Trowbridge-Reitz D at unit normal `n` and half vector `h`, with `alpha` clamped to
+/// `[GGX_MIN_ALPHA, 1]`, and the clamped `alpha^2`. `1 - (N.H)^2` is formed as `|N x H|^2` to
+/// avoid cancellation.
+pub(crate) fn ggx_d<R: Real>(alpha: R, n: V3<R>, h: V3<R>) -> (R, R) {
+    let a = alpha.max(c(GGX_MIN_ALPHA)).min(R::one());
+    let a2 = a * a;
+    let n_dot_h = dot(n, h).max(R::zero()).min(R::one());
+    let n_cross_h = cross(n, h);
+    let d_denominator = n_dot_h * n_dot_h * a2 + dot(n_cross_h, n_cross_h);
+    (a2 * R::FRAC_1_PI() / (d_denominator * d_denominator), a2)
+}
+
 /// Cook-Torrance with GGX / Trowbridge-Reitz D, Smith height-correlated visibility and Schlick
-/// Fresnel: `D * Vis * F * N.L`. D uses `1 - (N.H)^2 = |N x H|^2` to avoid cancellation.
+/// Fresnel: `D * Vis * F * N.L` ([`ggx_d`]).
 pub fn ggx<R: Real>(alpha: R, f0: R, f90: R, n: V3<R>, v: V3<R>, l: V3<R>) -> R {
     let Some(s) = lit(n, v, l) else {
         return R::zero();
@@ -160,12 +172,7 @@ pub fn ggx<R: Real>(alpha: R, f0: R, f90: R, n: V3<R>, v: V3<R>, l: V3<R>) -> R 
     let Some(h) = normalize(add(s.l, s.v)) else {
         return R::zero();
     };
-    let a = alpha.max(c(GGX_MIN_ALPHA)).min(R::one());
-    let a2 = a * a;
-    let n_dot_h = dot(s.n, h).max(R::zero()).min(R::one());
-    let n_cross_h = cross(s.n, h);
-    let d_denominator = n_dot_h * n_dot_h * a2 + dot(n_cross_h, n_cross_h);
-    let d = a2 * R::FRAC_1_PI() / (d_denominator * d_denominator);
+    let (d, a2) = ggx_d(alpha, s.n, h);
     let (nl, nv) = (s.n_dot_l, s.n_dot_v);
     let vis = c::<R>(0.5)
         / (nl * (nv * nv * (R::one() - a2) + a2).sqrt()

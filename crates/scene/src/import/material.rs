@@ -1,5 +1,5 @@
-//! A glTF material as a histencil [`Material`]: the BRDF named in its `extras`, or a documented
-//! approximation of its metallic-roughness parameters.
+//! A glTF material as a histencil [`Material`]: the BRDF named in its `extras`, or glTF's own
+//! metallic-roughness BRDF with its factors.
 
 use crate::Material;
 use glam::Vec3;
@@ -22,13 +22,11 @@ pub enum MaterialError {
 /// The material of `extras` (the material's raw JSON extras, if any) and the metallic-roughness
 /// factors. With `"brdf"` in the extras, the BRDF is `Brdf::parse(name, other keys)`, exactly as
 /// `histencil brdf-eval` takes it, and the tint is `"tint"` or the base colour. Without it, the
-/// fallback is:
+/// material is glTF's own: [`Brdf::GltfMetalRough`] with `alpha = roughness^2` and the
+/// `metallic` factor (each clamped to `[0, 1]`), the base colour as its tint, and the
+/// metallic-roughness texture applied per texel as glTF defines ([`crate::textured_brdf`]).
 ///
-/// - `metallic < 0.5` and `roughness >= 0.5`: Lambert (a rough dielectric is mostly diffuse);
-/// - otherwise GGX with `alpha = roughness^2` (at least 0.01: a mirror's alpha 0 has no highlight
-///   to rasterise), `f0 = 0.04` blended to 1 by `metallic`, `f90 = 1`.
-///
-/// Base-colour textures are ignored: the tint is `baseColorFactor`'s RGB.
+/// Base-colour textures are applied by the renderer (they multiply the tint per texel).
 pub fn material_from_gltf(
     extras: Option<&str>,
     base_color: [f32; 4],
@@ -44,7 +42,7 @@ pub fn material_from_gltf(
         },
     };
     let Some(mut params) = extras.filter(|m| m.contains_key("brdf")) else {
-        return Ok(Material::new(fallback_brdf(metallic, roughness), base_tint));
+        return Ok(Material::new(gltf_brdf(metallic, roughness), base_tint));
     };
     let name = match params.remove("brdf") {
         Some(Value::String(name)) => name,
@@ -67,19 +65,11 @@ fn parse_tint(value: &Value) -> Option<Vec3> {
     Some(Vec3::from(rgb))
 }
 
-fn fallback_brdf(metallic: f32, roughness: f32) -> Brdf {
-    let (metallic, roughness) = (
-        f64::from(metallic).clamp(0.0, 1.0),
-        f64::from(roughness).clamp(0.0, 1.0),
-    );
-    if metallic < 0.5 && roughness >= 0.5 {
-        Brdf::Lambert { rho: 1.0 }
-    } else {
-        Brdf::Ggx {
-            alpha: (roughness * roughness).max(0.01),
-            f0: 0.04 + 0.96 * metallic,
-            f90: 1.0,
-        }
+fn gltf_brdf(metallic: f32, roughness: f32) -> Brdf {
+    let roughness = f64::from(roughness).clamp(0.0, 1.0);
+    Brdf::GltfMetalRough {
+        alpha: roughness * roughness,
+        metallic: f64::from(metallic).clamp(0.0, 1.0),
     }
 }
 
@@ -128,17 +118,31 @@ mod tests {
     }
 
     #[test]
-    fn the_pbr_fallback() {
-        let rough = material_from_gltf(None, [0.5, 0.5, 0.5, 1.0], 0.0, 1.0).unwrap();
-        assert_eq!(rough.brdf, Brdf::Lambert { rho: 1.0 });
-        assert_eq!(rough.tint, Vec3::splat(0.5));
-        let other_extras = material_from_gltf(Some(r#"{"author": "x"}"#), WHITE, 1.0, 0.0).unwrap();
+    fn without_a_brdf_in_the_extras_a_material_is_gltfs_own() {
+        let rough = material_from_gltf(None, [0.5, 0.4, 0.3, 1.0], 0.0, 1.0).unwrap();
+        assert_eq!(
+            rough.brdf,
+            Brdf::GltfMetalRough {
+                alpha: 1.0,
+                metallic: 0.0
+            }
+        );
+        assert_eq!(rough.tint, Vec3::new(0.5, 0.4, 0.3));
+        let other_extras = material_from_gltf(Some(r#"{"author": "x"}"#), WHITE, 1.0, 0.5).unwrap();
         assert_eq!(
             other_extras.brdf,
-            Brdf::Ggx {
-                alpha: 0.01,
-                f0: 1.0,
-                f90: 1.0
+            Brdf::GltfMetalRough {
+                alpha: 0.25,
+                metallic: 1.0
+            }
+        );
+        // Factors outside glTF's range are clamped into it.
+        let clamped = material_from_gltf(None, WHITE, 3.0, -1.0).unwrap();
+        assert_eq!(
+            clamped.brdf,
+            Brdf::GltfMetalRough {
+                alpha: 0.0,
+                metallic: 1.0
             }
         );
     }

@@ -180,6 +180,8 @@ impl<'c> Renderer<'c> {
     /// # Errors
     /// [`crate::Error::LutTexturedParameters`] when an object's metallic-roughness map changes
     /// its BRDF's parameters per texel ([`histencil_scene::Material::parameters_vary`]),
+    /// [`crate::Error::LutUntabulable`] when an object's BRDF is not its tint times a function
+    /// of the angles ([`histencil_brdf::Brdf::is_tabulable`]: glTF's metallic-roughness),
     /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
     /// [`LutTables::new`].
     pub fn lut_tables(&mut self) -> Result<&LutTables<'c>> {
@@ -191,6 +193,17 @@ impl<'c> Renderer<'c> {
                 .find(|o| o.material.parameters_vary())
             {
                 return Err(crate::Error::LutTexturedParameters {
+                    object: o.name.clone(),
+                    brdf: o.material.brdf.id().name(),
+                });
+            }
+            if let Some(o) = self
+                .scene
+                .objects
+                .iter()
+                .find(|o| !o.material.brdf.is_tabulable())
+            {
+                return Err(crate::Error::LutUntabulable {
                     object: o.name.clone(),
                     brdf: o.material.brdf.id().name(),
                 });
