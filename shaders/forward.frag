@@ -16,7 +16,7 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     Surface s = surface_from_material(in_world_position, in_world_normal, in_uv,
-                                      in_world_tangent, in_color);
+                                      in_world_tangent, in_color, gl_FrontFacing);
     vec3 sum = material_emissive(in_uv);
     for (uint i = 0; i < frame.counts.x; ++i) {
         sum += shade_light(lights[i], s);

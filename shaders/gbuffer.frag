@@ -19,7 +19,7 @@ layout(location = 2) out vec4 out_material;
 
 void main() {
     Surface s = surface_from_material(in_world_position, in_world_normal, in_uv,
-                                      in_world_tangent, in_color);
+                                      in_world_tangent, in_color, gl_FrontFacing);
     GBufferTexel t = gbuffer_encode(s.tint, s.normal, in_linear_depth, s.params.xyz, s.brdf,
                                     uint(draw.tint.w));
     out_albedo = t.albedo;

@@ -71,9 +71,11 @@ vec4 material_textured_params(uint model, vec4 p, float roughness, float metalli
 
 // The surface at a fragment of the draw: the draw's material, its maps read at `uv`, the vertex
 // colour, and the normal map in the frame of `world_tangent` (xyz along +u, w the bitangent's
-// sign).
+// sign). A back face (only a double-sided material's is drawn) turns its shading normal toward
+// the viewer, as glTF's doubleSided asks: the whole tangent frame flipped, as Khronos's sample
+// viewer does.
 Surface surface_from_material(vec3 world_position, vec3 world_normal, vec4 uv,
-                              vec4 world_tangent, vec4 color) {
+                              vec4 world_tangent, vec4 color, bool front_facing) {
     Surface s = surface_from_draw(world_position, world_normal);
     vec4 base = texture(sampler2D(map_base_color, sampler_base_color),
                         material_map_uv(MAP_BASE_COLOR, uv));
@@ -99,6 +101,9 @@ Surface surface_from_material(vec3 world_position, vec3 world_normal, vec4 uv,
                 s.normal = bent / len;
             }
         }
+    }
+    if (!front_facing) {
+        s.normal = -s.normal;
     }
     return s;
 }

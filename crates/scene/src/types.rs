@@ -101,16 +101,21 @@ pub struct Material {
     /// `KHR_materials_emissive_strength`), times the emissive map where there is one. It is
     /// added once per pixel, whatever the lights; alpha entities do not emit (yet).
     pub emissive: Vec3,
+    /// Drawn without back-face culling, its back faces lit with the normal flipped toward the
+    /// viewer (glTF's `doubleSided`), in forward and the G-buffer alike. Opaque surfaces only:
+    /// alpha entities are lit from their lightmaps and ignore it.
+    pub double_sided: bool,
 }
 
 impl Material {
-    /// An untextured material that emits nothing.
+    /// An untextured, single-sided material that emits nothing.
     pub fn new(brdf: Brdf, tint: Vec3) -> Self {
         Self {
             brdf,
             tint,
             maps: MaterialMaps::default(),
             emissive: Vec3::ZERO,
+            double_sided: false,
         }
     }
 

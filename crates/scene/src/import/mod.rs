@@ -229,6 +229,7 @@ impl Importer<'_> {
             })?;
             let blend = gltf_material.alpha_mode() == gltf::material::AlphaMode::Blend;
             let mut material = material;
+            material.double_sided = gltf_material.double_sided();
             // Alpha entities are lit per entity from their lightmaps and do not read maps or
             // emit.
             if !blend {

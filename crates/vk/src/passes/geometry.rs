@@ -18,7 +18,8 @@ use crate::state::{apply, oriented, with_stencil, OPAQUE};
 use crate::teardown::build;
 use ash::vk;
 use histencil_model::{
-    CompareOp, DepthConvention, DepthState, FaceStencil, PassState, StencilLayout, StencilOp,
+    CompareOp, CullMode, DepthConvention, DepthState, FaceStencil, PassState, StencilLayout,
+    StencilOp,
 };
 use histencil_scene::Scene;
 
@@ -286,7 +287,12 @@ impl Draw<'_> {
         }
         let mut bound = None;
         for (i, object) in inputs.scene.objects.iter().enumerate() {
-            let Some(state) = state_of(i) else { continue };
+            let Some(mut state) = state_of(i) else {
+                continue;
+            };
+            if object.material.double_sided {
+                state.cull = CullMode::None;
+            }
             apply(self.ctx, cmd, &state);
             let set = inputs.material_sets[i];
             if bound != Some(set) {
