@@ -1,7 +1,7 @@
 //! A glTF material as a histencil [`Material`]: the BRDF named in its `extras`, or glTF's own
 //! metallic-roughness BRDF with its factors.
 
-use crate::Material;
+use crate::{Material, MAX_TINT};
 use glam::Vec3;
 use histencil_brdf::{Brdf, BrdfError};
 use serde_json::{Map, Value};
@@ -13,7 +13,7 @@ pub enum MaterialError {
     NotAnObject,
     #[error("`brdf` must be a string naming a model")]
     NameNotAString,
-    #[error("`tint` must be an array of 3 non-negative numbers")]
+    #[error("`tint` must be an array of 3 numbers in [0, {MAX_TINT}]")]
     BadTint,
     #[error(transparent)]
     Brdf(#[from] BrdfError),
@@ -59,7 +59,11 @@ fn parse_tint(value: &Value) -> Option<Vec3> {
     let items = value.as_array().filter(|a| a.len() == 3)?;
     let mut rgb = [0.0f32; 3];
     for (out, item) in rgb.iter_mut().zip(items) {
-        let x = item.as_f64().filter(|x| x.is_finite() && *x >= 0.0)?;
+        // Held to the scene's range here, in f64: a value finite in f64 but not in f32
+        // (1e39) would otherwise become an infinite tint (found by fuzzing).
+        let x = item
+            .as_f64()
+            .filter(|x| (0.0..=f64::from(MAX_TINT)).contains(x))?;
         *out = x as f32;
     }
     Some(Vec3::from(rgb))
@@ -100,17 +104,23 @@ mod tests {
 
     #[test]
     fn bad_extras_are_named() {
-        let err = |extras| material_from_gltf(Some(extras), WHITE, 0.0, 1.0).unwrap_err();
+        let err = |extras: &str| material_from_gltf(Some(extras), WHITE, 0.0, 1.0).unwrap_err();
         assert!(matches!(
             err(r#"{"brdf": "velvet"}"#),
             MaterialError::Brdf(BrdfError::UnknownModel(name)) if name == "velvet"
         ));
         assert_eq!(err(r#"{"brdf": 3}"#), MaterialError::NameNotAString);
         assert_eq!(err(r#"[1, 2]"#), MaterialError::NotAnObject);
-        assert_eq!(
-            err(r#"{"brdf": "lambert", "rho": 1, "tint": [1, -1, 0]}"#),
-            MaterialError::BadTint
-        );
+        for tint in [
+            "[1, -1, 0]",
+            "[1e39, 0, 0]",
+            "[0, 3e20, 0]",
+            "[1001, 0, 0]",
+            "[1, 1]",
+        ] {
+            let extras = format!(r#"{{"brdf": "lambert", "rho": 1, "tint": {tint}}}"#);
+            assert_eq!(err(&extras), MaterialError::BadTint, "{tint}");
+        }
         assert!(matches!(
             err(r#"{"brdf": "lambert", "rho": 1, "shininess": 3}"#),
             MaterialError::Brdf(BrdfError::UnknownParam { .. })
