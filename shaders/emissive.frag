@@ -16,5 +16,8 @@ layout(location = 5) in vec4 in_color;
 layout(location = 0) out vec4 out_color;
 
 void main() {
+    if (material_masked(in_uv, in_color)) {
+        discard;
+    }
     out_color = vec4(material_emissive(in_uv), 0.0);
 }

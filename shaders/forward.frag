@@ -15,6 +15,9 @@ layout(location = 5) in vec4 in_color;
 layout(location = 0) out vec4 out_color;
 
 void main() {
+    if (material_masked(in_uv, in_color)) {
+        discard;
+    }
     Surface s = surface_from_material(in_world_position, in_world_normal, in_uv,
                                       in_world_tangent, in_color, gl_FrontFacing);
     vec3 sum = material_emissive(in_uv);

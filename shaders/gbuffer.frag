@@ -18,6 +18,9 @@ layout(location = 1) out vec4 out_normal_depth;
 layout(location = 2) out vec4 out_material;
 
 void main() {
+    if (material_masked(in_uv, in_color)) {
+        discard;
+    }
     Surface s = surface_from_material(in_world_position, in_world_normal, in_uv,
                                       in_world_tangent, in_color, gl_FrontFacing);
     GBufferTexel t = gbuffer_encode(s.tint, s.normal, in_linear_depth, s.params.xyz, s.brdf,

@@ -22,6 +22,9 @@ layout(set = 1, binding = 0, std140) uniform MaterialMaps {
     vec4 normal_map;
     // rgb: the radiance the surface emits, times the emissive map.
     vec4 emissive;
+    // x: 1 where fragments are masked (glTF MASK); y: the threshold on texel alpha times vertex
+    // alpha (alphaCutoff / baseColorFactor.a).
+    vec4 alpha_mask;
 } material_maps;
 layout(set = 1, binding = 1) uniform texture2D map_base_color;
 layout(set = 1, binding = 2) uniform texture2D map_normal;
@@ -106,6 +109,17 @@ Surface surface_from_material(vec3 world_position, vec3 world_normal, vec4 uv,
         s.normal = -s.normal;
     }
     return s;
+}
+
+// Whether glTF's MASK cuts the fragment at `uv` with vertex colour `color` away: every pass that
+// draws the surface (G-buffer, forward, emissive) discards it alike.
+bool material_masked(vec4 uv, vec4 color) {
+    if (material_maps.alpha_mask.x < 0.5) {
+        return false;
+    }
+    float alpha = texture(sampler2D(map_base_color, sampler_base_color),
+                          material_map_uv(MAP_BASE_COLOR, uv)).a * color.a;
+    return alpha < material_maps.alpha_mask.y;
 }
 
 // The radiance the draw's surface emits at `uv`: added once per pixel, not per light.

@@ -151,6 +151,11 @@ pub struct MaterialMaps {
     pub normal_scale: f32,
     pub metallic_roughness: Option<TextureRef>,
     pub emissive: Option<TextureRef>,
+    /// glTF's `alphaMode: MASK`: a fragment whose base-colour texel alpha times `COLOR_0`'s
+    /// alpha is below this is discarded (in the G-buffer, forward and emissive passes alike).
+    /// It is `alphaCutoff / baseColorFactor.a`, so the factor is applied without storing it;
+    /// `None` for opaque surfaces.
+    pub alpha_cutoff: Option<f32>,
 }
 
 /// How many maps a material has ([`MaterialMaps::refs`]).

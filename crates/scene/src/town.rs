@@ -164,6 +164,7 @@ fn textured_material(m: usize, images: &mut Vec<TextureImage>) -> Material {
             metallic_roughness: Some(TextureRef::new(first + 2)),
             // Every eighth material glows through its base colour pattern.
             emissive: glows.then(|| TextureRef::new(first)),
+            alpha_cutoff: None,
         },
         emissive: if glows { tint * 0.8 } else { Vec3::ZERO },
         ..Material::new(brdf, tint)

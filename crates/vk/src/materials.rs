@@ -25,6 +25,9 @@ pub struct MaterialRecord {
     pub normal_map: [f32; 4],
     /// rgb: the radiance the surface emits (times the emissive map).
     pub emissive: [f32; 4],
+    /// x: 1 where fragments are masked (glTF MASK); y: the threshold on texel alpha times
+    /// vertex alpha ([`MaterialMaps::alpha_cutoff`]).
+    pub alpha_mask: [f32; 4],
 }
 
 impl MaterialRecord {
@@ -41,10 +44,15 @@ impl MaterialRecord {
             Some(_) => [1.0, maps.normal_scale, 0.0, 0.0],
             None => [0.0; 4],
         };
+        let alpha_mask = match maps.alpha_cutoff {
+            Some(threshold) => [1.0, threshold, 0.0, 0.0],
+            None => [0.0; 4],
+        };
         Self {
             transform,
             normal_map,
             emissive: emissive.extend(0.0).to_array(),
+            alpha_mask,
         }
     }
 }

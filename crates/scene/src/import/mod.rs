@@ -92,6 +92,30 @@ pub enum ImportError {
     Scene(#[from] SceneError),
 }
 
+/// The threshold on texel alpha times vertex alpha that glTF's `alpha * factor >= cutoff` is:
+/// `cutoff / factor`, with a factor of 0 keeping everything (cutoff 0) or nothing, and a
+/// cutoff that is not a finite number in glTF's `[0, 1]`-ish sense taken at its nearest end.
+fn mask_threshold(cutoff: f32, factor: f32) -> f32 {
+    let cutoff = if cutoff.is_nan() {
+        0.5
+    } else {
+        cutoff.max(0.0)
+    };
+    let factor = if factor.is_nan() {
+        1.0
+    } else {
+        factor.clamp(0.0, 1.0)
+    };
+    if cutoff == 0.0 {
+        0.0
+    } else if factor == 0.0 {
+        // Above any alpha a texel and a vertex can multiply to.
+        2.0
+    } else {
+        (cutoff / factor).min(2.0)
+    }
+}
+
 /// Deepest node hierarchy accepted; deeper is taken for a cycle.
 const MAX_NODE_DEPTH: usize = 64;
 
@@ -320,6 +344,12 @@ impl Importer<'_> {
         };
         maps.base_color = info(pbr.base_color_texture())?;
         maps.metallic_roughness = info(pbr.metallic_roughness_texture())?;
+        if m.alpha_mode() == gltf::material::AlphaMode::Mask {
+            maps.alpha_cutoff = Some(mask_threshold(
+                m.alpha_cutoff().unwrap_or(0.5),
+                pbr.base_color_factor()[3],
+            ));
+        }
         if emits {
             maps.emissive = info(m.emissive_texture())?;
         }
