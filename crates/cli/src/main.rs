@@ -282,11 +282,16 @@ fn parse_byte(text: &str) -> Result<u8, String> {
     parsed.map_err(|_| format!("`{text}` is not a byte (0-255 or 0x00-0xFF)"))
 }
 
-/// The scene `--scene` names. A scene without lights gets the default rig unless `lights` is
+/// The scene `--scene` names. What a glTF file holds but histencil does not render is said on
+/// stderr, once per feature. A scene without lights gets the default rig unless `lights` is
 /// `Off`, announced on stderr; left unlit it gets a warning, since its black image is correct
 /// but looks like a failure.
 pub(crate) fn load_scene_arg(spec: &str, lights: DefaultLights) -> Result<histencil_scene::Scene> {
-    let (scene, rigged) = with_default_lights(histencil_scene::load_scene(spec)?, lights);
+    let imported = histencil_scene::load_scene_noted(spec)?;
+    for note in &imported.unrendered {
+        eprintln!("histencil: scene `{spec}`: not rendered: {note}");
+    }
+    let (scene, rigged) = with_default_lights(imported.scene, lights);
     if rigged {
         eprintln!(
             "histencil: scene `{spec}` has no lights: lit by the default rig (a key directional \

@@ -134,7 +134,7 @@ fn images_are_written_in_the_format_their_name_says_or_refused_before_rendering(
 /// A scene named by its bare file name is read from the current folder, with its external
 /// buffer and image (the fuzz seed that names them, beside them in a folder of its own).
 #[test]
-fn a_bare_scene_file_name_is_found_in_the_current_folder() {
+fn a_bare_scene_file_name_is_found_in_the_current_folder_and_unrendered_features_named() {
     let fuzz = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz");
     let dir = std::env::temp_dir().join(format!("histencil-bare-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -163,6 +163,25 @@ fn a_bare_scene_file_name_is_found_in_the_current_folder() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{stderr}");
     assert!(dir.join("frame.png").is_file());
+    assert!(!stderr.contains("not rendered"), "{stderr}");
+    // What a file holds but histencil does not render is said once: an occlusion map.
+    let gltf = dir.join("external.gltf");
+    let text = std::fs::read_to_string(&gltf).unwrap().replacen(
+        r#""materials":[{"#,
+        r#""materials":[{"occlusionTexture":{"index":0},"#,
+        1,
+    );
+    std::fs::write(&gltf, text).unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_histencil"))
+        .current_dir(&dir)
+        .args(["render", "--scene", "external.gltf", "--frames", "1"])
+        .args(["--width", "32", "--height", "24", "--out", "frame.png"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let note = "scene `external.gltf`: not rendered: occlusionTexture (1 material)";
+    assert_eq!(stderr.matches(note).count(), 1, "{stderr}");
     std::fs::remove_dir_all(dir).unwrap();
 }
 

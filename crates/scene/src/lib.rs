@@ -16,8 +16,9 @@ pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICE
 pub use alpha_scenes::{glass_sphere, smoke_volume};
 pub use embedded::{embedded, embedded_names, EMBEDDED};
 pub use import::{
-    import_gltf, load_gltf, load_scene, material_from_gltf, ImportError, MaterialError,
-    MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES, SUPPORTED_REQUIRED_EXTENSIONS,
+    import_gltf, import_gltf_noted, load_gltf, load_gltf_noted, load_scene, load_scene_noted,
+    material_from_gltf, ImportError, Imported, MaterialError, MAX_DECODED_IMAGE_BYTES,
+    MAX_IMAGE_FILE_BYTES, SUPPORTED_REQUIRED_EXTENSIONS,
 };
 pub use light_rig::{
     default_light_rig, with_default_lights, DefaultLights, FILL_SHARE, KEY_RADIANCE,

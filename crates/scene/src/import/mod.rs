@@ -20,6 +20,7 @@ mod buffers;
 mod document;
 mod images;
 mod material;
+mod notes;
 pub(crate) mod tangents;
 mod uv_layout;
 
@@ -121,16 +122,38 @@ const MAX_NODE_DEPTH: usize = 64;
 
 /// An embedded scene by name, or a glTF file when `spec` ends in `.gltf` or `.glb`.
 pub fn load_scene(spec: &str) -> Result<Scene, ImportError> {
+    load_scene_noted(spec).map(|imported| imported.scene)
+}
+
+/// A scene and what its file holds that histencil does not render (for the user: said once).
+#[derive(Clone, Debug)]
+pub struct Imported {
+    pub scene: Scene,
+    /// One line per glTF feature read past without rendering it (`occlusionTexture`,
+    /// animations, extensions not read, ...); empty for embedded scenes.
+    pub unrendered: Vec<String>,
+}
+
+/// [`load_scene`] with the notes of what a glTF file holds but histencil does not render.
+pub fn load_scene_noted(spec: &str) -> Result<Imported, ImportError> {
     let lower = spec.to_ascii_lowercase();
     if lower.ends_with(".gltf") || lower.ends_with(".glb") {
-        load_gltf(Path::new(spec))
+        load_gltf_noted(Path::new(spec))
     } else {
-        Ok(crate::embedded(spec)?)
+        Ok(Imported {
+            scene: crate::embedded(spec)?,
+            unrendered: Vec::new(),
+        })
     }
 }
 
 /// Reads and imports a `.gltf` or `.glb` file; external buffers are read next to it.
 pub fn load_gltf(path: &Path) -> Result<Scene, ImportError> {
+    load_gltf_noted(path).map(|imported| imported.scene)
+}
+
+/// [`load_gltf`] with the notes of what the file holds but histencil does not render.
+pub fn load_gltf_noted(path: &Path) -> Result<Imported, ImportError> {
     let bytes = buffers::read_regular_file(path, ReadLimit::AtMost(MAX_IMPORT_BYTES)).map_err(
         |problem| ImportError::Io {
             path: path.display().to_string(),
@@ -141,9 +164,9 @@ pub fn load_gltf(path: &Path) -> Result<Scene, ImportError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut scene = import_gltf(&bytes, path.parent(), &name)?;
-    scene.description = format!("glTF {}", path.display());
-    Ok(scene)
+    let mut imported = import_gltf_noted(&bytes, path.parent(), &name)?;
+    imported.scene.description = format!("glTF {}", path.display());
+    Ok(imported)
 }
 
 /// Imports glTF or GLB bytes; relative buffer URIs are read from `base_dir`.
@@ -152,7 +175,17 @@ pub fn import_gltf(
     base_dir: Option<&Path>,
     name: &str,
 ) -> Result<Scene, ImportError> {
+    import_gltf_noted(bytes, base_dir, name).map(|imported| imported.scene)
+}
+
+/// [`import_gltf`] with the notes of what the file holds but histencil does not render.
+pub fn import_gltf_noted(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+) -> Result<Imported, ImportError> {
     let gltf = document::parse(bytes)?;
+    let unrendered = notes::unrendered(&gltf.document);
     let buffers = buffers::load_buffers(&gltf.document, gltf.blob, base_dir)?;
     let mut importer = Importer {
         buffers: &buffers,
@@ -186,7 +219,7 @@ pub fn import_gltf(
     };
     scene.validate()?;
     scene.normalise_lights();
-    Ok(scene)
+    Ok(Imported { scene, unrendered })
 }
 
 struct Importer<'a> {
