@@ -10,12 +10,14 @@
 
 use super::ImportError;
 
-/// The extensions `gltf` parses for histencil (its features in the workspace manifest); a file
-/// requiring any other cannot be imported.
-pub const SUPPORTED_REQUIRED_EXTENSIONS: [&str; 3] = [
+/// The extensions histencil reads: those `gltf` parses for it (its features in the workspace
+/// manifest) and `KHR_mesh_quantization` (import/attributes.rs). A file requiring any other
+/// cannot be imported.
+pub const SUPPORTED_REQUIRED_EXTENSIONS: [&str; 4] = [
     "KHR_lights_punctual",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
+    super::attributes::MESH_QUANTIZATION,
 ];
 
 const GLB_MAGIC: &[u8; 4] = b"glTF";
@@ -29,7 +31,7 @@ pub fn parse(bytes: &[u8]) -> Result<gltf::Gltf, ImportError> {
     let parse_error = |e: gltf::Error| ImportError::Parse(e.to_string());
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(parse_error)?;
-    let json = document.into_json();
+    let mut json = document.into_json();
     if let Some(unsupported) = json
         .extensions_required
         .iter()
@@ -38,6 +40,11 @@ pub fn parse(bytes: &[u8]) -> Result<gltf::Gltf, ImportError> {
         return Err(ImportError::UnsupportedExtension(unsupported.clone()));
     }
     check_position_accessors(&json)?;
+    // The `gltf` crate does not know KHR_mesh_quantization and its validation would refuse the
+    // file for requiring it; histencil reads it (import/attributes.rs), and `extensionsUsed`
+    // still says it is used.
+    json.extensions_required
+        .retain(|e| e != super::attributes::MESH_QUANTIZATION);
     let document = gltf::Document::from_json(json).map_err(parse_error)?;
     Ok(gltf::Gltf { document, blob })
 }

@@ -16,6 +16,7 @@
 //! Anything the renderer cannot take gives an [`ImportError`] naming the file's element, never a
 //! panic: truncated files, missing or short buffers, accessors past their views, unknown BRDFs.
 
+mod attributes;
 mod buffers;
 mod document;
 mod images;
@@ -187,8 +188,13 @@ pub fn import_gltf_noted(
     let gltf = document::parse(bytes)?;
     let unrendered = notes::unrendered(&gltf.document);
     let buffers = buffers::load_buffers(&gltf.document, gltf.blob, base_dir)?;
+    let quantized = gltf
+        .document
+        .extensions_used()
+        .any(|e| e == attributes::MESH_QUANTIZATION);
     let mut importer = Importer {
         buffers: &buffers,
+        quantized,
         scene: Scene {
             name: name.to_owned(),
             description: "glTF".to_owned(),
@@ -224,6 +230,8 @@ pub fn import_gltf_noted(
 
 struct Importer<'a> {
     buffers: &'a [Vec<u8>],
+    /// The file uses `KHR_mesh_quantization`: integer attribute types are allowed.
+    quantized: bool,
     scene: Scene,
     images: images::Images<'a>,
     /// `(mesh, primitive, mirrored)` to its index in `scene.meshes`: a mesh used by several
@@ -309,10 +317,14 @@ impl Importer<'_> {
             let (slot, fit) = match self.mesh_slots.get(&key) {
                 Some(found) => *found,
                 None => {
-                    let (fitted, fit) = read_primitive(self.buffers, &primitive, mirrored, needs)
-                        .map_err(|p| {
-                        mesh_error(format!("primitive {}: {p}", primitive.index()))
-                    })?;
+                    let (fitted, fit) = read_primitive(
+                        self.buffers,
+                        &primitive,
+                        mirrored,
+                        needs,
+                        self.quantized,
+                    )
+                    .map_err(|p| mesh_error(format!("primitive {}: {p}", primitive.index())))?;
                     let slot = (self.scene.meshes.len() as u32, fit);
                     self.scene.meshes.push(fitted);
                     self.mesh_slots.insert(key, slot);
@@ -420,6 +432,7 @@ fn read_primitive(
     primitive: &gltf::Primitive,
     mirrored: bool,
     needs: Needs,
+    quantized: bool,
 ) -> Result<(Mesh, Mat4), String> {
     if primitive.mode() != gltf::mesh::Mode::Triangles {
         return Err(format!(
@@ -442,25 +455,20 @@ fn read_primitive(
     for accessor in checked.iter().flatten() {
         buffers::check_accessor(accessor, buffers)?;
     }
-    check_attribute_type(
-        "POSITION",
-        &positions_accessor,
-        &[DataType::F32],
-        Dimensions::Vec3,
-    )?;
-    if let Some(normals) = primitive.get(&gltf::Semantic::Normals) {
-        check_attribute_type("NORMAL", &normals, &[DataType::F32], Dimensions::Vec3)?;
-    }
-    let normalised = [DataType::F32, DataType::U8, DataType::U16];
-    for set in 0..2 {
-        if let Some(uvs) = primitive.get(&gltf::Semantic::TexCoords(set)) {
-            let semantic = format!("TEXCOORD_{set}");
-            check_attribute_type(&semantic, &uvs, &normalised, Dimensions::Vec2)?;
+    use attributes::Attribute;
+    let semantics = [
+        (Attribute::Position, gltf::Semantic::Positions),
+        (Attribute::Normal, gltf::Semantic::Normals),
+        (Attribute::Tangent, gltf::Semantic::Tangents),
+        (Attribute::TexCoord(0), gltf::Semantic::TexCoords(0)),
+        (Attribute::TexCoord(1), gltf::Semantic::TexCoords(1)),
+    ];
+    for (attribute, semantic) in semantics {
+        if let Some(accessor) = primitive.get(&semantic) {
+            attributes::check_type(attribute, &accessor, quantized)?;
         }
     }
-    if let Some(tangents) = primitive.get(&gltf::Semantic::Tangents) {
-        check_attribute_type("TANGENT", &tangents, &[DataType::F32], Dimensions::Vec4)?;
-    }
+    let normalised = [DataType::F32, DataType::U8, DataType::U16];
     if let Some(colors) = primitive.get(&gltf::Semantic::Colors(0)) {
         let dimensions = match colors.dimensions() {
             Dimensions::Vec3 => Dimensions::Vec3,
@@ -473,9 +481,14 @@ fn read_primitive(
         check_attribute_type("indices", &indices, &types, Dimensions::Scalar)?;
     }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-    let positions: Vec<Vec3> = reader
-        .read_positions()
-        .ok_or("POSITION is not a float vec3")?
+    let read_vec2 = |set: u32| {
+        primitive
+            .get(&gltf::Semantic::TexCoords(set))
+            .map(|a| attributes::read::<2>(&a, buffers))
+            .transpose()
+    };
+    let positions: Vec<Vec3> = attributes::read::<3>(&positions_accessor, buffers)?
+        .into_iter()
         .map(Vec3::from)
         .collect();
     if positions.is_empty() || !positions.iter().all(|p| p.is_finite()) {
@@ -496,10 +509,13 @@ fn read_primitive(
         Some(len) if len != count => Err(format!("{name} and POSITION counts differ")),
         _ => Ok(()),
     };
-    let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|t| t.into_f32().collect());
-    let uvs1: Option<Vec<[f32; 2]>> = reader.read_tex_coords(1).map(|t| t.into_f32().collect());
+    let uvs: Option<Vec<[f32; 2]>> = read_vec2(0)?;
+    let uvs1: Option<Vec<[f32; 2]>> = read_vec2(1)?;
     let colors: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|c| c.into_rgba_f32().collect());
-    let tangents: Option<Vec<[f32; 4]>> = reader.read_tangents().map(Iterator::collect);
+    let tangents: Option<Vec<[f32; 4]>> = primitive
+        .get(&gltf::Semantic::Tangents)
+        .map(|a| attributes::read::<4>(&a, buffers))
+        .transpose()?;
     same_count("TEXCOORD_0", uvs.as_ref().map(Vec::len))?;
     same_count("TEXCOORD_1", uvs1.as_ref().map(Vec::len))?;
     same_count("COLOR_0", colors.as_ref().map(Vec::len))?;
@@ -513,9 +529,15 @@ fn read_primitive(
             return Err(format!("alphaMode BLEND: {problem}"));
         }
     }
-    let normals: Option<Vec<Vec3>> = reader
-        .read_normals()
-        .map(|n| n.map(|n| Vec3::from(n).normalize_or(Vec3::Y)).collect());
+    let normals: Option<Vec<Vec3>> = primitive
+        .get(&gltf::Semantic::Normals)
+        .map(|a| attributes::read::<3>(&a, buffers))
+        .transpose()?
+        .map(|n| {
+            n.into_iter()
+                .map(|n| Vec3::from(n).normalize_or(Vec3::Y))
+                .collect()
+        });
     for (set, has) in [uvs.is_some(), uvs1.is_some()].into_iter().enumerate() {
         if needs.texcoords[set] && !has {
             return Err(format!(
