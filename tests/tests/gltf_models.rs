@@ -152,3 +152,81 @@ fn a_quantized_mesh_renders_as_its_float_original() {
     // Measured: mean 0.016/255, max 41/255 on silhouette pixels.
     assert!(d.mean < 0.1, "{d:?}");
 }
+
+/// The mean colour of each of the eight rows of TextureSettingsTest's "Test" and "Sample pass"
+/// columns, at 256x256 under the default rig (the board is framed the same way every time).
+fn texture_settings_columns(edit: impl Fn(&mut Scene)) -> Vec<([f64; 3], [f64; 3])> {
+    let dir = models().expect("checked by the caller");
+    let file = dir.join("TextureSettingsTest/TextureSettingsTest.gltf");
+    let (mut scene, _) = histencil_scene::with_default_lights(
+        histencil_scene::load_gltf(&file).unwrap(),
+        histencil_scene::DefaultLights::IfNone,
+    );
+    edit(&mut scene);
+    let frame = histencil_tests::with_validated_context(|ctx| {
+        let mut renderer = histencil_vk::Renderer::new(ctx, scene, 256, 256).unwrap();
+        let readback = histencil_vk::Readback {
+            ldr: true,
+            ..histencil_vk::Readback::NONE
+        };
+        let images = renderer.render(histencil_vk::Shading::Forward, readback);
+        images.unwrap().images.ldr.unwrap()
+    });
+    let mean = |x0: u32, y0: u32, x1: u32, y1: u32| {
+        let mut sum = [0.0; 3];
+        for y in y0..y1 {
+            for x in x0..x1 {
+                for (s, c) in sum.iter_mut().zip(frame.get_pixel(x, y).0) {
+                    *s += f64::from(c);
+                }
+            }
+        }
+        sum.map(|s| s / f64::from((x1 - x0) * (y1 - y0)))
+    };
+    // Row bands and the two columns, measured on the render.
+    let rows = [68, 86, 103, 119, 135, 150, 165, 179, 194];
+    rows.windows(2)
+        .map(|band| {
+            (
+                mean(127, band[0], 147, band[1]),
+                mean(161, band[0], 181, band[1]),
+            )
+        })
+        .collect()
+}
+
+/// TextureSettingsTest's "Test" column (single- and double-sided, clamp, repeat and mirror in s
+/// and t) looks like its "Sample pass" column, row by row: a failed setting shows a red X
+/// where the sample shows a green check. The double-sided row failed while back faces were
+/// culled.
+#[test]
+fn texture_settings_test_matches_its_sample_pass_column() {
+    if models().is_none() {
+        return;
+    }
+    let assert_rows = |rows: &[([f64; 3], [f64; 3])]| {
+        for (row, (test, sample)) in rows.iter().enumerate() {
+            let off = test
+                .iter()
+                .zip(sample)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                off < 8.0,
+                "row {row}: test {test:?} against sample {sample:?}"
+            );
+        }
+    };
+    assert_rows(&texture_settings_columns(|_| {}));
+    // The check can fail: culling the double-sided row's back face again shows its red X.
+    let culled = texture_settings_columns(|scene| {
+        for object in &mut scene.objects {
+            object.material.double_sided = false;
+        }
+    });
+    let caught = std::panic::catch_unwind(|| assert_rows(&culled));
+    assert!(
+        caught.is_err(),
+        "single-sided rendering passed the double-sided row"
+    );
+}
