@@ -126,6 +126,13 @@ impl Pass {
 pub enum PlanError {
     #[error("BRDF slot {slot} is not in the layout ({brdfs} BRDFs in use)")]
     SlotOutOfRange { slot: u32, brdfs: u32 },
+    /// `PlanInputs::brdf_bounds` must hold one list (possibly empty) per BRDF slot of the
+    /// layout: fewer would light the missing BRDFs' surfaces with nothing and say nothing.
+    #[error(
+        "brdf_bounds has {bounds} entries, but the stencil layout has {brdfs} BRDFs: give one \
+         list of world boxes per BRDF slot, empty for a BRDF with no surfaces"
+    )]
+    BoundsCount { bounds: usize, brdfs: u32 },
     #[error("single-BRDF technique asked for a light affecting {count} BRDFs")]
     SingleWithManyBrdfs { count: usize },
     #[error("light {index}: {problem}")]

@@ -261,15 +261,16 @@ fn classify(view: &View, shape: &LightShape, bound: (DVec3, f64)) -> LightCase {
 ///
 /// # Errors
 /// [`PlanError::BadLight`] and [`PlanError::BadBounds`] name the input that cannot be planned
-/// with; [`PlanError::SlotOutOfRange`] when bounds are given for more BRDFs than the layout has.
+/// with; [`PlanError::BoundsCount`] unless the bounds hold exactly one list per BRDF of the
+/// layout (an engine that passed too few used to get surfaces silently left unlit).
 pub fn plan_frame(
     layout: &StencilLayout,
     inputs: &PlanInputs,
     settings: &PlanSettings,
 ) -> Result<FramePlan, PlanError> {
-    if inputs.brdf_bounds.len() > layout.brdfs_in_use() as usize {
-        return Err(PlanError::SlotOutOfRange {
-            slot: inputs.brdf_bounds.len() as u32 - 1,
+    if inputs.brdf_bounds.len() != layout.brdfs_in_use() as usize {
+        return Err(PlanError::BoundsCount {
+            bounds: inputs.brdf_bounds.len(),
             brdfs: layout.brdfs_in_use(),
         });
     }
@@ -400,7 +401,7 @@ mod tests {
         ];
         for light in bad_lights {
             let lights = [point([0.0; 3], 1.0), light];
-            let err = plan(&lights, &[vec![UNIT]]).unwrap_err();
+            let err = plan(&lights, &[vec![UNIT], vec![]]).unwrap_err();
             assert!(
                 matches!(err, PlanError::BadLight { index: 1, .. }),
                 "{light:?}: {err}"
@@ -435,8 +436,20 @@ mod tests {
                 "{bounds:?}: {err}"
             );
         }
-        let err = plan(&[], &[vec![], vec![], vec![UNIT]]).unwrap_err();
-        assert_eq!(err, PlanError::SlotOutOfRange { slot: 2, brdfs: 2 });
+        for bounds in [vec![], vec![vec![UNIT]], vec![vec![], vec![], vec![UNIT]]] {
+            let err = plan(&[], &bounds).unwrap_err();
+            assert_eq!(
+                err,
+                PlanError::BoundsCount {
+                    bounds: bounds.len(),
+                    brdfs: 2
+                }
+            );
+            assert!(err
+                .to_string()
+                .contains(&format!("has {} entries", bounds.len())));
+            assert!(err.to_string().contains("has 2 BRDFs"));
+        }
     }
 
     /// Light 0 reaches slot 0's box only, light 1 both, light 2 nothing; the directional light
