@@ -626,3 +626,48 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
     }
     engine.destroy().assert_clean();
 }
+
+/// The depth-stencil format is named once: a context lent one (`BorrowedDevice::depth_stencil`)
+/// refuses a lighting described in another, naming both, before it makes anything; a context
+/// lent none takes the lighting's.
+#[test]
+fn a_lighting_in_another_depth_format_than_the_context_was_lent_is_refused() {
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
+    let engine = Engine::start();
+    {
+        let lent = histencil_vk::BorrowedDevice {
+            depth_stencil: Some(histencil_vk::DepthStencilFormat::D32S8),
+            ..engine.lend(engine.queue_family)
+        };
+        // SAFETY: as in the frames-in-flight test.
+        let ctx = unsafe { Context::from_raw(lent) }.expect("context");
+        let renderer = Renderer::new(&ctx, scene.clone(), 32, 16).unwrap();
+        let desc = LightingDesc {
+            layout: *renderer.stencil_layout(),
+            brdfs: renderer.brdfs().to_vec(),
+            extent: vk::Extent2D {
+                width: 32,
+                height: 16,
+            },
+            depth_stencil_format: vk::Format::D24_UNORM_S8_UINT,
+            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+            frames_in_flight: 1,
+            max_lights: scene.lights.len() as u32,
+            hi_stencil: false,
+        };
+        let in_use = ctx.memory_in_use();
+        let err = DeferredLighting::new(&ctx, &desc).err().expect("refused");
+        let text = err.to_string();
+        assert!(
+            text.contains("D24_UNORM_S8_UINT") && text.contains("D32_SFLOAT_S8_UINT"),
+            "{text}"
+        );
+        assert_eq!(ctx.memory_in_use(), in_use);
+        let named = LightingDesc {
+            depth_stencil_format: vk::Format::D32_SFLOAT_S8_UINT,
+            ..desc
+        };
+        drop(DeferredLighting::new(&ctx, &named).expect("the lent format"));
+    }
+    assert!(engine.destroy().problems().is_empty());
+}

@@ -91,7 +91,9 @@ pub struct BorrowedDevice {
     /// `VK_EXT_debug_utils` is enabled on `instance`: histencil then names its objects and
     /// labels its passes (the engine's messenger receives any validation message).
     pub debug_utils: bool,
-    /// As [`ContextDesc::depth_stencil`].
+    /// As [`ContextDesc::depth_stencil`]. When named, [`crate::DeferredLighting::new`] refuses
+    /// a [`crate::LightingDesc::depth_stencil_format`] that differs, so the format cannot mean
+    /// two things; `None` leaves the lighting's format the only one that counts.
     pub depth_stencil: Option<DepthStencilFormat>,
     /// As [`ContextDesc::memory_budget`]: the share of the engine's memory histencil may take.
     pub memory_budget: Option<u64>,
@@ -117,6 +119,9 @@ pub struct Context {
     device_name: String,
     pub(crate) depth_stencil_format: vk::Format,
     depth_stencil: DepthStencilFormat,
+    /// The depth-stencil format was named when the context was made (not picked for it): the
+    /// lighting's targets must then be in it.
+    pub(crate) depth_stencil_named: bool,
     pub(crate) timestamp_period_ns: f64,
     pub(crate) max_image_dimension: u32,
     pub(crate) max_storage_buffer_range: u32,
@@ -374,6 +379,7 @@ impl Context {
             device_name,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
+            depth_stencil_named: desc.depth_stencil.is_some(),
             timestamp_period_ns: f64::from(limits.timestamp_period),
             max_image_dimension: limits.max_image_dimension2_d,
             max_storage_buffer_range: limits.max_storage_buffer_range,
@@ -435,6 +441,7 @@ impl Context {
                  timestamps"
             )));
         }
+        let depth_stencil_named = depth_stencil.is_some();
         let depth_stencil = pick_depth_stencil_format(&instance, physical_device, depth_stencil)?;
         // SAFETY: as above.
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
@@ -459,6 +466,7 @@ impl Context {
             device_name,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
+            depth_stencil_named,
             timestamp_period_ns: f64::from(props.limits.timestamp_period),
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,

@@ -191,6 +191,13 @@ impl<'c> DeferredLighting<'c> {
     /// flight or too many BRDFs for the layout; Vulkan and allocation errors.
     pub fn new(ctx: &'c Context, desc: &LightingDesc) -> Result<Self> {
         check_desc(desc)?;
+        if ctx.depth_stencil_named && desc.depth_stencil_format != ctx.depth_stencil_format {
+            return Err(bad(format!(
+                "depth-stencil format {:?}, but the context was lent {:?} \
+                 (BorrowedDevice::depth_stencil): name one format, or leave the context's None",
+                desc.depth_stencil_format, ctx.depth_stencil_format
+            )));
+        }
         let mut this = Self {
             ctx,
             desc: desc.clone(),
