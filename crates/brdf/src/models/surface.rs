@@ -164,7 +164,7 @@ pub(crate) fn ggx_d<R: Real>(alpha: R, n: V3<R>, h: V3<R>) -> (R, R) {
 }
 
 /// Cook-Torrance with GGX / Trowbridge-Reitz D, Smith height-correlated visibility and Schlick
-/// Fresnel: `D * Vis * F * N.L` ([`ggx_d`]).
+/// Fresnel: `D * Vis * F * N.L`, D with `1 - (N.H)^2` formed as `|N x H|^2` against cancellation.
 pub fn ggx<R: Real>(alpha: R, f0: R, f90: R, n: V3<R>, v: V3<R>, l: V3<R>) -> R {
     let Some(s) = lit(n, v, l) else {
         return R::zero();
