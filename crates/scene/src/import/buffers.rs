@@ -292,7 +292,16 @@ fn check_elements(
             view.buffer().index()
         ));
     }
-    let stride = view.stride().unwrap_or(element).max(element);
+    // Elements may not overlap: the gltf crate's accessor iterator asserts this (found by
+    // fuzzing), and a smaller stride is no valid layout.
+    if let Some(stride) = view.stride().filter(|s| *s < element) {
+        return Err(format!(
+            "{which}: buffer view {} has byteStride {stride}, less than its {element}-byte \
+             elements",
+            view.index()
+        ));
+    }
+    let stride = view.stride().unwrap_or(element);
     let needed = match count {
         0 => Some(0),
         n => (n - 1)
