@@ -150,7 +150,7 @@ fn validate_with_naga(name: &str, spirv: &[u8]) {
 
 fn main() {
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
-    let shader_dir = manifest.join("../../shaders");
+    let shader_dir = manifest.join("shaders");
     let include_dir = shader_dir.join("include");
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     println!("cargo:rerun-if-changed={}", shader_dir.display());

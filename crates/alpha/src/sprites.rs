@@ -6,7 +6,7 @@ use crate::probes::camera_axes;
 use glam::Vec3;
 use histencil_scene::{Camera, ParticleLayout, ParticleSystem};
 
-/// One vertex of the particle pass (`shaders/particle.vert`).
+/// One vertex of the particle pass (`crates/vk/shaders/particle.vert`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SpriteVertex {

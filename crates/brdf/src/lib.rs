@@ -1,5 +1,5 @@
 //! BRDF maths for histencil: one definition, spelled twice (here in Rust, generic over f32 and
-//! f64, and in GLSL under `shaders/include/brdf/`), held together by tests.
+//! f64, and in GLSL under `crates/vk/shaders/include/brdf/`), held together by tests.
 //!
 //! # Convention
 //! Every function returns `f_r * cos(theta_L)`: the reflected radiance for a directional light of

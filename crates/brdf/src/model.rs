@@ -1,5 +1,5 @@
 //! A BRDF with its parameters: parsed from a name and a JSON object, evaluated in f64 or f32,
-//! and packed for the GLSL spelling (`shaders/include/brdf/eval.glsl`).
+//! and packed for the GLSL spelling (`crates/vk/shaders/include/brdf/eval.glsl`).
 
 use crate::id::BrdfId;
 use crate::models;

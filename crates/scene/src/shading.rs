@@ -1,4 +1,4 @@
-//! The light code of `shaders/include/light.glsl` on the CPU, in f32: what arrives at a point
+//! The light code of `crates/vk/shaders/include/light.glsl` on the CPU, in f32: what arrives at a point
 //! from a light, and what a material reflects of it towards the eye. For estimates that must
 //! agree with what the GPU draws (the alpha lightmaps' parameter choice), not for references:
 //! BRDF accuracy is held by `histencil-brdf`'s f64 reference.

@@ -2,7 +2,7 @@
 //! `KHR_texture_transform`, sampler), and how a metallic-roughness texel modulates each BRDF.
 //!
 //! The renderer's G-buffer pass and its forward reference read a material's maps through one
-//! GLSL function (`shaders/include/material.glsl`), so the surface every technique lights is the
+//! GLSL function (`crates/vk/shaders/include/material.glsl`), so the surface every technique lights is the
 //! surface forward lights: textures change what is shaded, never the exactness of a technique.
 
 use histencil_brdf::Brdf;
@@ -202,7 +202,7 @@ const MAX_TEXTURED_EXPONENT: f64 = 1e4;
 /// - Lambert, Kajiya-Kay, Penner skin: unchanged (no roughness; fibre and skin parameters are
 ///   not what the texture describes).
 ///
-/// The GLSL spelling is `material_textured_params` in `shaders/include/material.glsl`.
+/// The GLSL spelling is `material_textured_params` in `crates/vk/shaders/include/material.glsl`.
 pub fn textured_brdf(brdf: Brdf, roughness: f32, metallic: f32) -> Brdf {
     let r = f64::from(roughness).clamp(0.0, 1.0);
     let m = f64::from(metallic).clamp(0.0, 1.0);

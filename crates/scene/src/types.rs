@@ -89,7 +89,7 @@ impl Object {
 /// radiance is `brdf.eval_tinted(tint, N, T, V, L) * incident`: `tint * brdf(N, T, V, L)` for
 /// the talk's models, and for glTF's metallic-roughness `tint` is the base colour, with a white
 /// dielectric specular ([`histencil_brdf::Parts`]); Kajiya-Kay's fibre tangent is the world +Y
-/// axis projected onto the surface (see `shaders/include/light.glsl`).
+/// axis projected onto the surface (see `crates/vk/shaders/include/light.glsl`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
     pub brdf: Brdf,

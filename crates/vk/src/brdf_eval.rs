@@ -1,4 +1,4 @@
-//! Evaluates BRDF cases on the GPU with the GLSL spelling (`shaders/brdf_eval.comp`), so the
+//! Evaluates BRDF cases on the GPU with the GLSL spelling (`crates/vk/shaders/brdf_eval.comp`), so the
 //! shipping shader code can be held to the f64 reference. One dispatch per call.
 
 use crate::compute::{pad, CaseKernel};
@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::shaders;
 use histencil_brdf::{Brdf, Parts, V3};
 
-/// std430 mirror of `BrdfCase` in `shaders/brdf_eval.comp`.
+/// std430 mirror of `BrdfCase` in `crates/vk/shaders/brdf_eval.comp`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuBrdfCase {

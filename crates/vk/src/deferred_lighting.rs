@@ -9,7 +9,7 @@
 //! slots and records into one again only after the GPU finished the frame that last used it
 //! (the engine's own fence per frame in flight does this).
 //!
-//! The G-buffer contract (`shaders/include/gbuffer_write.glsl` writes it, `gbuffer.glsl` reads
+//! The G-buffer contract (`crates/vk/shaders/include/gbuffer_write.glsl` writes it, `gbuffer.glsl` reads
 //! it): [`crate::GBUFFER_FORMATS`] in that order, each pixel's BRDF slot in the stencil's BRDF
 //! field with the culling bit clear ([`gbuffer_stencil_reference`]), standard or reversed depth as
 //! the [`ViewDesc`] says.

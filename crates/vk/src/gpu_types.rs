@@ -1,4 +1,4 @@
-//! The CPU side of the GPU data blocks. Each mirrors a GLSL block in `shaders/include` field for
+//! The CPU side of the GPU data blocks. Each mirrors a GLSL block in `crates/vk/shaders/include` field for
 //! field (std140 / std430 / push constants); the sizes are asserted in tests.
 
 use crate::shader_consts::LIGHT_KINDS;

@@ -3,7 +3,7 @@
 //! A frame is: G-buffer pass (surface attributes; each draw's BRDF slot into the stencil BRDF
 //! bits), lighting pass (light volumes with the talk's stencil depth culling, additive into an
 //! RGBA16F target), tonemap, readback. The forward reference draws the same scene with the same
-//! light code (`shaders/include/light.glsl`) per pixel, and is the ground truth for error figures.
+//! light code (`crates/vk/shaders/include/light.glsl`) per pixel, and is the ground truth for error figures.
 //!
 //! Everything is named (objects, allocations) and every pass sits in a debug label; barriers are
 //! derived in one place ([`access`]) from declared accesses. Tests run under the Khronos

@@ -1,5 +1,5 @@
 //! The LUT technique's tables on the GPU: every material's [`Lut`] baked by histencil-brdf,
-//! in one storage buffer of values with a header per table (`shaders/include/lut.glsl`), and an
+//! in one storage buffer of values with a header per table (`crates/vk/shaders/include/lut.glsl`), and an
 //! evaluator that runs the GLSL lookup on chosen directions so it can be held to
 //! [`Lut::lookup`].
 
@@ -14,7 +14,7 @@ use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, V3};
 
-/// std430 mirror of `LutTable` in `shaders/include/lut.glsl`.
+/// std430 mirror of `LutTable` in `crates/vk/shaders/include/lut.glsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuLutTable {
@@ -129,7 +129,7 @@ impl Drop for LutTables<'_> {
     }
 }
 
-/// std430 mirror of `LutCase` in `shaders/lut_eval.comp`.
+/// std430 mirror of `LutCase` in `crates/vk/shaders/lut_eval.comp`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuLutCase {

@@ -1,7 +1,7 @@
 //! Materials on the GPU: the scene's images as textures (sRGB where a base colour reads them,
 //! linear for the other maps; every mip level made on the CPU and uploaded through staging into
 //! device-local memory), their samplers, and one descriptor set per distinct set of maps, set 1
-//! of the mesh pipelines (`shaders/include/material.glsl`). Objects without maps share a set
+//! of the mesh pipelines (`crates/vk/shaders/include/material.glsl`). Objects without maps share a set
 //! whose maps are a white texel, which changes nothing.
 
 use crate::context::Context;

@@ -9,7 +9,7 @@ use crate::teardown::build;
 use ash::vk;
 
 /// The G-buffer's formats, in binding order: albedo, normal-depth, material
-/// (`shaders/include/gbuffer_write.glsl` says what each channel holds).
+/// (`crates/vk/shaders/include/gbuffer_write.glsl` says what each channel holds).
 pub const GBUFFER_FORMATS: [vk::Format; 3] = [
     vk::Format::R16G16B16A16_SFLOAT, // gbuffer-albedo
     vk::Format::R32G32B32A32_SFLOAT, // gbuffer-normal-depth

@@ -13,7 +13,7 @@
 //! angles: a dielectric's specular lobe is white. It is affine in the base colour, so it is
 //! returned in two parts, `f * N.L = base * tinted + white` ([`crate::Brdf::eval_parts`]), which
 //! the renderer combines with the surface's tint in one place (`brdf_eval_tinted` in
-//! `shaders/include/brdf/eval.glsl`, [`crate::Brdf::eval_tinted`]).
+//! `crates/vk/shaders/include/brdf/eval.glsl`, [`crate::Brdf::eval_tinted`]).
 
 use super::surface::{ggx_d, lit};
 use crate::vector::{add, c, dot, normalize, Real, V3};

@@ -8,7 +8,7 @@ use histencil_alpha::{bake_probes, fit_frame, EntityRegion, Probe, ProbeFrame, V
 use histencil_alpha::{AlphaEntity, AlphaEntityKind};
 use histencil_scene::{Light, Material, ParticleLayout};
 
-/// One entity's lightmap record: `AlphaEntity` in `shaders/include/alpha_entity.glsl` (std430,
+/// One entity's lightmap record: `AlphaEntity` in `crates/vk/shaders/include/alpha_entity.glsl` (std430,
 /// 208 bytes), which an engine's alpha shader reads to sample the atlas.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]

@@ -3,7 +3,7 @@
 //! that reaches it (one additive draw per pair, with the deferred pass's light code), in the
 //! caller's command buffer. The engine plans the regions with
 //! [`histencil_alpha::plan_regions`] and samples the atlas from its own alpha shaders through
-//! `shaders/include/lightmap_sample.glsl`, reading each entity's record from
+//! `crates/vk/shaders/include/lightmap_sample.glsl`, reading each entity's record from
 //! [`AlphaLightmaps::entity_buffer`].
 //!
 //! Frames in flight work as in [`crate::DeferredLighting`]: each slot has its own buffers and
