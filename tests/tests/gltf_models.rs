@@ -230,3 +230,83 @@ fn texture_settings_test_matches_its_sample_pass_column() {
         "single-sided rendering passed the double-sided row"
     );
 }
+
+/// The vertical shading gradient (upper half minus lower half, 8-bit luminance) of each of
+/// NormalTangentTest's 15 cell pairs, geometry cell then normal-mapped cell, lit by the
+/// default rig from the upper left, with every material made Lambert so the metal column
+/// shades too, at 256x256. `edit` changes the imported scene first.
+fn normal_tangent_gradients(edit: impl Fn(&mut Scene)) -> Vec<(f64, f64)> {
+    let dir = models().expect("checked by the caller");
+    let file = dir.join("NormalTangentTest/NormalTangentTest.gltf");
+    let (mut scene, _) = histencil_scene::with_default_lights(
+        histencil_scene::load_gltf(&file).unwrap(),
+        histencil_scene::DefaultLights::IfNone,
+    );
+    for object in &mut scene.objects {
+        object.material.brdf = histencil_brdf::Brdf::Lambert { rho: 1.0 };
+    }
+    edit(&mut scene);
+    let frame = histencil_tests::with_validated_context(|ctx| {
+        let mut renderer = histencil_vk::Renderer::new(ctx, scene, 256, 256).unwrap();
+        let readback = histencil_vk::Readback {
+            ldr: true,
+            ..histencil_vk::Readback::NONE
+        };
+        let images = renderer.render(histencil_vk::Shading::Forward, readback);
+        images.unwrap().images.ldr.unwrap()
+    });
+    let luminance = |x: u32, y: u32| {
+        let p = frame.get_pixel(x, y).0;
+        0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
+    };
+    let mean = |(x0, x1): (u32, u32), (y0, y1): (u32, u32)| {
+        let sum: f64 = (x0..x1)
+            .flat_map(|x| (y0..y1).map(move |y| (x, y)))
+            .map(|(x, y)| luminance(x, y))
+            .sum();
+        sum / f64::from((x1 - x0) * (y1 - y0))
+    };
+    let gradient = |xs: (u32, u32), (y0, y1): (u32, u32)| {
+        let middle = (y0 + y1) / 2;
+        mean(xs, (y0, middle)) - mean(xs, (middle, y1))
+    };
+    // Cells measured on the render: three column groups of pairs, five rows.
+    let pairs = [
+        ((41, 63), (67, 90)),
+        ((105, 124), (131, 150)),
+        ((165, 187), (191, 214)),
+    ];
+    let rows = [(46, 66), (79, 97), (109, 126), (138, 153), (164, 178)];
+    pairs
+        .iter()
+        .flat_map(|&(geometry, mapped)| rows.iter().map(move |&row| (geometry, mapped, row)))
+        .map(|(geometry, mapped, row)| (gradient(geometry, row), gradient(mapped, row)))
+        .collect()
+}
+
+/// NormalTangentTest (no TANGENT: histencil generates them) lights each normal-mapped cell as
+/// its geometry cell: both brighter at the top, toward the light. The README's "flipped Y"
+/// failure lights the mapped cells from below; flipping the generated tangents' handedness
+/// reproduces it, and the check catches that.
+#[test]
+fn normal_mapped_cells_are_lit_like_their_geometry_cells() {
+    if models().is_none() {
+        return;
+    }
+    let lit_alike = |pairs: &[(f64, f64)]| {
+        pairs
+            .iter()
+            .all(|&(geometry, mapped)| geometry > 5.0 && mapped > 5.0)
+    };
+    let pairs = normal_tangent_gradients(|_| {});
+    assert!(lit_alike(&pairs), "{pairs:?}");
+    let flipped = normal_tangent_gradients(|scene| {
+        for mesh in &mut scene.meshes {
+            for v in &mut mesh.vertices {
+                v.tangent[3] = -v.tangent[3];
+            }
+        }
+    });
+    assert!(!lit_alike(&flipped), "flipped tangents pass: {flipped:?}");
+    println!("correct {pairs:.0?}\nflipped {flipped:.0?}");
+}
