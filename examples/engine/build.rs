@@ -1,29 +1,41 @@
-//! The engine's own shaders, compiled with glslc. `gbuffer.frag` includes histencil's
-//! `gbuffer_write.glsl` and the alpha shaders its `lightmap_sample.glsl`; histencil-vk says where
-//! they are (DEP_HISTENCIL_GLSL_INCLUDE).
+//! The engine's own shaders, compiled with glslc, and histencil's light shaders compiled with the
+//! engine's decode hook (`shaders/histencil_hooks`) by histencil_build. `gbuffer.frag` includes
+//! histencil's `gbuffer_write.glsl` and the alpha shaders its `lightmap_sample.glsl`; histencil-vk
+//! says where they are (DEP_HISTENCIL_GLSL_INCLUDE, and DEP_HISTENCIL_GLSL_GENERATED for the
+//! BRDF ids the compact G-buffer names).
 
 use std::path::PathBuf;
 
 fn main() {
     let include = std::env::var("DEP_HISTENCIL_GLSL_INCLUDE")
         .expect("histencil-vk publishes its GLSL include folder");
+    let generated = std::env::var("DEP_HISTENCIL_GLSL_GENERATED")
+        .expect("histencil-vk publishes its generated GLSL");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     let glslc = std::env::var("HISTENCIL_GLSLC").unwrap_or_else(|_| "glslc".into());
-    println!("cargo:rerun-if-changed=shaders/alpha.glsl");
+    for shared in ["alpha.glsl", "histencil_hooks/compact_gbuffer.glsl"] {
+        println!("cargo:rerun-if-changed=shaders/{shared}");
+    }
+    // (output, source, defines): the compact G-buffer's vertex stage is gbuffer.vert without
+    // the linear depth output.
     let stages = [
-        "gbuffer.vert",
-        "gbuffer.frag",
-        "alpha_object.vert",
-        "alpha_object.frag",
-        "particle.vert",
-        "particle.frag",
+        ("gbuffer.vert", "gbuffer.vert", None),
+        ("gbuffer_compact.vert", "gbuffer.vert", Some("-DCOMPACT")),
+        ("gbuffer.frag", "gbuffer.frag", None),
+        ("gbuffer_compact.frag", "gbuffer_compact.frag", None),
+        ("alpha_object.vert", "alpha_object.vert", None),
+        ("alpha_object.frag", "alpha_object.frag", None),
+        ("particle.vert", "particle.vert", None),
+        ("particle.frag", "particle.frag", None),
     ];
-    for name in stages {
-        let source = format!("shaders/{name}");
+    for (name, source, define) in stages {
+        let source = format!("shaders/{source}");
         println!("cargo:rerun-if-changed={source}");
         let status = std::process::Command::new(&glslc)
             .args(["--target-env=vulkan1.3", "-O", "-Werror"])
+            .args(define)
             .arg(format!("-I{include}"))
+            .arg(format!("-I{generated}"))
             .arg(&source)
             .arg("-o")
             .arg(out.join(format!("{name}.spv")))
@@ -31,4 +43,8 @@ fn main() {
             .expect("glslc (apt install glslc, or the Vulkan SDK)");
         assert!(status.success(), "glslc failed on {source}");
     }
+    // histencil's light shaders with the engine's decode hook, which includes the layout beside
+    // it (histencil_hooks/compact_gbuffer.glsl, shared with gbuffer_compact.frag).
+    let hooks = std::path::Path::new("shaders/histencil_hooks");
+    histencil_build::compile_light_shaders(hooks, &out).unwrap_or_else(|e| panic!("{e}"));
 }

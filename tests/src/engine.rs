@@ -399,7 +399,9 @@ impl EngineTargets {
     /// As histencil sees them, before anything touched them.
     pub fn refs(&self) -> histencil_vk::LightingTargets {
         histencil_vk::LightingTargets {
-            gbuffer: [0, 1, 2].map(|i| self.gbuffer[i].as_ref(ImageState::UNDEFINED)),
+            gbuffer: (0..3)
+                .map(|i| self.gbuffer[i].as_ref(ImageState::UNDEFINED))
+                .collect(),
             depth_stencil: self.depth.as_ref(ImageState::UNDEFINED),
             hdr: self.hdr.as_ref(ImageState::UNDEFINED),
         }

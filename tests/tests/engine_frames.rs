@@ -10,8 +10,8 @@ use glam::Vec3;
 use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
 use histencil_tests::engine::{barrier, copy_to_buffer, Engine};
 use histencil_vk::{
-    Backend, BrdfSource, Context, DeferredLighting, ImageState, LightingDesc, LightingFrame,
-    LightingTargets, Readback, Renderer, Technique,
+    Backend, BrdfSource, Context, DeferredLighting, HookSets, ImageState, LightHooks, LightingDesc,
+    LightingFrame, LightingTargets, Readback, Renderer, Technique,
 };
 
 const WIDTH: u32 = 96;
@@ -94,6 +94,7 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
                 frames_in_flight: IN_FLIGHT as u32,
                 max_lights: scene.lights.len() as u32,
                 hi_stencil: true,
+                hooks: LightHooks::Builtin,
             },
         )
         .unwrap();
@@ -166,6 +167,7 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
                     timestamps: f == FRAMES - 1 || f == FRAMES - 4,
                     brdf_source: BrdfSource::Formula,
                     tile_stats: false,
+                    hook_sets: HookSets::default(),
                 };
                 lighting.record(slot.cmd, &frame, &mut targets).unwrap();
                 if f == FRAMES - 1 {
@@ -287,6 +289,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             frames_in_flight: 2,
             max_lights: scene.lights.len() as u32,
             hi_stencil: true,
+            hooks: LightHooks::Builtin,
         };
         let bad_descs = [
             LightingDesc {
@@ -352,6 +355,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             timestamps: false,
             brdf_source: BrdfSource::Formula,
             tile_stats: false,
+            hook_sets: HookSets::default(),
         };
         let reversed = histencil_model::ViewDesc {
             depth: histencil_model::DepthConvention::Reversed,
@@ -362,14 +366,14 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
         orthographic.view_to_clip[3][3] = 1.0;
         let few_lights = &scene.lights[..2];
         let cases: Vec<(&str, LightingFrame, LightingTargets)> = vec![
-            ("slot", LightingFrame { slot: 2, ..frame }, targets),
+            ("slot", LightingFrame { slot: 2, ..frame }, targets.clone()),
             (
                 "plan lights input",
                 LightingFrame {
                     lights: few_lights,
                     ..frame
                 },
-                targets,
+                targets.clone(),
             ),
             (
                 "depth",
@@ -377,7 +381,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
                     view: &reversed,
                     ..frame
                 },
-                targets,
+                targets.clone(),
             ),
             (
                 "perspective",
@@ -385,22 +389,22 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
                     view: &orthographic,
                     ..frame
                 },
-                targets,
+                targets.clone(),
             ),
             (
                 "is 8x8",
                 frame,
                 LightingTargets {
                     hdr: small.as_ref(ImageState::UNDEFINED),
-                    ..targets
+                    ..targets.clone()
                 },
             ),
             (
                 "expects",
                 frame,
                 LightingTargets {
-                    gbuffer: [targets.gbuffer[1], targets.gbuffer[0], targets.gbuffer[2]],
-                    ..targets
+                    gbuffer: vec![targets.gbuffer[1], targets.gbuffer[0], targets.gbuffer[2]],
+                    ..targets.clone()
                 },
             ),
         ];
@@ -410,7 +414,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
                 .unwrap();
             for (expected, frame, mut targets) in cases {
-                let before = targets;
+                let before = targets.clone();
                 let err = lighting
                     .record(cmd, &frame, &mut targets)
                     .expect_err(expected);
@@ -434,6 +438,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             &ctx,
             &LightingDesc {
                 hi_stencil: false,
+                hooks: LightHooks::Builtin,
                 ..desc.clone()
             },
         )
@@ -469,6 +474,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
                     "statistics",
                     LightingFrame {
                         tile_stats: true,
+                        hook_sets: HookSets::default(),
                         ..frame
                     },
                 ),
@@ -541,6 +547,7 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
                 frames_in_flight: 1,
                 max_lights: scene.lights.len() as u32,
                 hi_stencil: true,
+                hooks: LightHooks::Builtin,
             },
         )
         .unwrap();
@@ -561,6 +568,7 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
             timestamps: false,
             brdf_source: BrdfSource::Table,
             tile_stats: true,
+            hook_sets: HookSets::default(),
         };
         let d = &engine.device;
         unsafe {
@@ -654,6 +662,7 @@ fn a_lighting_in_another_depth_format_than_the_context_was_lent_is_refused() {
             frames_in_flight: 1,
             max_lights: scene.lights.len() as u32,
             hi_stencil: false,
+            hooks: LightHooks::Builtin,
         };
         let in_use = ctx.memory_in_use();
         let err = DeferredLighting::new(&ctx, &desc).err().expect("refused");

@@ -9,8 +9,8 @@ use histencil_brdf::BrdfId;
 use histencil_model::StencilLayout;
 use histencil_tests::engine::Engine;
 use histencil_vk::{
-    AlphaLightmaps, AlphaLightmapsDesc, BorrowedDevice, Context, DeferredLighting, LightingDesc,
-    LutTables,
+    AlphaLightmaps, AlphaLightmapsDesc, BorrowedDevice, Context, DeferredLighting, LightHooks,
+    LightingDesc, LutTables,
 };
 
 #[test]
@@ -40,6 +40,7 @@ fn making_and_freeing_the_engine_facing_parts_uses_no_queue() {
                 frames_in_flight: 2,
                 max_lights: 8,
                 hi_stencil: true,
+                hooks: LightHooks::Builtin,
             },
         )
         .expect("lighting");

@@ -2,9 +2,12 @@
 // Deferred light shader for one light. SHADED_BRDF picks the BRDF at pipeline creation: a
 // BRDF_* id gives the talk's per-BRDF shader (the stencil test guarantees the pixel's BRDF), and
 // BRANCH_ON_GBUFFER gives the uber shader that branches on the G-buffer's id.
-// The hi-stencil emulation's work: include/light_tiles.glsl.
+// The hi-stencil emulation's work: include/light_tiles.glsl. The surface comes from the decode
+// hook and each light is scaled by the visibility hook (hooks/: histencil's G-buffer and no
+// shadows, unless an engine compiled this with its own; histencil_build).
 #include "light.glsl"
-#include "gbuffer.glsl"
+#include "surface_decode.glsl"
+#include "light_visibility.glsl"
 #include "light_tiles.glsl"
 
 layout(early_fragment_tests) in;
@@ -19,7 +22,7 @@ void main() {
         discard;
     }
     Surface s;
-    if (!gbuffer_load(gl_FragCoord.xy, s)) {
+    if (!decode_surface(gl_FragCoord.xy, s)) {
         out_color = vec4(0.0);
         return;
     }
@@ -34,5 +37,11 @@ void main() {
         model = SHADED_BRDF;
         break;
     }
-    out_color = vec4(shade_light_with(lights[light_draw.light_index], s, model), 0.0);
+    uint index = light_draw.light_index;
+    Light light = lights[index];
+    vec3 lit = shade_light_with(light, s, model);
+    if (any(greaterThan(lit, vec3(0.0)))) {
+        lit *= light_visibility(index, light, s);
+    }
+    out_color = vec4(lit, 0.0);
 }

@@ -4,7 +4,8 @@
 // hi-stencil work are the branching shader's; only `f_r * cos` comes from the table, indexed by
 // the material index the G-buffer stores in albedo alpha.
 #include "light.glsl"
-#include "gbuffer.glsl"
+#include "surface_decode.glsl"
+#include "light_visibility.glsl"
 #include "light_tiles.glsl"
 #define LUT_SET 3
 #define LUT_BINDING 0
@@ -19,17 +20,19 @@ void main() {
         discard;
     }
     Surface s;
-    if (!gbuffer_load(gl_FragCoord.xy, s)) {
+    if (!decode_surface(gl_FragCoord.xy, s)) {
         out_color = vec4(0.0);
         return;
     }
+    uint index = light_draw.light_index;
+    Light light = lights[index];
     vec3 L;
-    vec3 incident = light_incident(lights[light_draw.light_index], s.position, L);
+    vec3 incident = light_incident(light, s.position, L);
     if (all(equal(incident, vec3(0.0)))) {
         out_color = vec4(0.0);
         return;
     }
     vec3 V = normalize(frame.eye.xyz - s.position);
-    vec3 f = lut_lookup(gbuffer_material_index(gl_FragCoord.xy), s.normal, fibre_tangent(s.normal), V, L);
-    out_color = vec4(incident * (s.tint * f), 0.0);
+    vec3 f = lut_lookup(decode_lut_material(gl_FragCoord.xy), s.normal, fibre_tangent(s.normal), V, L);
+    out_color = vec4(incident * (s.tint * f) * light_visibility(index, light, s), 0.0);
 }

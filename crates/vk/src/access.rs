@@ -60,12 +60,19 @@ impl ImageRef {
 /// The caller's images a frame is lit in, each with its current state. Recording leaves every
 /// [`ImageRef::state`] as the recorded commands leave the image, for the caller's next barrier:
 /// the G-buffer images sampled by fragment shaders, the depth-stencil and HDR images attached.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct LightingTargets {
-    /// Albedo, normal-depth, material, in [`crate::GBUFFER_FORMATS`]; usage `SAMPLED`.
-    pub gbuffer: [ImageRef; 3],
+    /// The images the decode hook reads, each barriered for fragment-shader reads
+    /// (`SHADER_READ_ONLY_OPTIMAL`), usage `SAMPLED`. With histencil's built-in decode: albedo,
+    /// normal-depth, material, in [`crate::GBUFFER_FORMATS`]. With an engine's decode hook
+    /// ([`crate::LightHooks::Engine`]): the engine's own images, any number and formats, read
+    /// through the engine's decode set.
+    pub gbuffer: Vec<ImageRef>,
     /// The G-buffer pass's depth and stencil; usage `DEPTH_STENCIL_ATTACHMENT | TRANSFER_SRC`
-    /// (the hi-stencil emulation and 360-like save/restore copy the stencil out).
+    /// (the hi-stencil emulation and 360-like save/restore copy the stencil out), and `SAMPLED`
+    /// where an engine's decode hook reads depth. With an engine's decode hook the light passes
+    /// attach it in `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`, so the decode may sample its
+    /// depth aspect (through a depth-only view of the engine's).
     pub depth_stencil: ImageRef,
     /// Where light accumulates; usage `COLOR_ATTACHMENT`.
     pub hdr: ImageRef,
@@ -102,6 +109,9 @@ pub enum ImageAccess {
     ColorAttachment,
     /// Depth and stencil tested and written as the depth-stencil attachment.
     DepthStencilAttachment,
+    /// Stencil tested and written as the attachment while its depth aspect is read-only:
+    /// depth tested, and sampled by fragment shaders through a depth-aspect view.
+    StencilAttachmentDepthSampled,
     /// Read by fragment shaders.
     FragmentSampled,
     /// Source of a copy to a buffer.
@@ -124,6 +134,11 @@ pub fn access_info(
             vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
             S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
             A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
+        ),
+        ImageAccess::StencilAttachmentDepthSampled => (
+            vk::ImageLayout::DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL,
+            S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS | S::FRAGMENT_SHADER,
+            A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE | A::SHADER_READ,
         ),
         ImageAccess::FragmentSampled => (
             vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,

@@ -125,6 +125,8 @@ pub struct Context {
     pub(crate) timestamp_period_ns: f64,
     pub(crate) max_image_dimension: u32,
     pub(crate) max_storage_buffer_range: u32,
+    /// How many descriptor sets a pipeline layout may hold (an engine's visibility hook needs 5).
+    pub(crate) max_bound_descriptor_sets: u32,
     pub(crate) memory: MemoryAccount,
 }
 
@@ -383,6 +385,7 @@ impl Context {
             timestamp_period_ns: f64::from(limits.timestamp_period),
             max_image_dimension: limits.max_image_dimension2_d,
             max_storage_buffer_range: limits.max_storage_buffer_range,
+            max_bound_descriptor_sets: limits.max_bound_descriptor_sets,
             memory: MemoryAccount::new(desc.memory_budget),
         };
         ctx.name(ctx.device.handle(), "histencil-device");
@@ -470,6 +473,7 @@ impl Context {
             timestamp_period_ns: f64::from(props.limits.timestamp_period),
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
+            max_bound_descriptor_sets: props.limits.max_bound_descriptor_sets,
             memory: MemoryAccount::new(memory_budget),
         })
     }

@@ -23,6 +23,7 @@ use crate::descriptors::{
 use crate::error::{Error, Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight, PUSH_CONSTANT_BYTES};
 use crate::hi_stencil::HiStencilSurface;
+use crate::hooks::{HookSets, LightHooks};
 use crate::meshes::LightVolumes;
 use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
 use crate::passes::lighting::LightingPass;
@@ -57,6 +58,9 @@ pub struct LightingDesc {
     /// save/restore): a word per 8x8 tile and two bytes per pixel of scratch. Without it only
     /// plans for the native backend can be recorded.
     pub hi_stencil: bool,
+    /// Where the light shaders get each pixel's surface and each light's visibility:
+    /// histencil's G-buffer and no shadows, or the engine's hooks ([`crate::EngineHooks`]).
+    pub hooks: LightHooks,
 }
 
 /// One frame's lighting.
@@ -81,6 +85,8 @@ pub struct LightingFrame<'a> {
     /// Count hi-stencil tiles tested and culled and fragments shaded
     /// ([`DeferredLighting::tile_stats`]); needs `LightingDesc::hi_stencil`.
     pub tile_stats: bool,
+    /// The engine's sets for its hooks (none with histencil's built-in hooks).
+    pub hook_sets: HookSets,
 }
 
 /// The per-frame-in-flight part: buffers the host writes at record time and the sets that point
@@ -89,6 +95,7 @@ struct Slot {
     uniforms: Buffer,
     lights: Buffer,
     frame_set: vk::DescriptorSet,
+    /// histencil's G-buffer set; null with an engine's decode hook.
     gbuffer_set: vk::DescriptorSet,
     timer: SlotTimer,
 }
@@ -106,7 +113,7 @@ struct Slot {
 /// };
 /// use histencil_scene::Light;
 /// use histencil_vk::{
-///     Backend, BrdfSource, DeferredLighting, ImageRef, LightingFrame, LightingTargets,
+///     Backend, BrdfSource, DeferredLighting, HookSets, ImageRef, LightingFrame, LightingTargets,
 /// };
 ///
 /// /// `gbuffer`, `depth_stencil` and `hdr` carry the states the engine's barriers left.
@@ -117,7 +124,7 @@ struct Slot {
 ///     view: &ViewDesc,
 ///     lights: &[Light],
 ///     brdf_bounds: &[Vec<histencil_model::Aabb>],
-///     images: ([ImageRef; 3], ImageRef, ImageRef),
+///     images: (Vec<ImageRef>, ImageRef, ImageRef),
 /// ) -> Result<LightingTargets, Box<dyn std::error::Error>> {
 ///     let layout: StencilLayout = lighting.desc().layout;
 ///     let shapes: Vec<_> = lights.iter().map(Light::shape).collect();
@@ -143,6 +150,7 @@ struct Slot {
 ///         timestamps: false,
 ///         brdf_source: BrdfSource::Formula,
 ///         tile_stats: false,
+///         hook_sets: HookSets::default(),
 ///     };
 ///     // SAFETY: `cmd` is recording on the lighting's device, the images' states are true, and
 ///     // the frame two frames ago (the last one in this slot) has finished on the GPU.
@@ -153,7 +161,8 @@ struct Slot {
 pub struct DeferredLighting<'c> {
     ctx: &'c Context,
     desc: LightingDesc,
-    /// Frame, G-buffer, hi-stencil and LUT set layouts: sets 0 to 3 of every light pipeline.
+    /// Frame, G-buffer, hi-stencil and LUT set layouts: sets 0 to 3 of every light pipeline
+    /// (with an engine's decode hook, set 1 is the engine's layout and this one stays null).
     set_layouts: [vk::DescriptorSetLayout; 4],
     pipeline_layout: vk::PipelineLayout,
     pool: vk::DescriptorPool,
@@ -191,6 +200,7 @@ impl<'c> DeferredLighting<'c> {
     /// flight or too many BRDFs for the layout; Vulkan and allocation errors.
     pub fn new(ctx: &'c Context, desc: &LightingDesc) -> Result<Self> {
         check_desc(desc)?;
+        desc.hooks.check(ctx)?;
         if ctx.depth_stencil_named && desc.depth_stencil_format != ctx.depth_stencil_format {
             return Err(bad(format!(
                 "depth-stencil format {:?}, but the context was lent {:?} \
@@ -213,6 +223,7 @@ impl<'c> DeferredLighting<'c> {
             in_flight: InFlight::default(),
             pipelines: LightPipelines::new(
                 vk::PipelineLayout::null(),
+                desc.hooks.modules(),
                 desc.hdr_format,
                 desc.depth_stencil_format,
             ),
@@ -230,18 +241,29 @@ impl<'c> DeferredLighting<'c> {
             ("hi-stencil-set-layout", HI_STENCIL_SET),
             ("lut-set-layout", LUT_SET),
         ];
+        let hooks = self.desc.hooks;
+        let builtin = matches!(hooks, LightHooks::Builtin);
         for (i, (name, set)) in named.into_iter().enumerate() {
+            if i == 1 && !builtin {
+                continue;
+            }
             self.set_layouts[i] = create_set_layout(ctx, name, set, GRAPHICS_STAGES)?;
+        }
+        let mut layouts = self.set_layouts.to_vec();
+        if let LightHooks::Engine(engine) = hooks {
+            layouts[1] = engine.decode_layout;
+            layouts.extend(engine.visibility_layout);
         }
         self.pipeline_layout = create_pipeline_layout(
             ctx,
             "lighting-pipeline-layout",
-            &self.set_layouts,
+            &layouts,
             GRAPHICS_STAGES,
             PUSH_CONSTANT_BYTES,
         )?;
         self.pipelines = LightPipelines::new(
             self.pipeline_layout,
+            hooks.modules(),
             self.desc.hdr_format,
             self.desc.depth_stencil_format,
         );
@@ -271,8 +293,9 @@ impl<'c> DeferredLighting<'c> {
                 .ty(vk::DescriptorType::SAMPLED_IMAGE)
                 .descriptor_count(slots * GBUFFER_SET.len() as u32),
         ];
+        let sets_per_slot = if builtin { 2 } else { 1 };
         let info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(2 * slots + 2)
+            .max_sets(sets_per_slot * slots + 2)
             .pool_sizes(&sizes);
         self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
             .call("vkCreateDescriptorPool")?;
@@ -280,7 +303,10 @@ impl<'c> DeferredLighting<'c> {
         let [frame_layout, gbuffer_layout, hi_stencil_layout, lut_layout] = self.set_layouts;
         let mut layouts = vec![hi_stencil_layout, lut_layout];
         for _ in 0..slots {
-            layouts.extend([frame_layout, gbuffer_layout]);
+            layouts.push(frame_layout);
+            if builtin {
+                layouts.push(gbuffer_layout);
+            }
         }
         let alloc = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(self.pool)
@@ -295,10 +321,13 @@ impl<'c> DeferredLighting<'c> {
         self.lut_set = sets[1];
 
         let light_bytes = u64::from(self.desc.max_lights.max(1)) * size_of::<GpuLight>() as u64;
-        for (i, pair) in sets[2..].chunks(2).enumerate() {
-            let (frame_set, gbuffer_set) = (pair[0], pair[1]);
+        for (i, pair) in sets[2..].chunks(sets_per_slot as usize).enumerate() {
+            let frame_set = pair[0];
+            let gbuffer_set = pair.get(1).copied().unwrap_or_default();
             ctx.name(frame_set, &format!("lighting-frame-set-{i}"));
-            ctx.name(gbuffer_set, &format!("lighting-gbuffer-set-{i}"));
+            if builtin {
+                ctx.name(gbuffer_set, &format!("lighting-gbuffer-set-{i}"));
+            }
             let uniforms = Buffer::new(
                 ctx,
                 &format!("lighting-uniforms-{i}"),
@@ -432,13 +461,27 @@ fn check_frame(
         }
         Ok(())
     };
-    let names = [
-        "G-buffer albedo",
-        "G-buffer normal-depth",
-        "G-buffer material",
-    ];
-    for ((image, name), format) in targets.gbuffer.iter().zip(names).zip(GBUFFER_FORMATS) {
-        expect(name, image, format)?;
+    desc.hooks.check_sets(&frame.hook_sets)?;
+    if let LightHooks::Builtin = desc.hooks {
+        let names = [
+            "G-buffer albedo",
+            "G-buffer normal-depth",
+            "G-buffer material",
+        ];
+        if targets.gbuffer.len() != names.len() {
+            return Err(bad(format!(
+                "{} G-buffer images, and histencil's G-buffer has {}",
+                targets.gbuffer.len(),
+                names.len()
+            )));
+        }
+        for ((image, name), format) in targets.gbuffer.iter().zip(names).zip(GBUFFER_FORMATS) {
+            expect(name, image, format)?;
+        }
+    } else {
+        for (i, image) in targets.gbuffer.iter().enumerate() {
+            expect(&format!("surface image {i}"), image, image.format)?;
+        }
     }
     expect(
         "the depth-stencil target",
@@ -526,8 +569,15 @@ impl DeferredLighting<'_> {
         slot.uniforms.write(bytemuck::bytes_of(&uniforms));
         let gpu_lights: Vec<GpuLight> = frame.lights.iter().map(GpuLight::new).collect();
         slot.lights.write(bytemuck::cast_slice(&gpu_lights));
-        write_sampled_images(ctx, slot.gbuffer_set, &targets.gbuffer.map(|g| g.view));
-        let mut sets = vec![slot.frame_set, slot.gbuffer_set, self.hi_stencil_set];
+        let decode_set = match frame.hook_sets.decode {
+            Some(set) => set,
+            None => {
+                let views: Vec<vk::ImageView> = targets.gbuffer.iter().map(|g| g.view).collect();
+                write_sampled_images(ctx, slot.gbuffer_set, &views);
+                slot.gbuffer_set
+            }
+        };
+        let mut sets = vec![slot.frame_set, decode_set, self.hi_stencil_set];
         if source == BrdfSource::Table {
             sets.push(self.lut_set);
         }
@@ -541,10 +591,12 @@ impl DeferredLighting<'_> {
             pipelines: &self.pipelines,
             pipeline_layout: self.pipeline_layout,
             sets: &sets,
+            visibility_set: frame.hook_sets.visibility,
             brdf_source: source,
             extent: self.desc.extent,
             count_stats,
             clear_hdr: frame.clear_hdr,
+            depth_sampled: self.desc.hooks.samples_depth(),
         };
         let timer = slot.timer.active();
         self.in_flight.mark();
@@ -637,6 +689,7 @@ impl Drop for DeferredLighting<'_> {
         unsafe {
             d.destroy_descriptor_pool(self.pool, None);
             d.destroy_pipeline_layout(self.pipeline_layout, None);
+            // The null ones (set 1 with an engine's decode hook) are no-ops.
             for l in self.set_layouts {
                 d.destroy_descriptor_set_layout(l, None);
             }

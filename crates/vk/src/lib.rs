@@ -21,6 +21,7 @@ pub mod descriptors;
 mod error;
 pub mod gpu_types;
 mod hi_stencil;
+mod hooks;
 mod image_error;
 mod lut;
 mod materials;
@@ -60,6 +61,7 @@ pub use deferred_lighting::{
 pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;
 pub use histencil_model::{CostModel, FlushPolicy, TileStats};
+pub use hooks::{EngineHooks, HookSets, LightHooks, LightModules};
 pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
 pub use materials::{

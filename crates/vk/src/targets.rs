@@ -84,7 +84,7 @@ impl Targets {
     /// The targets the lighting records against, with their current states.
     pub fn lighting(&self) -> LightingTargets {
         LightingTargets {
-            gbuffer: [*self.gbuffer[0], *self.gbuffer[1], *self.gbuffer[2]],
+            gbuffer: vec![*self.gbuffer[0], *self.gbuffer[1], *self.gbuffer[2]],
             depth_stencil: *self.depth_stencil,
             hdr: *self.hdr,
         }

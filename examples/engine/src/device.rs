@@ -247,6 +247,20 @@ impl Gpu {
         Buffer { buffer, allocation }
     }
 
+    /// A view of the depth aspect alone of a depth-stencil `image`, for sampling depth.
+    pub fn depth_view(&self, image: &Image) -> vk::ImageView {
+        let range = vk::ImageSubresourceRange::default()
+            .aspect_mask(vk::ImageAspectFlags::DEPTH)
+            .level_count(1)
+            .layer_count(1);
+        let info = vk::ImageViewCreateInfo::default()
+            .image(image.target.image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(image.target.format)
+            .subresource_range(range);
+        unsafe { self.device.create_image_view(&info, None) }.expect("depth view")
+    }
+
     pub fn free_image(&self, image: Image) {
         unsafe {
             self.device.destroy_image_view(image.target.view, None);

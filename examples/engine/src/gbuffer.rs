@@ -1,6 +1,8 @@
-//! The engine's G-buffer pass: its own shaders (writing histencil's contract through
-//! `gbuffer_write.glsl`), reversed-Z depth, and each draw's stencil: the BRDF slot where
-//! histencil's layout puts it, the engine's own bits where the engine keeps them.
+//! The engine's G-buffer pass: its own shaders, writing either its own compact layout
+//! (`shaders/histencil_hooks/compact_gbuffer.glsl`, which histencil's light shaders read through
+//! the engine's decode hook) or histencil's contract (`gbuffer_write.glsl`); reversed-Z depth,
+//! and each draw's stencil: the BRDF slot where histencil's layout puts it, the engine's own bits
+//! where the engine keeps them.
 
 use crate::device::{barrier, graphics_pipeline, Gpu, GpuMesh, PipelineSpec};
 use crate::world::World;
@@ -28,7 +30,43 @@ struct DrawPush {
     brdf: [f32; 4],
 }
 
+/// Which G-buffer layout a pass writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GBufferKind {
+    /// The engine's own: two targets, 12 bytes per pixel, depth from the depth attachment.
+    Compact,
+    /// histencil's contract: three targets, 40 bytes per pixel.
+    Histencil,
+}
+
+/// The compact layout's targets (compact_gbuffer.glsl).
+pub const COMPACT_FORMATS: [vk::Format; 2] =
+    [vk::Format::R8G8B8A8_UNORM, vk::Format::R16G16B16A16_UNORM];
+
+impl GBufferKind {
+    pub fn formats(self) -> &'static [vk::Format] {
+        match self {
+            GBufferKind::Compact => &COMPACT_FORMATS,
+            GBufferKind::Histencil => &GBUFFER_FORMATS,
+        }
+    }
+
+    /// Bytes per pixel of the colour targets (the depth-stencil is the same for both).
+    pub fn bytes_per_pixel(self) -> u32 {
+        self.formats()
+            .iter()
+            .map(|f| match *f {
+                vk::Format::R8G8B8A8_UNORM => 4,
+                vk::Format::R16G16B16A16_UNORM | vk::Format::R16G16B16A16_SFLOAT => 8,
+                vk::Format::R32G32B32A32_SFLOAT => 16,
+                other => panic!("no size for {other:?}"),
+            })
+            .sum()
+    }
+}
+
 pub struct GBufferPass {
+    pub kind: GBufferKind,
     pub set_layout: vk::DescriptorSetLayout,
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
@@ -36,7 +74,7 @@ pub struct GBufferPass {
 }
 
 impl GBufferPass {
-    pub fn new(gpu: &Gpu) -> Self {
+    pub fn new(gpu: &Gpu, kind: GBufferKind) -> Self {
         let d = &gpu.device;
         let binding = [vk::DescriptorSetLayoutBinding::default()
             .binding(0)
@@ -68,16 +106,26 @@ impl GBufferPass {
             .pass_op(vk::StencilOp::REPLACE)
             .compare_mask(0xFF);
         let f32x3 = vk::Format::R32G32B32_SFLOAT;
-        let blend = [vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA); 3];
+        let blend = vec![
+            vk::PipelineColorBlendAttachmentState::default()
+                .color_write_mask(vk::ColorComponentFlags::RGBA);
+            kind.formats().len()
+        ];
+        let (vertex, fragment): (&[u8], &[u8]) = match kind {
+            GBufferKind::Compact => (
+                include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer_compact.vert.spv")),
+                include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer_compact.frag.spv")),
+            ),
+            GBufferKind::Histencil => (
+                include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer.vert.spv")),
+                include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer.frag.spv")),
+            ),
+        };
         let pipeline = graphics_pipeline(
             d,
             layout,
             &PipelineSpec {
-                shaders: (
-                    include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer.vert.spv")),
-                    include_bytes!(concat!(env!("OUT_DIR"), "/gbuffer.frag.spv")),
-                ),
+                shaders: (vertex, fragment),
                 // histencil_scene's vertex: position, normal, uv (32 bytes).
                 vertex: (32, &[(f32x3, 0), (f32x3, 12)]),
                 cull: vk::CullModeFlags::BACK,
@@ -90,7 +138,7 @@ impl GBufferPass {
                     .front(stencil)
                     .back(stencil),
                 blend: &blend,
-                color_formats: &GBUFFER_FORMATS,
+                color_formats: kind.formats(),
                 dynamic: &[
                     vk::DynamicState::STENCIL_REFERENCE,
                     vk::DynamicState::STENCIL_WRITE_MASK,
@@ -98,6 +146,7 @@ impl GBufferPass {
             },
         );
         Self {
+            kind,
             set_layout,
             layout,
             pipeline,
@@ -114,7 +163,7 @@ impl GBufferPass {
         camera_set: vk::DescriptorSet,
         world: &World,
         layout: &StencilLayout,
-        gbuffer: &mut [ImageRef; 3],
+        gbuffer: &mut [ImageRef],
         depth_stencil: &mut ImageRef,
     ) {
         let color = ImageState {
@@ -138,12 +187,16 @@ impl GBufferPass {
         let clear = |c: [f32; 4]| vk::ClearValue {
             color: vk::ClearColorValue { float32: c },
         };
-        // The contract's clears: material w = -1 is "no geometry".
-        let clears = [
-            clear([0.0; 4]),
-            clear([0.0; 4]),
-            clear([0.0, 0.0, 0.0, -1.0]),
-        ];
+        // histencil's contract: material w = -1 is "no geometry"; the compact layout marks it
+        // by the far plane's depth.
+        let clears = match self.kind {
+            GBufferKind::Histencil => vec![
+                clear([0.0; 4]),
+                clear([0.0; 4]),
+                clear([0.0, 0.0, 0.0, -1.0]),
+            ],
+            GBufferKind::Compact => vec![clear([0.0; 4]); 2],
+        };
         let colors: Vec<_> = gbuffer
             .iter()
             .zip(clears)
@@ -232,5 +285,102 @@ impl GBufferPass {
                 .destroy_descriptor_set_layout(self.set_layout, None);
         }
         gpu.free_mesh(self.unit_box);
+    }
+}
+
+/// The engine's decode hook's descriptor sets: its two compact targets and the depth aspect of
+/// its depth-stencil image, one set per frame in flight (the images are the same every frame).
+pub struct CompactDecode {
+    pub set_layout: vk::DescriptorSetLayout,
+    pool: vk::DescriptorPool,
+    pub sets: Vec<vk::DescriptorSet>,
+}
+
+impl CompactDecode {
+    /// `depth_view` is a depth-aspect view of the depth-stencil image.
+    pub fn new(
+        gpu: &Gpu,
+        in_flight: usize,
+        targets: &[ImageRef],
+        depth_view: vk::ImageView,
+    ) -> Self {
+        let d = &gpu.device;
+        let bindings: Vec<_> = (0..3)
+            .map(|i| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i)
+                    .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+            })
+            .collect();
+        let set_layout = unsafe {
+            d.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                None,
+            )
+        }
+        .unwrap();
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::SAMPLED_IMAGE)
+            .descriptor_count(3 * in_flight as u32)];
+        let pool = unsafe {
+            d.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default()
+                    .max_sets(in_flight as u32)
+                    .pool_sizes(&sizes),
+                None,
+            )
+        }
+        .unwrap();
+        let layouts = vec![set_layout; in_flight];
+        let sets = unsafe {
+            d.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(pool)
+                    .set_layouts(&layouts),
+            )
+        }
+        .unwrap();
+        // The layouts the images are in while histencil's light passes read them.
+        let color = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        let depth = vk::ImageLayout::DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL;
+        let infos: Vec<[vk::DescriptorImageInfo; 1]> = targets
+            .iter()
+            .map(|t| (t.view, color))
+            .chain([(depth_view, depth)])
+            .map(|(view, layout)| {
+                [vk::DescriptorImageInfo::default()
+                    .image_view(view)
+                    .image_layout(layout)]
+            })
+            .collect();
+        for set in &sets {
+            let writes: Vec<_> = infos
+                .iter()
+                .enumerate()
+                .map(|(i, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(*set)
+                        .dst_binding(i as u32)
+                        .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                        .image_info(info)
+                })
+                .collect();
+            unsafe { d.update_descriptor_sets(&writes, &[]) };
+        }
+        Self {
+            set_layout,
+            pool,
+            sets,
+        }
+    }
+
+    pub fn destroy(self, gpu: &Gpu) {
+        unsafe {
+            gpu.device.destroy_descriptor_pool(self.pool, None);
+            gpu.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
+        }
     }
 }

@@ -14,11 +14,12 @@
 mod alpha;
 mod device;
 mod gbuffer;
+mod layouts;
 mod world;
 
 use ash::vk;
 use device::{barrier, Buffer, Gpu, Image};
-use gbuffer::{CameraBlock, GBufferPass, DEPTH_FORMAT, ENGINE_MASK};
+use gbuffer::{CameraBlock, CompactDecode, GBufferKind, GBufferPass, DEPTH_FORMAT, ENGINE_MASK};
 use gpu_allocator::MemoryLocation;
 use histencil_alpha::{plan_entities, ChoiceSettings, Viewer};
 use histencil_model::{
@@ -27,9 +28,9 @@ use histencil_model::{
 };
 use histencil_vk::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, AlphaMode,
-    Backend, BrdfSource, Context, DeferredLighting, FrameDesc, ImageState, LightingDesc,
-    LightingFrame, LightingTargets, LightmapFrame, Readback, Renderer, Shading, Technique,
-    GBUFFER_FORMATS,
+    Backend, BrdfSource, Context, DeferredLighting, EngineHooks, FrameDesc, HookSets, ImageState,
+    LightHooks, LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame,
+    Readback, Renderer, Shading, Technique,
 };
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -39,9 +40,45 @@ const WIDTH: u32 = 160;
 const HEIGHT: u32 = 96;
 const FRAMES: usize = 120;
 const IN_FLIGHT: usize = 2;
+/// Lights the engine shadows through histencil's visibility hook: none yet.
+const SHADOWED_LIGHTS: usize = 0;
+/// Frames of each G-buffer layout timed for the comparison.
+const TIMING_ROUNDS: usize = 21;
 const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// histencil's light shaders compiled with the engine's decode hook (build.rs).
+const LIGHT_MODULES: LightModules =
+    include!(concat!(env!("OUT_DIR"), "/histencil_light_modules.rs"));
 /// The engine's lightmap atlas: what its alpha entities need at this size fits easily.
 const ATLAS_SIDE: u32 = 256;
+
+/// Frame `f`'s camera, lights and plan for `backend`: histencil plans on plain data.
+fn plan(
+    layout: &StencilLayout,
+    brdf_bounds: &[Vec<histencil_model::Aabb>],
+    f: usize,
+    backend: Backend,
+) -> (
+    ViewDesc,
+    Vec<histencil_scene::Light>,
+    histencil_model::FramePlan,
+) {
+    let view = view(f);
+    let lights = world::lights(f);
+    let shapes: Vec<_> = lights.iter().map(|l| l.shape()).collect();
+    let checked = View::new(&view).expect("the engine's view");
+    let settings = PlanSettings {
+        technique: TechniqueChoice::Stencil,
+        caps: backend.platform().caps(),
+        flush: FlushPolicy::Auto,
+    };
+    let inputs = PlanInputs {
+        lights: &shapes,
+        brdf_bounds,
+        view: &checked,
+    };
+    let plan = plan_frame(layout, &inputs, &settings).expect("a plan");
+    (view, lights, plan)
+}
 
 /// Frame `f`'s platform behaviour: PS3-like and native in turn.
 fn backend(f: usize) -> Backend {
@@ -111,6 +148,28 @@ fn main() {
     // SAFETY: the engine's handles outlive the context, its device was made with histencil's
     // REQUIREMENTS, and the engine submits from this thread only.
     let ctx = unsafe { Context::from_raw(gpu.lend()) }.expect("histencil on the engine's device");
+
+    let gbuffer_pass = GBufferPass::new(&gpu, GBufferKind::Compact);
+    use vk::ImageUsageFlags as U;
+    let gbuffer: Vec<Image> = ["albedo", "normal-params"]
+        .iter()
+        .zip(gbuffer_pass.kind.formats())
+        .map(|(n, f)| gpu.image(n, *f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+        .collect();
+    // Sampled too: the decode hook reads depth from it.
+    let depth = gpu.image(
+        "depth",
+        DEPTH_FORMAT,
+        extent,
+        U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC | U::SAMPLED,
+    );
+    let depth_view = gpu.depth_view(&depth);
+    let gbuffer_refs: Vec<_> = gbuffer.iter().map(|g| g.target).collect();
+    let decode = CompactDecode::new(&gpu, IN_FLIGHT, &gbuffer_refs, depth_view);
+    // SAFETY: the decode set layout is the engine's, on the lent device, and is destroyed after
+    // the lighting; LIGHT_MODULES come from histencil_build of this histencil-vk.
+    let hooks = unsafe { EngineHooks::new(LIGHT_MODULES, decode.set_layout, None) }
+        .expect("the engine's light shaders");
     let mut lighting = DeferredLighting::new(
         &ctx,
         &LightingDesc {
@@ -123,23 +182,10 @@ fn main() {
             max_lights: world::LIGHTS as u32,
             // The PS3-like frames need the emulated hi-stencil.
             hi_stencil: true,
+            hooks: LightHooks::Engine(hooks),
         },
     )
     .expect("lighting");
-
-    let gbuffer_pass = GBufferPass::new(&gpu);
-    use vk::ImageUsageFlags as U;
-    let gbuffer: Vec<Image> = ["albedo", "normal-depth", "material"]
-        .iter()
-        .zip(GBUFFER_FORMATS)
-        .map(|(n, f)| gpu.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
-        .collect();
-    let depth = gpu.image(
-        "depth",
-        DEPTH_FORMAT,
-        extent,
-        U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
-    );
     let hdr = gpu.image(
         "hdr",
         HDR_FORMAT,
@@ -168,7 +214,7 @@ fn main() {
     let mut alpha_pass = alpha::AlphaPass::new(&gpu, gbuffer_pass.set_layout, IN_FLIGHT);
     let sphere = world::sphere_mesh();
     let mut targets = LightingTargets {
-        gbuffer: [gbuffer[0].target, gbuffer[1].target, gbuffer[2].target],
+        gbuffer: gbuffer_refs,
         depth_stencil: depth.target,
         hdr: hdr.target,
     };
@@ -271,21 +317,7 @@ fn main() {
     let started = Instant::now();
     for f in 0..FRAMES {
         let slot = &mut slots[f % IN_FLIGHT];
-        let view = view(f);
-        let lights = world::lights(f);
-        let shapes: Vec<_> = lights.iter().map(|l| l.shape()).collect();
-        let checked = View::new(&view).expect("the engine's view");
-        let settings = PlanSettings {
-            technique: TechniqueChoice::Stencil,
-            caps: backend(f).platform().caps(),
-            flush: FlushPolicy::Auto,
-        };
-        let inputs = PlanInputs {
-            lights: &shapes,
-            brdf_bounds: &brdf_bounds,
-            view: &checked,
-        };
-        let plan = plan_frame(&layout, &inputs, &settings).expect("a plan");
+        let (view, lights, plan) = plan(&layout, &brdf_bounds, f, backend(f));
         let capture = captures.iter().find(|c| c.frame == f);
         unsafe {
             // Wait for the frame that last used this slot: the only wait, and the engine's own.
@@ -326,6 +358,10 @@ fn main() {
                 timestamps: false,
                 brdf_source: BrdfSource::Formula,
                 tile_stats: false,
+                hook_sets: HookSets {
+                    decode: Some(decode.sets[f % IN_FLIGHT]),
+                    visibility: None,
+                },
             };
             // SAFETY: the command buffer is recording on the engine's device; the images' states
             // are the ones the engine's own barriers left; this slot's last frame has finished.
@@ -413,6 +449,63 @@ fn main() {
     unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
     let engine_ms = started.elapsed().as_secs_f64() * 1e3 / FRAMES as f64;
 
+    // The lighting's time with the compact G-buffer against histencil's 40-byte layout, on the
+    // last frame's state, native stencil, in one run.
+    let histencil_pass = GBufferPass::new(&gpu, GBufferKind::Histencil);
+    let histencil_images: Vec<Image> = ["albedo-40", "normal-depth-40", "material-40"]
+        .iter()
+        .zip(histencil_pass.kind.formats())
+        .map(|(n, f)| gpu.image(n, *f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+        .collect();
+    let mut histencil_lighting = DeferredLighting::new(
+        &ctx,
+        &LightingDesc {
+            hooks: LightHooks::Builtin,
+            ..lighting.desc().clone()
+        },
+    )
+    .expect("lighting with histencil's G-buffer");
+    let timing_ms = {
+        let f = FRAMES - 1;
+        let (view, lights, plan) = plan(&layout, &brdf_bounds, f, Backend::Native);
+        let slot = &mut slots[0];
+        slot.camera.write(bytemuck::bytes_of(&CameraBlock {
+            view: view.world_to_view,
+            proj: view.view_to_clip,
+        }));
+        let frame = layouts::Frame {
+            cmd: slot.cmd,
+            pool: slot.pool,
+            fence: slot.fence,
+            camera_set: slot.camera_set,
+            world: &world,
+            layout: &layout,
+            view: &view,
+            lights: &lights,
+            plan: &plan,
+        };
+        let mut variants = [
+            layouts::Layout {
+                pass: &gbuffer_pass,
+                images: targets.gbuffer.clone(),
+                lighting: &mut lighting,
+                hook_sets: HookSets {
+                    decode: Some(decode.sets[0]),
+                    visibility: None,
+                },
+            },
+            layouts::Layout {
+                pass: &histencil_pass,
+                images: histencil_images.iter().map(|i| i.target).collect(),
+                lighting: &mut histencil_lighting,
+                hook_sets: HookSets::default(),
+            },
+        ];
+        // SAFETY: every frame above has finished (the fences were waited for); the handles
+        // are the engine's, live.
+        unsafe { layouts::time(&gpu, &frame, &mut variants, &mut targets, TIMING_ROUNDS) }
+    };
+
     // histencil's forward reference of each captured state, and the Renderer's own stencil frame
     // of the same state for the frame time.
     let mut worst = 0u8;
@@ -487,12 +580,25 @@ fn main() {
          histencil's Renderer on the same state: {renderer_ms:.1} ms per frame (it waits for each)"
     );
 
+    let [(compact, c_lo, c_hi), (full, f_lo, f_hi)] =
+        [0, 1].map(|i| layouts::median_interval(&timing_ms[i]));
+    println!(
+        "lighting GPU time, native stencil, frame {}, {TIMING_ROUNDS} frames of each layout in \
+         turn: compact G-buffer ({} bytes per pixel) median {compact:.3} ms [{c_lo:.3}, \
+         {c_hi:.3}], histencil's ({} bytes per pixel) {full:.3} ms [{f_lo:.3}, {f_hi:.3}] (95 % \
+         intervals); compact / histencil {:.3}",
+        FRAMES - 1,
+        GBufferKind::Compact.bytes_per_pixel(),
+        GBufferKind::Histencil.bytes_per_pixel(),
+        compact / full
+    );
     unsafe {
         let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
         d.wait_for_fences(&fences, true, u64::MAX).unwrap();
         // The GPU is done with every frame: histencil's parts are freed without the
         // device-wide wait that dropping them would do.
         lighting.destroy();
+        histencil_lighting.destroy();
         lightmaps.destroy();
         for s in slots.drain(..) {
             d.destroy_fence(s.fence, None);
@@ -507,17 +613,26 @@ fn main() {
         gpu.free_buffer(c.stencil_before);
         gpu.free_buffer(c.stencil_after);
     }
-    for image in gbuffer.into_iter().chain([depth, hdr, atlas_image]) {
+    unsafe { gpu.device.destroy_image_view(depth_view, None) };
+    for image in gbuffer
+        .into_iter()
+        .chain(histencil_images)
+        .chain([depth, hdr, atlas_image])
+    {
         gpu.free_image(image);
     }
+    let bytes = gbuffer_pass.kind.bytes_per_pixel();
     gbuffer_pass.destroy(&gpu);
+    histencil_pass.destroy(&gpu);
+    decode.destroy(&gpu);
     alpha_pass.destroy(&gpu);
     drop(ctx);
     gpu.destroy();
     let messages = device::MESSAGES.load(Ordering::SeqCst);
     println!(
         "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward, \
-         engine stencil bits {}, {messages} validation messages",
+         engine stencil bits {}, {messages} validation messages, G-buffer {bytes} bytes per \
+         pixel, {SHADOWED_LIGHTS} shadowed lights",
         if intact { "intact" } else { "NOT intact" }
     );
     let alpha_ok = alpha_worst <= ALPHA_TOLERANCE && alpha_pixels > 0;

@@ -3,6 +3,7 @@
 
 use crate::context::Context;
 use crate::error::Result;
+use crate::hooks::LightModules;
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::shaders;
 use ash::vk;
@@ -56,6 +57,8 @@ const BRANCH_ON_GBUFFER: u32 = u32::MAX;
 
 pub struct LightPipelines {
     layout: vk::PipelineLayout,
+    /// The light shaders: histencil's, or compiled with an engine's hooks.
+    modules: LightModules,
     hdr_format: vk::Format,
     depth_stencil_format: vk::Format,
     pipelines: HashMap<LightPipelineKey, vk::Pipeline>,
@@ -64,11 +67,13 @@ pub struct LightPipelines {
 impl LightPipelines {
     pub fn new(
         layout: vk::PipelineLayout,
+        modules: LightModules,
         hdr_format: vk::Format,
         depth_stencil_format: vk::Format,
     ) -> Self {
         Self {
             layout,
+            modules,
             hdr_format,
             depth_stencil_format,
             pipelines: HashMap::new(),
@@ -91,7 +96,7 @@ impl LightPipelines {
                 VertexInput::None,
             ),
         };
-        let light = ("deferred_light.frag", shaders::DEFERRED_LIGHT_FRAG);
+        let light = ("deferred_light.frag", self.modules.deferred_light);
         let (fragment, specialization, shader_name) = match shader {
             LightShader::StencilOnly => (None, None, "stencil".to_owned()),
             LightShader::TouchTiles => (
@@ -125,7 +130,7 @@ impl LightPipelines {
             // Constant 0 is unused by the LUT shader; both are given so every light shader
             // specialises the same way.
             LightShader::Lut { tiles } => (
-                Some(("lut_light.frag", shaders::LUT_LIGHT_FRAG)),
+                Some(("lut_light.frag", self.modules.lut_light)),
                 Some([
                     BRANCH_ON_GBUFFER,
                     u32::from(tiles == TileWork::TestAndCount),

@@ -12,7 +12,7 @@
 use super::light_pipelines::{
     pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
 };
-use super::{begin_hdr_rendering, Load, CLEAR_BLACK};
+use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
 use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
 use crate::context::Context;
 use crate::error::{Error, Result};
@@ -58,12 +58,18 @@ pub struct LightingPass<'a> {
     pub pipeline_layout: vk::PipelineLayout,
     /// Frame, G-buffer and hi-stencil sets, and the LUT set when shading from tables.
     pub sets: &'a [vk::DescriptorSet],
+    /// The engine's visibility hook set, bound at set 4.
+    pub visibility_set: Option<vk::DescriptorSet>,
     pub brdf_source: BrdfSource,
     pub extent: vk::Extent2D,
     /// Count tile and fragment statistics (extra draws and atomics).
     pub count_stats: bool,
     /// Clear the HDR target first (otherwise light adds onto it).
     pub clear_hdr: bool,
+    /// The decode hook may sample the depth aspect: the depth-stencil is attached with
+    /// read-only depth (`DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`). Light passes never
+    /// write depth.
+    pub depth_sampled: bool,
 }
 
 /// Whether the HDR and depth-stencil attachments are bound. Hi-stencil writes, flushes and the
@@ -85,13 +91,18 @@ impl Rendering {
             Load::Clear(CLEAR_BLACK)
         };
         let attachments = (&mut targets.hdr, &mut targets.depth_stencil);
-        begin_hdr_rendering(
+        let depth = if pass.depth_sampled {
+            ImageAccess::StencilAttachmentDepthSampled
+        } else {
+            ImageAccess::DepthStencilAttachment
+        };
+        begin_hdr_rendering_as(
             pass.ctx,
             pass.cmd,
             attachments,
             pass.extent,
-            hdr,
-            Load::Keep,
+            (hdr, Load::Keep),
+            depth,
         );
         self.open = true;
         self.cleared = true;
@@ -111,6 +122,9 @@ impl Rendering {
         memory_barrier(pass.ctx, pass.cmd);
     }
 }
+
+/// The set index of an engine's visibility hook (hooks/light_visibility.glsl).
+const VISIBILITY_SET_INDEX: u32 = 4;
 
 /// A stamp per draw that is unique in the frame and never 0 (the cleared `touched` value).
 fn stamp(step: usize, count_draw: bool) -> u32 {
@@ -150,6 +164,16 @@ impl LightingPass<'_> {
                 self.sets,
                 &[],
             );
+            if let Some(set) = self.visibility_set {
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.pipeline_layout,
+                    VISIBILITY_SET_INDEX,
+                    &[set],
+                    &[],
+                );
+            }
         }
         let mut rendering = Rendering {
             open: false,

@@ -145,10 +145,25 @@ pub(crate) fn begin_all_cleared(
 pub(crate) fn begin_hdr_rendering(
     ctx: &Context,
     cmd: vk::CommandBuffer,
-    (hdr_image, depth_stencil): (&mut ImageRef, &mut ImageRef),
+    attachments: (&mut ImageRef, &mut ImageRef),
     extent: vk::Extent2D,
     hdr: Load,
     depth: Load,
+) {
+    let access = ImageAccess::DepthStencilAttachment;
+    begin_hdr_rendering_as(ctx, cmd, attachments, extent, (hdr, depth), access);
+}
+
+/// [`begin_hdr_rendering`] with the depth-stencil attached for `depth_access`: the
+/// read-write attachment, or read-only depth beside a written stencil (the lighting pass when
+/// an engine's decode hook samples depth).
+pub(crate) fn begin_hdr_rendering_as(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    (hdr_image, depth_stencil): (&mut ImageRef, &mut ImageRef),
+    extent: vk::Extent2D,
+    (hdr, depth): (Load, Load),
+    depth_access: ImageAccess,
 ) {
     let contents = |load| match load {
         Load::Clear(_) => Contents::Discard,
@@ -161,14 +176,8 @@ pub(crate) fn begin_hdr_rendering(
         ImageAccess::ColorAttachment,
         contents(hdr),
     );
-    transition(
-        ctx,
-        cmd,
-        depth_stencil,
-        ImageAccess::DepthStencilAttachment,
-        contents(depth),
-    );
+    transition(ctx, cmd, depth_stencil, depth_access, contents(depth));
     let colors = [color_attachment(hdr_image, hdr)];
-    let ds = depth_stencil_attachment(depth_stencil, depth);
+    let ds = attachment(depth_stencil, depth_stencil.state.layout, depth);
     begin_rendering(ctx, cmd, extent, &colors, Some(&ds));
 }

@@ -8,6 +8,7 @@ use crate::deferred_lighting::{DeferredLighting, LightingDesc};
 use crate::descriptors::Descriptors;
 use crate::error::{Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::hooks::LightHooks;
 use crate::materials::GpuMaterials;
 use crate::meshes::Meshes;
 use crate::passes::geometry::{MeshFormats, MeshPasses};
@@ -105,6 +106,7 @@ impl<'c> Renderer<'c> {
                 frames_in_flight: 1,
                 max_lights: scene.lights.len() as u32,
                 hi_stencil: true,
+                hooks: LightHooks::Builtin,
             },
         )?;
         // Each part is destroyed if a later one fails; `keep` hands it to the renderer.

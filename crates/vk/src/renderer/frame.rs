@@ -7,6 +7,7 @@ use crate::access::LightingTargets;
 use crate::alpha::AlphaInputs;
 use crate::deferred_lighting::LightingFrame;
 use crate::error::{Result, VkCall};
+use crate::hooks::HookSets;
 use crate::passes::geometry::{GbufferStencil, MeshInputs};
 use crate::passes::light_pipelines::BrdfSource;
 use crate::passes::tonemap::TonemapInputs;
@@ -135,6 +136,7 @@ impl Renderer<'_> {
             timestamps: desc.pass_timing,
             brdf_source: technique.brdf_source(),
             tile_stats: desc.tile_stats,
+            hook_sets: HookSets::default(),
         };
         let mut targets = self.targets.lighting();
         // SAFETY: `cmd` records on this context's device; the targets' states are the ones this

@@ -1,0 +1,42 @@
+// The engine's own compact G-buffer: 12 bytes per pixel in two targets, depth from the depth
+// attachment (histencil's own layout is 40 bytes plus depth). Written by gbuffer_compact.frag,
+// read by the decode hook (histencil_hooks/surface_decode.glsl) that histencil's light shaders
+// are compiled with.
+//
+//   target 0  R8G8B8A8_UNORM      rgb: tint (linear, in [0, 1]); a: BRDF model id / 255
+//   target 1  R16G16B16A16_UNORM  xy: octahedral unit normal; zw: the BRDF's first two packed
+//                                 parameters divided by compact_param_scale
+//
+// The third packed parameter (GGX's f90) is 1 for every material of this engine, so it is not
+// stored. Clear: all zeros (the depth attachment's far plane marks "no geometry").
+#ifndef COMPACT_GBUFFER_GLSL
+#define COMPACT_GBUFFER_GLSL
+
+#include "generated.glsl"
+
+// Parameters are stored in [0, 1]: Blinn-Phong's exponent is divided by 2048, the others are
+// already there (Lambert rho, Oren-Nayar rho and sigma, GGX alpha and f0).
+float compact_param_scale(uint model) {
+    return model == BRDF_BLINN_PHONG ? 2048.0 : 1.0;
+}
+
+float sign_not_zero(float v) {
+    return v >= 0.0 ? 1.0 : -1.0;
+}
+
+// A unit vector on the octahedron, unfolded to [0, 1]^2.
+vec2 octahedral_encode(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(sign_not_zero(n.x), sign_not_zero(n.y));
+    return e * 0.5 + 0.5;
+}
+
+vec3 octahedral_decode(vec2 f) {
+    f = f * 2.0 - 1.0;
+    vec3 n = vec3(f, 1.0 - abs(f.x) - abs(f.y));
+    float t = clamp(-n.z, 0.0, 1.0);
+    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
+    return normalize(n);
+}
+
+#endif
