@@ -13,14 +13,22 @@ fn main() {
         .expect("histencil-vk publishes its generated GLSL");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     let glslc = std::env::var("HISTENCIL_GLSLC").unwrap_or_else(|_| "glslc".into());
-    for shared in ["alpha.glsl", "histencil_hooks/compact_gbuffer.glsl"] {
+    for shared in [
+        "alpha.glsl",
+        "histencil_hooks/compact_gbuffer.glsl",
+        "histencil_hooks/light_visibility.glsl",
+    ] {
         println!("cargo:rerun-if-changed=shaders/{shared}");
     }
     // (output, source, defines): the compact G-buffer's vertex stage is gbuffer.vert without
-    // the linear depth output.
+    // the linear depth output, the forward reference's with the world position instead.
     let stages = [
         ("gbuffer.vert", "gbuffer.vert", None),
         ("gbuffer_compact.vert", "gbuffer.vert", Some("-DCOMPACT")),
+        ("forward.vert", "gbuffer.vert", Some("-DFORWARD")),
+        ("forward.frag", "forward.frag", None),
+        ("shadow.vert", "shadow.vert", None),
+        ("shadow.frag", "shadow.frag", None),
         ("gbuffer.frag", "gbuffer.frag", None),
         ("gbuffer_compact.frag", "gbuffer_compact.frag", None),
         ("alpha_object.vert", "alpha_object.vert", None),
@@ -43,8 +51,9 @@ fn main() {
             .expect("glslc (apt install glslc, or the Vulkan SDK)");
         assert!(status.success(), "glslc failed on {source}");
     }
-    // histencil's light shaders with the engine's decode hook, which includes the layout beside
-    // it (histencil_hooks/compact_gbuffer.glsl, shared with gbuffer_compact.frag).
+    // histencil's light shaders with the engine's decode and visibility hooks; the decode
+    // includes the layout beside it (histencil_hooks/compact_gbuffer.glsl, shared with
+    // gbuffer_compact.frag and forward.frag).
     let hooks = std::path::Path::new("shaders/histencil_hooks");
     histencil_build::compile_light_shaders(hooks, &out).unwrap_or_else(|e| panic!("{e}"));
 }

@@ -322,6 +322,8 @@ fn blended_pipeline(
                 .depth_compare_op(vk::CompareOp::GREATER_OR_EQUAL),
             blend: &blend,
             color_formats: &[vk::Format::R16G16B16A16_SFLOAT],
+            depth_format: crate::gbuffer::DEPTH_FORMAT,
+            depth_bias: None,
             dynamic: &[],
         },
     )

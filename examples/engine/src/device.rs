@@ -424,6 +424,10 @@ pub struct PipelineSpec<'a> {
     /// One per colour attachment.
     pub blend: &'a [vk::PipelineColorBlendAttachmentState],
     pub color_formats: &'a [vk::Format],
+    /// The depth attachment's format; its stencil too when it has one.
+    pub depth_format: vk::Format,
+    /// Constant and slope-scaled depth bias (the shadow map pass).
+    pub depth_bias: Option<(f32, f32)>,
     /// Dynamic state besides viewport and scissor.
     pub dynamic: &'a [vk::DynamicState],
 }
@@ -470,7 +474,14 @@ pub fn graphics_pipeline(
     let viewport = vk::PipelineViewportStateCreateInfo::default()
         .viewport_count(1)
         .scissor_count(1);
+    let (bias, constant, slope) = match spec.depth_bias {
+        Some((c, s)) => (true, c, s),
+        None => (false, 0.0, 0.0),
+    };
     let raster = vk::PipelineRasterizationStateCreateInfo::default()
+        .depth_bias_enable(bias)
+        .depth_bias_constant_factor(constant)
+        .depth_bias_slope_factor(slope)
         .cull_mode(spec.cull)
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
@@ -484,8 +495,11 @@ pub fn graphics_pipeline(
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(spec.color_formats)
-        .depth_attachment_format(crate::gbuffer::DEPTH_FORMAT)
-        .stencil_attachment_format(crate::gbuffer::DEPTH_FORMAT);
+        .depth_attachment_format(spec.depth_format)
+        .stencil_attachment_format(match spec.depth_format {
+            vk::Format::D32_SFLOAT_S8_UINT | vk::Format::D24_UNORM_S8_UINT => spec.depth_format,
+            _ => vk::Format::UNDEFINED,
+        });
     let info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)
@@ -506,4 +520,108 @@ pub fn graphics_pipeline(
         d.destroy_shader_module(frag, None);
     }
     pipeline
+}
+
+/// A descriptor set layout with one descriptor per binding: binding `i` of type and stages
+/// `bindings[i]`.
+pub fn set_layout(
+    d: &ash::Device,
+    bindings: &[(vk::DescriptorType, vk::ShaderStageFlags)],
+) -> vk::DescriptorSetLayout {
+    let bindings: Vec<_> = bindings
+        .iter()
+        .enumerate()
+        .map(|(i, (ty, stages))| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(i as u32)
+                .descriptor_type(*ty)
+                .descriptor_count(1)
+                .stage_flags(*stages)
+        })
+        .collect();
+    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+    unsafe { d.create_descriptor_set_layout(&info, None) }.expect("set layout")
+}
+
+/// A pool and `count` sets of `layout`, whose bindings hold `types` (one descriptor each).
+pub fn allocate_sets(
+    d: &ash::Device,
+    layout: vk::DescriptorSetLayout,
+    count: usize,
+    types: &[vk::DescriptorType],
+) -> (vk::DescriptorPool, Vec<vk::DescriptorSet>) {
+    let sizes: Vec<_> = types
+        .iter()
+        .map(|ty| {
+            vk::DescriptorPoolSize::default()
+                .ty(*ty)
+                .descriptor_count(count as u32)
+        })
+        .collect();
+    let info = vk::DescriptorPoolCreateInfo::default()
+        .max_sets(count as u32)
+        .pool_sizes(&sizes);
+    let pool = unsafe { d.create_descriptor_pool(&info, None) }.expect("descriptor pool");
+    let layouts = vec![layout; count];
+    let alloc = vk::DescriptorSetAllocateInfo::default()
+        .descriptor_pool(pool)
+        .set_layouts(&layouts);
+    let sets = unsafe { d.allocate_descriptor_sets(&alloc) }.expect("descriptor sets");
+    (pool, sets)
+}
+
+/// A depth(-stencil) attachment in `layout`, cleared to `depth` and stencil 0, kept after the
+/// pass or not.
+pub fn depth_attachment(
+    view: vk::ImageView,
+    layout: vk::ImageLayout,
+    depth: f32,
+    store: bool,
+) -> vk::RenderingAttachmentInfo<'static> {
+    vk::RenderingAttachmentInfo::default()
+        .image_view(view)
+        .image_layout(layout)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(if store {
+            vk::AttachmentStoreOp::STORE
+        } else {
+            vk::AttachmentStoreOp::DONT_CARE
+        })
+        .clear_value(vk::ClearValue {
+            depth_stencil: vk::ClearDepthStencilValue { depth, stencil: 0 },
+        })
+}
+
+/// Begins rendering over `extent` into `colors` and `depth` (its stencil too with `stencil`)
+/// and sets the whole-extent viewport and scissor.
+///
+/// # Safety
+/// `cmd` is recording outside rendering on `d`; the attachments' images are in the layouts
+/// their infos name.
+pub unsafe fn begin_rendering(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    extent: vk::Extent2D,
+    colors: &[vk::RenderingAttachmentInfo],
+    depth: &vk::RenderingAttachmentInfo,
+    stencil: bool,
+) {
+    let area = vk::Rect2D::default().extent(extent);
+    let mut info = vk::RenderingInfo::default()
+        .render_area(area)
+        .layer_count(1)
+        .color_attachments(colors)
+        .depth_attachment(depth);
+    if stencil {
+        info = info.stencil_attachment(depth);
+    }
+    let viewport = vk::Viewport {
+        width: extent.width as f32,
+        height: extent.height as f32,
+        max_depth: 1.0,
+        ..Default::default()
+    };
+    d.cmd_begin_rendering(cmd, &info);
+    d.cmd_set_viewport(cmd, 0, &[viewport]);
+    d.cmd_set_scissor(cmd, 0, &[area]);
 }

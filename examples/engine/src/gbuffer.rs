@@ -4,7 +4,10 @@
 //! and each draw's stencil: the BRDF slot where histencil's layout puts it, the engine's own bits
 //! where the engine keeps them.
 
-use crate::device::{barrier, graphics_pipeline, Gpu, GpuMesh, PipelineSpec};
+use crate::device::{
+    allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, set_layout, Gpu,
+    GpuMesh, PipelineSpec,
+};
 use crate::world::World;
 use ash::vk;
 use histencil_model::StencilLayout;
@@ -22,12 +25,31 @@ pub struct CameraBlock {
     pub proj: [[f32; 4]; 4],
 }
 
+/// A draw's push constants (`Draw` in gbuffer.vert, gbuffer*.frag and forward.frag).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct DrawPush {
+pub struct DrawPush {
     model: [[f32; 4]; 4],
     tint_material: [f32; 4],
     brdf: [f32; 4],
+}
+
+impl DrawPush {
+    /// Object `index` of the world: its transform, tint and material index, packed BRDF
+    /// parameters and model id.
+    pub fn new(object: &crate::world::Object, index: usize) -> Self {
+        let p = object.brdf.packed_params();
+        Self {
+            model: object.transform.to_cols_array_2d(),
+            tint_material: object.tint.extend(index as f32).to_array(),
+            brdf: [
+                p[0] as f32,
+                p[1] as f32,
+                p[2] as f32,
+                object.brdf.model_index() as f32,
+            ],
+        }
+    }
 }
 
 /// Which G-buffer layout a pass writes.
@@ -139,6 +161,8 @@ impl GBufferPass {
                     .back(stencil),
                 blend: &blend,
                 color_formats: kind.formats(),
+                depth_format: DEPTH_FORMAT,
+                depth_bias: None,
                 dynamic: &[
                     vk::DynamicState::STENCIL_REFERENCE,
                     vk::DynamicState::STENCIL_WRITE_MASK,
@@ -209,36 +233,11 @@ impl GBufferPass {
                     .clear_value(c)
             })
             .collect();
-        let ds = vk::RenderingAttachmentInfo::default()
-            .image_view(depth_stencil.view)
-            .image_layout(depth.layout)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                // Reversed Z: the far plane is 0.
-                depth_stencil: vk::ClearDepthStencilValue {
-                    depth: 0.0,
-                    stencil: 0,
-                },
-            });
-        let area = vk::Rect2D::default().extent(extent);
-        let info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&colors)
-            .depth_attachment(&ds)
-            .stencil_attachment(&ds);
-        let viewport = vk::Viewport {
-            width: extent.width as f32,
-            height: extent.height as f32,
-            max_depth: 1.0,
-            ..Default::default()
-        };
+        // Reversed Z: the far plane is 0.
+        let ds = depth_attachment(depth_stencil.view, depth.layout, 0.0, true);
         let faces = vk::StencilFaceFlags::FRONT_AND_BACK;
         unsafe {
-            d.cmd_begin_rendering(cmd, &info);
-            d.cmd_set_viewport(cmd, 0, &[viewport]);
-            d.cmd_set_scissor(cmd, 0, &[area]);
+            begin_rendering(d, cmd, extent, &colors, &ds, true);
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             d.cmd_bind_descriptor_sets(
                 cmd,
@@ -253,17 +252,7 @@ impl GBufferPass {
                     .expect("every object's slot is in the layout");
                 d.cmd_set_stencil_reference(cmd, faces, u32::from(reference | object.stencil));
                 d.cmd_set_stencil_write_mask(cmd, faces, u32::from(mask | ENGINE_MASK));
-                let p = object.brdf.packed_params();
-                let push = DrawPush {
-                    model: object.transform.to_cols_array_2d(),
-                    tint_material: object.tint.extend(i as f32).to_array(),
-                    brdf: [
-                        p[0] as f32,
-                        p[1] as f32,
-                        p[2] as f32,
-                        object.brdf.model_index() as f32,
-                    ],
-                };
+                let push = DrawPush::new(object, i);
                 d.cmd_push_constants(
                     cmd,
                     self.layout,
@@ -305,43 +294,12 @@ impl CompactDecode {
         depth_view: vk::ImageView,
     ) -> Self {
         let d = &gpu.device;
-        let bindings: Vec<_> = (0..3)
-            .map(|i| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i)
-                    .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-            })
-            .collect();
-        let set_layout = unsafe {
-            d.create_descriptor_set_layout(
-                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
-                None,
-            )
-        }
-        .unwrap();
-        let sizes = [vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::SAMPLED_IMAGE)
-            .descriptor_count(3 * in_flight as u32)];
-        let pool = unsafe {
-            d.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default()
-                    .max_sets(in_flight as u32)
-                    .pool_sizes(&sizes),
-                None,
-            )
-        }
-        .unwrap();
-        let layouts = vec![set_layout; in_flight];
-        let sets = unsafe {
-            d.allocate_descriptor_sets(
-                &vk::DescriptorSetAllocateInfo::default()
-                    .descriptor_pool(pool)
-                    .set_layouts(&layouts),
-            )
-        }
-        .unwrap();
+        let sampled = (
+            vk::DescriptorType::SAMPLED_IMAGE,
+            vk::ShaderStageFlags::FRAGMENT,
+        );
+        let set_layout = set_layout(d, &[sampled; 3]);
+        let (pool, sets) = allocate_sets(d, set_layout, in_flight, &[sampled.0; 3]);
         // The layouts the images are in while histencil's light passes read them.
         let color = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         let depth = vk::ImageLayout::DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL;

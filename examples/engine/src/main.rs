@@ -15,6 +15,8 @@ mod alpha;
 mod device;
 mod gbuffer;
 mod layouts;
+mod reference;
+mod shadow;
 mod world;
 
 use ash::vk;
@@ -26,6 +28,7 @@ use histencil_model::{
     plan_frame, DepthConvention, FarPlane, FlushPolicy, Perspective, PlanInputs, PlanSettings,
     StencilBits, StencilLayout, TechniqueChoice, View, ViewDesc,
 };
+use histencil_vk::gpu_types::FrameUniforms;
 use histencil_vk::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, AlphaMode,
     Backend, BrdfSource, Context, DeferredLighting, EngineHooks, FrameDesc, HookSets, ImageState,
@@ -40,8 +43,8 @@ const WIDTH: u32 = 160;
 const HEIGHT: u32 = 96;
 const FRAMES: usize = 120;
 const IN_FLIGHT: usize = 2;
-/// Lights the engine shadows through histencil's visibility hook: none yet.
-const SHADOWED_LIGHTS: usize = 0;
+/// Lights the engine shadows through histencil's visibility hook.
+const SHADOWED_LIGHTS: usize = 1;
 /// Frames of each G-buffer layout timed for the comparison.
 const TIMING_ROUNDS: usize = 21;
 const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -124,6 +127,8 @@ struct Capture {
     hdr: Buffer,
     stencil_before: Buffer,
     stencil_after: Buffer,
+    /// The engine's forward reference of the same state (shadows and G-buffer rounding).
+    reference: Buffer,
 }
 
 fn main() {
@@ -166,10 +171,13 @@ fn main() {
     let depth_view = gpu.depth_view(&depth);
     let gbuffer_refs: Vec<_> = gbuffer.iter().map(|g| g.target).collect();
     let decode = CompactDecode::new(&gpu, IN_FLIGHT, &gbuffer_refs, depth_view);
-    // SAFETY: the decode set layout is the engine's, on the lent device, and is destroyed after
-    // the lighting; LIGHT_MODULES come from histencil_build of this histencil-vk.
-    let hooks = unsafe { EngineHooks::new(LIGHT_MODULES, decode.set_layout, None) }
-        .expect("the engine's light shaders");
+    let mut shadow = shadow::ShadowMap::new(&gpu, IN_FLIGHT);
+    // SAFETY: the decode and shadow set layouts are the engine's, on the lent device, and are
+    // destroyed after the lighting; LIGHT_MODULES come from histencil_build of this
+    // histencil-vk.
+    let hooks =
+        unsafe { EngineHooks::new(LIGHT_MODULES, decode.set_layout, Some(shadow.set_layout)) }
+            .expect("the engine's light shaders");
     let mut lighting = DeferredLighting::new(
         &ctx,
         &LightingDesc {
@@ -179,7 +187,7 @@ fn main() {
             depth_stencil_format: DEPTH_FORMAT,
             hdr_format: HDR_FORMAT,
             frames_in_flight: IN_FLIGHT as u32,
-            max_lights: world::LIGHTS as u32,
+            max_lights: world::LIGHTS as u32 + 1,
             // The PS3-like frames need the emulated hi-stencil.
             hi_stencil: true,
             hooks: LightHooks::Engine(hooks),
@@ -310,15 +318,29 @@ fn main() {
             hdr: readback("hdr-readback", pixels * 8),
             stencil_before: readback("stencil-before", pixels),
             stencil_after: readback("stencil-after", pixels),
+            reference: readback("reference-readback", pixels * 8),
         })
         .into();
 
+    // One forward reference per captured frame: both may be in flight at once.
+    let mut references: Vec<reference::ForwardReference> = captures
+        .iter()
+        .map(|_| {
+            reference::ForwardReference::new(
+                &gpu,
+                extent,
+                HDR_FORMAT,
+                shadow.set_layout,
+                world::LIGHTS + 1,
+            )
+        })
+        .collect();
     let brdf_bounds = world.brdf_bounds();
     let started = Instant::now();
     for f in 0..FRAMES {
         let slot = &mut slots[f % IN_FLIGHT];
         let (view, lights, plan) = plan(&layout, &brdf_bounds, f, backend(f));
-        let capture = captures.iter().find(|c| c.frame == f);
+        let capture = captures.iter().position(|c| c.frame == f);
         unsafe {
             // Wait for the frame that last used this slot: the only wait, and the engine's own.
             d.wait_for_fences(&[slot.fence], true, u64::MAX).unwrap();
@@ -341,7 +363,12 @@ fn main() {
                 &mut targets.gbuffer,
                 &mut targets.depth_stencil,
             );
-            if let Some(c) = capture {
+            // The spot light's shadow map, which histencil's visibility hook samples.
+            let shadowed = &lights[world::SHADOWED_LIGHT];
+            let light_view_proj = world::shadow_view_proj(shadowed);
+            let block = shadow::ShadowBlock::new(light_view_proj, Some(world::SHADOWED_LIGHT));
+            shadow.record(d, slot.cmd, f % IN_FLIGHT, &world, light_view_proj, block);
+            if let Some(c) = capture.map(|i| &captures[i]) {
                 copy_stencil(
                     d,
                     slot.cmd,
@@ -360,7 +387,7 @@ fn main() {
                 tile_stats: false,
                 hook_sets: HookSets {
                     decode: Some(decode.sets[f % IN_FLIGHT]),
-                    visibility: None,
+                    visibility: Some(shadow.sets[f % IN_FLIGHT]),
                 },
             };
             // SAFETY: the command buffer is recording on the engine's device; the images' states
@@ -368,7 +395,7 @@ fn main() {
             lighting
                 .record(slot.cmd, &frame, &mut targets)
                 .expect("lighting recorded");
-            if let Some(c) = capture {
+            if let Some(c) = capture.map(|i| &captures[i]) {
                 copy_stencil(
                     d,
                     slot.cmd,
@@ -376,6 +403,19 @@ fn main() {
                     c.stencil_after.buffer,
                 );
                 copy_color(d, slot.cmd, &mut targets.hdr, c.lit.buffer);
+            }
+            if let Some(i) = capture {
+                let uniforms = FrameUniforms::from_view(&view, WIDTH, HEIGHT, lights.len() as u32)
+                    .expect("the engine's projection");
+                let set = shadow.sets[f % IN_FLIGHT];
+                let reference = &mut references[i];
+                reference.record(d, slot.cmd, &world, &uniforms, &lights, set);
+                copy_color(
+                    d,
+                    slot.cmd,
+                    &mut reference.hdr.target,
+                    captures[i].reference.buffer,
+                );
             }
             // The translucent entities: histencil plans their regions and lights them into the
             // engine's atlas; the engine draws them with its own shaders.
@@ -435,7 +475,7 @@ fn main() {
                 &mut atlas,
                 (&mut targets.hdr, &mut targets.depth_stencil),
             );
-            if let Some(c) = capture {
+            if let Some(c) = capture.map(|i| &captures[i]) {
                 copy_color(d, slot.cmd, &mut targets.hdr, c.hdr.buffer);
                 host_barrier(d, slot.cmd);
             }
@@ -473,6 +513,13 @@ fn main() {
             view: view.world_to_view,
             proj: view.view_to_clip,
         }));
+        // The two layouts differ in the decode only: slot 0's shadow block names no light, so
+        // the visibility hook returns 1 without reading the map.
+        let light_view_proj = world::shadow_view_proj(&lights[world::SHADOWED_LIGHT]);
+        shadow.blocks[0].write(bytemuck::bytes_of(&shadow::ShadowBlock::new(
+            light_view_proj,
+            None,
+        )));
         let frame = layouts::Frame {
             cmd: slot.cmd,
             pool: slot.pool,
@@ -491,7 +538,7 @@ fn main() {
                 lighting: &mut lighting,
                 hook_sets: HookSets {
                     decode: Some(decode.sets[0]),
-                    visibility: None,
+                    visibility: Some(shadow.sets[0]),
                 },
             },
             layouts::Layout {
@@ -513,6 +560,7 @@ fn main() {
     let mut renderer_ms = 0.0;
     let (mut alpha_worst, mut alpha_mean, mut forward_mean) = (0u8, 0.0f64, 0.0f64);
     let mut alpha_pixels = usize::MAX;
+    let mut shadowed_pixels = usize::MAX;
     for c in &captures {
         let scene = world::scene(&world, c.frame);
         let hdr_only = Readback {
@@ -523,11 +571,21 @@ fn main() {
             let frame = renderer.render_frame(&desc).expect("reference frame");
             frame.images.hdr.expect("hdr").into_raw()
         };
-        // Lighting: the opaque world, forward, against the engine's HDR before its alpha pass.
+        // Lighting: the engine's forward reference of the same state (its shadows, its G-buffer's
+        // rounding) against the engine's HDR before its alpha pass.
+        let lit = half_floats(&c.lit);
+        worst = worst.max(max_difference(&half_floats(&c.reference), &lit, |_| true).0);
+        // histencil's own forward frame knows no shadows: the pixels where the engine's differs
+        // from it are the shadowed ones. The alpha comparisons below skip them.
         let mut opaque =
             Renderer::new(&ctx, scene.without_alpha(), WIDTH, HEIGHT).expect("reference renderer");
         let forward = hdr_of(&mut opaque, FrameDesc::new(Shading::Forward, hdr_only));
-        worst = worst.max(max_difference(&forward, &half_floats(&c.lit)).0);
+        let unshadowed: Vec<bool> = pixel_differences(&forward, &lit)
+            .into_iter()
+            .map(|d| d <= 1)
+            .collect();
+        shadowed_pixels = shadowed_pixels.min(unshadowed.iter().filter(|u| !**u).count());
+        let keep = |p: usize| unshadowed[p];
         // Alpha: histencil's own lightmap frame of the same state, and the per-pixel reference.
         let mut renderer = Renderer::new(&ctx, scene, WIDTH, HEIGHT).expect("reference renderer");
         let with_alpha = |alpha| FrameDesc {
@@ -538,17 +596,16 @@ fn main() {
         let per_pixel = hdr_of(&mut renderer, with_alpha(AlphaMode::Forward));
         let ours = half_floats(&c.hdr);
         // The pixels the engine's alpha pass changed: it must have drawn something.
-        let lit = half_floats(&c.lit);
         let changed = lit
             .chunks_exact(4)
             .zip(ours.chunks_exact(4))
             .filter(|(a, b)| a[..3] != b[..3])
             .count();
         alpha_pixels = alpha_pixels.min(changed);
-        let (max, mean) = max_difference(&lightmapped, &ours);
+        let (max, mean) = max_difference(&lightmapped, &ours, keep);
         alpha_worst = alpha_worst.max(max);
         alpha_mean += mean / captures.len() as f64;
-        forward_mean += max_difference(&per_pixel, &ours).1 / captures.len() as f64;
+        forward_mean += max_difference(&per_pixel, &ours, keep).1 / captures.len() as f64;
         let before = c.stencil_before.bytes();
         let after = c.stencil_after.bytes();
         let marked = before.iter().filter(|s| **s & ENGINE_MASK != 0).count();
@@ -573,7 +630,8 @@ fn main() {
     println!(
         "alpha: {alpha_pixels} pixels or more drawn; engine frame vs histencil's lightmap frame of \
          the same state max {alpha_worst}/255 (mean {alpha_mean:.3}); lightmaps vs per-pixel \
-         forward alpha mean {forward_mean:.3}/255 over the frame"
+         forward alpha mean {forward_mean:.3}/255 over the frame; both over the pixels the \
+         spot light's shadow does not darken ({shadowed_pixels} or more are)"
     );
     println!(
         "engine: {engine_ms:.1} ms per frame with {IN_FLIGHT} in flight (wall clock, validation on); \
@@ -612,6 +670,7 @@ fn main() {
         gpu.free_buffer(c.hdr);
         gpu.free_buffer(c.stencil_before);
         gpu.free_buffer(c.stencil_after);
+        gpu.free_buffer(c.reference);
     }
     unsafe { gpu.device.destroy_image_view(depth_view, None) };
     for image in gbuffer
@@ -625,6 +684,10 @@ fn main() {
     gbuffer_pass.destroy(&gpu);
     histencil_pass.destroy(&gpu);
     decode.destroy(&gpu);
+    shadow.destroy(&gpu);
+    for r in references {
+        r.destroy(&gpu);
+    }
     alpha_pass.destroy(&gpu);
     drop(ctx);
     gpu.destroy();
@@ -636,7 +699,8 @@ fn main() {
         if intact { "intact" } else { "NOT intact" }
     );
     let alpha_ok = alpha_worst <= ALPHA_TOLERANCE && alpha_pixels > 0;
-    if worst > 1 || !alpha_ok || !intact || messages > 0 {
+    // The shadow must darken something, or the visibility hook went unused.
+    if worst > 1 || !alpha_ok || !intact || messages > 0 || shadowed_pixels == 0 {
         std::process::exit(1);
     }
 }
@@ -654,10 +718,14 @@ fn half_floats(buffer: &Buffer) -> Vec<f32> {
         .collect()
 }
 
-/// The largest and the mean difference of two RGBA HDR images after tonemapping to 8 bits.
-fn max_difference(a: &[f32], b: &[f32]) -> (u8, f64) {
+/// The largest and the mean difference of two RGBA HDR images after tonemapping to 8 bits, over
+/// the pixels `keep` keeps.
+fn max_difference(a: &[f32], b: &[f32], keep: impl Fn(usize) -> bool) -> (u8, f64) {
     let (mut max, mut sum, mut n) = (0u8, 0u64, 0u64);
-    for (a, b) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+    for (p, (a, b)) in a.chunks_exact(4).zip(b.chunks_exact(4)).enumerate() {
+        if !keep(p) {
+            continue;
+        }
         for ch in 0..3 {
             let d = tonemap(a[ch]).abs_diff(tonemap(b[ch]));
             max = max.max(d);
@@ -666,6 +734,19 @@ fn max_difference(a: &[f32], b: &[f32]) -> (u8, f64) {
         }
     }
     (max, sum as f64 / n.max(1) as f64)
+}
+
+/// Per pixel, the largest channel difference of two RGBA HDR images after tonemapping.
+fn pixel_differences(a: &[f32], b: &[f32]) -> Vec<u8> {
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .map(|(a, b)| {
+            (0..3)
+                .map(|ch| tonemap(a[ch]).abs_diff(tonemap(b[ch])))
+                .max()
+                .unwrap_or(0)
+        })
+        .collect()
 }
 
 /// histencil's tonemap (exposure 1, Reinhard, sRGB), on the CPU, to 8 bits.

@@ -11,6 +11,8 @@ use histencil_scene::{
 };
 
 pub const LIGHTS: usize = 64;
+/// The spot light the engine shadows, after the point lights: the last of the frame's lights.
+pub const SHADOWED_LIGHT: usize = LIGHTS;
 
 /// The engine's own stencil data: what it keeps in its two bits.
 pub const WALKABLE: u8 = 0x80;
@@ -120,8 +122,54 @@ impl World {
 /// one pixel next to it (the position each reconstructs differs by an ulp).
 const LIGHT_HEIGHTS: [f32; 5] = [0.3, 0.55, 0.95, 1.25, 1.6];
 
-/// 64 point lights circling the room at frame `frame`, each on its own orbit.
+/// 64 point lights circling the room at frame `frame`, each on its own orbit, and a shadowed
+/// spot light swinging over the boxes ([`SHADOWED_LIGHT`]).
 pub fn lights(frame: usize) -> Vec<Light> {
+    let mut lights = point_lights(frame);
+    lights.push(spot_light(frame));
+    lights
+}
+
+/// The shadowed spot light: high above the room, aimed past the boxes so their shadows fall
+/// across the floor.
+pub fn spot_light(frame: usize) -> Light {
+    let t = frame as f32 * 0.02;
+    let position = Vec3::new(2.5 * t.cos(), 4.5, 2.5 * t.sin());
+    let target = Vec3::new(-0.5 * t.cos(), 0.0, -0.5 * t.sin());
+    Light {
+        kind: histencil_scene::LightKind::Spot {
+            direction: (target - position).normalize(),
+            inner_angle: 0.6,
+            outer_angle: 0.75,
+        },
+        position,
+        radius: 12.0,
+        color: Vec3::new(60.0, 56.0, 48.0),
+    }
+}
+
+/// World to the shadow map's clip space for `light` (a spot): a perspective projection along
+/// its direction covering its cone, depth 0 at `near` to 1 at its range.
+pub fn shadow_view_proj(light: &Light) -> Mat4 {
+    let histencil_scene::LightKind::Spot {
+        direction,
+        outer_angle,
+        ..
+    } = light.kind
+    else {
+        panic!("the shadowed light is a spot");
+    };
+    let up = if direction.y.abs() > 0.99 {
+        Vec3::X
+    } else {
+        Vec3::Y
+    };
+    let view = glam::camera::rh::view::look_to_mat4(light.position, direction, up);
+    let fov = 2.0 * outer_angle + 0.05;
+    glam::camera::rh::proj::vulkan::perspective(fov, 1.0, 0.5, light.radius) * view
+}
+
+fn point_lights(frame: usize) -> Vec<Light> {
     (0..LIGHTS)
         .map(|i| {
             let t = frame as f32 * 0.05;

@@ -39,4 +39,20 @@ vec3 octahedral_decode(vec2 f) {
     return normalize(n);
 }
 
+// What the deferred path reads back for a surface written with these values: each stored field
+// rounded to its format's steps as a UNORM write rounds (to nearest; Vulkan lets a device pick
+// either neighbour, a step of 1/255 in tint or 1/65535 elsewhere). For the forward reference.
+#ifdef SURFACE_GLSL
+Surface compact_round_trip(vec3 position, vec3 unit_normal, vec3 tint, vec2 params, uint model) {
+    float scale = compact_param_scale(model);
+    Surface s;
+    s.position = position;
+    s.normal = octahedral_decode(round(octahedral_encode(unit_normal) * 65535.0) / 65535.0);
+    s.tint = round(clamp(tint, 0.0, 1.0) * 255.0) / 255.0;
+    s.params = vec4(round(clamp(params / scale, 0.0, 1.0) * 65535.0) / 65535.0 * scale, 1.0, 0.0);
+    s.brdf = model;
+    return s;
+}
+#endif
+
 #endif

@@ -1,0 +1,35 @@
+#version 460
+// The engine's forward reference for its lighting: every light at every pixel of every draw,
+// through histencil's own shading (light.glsl, which reads set 0 as histencil's frame.glsl lays
+// it out), with the same round trip through the compact G-buffer's formats as the deferred path
+// (compact_round_trip) and the same shadows (the visibility hook, set 4).
+#extension GL_GOOGLE_include_directive : require
+#include "light.glsl"
+#include "histencil_hooks/compact_gbuffer.glsl"
+#include "histencil_hooks/light_visibility.glsl"
+
+layout(push_constant) uniform Draw {
+    mat4 model;
+    vec4 tint_material;
+    vec4 brdf;
+} draw;
+
+layout(location = 0) in vec3 in_normal;
+layout(location = 1) in vec3 in_world;
+
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Surface s = compact_round_trip(in_world, normalize(in_normal), draw.tint_material.rgb,
+                                   draw.brdf.xy, uint(draw.brdf.w));
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < frame.counts.x; ++i) {
+        Light light = lights[i];
+        vec3 lit = shade_light(light, s);
+        if (any(greaterThan(lit, vec3(0.0)))) {
+            lit *= light_visibility(i, light, s);
+        }
+        sum += lit;
+    }
+    out_color = vec4(sum, 0.0);
+}
