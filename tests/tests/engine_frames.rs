@@ -400,6 +400,25 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
                 },
             ),
             (
+                "built-in hooks",
+                LightingFrame {
+                    hook_sets: HookSets {
+                        decode: Some(vk::DescriptorSet::null()),
+                        visibility: None,
+                    },
+                    ..frame
+                },
+                targets.clone(),
+            ),
+            (
+                "histencil's G-buffer has 3",
+                frame,
+                LightingTargets {
+                    gbuffer: targets.gbuffer[..2].to_vec(),
+                    ..targets.clone()
+                },
+            ),
+            (
                 "expects",
                 frame,
                 LightingTargets {

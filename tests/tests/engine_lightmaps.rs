@@ -73,7 +73,7 @@ fn layout_for(scene: &Scene, entities: &[AlphaEntity]) -> LightmapLayout {
 unsafe fn record_frame(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
-    lightmaps: &mut AlphaLightmaps,
+    lightmaps: &mut AlphaLightmaps<&Context>,
     frame: &LightmapFrame,
     atlas: &mut ImageRef,
     readback: Option<&EngineBuffer>,
@@ -615,7 +615,7 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
         );
         // A direction map these lightmaps were not made for, or one that does not match.
         let refuse_directional = |what: &str,
-                                  lightmaps: &mut AlphaLightmaps,
+                                  lightmaps: &mut AlphaLightmaps<&Context>,
                                   direction: &EngineImage| {
             let mut direction = direction.as_ref(ImageState::UNDEFINED);
             let err =

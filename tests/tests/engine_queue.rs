@@ -9,9 +9,29 @@ use histencil_brdf::BrdfId;
 use histencil_model::StencilLayout;
 use histencil_tests::engine::Engine;
 use histencil_vk::{
-    AlphaLightmaps, AlphaLightmapsDesc, BorrowedDevice, Context, DeferredLighting, LightHooks,
-    LightingDesc, LutTables,
+    AlphaLightmaps, AlphaLightmapsDesc, BorrowedDevice, Context, DeferredLighting, EngineHooks,
+    LightHooks, LightModules, LightingDesc, LutTables,
 };
+use std::sync::Arc;
+
+/// A small lighting of two BRDFs, with the hi-stencil emulation.
+fn lighting_desc(ctx: &Context) -> LightingDesc {
+    let brdfs = vec![BrdfId::Lambert, BrdfId::Ggx];
+    LightingDesc {
+        layout: StencilLayout::new(brdfs.len() as u32, 0).unwrap(),
+        brdfs,
+        extent: vk::Extent2D {
+            width: 64,
+            height: 32,
+        },
+        depth_stencil_format: ctx.depth_stencil_format().vk(),
+        hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+        frames_in_flight: 2,
+        max_lights: 8,
+        hi_stencil: true,
+        hooks: LightHooks::Builtin,
+    }
+}
 
 #[test]
 fn making_and_freeing_the_engine_facing_parts_uses_no_queue() {
@@ -25,25 +45,7 @@ fn making_and_freeing_the_engine_facing_parts_uses_no_queue() {
         // may use it.
         let ctx = unsafe { Context::from_raw(lent) }.expect("context");
         let held = ctx.memory_in_use();
-        let brdfs = vec![BrdfId::Lambert, BrdfId::Ggx];
-        let mut lighting = DeferredLighting::new(
-            &ctx,
-            &LightingDesc {
-                layout: StencilLayout::new(brdfs.len() as u32, 0).unwrap(),
-                brdfs,
-                extent: vk::Extent2D {
-                    width: 64,
-                    height: 32,
-                },
-                depth_stencil_format: ctx.depth_stencil_format().vk(),
-                hdr_format: vk::Format::R16G16B16A16_SFLOAT,
-                frames_in_flight: 2,
-                max_lights: 8,
-                hi_stencil: true,
-                hooks: LightHooks::Builtin,
-            },
-        )
-        .expect("lighting");
+        let mut lighting = DeferredLighting::new(&ctx, &lighting_desc(&ctx)).expect("lighting");
         let lightmaps = AlphaLightmaps::new(
             &ctx,
             &AlphaLightmapsDesc {
@@ -67,4 +69,104 @@ fn making_and_freeing_the_engine_facing_parts_uses_no_queue() {
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
     engine.destroy().assert_clean();
+}
+
+/// What an engine writes: its renderer struct owns the context (shared) and histencil's parts
+/// beside it, with no lifetime tying them; the parts keep the context alive whatever order the
+/// fields drop in, and free everything they made.
+struct EngineRenderer {
+    ctx: Arc<Context>,
+    lighting: DeferredLighting<Arc<Context>>,
+    lightmaps: AlphaLightmaps<Arc<Context>>,
+    tables: LutTables<Arc<Context>>,
+}
+
+impl EngineRenderer {
+    fn new(ctx: Context) -> Self {
+        let ctx = Arc::new(ctx);
+        let mut lighting =
+            DeferredLighting::new(ctx.clone(), &lighting_desc(&ctx)).expect("lighting");
+        let lightmaps = AlphaLightmaps::new(
+            ctx.clone(),
+            &AlphaLightmapsDesc {
+                atlas_format: vk::Format::R16G16B16A16_SFLOAT,
+                frames_in_flight: 2,
+                direction_format: None,
+            },
+        )
+        .expect("lightmaps");
+        let tables = LutTables::new(ctx.clone(), &report_materials(), 4).expect("tables");
+        // SAFETY: the tables live as long as the lighting, in the same struct.
+        unsafe { lighting.set_lut_tables(&tables) };
+        Self {
+            ctx,
+            lighting,
+            lightmaps,
+            tables,
+        }
+    }
+}
+
+#[test]
+fn an_engine_struct_owns_the_parts_beside_its_context() {
+    let engine = Engine::start();
+    {
+        // SAFETY: the engine's handles outlive the context, which the struct below owns.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let held = ctx.memory_in_use();
+        let renderer = EngineRenderer::new(ctx);
+        assert!(renderer.ctx.memory_in_use() > held);
+        assert_eq!(
+            Arc::strong_count(&renderer.ctx),
+            4,
+            "each part holds the context"
+        );
+        assert_eq!(renderer.lighting.desc().brdfs.len(), 2);
+        assert_eq!(renderer.tables.luts().len(), report_materials().len());
+        let EngineRenderer {
+            ctx,
+            lighting,
+            lightmaps,
+            tables,
+        } = renderer;
+        // The struct's own handle goes first: the parts still hold the context.
+        let weak = Arc::downgrade(&ctx);
+        drop(ctx);
+        drop(lighting);
+        drop(lightmaps);
+        let ctx = weak.upgrade().expect("the tables still hold the context");
+        drop(tables);
+        assert_eq!(ctx.memory_in_use(), held, "everything freed");
+        assert_eq!(Arc::strong_count(&ctx), 1);
+    }
+    engine.destroy().assert_clean();
+}
+
+/// An engine may keep the context and histencil's parts in a struct it shares or moves between
+/// threads (submitting stays the engine's, from any one thread at a time).
+#[allow(dead_code)]
+fn the_parts_can_move_between_threads() {
+    fn sendable<T: Send>() {}
+    fn shared<T: Send + Sync>() {}
+    shared::<Context>();
+    sendable::<EngineRenderer>();
+}
+
+#[test]
+fn engine_hooks_that_are_not_spirv_are_refused() {
+    let modules = LightModules {
+        deferred_light: b"#version 460\nvoid main() {}\n",
+        lut_light: LightModules::BUILTIN.lut_light,
+    };
+    // SAFETY: refused before the (null) layouts could be used.
+    let err = unsafe { EngineHooks::new(modules, vk::DescriptorSetLayout::null(), None) }
+        .expect_err("GLSL source is not SPIR-V");
+    assert!(
+        err.to_string().contains("deferred_light: not SPIR-V"),
+        "{err}"
+    );
+    // SAFETY: as above; histencil's own modules are SPIR-V.
+    let ok =
+        unsafe { EngineHooks::new(LightModules::BUILTIN, vk::DescriptorSetLayout::null(), None) };
+    assert!(ok.is_ok());
 }

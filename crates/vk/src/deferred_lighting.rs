@@ -36,6 +36,7 @@ use gpu_allocator::MemoryLocation;
 use histencil_brdf::BrdfId;
 use histencil_model::{FramePlan, StencilLayout, Step, TileStats, ViewDesc};
 use histencil_scene::Light;
+use std::ops::Deref;
 
 /// What a [`DeferredLighting`] is made for: fixed for its lifetime.
 #[derive(Clone, Debug)]
@@ -102,6 +103,9 @@ struct Slot {
 
 /// The lighting passes of the talk, recorded into an engine's frames.
 ///
+/// `C` is how it holds its context: `&Context`, or `Arc<Context>` so that an engine's struct
+/// owns it beside the context (as [`crate::AlphaLightmaps`] and [`crate::LutTables`] do).
+///
 /// What an engine writes per frame, after its own G-buffer pass and before its own post
 /// passes (the whole engine: `examples/engine`):
 ///
@@ -113,12 +117,12 @@ struct Slot {
 /// };
 /// use histencil_scene::Light;
 /// use histencil_vk::{
-///     Backend, BrdfSource, DeferredLighting, HookSets, ImageRef, LightingFrame, LightingTargets,
+///     Backend, BrdfSource, Context, DeferredLighting, HookSets, ImageRef, LightingFrame, LightingTargets,
 /// };
 ///
 /// /// `gbuffer`, `depth_stencil` and `hdr` carry the states the engine's barriers left.
 /// fn light(
-///     lighting: &mut DeferredLighting,
+///     lighting: &mut DeferredLighting<&Context>,
 ///     cmd: vk::CommandBuffer,
 ///     frame_index: u64,
 ///     view: &ViewDesc,
@@ -158,8 +162,8 @@ struct Slot {
 ///     Ok(targets) // each image's state now, for the engine's next barrier
 /// }
 /// ```
-pub struct DeferredLighting<'c> {
-    ctx: &'c Context,
+pub struct DeferredLighting<C: Deref<Target = Context>> {
+    ctx: C,
     desc: LightingDesc,
     /// Frame, G-buffer, hi-stencil and LUT set layouts: sets 0 to 3 of every light pipeline
     /// (with an engine's decode hook, set 1 is the engine's layout and this one stays null).
@@ -190,7 +194,7 @@ pub fn gbuffer_stencil_reference(layout: &StencilLayout, slot: u32) -> Option<(u
     })
 }
 
-impl<'c> DeferredLighting<'c> {
+impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// Creates the pipeline layout, the light volumes, the hi-stencil emulation and every slot's
     /// buffers and sets. Light pipelines are made when a plan first needs them
     /// ([`DeferredLighting::prepare`]). A failure half way frees what was made.
@@ -198,9 +202,9 @@ impl<'c> DeferredLighting<'c> {
     /// # Errors
     /// [`Error::BadFrame`] for a zero extent, a depth format without stencil, no frames in
     /// flight or too many BRDFs for the layout; Vulkan and allocation errors.
-    pub fn new(ctx: &'c Context, desc: &LightingDesc) -> Result<Self> {
+    pub fn new(ctx: C, desc: &LightingDesc) -> Result<Self> {
         check_desc(desc)?;
-        desc.hooks.check(ctx)?;
+        desc.hooks.check(&ctx)?;
         if ctx.depth_stencil_named && desc.depth_stencil_format != ctx.depth_stencil_format {
             return Err(bad(format!(
                 "depth-stencil format {:?}, but the context was lent {:?} \
@@ -234,7 +238,7 @@ impl<'c> DeferredLighting<'c> {
     }
 
     fn create(&mut self) -> Result<()> {
-        let ctx = self.ctx;
+        let ctx: &Context = &self.ctx;
         let named = [
             ("frame-set-layout", FRAME_SET),
             ("gbuffer-set-layout", GBUFFER_SET),
@@ -491,7 +495,7 @@ fn check_frame(
     expect("the HDR target", &targets.hdr, desc.hdr_format)
 }
 
-impl DeferredLighting<'_> {
+impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// What this lighting was made for.
     pub fn desc(&self) -> &LightingDesc {
         &self.desc
@@ -509,7 +513,7 @@ impl DeferredLighting<'_> {
         count_stats: bool,
         source: BrdfSource,
     ) -> Result<()> {
-        let (ctx, brdfs) = (self.ctx, &self.desc.brdfs);
+        let (ctx, brdfs) = (&*self.ctx, &self.desc.brdfs);
         prepare_pipelines(ctx, &mut self.pipelines, plan, brdfs, count_stats, source)
     }
 
@@ -561,7 +565,7 @@ impl DeferredLighting<'_> {
             ));
         }
         self.prepare_for(frame.plan, count_stats, source)?;
-        let ctx = self.ctx;
+        let ctx: &Context = &self.ctx;
         let slot = &mut self.slots[frame.slot as usize];
         let steps = frame.plan.steps.len() as u32;
         let name = "lighting-step-timestamps";
@@ -608,7 +612,7 @@ impl DeferredLighting<'_> {
     /// GPU has finished it (`None` when that frame had none). Waits for the query results.
     pub fn step_timings(&self, slot: u32) -> Result<Option<LightingBreakdown>> {
         match self.slots.get(slot as usize).and_then(|s| s.timer.last()) {
-            Some(t) => Ok(Some(t.read(self.ctx)?)),
+            Some(t) => Ok(Some(t.read(&self.ctx)?)),
             None => Ok(None),
         }
     }
@@ -652,8 +656,11 @@ impl DeferredLighting<'_> {
     /// `tables` outlive every command buffer recorded with [`BrdfSource::Table`] after this
     /// call, until the GPU has finished them; no command buffer that reads earlier tables is
     /// still pending (the set is rewritten in place).
-    pub unsafe fn set_lut_tables(&mut self, tables: &crate::LutTables) {
-        write_storage_buffers(self.ctx, self.lut_set, &tables.buffers());
+    pub unsafe fn set_lut_tables(
+        &mut self,
+        tables: &crate::LutTables<impl Deref<Target = Context>>,
+    ) {
+        write_storage_buffers(&self.ctx, self.lut_set, &tables.buffers());
         self.lut_written = true;
     }
 
@@ -666,12 +673,12 @@ impl DeferredLighting<'_> {
     }
 }
 
-impl Drop for DeferredLighting<'_> {
+impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
     /// Once this has recorded, waits for the device to go idle (so nothing else may use any
     /// of its queues meanwhile; [`DeferredLighting::destroy`] does not wait), then frees
     /// everything, also after a creation that failed half way.
     fn drop(&mut self) {
-        let ctx = self.ctx;
+        let ctx: &Context = &self.ctx;
         let d = &ctx.device;
         self.in_flight.wait(ctx);
         self.pipelines.destroy(ctx);

@@ -13,6 +13,7 @@ use crate::teardown::InFlight;
 use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, V3};
+use std::ops::Deref;
 
 /// std430 mirror of `LutTable` in `crates/vk/shaders/include/lut.glsl`.
 #[repr(C)]
@@ -25,9 +26,10 @@ struct GpuLutTable {
     curvature: f32,
 }
 
-/// One table per material, baked at one resolution and uploaded.
-pub struct LutTables<'c> {
-    ctx: &'c Context,
+/// One table per material, baked at one resolution and uploaded. `C` holds the context:
+/// `&Context` or `Arc<Context>` (see [`crate::DeferredLighting`]).
+pub struct LutTables<C: Deref<Target = Context>> {
+    ctx: C,
     luts: Vec<Lut>,
     resolution: u32,
     headers: Buffer,
@@ -36,14 +38,14 @@ pub struct LutTables<'c> {
     in_flight: InFlight,
 }
 
-impl<'c> LutTables<'c> {
+impl<C: Deref<Target = Context>> LutTables<C> {
     /// Bakes a table of `resolution` points per axis for each of `materials` (a material's
     /// index here is its table index) and uploads them.
     ///
     /// # Errors
     /// [`Error::Lut`] for a resolution histencil-brdf refuses, [`Error::LutTooLarge`] when the
     /// values exceed the device's storage-buffer range, and allocation errors.
-    pub fn new(ctx: &'c Context, materials: &[Brdf], resolution: u32) -> Result<Self> {
+    pub fn new(ctx: C, materials: &[Brdf], resolution: u32) -> Result<Self> {
         let luts = materials
             .iter()
             .map(|b| Lut::bake(*b, resolution))
@@ -60,6 +62,8 @@ impl<'c> LutTables<'c> {
             values.extend(lut.values.iter().flatten());
         }
         let bytes = (values.len() * 4) as u64;
+        let owner = ctx;
+        let ctx: &Context = &owner;
         let limit = u64::from(ctx.max_storage_buffer_range);
         if bytes > limit {
             return Err(Error::LutTooLarge { bytes, limit });
@@ -78,7 +82,7 @@ impl<'c> LutTables<'c> {
         let mut in_flight = InFlight::default();
         in_flight.mark();
         Ok(Self {
-            ctx,
+            ctx: owner,
             luts,
             resolution,
             headers,
@@ -119,13 +123,13 @@ impl<'c> LutTables<'c> {
     }
 }
 
-impl Drop for LutTables<'_> {
+impl<C: Deref<Target = Context>> Drop for LutTables<C> {
     /// Waits for the device to go idle (so nothing else may use any of its queues meanwhile;
     /// [`LutTables::destroy`] does not wait), then frees the tables.
     fn drop(&mut self) {
-        self.in_flight.wait(self.ctx);
-        self.headers.destroy(self.ctx);
-        self.values.destroy(self.ctx);
+        self.in_flight.wait(&self.ctx);
+        self.headers.destroy(&self.ctx);
+        self.values.destroy(&self.ctx);
     }
 }
 
@@ -164,7 +168,7 @@ impl LutEvaluator {
     pub fn evaluate(
         &self,
         ctx: &Context,
-        tables: &LutTables,
+        tables: &LutTables<impl Deref<Target = Context>>,
         cases: &[(u32, [V3<f32>; 4])],
     ) -> Result<Vec<[f32; 3]>> {
         let gpu: Vec<GpuLutCase> = cases

@@ -11,7 +11,7 @@ use ash::vk;
 use histencil_model::{FramePlan, StencilLayout, ViewDesc};
 use histencil_scene::Light;
 use histencil_vk::{
-    median_of_sorted, BrdfSource, DeferredLighting, HookSets, ImageRef, LightingFrame,
+    median_of_sorted, BrdfSource, Context, DeferredLighting, HookSets, ImageRef, LightingFrame,
     LightingTargets,
 };
 
@@ -19,7 +19,7 @@ use histencil_vk::{
 pub struct Layout<'a, 'c> {
     pub pass: &'a GBufferPass,
     pub images: Vec<ImageRef>,
-    pub lighting: &'a mut DeferredLighting<'c>,
+    pub lighting: &'a mut DeferredLighting<&'c Context>,
     pub hook_sets: HookSets,
 }
 

@@ -31,6 +31,7 @@ use histencil_alpha::AlphaEntity;
 use histencil_alpha::{LightmapLayout, Region, Viewer};
 use histencil_model::ViewDesc;
 use histencil_scene::Light;
+use std::ops::Deref;
 
 /// What an [`AlphaLightmaps`] is made for: fixed for its lifetime.
 #[derive(Clone, Copy, Debug)]
@@ -94,10 +95,10 @@ const STORAGE_NAMES: [&str; 4] = [
 /// use histencil_alpha::{plan_entities, ChoiceSettings, Viewer};
 /// use histencil_model::ViewDesc;
 /// use histencil_scene::Light;
-/// use histencil_vk::{AlphaEntity, AlphaLightmaps, ImageRef, LightmapFrame};
+/// use histencil_vk::{AlphaEntity, AlphaLightmaps, Context, ImageRef, LightmapFrame};
 ///
 /// fn lightmaps(
-///     lightmaps: &mut AlphaLightmaps,
+///     lightmaps: &mut AlphaLightmaps<&Context>,
 ///     cmd: vk::CommandBuffer,
 ///     slot: u32,
 ///     view: &ViewDesc,
@@ -119,8 +120,8 @@ const STORAGE_NAMES: [&str; 4] = [
 ///     Ok(())
 /// }
 /// ```
-pub struct AlphaLightmaps<'c> {
-    ctx: &'c Context,
+pub struct AlphaLightmaps<C: Deref<Target = Context>> {
+    ctx: C,
     desc: AlphaLightmapsDesc,
     /// Frame and alpha set layouts: sets 0 and 1 of the lightmap pass (and of histencil's alpha
     /// pass).
@@ -135,14 +136,14 @@ pub struct AlphaLightmaps<'c> {
     in_flight: InFlight,
 }
 
-impl<'c> AlphaLightmaps<'c> {
+impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// Creates the lightmap pipeline and every slot's buffers and sets. A failure half way
     /// frees what was made.
     ///
     /// # Errors
     /// [`Error::BadFrame`] for no frames in flight or a depth-stencil atlas format; Vulkan and
     /// allocation errors.
-    pub fn new(ctx: &'c Context, desc: &AlphaLightmapsDesc) -> Result<Self> {
+    pub fn new(ctx: C, desc: &AlphaLightmapsDesc) -> Result<Self> {
         if desc.frames_in_flight == 0 {
             return Err(bad("frames_in_flight must be at least 1".into()));
         }
@@ -175,7 +176,7 @@ impl<'c> AlphaLightmaps<'c> {
     }
 
     fn create(&mut self) -> Result<()> {
-        let ctx = self.ctx;
+        let ctx: &Context = &self.ctx;
         self.set_layouts[0] =
             create_set_layout(ctx, "lightmap-frame-set-layout", FRAME_SET, GRAPHICS_STAGES)?;
         self.set_layouts[1] =
@@ -322,7 +323,7 @@ impl<'c> AlphaLightmaps<'c> {
     /// Vulkan errors reading the queries.
     pub fn timings(&self, slot: u32) -> Result<Option<LightmapTimings>> {
         match self.slots.get(slot as usize).and_then(|s| s.timer.last()) {
-            Some(timer) => Ok(Some(timer.read_lightmaps(self.ctx)?)),
+            Some(timer) => Ok(Some(timer.read_lightmaps(&self.ctx)?)),
             None => Ok(None),
         }
     }
@@ -401,7 +402,7 @@ impl<'c> AlphaLightmaps<'c> {
             FrameUniforms::from_view(frame.view, e.width, e.height, frame.lights.len() as u32)
                 .map_err(|p| bad(p.to_string()))?;
         let records = frame_records(frame.entities, &frame.layout.regions, &viewer, frame.lights);
-        let ctx = self.ctx;
+        let ctx: &Context = &self.ctx;
         let slot = &mut self.slots[frame.slot as usize];
         let gpu_lights: Vec<GpuLight> = frame.lights.iter().map(GpuLight::new).collect();
         let FrameRecords {
@@ -467,7 +468,7 @@ impl<'c> AlphaLightmaps<'c> {
         atlas: &mut ImageRef,
         direction: Option<&mut ImageRef>,
     ) {
-        let ctx = self.ctx;
+        let ctx: &Context = &self.ctx;
         self.in_flight.mark();
         let slot = &mut self.slots[slot as usize];
         // Queries are reset outside rendering, as Vulkan requires.
@@ -547,12 +548,12 @@ impl<'c> AlphaLightmaps<'c> {
     }
 }
 
-impl Drop for AlphaLightmaps<'_> {
+impl<C: Deref<Target = Context>> Drop for AlphaLightmaps<C> {
     /// Once these have recorded, waits for the device to go idle (so nothing else may use any
     /// of its queues meanwhile; [`AlphaLightmaps::destroy`] does not wait), then frees
     /// everything, also after a creation that failed half way.
     fn drop(&mut self) {
-        let ctx = self.ctx;
+        let ctx: &Context = &self.ctx;
         let d = &ctx.device;
         self.in_flight.wait(ctx);
         for slot in &mut self.slots {

@@ -118,7 +118,7 @@ pub(crate) struct AlphaLighting<'c> {
     /// Per particle system: its first sprite vertex and vertex count.
     sprite_ranges: Vec<(u32, u32)>,
     lightmap_draws: usize,
-    lightmaps: AlphaLightmaps<'c>,
+    lightmaps: AlphaLightmaps<&'c Context>,
     lightmap: Image,
     /// The direction map of directional frames, as large as the atlas.
     direction_map: Image,
@@ -214,7 +214,7 @@ impl<'c> AlphaLighting<'c> {
         ctx: &'c Context,
         scene: &Scene,
         AlphaPlan { layout, parameters }: AlphaPlan,
-        lightmaps: AlphaLightmaps<'c>,
+        lightmaps: AlphaLightmaps<&'c Context>,
         frame_layout: vk::DescriptorSetLayout,
         parts: &mut Parts,
     ) -> Result<Self> {

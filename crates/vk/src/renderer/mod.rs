@@ -104,11 +104,11 @@ pub struct Renderer<'c> {
     /// What it was built with: the LUT resolution, lightmap side and costs are read from here.
     desc: RendererDesc,
     /// Baked when the LUT technique first renders.
-    lut_tables: Option<LutTables<'c>>,
+    lut_tables: Option<LutTables<&'c Context>>,
     /// Created at the first frame of a scene with alpha entities.
     alpha: Option<AlphaLighting<'c>>,
     /// The lighting passes, as an engine records them, into this renderer's targets.
-    lighting: DeferredLighting<'c>,
+    lighting: DeferredLighting<&'c Context>,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -184,7 +184,7 @@ impl<'c> Renderer<'c> {
     /// of the angles ([`histencil_brdf::Brdf::is_tabulable`]: glTF's metallic-roughness),
     /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
     /// [`LutTables::new`].
-    pub fn lut_tables(&mut self) -> Result<&LutTables<'c>> {
+    pub fn lut_tables(&mut self) -> Result<&LutTables<&'c Context>> {
         if self.lut_tables.is_none() {
             if let Some(o) = self
                 .scene
