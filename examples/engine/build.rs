@@ -1,16 +1,16 @@
 //! The engine's own shaders, compiled with glslc, and histencil's light shaders compiled with the
 //! engine's decode hook (`shaders/histencil_hooks`) by histencil_build. `gbuffer.frag` includes
-//! histencil's `gbuffer_write.glsl` and the alpha shaders its `lightmap_sample.glsl`; histencil-vk
-//! says where they are (DEP_HISTENCIL_GLSL_INCLUDE, and DEP_HISTENCIL_GLSL_GENERATED for the
+//! histencil's `gbuffer_write.glsl` and the alpha shaders its `lightmap_sample.glsl`; histencil
+//! says where they are (DEP_HISTENCIL_INCLUDE, and DEP_HISTENCIL_GENERATED for the
 //! BRDF ids the compact G-buffer names).
 
 use std::path::PathBuf;
 
 fn main() {
-    let include = std::env::var("DEP_HISTENCIL_GLSL_INCLUDE")
-        .expect("histencil-vk publishes its GLSL include folder");
-    let generated = std::env::var("DEP_HISTENCIL_GLSL_GENERATED")
-        .expect("histencil-vk publishes its generated GLSL");
+    let include = std::env::var("DEP_HISTENCIL_INCLUDE")
+        .expect("histencil publishes its GLSL include folder");
+    let generated =
+        std::env::var("DEP_HISTENCIL_GENERATED").expect("histencil publishes its generated GLSL");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     let glslc = std::env::var("HISTENCIL_GLSLC").unwrap_or_else(|_| "glslc".into());
     for shared in [

@@ -8,13 +8,13 @@
 //! `build.rs` calls [`compile_light_shaders`]:
 //!
 //! ```no_run
-//! // build.rs of an engine that depends on histencil-vk (directly: cargo hands histencil-vk's
-//! // shader folders only to the build scripts of its direct dependents).
+//! // build.rs of an engine that depends on histencil (directly: cargo hands its shader folders
+//! // only to the build scripts of direct dependents).
 //! let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap());
 //! histencil_build::compile_light_shaders("shaders/histencil_hooks".as_ref(), &out)
 //!     .unwrap_or_else(|e| panic!("{e}"));
-//! // main.rs:
-//! // const LIGHT_MODULES: histencil_vk::LightModules =
+//! // main.rs, with histencil::LightModules in scope:
+//! // const LIGHT_MODULES: LightModules =
 //! //     include!(concat!(env!("OUT_DIR"), "/histencil_light_modules.rs"));
 //! ```
 //!
@@ -23,7 +23,7 @@
 //! (linking shaderc needs per-distribution link flags; see histencil-vk's build script), and a
 //! mistake in a hook is a build error naming the engine's file and line, not a run-time failure.
 //! An engine that generates hooks at run time can run the same `glslc` command and hand the
-//! SPIR-V to `histencil_vk::LightModules` itself.
+//! SPIR-V to `histencil::LightModules` itself.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -48,8 +48,8 @@ pub const HOOKED_STAGES: [&str; 2] = ["deferred_light.frag", "lut_light.frag"];
 /// Why the light shaders could not be compiled.
 #[derive(Debug)]
 pub enum BuildError {
-    /// A `DEP_HISTENCIL_GLSL_*` variable is missing: the calling build script's package does not
-    /// depend on histencil-vk directly.
+    /// A `DEP_HISTENCIL_*` variable is missing: the calling build script's package does not
+    /// depend on histencil or histencil-vk directly.
     NotADependent(&'static str),
     /// The hook folder holds neither hook file: nothing would change.
     NoHooks(PathBuf),
@@ -66,8 +66,8 @@ impl fmt::Display for BuildError {
         match self {
             BuildError::NotADependent(var) => write!(
                 f,
-                "{var} is not set: call histencil_build from the build script of a package that \
-                 depends on histencil-vk directly"
+                "DEP_HISTENCIL_{var} is not set: call histencil_build from the build script of a \
+                 package that depends on histencil (or histencil-vk) directly"
             ),
             BuildError::NoHooks(dir) => write!(
                 f,
@@ -129,23 +129,31 @@ pub fn run_glslc(mut command: Command, stage: &str) -> Result<(), BuildError> {
     }
 }
 
+/// histencil-vk's metadata `name`, as a direct dependent of histencil-vk
+/// (`DEP_HISTENCIL_GLSL_*`) or of the `histencil` crate (`DEP_HISTENCIL_*`) sees it.
 fn dep_var(name: &'static str) -> Result<PathBuf, BuildError> {
-    std::env::var_os(name)
-        .map(PathBuf::from)
-        .ok_or(BuildError::NotADependent(name))
+    [
+        format!("DEP_HISTENCIL_GLSL_{name}"),
+        format!("DEP_HISTENCIL_{name}"),
+    ]
+    .iter()
+    .find_map(std::env::var_os)
+    .map(PathBuf::from)
+    .ok_or(BuildError::NotADependent(name))
 }
 
 /// Compiles [`HOOKED_STAGES`] with the hook files in `hook_folder` searched before histencil's
 /// own, into `out_dir/histencil/`, and writes `out_dir/histencil_light_modules.rs`: a
-/// `histencil_vk::LightModules` expression holding the SPIR-V, for `include!`. Tells cargo to
+/// `LightModules { .. }` expression holding the SPIR-V, for `include!` where `LightModules` is in
+/// scope (`histencil::LightModules` or `histencil_vk::LightModules`). Tells cargo to
 /// rerun when a hook file or histencil's shaders change.
 ///
 /// # Errors
 /// [`BuildError`]: not run from a direct dependent's build script, an empty hook folder, no
 /// `glslc`, a hook that does not compile (glslc's message names the file and line), I/O.
 pub fn compile_light_shaders(hook_folder: &Path, out_dir: &Path) -> Result<PathBuf, BuildError> {
-    let shaders = dep_var("DEP_HISTENCIL_GLSL_SHADERS")?;
-    let generated = dep_var("DEP_HISTENCIL_GLSL_GENERATED")?;
+    let shaders = dep_var("SHADERS")?;
+    let generated = dep_var("GENERATED")?;
     println!("cargo:rerun-if-env-changed=HISTENCIL_GLSLC");
     println!("cargo:rerun-if-changed={}", hook_folder.display());
     let mut any = false;
@@ -169,7 +177,8 @@ pub fn compile_light_shaders(hook_folder: &Path, out_dir: &Path) -> Result<PathB
         generated.as_path(),
         defaults.as_path(),
     ];
-    let mut fields = String::from("histencil_vk::LightModules {\n");
+    // Unqualified: the engine names it through `histencil` or `histencil_vk`, whichever it uses.
+    let mut fields = String::from("LightModules {\n");
     for stage in HOOKED_STAGES {
         let source = shaders.join(stage);
         let out = target.join(format!("{stage}.spv"));

@@ -22,10 +22,12 @@ mod error;
 pub mod gpu_types;
 mod hi_stencil;
 mod hooks;
+#[cfg(feature = "tools")]
 mod image_error;
 mod lut;
 mod materials;
 mod meshes;
+#[cfg(feature = "tools")]
 mod output;
 pub mod passes;
 mod pipelines;
@@ -62,12 +64,14 @@ pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;
 pub use histencil_model::{CostModel, FlushPolicy, TileStats};
 pub use hooks::{EngineHooks, HookSets, LightHooks, LightModules};
+#[cfg(feature = "tools")]
 pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
 pub use materials::{
     mip_chain, plan_materials, srgb_to_linear, GpuMaterials, MaterialPlan, MaterialRecord, SetPlan,
     TextureKey,
 };
+#[cfg(feature = "tools")]
 pub use output::{
     check_image_output, check_output_dir, check_output_file, image_format, save_image_as, save_png,
     write_atomically, ImageKind,
@@ -78,4 +82,6 @@ pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
 pub use targets::{check_extent, GBUFFER_FORMATS};
 pub use technique::{Backend, FrameDesc, Shading, Technique};
-pub use timing::{median_of_sorted, FrameTimings, LightingBreakdown, LightmapTimings};
+#[cfg(feature = "tools")]
+pub use timing::median_of_sorted;
+pub use timing::{FrameTimings, LightingBreakdown, LightmapTimings};

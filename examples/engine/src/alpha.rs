@@ -7,8 +7,8 @@ use crate::device::{barrier, graphics_pipeline, Buffer, Gpu, GpuMesh, PipelineSp
 use crate::world::AlphaWorld;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use histencil_alpha::SpriteVertex;
-use histencil_vk::{ImageRef, ImageState};
+use histencil::alpha::SpriteVertex;
+use histencil::vk::{ImageRef, ImageState};
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -190,7 +190,7 @@ impl AlphaPass {
         (hdr, depth): (&mut ImageRef, &mut ImageRef),
     ) {
         let sprites: Vec<SpriteVertex> =
-            histencil_alpha::sprite_vertices(&alpha.camera, &alpha.smoke, 1);
+            histencil::alpha::sprite_vertices(&alpha.camera, &alpha.smoke, 1);
         assert!(sprites.len() as u64 <= MAX_SPRITE_VERTICES);
         self.sprites[slot].write(bytemuck::cast_slice(&sprites));
         barrier(d, cmd, atlas, SAMPLED, false);

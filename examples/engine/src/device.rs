@@ -1,13 +1,13 @@
 //! The engine's own Vulkan: instance with the validation layer and synchronisation validation, a
 //! messenger that counts what it reports, a device made with what histencil requires
-//! (`histencil_vk::REQUIREMENTS`), a gpu-allocator allocator, and images and buffers from it.
+//! (`histencil::vk::REQUIREMENTS`), a gpu-allocator allocator, and images and buffers from it.
 
 use ash::vk;
 use gpu_allocator::vulkan::{
     Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc,
 };
 use gpu_allocator::MemoryLocation;
-use histencil_vk::{
+use histencil::vk::{
     aspect_of, BorrowedDevice, DepthStencilFormat, ImageRef, ImageState, REQUIREMENTS,
 };
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -374,7 +374,7 @@ impl GpuMesh {
 
 impl Gpu {
     /// Uploads `mesh` into host-visible vertex and index buffers named after `name`.
-    pub fn mesh(&self, name: &str, mesh: &histencil_scene::Mesh) -> GpuMesh {
+    pub fn mesh(&self, name: &str, mesh: &histencil::scene::Mesh) -> GpuMesh {
         let floats: Vec<f32> = mesh
             .vertices
             .iter()

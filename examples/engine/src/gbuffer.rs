@@ -10,8 +10,8 @@ use crate::device::{
 };
 use crate::world::World;
 use ash::vk;
-use histencil_model::StencilLayout;
-use histencil_vk::{gbuffer_stencil_reference, ImageRef, ImageState, GBUFFER_FORMATS};
+use histencil::model::StencilLayout;
+use histencil::vk::{gbuffer_stencil_reference, ImageRef, ImageState, GBUFFER_FORMATS};
 
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT_S8_UINT;
 
@@ -174,7 +174,7 @@ impl GBufferPass {
             set_layout,
             layout,
             pipeline,
-            unit_box: gpu.mesh("box", &histencil_scene::unit_box()),
+            unit_box: gpu.mesh("box", &histencil::scene::unit_box()),
         }
     }
 

@@ -8,12 +8,10 @@ use crate::device::Gpu;
 use crate::gbuffer::GBufferPass;
 use crate::world::World;
 use ash::vk;
-use histencil_model::{FramePlan, StencilLayout, ViewDesc};
-use histencil_scene::Light;
-use histencil_vk::{
-    median_of_sorted, BrdfSource, Context, DeferredLighting, HookSets, ImageRef, LightingFrame,
-    LightingTargets,
+use histencil::{
+    BrdfSource, Context, DeferredLighting, HookSets, ImageRef, LightingFrame, LightingTargets,
 };
+use histencil::{FramePlan, Light, StencilLayout, ViewDesc};
 
 /// One G-buffer layout: the pass that writes it, its images, the lighting that reads them.
 pub struct Layout<'a, 'c> {
@@ -108,5 +106,11 @@ pub fn median_interval(v: &[f64]) -> (f64, f64, f64) {
     let half = 0.98 * n.sqrt();
     let lo = ((n / 2.0 - half).floor().max(1.0) as usize) - 1;
     let hi = ((n / 2.0 + 1.0 + half).ceil() as usize).min(v.len()) - 1;
-    (median_of_sorted(v), v[lo], v[hi])
+    let mid = v.len() / 2;
+    let median = if v.len() % 2 == 1 {
+        v[mid]
+    } else {
+        0.5 * (v[mid - 1] + v[mid])
+    };
+    (median, v[lo], v[hi])
 }

@@ -2,10 +2,10 @@
 //! (`device.rs`), its world (`world.rs`), its G-buffer pass and shaders (`gbuffer.rs`), a
 //! reversed-Z D32S8 depth buffer with its own data in stencil bits 6 and 7, command buffers and
 //! fences with two frames in flight. histencil plans each frame on plain data
-//! (`histencil_model::plan_frame`) and records its stencil-masked light volumes into the engine's
-//! command buffer (`histencil_vk::DeferredLighting`), alternating the PS3-like and native
+//! (`histencil::model::plan_frame`) and records its stencil-masked light volumes into the engine's
+//! command buffer (`histencil::vk::DeferredLighting`), alternating the PS3-like and native
 //! platform behaviours. Its glass sphere and smoke cloud are lit by histencil's per-entity
-//! lightmaps (`histencil_vk::AlphaLightmaps`, into the engine's own atlas) and drawn by the
+//! lightmaps (`histencil::vk::AlphaLightmaps`, into the engine's own atlas) and drawn by the
 //! engine's own alpha shaders, which sample them through histencil's `lightmap_sample.glsl`. The
 //! last frame of each backend is compared with histencil's forward reference of the same state
 //! (lighting) and with histencil's own lightmap frame (alpha), and the engine's stencil bits are
@@ -23,18 +23,16 @@ use ash::vk;
 use device::{barrier, Buffer, Gpu, Image};
 use gbuffer::{CameraBlock, CompactDecode, GBufferKind, GBufferPass, DEPTH_FORMAT, ENGINE_MASK};
 use gpu_allocator::MemoryLocation;
-use histencil_alpha::{plan_entities, ChoiceSettings, Viewer};
-use histencil_model::{
-    plan_frame, DepthConvention, FarPlane, FlushPolicy, Perspective, PlanInputs, PlanSettings,
-    StencilBits, StencilLayout, TechniqueChoice, View, ViewDesc,
+use histencil::vk::gpu_types::FrameUniforms;
+use histencil::{
+    mesh_bounds, plan_entities, plan_frame, AlphaEntity, AlphaEntityKind, AlphaLightmaps,
+    AlphaLightmapsDesc, Backend, BrdfSource, ChoiceSettings, Context, DeferredLighting,
+    DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSets, ImageState, LightHooks,
+    LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame, Perspective,
+    PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice, View, ViewDesc, Viewer,
 };
-use histencil_vk::gpu_types::FrameUniforms;
-use histencil_vk::{
-    mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, AlphaMode,
-    Backend, BrdfSource, Context, DeferredLighting, EngineHooks, FrameDesc, HookSets, ImageState,
-    LightHooks, LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame,
-    Readback, Renderer, Shading, Technique,
-};
+// histencil's own renderer, as the reference the engine's frames are compared with.
+use histencil::vk::{AlphaMode, FrameDesc, Readback, Renderer, Shading, Technique};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 use world::{AlphaWorld, World};
@@ -57,13 +55,13 @@ const ATLAS_SIDE: u32 = 256;
 /// Frame `f`'s camera, lights and plan for `backend`: histencil plans on plain data.
 fn plan(
     layout: &StencilLayout,
-    brdf_bounds: &[Vec<histencil_model::Aabb>],
+    brdf_bounds: &[Vec<histencil::model::Aabb>],
     f: usize,
     backend: Backend,
 ) -> (
     ViewDesc,
-    Vec<histencil_scene::Light>,
-    histencil_model::FramePlan,
+    Vec<histencil::scene::Light>,
+    histencil::model::FramePlan,
 ) {
     let view = view(f);
     let lights = world::lights(f);
@@ -773,7 +771,7 @@ const TRANSFER_READ: ImageState = ImageState {
 unsafe fn copy_stencil(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
-    image: &mut histencil_vk::ImageRef,
+    image: &mut histencil::vk::ImageRef,
     buffer: vk::Buffer,
 ) {
     copy(d, cmd, image, vk::ImageAspectFlags::STENCIL, buffer);
@@ -786,7 +784,7 @@ unsafe fn copy_stencil(
 unsafe fn copy_color(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
-    image: &mut histencil_vk::ImageRef,
+    image: &mut histencil::vk::ImageRef,
     buffer: vk::Buffer,
 ) {
     copy(d, cmd, image, vk::ImageAspectFlags::COLOR, buffer);
@@ -800,7 +798,7 @@ unsafe fn copy_color(
 unsafe fn copy(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
-    image: &mut histencil_vk::ImageRef,
+    image: &mut histencil::vk::ImageRef,
     aspect: vk::ImageAspectFlags,
     buffer: vk::Buffer,
 ) {

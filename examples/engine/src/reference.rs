@@ -12,9 +12,9 @@ use crate::gbuffer::{DrawPush, DEPTH_FORMAT};
 use crate::world::World;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use histencil_scene::Light;
-use histencil_vk::gpu_types::{FrameUniforms, GpuLight};
-use histencil_vk::{ImageRef, ImageState};
+use histencil::scene::Light;
+use histencil::vk::gpu_types::{FrameUniforms, GpuLight};
+use histencil::vk::{ImageRef, ImageState};
 
 pub struct ForwardReference {
     frame_layout: vk::DescriptorSetLayout,
@@ -157,7 +157,7 @@ impl ForwardReference {
             lights,
             depth,
             hdr,
-            unit_box: gpu.mesh("reference-box", &histencil_scene::unit_box()),
+            unit_box: gpu.mesh("reference-box", &histencil::scene::unit_box()),
         }
     }
 

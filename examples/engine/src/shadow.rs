@@ -10,7 +10,7 @@ use crate::world::World;
 use ash::vk;
 use glam::Mat4;
 use gpu_allocator::MemoryLocation;
-use histencil_vk::ImageState;
+use histencil::vk::ImageState;
 
 /// The shadow map's side in texels and format.
 pub const SIDE: u32 = 1024;
@@ -175,7 +175,7 @@ impl ShadowMap {
             sampler,
             layout,
             pipeline,
-            unit_box: gpu.mesh("shadow-box", &histencil_scene::unit_box()),
+            unit_box: gpu.mesh("shadow-box", &histencil::scene::unit_box()),
             set_layout,
             pool,
             blocks,

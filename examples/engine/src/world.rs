@@ -3,9 +3,9 @@
 //! `histencil_scene` for its procedural meshes and particles and for the forward reference.
 
 use glam::{Mat4, Quat, Vec3};
-use histencil_brdf::{Brdf, BrdfId};
-use histencil_model::Aabb;
-use histencil_scene::{
+use histencil::brdf::{Brdf, BrdfId};
+use histencil::model::Aabb;
+use histencil::scene::{
     uv_sphere, AlphaObject, Camera, Light, Material, Mesh, Object as SceneObject, ParticleLayout,
     ParticleSystem, Scene, Shape,
 };
@@ -137,7 +137,7 @@ pub fn spot_light(frame: usize) -> Light {
     let position = Vec3::new(2.5 * t.cos(), 4.5, 2.5 * t.sin());
     let target = Vec3::new(-0.5 * t.cos(), 0.0, -0.5 * t.sin());
     Light {
-        kind: histencil_scene::LightKind::Spot {
+        kind: histencil::scene::LightKind::Spot {
             direction: (target - position).normalize(),
             inner_angle: 0.6,
             outer_angle: 0.75,
@@ -151,7 +151,7 @@ pub fn spot_light(frame: usize) -> Light {
 /// World to the shadow map's clip space for `light` (a spot): a perspective projection along
 /// its direction covering its cone, depth 0 at `near` to 1 at its range.
 pub fn shadow_view_proj(light: &Light) -> Mat4 {
-    let histencil_scene::LightKind::Spot {
+    let histencil::scene::LightKind::Spot {
         direction,
         outer_angle,
         ..
@@ -224,8 +224,8 @@ pub fn sphere_mesh() -> Mesh {
 impl AlphaWorld {
     pub fn at(frame: usize) -> Self {
         let t = frame as f32 * 0.05;
-        let glass = histencil_scene::glass_sphere(Vec3::new(0.4, 1.1 + 0.2 * t.sin(), 0.3), 0.55);
-        let mut smoke = histencil_scene::smoke_volume(
+        let glass = histencil::scene::glass_sphere(Vec3::new(0.4, 1.1 + 0.2 * t.sin(), 0.3), 0.55);
+        let mut smoke = histencil::scene::smoke_volume(
             Vec3::new(-1.6, 0.9 + 0.1 * t, 1.4),
             0.8,
             48,
