@@ -189,6 +189,8 @@ enum TechniqueArg {
     Branching,
     Adaptive,
     Lut,
+    /// Tile classification and one indirect dispatch per BRDF (today's engines).
+    Tiled,
     Deferred,
     Forward,
 }
@@ -249,6 +251,7 @@ impl RenderArgs {
             TechniqueArg::Branching => Technique::Branching { backend, flush }.into(),
             TechniqueArg::Adaptive => Technique::Adaptive { backend, flush }.into(),
             TechniqueArg::Lut => Technique::Lut { backend, flush }.into(),
+            TechniqueArg::Tiled => Technique::Tiled.into(),
             TechniqueArg::Deferred => Technique::DEFERRED.into(),
             TechniqueArg::Forward => Shading::Forward,
         }

@@ -114,6 +114,10 @@ pub enum ImageAccess {
     StencilAttachmentDepthSampled,
     /// Read by fragment shaders.
     FragmentSampled,
+    /// Read by compute shaders.
+    ComputeSampled,
+    /// Read and written by compute shaders as a storage image.
+    ComputeStorage,
     /// Source of a copy to a buffer.
     TransferSource,
 }
@@ -146,6 +150,16 @@ pub fn access_info(
             // SHADER_READ rather than its sync2 refinement SHADER_SAMPLED_READ: the same
             // dependency, and the one the best-practices layer expects with this layout.
             A::SHADER_READ,
+        ),
+        ImageAccess::ComputeSampled => (
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            S::COMPUTE_SHADER,
+            A::SHADER_READ,
+        ),
+        ImageAccess::ComputeStorage => (
+            vk::ImageLayout::GENERAL,
+            S::COMPUTE_SHADER,
+            A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
         ),
         ImageAccess::TransferSource => (
             vk::ImageLayout::TRANSFER_SRC_OPTIMAL,

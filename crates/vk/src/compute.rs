@@ -47,7 +47,7 @@ impl ComputePipeline {
         let result = create_pipeline_layout(ctx, &layout_name, &[set_layout], compute, push_bytes)
             .and_then(|layout| {
                 made.layout = layout;
-                create_compute_pipeline(ctx, &format!("{name}-pipeline"), module, layout)
+                create_compute_pipeline(ctx, &format!("{name}-pipeline"), module, layout, &[])
             });
         match result {
             Ok(pipeline) => {

@@ -13,6 +13,7 @@ pub enum BindingKind {
     StorageBuffer,
     SampledImage,
     Sampler,
+    StorageImage,
 }
 
 impl BindingKind {
@@ -22,6 +23,7 @@ impl BindingKind {
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             BindingKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
             BindingKind::Sampler => vk::DescriptorType::SAMPLER,
+            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
         }
     }
 }
@@ -118,6 +120,15 @@ pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[
     binding(2, BindingKind::Sampler, "lightmap_sampler"),
 ];
 
+/// Set 2 of the tiled technique's compute passes (include/tiled.glsl): dispatch arguments, tile
+/// lists and light masks, and the HDR target as a storage image.
+pub const TILED_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, ""),
+    binding(3, BindingKind::StorageImage, "tiled_hdr"),
+];
+
 /// The pipeline layouts: which sets, in order.
 pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, MATERIAL_SET];
 pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET, LUT_SET];
@@ -128,6 +139,7 @@ pub const LUT_EVAL_LAYOUT: &[&[BindingDesc]] = &[LUT_EVAL_SET];
 pub const ALPHA_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET, ALPHA_LIGHTMAP_SET];
 /// The lightmap pass renders into the atlas, so it does not bind it.
 pub const LIGHTMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET];
+pub const TILED_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, TILED_SET];
 
 /// Every shader module and the pipeline layout it is used with.
 pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
@@ -153,6 +165,8 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("alpha_object.frag", ALPHA_LAYOUT),
     ("particle.vert", ALPHA_LAYOUT),
     ("particle.frag", ALPHA_LAYOUT),
+    ("tile_classify.comp", TILED_LAYOUT),
+    ("tile_shade.comp", TILED_LAYOUT),
 ];
 
 /// The stages of the graphics passes: every binding and push constant is visible to both.

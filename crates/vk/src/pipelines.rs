@@ -63,18 +63,41 @@ pub(crate) fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<v
     Ok(module)
 }
 
-/// A named compute pipeline running `module` (name, SPIR-V) with `layout`.
+/// The map entries and data of 32-bit specialisation constants 0, 1, ... set to `constants`.
+fn specialization_data(constants: &[u32]) -> (Vec<vk::SpecializationMapEntry>, Vec<u8>) {
+    let entries = (0..constants.len() as u32)
+        .map(|id| {
+            vk::SpecializationMapEntry::default()
+                .constant_id(id)
+                .offset(4 * id)
+                .size(4)
+        })
+        .collect();
+    let bytes = constants.iter().flat_map(|c| c.to_ne_bytes()).collect();
+    (entries, bytes)
+}
+
+/// A named compute pipeline running `module` (name, SPIR-V) with `layout`, its specialisation
+/// constants 0, 1, ... set to `specialization`.
 pub(crate) fn create_compute_pipeline(
     ctx: &Context,
     name: &str,
     module: (&str, &[u8]),
     layout: vk::PipelineLayout,
+    specialization: &[u32],
 ) -> Result<vk::Pipeline> {
     let shader = create_module(ctx, module.0, module.1)?;
-    let stage = vk::PipelineShaderStageCreateInfo::default()
+    let (entries, bytes) = specialization_data(specialization);
+    let info = vk::SpecializationInfo::default()
+        .map_entries(&entries)
+        .data(&bytes);
+    let mut stage = vk::PipelineShaderStageCreateInfo::default()
         .stage(vk::ShaderStageFlags::COMPUTE)
         .module(shader)
         .name(c"main");
+    if !specialization.is_empty() {
+        stage = stage.specialization_info(&info);
+    }
     let info = [vk::ComputePipelineCreateInfo::default()
         .stage(stage)
         .layout(layout)];
@@ -181,19 +204,7 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
         .stage(vk::ShaderStageFlags::VERTEX)
         .module(vertex_module)
         .name(c"main")];
-    let entries: Vec<vk::SpecializationMapEntry> = (0..desc.specialization.len() as u32)
-        .map(|id| {
-            vk::SpecializationMapEntry::default()
-                .constant_id(id)
-                .offset(4 * id)
-                .size(4)
-        })
-        .collect();
-    let constant_bytes: Vec<u8> = desc
-        .specialization
-        .iter()
-        .flat_map(|c| c.to_ne_bytes())
-        .collect();
+    let (entries, constant_bytes) = specialization_data(desc.specialization);
     let specialization = (!entries.is_empty()).then(|| {
         vk::SpecializationInfo::default()
             .map_entries(&entries)

@@ -12,6 +12,13 @@ pub const LIGHT_KINDS: [(&str, u32); 3] = [
 /// surface covers this many pixels squared, like the 8x8 granularity of console hi-stencil.
 pub const HI_STENCIL_TILE: u32 = 8;
 
+/// Side of a tile of the tiled technique in pixels (GLSL `TILED_TILE`): one workgroup of the
+/// classification and of a shade kernel covers one tile.
+pub const TILED_TILE: u32 = 16;
+/// BRDF model ids the tiled classification maps to slots (GLSL `TILED_MODELS`): at least
+/// `BrdfId::ALL.len()` (build.rs checks).
+pub const TILED_MODELS: u32 = 8;
+
 /// `LightDraw.flags` bit: reject fragments in tiles the active hi-stencil surface marks failing.
 pub const LIGHT_DRAW_HI_STENCIL_TEST: u32 = 1;
 /// `LightDraw.flags` bit: count shaded fragments into the tile statistics.

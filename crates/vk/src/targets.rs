@@ -68,7 +68,8 @@ impl Targets {
                 "hdr-color",
                 HDR_FORMAT,
                 extent,
-                U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC,
+                // STORAGE: the tiled technique adds its lights with compute shaders.
+                U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC | U::STORAGE,
             )?;
             t.ldr = Image::new(
                 ctx,

@@ -105,6 +105,13 @@ pub enum Technique {
         backend: Backend,
         flush: FlushPolicy,
     },
+    /// Today's engines' way (Unity HDRP's material tiles, UE5 Substrate's classification,
+    /// Battlefield 3's tiled light lists): a compute pass classifies each 16x16 tile by the
+    /// BRDFs its pixels use and the lights that can reach it, then one indirect dispatch per
+    /// BRDF shades that BRDF's tiles with a kernel specialised to it, each pixel once by its
+    /// own BRDF with its tile's lights (`passes/tiled.rs`). No stencil, no hi-stencil: the same
+    /// on every platform.
+    Tiled,
 }
 
 impl Technique {
@@ -125,6 +132,13 @@ impl Technique {
             }
             // Planned as branching: one draw per light, whatever the pixel's BRDF.
             Technique::Lut { backend, flush } => (TechniqueChoice::Branching, backend, flush),
+            // Not planned: the classification decides on the GPU. The branching plan is what
+            // the statistics and checks of a plan see.
+            Technique::Tiled => (
+                TechniqueChoice::Branching,
+                Backend::Native,
+                FlushPolicy::Auto,
+            ),
         };
         PlanSettings {
             technique,

@@ -16,6 +16,10 @@ fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, S
                 naga::AddressSpace::Uniform => BindingKind::UniformBuffer,
                 naga::AddressSpace::Storage { .. } => BindingKind::StorageBuffer,
                 naga::AddressSpace::Handle => match module.types[var.ty].inner {
+                    naga::TypeInner::Image {
+                        class: naga::ImageClass::Storage { .. },
+                        ..
+                    } => BindingKind::StorageImage,
                     naga::TypeInner::Image { .. } => BindingKind::SampledImage,
                     naga::TypeInner::Sampler { .. } => BindingKind::Sampler,
                     ref other => panic!("{name}: unexpected handle type {other:?}"),

@@ -10,6 +10,7 @@
 pub mod geometry;
 pub mod light_pipelines;
 pub mod lighting;
+pub(crate) mod tiled;
 pub mod tonemap;
 
 use crate::access::{transition, Contents, ImageAccess, ImageRef};

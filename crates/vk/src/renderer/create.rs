@@ -171,6 +171,7 @@ impl<'c> Renderer<'c> {
             lut_tables: None,
             alpha: None,
             lighting,
+            tiled: None,
             extent,
             targets: targets.keep(),
             meshes: meshes.keep(),
@@ -250,6 +251,9 @@ impl Drop for Renderer<'_> {
         }
         if let Some(a) = self.alpha.as_mut() {
             a.destroy(ctx);
+        }
+        if let Some(t) = self.tiled.as_mut() {
+            t.destroy(ctx);
         }
         self.maps.destroy(ctx);
         self.mesh_passes.destroy(ctx);

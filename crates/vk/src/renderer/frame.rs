@@ -76,7 +76,8 @@ impl Renderer<'_> {
         self.readback.record(ctx, cmd, &mut self.targets, readback);
         self.submit_and_wait()?;
         let mut timings = self.timestamps.read(ctx)?;
-        if desc.pass_timing && deferred.is_some() {
+        let planned = deferred.as_ref().filter(|(t, _)| *t != Technique::Tiled);
+        if desc.pass_timing && planned.is_some() {
             timings.lighting = self.lighting.step_timings(0)?;
         }
         if let Some(alpha) = self.alpha.as_ref().filter(|_| desc.pass_timing) {
@@ -84,7 +85,9 @@ impl Renderer<'_> {
         }
         let images = self.readback.read(readback)?;
         let tile_stats = match &deferred {
-            Some((_, plan)) if desc.tile_stats => self.lighting.tile_stats(plan),
+            Some((t, plan)) if desc.tile_stats && *t != Technique::Tiled => {
+                self.lighting.tile_stats(plan)
+            }
             _ => None,
         };
         Ok(Frame {
@@ -127,6 +130,17 @@ impl Renderer<'_> {
             self.targets.lit(&targets);
         }
         self.timestamps.mark(ctx, cmd, "gbuffer");
+        if technique == Technique::Tiled {
+            self.tiled_lighting()?;
+            let tiled = self.tiled.as_ref().expect("made above");
+            let mut targets = self.targets.lighting();
+            tiled.record_classify(ctx, cmd, &mut targets, !emits);
+            self.timestamps.mark(ctx, cmd, "tile-classify");
+            tiled.record_shade(ctx, cmd);
+            self.targets.lit(&targets);
+            self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
+            return Ok(());
+        }
         let frame = LightingFrame {
             slot: 0,
             view,

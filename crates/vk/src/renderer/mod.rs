@@ -17,6 +17,7 @@ use crate::lut::LutTables;
 use crate::materials::GpuMaterials;
 use crate::meshes::Meshes;
 use crate::passes::geometry::MeshPasses;
+use crate::passes::tiled::{TiledInputs, TiledLighting};
 use crate::passes::tonemap::Tonemap;
 use crate::readback::{FrameImages, ReadbackBuffers};
 use crate::resources::Buffer;
@@ -109,6 +110,8 @@ pub struct Renderer<'c> {
     alpha: Option<AlphaLighting<'c>>,
     /// The lighting passes, as an engine records them, into this renderer's targets.
     lighting: DeferredLighting<&'c Context>,
+    /// The tiled technique's passes, made at its first frame.
+    tiled: Option<TiledLighting>,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -262,6 +265,24 @@ impl<'c> Renderer<'c> {
             )?);
         }
         Ok(self.alpha.as_mut())
+    }
+
+    /// The tiled technique's passes, made at its first frame.
+    fn tiled_lighting(&mut self) -> Result<&TiledLighting> {
+        if self.tiled.is_none() {
+            let t = &self.targets;
+            let inputs = TiledInputs {
+                extent: self.extent,
+                brdfs: &self.brdfs,
+                max_lights: self.scene.lights.len() as u32,
+                frame_uniforms: self.frame_uniforms.handle,
+                lights: self.lights.handle,
+                gbuffer: [t.gbuffer[0].view, t.gbuffer[1].view, t.gbuffer[2].view],
+                hdr: t.hdr.view,
+            };
+            self.tiled = Some(TiledLighting::new(self.ctx, &inputs)?);
+        }
+        Ok(self.tiled.as_ref().expect("made above"))
     }
 
     /// Light pipelines created so far.

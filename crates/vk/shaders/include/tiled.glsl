@@ -1,0 +1,33 @@
+// The tiled technique's own resources (set 2) and settings (push constants), shared by its two
+// compute passes (tile_classify.comp, tile_shade.comp). Rust mirror: crates/vk/src/passes/tiled.rs.
+#ifndef TILED_GLSL
+#define TILED_GLSL
+
+#include "generated.glsl"
+
+// Per BRDF slot s, the indirect dispatch of its shade pass at words 4s to 4s + 2: x tiles,
+// y = z = 1 (word 4s + 3 unused). Words, not uvec4s: atomics act on whole words.
+layout(set = 2, binding = 0, std430) buffer TiledDispatch {
+    uint dispatch[];
+};
+// Per BRDF slot, the tiles that contain it: slot s's list starts at s * tiled.tiles.
+layout(set = 2, binding = 1, std430) buffer TileLists {
+    uint tile_lists[];
+};
+// Per tile, a bit per light that can reach it (tiled.words words, light i at bit i % 32 of word
+// i / 32), so the shade pass adds the lights in the scene's order, as forward does.
+layout(set = 2, binding = 2, std430) buffer TileLights {
+    uint tile_lights[];
+};
+// The HDR target, read and written by the shade pass, cleared by the classification on request.
+layout(set = 2, binding = 3, rgba16f) uniform image2D tiled_hdr;
+
+layout(push_constant) uniform Tiled {
+    uint tiles_x; // tiles per row
+    uint tiles;   // tiles in the frame
+    uint words;   // light mask words per tile
+    uint clear;   // 1: the classification clears the HDR target first
+    uint slot_of_model[TILED_MODELS]; // BRDF model id -> stencil slot (or ~0u: not in the frame)
+} tiled;
+
+#endif

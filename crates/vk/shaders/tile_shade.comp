@@ -1,0 +1,36 @@
+#version 460
+// The tiled technique's shade pass for one BRDF, dispatched indirectly over the tiles that
+// contain it (tile_classify.comp): each of the tile's pixels of this BRDF adds every light of
+// the tile's mask, in the scene's order, with the BRDF specialised in (SHADED_BRDF); pixels of
+// other BRDFs are left to their own BRDF's pass.
+#include "light.glsl"
+#include "gbuffer.glsl"
+#include "tiled.glsl"
+
+layout(local_size_x = TILED_TILE, local_size_y = TILED_TILE) in;
+
+layout(constant_id = 0) const uint SHADED_BRDF = 0u;
+layout(constant_id = 1) const uint SHADED_SLOT = 0u;
+
+void main() {
+    uint tile = tile_lists[SHADED_SLOT * tiled.tiles + gl_WorkGroupID.x];
+    uvec2 origin = uvec2(tile % tiled.tiles_x, tile / tiled.tiles_x) * TILED_TILE;
+    ivec2 px = ivec2(origin + gl_LocalInvocationID.xy);
+    if (any(greaterThanEqual(px, ivec2(frame.viewport.xy)))) {
+        return;
+    }
+    Surface s;
+    if (!gbuffer_load(vec2(px) + 0.5, s) || s.brdf != SHADED_BRDF) {
+        return;
+    }
+    vec3 sum = vec3(0.0);
+    for (uint w = 0u; w < tiled.words; ++w) {
+        uint bits = tile_lights[tile * tiled.words + w];
+        while (bits != 0u) {
+            uint b = uint(findLSB(bits));
+            bits &= bits - 1u;
+            sum += shade_light_with(lights[w * 32u + b], s, SHADED_BRDF);
+        }
+    }
+    imageStore(tiled_hdr, px, imageLoad(tiled_hdr, px) + vec4(sum, 0.0));
+}

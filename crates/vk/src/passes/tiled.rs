@@ -1,0 +1,374 @@
+//! The tiled technique, the way engines today light many BRDFs (Unity HDRP's material feature
+//! tiles, UE5 Substrate's classification, Battlefield 3's tiled light lists), next to the
+//! talk's: a compute pass classifies each `TILED_TILE`-pixel-square tile of the G-buffer (the
+//! BRDFs its pixels use, their depth range, the lights that can reach them) into one list of
+//! tiles per BRDF with its indirect dispatch arguments, all on the GPU; then one indirect
+//! dispatch per BRDF in the frame runs a kernel specialised to that BRDF over its tiles, and each
+//! pixel adds the tile's lights by its own BRDF, once. A tile with pixels of several BRDFs is in
+//! several lists, and each BRDF's kernel shades only its own pixels there.
+//! Shaders: `tile_classify.comp`, `tile_shade.comp`, `include/tiled.glsl`.
+
+use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
+use crate::context::Context;
+use crate::descriptors::{
+    create_pipeline_layout, create_set_layout, write_frame_set, write_sampled_images, FRAME_SET,
+    GBUFFER_SET, TILED_SET,
+};
+use crate::error::{Error, Result, VkCall};
+use crate::pipelines::create_compute_pipeline;
+use crate::resources::Buffer;
+use crate::shader_consts::{TILED_MODELS, TILED_TILE};
+use crate::shaders;
+use crate::teardown::{build, Destroy};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use histencil_brdf::BrdfId;
+
+/// `Tiled` in include/tiled.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct TiledPush {
+    tiles_x: u32,
+    tiles: u32,
+    words: u32,
+    clear: u32,
+    slot_of_model: [u32; TILED_MODELS as usize],
+}
+
+/// The most BRDF slots the classification's masks and lists hold.
+const MAX_SLOTS: usize = 32;
+
+#[derive(Default)]
+pub(crate) struct TiledLighting {
+    /// Frame (uniforms, lights), G-buffer and tiled sets, for the compute stage.
+    set_layouts: [vk::DescriptorSetLayout; 3],
+    pipeline_layout: vk::PipelineLayout,
+    pool: vk::DescriptorPool,
+    sets: Vec<vk::DescriptorSet>,
+    classify: vk::Pipeline,
+    /// The shade kernel of each BRDF slot.
+    shade: Vec<vk::Pipeline>,
+    dispatch: Buffer,
+    lists: Buffer,
+    masks: Buffer,
+    push: Option<TiledPush>,
+    tiles_xy: (u32, u32),
+}
+
+/// What the tiled lighting reads: the renderer's frame buffers and G-buffer, its HDR target.
+pub(crate) struct TiledInputs<'a> {
+    pub extent: vk::Extent2D,
+    /// The BRDF of each stencil slot.
+    pub brdfs: &'a [BrdfId],
+    pub max_lights: u32,
+    pub frame_uniforms: vk::Buffer,
+    pub lights: vk::Buffer,
+    pub gbuffer: [vk::ImageView; 3],
+    pub hdr: vk::ImageView,
+}
+
+impl Destroy for TiledLighting {
+    fn destroy(&mut self, ctx: &Context) {
+        let d = &ctx.device;
+        unsafe {
+            for p in self.shade.drain(..).chain([self.classify]) {
+                d.destroy_pipeline(p, None);
+            }
+            self.classify = vk::Pipeline::null();
+            d.destroy_descriptor_pool(self.pool, None);
+            self.pool = vk::DescriptorPool::null();
+            d.destroy_pipeline_layout(self.pipeline_layout, None);
+            self.pipeline_layout = vk::PipelineLayout::null();
+            for l in &mut self.set_layouts {
+                d.destroy_descriptor_set_layout(*l, None);
+                *l = vk::DescriptorSetLayout::null();
+            }
+        }
+        self.dispatch.destroy(ctx);
+        self.lists.destroy(ctx);
+        self.masks.destroy(ctx);
+    }
+}
+
+impl TiledLighting {
+    /// Layouts, pipelines (the classification and one shade kernel per BRDF slot), the tile
+    /// buffers for `inputs.extent`, and the sets pointing at `inputs`; a failure half way frees
+    /// what was made.
+    pub fn new(ctx: &Context, inputs: &TiledInputs) -> Result<Self> {
+        if inputs.brdfs.len() > MAX_SLOTS {
+            return Err(Error::BadFrame(format!(
+                "the tiled technique takes at most {MAX_SLOTS} BRDFs, not {}",
+                inputs.brdfs.len()
+            )));
+        }
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let e = inputs.extent;
+        let tiles_xy = (e.width.div_ceil(TILED_TILE), e.height.div_ceil(TILED_TILE));
+        let tiles = tiles_xy.0 * tiles_xy.1;
+        let words = inputs.max_lights.div_ceil(32).max(1);
+        let mut slot_of_model = [u32::MAX; TILED_MODELS as usize];
+        for (slot, brdf) in inputs.brdfs.iter().enumerate() {
+            slot_of_model[brdf.index() as usize] = slot as u32;
+        }
+        build(ctx, |t: &mut Self| {
+            let named = [
+                ("tiled-frame-set-layout", FRAME_SET),
+                ("tiled-gbuffer-set-layout", GBUFFER_SET),
+                ("tiled-set-layout", TILED_SET),
+            ];
+            for (i, (name, set)) in named.into_iter().enumerate() {
+                t.set_layouts[i] = create_set_layout(ctx, name, set, compute)?;
+            }
+            let push_bytes = size_of::<TiledPush>() as u32;
+            t.pipeline_layout = create_pipeline_layout(
+                ctx,
+                "tiled-pipeline-layout",
+                &t.set_layouts,
+                compute,
+                push_bytes,
+            )?;
+            let module = ("tile_classify.comp", shaders::TILE_CLASSIFY_COMP);
+            t.classify = create_compute_pipeline(
+                ctx,
+                "tiled-classify-pipeline",
+                module,
+                t.pipeline_layout,
+                &[],
+            )?;
+            for (slot, brdf) in inputs.brdfs.iter().enumerate() {
+                let module = ("tile_shade.comp", shaders::TILE_SHADE_COMP);
+                let name = format!("tiled-shade-{}-pipeline", brdf.name());
+                let constants = [brdf.index(), slot as u32];
+                let p = create_compute_pipeline(ctx, &name, module, t.pipeline_layout, &constants)?;
+                t.shade.push(p);
+            }
+            use vk::BufferUsageFlags as U;
+            let storage = U::STORAGE_BUFFER;
+            let gpu = MemoryLocation::GpuOnly;
+            t.dispatch = Buffer::new(
+                ctx,
+                "tiled-dispatch",
+                (MAX_SLOTS * 16) as u64,
+                storage | U::INDIRECT_BUFFER | U::TRANSFER_DST,
+                gpu,
+            )?;
+            let slots = inputs.brdfs.len().max(1) as u64;
+            t.lists = Buffer::new(
+                ctx,
+                "tiled-lists",
+                slots * u64::from(tiles) * 4,
+                storage,
+                gpu,
+            )?;
+            let mask_bytes = u64::from(tiles) * u64::from(words) * 4;
+            t.masks = Buffer::new(ctx, "tiled-light-masks", mask_bytes, storage, gpu)?;
+            let sizes = [
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::UNIFORM_BUFFER)
+                    .descriptor_count(1),
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::STORAGE_BUFFER)
+                    .descriptor_count(4),
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::SAMPLED_IMAGE)
+                    .descriptor_count(3),
+                vk::DescriptorPoolSize::default()
+                    .ty(vk::DescriptorType::STORAGE_IMAGE)
+                    .descriptor_count(1),
+            ];
+            let info = vk::DescriptorPoolCreateInfo::default()
+                .max_sets(3)
+                .pool_sizes(&sizes);
+            t.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
+                .call("vkCreateDescriptorPool")?;
+            ctx.name(t.pool, "tiled-descriptor-pool");
+            let alloc = vk::DescriptorSetAllocateInfo::default()
+                .descriptor_pool(t.pool)
+                .set_layouts(&t.set_layouts);
+            t.sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+                .call("vkAllocateDescriptorSets")?;
+            for (set, name) in
+                t.sets
+                    .iter()
+                    .zip(["tiled-frame-set", "tiled-gbuffer-set", "tiled-set"])
+            {
+                ctx.name(*set, name);
+            }
+            write_frame_set(ctx, t.sets[0], inputs.frame_uniforms, inputs.lights);
+            write_sampled_images(ctx, t.sets[1], &inputs.gbuffer);
+            write_tiled_set(
+                ctx,
+                t.sets[2],
+                [t.dispatch.handle, t.lists.handle, t.masks.handle],
+                inputs.hdr,
+            );
+            t.push = Some(TiledPush {
+                tiles_x: tiles_xy.0,
+                tiles,
+                words,
+                clear: 0,
+                slot_of_model,
+            });
+            t.tiles_xy = tiles_xy;
+            Ok(())
+        })
+    }
+
+    /// Records the classification: the G-buffer read by compute shaders, the HDR target
+    /// cleared first with `clear` and left in `GENERAL` for the shade kernels
+    /// ([`TiledLighting::record_shade`], next).
+    pub fn record_classify(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        targets: &mut LightingTargets,
+        clear: bool,
+    ) {
+        let d = &ctx.device;
+        let push = TiledPush {
+            clear: u32::from(clear),
+            ..self.push.expect("made")
+        };
+        ctx.begin_label(cmd, "tiled-classify");
+        for image in targets.gbuffer.iter_mut() {
+            transition(ctx, cmd, image, ImageAccess::ComputeSampled, Contents::Keep);
+        }
+        let hdr_contents = if clear {
+            Contents::Discard
+        } else {
+            Contents::Keep
+        };
+        transition(
+            ctx,
+            cmd,
+            &mut targets.hdr,
+            ImageAccess::ComputeStorage,
+            hdr_contents,
+        );
+        // Each slot's dispatch starts at zero tiles.
+        let reset: Vec<u32> = (0..MAX_SLOTS).flat_map(|_| [0, 1, 1, 0]).collect();
+        unsafe {
+            d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
+        }
+        buffer_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::COPY,
+                vk::AccessFlags2::TRANSFER_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            ),
+        );
+        unsafe {
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.pipeline_layout,
+                0,
+                &self.sets,
+                &[],
+            );
+            d.cmd_push_constants(
+                cmd,
+                self.pipeline_layout,
+                vk::ShaderStageFlags::COMPUTE,
+                0,
+                bytemuck::bytes_of(&push),
+            );
+        }
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.classify);
+            d.cmd_dispatch(cmd, self.tiles_xy.0, self.tiles_xy.1, 1);
+        }
+        // The lists and masks for the shade kernels, the counts for the indirect dispatches.
+        buffer_barrier(
+            ctx,
+            cmd,
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+                vk::AccessFlags2::SHADER_STORAGE_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
+                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            ),
+        );
+        ctx.end_label(cmd);
+    }
+
+    /// Records one indirect dispatch per BRDF slot over its tiles, after
+    /// [`TiledLighting::record_classify`] in the same command buffer (whose sets and push
+    /// constants stay bound); the HDR target stays in `GENERAL`.
+    pub fn record_shade(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        let d = &ctx.device;
+        ctx.begin_label(cmd, "tiled-shade");
+        for (slot, pipeline) in self.shade.iter().enumerate() {
+            ctx.begin_label(cmd, &format!("tiled-shade-{slot}"));
+            unsafe {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);
+                d.cmd_dispatch_indirect(cmd, self.dispatch.handle, (slot * 16) as u64);
+            }
+            ctx.end_label(cmd);
+            // The next BRDF's kernel adds onto the same image (other pixels, but one image).
+            memory_barrier(ctx, cmd);
+        }
+        ctx.end_label(cmd);
+    }
+}
+
+/// A global barrier between `src` and `dst` (stage, access) for the tile buffers.
+fn buffer_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(src.0)
+        .src_access_mask(src.1)
+        .dst_stage_mask(dst.0)
+        .dst_access_mask(dst.1)];
+    let info = vk::DependencyInfo::default().memory_barriers(&barrier);
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &info) };
+}
+
+/// Points the tiled set at its three buffers and the HDR target (storage, `GENERAL`).
+fn write_tiled_set(
+    ctx: &Context,
+    set: vk::DescriptorSet,
+    buffers: [vk::Buffer; 3],
+    hdr: vk::ImageView,
+) {
+    let infos = buffers.map(|b| {
+        [vk::DescriptorBufferInfo::default()
+            .buffer(b)
+            .range(vk::WHOLE_SIZE)]
+    });
+    let image = [vk::DescriptorImageInfo::default()
+        .image_view(hdr)
+        .image_layout(vk::ImageLayout::GENERAL)];
+    let mut writes: Vec<vk::WriteDescriptorSet> = infos
+        .iter()
+        .enumerate()
+        .map(|(i, info)| {
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(i as u32)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .buffer_info(info)
+        })
+        .collect();
+    writes.push(
+        vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(3)
+            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+            .image_info(&image),
+    );
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+}
