@@ -13,7 +13,8 @@
 use histencil_brdf::BrdfId;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{
-    Backend, CostModel, FlushPolicy, Readback, Renderer, RendererDesc, Shading, Technique,
+    Backend, CostModel, FlushPolicy, MixedTiles, Readback, Renderer, RendererDesc, Shading,
+    Technique,
 };
 
 const SIZE: u32 = 160;
@@ -100,14 +101,28 @@ fn check(scene_name: &str) {
         for (label, technique) in techniques() {
             images.push((label, against_forward(label, technique, TOLERANCE).0));
         }
-        // The tiled technique: exact like the others, and the same twice (its tile lists are
-        // appended in whatever order the GPU runs the tiles; each pixel is shaded once).
-        let (tiled, _) = against_forward("tiled", Technique::Tiled, TOLERANCE);
-        let (again, _) = against_forward("tiled", Technique::Tiled, TOLERANCE);
+        // The tiled technique, either way with mixed tiles: exact like the others, the same
+        // twice (its tile lists are appended in whatever order the GPU runs the tiles; each
+        // pixel is shaded once), and the same both ways (a pixel's sum does not depend on which
+        // kernel computes it).
+        let per_brdf = Technique::Tiled {
+            mixed: MixedTiles::PerBrdf,
+        };
+        let branching_mixed = Technique::Tiled {
+            mixed: MixedTiles::Branching,
+        };
+        let (tiled, _) = against_forward("tiled", per_brdf, TOLERANCE);
+        let (again, _) = against_forward("tiled", per_brdf, TOLERANCE);
         assert_eq!(
             diff(&tiled, &again).pixels_differing,
             0,
             "{scene_name}: tiled twice"
+        );
+        let (mixed, _) = against_forward("tiled-mixed-branching", branching_mixed, TOLERANCE);
+        assert_eq!(
+            diff(&tiled, &mixed).pixels_differing,
+            0,
+            "{scene_name}: tiled both ways"
         );
         // The LUT technique is approximate: its own tolerance, at the default resolution, with
         // hi-stencil (ps3) and without (native). It has no table for glTF's metallic-roughness

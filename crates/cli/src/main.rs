@@ -6,8 +6,8 @@ use histencil_alpha::ParameterKind;
 use histencil_check::matrix::Platform;
 use histencil_scene::{with_default_lights, DefaultLights};
 use histencil_vk::{
-    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, ImageKind, Readback, Renderer,
-    RendererDesc, Shading, Technique,
+    AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, ImageKind, MixedTiles, Readback,
+    Renderer, RendererDesc, Shading, Technique,
 };
 use image::DynamicImage;
 use std::path::PathBuf;
@@ -189,8 +189,11 @@ enum TechniqueArg {
     Branching,
     Adaptive,
     Lut,
-    /// Tile classification and one indirect dispatch per BRDF (today's engines).
+    /// Tile classification and one indirect dispatch per BRDF (today's engines); a tile of
+    /// several BRDFs is shaded once, branching.
     Tiled,
+    /// As tiled, with each BRDF's kernel running over a tile of several BRDFs.
+    TiledPerBrdf,
     Deferred,
     Forward,
 }
@@ -251,7 +254,14 @@ impl RenderArgs {
             TechniqueArg::Branching => Technique::Branching { backend, flush }.into(),
             TechniqueArg::Adaptive => Technique::Adaptive { backend, flush }.into(),
             TechniqueArg::Lut => Technique::Lut { backend, flush }.into(),
-            TechniqueArg::Tiled => Technique::Tiled.into(),
+            TechniqueArg::Tiled => Technique::Tiled {
+                mixed: MixedTiles::Branching,
+            }
+            .into(),
+            TechniqueArg::TiledPerBrdf => Technique::Tiled {
+                mixed: MixedTiles::PerBrdf,
+            }
+            .into(),
             TechniqueArg::Deferred => Technique::DEFERRED.into(),
             TechniqueArg::Forward => Shading::Forward,
         }

@@ -66,7 +66,13 @@ void main() {
     }
     barrier();
     uint brdfs = tile_brdfs;
-    if (local < 32u && (brdfs & (1u << local)) != 0u) {
+    bool mixed = (brdfs & (brdfs - 1u)) != 0u; // more than one bit
+    if (mixed && tiled.mixed != TILED_PER_BRDF) {
+        if (local == 0u) {
+            uint i = atomicAdd(dispatch[4u * TILED_MIXED_SLOT], 1u);
+            tile_lists[TILED_MIXED_SLOT * tiled.tiles + i] = tile;
+        }
+    } else if (local < 32u && (brdfs & (1u << local)) != 0u) {
         uint i = atomicAdd(dispatch[4u * local], 1u);
         tile_lists[local * tiled.tiles + i] = tile;
     }

@@ -2,13 +2,15 @@
 // The tiled technique's shade pass for one BRDF, dispatched indirectly over the tiles that
 // contain it (tile_classify.comp): each of the tile's pixels of this BRDF adds every light of
 // the tile's mask, in the scene's order, with the BRDF specialised in (SHADED_BRDF); pixels of
-// other BRDFs are left to their own BRDF's pass.
+// other BRDFs are left to their own BRDF's pass. Specialised to BRANCH_ON_GBUFFER, it is the
+// one pass over the mixed tiles (list TILED_MIXED_SLOT) that branches on each pixel's BRDF.
 #include "light.glsl"
 #include "gbuffer.glsl"
 #include "tiled.glsl"
 
 layout(local_size_x = TILED_TILE, local_size_y = TILED_TILE) in;
 
+const uint BRANCH_ON_GBUFFER = 0xFFFFFFFFu;
 layout(constant_id = 0) const uint SHADED_BRDF = 0u;
 layout(constant_id = 1) const uint SHADED_SLOT = 0u;
 
@@ -20,7 +22,21 @@ void main() {
         return;
     }
     Surface s;
-    if (!gbuffer_load(vec2(px) + 0.5, s) || s.brdf != SHADED_BRDF) {
+    if (!gbuffer_load(vec2(px) + 0.5, s)) {
+        return;
+    }
+    // A switch on the constant itself: a comparison of two constants would become
+    // OpSpecConstantOp, which naga cannot read (as in deferred_light.frag).
+    uint model;
+    switch (SHADED_BRDF) {
+    case BRANCH_ON_GBUFFER:
+        model = s.brdf;
+        break;
+    default:
+        model = SHADED_BRDF;
+        break;
+    }
+    if (s.brdf != model) {
         return;
     }
     vec3 sum = vec3(0.0);
@@ -29,7 +45,7 @@ void main() {
         while (bits != 0u) {
             uint b = uint(findLSB(bits));
             bits &= bits - 1u;
-            sum += shade_light_with(lights[w * 32u + b], s, SHADED_BRDF);
+            sum += shade_light_with(lights[w * 32u + b], s, model);
         }
     }
     imageStore(tiled_hdr, px, imageLoad(tiled_hdr, px) + vec4(sum, 0.0));

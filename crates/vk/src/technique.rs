@@ -4,6 +4,7 @@
 
 use crate::alpha::AlphaMode;
 use crate::passes::light_pipelines::BrdfSource;
+pub use crate::passes::tiled::MixedTiles;
 use crate::readback::Readback;
 use histencil_model::{
     CostModel, DepthConvention, FlushPolicy, Native, PlanSettings, PlatformBackend, Ps3Like,
@@ -110,8 +111,8 @@ pub enum Technique {
     /// BRDFs its pixels use and the lights that can reach it, then one indirect dispatch per
     /// BRDF shades that BRDF's tiles with a kernel specialised to it, each pixel once by its
     /// own BRDF with its tile's lights (`passes/tiled.rs`). No stencil, no hi-stencil: the same
-    /// on every platform.
-    Tiled,
+    /// on every platform. `mixed` says how tiles of several BRDFs are shaded.
+    Tiled { mixed: MixedTiles },
 }
 
 impl Technique {
@@ -134,7 +135,7 @@ impl Technique {
             Technique::Lut { backend, flush } => (TechniqueChoice::Branching, backend, flush),
             // Not planned: the classification decides on the GPU. The branching plan is what
             // the statistics and checks of a plan see.
-            Technique::Tiled => (
+            Technique::Tiled { .. } => (
                 TechniqueChoice::Branching,
                 Backend::Native,
                 FlushPolicy::Auto,

@@ -10,8 +10,8 @@ use crate::variants::{light_size_scene, with_brdf_count};
 use crate::Result;
 use histencil_scene::Scene;
 use histencil_vk::{
-    Backend, Context, CostModel, FlushPolicy, FrameDesc, Readback, Renderer, RendererDesc, Shading,
-    Technique,
+    Backend, Context, CostModel, FlushPolicy, FrameDesc, MixedTiles, Readback, Renderer,
+    RendererDesc, Shading, Technique,
 };
 
 /// What a comparison run measures.
@@ -101,6 +101,18 @@ pub fn table_rows() -> Vec<(&'static str, Technique)> {
             Technique::Adaptive {
                 backend: Backend::Native,
                 flush,
+            },
+        ),
+        (
+            "tiled",
+            Technique::Tiled {
+                mixed: MixedTiles::PerBrdf,
+            },
+        ),
+        (
+            "tiled, mixed branching",
+            Technique::Tiled {
+                mixed: MixedTiles::Branching,
             },
         ),
     ]
@@ -492,10 +504,12 @@ pub fn run_compare(
 /// The most rounds one measurement set takes, whatever its target and budget.
 pub const MAX_ROUNDS: usize = 400;
 
-/// The lighting pass's time in one frame.
+/// The lighting's time in one frame: the lighting pass, and the tiled technique's
+/// classification before it.
 fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<f64> {
     let timings = renderer.render(technique, Readback::NONE)?.timings;
-    Ok(timings.pass_ms("lighting").unwrap_or(0.0))
+    let classify = timings.pass_ms("tile-classify").unwrap_or(0.0);
+    Ok(timings.pass_ms("lighting").unwrap_or(0.0) + classify)
 }
 
 /// Branching, stencil and adaptive on the native backend: the light-size sweep's three.

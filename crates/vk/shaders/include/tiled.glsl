@@ -5,12 +5,18 @@
 
 #include "generated.glsl"
 
+// The list of mixed tiles, after every BRDF slot's.
+const uint TILED_MIXED_SLOT = 32u;
+// tiled.mixed: mixed tiles go to each of their BRDFs' lists.
+const uint TILED_PER_BRDF = ~0u;
+
 // Per BRDF slot s, the indirect dispatch of its shade pass at words 4s to 4s + 2: x tiles,
 // y = z = 1 (word 4s + 3 unused). Words, not uvec4s: atomics act on whole words.
 layout(set = 2, binding = 0, std430) buffer TiledDispatch {
     uint dispatch[];
 };
-// Per BRDF slot, the tiles that contain it: slot s's list starts at s * tiled.tiles.
+// Per BRDF slot, the tiles that contain it: slot s's list starts at s * tiled.tiles. List
+// TILED_MIXED_SLOT holds the tiles of several BRDFs when they are shaded once, branching.
 layout(set = 2, binding = 1, std430) buffer TileLists {
     uint tile_lists[];
 };
@@ -27,6 +33,8 @@ layout(push_constant) uniform Tiled {
     uint tiles;   // tiles in the frame
     uint words;   // light mask words per tile
     uint clear;   // 1: the classification clears the HDR target first
+    uint mixed;   // the list mixed tiles go to: TILED_MIXED_SLOT (one branching pass), or
+                  // TILED_PER_BRDF (each of their BRDFs' lists)
     uint slot_of_model[TILED_MODELS]; // BRDF model id -> stencil slot (or ~0u: not in the frame)
 } tiled;
 

@@ -32,11 +32,27 @@ struct TiledPush {
     tiles: u32,
     words: u32,
     clear: u32,
+    mixed: u32,
     slot_of_model: [u32; TILED_MODELS as usize],
 }
 
 /// The most BRDF slots the classification's masks and lists hold.
 const MAX_SLOTS: usize = 32;
+/// The list of mixed tiles shaded once, branching (`TILED_MIXED_SLOT`), after the slots'.
+const MIXED_SLOT: usize = MAX_SLOTS;
+/// `tiled.mixed` for mixed tiles in each of their BRDFs' lists (`TILED_PER_BRDF`).
+const PER_BRDF: u32 = u32::MAX;
+/// `SHADED_BRDF` of the branching kernel.
+const BRANCH_ON_GBUFFER: u32 = u32::MAX;
+
+/// What the tiled technique does with a tile whose pixels use several BRDFs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MixedTiles {
+    /// Each of its BRDFs' kernels runs over it, each shading its own pixels (the others idle).
+    PerBrdf,
+    /// One kernel runs over it, branching on each pixel's BRDF (HDRP's catch-all variant).
+    Branching,
+}
 
 #[derive(Default)]
 pub(crate) struct TiledLighting {
@@ -48,6 +64,8 @@ pub(crate) struct TiledLighting {
     classify: vk::Pipeline,
     /// The shade kernel of each BRDF slot.
     shade: Vec<vk::Pipeline>,
+    /// The branching kernel over mixed tiles.
+    branching: vk::Pipeline,
     dispatch: Buffer,
     lists: Buffer,
     masks: Buffer,
@@ -71,10 +89,11 @@ impl Destroy for TiledLighting {
     fn destroy(&mut self, ctx: &Context) {
         let d = &ctx.device;
         unsafe {
-            for p in self.shade.drain(..).chain([self.classify]) {
+            for p in self.shade.drain(..).chain([self.classify, self.branching]) {
                 d.destroy_pipeline(p, None);
             }
             self.classify = vk::Pipeline::null();
+            self.branching = vk::Pipeline::null();
             d.destroy_descriptor_pool(self.pool, None);
             self.pool = vk::DescriptorPool::null();
             d.destroy_pipeline_layout(self.pipeline_layout, None);
@@ -142,24 +161,28 @@ impl TiledLighting {
                 let p = create_compute_pipeline(ctx, &name, module, t.pipeline_layout, &constants)?;
                 t.shade.push(p);
             }
+            let module = ("tile_shade.comp", shaders::TILE_SHADE_COMP);
+            let constants = [BRANCH_ON_GBUFFER, MIXED_SLOT as u32];
+            t.branching = create_compute_pipeline(
+                ctx,
+                "tiled-shade-branching-pipeline",
+                module,
+                t.pipeline_layout,
+                &constants,
+            )?;
             use vk::BufferUsageFlags as U;
             let storage = U::STORAGE_BUFFER;
             let gpu = MemoryLocation::GpuOnly;
             t.dispatch = Buffer::new(
                 ctx,
                 "tiled-dispatch",
-                (MAX_SLOTS * 16) as u64,
+                ((MIXED_SLOT + 1) * 16) as u64,
                 storage | U::INDIRECT_BUFFER | U::TRANSFER_DST,
                 gpu,
             )?;
-            let slots = inputs.brdfs.len().max(1) as u64;
-            t.lists = Buffer::new(
-                ctx,
-                "tiled-lists",
-                slots * u64::from(tiles) * 4,
-                storage,
-                gpu,
-            )?;
+            // Every slot's list and the mixed tiles' (which the shaders find at MIXED_SLOT).
+            let lists = (MIXED_SLOT + 1) as u64 * u64::from(tiles) * 4;
+            t.lists = Buffer::new(ctx, "tiled-lists", lists, storage, gpu)?;
             let mask_bytes = u64::from(tiles) * u64::from(words) * 4;
             t.masks = Buffer::new(ctx, "tiled-light-masks", mask_bytes, storage, gpu)?;
             let sizes = [
@@ -207,6 +230,7 @@ impl TiledLighting {
                 tiles,
                 words,
                 clear: 0,
+                mixed: PER_BRDF,
                 slot_of_model,
             });
             t.tiles_xy = tiles_xy;
@@ -223,10 +247,15 @@ impl TiledLighting {
         cmd: vk::CommandBuffer,
         targets: &mut LightingTargets,
         clear: bool,
+        mixed: MixedTiles,
     ) {
         let d = &ctx.device;
         let push = TiledPush {
             clear: u32::from(clear),
+            mixed: match mixed {
+                MixedTiles::PerBrdf => PER_BRDF,
+                MixedTiles::Branching => MIXED_SLOT as u32,
+            },
             ..self.push.expect("made")
         };
         ctx.begin_label(cmd, "tiled-classify");
@@ -246,7 +275,7 @@ impl TiledLighting {
             hdr_contents,
         );
         // Each slot's dispatch starts at zero tiles.
-        let reset: Vec<u32> = (0..MAX_SLOTS).flat_map(|_| [0, 1, 1, 0]).collect();
+        let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
         unsafe {
             d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
         }
@@ -301,13 +330,15 @@ impl TiledLighting {
         ctx.end_label(cmd);
     }
 
-    /// Records one indirect dispatch per BRDF slot over its tiles, after
-    /// [`TiledLighting::record_classify`] in the same command buffer (whose sets and push
-    /// constants stay bound); the HDR target stays in `GENERAL`.
-    pub fn record_shade(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+    /// Records one indirect dispatch per BRDF slot over its tiles, and with
+    /// [`MixedTiles::Branching`] one over the mixed tiles, after
+    /// [`TiledLighting::record_classify`] with the same `mixed` in the same command buffer
+    /// (whose sets and push constants stay bound); the HDR target stays in `GENERAL`.
+    pub fn record_shade(&self, ctx: &Context, cmd: vk::CommandBuffer, mixed: MixedTiles) {
         let d = &ctx.device;
         ctx.begin_label(cmd, "tiled-shade");
-        for (slot, pipeline) in self.shade.iter().enumerate() {
+        let branching = (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
+        for (slot, pipeline) in self.shade.iter().enumerate().chain(branching) {
             ctx.begin_label(cmd, &format!("tiled-shade-{slot}"));
             unsafe {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);

@@ -76,7 +76,9 @@ impl Renderer<'_> {
         self.readback.record(ctx, cmd, &mut self.targets, readback);
         self.submit_and_wait()?;
         let mut timings = self.timestamps.read(ctx)?;
-        let planned = deferred.as_ref().filter(|(t, _)| *t != Technique::Tiled);
+        let planned = deferred
+            .as_ref()
+            .filter(|(t, _)| !matches!(t, Technique::Tiled { .. }));
         if desc.pass_timing && planned.is_some() {
             timings.lighting = self.lighting.step_timings(0)?;
         }
@@ -85,7 +87,7 @@ impl Renderer<'_> {
         }
         let images = self.readback.read(readback)?;
         let tile_stats = match &deferred {
-            Some((t, plan)) if desc.tile_stats && *t != Technique::Tiled => {
+            Some((t, plan)) if desc.tile_stats && !matches!(t, Technique::Tiled { .. }) => {
                 self.lighting.tile_stats(plan)
             }
             _ => None,
@@ -130,13 +132,13 @@ impl Renderer<'_> {
             self.targets.lit(&targets);
         }
         self.timestamps.mark(ctx, cmd, "gbuffer");
-        if technique == Technique::Tiled {
+        if let Technique::Tiled { mixed } = technique {
             self.tiled_lighting()?;
             let tiled = self.tiled.as_ref().expect("made above");
             let mut targets = self.targets.lighting();
-            tiled.record_classify(ctx, cmd, &mut targets, !emits);
+            tiled.record_classify(ctx, cmd, &mut targets, !emits, mixed);
             self.timestamps.mark(ctx, cmd, "tile-classify");
-            tiled.record_shade(ctx, cmd);
+            tiled.record_shade(ctx, cmd, mixed);
             self.targets.lit(&targets);
             self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
             return Ok(());
