@@ -70,8 +70,8 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
 
     let json = read_json(&dir.join("report.json"));
     let numbers = count_finite_numbers(&json, "report");
-    // 6 rows x 3 counts x (4 timing + 2 overhead + 3 error + 1) numbers at least.
-    assert!(numbers > 6 * 3 * 10, "{numbers} numbers");
+    // 8 rows x 3 counts x (4 timing + 2 overhead + 3 error + 1) numbers at least.
+    assert!(numbers > 8 * 3 * 10, "{numbers} numbers");
     let rows = json["rows"].as_array().unwrap();
     let names: Vec<&str> = rows
         .iter()
@@ -85,7 +85,9 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
             "stencil ps3",
             "stencil native",
             "lut",
-            "adaptive"
+            "adaptive",
+            "tiled",
+            "tiled, mixed branching"
         ]
     );
     for row in rows {
@@ -104,7 +106,12 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
             assert!(max <= limit, "{name}: error max {max}");
         }
     }
-    assert_eq!(json["light_sizes"].as_array().unwrap().len(), 3);
+    let sizes = json["light_sizes"].as_array().unwrap();
+    assert_eq!(sizes.len(), 3);
+    for size in sizes {
+        assert!(size["tiled"]["median_ms"].as_f64().unwrap() > 0.0);
+        assert_eq!(size["samples_ms"]["tiled"].as_array().unwrap().len(), 2);
+    }
     assert_eq!(json["breakdown"].as_array().unwrap().len(), 3);
     assert!(json["device"].as_str().unwrap().contains("llvmpipe") || !json["device"].is_null());
 
@@ -123,6 +130,7 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
         "cleanup",
         "ms, +",
         "Light size",
+        "tiled / best",
         "FLIP",
     ] {
         assert!(md.contains(part), "report.md lacks `{part}`");

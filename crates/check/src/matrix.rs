@@ -11,7 +11,7 @@
 //! reads (it decides whether their failure must show).
 
 use histencil_model::FlushPolicy;
-use histencil_vk::{AlphaMode, Backend, DepthStencilFormat, Technique};
+use histencil_vk::{AlphaMode, Backend, DepthStencilFormat, MixedTiles, Technique};
 use std::fmt;
 
 /// The engine bits the G-buffer pass writes into the preserved stencil bits: the talk's example
@@ -37,15 +37,19 @@ pub enum Lighting {
     Deferred,
     Adaptive,
     Lut,
+    /// Tile classification and one dispatch per BRDF (mixed tiles branching); no stencil, so
+    /// one configuration, like deferred.
+    Tiled,
 }
 
 impl Lighting {
-    pub const ALL: [Lighting; 5] = [
+    pub const ALL: [Lighting; 6] = [
         Lighting::Stencil,
         Lighting::Branching,
         Lighting::Deferred,
         Lighting::Adaptive,
         Lighting::Lut,
+        Lighting::Tiled,
     ];
 
     pub fn name(self) -> &'static str {
@@ -55,6 +59,7 @@ impl Lighting {
             Lighting::Deferred => "deferred",
             Lighting::Adaptive => "adaptive",
             Lighting::Lut => "lut",
+            Lighting::Tiled => "tiled",
         }
     }
 }
@@ -189,6 +194,9 @@ impl Config {
             Lighting::Deferred => Technique::DEFERRED,
             Lighting::Adaptive => Technique::Adaptive { backend, flush },
             Lighting::Lut => Technique::Lut { backend, flush },
+            Lighting::Tiled => Technique::Tiled {
+                mixed: MixedTiles::Branching,
+            },
         }
     }
 }
@@ -218,6 +226,7 @@ impl Case {
             Some(c) => {
                 let lighting = match c.lighting {
                     Lighting::Deferred => "deferred".to_owned(),
+                    Lighting::Tiled => "tiled".to_owned(),
                     l => format!("{}-{}-{}", l.name(), c.platform.name(), flush_name(c.flush)),
                 };
                 let pattern = if c.pattern == 0 {
@@ -282,7 +291,8 @@ pub fn resolutions(quick: bool) -> Vec<(u32, u32)> {
 fn lighting_configs(pattern: u8, alpha: AlphaMode) -> Vec<Config> {
     let mut configs = Vec::new();
     for lighting in Lighting::ALL {
-        if lighting == Lighting::Deferred {
+        // Neither uses stencil or hi-stencil: one configuration on the native backend.
+        if lighting == Lighting::Deferred || lighting == Lighting::Tiled {
             configs.push(Config {
                 lighting,
                 platform: Platform::Native,
@@ -451,8 +461,8 @@ mod tests {
     fn the_matrix_holds_what_a_scene_needs_and_nothing_else() {
         let room = cases(ROOM, DepthStencilFormat::D32S8, (257, 129));
         // Per pattern: stencil, adaptive, lut 7 each (x360, save-restore, ps3 with two flushes,
-        // native with one), branching 6 (not on native), deferred 1.
-        let lighting = 3 * 7 + 6 + 1;
+        // native with one), branching 6 (not on native), deferred 1, tiled 1.
+        let lighting = 3 * 7 + 6 + 1 + 1;
         let known_wrong = 3;
         assert_eq!(room.len(), 1 + 2 * lighting + known_wrong);
         assert!(room

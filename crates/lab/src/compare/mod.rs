@@ -214,10 +214,12 @@ pub struct SizePoint {
     pub branching: Timing,
     pub stencil: Timing,
     pub adaptive: Timing,
-    /// The worst of the three techniques' errors against forward.
+    /// The tiled technique (mixed tiles branching).
+    pub tiled: Timing,
+    /// The worst of the four techniques' errors against forward.
     pub error: ImageError,
-    /// Every round's lighting time of branching, stencil and adaptive, interleaved.
-    pub samples: [Vec<f64>; 3],
+    /// Every round's lighting time of branching, stencil, adaptive and tiled, interleaved.
+    pub samples: [Vec<f64>; 4],
     pub sampled: Sampled,
 }
 
@@ -247,6 +249,18 @@ impl SizePoint {
             &self.samples[1]
         };
         ratio_interval(&self.samples[2], best)
+    }
+
+    /// Tiled's time over the better (by median) of branching and stencil, paired by round, and
+    /// its verdict (faster, slower, or indistinguishable).
+    pub fn tiled_over_best(&self) -> (Interval, Verdict) {
+        let best = if self.branching.median_ms <= self.stencil.median_ms {
+            &self.samples[0]
+        } else {
+            &self.samples[1]
+        };
+        let r = ratio_interval(&self.samples[3], best);
+        (r, Verdict::of(&r))
     }
 
     /// Adaptive's time over the better of branching and stencil (1 is ideal).
@@ -452,10 +466,10 @@ pub fn run_compare(
             error = error.worst(image_error(&frame(&mut renderer, technique)?, &reference));
         }
         // Interleaved, as the table; tracked: every pair's ratio.
-        let samples = std::cell::RefCell::new([vec![], vec![], vec![]]);
+        let samples = std::cell::RefCell::new([vec![], vec![], vec![], vec![]]);
         let pair_widths = || {
             let s = samples.borrow();
-            [(1, 0), (2, 0), (2, 1)]
+            [(1, 0), (2, 0), (2, 1), (3, 0), (3, 1)]
                 .map(|(a, b)| ratio_interval(&s[a], &s[b]).relative_half_width())
                 .to_vec()
         };
@@ -478,6 +492,7 @@ pub fn run_compare(
             branching: timings[0],
             stencil: timings[1],
             adaptive: timings[2],
+            tiled: timings[3],
             error,
             samples,
             sampled,
@@ -512,13 +527,17 @@ fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<f64> {
     Ok(timings.pass_ms("lighting").unwrap_or(0.0) + classify)
 }
 
-/// Branching, stencil and adaptive on the native backend: the light-size sweep's three.
-fn size_techniques() -> [Technique; 3] {
+/// Branching, stencil and adaptive on the native backend, and tiled: the light-size sweep's
+/// four.
+fn size_techniques() -> [Technique; 4] {
     let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
     [
         Technique::Branching { backend, flush },
         Technique::Stencil { backend, flush },
         Technique::Adaptive { backend, flush },
+        Technique::Tiled {
+            mixed: MixedTiles::Branching,
+        },
     ]
 }
 

@@ -190,15 +190,17 @@ impl CompareReport {
         md += "\n## Light size: where branching overtakes stencil\n\n\
                A striped wall in three BRDFs under lights covering the given fraction of the \
                screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
-               screens. Native backend; the error is the worst of the three techniques.\n\n\
-               | coverage | lights | rounds | branching | stencil | adaptive | stencil / branching | faster | adaptive / best | error max / mean / FLIP |\n\
-               |---|---|---|---|---|---|---|---|---|---|\n";
+               screens. Native backend; tiled with mixed tiles branching; the error is the worst \
+               of the four techniques.\n\n\
+               | coverage | lights | rounds | branching | stencil | adaptive | tiled | stencil / branching | faster | adaptive / best | tiled / best | error max / mean / FLIP |\n\
+               |---|---|---|---|---|---|---|---|---|---|---|---|\n";
         for p in &self.sizes {
             let (ratio, _) = p.stencil_over_branching();
             let best = p.adaptive_over_best_interval();
+            let (tiled, tiled_verdict) = p.tiled_over_best();
             let _ = writeln!(
                 md,
-                "| {:.1} % | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} |",
+                "| {:.1} % | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} |",
                 p.coverage * 100.0,
                 p.lights,
                 p.sampled.rounds,
@@ -206,9 +208,12 @@ impl CompareReport {
                 interval_text(&median_interval(&p.samples[0])),
                 interval_text(&median_interval(&p.samples[1])),
                 interval_text(&median_interval(&p.samples[2])),
+                interval_text(&median_interval(&p.samples[3])),
                 ratio_text(&ratio),
                 p.faster(),
                 ratio_text(&best),
+                ratio_text(&tiled),
+                tiled_verdict.word(),
                 error_text(&p.error)
             );
         }
@@ -278,7 +283,7 @@ impl CompareReport {
 
     fn plot_sizes(&self, path: &Path) -> Result<()> {
         // Per light: each technique's median and interval over the size point's rounds.
-        let series = ["branching", "stencil", "adaptive"]
+        let series = ["branching", "stencil", "adaptive", "tiled"]
             .into_iter()
             .enumerate()
             .map(|(i, name)| {
@@ -454,9 +459,16 @@ fn size_json(p: &SizePoint) -> Value {
         "adaptive": timing_json(&p.adaptive),
         "adaptive_over_best": p.adaptive_over_best(),
         "adaptive_over_best_interval": interval_json(&p.adaptive_over_best_interval()),
+        "tiled": timing_json(&p.tiled),
+        "tiled_over_best": interval_json(&p.tiled_over_best().0),
         "stencil_over_branching": interval_json(&p.stencil_over_branching().0),
         "faster": p.faster(),
-        "samples_ms": {"branching": p.samples[0], "stencil": p.samples[1], "adaptive": p.samples[2]},
+        "samples_ms": {
+            "branching": p.samples[0],
+            "stencil": p.samples[1],
+            "adaptive": p.samples[2],
+            "tiled": p.samples[3],
+        },
         "sampling": sampled_json(&p.sampled),
         "error": error_json(&p.error),
     })
