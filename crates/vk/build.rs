@@ -69,7 +69,6 @@ fn generated_glsl() -> String {
         histencil_brdf::BrdfId::ALL.len() <= TILED_MODELS as usize,
         "raise TILED_MODELS"
     );
-    writeln!(s, "#define TILED_TILE {TILED_TILE}u").unwrap();
     writeln!(s, "#define TILED_MODELS {TILED_MODELS}u").unwrap();
     for axes in histencil_brdf::lut::LutAxes::ALL {
         writeln!(s, "#define {} {}u", axes.glsl_constant(), axes.index()).unwrap();

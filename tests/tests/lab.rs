@@ -70,8 +70,8 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
 
     let json = read_json(&dir.join("report.json"));
     let numbers = count_finite_numbers(&json, "report");
-    // 8 rows x 3 counts x (4 timing + 2 overhead + 3 error + 1) numbers at least.
-    assert!(numbers > 8 * 3 * 10, "{numbers} numbers");
+    // 9 rows x 3 counts x (4 timing + 2 overhead + 3 error + 1) numbers at least.
+    assert!(numbers > 9 * 3 * 10, "{numbers} numbers");
     let rows = json["rows"].as_array().unwrap();
     let names: Vec<&str> = rows
         .iter()
@@ -87,7 +87,8 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
             "lut",
             "adaptive",
             "tiled",
-            "tiled, mixed branching"
+            "tiled, mixed branching",
+            "tiled 8x8"
         ]
     );
     for row in rows {

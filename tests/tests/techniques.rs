@@ -14,7 +14,7 @@ use histencil_brdf::BrdfId;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{
     Backend, CostModel, FlushPolicy, MixedTiles, Readback, Renderer, RendererDesc, Shading,
-    Technique,
+    Technique, TileSide,
 };
 
 const SIZE: u32 = 160;
@@ -105,12 +105,9 @@ fn check(scene_name: &str) {
         // twice (its tile lists are appended in whatever order the GPU runs the tiles; each
         // pixel is shaded once), and the same both ways (a pixel's sum does not depend on which
         // kernel computes it).
-        let per_brdf = Technique::Tiled {
-            mixed: MixedTiles::PerBrdf,
-        };
-        let branching_mixed = Technique::Tiled {
-            mixed: MixedTiles::Branching,
-        };
+        let tiled_with = |mixed, side| Technique::Tiled { mixed, side };
+        let per_brdf = tiled_with(MixedTiles::PerBrdf, TileSide::Sixteen);
+        let branching_mixed = tiled_with(MixedTiles::Branching, TileSide::Sixteen);
         let (tiled, _) = against_forward("tiled", per_brdf, TOLERANCE);
         let (again, _) = against_forward("tiled", per_brdf, TOLERANCE);
         assert_eq!(
@@ -124,6 +121,16 @@ fn check(scene_name: &str) {
             0,
             "{scene_name}: tiled both ways"
         );
+        // 8x8 tiles, either way: the same pixels again.
+        for mixed in [MixedTiles::PerBrdf, MixedTiles::Branching] {
+            let small = tiled_with(mixed, TileSide::Eight);
+            let (image, _) = against_forward("tiled-8x8", small, TOLERANCE);
+            assert_eq!(
+                diff(&tiled, &image).pixels_differing,
+                0,
+                "{scene_name}: 8x8 tiles"
+            );
+        }
         // The LUT technique is approximate: its own tolerance, at the default resolution, with
         // hi-stencil (ps3) and without (native). It has no table for glTF's metallic-roughness
         // BRDF, and says so.

@@ -11,7 +11,7 @@
 //! reads (it decides whether their failure must show).
 
 use histencil_model::FlushPolicy;
-use histencil_vk::{AlphaMode, Backend, DepthStencilFormat, MixedTiles, Technique};
+use histencil_vk::{AlphaMode, Backend, DepthStencilFormat, MixedTiles, Technique, TileSide};
 use std::fmt;
 
 /// The engine bits the G-buffer pass writes into the preserved stencil bits: the talk's example
@@ -37,8 +37,8 @@ pub enum Lighting {
     Deferred,
     Adaptive,
     Lut,
-    /// Tile classification and one dispatch per BRDF (mixed tiles branching); no stencil, so
-    /// one configuration, like deferred.
+    /// Tile classification and one dispatch per BRDF (16x16 tiles, mixed tiles per BRDF); no
+    /// stencil, so one configuration, like deferred.
     Tiled,
 }
 
@@ -195,7 +195,8 @@ impl Config {
             Lighting::Adaptive => Technique::Adaptive { backend, flush },
             Lighting::Lut => Technique::Lut { backend, flush },
             Lighting::Tiled => Technique::Tiled {
-                mixed: MixedTiles::Branching,
+                mixed: MixedTiles::PerBrdf,
+                side: TileSide::Sixteen,
             },
         }
     }

@@ -7,7 +7,7 @@ use histencil_check::matrix::Platform;
 use histencil_scene::{with_default_lights, DefaultLights};
 use histencil_vk::{
     AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, ImageKind, MixedTiles, Readback,
-    Renderer, RendererDesc, Shading, Technique,
+    Renderer, RendererDesc, Shading, Technique, TileSide,
 };
 use image::DynamicImage;
 use std::path::PathBuf;
@@ -148,6 +148,9 @@ struct RenderArgs {
     /// figures).
     #[arg(long)]
     costs: Option<PathBuf>,
+    /// The tiled techniques' tile side in pixels.
+    #[arg(long, value_enum, default_value = "16")]
+    tile_size: TileSizeArg,
     /// Time every lighting step and print the talk's pass groups (setup, mask and shade per BRDF,
     /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
     #[arg(long)]
@@ -189,13 +192,21 @@ enum TechniqueArg {
     Branching,
     Adaptive,
     Lut,
-    /// Tile classification and one indirect dispatch per BRDF (today's engines); a tile of
-    /// several BRDFs is shaded once, branching.
+    /// Tile classification and one indirect dispatch per BRDF (today's engines); each BRDF's
+    /// kernel shades its own pixels of a tile of several BRDFs. Tiles of --tile-size pixels.
     Tiled,
-    /// As tiled, with each BRDF's kernel running over a tile of several BRDFs.
-    TiledPerBrdf,
+    /// As tiled, with a tile of several BRDFs shaded once by one kernel branching per pixel.
+    TiledMixedBranching,
     Deferred,
     Forward,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum TileSizeArg {
+    #[value(name = "8")]
+    Eight,
+    #[value(name = "16")]
+    Sixteen,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -234,6 +245,13 @@ enum FlushArg {
 }
 
 impl RenderArgs {
+    fn tile_side(&self) -> TileSide {
+        match self.tile_size {
+            TileSizeArg::Eight => TileSide::Eight,
+            TileSizeArg::Sixteen => TileSide::Sixteen,
+        }
+    }
+
     fn shading(&self) -> Shading {
         // The check's platform vocabulary names the same five backends.
         let backend = match self.backend {
@@ -255,11 +273,13 @@ impl RenderArgs {
             TechniqueArg::Adaptive => Technique::Adaptive { backend, flush }.into(),
             TechniqueArg::Lut => Technique::Lut { backend, flush }.into(),
             TechniqueArg::Tiled => Technique::Tiled {
-                mixed: MixedTiles::Branching,
+                mixed: MixedTiles::PerBrdf,
+                side: self.tile_side(),
             }
             .into(),
-            TechniqueArg::TiledPerBrdf => Technique::Tiled {
-                mixed: MixedTiles::PerBrdf,
+            TechniqueArg::TiledMixedBranching => Technique::Tiled {
+                mixed: MixedTiles::Branching,
+                side: self.tile_side(),
             }
             .into(),
             TechniqueArg::Deferred => Technique::DEFERRED.into(),

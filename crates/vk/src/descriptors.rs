@@ -167,6 +167,8 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("particle.frag", ALPHA_LAYOUT),
     ("tile_classify.comp", TILED_LAYOUT),
     ("tile_shade.comp", TILED_LAYOUT),
+    ("tile_classify_8.comp", TILED_LAYOUT),
+    ("tile_shade_8.comp", TILED_LAYOUT),
 ];
 
 /// The stages of the graphics passes: every binding and push constant is visible to both.

@@ -12,9 +12,6 @@ pub const LIGHT_KINDS: [(&str, u32); 3] = [
 /// surface covers this many pixels squared, like the 8x8 granularity of console hi-stencil.
 pub const HI_STENCIL_TILE: u32 = 8;
 
-/// Side of a tile of the tiled technique in pixels (GLSL `TILED_TILE`): one workgroup of the
-/// classification and of a shade kernel covers one tile.
-pub const TILED_TILE: u32 = 16;
 /// BRDF model ids the tiled classification maps to slots (GLSL `TILED_MODELS`): at least
 /// `BrdfId::ALL.len()` (build.rs checks).
 pub const TILED_MODELS: u32 = 8;

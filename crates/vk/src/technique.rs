@@ -4,7 +4,7 @@
 
 use crate::alpha::AlphaMode;
 use crate::passes::light_pipelines::BrdfSource;
-pub use crate::passes::tiled::MixedTiles;
+pub use crate::passes::tiled::{MixedTiles, TileSide};
 use crate::readback::Readback;
 use histencil_model::{
     CostModel, DepthConvention, FlushPolicy, Native, PlanSettings, PlatformBackend, Ps3Like,
@@ -111,8 +111,9 @@ pub enum Technique {
     /// BRDFs its pixels use and the lights that can reach it, then one indirect dispatch per
     /// BRDF shades that BRDF's tiles with a kernel specialised to it, each pixel once by its
     /// own BRDF with its tile's lights (`passes/tiled.rs`). No stencil, no hi-stencil: the same
-    /// on every platform. `mixed` says how tiles of several BRDFs are shaded.
-    Tiled { mixed: MixedTiles },
+    /// on every platform. `mixed` says how tiles of several BRDFs are shaded, `side` how big a
+    /// tile is.
+    Tiled { mixed: MixedTiles, side: TileSide },
 }
 
 impl Technique {

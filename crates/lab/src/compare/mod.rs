@@ -11,7 +11,7 @@ use crate::Result;
 use histencil_scene::Scene;
 use histencil_vk::{
     Backend, Context, CostModel, FlushPolicy, FrameDesc, MixedTiles, Readback, Renderer,
-    RendererDesc, Shading, Technique,
+    RendererDesc, Shading, Technique, TileSide,
 };
 
 /// What a comparison run measures.
@@ -107,12 +107,21 @@ pub fn table_rows() -> Vec<(&'static str, Technique)> {
             "tiled",
             Technique::Tiled {
                 mixed: MixedTiles::PerBrdf,
+                side: TileSide::Sixteen,
             },
         ),
         (
             "tiled, mixed branching",
             Technique::Tiled {
                 mixed: MixedTiles::Branching,
+                side: TileSide::Sixteen,
+            },
+        ),
+        (
+            "tiled 8x8",
+            Technique::Tiled {
+                mixed: MixedTiles::PerBrdf,
+                side: TileSide::Eight,
             },
         ),
     ]
@@ -214,7 +223,7 @@ pub struct SizePoint {
     pub branching: Timing,
     pub stencil: Timing,
     pub adaptive: Timing,
-    /// The tiled technique (mixed tiles branching).
+    /// The tiled technique (16x16 tiles, mixed tiles per BRDF).
     pub tiled: Timing,
     /// The worst of the four techniques' errors against forward.
     pub error: ImageError,
@@ -536,7 +545,8 @@ fn size_techniques() -> [Technique; 4] {
         Technique::Stencil { backend, flush },
         Technique::Adaptive { backend, flush },
         Technique::Tiled {
-            mixed: MixedTiles::Branching,
+            mixed: MixedTiles::PerBrdf,
+            side: TileSide::Sixteen,
         },
     ]
 }

@@ -190,7 +190,7 @@ impl CompareReport {
         md += "\n## Light size: where branching overtakes stencil\n\n\
                A striped wall in three BRDFs under lights covering the given fraction of the \
                screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
-               screens. Native backend; tiled with mixed tiles branching; the error is the worst \
+               screens. Native backend; tiled with 16x16 tiles, mixed tiles per BRDF; the error is the worst \
                of the four techniques.\n\n\
                | coverage | lights | rounds | branching | stencil | adaptive | tiled | stencil / branching | faster | adaptive / best | tiled / best | error max / mean / FLIP |\n\
                |---|---|---|---|---|---|---|---|---|---|---|---|\n";

@@ -1,6 +1,6 @@
 //! The tiled technique, the way engines today light many BRDFs (Unity HDRP's material feature
 //! tiles, UE5 Substrate's classification, Battlefield 3's tiled light lists), next to the
-//! talk's: a compute pass classifies each `TILED_TILE`-pixel-square tile of the G-buffer (the
+//! talk's: a compute pass classifies each 8x8 or 16x16 tile ([`TileSide`]) of the G-buffer (the
 //! BRDFs its pixels use, their depth range, the lights that can reach them) into one list of
 //! tiles per BRDF with its indirect dispatch arguments, all on the GPU; then one indirect
 //! dispatch per BRDF in the frame runs a kernel specialised to that BRDF over its tiles, and each
@@ -17,7 +17,7 @@ use crate::descriptors::{
 use crate::error::{Error, Result, VkCall};
 use crate::pipelines::create_compute_pipeline;
 use crate::resources::Buffer;
-use crate::shader_consts::{TILED_MODELS, TILED_TILE};
+use crate::shader_consts::TILED_MODELS;
 use crate::shaders;
 use crate::teardown::{build, Destroy};
 use ash::vk;
@@ -44,6 +44,40 @@ const MIXED_SLOT: usize = MAX_SLOTS;
 const PER_BRDF: u32 = u32::MAX;
 /// `SHADED_BRDF` of the branching kernel.
 const BRANCH_ON_GBUFFER: u32 = u32::MAX;
+
+/// The side of the tiled technique's tiles (`TILED_TILE` of the stages it picks): one workgroup
+/// of the classification and of a shade kernel covers one tile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TileSide {
+    /// 8x8 pixels: fewer wasted invocations on mixed and partly covered tiles, four times the
+    /// tiles to classify and list.
+    Eight,
+    /// 16x16 pixels, as HDRP's classification.
+    Sixteen,
+}
+
+impl TileSide {
+    pub fn pixels(self) -> u32 {
+        match self {
+            TileSide::Eight => 8,
+            TileSide::Sixteen => 16,
+        }
+    }
+
+    /// The classification and shade stages built for this side.
+    fn modules(self) -> [(&'static str, &'static [u8]); 2] {
+        match self {
+            TileSide::Eight => [
+                ("tile_classify_8.comp", shaders::TILE_CLASSIFY_8_COMP),
+                ("tile_shade_8.comp", shaders::TILE_SHADE_8_COMP),
+            ],
+            TileSide::Sixteen => [
+                ("tile_classify.comp", shaders::TILE_CLASSIFY_COMP),
+                ("tile_shade.comp", shaders::TILE_SHADE_COMP),
+            ],
+        }
+    }
+}
 
 /// What the tiled technique does with a tile whose pixels use several BRDFs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -76,6 +110,7 @@ pub(crate) struct TiledLighting {
 /// What the tiled lighting reads: the renderer's frame buffers and G-buffer, its HDR target.
 pub(crate) struct TiledInputs<'a> {
     pub extent: vk::Extent2D,
+    pub side: TileSide,
     /// The BRDF of each stencil slot.
     pub brdfs: &'a [BrdfId],
     pub max_lights: u32,
@@ -122,7 +157,9 @@ impl TiledLighting {
         }
         let compute = vk::ShaderStageFlags::COMPUTE;
         let e = inputs.extent;
-        let tiles_xy = (e.width.div_ceil(TILED_TILE), e.height.div_ceil(TILED_TILE));
+        let tile = inputs.side.pixels();
+        let tiles_xy = (e.width.div_ceil(tile), e.height.div_ceil(tile));
+        let [classify, shade] = inputs.side.modules();
         let tiles = tiles_xy.0 * tiles_xy.1;
         let words = inputs.max_lights.div_ceil(32).max(1);
         let mut slot_of_model = [u32::MAX; TILED_MODELS as usize];
@@ -146,7 +183,7 @@ impl TiledLighting {
                 compute,
                 push_bytes,
             )?;
-            let module = ("tile_classify.comp", shaders::TILE_CLASSIFY_COMP);
+            let module = classify;
             t.classify = create_compute_pipeline(
                 ctx,
                 "tiled-classify-pipeline",
@@ -155,13 +192,13 @@ impl TiledLighting {
                 &[],
             )?;
             for (slot, brdf) in inputs.brdfs.iter().enumerate() {
-                let module = ("tile_shade.comp", shaders::TILE_SHADE_COMP);
+                let module = shade;
                 let name = format!("tiled-shade-{}-pipeline", brdf.name());
                 let constants = [brdf.index(), slot as u32];
                 let p = create_compute_pipeline(ctx, &name, module, t.pipeline_layout, &constants)?;
                 t.shade.push(p);
             }
-            let module = ("tile_shade.comp", shaders::TILE_SHADE_COMP);
+            let module = shade;
             let constants = [BRANCH_ON_GBUFFER, MIXED_SLOT as u32];
             t.branching = create_compute_pipeline(
                 ctx,

@@ -171,7 +171,7 @@ impl<'c> Renderer<'c> {
             lut_tables: None,
             alpha: None,
             lighting,
-            tiled: None,
+            tiled: Vec::new(),
             extent,
             targets: targets.keep(),
             meshes: meshes.keep(),
@@ -252,7 +252,7 @@ impl Drop for Renderer<'_> {
         if let Some(a) = self.alpha.as_mut() {
             a.destroy(ctx);
         }
-        if let Some(t) = self.tiled.as_mut() {
+        for (_, t) in &mut self.tiled {
             t.destroy(ctx);
         }
         self.maps.destroy(ctx);

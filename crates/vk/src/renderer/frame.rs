@@ -132,9 +132,9 @@ impl Renderer<'_> {
             self.targets.lit(&targets);
         }
         self.timestamps.mark(ctx, cmd, "gbuffer");
-        if let Technique::Tiled { mixed } = technique {
-            self.tiled_lighting()?;
-            let tiled = self.tiled.as_ref().expect("made above");
+        if let Technique::Tiled { mixed, side } = technique {
+            self.tiled_lighting(side)?;
+            let tiled = &self.tiled.iter().find(|(s, _)| *s == side).expect("made").1;
             let mut targets = self.targets.lighting();
             tiled.record_classify(ctx, cmd, &mut targets, !emits, mixed);
             self.timestamps.mark(ctx, cmd, "tile-classify");
