@@ -64,8 +64,8 @@ fn a_clean_slice_passes_and_its_known_wrong_cases_fail_as_expected() {
     assert_eq!(xml.matches("failed as expected").count(), 3, "{xml}");
     let report: serde_json::Value = serde_json::from_str(&text(&json)).unwrap();
     let cases = report["cases"].as_array().unwrap();
-    // The reference, 2 patterns x 28 lighting configurations, 3 known-wrong, the teardown.
-    assert_eq!(cases.len(), 1 + 2 * 28 + 3 + 1);
+    // The reference, 2 patterns x 29 lighting configurations, 3 known-wrong, the teardown.
+    assert_eq!(cases.len(), 1 + 2 * 29 + 3 + 1);
     assert!(cases.iter().all(|c| c["outcome"] == "passed"));
     let stencil_ps3 = cases
         .iter()
@@ -155,10 +155,10 @@ fn list_prints_the_matrix_without_a_device() {
             .filter(|l| l.starts_with("default\t"))
             .count()
     };
-    // Per format and resolution: the reference and 56 lighting cases, plus 3 known-wrong cases
-    // on D32S8 at 64x64 and up.
-    assert_eq!(count(&quick), 2 * 3 * 57 + 3);
-    assert_eq!(count(&full), 2 * 4 * 57 + 2 * 3);
+    // Per format and resolution: the reference and 58 lighting cases (29 per pattern, tiled
+    // among them), plus 3 known-wrong cases on D32S8 at 64x64 and up.
+    assert_eq!(count(&quick), 2 * 3 * 59 + 3);
+    assert_eq!(count(&full), 2 * 4 * 59 + 2 * 3);
     assert!(quick.contains("default\tstencil-x360-no-zeroing-auto-pA0-lightmap-d32s8-257x129\tWrong(PreservedBitsNotZeroed)"), "{quick}");
     assert!(full.contains("d24s8-1280x720"));
 }
