@@ -600,6 +600,7 @@ fn demo_prints_the_tour_and_writes_the_contact_sheet_under_validation() {
         "stencil, PS3-like",
         "stencil, 360-like (zeroing)",
         "stencil, 360-like (save/restore)",
+        "tiled, native",
     ] {
         assert!(stdout.contains(row), "{row}: {stdout}");
     }

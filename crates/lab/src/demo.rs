@@ -11,7 +11,8 @@ use crate::measure::{frame, time_passes, Timing};
 use crate::Result;
 use histencil_scene::Scene;
 use histencil_vk::{
-    Backend, Context, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique, TileStats,
+    Backend, Context, FlushPolicy, FrameDesc, MixedTiles, Readback, Renderer, Shading, Technique,
+    TileSide, TileStats,
 };
 use image::{RgbImage, RgbaImage};
 use std::fmt::Write as _;
@@ -81,7 +82,7 @@ fn stencil(backend: Backend, flush: FlushPolicy) -> Technique {
 }
 
 /// The rows, in the table's order.
-fn configurations() -> [(&'static str, Shading); 6] {
+fn configurations() -> [(&'static str, Shading); 7] {
     let auto = FlushPolicy::Auto;
     [
         ("forward (reference)", Shading::Forward),
@@ -98,6 +99,14 @@ fn configurations() -> [(&'static str, Shading); 6] {
                 },
                 auto,
             )
+            .into(),
+        ),
+        (
+            "tiled, native",
+            Technique::Tiled {
+                mixed: MixedTiles::PerBrdf,
+                side: TileSide::Sixteen,
+            }
             .into(),
         ),
     ]
@@ -120,12 +129,12 @@ pub fn run_demo(
     let mut rows = Vec::new();
     for (label, shading) in configurations() {
         step(label);
-        let pass = shading.lighting_pass();
+        let passes = shading.lighting_passes();
         let desc = FrameDesc {
             preserved_pattern: DEMO_PATTERN,
             ..FrameDesc::new(shading, all)
         };
-        let time = time_passes(&mut renderer, desc, &[pass], settings.frames)?;
+        let time = time_passes(&mut renderer, desc, passes, settings.frames)?;
         let images = renderer.render_frame(&desc)?.images;
         let ldr = images.ldr.expect("asked for");
         let error = frames

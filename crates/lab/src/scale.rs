@@ -169,7 +169,7 @@ pub fn run_scale(
             let t = renderer.render_frame(&FrameDesc::from(shading))?.timings;
             let pass = |name| t.pass_ms(name).unwrap_or(0.0);
             s.0.push(pass("gbuffer"));
-            s.1.push(pass(shading.lighting_pass()));
+            s.1.push(shading.lighting_passes().iter().map(|p| pass(p)).sum());
             s.2.push(t.total_ms());
         }
     }

@@ -77,6 +77,16 @@ impl Shading {
             Shading::Deferred(_) => "lighting",
         }
     }
+
+    /// Every timed pass the frame's lighting takes: [`Shading::lighting_pass`], after the
+    /// tiled technique's classification (`tile-classify`) for that technique.
+    pub fn lighting_passes(self) -> &'static [&'static str] {
+        match self {
+            Shading::Forward => &["forward"],
+            Shading::Deferred(Technique::Tiled { .. }) => &["tile-classify", "lighting"],
+            Shading::Deferred(_) => &["lighting"],
+        }
+    }
 }
 
 /// How a deferred frame's G-buffer is lit.
