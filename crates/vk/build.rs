@@ -65,6 +65,11 @@ fn generated_glsl() -> String {
         writeln!(s, "#define {name} {value}u").unwrap();
     }
     writeln!(s, "#define HI_STENCIL_TILE {HI_STENCIL_TILE}u").unwrap();
+    writeln!(
+        s,
+        "#define HI_STENCIL_UPDATE_GROUP {HI_STENCIL_UPDATE_GROUP}u"
+    )
+    .unwrap();
     assert!(
         histencil_brdf::BrdfId::ALL.len() <= TILED_MODELS as usize,
         "raise TILED_MODELS"

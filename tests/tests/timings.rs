@@ -131,3 +131,45 @@ fn lightmaps_are_timed_per_entity() {
         assert!(forward.unwrap().timings.lightmaps.is_none());
     });
 }
+
+/// The emulated backends time the emulator's bookkeeping apart from the platform's technique:
+/// present, positive and inside the lighting pass for PS3-like and 360-like, every frame, and
+/// absent on native, which emulates nothing.
+#[test]
+fn emulated_backends_time_their_bookkeeping_apart() {
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
+    with_validated_context(|ctx| {
+        let mut renderer = Renderer::new(ctx, scene, 96, 96).expect("renderer");
+        let x360 = Backend::X360 {
+            zero_preserved: true,
+            save_restore: false,
+        };
+        let flush = FlushPolicy::Auto;
+        for backend in [Backend::Ps3, x360] {
+            let technique = Technique::Stencil { backend, flush };
+            let timings = renderer
+                .render(technique, Readback::NONE)
+                .expect("frame")
+                .timings;
+            let lighting = timings.pass_ms("lighting").unwrap();
+            let bookkeeping = timings
+                .bookkeeping_ms
+                .unwrap_or_else(|| panic!("{backend:?}: no bookkeeping time"));
+            assert!(
+                bookkeeping > 0.0 && bookkeeping < lighting,
+                "{backend:?}: bookkeeping {bookkeeping} ms of lighting {lighting} ms"
+            );
+            let technique_ms = timings.technique_ms().unwrap();
+            assert!((technique_ms + bookkeeping - lighting).abs() < 1e-9);
+            // Median over frames keeps it.
+            let median = renderer.measure(technique, 3).expect("frames");
+            assert!(median.bookkeeping_ms.is_some_and(|b| b > 0.0));
+        }
+        let native = renderer.render(STENCIL, Readback::NONE).expect("frame");
+        assert_eq!(native.timings.bookkeeping_ms, None);
+        assert_eq!(
+            native.timings.technique_ms(),
+            native.timings.pass_ms("lighting")
+        );
+    });
+}

@@ -425,6 +425,16 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             shading,
             ctx.device_name()
         );
+        if let (Some(bookkeeping), Some(lighting)) =
+            (timings.bookkeeping_ms, timings.pass_ms("lighting"))
+        {
+            println!(
+                "emulated hi-stencil (medians): the platform's technique {:.2} ms + the \
+                 emulator's bookkeeping {bookkeeping:.2} ms (resets, splits, stencil copies, tile \
+                 updates, flush copies) = lighting {lighting:.2} ms",
+                lighting - bookkeeping
+            );
+        }
         if let Some(lighting) = &timings.lighting {
             print!("{}", describe_breakdown(lighting));
         }

@@ -1,25 +1,31 @@
 #version 460
-// Hi-stencil write, second half: one workgroup per tile. A tile the draw covered (its stamp is
-// this draw's) may pass when any of its pixels passes the hi-stencil compare on the stencil the
-// draw left: `(stencil & read_mask) OP reference`, as histencil_model::HiStencilState says.
+// Hi-stencil write, second half: one invocation per tile the draw touched (listed by
+// hi_stencil_touch.frag, dispatched indirectly over that list). The tile may pass when any of
+// its pixels passes the hi-stencil compare on the stencil the draw left:
+// `(stencil & read_mask) OP reference`, as histencil_model::HiStencilState says. No shared
+// memory and no barriers: a CPU rasteriser runs a workgroup with barriers one invocation at a
+// time, switching between them at each barrier.
 #include "generated.glsl"
 #include "stencil_bytes.glsl"
 
-layout(local_size_x = HI_STENCIL_TILE, local_size_y = HI_STENCIL_TILE) in;
+layout(local_size_x = HI_STENCIL_UPDATE_GROUP) in;
 
 // The stencil after the draw, copied out as tightly packed bytes.
 layout(set = 0, binding = 0, std430) readonly buffer StencilCopy {
     uint stencil_copy[];
 };
-layout(set = 0, binding = 1, std430) readonly buffer Touched {
-    uint touched[];
-};
+layout(set = 0, binding = 1, std430) readonly buffer TouchedList {
+    uint groups;
+    uint group_y;
+    uint group_z;
+    uint count;
+    uint tiles[];
+} touched_list;
 layout(set = 0, binding = 2, std430) writeonly buffer Pending {
     uint pending[];
 };
 
 layout(push_constant) uniform Update {
-    uint stamp;
     uint compare;   // VkCompareOp
     uint reference;
     uint read_mask; // 0xFF without a read mask (360-like)
@@ -27,8 +33,6 @@ layout(push_constant) uniform Update {
     uint height;
     uint tiles_x;
 } update;
-
-shared uint any_pixel_passes;
 
 bool compare_passes(uint op, uint a, uint b) {
     switch (op) {
@@ -44,25 +48,23 @@ bool compare_passes(uint op, uint a, uint b) {
 }
 
 void main() {
-    uint tile = gl_WorkGroupID.y * update.tiles_x + gl_WorkGroupID.x;
-    // The whole workgroup takes the same branch, so the barriers below stay uniform.
-    if (touched[tile] != update.stamp) {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= touched_list.count) {
         return;
     }
-    if (gl_LocalInvocationIndex == 0u) {
-        any_pixel_passes = 0u;
-    }
-    barrier();
-    uvec2 px = gl_GlobalInvocationID.xy;
-    if (px.x < update.width && px.y < update.height) {
-        uint index = px.y * update.width + px.x;
-        uint stencil = stencil_byte(stencil_copy[index >> 2], index);
-        if (compare_passes(update.compare, stencil & update.read_mask, update.reference)) {
-            atomicOr(any_pixel_passes, 1u);
+    uint tile = touched_list.tiles[i];
+    uvec2 origin = uvec2(tile % update.tiles_x, tile / update.tiles_x) * HI_STENCIL_TILE;
+    uvec2 end = min(origin + HI_STENCIL_TILE, uvec2(update.width, update.height));
+    uint passes = 0u;
+    for (uint y = origin.y; y < end.y && passes == 0u; ++y) {
+        for (uint x = origin.x; x < end.x; ++x) {
+            uint index = y * update.width + x;
+            uint stencil = stencil_byte(stencil_copy[index >> 2], index);
+            if (compare_passes(update.compare, stencil & update.read_mask, update.reference)) {
+                passes = 1u;
+                break;
+            }
         }
     }
-    barrier();
-    if (gl_LocalInvocationIndex == 0u) {
-        pending[tile] = any_pixel_passes;
-    }
+    pending[tile] = passes;
 }

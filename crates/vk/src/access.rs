@@ -224,7 +224,8 @@ pub(crate) fn transition(
 /// hazard through a stage missing here.
 pub(crate) fn memory_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
     use vk::PipelineStageFlags2 as S;
-    let stages = S::VERTEX_INPUT
+    let stages = S::DRAW_INDIRECT
+        | S::VERTEX_INPUT
         | S::VERTEX_SHADER
         | S::EARLY_FRAGMENT_TESTS
         | S::FRAGMENT_SHADER

@@ -26,7 +26,7 @@ use crate::hi_stencil::HiStencilSurface;
 use crate::hooks::{HookSets, LightHooks};
 use crate::meshes::LightVolumes;
 use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
-use crate::passes::lighting::LightingPass;
+use crate::passes::lighting::{Emulation, LightingPass};
 use crate::resources::Buffer;
 use crate::targets::GBUFFER_FORMATS;
 use crate::teardown::InFlight;
@@ -99,6 +99,8 @@ struct Slot {
     /// histencil's G-buffer set; null with an engine's decode hook.
     gbuffer_set: vk::DescriptorSet,
     timer: SlotTimer,
+    /// The hi-stencil emulation's bookkeeping against the technique (`Emulation`).
+    emulation: SlotTimer,
 }
 
 /// The lighting passes of the talk, recorded into an engine's frames.
@@ -361,6 +363,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 frame_set,
                 gbuffer_set,
                 timer: SlotTimer::default(),
+                emulation: SlotTimer::default(),
             });
         }
         Ok(())
@@ -570,6 +573,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let steps = frame.plan.steps.len() as u32;
         let name = "lighting-step-timestamps";
         slot.timer.prepare(ctx, name, frame.timestamps, steps)?;
+        let name = "lighting-emulation-timestamps";
+        let emulated = needs_hi_stencil(frame.plan);
+        let marks = Emulation::marks(frame.plan);
+        slot.emulation.prepare(ctx, name, emulated, marks)?;
         slot.uniforms.write(bytemuck::bytes_of(&uniforms));
         let gpu_lights: Vec<GpuLight> = frame.lights.iter().map(GpuLight::new).collect();
         slot.lights.write(bytemuck::cast_slice(&gpu_lights));
@@ -603,9 +610,28 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             depth_sampled: self.desc.hooks.samples_depth(),
         };
         let timer = slot.timer.active();
+        let emulation = slot.emulation.active();
         self.in_flight.mark();
         let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
-        pass.record(targets, hi_stencil, timer)
+        pass.record(targets, hi_stencil, timer, emulation)
+    }
+
+    /// Of the last frame recorded into `slot`, once the GPU has finished it: the time the
+    /// hi-stencil emulator spent on bookkeeping a console does not do (resetting its tile
+    /// surface, the split, stencil copy and tile update after each hi-stencil write, the copy
+    /// at each flush), in milliseconds; the rest of the lighting is the platform's technique.
+    /// `None` when that frame's plan used no hi-stencil (a native plan). Every frame with
+    /// hi-stencil writes these timestamps, two per piece of bookkeeping, where rendering is
+    /// split anyway. Waits for the query results.
+    pub fn emulation_ms(&self, slot: u32) -> Result<Option<f64>> {
+        match self
+            .slots
+            .get(slot as usize)
+            .and_then(|s| s.emulation.last())
+        {
+            Some(t) => Ok(t.read(&self.ctx)?.group_ms(Emulation::BOOKKEEPING)),
+            None => Ok(None),
+        }
     }
 
     /// The per-step GPU times of the last frame recorded into `slot` with timestamps, once the
@@ -686,6 +712,7 @@ impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
             slot.uniforms.destroy(ctx);
             slot.lights.destroy(ctx);
             slot.timer.destroy(ctx);
+            slot.emulation.destroy(ctx);
         }
         if let Some(h) = self.hi_stencil.as_mut() {
             h.destroy(ctx);

@@ -74,8 +74,10 @@ pub const HI_STENCIL_SET: &[BindingDesc] = &[
     binding(1, BindingKind::StorageBuffer, ""),
     binding(2, BindingKind::StorageBuffer, "hi_stats"),
     binding(3, BindingKind::StorageBuffer, ""),
+    binding(4, BindingKind::StorageBuffer, ""),
 ];
-/// The tile update's stencil copy (read), covered stamps (read) and pending surface (written);
+/// The tile update's stencil copy (read), the list of tiles the write draw touched (read) and
+/// the pending surface (written);
 /// see `hi_stencil.rs`.
 pub const HI_STENCIL_UPDATE_SET: &[BindingDesc] = &[
     binding(0, BindingKind::StorageBuffer, ""),

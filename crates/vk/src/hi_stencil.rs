@@ -3,9 +3,10 @@
 //!
 //! The coarse surface is one word per [`HI_STENCIL_TILE`]-pixel tile, in two buffers: `pending`
 //! (what write-enabled draws evaluated) and `active` (what testing draws see). A hi-stencil
-//! write is a *split pass*: the draw marks the tiles it rasterises (`hi_stencil_touch.frag`),
-//! rendering ends, the stencil is copied out and `hi_stencil_update.comp` re-evaluates the
-//! marked tiles into `pending`. A flush, or the next write while one is unflushed (the latest
+//! write is a *split pass*: the draw marks the tiles it rasterises and lists each once
+//! (`hi_stencil_touch.frag`), rendering ends, the stencil is copied out and
+//! `hi_stencil_update.comp`, dispatched indirectly over that list, re-evaluates the listed
+//! tiles into `pending`: a small light's write costs its own tiles, not the screen's. A flush, or the next write while one is unflushed (the latest
 //! point hardware could retire it), copies `pending` to `active`. Testing draws reject
 //! fragments of failing tiles in the light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
 //!
@@ -31,7 +32,6 @@ use histencil_model::{HiStencilState, TileStats};
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct UpdatePush {
-    stamp: u32,
     compare: u32,
     reference: u32,
     read_mask: u32,
@@ -47,10 +47,12 @@ const STATS_WORDS: usize = 4;
 pub struct HiStencilSurface {
     extent: vk::Extent2D,
     tiles_x: u32,
-    tiles_y: u32,
     active: Buffer,
     pending: Buffer,
     touched: Buffer,
+    /// The tiles the current write draw touched, behind the update's indirect dispatch
+    /// arguments and their count (`HiStencilTouchedList` in include/hi_stencil.glsl).
+    touched_list: Buffer,
     stats: Buffer,
     stencil_copy: Buffer,
     saved: Buffer,
@@ -60,6 +62,9 @@ pub struct HiStencilSurface {
     /// A write since the last flush has not become active yet (see the module doc).
     unflushed: bool,
 }
+
+/// The touched list's header: the update's dispatch arguments and the tile count.
+const LIST_HEADER_BYTES: u64 = 16;
 
 /// Bytes of a buffer holding one stencil byte per pixel, rounded up to whole words.
 fn stencil_bytes(extent: vk::Extent2D) -> u64 {
@@ -83,6 +88,11 @@ impl HiStencilSurface {
                 storage | U::TRANSFER_SRC,
             )?);
             made.push(gpu("hi-stencil-touched", tile_bytes, storage)?);
+            made.push(gpu(
+                "hi-stencil-touched-list",
+                LIST_HEADER_BYTES + tile_bytes,
+                storage | U::INDIRECT_BUFFER,
+            )?);
             made.push(Buffer::new(
                 ctx,
                 "hi-stencil-stats",
@@ -100,11 +110,9 @@ impl HiStencilSurface {
             }
             return Err(e);
         }
-        let mut buffers = made.into_iter();
-        let mut next = || buffers.next().expect("six buffers were made");
-        let (active, pending, touched, stats, stencil_copy, saved) =
-            (next(), next(), next(), next(), next(), next());
-
+        // In the order made: active, pending, touched, touched list, stats, stencil copy, saved.
+        let handle = |i: usize| made[i].handle;
+        let update_set = [handle(5), handle(3), handle(1)];
         let update = ComputePipeline::new(
             ctx,
             "hi-stencil-update",
@@ -112,12 +120,12 @@ impl HiStencilSurface {
             ("hi-stencil-update-comp", shaders::HI_STENCIL_UPDATE_COMP),
             std::mem::size_of::<UpdatePush>() as u32,
         );
-        let made = update.and_then(|mut update| {
+        let update = update.and_then(|mut update| {
             match create_storage_buffer_set(
                 ctx,
                 "hi-stencil-update",
                 update.set_layout,
-                &[stencil_copy.handle, touched.handle, pending.handle],
+                &update_set,
             ) {
                 Ok(pool_set) => Ok((update, pool_set)),
                 Err(e) => {
@@ -126,22 +134,27 @@ impl HiStencilSurface {
                 }
             }
         });
-        let (update, (pool, set)) = match made {
+        let (update, (pool, set)) = match update {
             Ok(made) => made,
             Err(e) => {
-                for mut b in [active, pending, touched, stats, stencil_copy, saved] {
+                for mut b in made {
                     b.destroy(ctx);
                 }
                 return Err(e);
             }
         };
+        let Ok([active, pending, touched, touched_list, stats, stencil_copy, saved]) =
+            <[Buffer; 7]>::try_from(made)
+        else {
+            unreachable!("seven buffers were made")
+        };
         Ok(Self {
             extent,
             tiles_x,
-            tiles_y,
             active,
             pending,
             touched,
+            touched_list,
             stats,
             stencil_copy,
             saved,
@@ -153,12 +166,13 @@ impl HiStencilSurface {
     }
 
     /// The buffers of set 2 of the light pipelines (`HI_STENCIL_SET`), in binding order.
-    pub fn light_set_buffers(&self) -> [vk::Buffer; 4] {
+    pub fn light_set_buffers(&self) -> [vk::Buffer; 5] {
         [
             self.active.handle,
             self.touched.handle,
             self.stats.handle,
             self.saved.handle,
+            self.touched_list.handle,
         ]
     }
 
@@ -173,6 +187,7 @@ impl HiStencilSurface {
             d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.touched.handle, 0, vk::WHOLE_SIZE, 0);
             d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
+            self.clear_list(ctx, cmd);
         }
         memory_barrier(ctx, cmd);
         self.unflushed = false;
@@ -191,22 +206,31 @@ impl HiStencilSurface {
         self.unflushed = false;
     }
 
-    /// Outside rendering, after a draw with stamp `stamp` marked its tiles: retires an
-    /// unflushed earlier write, then evaluates `hi` on the marked tiles into pending state.
+    /// Empties the touched list: no update workgroups (y = z = 1), no tiles.
+    fn clear_list(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        let header: [u32; 4] = [0, 1, 1, 0];
+        let bytes = bytemuck::bytes_of(&header);
+        unsafe {
+            ctx.device
+                .cmd_update_buffer(cmd, self.touched_list.handle, 0, bytes)
+        };
+    }
+
+    /// Outside rendering, after a write draw listed the tiles it touched: retires an
+    /// unflushed earlier write, then evaluates `hi` on the listed tiles into pending state and
+    /// empties the list for the next write.
     pub fn record_update(
         &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
         depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
-        stamp: u32,
     ) {
         if self.unflushed {
             self.record_flush(ctx, cmd);
         }
         self.copy_stencil(ctx, cmd, depth_stencil, CopyTo::Scratch);
         let push = UpdatePush {
-            stamp,
             compare: compare_op(hi.compare).as_raw() as u32,
             reference: u32::from(hi.reference),
             read_mask: u32::from(hi.read_mask.unwrap_or(0xFF)),
@@ -216,7 +240,13 @@ impl HiStencilSurface {
         };
         self.update
             .bind(ctx, cmd, self.set, bytemuck::bytes_of(&push));
-        unsafe { ctx.device.cmd_dispatch(cmd, self.tiles_x, self.tiles_y, 1) };
+        unsafe {
+            ctx.device
+                .cmd_dispatch_indirect(cmd, self.touched_list.handle, 0)
+        };
+        // The list's counts are read (as dispatch arguments too) before they are zeroed.
+        memory_barrier(ctx, cmd);
+        self.clear_list(ctx, cmd);
         memory_barrier(ctx, cmd);
         self.unflushed = true;
     }
@@ -277,6 +307,7 @@ impl HiStencilSurface {
             &mut self.active,
             &mut self.pending,
             &mut self.touched,
+            &mut self.touched_list,
             &mut self.stats,
             &mut self.stencil_copy,
             &mut self.saved,

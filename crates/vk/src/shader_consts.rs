@@ -12,6 +12,11 @@ pub const LIGHT_KINDS: [(&str, u32); 3] = [
 /// surface covers this many pixels squared, like the 8x8 granularity of console hi-stencil.
 pub const HI_STENCIL_TILE: u32 = 8;
 
+/// Tiles per workgroup of the hi-stencil tile update (GLSL `HI_STENCIL_UPDATE_GROUP`): one
+/// invocation per tile a write draw touched, listed by that draw (`hi_stencil_touch.frag`). Read by build.rs.
+#[allow(dead_code)]
+pub const HI_STENCIL_UPDATE_GROUP: u32 = 64;
+
 /// BRDF model ids the tiled classification maps to slots (GLSL `TILED_MODELS`): at least
 /// `BrdfId::ALL.len()` (build.rs checks).
 pub const TILED_MODELS: u32 = 8;

@@ -16,6 +16,10 @@ pub struct FrameTimings {
     /// The alpha lightmap pass per entity, when asked for and the frame lights its alpha
     /// entities with lightmaps.
     pub lightmaps: Option<LightmapTimings>,
+    /// Of the lighting pass, the milliseconds the hi-stencil emulator spent on bookkeeping a
+    /// console does not do ([`crate::DeferredLighting::emulation_ms`]); the rest of `lighting`
+    /// is the platform's technique. Only on the emulated backends (PS3-like, 360-like).
+    pub bookkeeping_ms: Option<f64>,
 }
 
 /// The lightmap pass of one frame: clearing the atlas, then each entity's draws (one per light
@@ -83,6 +87,13 @@ impl FrameTimings {
         self.passes.iter().find(|p| p.0 == name).map(|p| p.1)
     }
 
+    /// The lighting pass without the hi-stencil emulator's bookkeeping: the platform's
+    /// technique (the whole lighting pass on the native backend).
+    pub fn technique_ms(&self) -> Option<f64> {
+        let lighting = self.pass_ms("lighting")?;
+        Some(lighting - self.bookkeeping_ms.unwrap_or(0.0))
+    }
+
     /// Per-pass median over frames of the same technique.
     pub fn median(frames: &[FrameTimings]) -> FrameTimings {
         let Some(first) = frames.first() else {
@@ -111,10 +122,15 @@ impl FrameTimings {
                 ),
             }
         });
+        let mut bookkeeping: Vec<f64> = frames.iter().filter_map(|f| f.bookkeeping_ms).collect();
+        bookkeeping.sort_by(f64::total_cmp);
+        let bookkeeping_ms =
+            (bookkeeping.len() == frames.len()).then(|| median_of_sorted(&bookkeeping));
         FrameTimings {
             passes,
             lighting,
             lightmaps,
+            bookkeeping_ms,
         }
     }
 }

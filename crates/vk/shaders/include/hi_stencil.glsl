@@ -27,6 +27,17 @@ layout(set = 2, binding = 3, std430) readonly buffer SavedStencil {
     uint saved_stencil[];
 };
 
+// The tiles the current write draw touched, each once, for the tile update's indirect dispatch:
+// its workgroup count (HI_STENCIL_UPDATE_GROUP tiles each) and y = z = 1, then the count.
+// hi_stencil.rs zeroes the counts after each update.
+layout(set = 2, binding = 4, std430) buffer HiStencilTouchedList {
+    uint groups;
+    uint group_y;
+    uint group_z;
+    uint count;
+    uint tiles[];
+} touched_list;
+
 uint hi_stencil_tile() {
     uint tiles_x = (uint(frame.viewport.x) + HI_STENCIL_TILE - 1u) / HI_STENCIL_TILE;
     uvec2 tile = uvec2(gl_FragCoord.xy) / HI_STENCIL_TILE;

@@ -123,6 +123,44 @@ impl Rendering {
     }
 }
 
+/// The emulator's bookkeeping timed apart from the technique it emulates: a timestamp on each
+/// side of every piece of work a console does not do (resetting the tile surface, ending
+/// rendering, copying the stencil out and re-evaluating tiles after a hi-stencil write, copying
+/// pending tiles to active at a flush), so the `bookkeeping` group is that work and the rest of
+/// the lighting pass is the platform's technique. What stays inside the technique's draws:
+/// marking touched tiles in a write draw and reading the tile surface in a testing draw, where
+/// hardware tests tiles before shading.
+pub(crate) struct Emulation;
+
+impl Emulation {
+    /// The group of a span of the platform's own passes.
+    pub const TECHNIQUE: &'static str = "technique";
+    /// The group of a span of emulator bookkeeping.
+    pub const BOOKKEEPING: &'static str = "bookkeeping";
+
+    /// Timestamps `plan` needs after the start mark: one after the reset, two per hi-stencil
+    /// write and flush, one at the end.
+    pub fn marks(plan: &FramePlan) -> u32 {
+        let ops = plan
+            .steps
+            .iter()
+            .filter(|step| match step {
+                Step::Pass { pass, .. } => pass.state.hi_stencil.is_some_and(|h| h.write),
+                Step::FlushHiStencil => true,
+                _ => false,
+            })
+            .count() as u32;
+        2 * ops + 2
+    }
+
+    /// Ends the span before it: `group` names what it timed.
+    fn mark(timer: &mut Option<&mut StepTimer>, pass: &LightingPass, group: &str) {
+        if let Some(t) = timer.as_deref_mut() {
+            t.mark(pass.ctx, pass.cmd, group.into(), None);
+        }
+    }
+}
+
 /// The set index of an engine's visibility hook (hooks/light_visibility.glsl).
 const VISIBILITY_SET_INDEX: u32 = 4;
 
@@ -132,12 +170,14 @@ fn stamp(step: usize, count_draw: bool) -> u32 {
 }
 
 impl LightingPass<'_> {
-    /// Records the plan; with `timer`, a timestamp after every step.
+    /// Records the plan; with `timer`, a timestamp after every step; with `emulation`, one on
+    /// each side of every piece of hi-stencil bookkeeping ([`Emulation::marks`]).
     pub(crate) fn record(
         &self,
         targets: &mut LightingTargets,
         hi_stencil: &mut HiStencilSurface,
         mut timer: Option<&mut StepTimer>,
+        mut emulation: Option<&mut StepTimer>,
     ) -> Result<()> {
         let (ctx, cmd) = (self.ctx, self.cmd);
         let d = &ctx.device;
@@ -154,7 +194,12 @@ impl LightingPass<'_> {
         if let Some(t) = timer.as_deref_mut() {
             t.reset(ctx, cmd);
         }
+        if let Some(t) = emulation.as_deref_mut() {
+            t.reset(ctx, cmd);
+            t.start(ctx, cmd);
+        }
         hi_stencil.record_reset(ctx, cmd);
+        Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
         unsafe {
             d.cmd_bind_descriptor_sets(
                 cmd,
@@ -197,14 +242,14 @@ impl LightingPass<'_> {
                     }
                     let scene_light = self.plan.lights[*light].input as u32;
                     ctx.begin_label(cmd, &pass.label());
-                    self.record_pass(
-                        targets,
-                        hi_stencil,
-                        &mut rendering,
-                        index,
-                        pass,
-                        scene_light,
-                    )?;
+                    self.record_pass(targets, &mut rendering, index, pass, scene_light)?;
+                    if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
+                        Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
+                        rendering.split(self);
+                        let ds = &mut targets.depth_stencil;
+                        hi_stencil.record_update(ctx, cmd, ds, &hi);
+                        Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
+                    }
                     ctx.end_label(cmd);
                     if let Some(t) = timer.as_deref_mut() {
                         let group = pass_group(pass.kind, self.brdfs, self.brdf_source);
@@ -213,8 +258,10 @@ impl LightingPass<'_> {
                 }
                 Step::FlushHiStencil => {
                     ctx.begin_label(cmd, "flush-hi-stencil");
+                    Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                     rendering.close(self);
                     hi_stencil.record_flush(ctx, cmd);
+                    Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     ctx.end_label(cmd);
                     if let Some(t) = timer.as_deref_mut() {
                         t.mark(ctx, cmd, "flush".into(), None);
@@ -247,6 +294,7 @@ impl LightingPass<'_> {
             ctx.end_label(cmd);
         }
         rendering.close(self);
+        Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
         if self.count_stats {
             hi_stencil.record_stats_readable(ctx, cmd);
         }
@@ -254,12 +302,11 @@ impl LightingPass<'_> {
         Ok(())
     }
 
-    /// One planned pass: the statistics draw of a hi-stencil test, the pass's own draw, and the
-    /// tile update of a hi-stencil write.
+    /// One planned pass: the statistics draw of a hi-stencil test and the pass's own draw (the
+    /// caller updates the tiles of a hi-stencil write).
     fn record_pass(
         &self,
         targets: &mut LightingTargets,
-        hi_stencil: &mut HiStencilSurface,
         rendering: &mut Rendering,
         step: usize,
         pass: &Pass,
@@ -310,16 +357,6 @@ impl LightingPass<'_> {
         };
         let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source);
         self.draw(key, state, pass.geometry, push);
-        if let Some(hi) = state.hi_stencil.filter(|h| h.write) {
-            rendering.split(self);
-            hi_stencil.record_update(
-                self.ctx,
-                self.cmd,
-                &mut targets.depth_stencil,
-                &hi,
-                push.stamp,
-            );
-        }
         Ok(())
     }
 

@@ -82,6 +82,9 @@ impl Renderer<'_> {
         if desc.pass_timing && planned.is_some() {
             timings.lighting = self.lighting.step_timings(0)?;
         }
+        if planned.is_some() {
+            timings.bookkeeping_ms = self.lighting.emulation_ms(0)?;
+        }
         if let Some(alpha) = self.alpha.as_ref().filter(|_| desc.pass_timing) {
             timings.lightmaps = alpha.lightmap_timings()?;
         }
