@@ -98,6 +98,31 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
             assert!(cell["lighting"]["median_ms"].as_f64().unwrap() > 0.0);
         }
         assert_eq!(cells[0]["overhead_ms"].as_f64(), Some(0.0));
+        // The emulated backends' bookkeeping is sampled apart, every round, wherever the plan
+        // uses hi-stencil (with several BRDFs; one BRDF under lights that hold the camera needs
+        // none); nothing else has any.
+        let emulated = row["technique"] == "stencil x360" || row["technique"] == "stencil ps3";
+        for cell in cells {
+            let bookkeeping = cell["bookkeeping_samples_ms"].as_array().unwrap();
+            let several = cell["brdfs"].as_u64().unwrap() > 1;
+            if !emulated || several {
+                assert_eq!(bookkeeping.len(), if emulated { 2 } else { 0 }, "{row}");
+            }
+            assert!(bookkeeping.iter().all(|b| b.as_f64().unwrap() > 0.0));
+        }
+    }
+    for row in report
+        .rows
+        .iter()
+        .filter(|r| r.name.starts_with("stencil "))
+    {
+        for cell in &row.cells {
+            let whole = cell.with_bookkeeping();
+            assert!(whole
+                .iter()
+                .zip(&cell.samples)
+                .all(|(w, t)| w >= t && *t > 0.0));
+        }
     }
     // The exact techniques stay within 1/255 of forward; the LUT within its stated tolerance.
     for (row, name) in rows.iter().zip(names) {
@@ -133,6 +158,8 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
         "Light size",
         "tiled / best",
         "FLIP",
+        "| backend | BRDFs | technique, ms | emulator bookkeeping, ms |",
+        "| stencil ps3 | 3 |",
     ] {
         assert!(md.contains(part), "report.md lacks `{part}`");
     }
@@ -298,6 +325,13 @@ fn the_demo_shows_each_failure_next_to_a_fix_that_matches_forward() {
     let report =
         with_validated_context(|ctx| histencil_lab::run_demo(ctx, settings, &mut |_| {}).unwrap());
     assert_eq!(report.failures.len(), 2);
+    // Each row's technique time, and the emulator's apart on the emulated backends only.
+    for row in &report.rows {
+        let emulated = row.label.contains("PS3-like") || row.label.contains("360-like");
+        assert_eq!(row.bookkeeping.is_some(), emulated, "{}", row.label);
+        assert!(row.time.median_ms > 0.0, "{}", row.label);
+    }
+    assert!(report.table().contains("emulator ms"));
     for pair in &report.failures {
         let ((failure_caption, failure), (fix_caption, fix)) = (&pair.failure, &pair.fix);
         let shown = histencil_lab::image_error(failure, fix);

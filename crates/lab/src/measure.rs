@@ -39,6 +39,42 @@ pub fn time_passes(
     passes: &[&str],
     frames: usize,
 ) -> Result<Timing> {
+    let samples = measured(renderer, desc, frames)?
+        .iter()
+        .map(|timings| passes.iter().filter_map(|p| timings.pass_ms(p)).sum())
+        .collect();
+    Ok(Timing::from_samples(samples))
+}
+
+/// As [`time_passes`], without the hi-stencil emulator's bookkeeping, which comes second
+/// (`None` where the frames emulate nothing): the platform's technique and the emulator apart.
+pub fn time_technique(
+    renderer: &mut Renderer,
+    desc: impl Into<FrameDesc>,
+    passes: &[&str],
+    frames: usize,
+) -> Result<(Timing, Option<Timing>)> {
+    let frames = measured(renderer, desc, frames)?;
+    let bookkeeping: Option<Vec<f64>> = frames.iter().map(|t| t.bookkeeping_ms).collect();
+    let technique = frames
+        .iter()
+        .map(|t| {
+            let passes: f64 = passes.iter().filter_map(|p| t.pass_ms(p)).sum();
+            passes - t.bookkeeping_ms.unwrap_or(0.0)
+        })
+        .collect();
+    Ok((
+        Timing::from_samples(technique),
+        bookkeeping.map(Timing::from_samples),
+    ))
+}
+
+/// The timings of `frames` frames of `desc` without readback, after the warm-up.
+fn measured(
+    renderer: &mut Renderer,
+    desc: impl Into<FrameDesc>,
+    frames: usize,
+) -> Result<Vec<histencil_vk::FrameTimings>> {
     let desc = FrameDesc {
         readback: Readback::NONE,
         ..desc.into()
@@ -46,12 +82,7 @@ pub fn time_passes(
     for _ in 0..WARM_UP_FRAMES {
         renderer.render_frame(&desc)?;
     }
-    let samples = renderer
-        .measure_frames(desc, frames)?
-        .iter()
-        .map(|timings| passes.iter().filter_map(|p| timings.pass_ms(p)).sum())
-        .collect();
-    Ok(Timing::from_samples(samples))
+    Ok(renderer.measure_frames(desc, frames)?)
 }
 
 /// The lighting pass's time (the talk's figure).

@@ -132,8 +132,13 @@ pub fn table_rows() -> Vec<(&'static str, Technique)> {
 pub struct Cell {
     pub brdfs: usize,
     /// The lighting time of every round, in round order (rounds interleave every technique at
-    /// every BRDF count, so sample `i` of two cells was measured under the same load).
+    /// every BRDF count, so sample `i` of two cells was measured under the same load): the
+    /// platform's technique only, without the hi-stencil emulator's bookkeeping.
     pub samples: Vec<f64>,
+    /// On the emulated backends, the emulator's bookkeeping in the same rounds (resets, splits,
+    /// stencil copies, tile updates, flush copies: `FrameTimings::bookkeeping_ms`); empty
+    /// elsewhere. The whole lighting pass of round `i` is `samples[i] + bookkeeping[i]`.
+    pub bookkeeping: Vec<f64>,
     pub error: ImageError,
 }
 
@@ -146,6 +151,15 @@ impl Cell {
     /// The median lighting time with its 95 % interval.
     pub fn interval(&self) -> Interval {
         median_interval(&self.samples)
+    }
+
+    /// The whole lighting pass of every round, the emulator's bookkeeping included.
+    pub fn with_bookkeeping(&self) -> Vec<f64> {
+        if self.bookkeeping.is_empty() {
+            return self.samples.clone();
+        }
+        let rounds = self.samples.iter().zip(&self.bookkeeping);
+        rounds.map(|(t, b)| t + b).collect()
     }
 }
 
@@ -420,6 +434,7 @@ pub fn run_compare(
         max_rounds: MAX_ROUNDS,
     };
     let samples = std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; renderers.len()]);
+    let mut bookkeeping = vec![vec![Vec::new(); rows_spec.len()]; renderers.len()];
     // The widths a verdict rests on: every overhead ratio against the 1-BRDF cell.
     let overhead_widths = || {
         let s = samples.borrow();
@@ -438,8 +453,9 @@ pub fn run_compare(
             progress(&format!("round {}", round + 1));
             for (count, (_, renderer, _)) in renderers.iter_mut().enumerate() {
                 for (row, (_, technique)) in rows_spec.iter().enumerate() {
-                    let ms = lighting_ms(renderer, *technique)?;
+                    let (ms, emulator) = lighting_ms(renderer, *technique)?;
                     samples.borrow_mut()[count][row].push(ms);
+                    bookkeeping[count][row].extend(emulator);
                 }
             }
             Ok(())
@@ -452,6 +468,7 @@ pub fn run_compare(
             row.cells.push(Cell {
                 brdfs: *brdfs,
                 samples: std::mem::take(&mut samples[count][r]),
+                bookkeeping: std::mem::take(&mut bookkeeping[count][r]),
                 error: *error,
             });
         }
@@ -486,7 +503,7 @@ pub fn run_compare(
             &sampling,
             |_| -> Result<()> {
                 for (i, technique) in size_techniques().into_iter().enumerate() {
-                    let ms = lighting_ms(&mut renderer, technique)?;
+                    let (ms, _) = lighting_ms(&mut renderer, technique)?;
                     samples.borrow_mut()[i].push(ms);
                 }
                 Ok(())
@@ -528,12 +545,14 @@ pub fn run_compare(
 /// The most rounds one measurement set takes, whatever its target and budget.
 pub const MAX_ROUNDS: usize = 400;
 
-/// The lighting's time in one frame: the lighting pass, and the tiled technique's
-/// classification before it.
-fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<f64> {
+/// The lighting's time in one frame: the technique's (the lighting pass without the
+/// hi-stencil emulator's bookkeeping, and the tiled technique's classification before it), and
+/// on an emulated backend the bookkeeping's.
+fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<(f64, Option<f64>)> {
     let timings = renderer.render(technique, Readback::NONE)?.timings;
     let classify = timings.pass_ms("tile-classify").unwrap_or(0.0);
-    Ok(timings.pass_ms("lighting").unwrap_or(0.0) + classify)
+    let own = timings.technique_ms().unwrap_or(0.0) + classify;
+    Ok((own, timings.bookkeeping_ms))
 }
 
 /// Branching, stencil and adaptive on the native backend, and tiled: the light-size sweep's

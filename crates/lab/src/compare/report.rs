@@ -5,7 +5,7 @@ use super::{Breakdown, CompareReport, Row, SizePoint};
 use crate::image_error::ImageError;
 use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis, Series};
-use crate::stats::median_interval;
+use crate::stats::{median_interval, ratio_interval, Verdict};
 use crate::{write_file, Result};
 use histencil_model::TalkFigures;
 use serde_json::{json, Value};
@@ -129,6 +129,7 @@ impl CompareReport {
                 error_text(&row.worst_error())
             );
         }
+        md += &self.emulation_markdown();
         md += "\nThe talk (Develop 2012, huge lights, ms):\n\n\
                | platform | 1 BRDF | 2 BRDFs branching | 3 BRDFs branching | 2 BRDFs stencil | 3 BRDFs stencil |\n\
                |---|---|---|---|---|---|\n";
@@ -245,6 +246,65 @@ impl CompareReport {
             }
         );
         md += "\nPlots: `lighting.png`, `light-size.png`, `speed-vs-error.png`.\n";
+        md
+    }
+
+    /// The emulated rows' technique and bookkeeping side by side, each with its interval, and
+    /// the technique against native stencil at the same BRDF count, paired by round.
+    fn emulation_markdown(&self) -> String {
+        let native = self.rows.iter().find(|r| r.name == "stencil native");
+        let emulated: Vec<&Row> = self
+            .rows
+            .iter()
+            .filter(|r| r.cells.iter().any(|c| !c.bookkeeping.is_empty()))
+            .collect();
+        let Some(native) = native.filter(|_| !emulated.is_empty()) else {
+            return String::new();
+        };
+        let mut md = String::from(
+            "\nThe PS3-like and 360-like rows time the platform's technique: the lighting pass \
+             without the hi-stencil emulator's bookkeeping (resetting its tile surface; after each \
+             hi-stencil write the split, the stencil copy and the tile update; the copy at each \
+             flush), which a timestamp on each side of it times apart. Still inside the \
+             technique's time: its write draws marking the tiles they touch, and its testing \
+             draws reading the tile surface in the fragment shader, where a console tests tiles \
+             before shading.\n\n\
+             | backend | BRDFs | technique, ms | emulator bookkeeping, ms | bookkeeping / whole | \
+             whole lighting, ms | stencil native, ms | technique / native |\n\
+             |---|---|---|---|---|---|---|---|\n",
+        );
+        for row in emulated {
+            for (cell, base) in row.cells.iter().zip(&native.cells) {
+                if cell.bookkeeping.is_empty() {
+                    let _ = writeln!(
+                        md,
+                        "| {} | {} | {} | none: no hi-stencil in this plan | - | - | {} | {} |",
+                        row.name,
+                        cell.brdfs,
+                        interval_text(&cell.interval()),
+                        interval_text(&base.interval()),
+                        ratio_text(&ratio_interval(&cell.samples, &base.samples))
+                    );
+                    continue;
+                }
+                let whole = cell.with_bookkeeping();
+                let share = ratio_interval(&cell.bookkeeping, &whole);
+                let ratio = ratio_interval(&cell.samples, &base.samples);
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | {} | {} | {} | {} | {} ({}) |",
+                    row.name,
+                    cell.brdfs,
+                    interval_text(&cell.interval()),
+                    interval_text(&median_interval(&cell.bookkeeping)),
+                    ratio_text(&share),
+                    interval_text(&median_interval(&whole)),
+                    interval_text(&base.interval()),
+                    ratio_text(&ratio),
+                    Verdict::of(&ratio).word()
+                );
+            }
+        }
         md
     }
 
@@ -422,6 +482,7 @@ fn row_json(row: &Row) -> Value {
                 "lighting": timing_json(&c.lighting()),
                 "lighting_interval_ms": interval_json(&c.interval()),
                 "lighting_samples_ms": c.samples,
+                "bookkeeping_samples_ms": c.bookkeeping,
                 "overhead_ms": ms,
                 "overhead_percent": pct,
                 "overhead_ratio": interval_json(&ratio),
