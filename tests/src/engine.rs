@@ -385,7 +385,7 @@ impl Engine {
             .zip(histencil_vk::GBUFFER_FORMATS)
             .map(|(n, f)| self.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
             .collect();
-        let depth_usage = U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC;
+        let depth_usage = U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC | U::SAMPLED;
         let hdr_usage = U::COLOR_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC;
         EngineTargets {
             gbuffer,

@@ -5,15 +5,13 @@
 // `(stencil & read_mask) OP reference`, as histencil_model::HiStencilState says. No shared
 // memory and no barriers: a CPU rasteriser runs a workgroup with barriers one invocation at a
 // time, switching between them at each barrier.
+#extension GL_EXT_samplerless_texture_functions : require
 #include "generated.glsl"
-#include "stencil_bytes.glsl"
 
 layout(local_size_x = HI_STENCIL_UPDATE_GROUP) in;
 
-// The stencil after the draw, copied out as tightly packed bytes.
-layout(set = 0, binding = 0, std430) readonly buffer StencilCopy {
-    uint stencil_copy[];
-};
+// The stencil the draw left, read in place through a stencil-aspect view.
+layout(set = 0, binding = 0) uniform utexture2D stencil_image;
 layout(set = 0, binding = 1, std430) readonly buffer TouchedList {
     uint groups;
     uint group_y;
@@ -58,8 +56,7 @@ void main() {
     uint passes = 0u;
     for (uint y = origin.y; y < end.y && passes == 0u; ++y) {
         for (uint x = origin.x; x < end.x; ++x) {
-            uint index = y * update.width + x;
-            uint stencil = stencil_byte(stencil_copy[index >> 2], index);
+            uint stencil = texelFetch(stencil_image, ivec2(x, y), 0).r;
             if (compare_passes(update.compare, stencil & update.read_mask, update.reference)) {
                 passes = 1u;
                 break;

@@ -68,9 +68,10 @@ pub struct LightingTargets {
     /// ([`crate::LightHooks::Engine`]): the engine's own images, any number and formats, read
     /// through the engine's decode set.
     pub gbuffer: Vec<ImageRef>,
-    /// The G-buffer pass's depth and stencil; usage `DEPTH_STENCIL_ATTACHMENT | TRANSFER_SRC`
-    /// (the hi-stencil emulation and 360-like save/restore copy the stencil out), and `SAMPLED`
-    /// where an engine's decode hook reads depth. With an engine's decode hook the light passes
+    /// The G-buffer pass's depth and stencil; usage `DEPTH_STENCIL_ATTACHMENT`, with
+    /// `SAMPLED` for the hi-stencil emulation (its tile update reads the stencil through a
+    /// stencil-aspect view) and where an engine's decode hook reads depth, and `TRANSFER_SRC`
+    /// for 360-like save/restore (which copies the stencil out). With an engine's decode hook the light passes
     /// attach it in `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`, so the decode may sample its
     /// depth aspect (through a depth-only view of the engine's).
     pub depth_stencil: ImageRef,
@@ -118,6 +119,9 @@ pub enum ImageAccess {
     ComputeSampled,
     /// Read and written by compute shaders as a storage image.
     ComputeStorage,
+    /// Depth and stencil read-only, the stencil read by compute shaders through a
+    /// stencil-aspect view (the hi-stencil tile update).
+    ComputeDepthStencilSampled,
     /// Source of a copy to a buffer.
     TransferSource,
 }
@@ -160,6 +164,11 @@ pub fn access_info(
             vk::ImageLayout::GENERAL,
             S::COMPUTE_SHADER,
             A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+        ),
+        ImageAccess::ComputeDepthStencilSampled => (
+            vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+            S::COMPUTE_SHADER,
+            A::SHADER_SAMPLED_READ,
         ),
         ImageAccess::TransferSource => (
             vk::ImageLayout::TRANSFER_SRC_OPTIMAL,

@@ -186,8 +186,10 @@ fn pick_depth_stencil_format(
     pd: vk::PhysicalDevice,
     wanted: Option<DepthStencilFormat>,
 ) -> Result<DepthStencilFormat> {
-    let needed =
-        vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+    // Sampled: the hi-stencil emulation reads the stencil through a stencil-aspect view.
+    let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT
+        | vk::FormatFeatureFlags::TRANSFER_SRC
+        | vk::FormatFeatureFlags::SAMPLED_IMAGE;
     let candidates = match wanted {
         Some(f) => vec![f],
         None => DepthStencilFormat::ALL.to_vec(),
@@ -203,7 +205,7 @@ fn pick_depth_stencil_format(
         .ok_or_else(|| {
             let names: Vec<_> = candidates.iter().map(|f| f.vk_name()).collect();
             Error::MissingFormat(format!(
-                "the device cannot use {} as a depth-stencil attachment copied out",
+                "the device cannot use {} as a depth-stencil attachment copied out and sampled",
                 names.join(" or ")
             ))
         })

@@ -29,7 +29,7 @@ use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelin
 use crate::passes::lighting::{Emulation, LightingPass};
 use crate::resources::Buffer;
 use crate::targets::GBUFFER_FORMATS;
-use crate::teardown::InFlight;
+use crate::teardown::{Destroy, InFlight};
 use crate::timing::{LightingBreakdown, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -283,9 +283,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 height: 1,
             }
         };
-        self.hi_stencil = Some(HiStencilSurface::new(ctx, surface)?);
-
         let slots = self.desc.frames_in_flight;
+        self.hi_stencil = Some(HiStencilSurface::new(ctx, surface, slots)?);
+
         let storage_per_slot = 1;
         let shared_storage = (HI_STENCIL_SET.len() + LUT_SET.len()) as u32;
         let sizes = [
@@ -406,6 +406,11 @@ fn needs_hi_stencil(plan: &FramePlan) -> bool {
         Step::Pass { pass, .. } => pass.state.tests_hi_stencil() || pass.state.writes_hi_stencil(),
         Step::FlushHiStencil | Step::SavePreserved { .. } | Step::RestorePreserved { .. } => true,
     })
+}
+
+/// Whether `plan` writes hi-stencil: its tile updates read the frame's stencil.
+fn writes_hi_stencil(plan: &FramePlan) -> bool {
+    plan.passes().any(|pass| pass.state.writes_hi_stencil())
 }
 
 /// Checks one frame against the lighting's description: the slot, the light count, the plan's
@@ -608,11 +613,15 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             count_stats,
             clear_hdr: frame.clear_hdr,
             depth_sampled: self.desc.hooks.samples_depth(),
+            slot: frame.slot,
         };
+        let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
+        if writes_hi_stencil(frame.plan) {
+            hi_stencil.prepare_slot(ctx, frame.slot, &targets.depth_stencil)?;
+        }
         let timer = slot.timer.active();
         let emulation = slot.emulation.active();
         self.in_flight.mark();
-        let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
         pass.record(targets, hi_stencil, timer, emulation)
     }
 

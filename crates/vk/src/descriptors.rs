@@ -74,14 +74,14 @@ pub const HI_STENCIL_SET: &[BindingDesc] = &[
     binding(1, BindingKind::StorageBuffer, ""),
     binding(2, BindingKind::StorageBuffer, "hi_stats"),
     binding(3, BindingKind::StorageBuffer, ""),
-    binding(4, BindingKind::StorageBuffer, ""),
+    binding(4, BindingKind::StorageBuffer, "touched_list"),
 ];
-/// The tile update's stencil copy (read), the list of tiles the write draw touched (read) and
-/// the pending surface (written);
+/// The tile update's stencil (a stencil-aspect view, read), the list of tiles the write draw
+/// touched (read) and the pending surface (written);
 /// see `hi_stencil.rs`.
 pub const HI_STENCIL_UPDATE_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, ""),
-    binding(1, BindingKind::StorageBuffer, ""),
+    binding(0, BindingKind::SampledImage, "stencil_image"),
+    binding(1, BindingKind::StorageBuffer, "touched_list"),
     binding(2, BindingKind::StorageBuffer, ""),
 ];
 /// Set 1 of the tonemap pipeline (tonemap.frag).

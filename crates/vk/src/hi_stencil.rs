@@ -4,9 +4,10 @@
 //! The coarse surface is one word per [`HI_STENCIL_TILE`]-pixel tile, in two buffers: `pending`
 //! (what write-enabled draws evaluated) and `active` (what testing draws see). A hi-stencil
 //! write is a *split pass*: the draw marks the tiles it rasterises and lists each once
-//! (`hi_stencil_touch.frag`), rendering ends, the stencil is copied out and
-//! `hi_stencil_update.comp`, dispatched indirectly over that list, re-evaluates the listed
-//! tiles into `pending`: a small light's write costs its own tiles, not the screen's. A flush, or the next write while one is unflushed (the latest
+//! (`hi_stencil_touch.frag`), rendering ends, and `hi_stencil_update.comp`, dispatched
+//! indirectly over that list, re-evaluates the listed tiles into `pending`, reading the stencil
+//! where it is through a stencil-aspect view: a small light's write costs its own tiles, not
+//! the screen's, and nothing is copied. A flush, or the next write while one is unflushed (the latest
 //! point hardware could retire it), copies `pending` to `active`. Testing draws reject
 //! fragments of failing tiles in the light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
 //!
@@ -17,13 +18,14 @@
 use crate::access::{memory_barrier, transition, Contents, ImageAccess, ImageRef};
 use crate::compute::ComputePipeline;
 use crate::context::Context;
-use crate::descriptors::{create_storage_buffer_set, HI_STENCIL_UPDATE_SET};
-use crate::error::Result;
+use crate::descriptors::HI_STENCIL_UPDATE_SET;
+use crate::error::{Result, VkCall};
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::Buffer;
 use crate::shader_consts::HI_STENCIL_TILE;
 use crate::shaders;
 use crate::state::compare_op;
+use crate::teardown::{build, Destroy};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_model::{HiStencilState, TileStats};
@@ -44,6 +46,7 @@ struct UpdatePush {
 const STATS_WORDS: usize = 4;
 
 /// The tile surface, its scratch buffers and the update pipeline.
+#[derive(Default)]
 pub struct HiStencilSurface {
     extent: vk::Extent2D,
     tiles_x: u32,
@@ -54,11 +57,14 @@ pub struct HiStencilSurface {
     /// arguments and their count (`HiStencilTouchedList` in include/hi_stencil.glsl).
     touched_list: Buffer,
     stats: Buffer,
-    stencil_copy: Buffer,
     saved: Buffer,
-    update: ComputePipeline,
+    update: Option<ComputePipeline>,
     pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
+    /// The update's set of each frame-in-flight slot: that slot's frame's stencil view, the
+    /// touched list and the pending surface.
+    sets: Vec<vk::DescriptorSet>,
+    /// The stencil-aspect view of each slot's last depth-stencil image (`prepare_slot`).
+    views: Vec<vk::ImageView>,
     /// A write since the last flush has not become active yet (see the module doc).
     unflushed: bool,
 }
@@ -71,98 +77,158 @@ fn stencil_bytes(extent: vk::Extent2D) -> u64 {
     (u64::from(extent.width) * u64::from(extent.height)).next_multiple_of(4)
 }
 
+impl Destroy for HiStencilSurface {
+    fn destroy(&mut self, ctx: &Context) {
+        if let Some(mut update) = self.update.take() {
+            update.destroy(ctx);
+        }
+        unsafe {
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            for view in self.views.drain(..) {
+                ctx.device.destroy_image_view(view, None);
+            }
+        }
+        self.pool = vk::DescriptorPool::null();
+        self.sets.clear();
+        for b in [
+            &mut self.active,
+            &mut self.pending,
+            &mut self.touched,
+            &mut self.touched_list,
+            &mut self.stats,
+            &mut self.saved,
+        ] {
+            b.destroy(ctx);
+        }
+    }
+}
+
 impl HiStencilSurface {
-    pub fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
+    /// The surface for `extent`, with an update set for each of `slots` frames in flight; a
+    /// failure half way frees what was made.
+    pub fn new(ctx: &Context, extent: vk::Extent2D, slots: u32) -> Result<Self> {
         let tiles_x = extent.width.div_ceil(HI_STENCIL_TILE);
         let tiles_y = extent.height.div_ceil(HI_STENCIL_TILE);
         let tile_bytes = u64::from(tiles_x * tiles_y) * 4;
         use vk::BufferUsageFlags as U;
         let gpu = |name, size, usage| Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly);
         let storage = U::STORAGE_BUFFER | U::TRANSFER_DST;
-        let mut made: Vec<Buffer> = Vec::new();
-        let result = (|| -> Result<()> {
-            made.push(gpu("hi-stencil-active", tile_bytes, storage)?);
-            made.push(gpu(
-                "hi-stencil-pending",
-                tile_bytes,
-                storage | U::TRANSFER_SRC,
-            )?);
-            made.push(gpu("hi-stencil-touched", tile_bytes, storage)?);
-            made.push(gpu(
-                "hi-stencil-touched-list",
-                LIST_HEADER_BYTES + tile_bytes,
-                storage | U::INDIRECT_BUFFER,
-            )?);
-            made.push(Buffer::new(
+        build(ctx, |h: &mut Self| {
+            h.extent = extent;
+            h.tiles_x = tiles_x;
+            h.active = gpu("hi-stencil-active", tile_bytes, storage)?;
+            let pending_usage = storage | U::TRANSFER_SRC;
+            h.pending = gpu("hi-stencil-pending", tile_bytes, pending_usage)?;
+            h.touched = gpu("hi-stencil-touched", tile_bytes, storage)?;
+            let list_bytes = LIST_HEADER_BYTES + tile_bytes;
+            let list_usage = storage | U::INDIRECT_BUFFER;
+            h.touched_list = gpu("hi-stencil-touched-list", list_bytes, list_usage)?;
+            h.stats = Buffer::new(
                 ctx,
                 "hi-stencil-stats",
                 (STATS_WORDS * 4) as u64,
                 storage,
                 MemoryLocation::GpuToCpu,
-            )?);
-            made.push(gpu("stencil-copy", stencil_bytes(extent), storage)?);
-            made.push(gpu("saved-stencil", stencil_bytes(extent), storage)?);
-            Ok(())
-        })();
-        if let Err(e) = result {
-            for mut b in made {
-                b.destroy(ctx);
-            }
-            return Err(e);
-        }
-        // In the order made: active, pending, touched, touched list, stats, stencil copy, saved.
-        let handle = |i: usize| made[i].handle;
-        let update_set = [handle(5), handle(3), handle(1)];
-        let update = ComputePipeline::new(
-            ctx,
-            "hi-stencil-update",
-            HI_STENCIL_UPDATE_SET,
-            ("hi-stencil-update-comp", shaders::HI_STENCIL_UPDATE_COMP),
-            std::mem::size_of::<UpdatePush>() as u32,
-        );
-        let update = update.and_then(|mut update| {
-            match create_storage_buffer_set(
+            )?;
+            h.saved = gpu("saved-stencil", stencil_bytes(extent), storage)?;
+            let update = ComputePipeline::new(
                 ctx,
                 "hi-stencil-update",
-                update.set_layout,
-                &update_set,
-            ) {
-                Ok(pool_set) => Ok((update, pool_set)),
-                Err(e) => {
-                    update.destroy(ctx);
-                    Err(e)
-                }
-            }
-        });
-        let (update, (pool, set)) = match update {
-            Ok(made) => made,
-            Err(e) => {
-                for mut b in made {
-                    b.destroy(ctx);
-                }
-                return Err(e);
-            }
-        };
-        let Ok([active, pending, touched, touched_list, stats, stencil_copy, saved]) =
-            <[Buffer; 7]>::try_from(made)
-        else {
-            unreachable!("seven buffers were made")
-        };
-        Ok(Self {
-            extent,
-            tiles_x,
-            active,
-            pending,
-            touched,
-            touched_list,
-            stats,
-            stencil_copy,
-            saved,
-            update,
-            pool,
-            set,
-            unflushed: false,
+                HI_STENCIL_UPDATE_SET,
+                ("hi-stencil-update-comp", shaders::HI_STENCIL_UPDATE_COMP),
+                size_of::<UpdatePush>() as u32,
+            )?;
+            let set_layout = update.set_layout;
+            h.update = Some(update);
+            h.create_sets(ctx, set_layout, slots)
         })
+    }
+
+    /// The pool and every slot's update set, with the touched list and pending surface written
+    /// (the stencil view is written per frame).
+    fn create_sets(
+        &mut self,
+        ctx: &Context,
+        layout: vk::DescriptorSetLayout,
+        slots: u32,
+    ) -> Result<()> {
+        let sizes = [
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::SAMPLED_IMAGE)
+                .descriptor_count(slots),
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(2 * slots),
+        ];
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(slots)
+            .pool_sizes(&sizes);
+        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
+            .call("vkCreateDescriptorPool")?;
+        ctx.name(self.pool, "hi-stencil-update-pool");
+        let layouts = vec![layout; slots as usize];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(self.pool)
+            .set_layouts(&layouts);
+        self.sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+            .call("vkAllocateDescriptorSets")?;
+        self.views = vec![vk::ImageView::null(); slots as usize];
+        let buffers = [self.touched_list.handle, self.pending.handle].map(|b| {
+            [vk::DescriptorBufferInfo::default()
+                .buffer(b)
+                .range(vk::WHOLE_SIZE)]
+        });
+        for (i, set) in self.sets.iter().enumerate() {
+            ctx.name(*set, &format!("hi-stencil-update-set-{i}"));
+            let writes: Vec<vk::WriteDescriptorSet> = buffers
+                .iter()
+                .enumerate()
+                .map(|(b, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(*set)
+                        .dst_binding(b as u32 + 1)
+                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                        .buffer_info(info)
+                })
+                .collect();
+            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        }
+        Ok(())
+    }
+
+    /// Points `slot`'s update set at a stencil-aspect view of `depth_stencil`, made anew (the
+    /// slot's last view goes: its frame has finished, which recording into the slot promises).
+    pub fn prepare_slot(
+        &mut self,
+        ctx: &Context,
+        slot: u32,
+        depth_stencil: &ImageRef,
+    ) -> Result<()> {
+        let (set, view) = (self.sets[slot as usize], &mut self.views[slot as usize]);
+        unsafe { ctx.device.destroy_image_view(*view, None) };
+        *view = vk::ImageView::null();
+        let info = vk::ImageViewCreateInfo::default()
+            .image(depth_stencil.image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(depth_stencil.format)
+            .subresource_range(
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(vk::ImageAspectFlags::STENCIL)
+                    .level_count(1)
+                    .layer_count(1),
+            );
+        *view = unsafe { ctx.device.create_image_view(&info, None) }.call("vkCreateImageView")?;
+        ctx.name(*view, &format!("hi-stencil-stencil-view-{slot}"));
+        let image = [vk::DescriptorImageInfo::default()
+            .image_view(*view)
+            .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(set)
+            .dst_binding(0)
+            .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+            .image_info(&image);
+        unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+        Ok(())
     }
 
     /// The buffers of set 2 of the light pipelines (`HI_STENCIL_SET`), in binding order.
@@ -187,8 +253,8 @@ impl HiStencilSurface {
             d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.touched.handle, 0, vk::WHOLE_SIZE, 0);
             d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
-            self.clear_list(ctx, cmd);
         }
+        self.clear_list(ctx, cmd);
         memory_barrier(ctx, cmd);
         self.unflushed = false;
     }
@@ -216,20 +282,24 @@ impl HiStencilSurface {
         };
     }
 
-    /// Outside rendering, after a write draw listed the tiles it touched: retires an
-    /// unflushed earlier write, then evaluates `hi` on the listed tiles into pending state and
-    /// empties the list for the next write.
+    /// Outside rendering, after a write draw listed the tiles it touched, in a frame recorded
+    /// into `slot` (prepared with this `depth_stencil`, [`HiStencilSurface::prepare_slot`]):
+    /// retires an unflushed earlier write, then evaluates `hi` on the listed tiles into pending
+    /// state, reading the stencil in place, and empties the list for the next write. Leaves
+    /// the depth-stencil image attached-ready.
     pub fn record_update(
         &mut self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
+        slot: u32,
         depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
     ) {
         if self.unflushed {
             self.record_flush(ctx, cmd);
         }
-        self.copy_stencil(ctx, cmd, depth_stencil, CopyTo::Scratch);
+        let stencil_read = ImageAccess::ComputeDepthStencilSampled;
+        transition(ctx, cmd, depth_stencil, stencil_read, Contents::Keep);
         let push = UpdatePush {
             compare: compare_op(hi.compare).as_raw() as u32,
             reference: u32::from(hi.reference),
@@ -238,12 +308,15 @@ impl HiStencilSurface {
             height: self.extent.height,
             tiles_x: self.tiles_x,
         };
-        self.update
-            .bind(ctx, cmd, self.set, bytemuck::bytes_of(&push));
+        let set = self.sets[slot as usize];
+        let update = self.update.as_ref().expect("made with the surface");
+        update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
         unsafe {
             ctx.device
                 .cmd_dispatch_indirect(cmd, self.touched_list.handle, 0)
         };
+        let attached = ImageAccess::DepthStencilAttachment;
+        transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
         // The list's counts are read (as dispatch arguments too) before they are zeroed.
         memory_barrier(ctx, cmd);
         self.clear_list(ctx, cmd);
@@ -253,26 +326,12 @@ impl HiStencilSurface {
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
     pub fn record_save(&self, ctx: &Context, cmd: vk::CommandBuffer, depth_stencil: &mut ImageRef) {
-        self.copy_stencil(ctx, cmd, depth_stencil, CopyTo::Saved);
-    }
-
-    fn copy_stencil(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        depth_stencil: &mut ImageRef,
-        to: CopyTo,
-    ) {
-        let buffer = match to {
-            CopyTo::Scratch => &self.stencil_copy,
-            CopyTo::Saved => &self.saved,
-        };
         copy_image_to_buffer(
             ctx,
             cmd,
             depth_stencil,
             vk::ImageAspectFlags::STENCIL,
-            buffer,
+            &self.saved,
         );
         transition(
             ctx,
@@ -299,28 +358,4 @@ impl HiStencilSurface {
             flushes: 0,
         }
     }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        self.update.destroy(ctx);
-        unsafe { ctx.device.destroy_descriptor_pool(self.pool, None) };
-        for b in [
-            &mut self.active,
-            &mut self.pending,
-            &mut self.touched,
-            &mut self.touched_list,
-            &mut self.stats,
-            &mut self.stencil_copy,
-            &mut self.saved,
-        ] {
-            b.destroy(ctx);
-        }
-    }
-}
-
-#[derive(Clone, Copy)]
-enum CopyTo {
-    /// For the tile update.
-    Scratch,
-    /// For restoring preserved bits after lighting.
-    Saved,
 }

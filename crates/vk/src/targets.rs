@@ -61,7 +61,7 @@ impl Targets {
                 "depth-stencil",
                 ctx.depth_stencil_format,
                 extent,
-                U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC,
+                U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC | U::SAMPLED,
             )?;
             t.hdr = Image::new(
                 ctx,

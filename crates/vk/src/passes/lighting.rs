@@ -70,6 +70,8 @@ pub struct LightingPass<'a> {
     /// read-only depth (`DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`). Light passes never
     /// write depth.
     pub depth_sampled: bool,
+    /// The frame-in-flight slot, whose hi-stencil update set reads this frame's stencil.
+    pub slot: u32,
 }
 
 /// Whether the HDR and depth-stencil attachments are bound. Hi-stencil writes, flushes and the
@@ -247,7 +249,7 @@ impl LightingPass<'_> {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
                         let ds = &mut targets.depth_stencil;
-                        hi_stencil.record_update(ctx, cmd, ds, &hi);
+                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi);
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     }
                     ctx.end_label(cmd);
