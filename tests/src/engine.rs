@@ -238,6 +238,33 @@ impl Engine {
         (pool, cmd)
     }
 
+    /// `count` frame slots: a command pool and buffer each, and a fence made signalled (the
+    /// first wait on a slot passes).
+    pub fn frame_slots(
+        &self,
+        count: usize,
+    ) -> Vec<(vk::CommandPool, vk::CommandBuffer, vk::Fence)> {
+        (0..count)
+            .map(|_| {
+                let (pool, cmd) = self.command_buffer();
+                let signalled =
+                    vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+                let fence = unsafe { self.device.create_fence(&signalled, None) }.expect("fence");
+                (pool, cmd, fence)
+            })
+            .collect()
+    }
+
+    /// Frees what [`Engine::frame_slots`] made, once the GPU is done with it.
+    pub fn free_frame_slots(&self, slots: &[(vk::CommandPool, vk::CommandBuffer, vk::Fence)]) {
+        for (pool, _, fence) in slots {
+            unsafe {
+                self.device.destroy_fence(*fence, None);
+                self.device.destroy_command_pool(*pool, None);
+            }
+        }
+    }
+
     pub fn free_image(&self, image: EngineImage) {
         unsafe {
             self.device.destroy_image_view(image.view, None);
@@ -386,7 +413,7 @@ impl Engine {
             .map(|(n, f)| self.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
             .collect();
         let depth_usage = U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC | U::SAMPLED;
-        let hdr_usage = U::COLOR_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC;
+        let hdr_usage = U::COLOR_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC | U::STORAGE;
         EngineTargets {
             gbuffer,
             depth: self.image("depth", depth_format, extent, depth_usage),
@@ -412,4 +439,59 @@ impl EngineTargets {
             engine.free_image(image);
         }
     }
+}
+
+/// The scene's lights at frame `f`: each circles its own position. Directions are unit vectors
+/// and ranges capped as the renderer's scene validation leaves them (`normalise_lights`).
+pub fn lights_at(scene: &histencil_scene::Scene, f: usize) -> Vec<histencil_scene::Light> {
+    let mut moved = scene.clone();
+    moved.lights = scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let angle = 0.7 * f as f32 + i as f32;
+            let offset = glam::Vec3::new(angle.cos(), 0.0, angle.sin()) * 0.6;
+            histencil_scene::Light {
+                position: l.position + offset,
+                ..*l
+            }
+        })
+        .collect();
+    moved.normalise_lights();
+    moved.lights
+}
+
+/// An RGBA16F image's bytes as floats.
+pub fn hdr_floats(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .chunks_exact(2)
+        .map(|h| f16_to_f32(u16::from_le_bytes([h[0], h[1]])))
+        .collect()
+}
+
+/// IEEE half to single, exactly.
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exponent = i32::from((h >> 10) & 0x1F);
+    let mantissa = f32::from(h & 0x3FF);
+    match exponent {
+        0 => sign * mantissa * 2f32.powi(-24),
+        31 => sign * f32::INFINITY,
+        e => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+/// Asserts that the engine's HDR channels equal the renderer's bit for bit, and that the
+/// renderer's frame is lit (more than an eighth of its channels above zero).
+pub fn assert_same_hdr(expected: &[f32], engine: &[f32]) {
+    assert_eq!(expected.len(), engine.len());
+    let lit = expected.iter().filter(|v| **v > 0.0).count();
+    assert!(lit > expected.len() / 8, "the reference is mostly dark");
+    let differing = expected
+        .iter()
+        .zip(engine)
+        .filter(|(e, a)| e.to_bits() != a.to_bits())
+        .count();
+    assert_eq!(differing, 0, "channels differ from the renderer's frame");
 }

@@ -6,9 +6,10 @@
 //! synchronisation validation must see nothing, leak reports included.
 
 use ash::vk;
-use glam::Vec3;
 use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
-use histencil_tests::engine::{barrier, copy_to_buffer, Engine};
+use histencil_tests::engine::{
+    assert_same_hdr, barrier, copy_to_buffer, hdr_floats, lights_at, Engine,
+};
 use histencil_vk::{
     Backend, BrdfSource, Context, DeferredLighting, HookSets, ImageState, LightHooks, LightingDesc,
     LightingFrame, LightingTargets, Readback, Renderer, Technique,
@@ -19,51 +20,11 @@ const HEIGHT: u32 = 64;
 const FRAMES: usize = 7;
 const IN_FLIGHT: usize = 2;
 
-/// The scene's lights at frame `f`: each circles its own position. Directions are unit vectors
-/// and ranges capped as the renderer's scene validation leaves them (`normalise_lights`).
-fn lights_at(scene: &histencil_scene::Scene, f: usize) -> Vec<histencil_scene::Light> {
-    let mut moved = scene.clone();
-    moved.lights = scene
-        .lights
-        .iter()
-        .enumerate()
-        .map(|(i, l)| {
-            let angle = 0.7 * f as f32 + i as f32;
-            let offset = Vec3::new(angle.cos(), 0.0, angle.sin()) * 0.6;
-            histencil_scene::Light {
-                position: l.position + offset,
-                ..*l
-            }
-        })
-        .collect();
-    moved.normalise_lights();
-    moved.lights
-}
-
 /// One frame slot of the engine: its pool, command buffer and fence.
 struct Slot {
     pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
-}
-
-fn hdr_floats(bytes: &[u8]) -> Vec<f32> {
-    bytes
-        .chunks_exact(2)
-        .map(|h| f16_to_f32(u16::from_le_bytes([h[0], h[1]])))
-        .collect()
-}
-
-/// IEEE half to single, exactly.
-fn f16_to_f32(h: u16) -> f32 {
-    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let exponent = i32::from((h >> 10) & 0x1F);
-    let mantissa = f32::from(h & 0x3FF);
-    match exponent {
-        0 => sign * mantissa * 2f32.powi(-24),
-        31 => sign * f32::INFINITY,
-        e => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
-    }
 }
 
 #[test]
@@ -214,16 +175,7 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
             ..Readback::NONE
         };
         let expected = reference.render(technique, readback_hdr).unwrap();
-        let expected = expected.images.hdr.unwrap().into_raw();
-        assert_eq!(expected.len(), engine_hdr_last.len());
-        let lit = expected.iter().filter(|v| **v > 0.0).count();
-        assert!(lit > expected.len() / 8, "the reference is mostly dark");
-        let differing = expected
-            .iter()
-            .zip(&engine_hdr_last)
-            .filter(|(e, a)| e.to_bits() != a.to_bits())
-            .count();
-        assert_eq!(differing, 0, "channels differ from the renderer's frame");
+        assert_same_hdr(&expected.images.hdr.unwrap().into_raw(), &engine_hdr_last);
 
         drop(reference);
         // SAFETY: every slot's fence was waited for above: the GPU is done with the lighting,

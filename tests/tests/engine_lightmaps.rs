@@ -131,18 +131,7 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
         let (first, last) = (engine.readback_buffer(bytes), engine.readback_buffer(bytes));
         let d = &engine.device;
         let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
-        let slots: Vec<_> = (0..2)
-            .map(|_| {
-                let (pool, cmd) = engine.command_buffer();
-                let signalled =
-                    vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
-                (
-                    pool,
-                    cmd,
-                    unsafe { d.create_fence(&signalled, None) }.unwrap(),
-                )
-            })
-            .collect();
+        let slots = engine.frame_slots(2);
         let view = scene.camera.view_desc(4.0 / 3.0);
         // Frames 0 and 5 light the same state through slots 0 and 1; between them the lights
         // move and the entities grow from two to six.
@@ -257,12 +246,7 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
         assert!(lit_regions.iter().all(|l| *l), "{lit_regions:?}");
 
         drop(lightmaps);
-        unsafe {
-            for (pool, _, fence) in &slots {
-                d.destroy_fence(*fence, None);
-                d.destroy_command_pool(*pool, None);
-            }
-        }
+        engine.free_frame_slots(&slots);
         engine.free_image(atlas_image);
         for b in [first, last, again] {
             engine.free_buffer(b);

@@ -156,7 +156,7 @@ fn the_parts_can_move_between_threads() {
 fn engine_hooks_that_are_not_spirv_are_refused() {
     let modules = LightModules {
         deferred_light: b"#version 460\nvoid main() {}\n",
-        lut_light: LightModules::BUILTIN.lut_light,
+        ..LightModules::BUILTIN
     };
     // SAFETY: refused before the (null) layouts could be used.
     let err = unsafe { EngineHooks::new(modules, vk::DescriptorSetLayout::null(), None) }
@@ -165,6 +165,15 @@ fn engine_hooks_that_are_not_spirv_are_refused() {
         err.to_string().contains("deferred_light: not SPIR-V"),
         "{err}"
     );
+    // Every module is checked, the tiled kernels too.
+    let modules = LightModules {
+        tile_shade_8: &[0x03, 0x02, 0x23, 0x07, 0],
+        ..LightModules::BUILTIN
+    };
+    // SAFETY: as above.
+    let err = unsafe { EngineHooks::new(modules, vk::DescriptorSetLayout::null(), None) }
+        .expect_err("five bytes are not SPIR-V");
+    assert!(err.to_string().contains("tile_shade_8"), "{err}");
     // SAFETY: as above; histencil's own modules are SPIR-V.
     let ok =
         unsafe { EngineHooks::new(LightModules::BUILTIN, vk::DescriptorSetLayout::null(), None) };

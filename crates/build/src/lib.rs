@@ -43,7 +43,14 @@ pub const GLSLC_OPTIONS: [&str; 4] = [
 pub const HOOK_FILES: [&str; 2] = ["surface_decode.glsl", "light_visibility.glsl"];
 
 /// The light shaders that call the hooks, compiled per engine.
-pub const HOOKED_STAGES: [&str; 2] = ["deferred_light.frag", "lut_light.frag"];
+pub const HOOKED_STAGES: [&str; 6] = [
+    "deferred_light.frag",
+    "lut_light.frag",
+    "tile_classify.comp",
+    "tile_shade.comp",
+    "tile_classify_8.comp",
+    "tile_shade_8.comp",
+];
 
 /// Why the light shaders could not be compiled.
 #[derive(Debug)]

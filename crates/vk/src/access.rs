@@ -122,6 +122,9 @@ pub enum ImageAccess {
     /// Depth and stencil read-only, the stencil read by compute shaders through a
     /// stencil-aspect view (the hi-stencil tile update).
     ComputeDepthStencilSampled,
+    /// The depth aspect read by compute shaders (an engine's decode hook in the tiled
+    /// technique), in the layout the light passes use for it.
+    ComputeDepthSampled,
     /// Source of a copy to a buffer.
     TransferSource,
 }
@@ -167,6 +170,11 @@ pub fn access_info(
         ),
         ImageAccess::ComputeDepthStencilSampled => (
             vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+            S::COMPUTE_SHADER,
+            A::SHADER_SAMPLED_READ,
+        ),
+        ImageAccess::ComputeDepthSampled => (
+            vk::ImageLayout::DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL,
             S::COMPUTE_SHADER,
             A::SHADER_SAMPLED_READ,
         ),

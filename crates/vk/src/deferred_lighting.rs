@@ -27,9 +27,11 @@ use crate::hooks::{HookSets, LightHooks};
 use crate::meshes::LightVolumes;
 use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
 use crate::passes::lighting::{Emulation, LightingPass};
+use crate::passes::tiled::{TiledDesc, TiledLighting, TiledSets};
 use crate::resources::Buffer;
 use crate::targets::GBUFFER_FORMATS;
 use crate::teardown::{Destroy, InFlight};
+use crate::technique::{MixedTiles, TileSide};
 use crate::timing::{LightingBreakdown, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -86,6 +88,26 @@ pub struct LightingFrame<'a> {
     /// Count hi-stencil tiles tested and culled and fragments shaded
     /// ([`DeferredLighting::tile_stats`]); needs `LightingDesc::hi_stencil`.
     pub tile_stats: bool,
+    /// The engine's sets for its hooks (none with histencil's built-in hooks).
+    pub hook_sets: HookSets,
+}
+
+/// One frame lit by the tiled technique ([`DeferredLighting::record_tiled`]): no plan, no
+/// stencil; the BRDF of each pixel comes from its surface.
+#[derive(Clone, Copy, Debug)]
+pub struct TiledFrame<'a> {
+    /// Which frame-in-flight slot's buffers and sets this frame uses (`< frames_in_flight`).
+    pub slot: u32,
+    /// The camera.
+    pub view: &'a ViewDesc,
+    /// The frame's lights.
+    pub lights: &'a [Light],
+    /// Clear the HDR target to black first; otherwise light adds onto its contents.
+    pub clear_hdr: bool,
+    /// The tiles' side.
+    pub side: TileSide,
+    /// What a tile of several BRDFs does.
+    pub mixed: MixedTiles,
     /// The engine's sets for its hooks (none with histencil's built-in hooks).
     pub hook_sets: HookSets,
 }
@@ -181,6 +203,8 @@ pub struct DeferredLighting<C: Deref<Target = Context>> {
     hi_stencil: Option<HiStencilSurface>,
     volumes: Option<LightVolumes>,
     pipelines: LightPipelines,
+    /// The tiled technique per tile side, made at its first frame with that side.
+    tiled: Vec<(TileSide, TiledLighting)>,
     in_flight: InFlight,
 }
 
@@ -226,6 +250,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             slots: Vec::new(),
             hi_stencil: None,
             volumes: None,
+            tiled: Vec::new(),
             in_flight: InFlight::default(),
             pipelines: LightPipelines::new(
                 vk::PipelineLayout::null(),
@@ -253,7 +278,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             if i == 1 && !builtin {
                 continue;
             }
-            self.set_layouts[i] = create_set_layout(ctx, name, set, GRAPHICS_STAGES)?;
+            // The tiled technique's compute kernels bind the frame, G-buffer and filler sets.
+            let stages = match i {
+                2 => GRAPHICS_STAGES,
+                _ => GRAPHICS_STAGES | vk::ShaderStageFlags::COMPUTE,
+            };
+            self.set_layouts[i] = create_set_layout(ctx, name, set, stages)?;
         }
         let mut layouts = self.set_layouts.to_vec();
         if let LightHooks::Engine(engine) = hooks {
@@ -420,19 +450,7 @@ fn check_frame(
     frame: &LightingFrame,
     targets: &LightingTargets,
 ) -> Result<()> {
-    if frame.slot >= desc.frames_in_flight {
-        return Err(bad(format!(
-            "slot {} of {} frames in flight",
-            frame.slot, desc.frames_in_flight
-        )));
-    }
-    if frame.lights.len() > desc.max_lights as usize {
-        return Err(bad(format!(
-            "{} lights, more than the {} this lighting was made for",
-            frame.lights.len(),
-            desc.max_lights
-        )));
-    }
+    check_slot_and_lights(desc, frame.slot, frame.lights.len())?;
     if let Some(l) = frame
         .plan
         .lights
@@ -458,6 +476,32 @@ fn check_frame(
             frame.plan.depth, frame.view.depth
         )));
     }
+    check_targets(desc, &frame.hook_sets, targets)
+}
+
+/// Checks a frame's slot and light count against the lighting's description.
+fn check_slot_and_lights(desc: &LightingDesc, slot: u32, lights: usize) -> Result<()> {
+    if slot >= desc.frames_in_flight {
+        return Err(bad(format!(
+            "slot {slot} of {} frames in flight",
+            desc.frames_in_flight
+        )));
+    }
+    if lights > desc.max_lights as usize {
+        return Err(bad(format!(
+            "{lights} lights, more than the {} this lighting was made for",
+            desc.max_lights
+        )));
+    }
+    Ok(())
+}
+
+/// Checks the hook sets and every target's extent and format against the description.
+fn check_targets(
+    desc: &LightingDesc,
+    hook_sets: &HookSets,
+    targets: &LightingTargets,
+) -> Result<()> {
     let expect = |what: &str, image: &ImageRef, format: vk::Format| {
         if image.extent != desc.extent {
             return Err(bad(format!(
@@ -473,7 +517,7 @@ fn check_frame(
         }
         Ok(())
     };
-    desc.hooks.check_sets(&frame.hook_sets)?;
+    desc.hooks.check_sets(hook_sets)?;
     if let LightHooks::Builtin = desc.hooks {
         let names = [
             "G-buffer albedo",
@@ -563,16 +607,14 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 "hi-stencil statistics from a lighting made without hi-stencil",
             ));
         }
-        let e = self.desc.extent;
-        let uniforms =
-            FrameUniforms::from_view(frame.view, e.width, e.height, frame.lights.len() as u32)
-                .map_err(|p| bad(p.to_string()))?;
         if source == BrdfSource::Table && !self.lut_written {
             return Err(Error::Unsupported(
                 "the LUT technique before its tables exist",
             ));
         }
         self.prepare_for(frame.plan, count_stats, source)?;
+        let inputs = (frame.view, frame.lights, &frame.hook_sets);
+        let (frame_set, decode_set) = self.write_slot(frame.slot, inputs, targets)?;
         let ctx: &Context = &self.ctx;
         let slot = &mut self.slots[frame.slot as usize];
         let steps = frame.plan.steps.len() as u32;
@@ -582,18 +624,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let emulated = needs_hi_stencil(frame.plan);
         let marks = Emulation::marks(frame.plan);
         slot.emulation.prepare(ctx, name, emulated, marks)?;
-        slot.uniforms.write(bytemuck::bytes_of(&uniforms));
-        let gpu_lights: Vec<GpuLight> = frame.lights.iter().map(GpuLight::new).collect();
-        slot.lights.write(bytemuck::cast_slice(&gpu_lights));
-        let decode_set = match frame.hook_sets.decode {
-            Some(set) => set,
-            None => {
-                let views: Vec<vk::ImageView> = targets.gbuffer.iter().map(|g| g.view).collect();
-                write_sampled_images(ctx, slot.gbuffer_set, &views);
-                slot.gbuffer_set
-            }
-        };
-        let mut sets = vec![slot.frame_set, decode_set, self.hi_stencil_set];
+        let mut sets = vec![frame_set, decode_set, self.hi_stencil_set];
         if source == BrdfSource::Table {
             sets.push(self.lut_set);
         }
@@ -641,6 +672,138 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             Some(t) => Ok(t.read(&self.ctx)?.group_ms(Emulation::BOOKKEEPING)),
             None => Ok(None),
         }
+    }
+
+    /// Writes `slot`'s uniforms from `view` and `lights`, and its G-buffer set from `targets`
+    /// with histencil's decode; returns the frame set and the decode set (the engine's, with
+    /// its hook).
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] when the view's projection cannot be inverted per pixel; nothing
+    /// is written then.
+    fn write_slot(
+        &mut self,
+        slot: u32,
+        (view, lights, hook_sets): (&ViewDesc, &[Light], &HookSets),
+        targets: &LightingTargets,
+    ) -> Result<(vk::DescriptorSet, vk::DescriptorSet)> {
+        let e = self.desc.extent;
+        let uniforms = FrameUniforms::from_view(view, e.width, e.height, lights.len() as u32)
+            .map_err(|p| bad(p.to_string()))?;
+        let ctx: &Context = &self.ctx;
+        let slot = &mut self.slots[slot as usize];
+        slot.uniforms.write(bytemuck::bytes_of(&uniforms));
+        let gpu_lights: Vec<GpuLight> = lights.iter().map(GpuLight::new).collect();
+        slot.lights.write(bytemuck::cast_slice(&gpu_lights));
+        let decode_set = match hook_sets.decode {
+            Some(set) => set,
+            None => {
+                let views: Vec<vk::ImageView> = targets.gbuffer.iter().map(|g| g.view).collect();
+                write_sampled_images(ctx, slot.gbuffer_set, &views);
+                slot.gbuffer_set
+            }
+        };
+        Ok((slot.frame_set, decode_set))
+    }
+
+    /// Records `frame` lit by the tiled technique into `cmd` against `targets`, as engines
+    /// today light many BRDFs: a compute pass classifies each tile of the surfaces (the BRDFs
+    /// its pixels use, their depth range, the lights that can reach it), then one indirect
+    /// dispatch per BRDF runs a kernel specialised to it over its tiles
+    /// (`crate::passes::tiled`). No plan and no stencil: the BRDF comes from each pixel's
+    /// surface, through the decode hook. Leaves the HDR target in `GENERAL` (written by compute
+    /// shaders) and the depth-stencil image as it was, or, with an engine's decode hook, with
+    /// its depth read by compute shaders in `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] when the frame does not fit this lighting (slot, light count, target
+    /// extents and formats), or the HDR format is not `R16G16B16A16_SFLOAT` (the kernels store
+    /// to it as `rgba16f`); pipeline creation errors. Nothing is recorded on an error.
+    ///
+    /// # Safety
+    /// As [`DeferredLighting::record`]; the HDR image also has `STORAGE` usage, and the
+    /// engine's hook resources are readable by compute shaders (its set layouts include the
+    /// compute stage, its barriers the compute-shader stage).
+    pub unsafe fn record_tiled(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &TiledFrame,
+        targets: &mut LightingTargets,
+    ) -> Result<()> {
+        self.record_tiled_with(cmd, frame, targets, |_| {})
+    }
+
+    /// [`DeferredLighting::record_tiled`], calling `between` after the classification is
+    /// recorded and before the shade kernels (the renderer's timestamp between the two).
+    ///
+    /// # Safety
+    /// As [`DeferredLighting::record_tiled`].
+    pub(crate) unsafe fn record_tiled_with(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &TiledFrame,
+        targets: &mut LightingTargets,
+        between: impl FnOnce(vk::CommandBuffer),
+    ) -> Result<()> {
+        check_slot_and_lights(&self.desc, frame.slot, frame.lights.len())?;
+        check_targets(&self.desc, &frame.hook_sets, targets)?;
+        if self.desc.hdr_format != vk::Format::R16G16B16A16_SFLOAT {
+            return Err(bad(format!(
+                "the tiled technique stores light as rgba16f, and the HDR target is {:?}",
+                self.desc.hdr_format
+            )));
+        }
+        self.prepare_tiled(frame.side)?;
+        let inputs = (frame.view, frame.lights, &frame.hook_sets);
+        let (frame_set, decode_set) = self.write_slot(frame.slot, inputs, targets)?;
+        let ctx: &Context = &self.ctx;
+        let tiled = &self
+            .tiled
+            .iter()
+            .find(|(s, _)| *s == frame.side)
+            .expect("made")
+            .1;
+        tiled.set_target(ctx, frame.slot, targets.hdr.view);
+        let sets = TiledSets {
+            slot: frame.slot,
+            frame: frame_set,
+            decode: decode_set,
+            visibility: frame.hook_sets.visibility,
+        };
+        self.in_flight.mark();
+        let depth_sampled = self.desc.hooks.samples_depth();
+        let (clear, mixed) = (frame.clear_hdr, frame.mixed);
+        tiled.record_classify(ctx, cmd, &sets, targets, depth_sampled, clear, mixed);
+        between(cmd);
+        tiled.record_shade(ctx, cmd, mixed);
+        Ok(())
+    }
+
+    /// Makes the tiled technique's pipelines and buffers for tiles of `side`, if not yet made.
+    fn prepare_tiled(&mut self, side: TileSide) -> Result<()> {
+        if self.tiled.iter().any(|(s, _)| *s == side) {
+            return Ok(());
+        }
+        let ctx: &Context = &self.ctx;
+        let hooks = self.desc.hooks;
+        let [frame, gbuffer, _, filler] = self.set_layouts;
+        let decode = match hooks {
+            LightHooks::Builtin => gbuffer,
+            LightHooks::Engine(engine) => engine.decode_layout,
+        };
+        let desc = TiledDesc {
+            extent: self.desc.extent,
+            side,
+            brdfs: &self.desc.brdfs,
+            max_lights: self.desc.max_lights,
+            frames_in_flight: self.desc.frames_in_flight,
+            modules: &hooks.modules(),
+            layouts: [frame, decode],
+            visibility: hooks.visibility_layout().map(|v| (filler, v)),
+        };
+        let made = TiledLighting::new(ctx, &desc)?;
+        self.tiled.push((side, made));
+        Ok(())
     }
 
     /// The per-step GPU times of the last frame recorded into `slot` with timestamps, once the
@@ -717,6 +880,9 @@ impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
         let d = &ctx.device;
         self.in_flight.wait(ctx);
         self.pipelines.destroy(ctx);
+        for (_, t) in &mut self.tiled {
+            t.destroy(ctx);
+        }
         for slot in &mut self.slots {
             slot.uniforms.destroy(ctx);
             slot.lights.destroy(ctx);

@@ -15,13 +15,18 @@ use crate::shaders;
 use ash::vk;
 use std::io::Cursor;
 
-/// The SPIR-V of the two light shaders that call the hooks: `deferred_light.frag` (the talk's
-/// per-BRDF and branching shaders, by specialisation) and `lut_light.frag` (the LUT technique).
+/// The SPIR-V of the light shaders that call the hooks: `deferred_light.frag` (the talk's
+/// per-BRDF and branching shaders, by specialisation), `lut_light.frag` (the LUT technique) and
+/// the tiled technique's classification and shade kernels for 16x16 and 8x8 tiles.
 /// `histencil_build::compile_light_shaders` writes this as an expression for `include!`.
 #[derive(Clone, Copy, Debug)]
 pub struct LightModules {
     pub deferred_light: &'static [u8],
     pub lut_light: &'static [u8],
+    pub tile_classify: &'static [u8],
+    pub tile_shade: &'static [u8],
+    pub tile_classify_8: &'static [u8],
+    pub tile_shade_8: &'static [u8],
 }
 
 impl LightModules {
@@ -29,7 +34,23 @@ impl LightModules {
     pub const BUILTIN: LightModules = LightModules {
         deferred_light: shaders::DEFERRED_LIGHT_FRAG,
         lut_light: shaders::LUT_LIGHT_FRAG,
+        tile_classify: shaders::TILE_CLASSIFY_COMP,
+        tile_shade: shaders::TILE_SHADE_COMP,
+        tile_classify_8: shaders::TILE_CLASSIFY_8_COMP,
+        tile_shade_8: shaders::TILE_SHADE_8_COMP,
     };
+
+    /// Each module with its name, for checks and messages.
+    fn named(&self) -> [(&'static str, &'static [u8]); 6] {
+        [
+            ("deferred_light", self.deferred_light),
+            ("lut_light", self.lut_light),
+            ("tile_classify", self.tile_classify),
+            ("tile_shade", self.tile_shade),
+            ("tile_classify_8", self.tile_classify_8),
+            ("tile_shade_8", self.tile_shade_8),
+        ]
+    }
 }
 
 /// Where a lighting's shaders get surfaces and visibility from (fixed for its life).
@@ -53,8 +74,8 @@ pub struct EngineHooks {
 
 impl EngineHooks {
     /// The engine's light shaders (from `histencil_build`), its decode hook's set layout (set 1)
-    /// and, when its visibility hook reads resources, that hook's set layout (set 4). Both
-    /// modules are checked to be SPIR-V.
+    /// and, when its visibility hook reads resources, that hook's set layout (set 4). Every
+    /// module is checked to be SPIR-V.
     ///
     /// # Errors
     /// [`Error::BadFrame`] when a module is not SPIR-V (wrong length or magic number).
@@ -62,17 +83,15 @@ impl EngineHooks {
     /// # Safety
     /// The layouts are live, from the device of every context a lighting is made on with these
     /// hooks, and outlive those lightings; they declare the bindings the hooks' GLSL reads, for
-    /// the fragment stage; the modules were compiled by `histencil_build` from this version of
+    /// the fragment stage, and for the compute stage too where the lighting records the tiled
+    /// technique ([`crate::DeferredLighting::record_tiled`]); the modules were compiled by `histencil_build` from this version of
     /// histencil-vk's shaders.
     pub unsafe fn new(
         modules: LightModules,
         decode_layout: vk::DescriptorSetLayout,
         visibility_layout: Option<vk::DescriptorSetLayout>,
     ) -> Result<Self> {
-        for (name, spirv) in [
-            ("deferred_light", modules.deferred_light),
-            ("lut_light", modules.lut_light),
-        ] {
+        for (name, spirv) in modules.named() {
             spirv_words(spirv).map_err(|e| Error::BadFrame(format!("{name}: {e}")))?;
         }
         Ok(Self {

@@ -58,7 +58,7 @@ pub use capture::SimulatorInputs;
 pub use context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat};
 pub use debug::{ValidationLog, ValidationMessage};
 pub use deferred_lighting::{
-    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame,
+    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, TiledFrame,
 };
 pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;

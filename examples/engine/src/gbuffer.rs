@@ -294,9 +294,10 @@ impl CompactDecode {
         depth_view: vk::ImageView,
     ) -> Self {
         let d = &gpu.device;
+        // Fragment shaders, and the tiled technique's compute kernels.
         let sampled = (
             vk::DescriptorType::SAMPLED_IMAGE,
-            vk::ShaderStageFlags::FRAGMENT,
+            vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE,
         );
         let set_layout = set_layout(d, &[sampled; 3]);
         let (pool, sets) = allocate_sets(d, set_layout, in_flight, &[sampled.0; 3]);

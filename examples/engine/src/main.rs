@@ -28,8 +28,9 @@ use histencil::{
     mesh_bounds, plan_entities, plan_frame, AlphaEntity, AlphaEntityKind, AlphaLightmaps,
     AlphaLightmapsDesc, Backend, BrdfSource, ChoiceSettings, Context, DeferredLighting,
     DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSets, ImageState, LightHooks,
-    LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame, Perspective,
-    PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice, View, ViewDesc, Viewer,
+    LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame, MixedTiles,
+    Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice, TileSide,
+    TiledFrame, View, ViewDesc, Viewer,
 };
 // histencil's own renderer, as the reference the engine's frames are compared with.
 use histencil::vk::{AlphaMode, FrameDesc, Readback, Renderer, Shading, Technique};
@@ -79,6 +80,23 @@ fn plan(
     };
     let plan = plan_frame(layout, &inputs, &settings).expect("a plan");
     (view, lights, plan)
+}
+
+/// The frame lit by the tiled technique, through the same hooks: the first captured one.
+const TILED_FRAME: usize = FRAMES - 2;
+
+/// How frame `f` is lit: planned, on its backend, or tiled.
+fn technique(f: usize) -> Technique {
+    if f == TILED_FRAME {
+        return Technique::Tiled {
+            mixed: MixedTiles::PerBrdf,
+            side: TileSide::Sixteen,
+        };
+    }
+    Technique::Stencil {
+        backend: backend(f),
+        flush: FlushPolicy::Auto,
+    }
 }
 
 /// Frame `f`'s platform behaviour: PS3-like and native in turn.
@@ -192,11 +210,12 @@ fn main() {
         },
     )
     .expect("lighting");
+    // Storage: the tiled technique's kernels write it.
     let hdr = gpu.image(
         "hdr",
         HDR_FORMAT,
         extent,
-        U::COLOR_ATTACHMENT | U::TRANSFER_SRC,
+        U::COLOR_ATTACHMENT | U::TRANSFER_SRC | U::STORAGE,
     );
     let mut lightmaps = AlphaLightmaps::new(
         &ctx,
@@ -390,9 +409,24 @@ fn main() {
             };
             // SAFETY: the command buffer is recording on the engine's device; the images' states
             // are the ones the engine's own barriers left; this slot's last frame has finished.
-            lighting
-                .record(slot.cmd, &frame, &mut targets)
-                .expect("lighting recorded");
+            // The tiled frame's kernels read the same hooks (their sets include the compute
+            // stage) and write the HDR image as storage.
+            match technique(f) {
+                Technique::Tiled { mixed, side } => {
+                    let tiled = TiledFrame {
+                        slot: frame.slot,
+                        view: &view,
+                        lights: &lights,
+                        clear_hdr: true,
+                        side,
+                        mixed,
+                        hook_sets: frame.hook_sets,
+                    };
+                    lighting.record_tiled(slot.cmd, &tiled, &mut targets)
+                }
+                _ => lighting.record(slot.cmd, &frame, &mut targets),
+            }
+            .expect("lighting recorded");
             if let Some(c) = capture.map(|i| &captures[i]) {
                 copy_stencil(
                     d,
@@ -612,10 +646,7 @@ fn main() {
                 .iter()
                 .zip(after)
                 .all(|(b, a)| (b ^ a) & ENGINE_MASK == 0);
-        let technique = Technique::Stencil {
-            backend: backend(c.frame),
-            flush: FlushPolicy::Auto,
-        };
+        let technique = technique(c.frame);
         let timed = Instant::now();
         let runs = 5;
         for _ in 0..runs {
@@ -693,7 +724,7 @@ fn main() {
     println!(
         "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward, \
          engine stencil bits {}, {messages} validation messages, G-buffer {bytes} bytes per \
-         pixel, {SHADOWED_LIGHTS} shadowed lights",
+         pixel, {SHADOWED_LIGHTS} shadowed lights, frame {TILED_FRAME} tiled through the hooks",
         if intact { "intact" } else { "NOT intact" }
     );
     let alpha_ok = alpha_worst <= ALPHA_TOLERANCE && alpha_pixels > 0;

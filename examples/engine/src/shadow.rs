@@ -62,10 +62,14 @@ pub struct ShadowMap {
     pub sets: Vec<vk::DescriptorSet>,
 }
 
-/// The state the map is in while fragment shaders sample it.
+/// The state the map is in while histencil's light shaders sample it: fragment shaders, and
+/// the tiled technique's compute kernels.
 const SAMPLED: ImageState = ImageState {
     layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
-    stage: vk::PipelineStageFlags2::FRAGMENT_SHADER,
+    stage: vk::PipelineStageFlags2::from_raw(
+        vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw()
+            | vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw(),
+    ),
     access: vk::AccessFlags2::SHADER_SAMPLED_READ,
 };
 
@@ -131,7 +135,8 @@ impl ShadowMap {
                 dynamic: &[],
             },
         );
-        let stage = vk::ShaderStageFlags::FRAGMENT;
+        // The tiled technique's kernels read it too.
+        let stage = vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
         let types = [
             vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
             vk::DescriptorType::UNIFORM_BUFFER,

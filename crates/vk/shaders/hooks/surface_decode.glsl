@@ -17,6 +17,9 @@
 
 #include "gbuffer.glsl"
 
+// The tiled classification reads depth and BRDF id straight from histencil's G-buffer.
+#define HISTENCIL_BUILTIN_DECODE
+
 bool decode_surface(vec2 frag_coord, out Surface s) {
     return gbuffer_load(frag_coord, s);
 }

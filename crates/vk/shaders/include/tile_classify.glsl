@@ -1,6 +1,6 @@
 // The tiled technique's first pass, one workgroup per TILED_TILE x TILED_TILE tile, on the GPU
-// with no readback: the set of BRDFs the tile's pixels use (from histencil's G-buffer) and their
-// depth range; each BRDF's list of the tiles that contain it and the count its shade pass
+// with no readback: the set of BRDFs the tile's pixels use (from the decode hook, or straight
+// from histencil's G-buffer, which holds both in two texels) and their depth range; each BRDF's list of the tiles that contain it and the count its shade pass
 // dispatches (appended atomically: the order of a list does not matter, each pixel is shaded by
 // one workgroup); and the lights that can reach the tile, tested against the view-space box
 // that holds the tile's pixel footprints between its nearest and farthest surface.
@@ -9,7 +9,7 @@
 #ifndef TILE_CLASSIFY_GLSL
 #define TILE_CLASSIFY_GLSL
 #include "frame.glsl"
-#include "gbuffer.glsl"
+#include "surface_decode.glsl"
 #include "tiled.glsl"
 
 layout(local_size_x = TILED_TILE, local_size_y = TILED_TILE) in;
@@ -28,6 +28,23 @@ const uint INVOCATIONS = TILED_TILE * TILED_TILE;
 vec3 view_point(vec2 p, float d) {
     vec2 ndc = p * frame.viewport.zw * 2.0 - 1.0;
     return vec3((ndc + frame.projection.zw) * frame.projection.xy, -1.0) * d;
+}
+
+// The BRDF model id and linear depth of the surface under pixel `px`; false where none.
+bool tile_surface(ivec2 px, out uint model, out float depth) {
+#ifdef HISTENCIL_BUILTIN_DECODE
+    depth = texelFetch(gbuffer_normal_depth, px, 0).w;
+    model = uint(texelFetch(gbuffer_material, px, 0).w);
+    return depth > 0.0;
+#else
+    Surface s;
+    if (!decode_surface(vec2(px) + 0.5, s)) {
+        return false;
+    }
+    model = s.brdf;
+    depth = max(-(frame.view * vec4(s.position, 1.0)).z, 0.0);
+    return true;
+#endif
 }
 
 // Whether `light` can light anything in the view-space box [lo, hi]: directional lights reach
@@ -59,9 +76,9 @@ void main() {
         if (tiled.clear != 0u) {
             imageStore(tiled_hdr, px, vec4(0.0));
         }
-        float depth = texelFetch(gbuffer_normal_depth, px, 0).w;
-        if (depth > 0.0) {
-            uint model = uint(texelFetch(gbuffer_material, px, 0).w);
+        uint model;
+        float depth;
+        if (tile_surface(px, model, depth)) {
             uint slot = model < TILED_MODELS ? tiled.slot_of_model[model] : ~0u;
             if (slot < 32u) {
                 atomicOr(tile_brdfs, 1u << slot);

@@ -8,7 +8,8 @@
 #ifndef TILE_SHADE_GLSL
 #define TILE_SHADE_GLSL
 #include "light.glsl"
-#include "gbuffer.glsl"
+#include "surface_decode.glsl"
+#include "light_visibility.glsl"
 #include "tiled.glsl"
 
 layout(local_size_x = TILED_TILE, local_size_y = TILED_TILE) in;
@@ -25,7 +26,7 @@ void main() {
         return;
     }
     Surface s;
-    if (!gbuffer_load(vec2(px) + 0.5, s)) {
+    if (!decode_surface(vec2(px) + 0.5, s)) {
         return;
     }
     // A switch on the constant itself: a comparison of two constants would become
@@ -48,7 +49,13 @@ void main() {
         while (bits != 0u) {
             uint b = uint(findLSB(bits));
             bits &= bits - 1u;
-            sum += shade_light_with(lights[w * 32u + b], s, model);
+            uint index = w * 32u + b;
+            Light light = lights[index];
+            vec3 lit = shade_light_with(light, s, model);
+            if (any(greaterThan(lit, vec3(0.0)))) {
+                lit *= light_visibility(index, light, s);
+            }
+            sum += lit;
         }
     }
     imageStore(tiled_hdr, px, imageLoad(tiled_hdr, px) + vec4(sum, 0.0));

@@ -10,15 +10,12 @@
 
 use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
 use crate::context::Context;
-use crate::descriptors::{
-    create_pipeline_layout, create_set_layout, write_frame_set, write_sampled_images, FRAME_SET,
-    GBUFFER_SET, TILED_SET,
-};
+use crate::descriptors::{create_pipeline_layout, create_set_layout, TILED_SET};
 use crate::error::{Error, Result, VkCall};
+use crate::hooks::LightModules;
 use crate::pipelines::create_compute_pipeline;
 use crate::resources::Buffer;
 use crate::shader_consts::TILED_MODELS;
-use crate::shaders;
 use crate::teardown::{build, Destroy};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -64,16 +61,17 @@ impl TileSide {
         }
     }
 
-    /// The classification and shade stages built for this side.
-    fn modules(self) -> [(&'static str, &'static [u8]); 2] {
+    /// The classification and shade stages built for this side, from `modules` (histencil's
+    /// or an engine's, compiled with its hooks).
+    fn modules(self, modules: &LightModules) -> [(&'static str, &'static [u8]); 2] {
         match self {
             TileSide::Eight => [
-                ("tile_classify_8.comp", shaders::TILE_CLASSIFY_8_COMP),
-                ("tile_shade_8.comp", shaders::TILE_SHADE_8_COMP),
+                ("tile_classify_8.comp", modules.tile_classify_8),
+                ("tile_shade_8.comp", modules.tile_shade_8),
             ],
             TileSide::Sixteen => [
-                ("tile_classify.comp", shaders::TILE_CLASSIFY_COMP),
-                ("tile_shade.comp", shaders::TILE_SHADE_COMP),
+                ("tile_classify.comp", modules.tile_classify),
+                ("tile_shade.comp", modules.tile_shade),
             ],
         }
     }
@@ -90,10 +88,11 @@ pub enum MixedTiles {
 
 #[derive(Default)]
 pub(crate) struct TiledLighting {
-    /// Frame (uniforms, lights), G-buffer and tiled sets, for the compute stage.
-    set_layouts: [vk::DescriptorSetLayout; 3],
+    /// The tiled set's layout (set 2); sets 0, 1, 3 and 4 are the lighting's.
+    set_layout: vk::DescriptorSetLayout,
     pipeline_layout: vk::PipelineLayout,
     pool: vk::DescriptorPool,
+    /// The tiled set of each frame-in-flight slot (its HDR target written per frame).
     sets: Vec<vk::DescriptorSet>,
     classify: vk::Pipeline,
     /// The shade kernel of each BRDF slot.
@@ -107,17 +106,29 @@ pub(crate) struct TiledLighting {
     tiles_xy: (u32, u32),
 }
 
-/// What the tiled lighting reads: the renderer's frame buffers and G-buffer, its HDR target.
-pub(crate) struct TiledInputs<'a> {
+/// What a [`TiledLighting`] is made for, inside a [`crate::DeferredLighting`].
+pub(crate) struct TiledDesc<'a> {
     pub extent: vk::Extent2D,
     pub side: TileSide,
     /// The BRDF of each stencil slot.
     pub brdfs: &'a [BrdfId],
     pub max_lights: u32,
-    pub frame_uniforms: vk::Buffer,
-    pub lights: vk::Buffer,
-    pub gbuffer: [vk::ImageView; 3],
-    pub hdr: vk::ImageView,
+    pub frames_in_flight: u32,
+    /// The light shaders: histencil's, or an engine's compiled with its hooks.
+    pub modules: &'a LightModules,
+    /// The lighting's set layouts for sets 0 (frame), 1 (decode), 3 (a filler where set 4 is
+    /// used) and 4 (the visibility hook's, if any): all with the compute stage.
+    pub layouts: [vk::DescriptorSetLayout; 2],
+    pub visibility: Option<(vk::DescriptorSetLayout, vk::DescriptorSetLayout)>,
+}
+
+/// The sets one tiled frame binds: the slot's frame and decode sets, the engine's visibility
+/// set if its hook has one.
+pub(crate) struct TiledSets {
+    pub slot: u32,
+    pub frame: vk::DescriptorSet,
+    pub decode: vk::DescriptorSet,
+    pub visibility: Option<vk::DescriptorSet>,
 }
 
 impl Destroy for TiledLighting {
@@ -131,12 +142,11 @@ impl Destroy for TiledLighting {
             self.branching = vk::Pipeline::null();
             d.destroy_descriptor_pool(self.pool, None);
             self.pool = vk::DescriptorPool::null();
+            self.sets.clear();
             d.destroy_pipeline_layout(self.pipeline_layout, None);
             self.pipeline_layout = vk::PipelineLayout::null();
-            for l in &mut self.set_layouts {
-                d.destroy_descriptor_set_layout(*l, None);
-                *l = vk::DescriptorSetLayout::null();
-            }
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+            self.set_layout = vk::DescriptorSetLayout::null();
         }
         self.dispatch.destroy(ctx);
         self.lists.destroy(ctx);
@@ -145,68 +155,49 @@ impl Destroy for TiledLighting {
 }
 
 impl TiledLighting {
-    /// Layouts, pipelines (the classification and one shade kernel per BRDF slot), the tile
-    /// buffers for `inputs.extent`, and the sets pointing at `inputs`; a failure half way frees
-    /// what was made.
-    pub fn new(ctx: &Context, inputs: &TiledInputs) -> Result<Self> {
-        if inputs.brdfs.len() > MAX_SLOTS {
+    /// The tiled set layout, the pipeline layout, the pipelines (the classification and one
+    /// shade kernel per BRDF slot), the tile buffers for `desc.extent` and a tiled set per slot
+    /// pointing at them; a failure half way frees what was made.
+    pub fn new(ctx: &Context, desc: &TiledDesc) -> Result<Self> {
+        if desc.brdfs.len() > MAX_SLOTS {
             return Err(Error::BadFrame(format!(
                 "the tiled technique takes at most {MAX_SLOTS} BRDFs, not {}",
-                inputs.brdfs.len()
+                desc.brdfs.len()
             )));
         }
         let compute = vk::ShaderStageFlags::COMPUTE;
-        let e = inputs.extent;
-        let tile = inputs.side.pixels();
+        let e = desc.extent;
+        let tile = desc.side.pixels();
         let tiles_xy = (e.width.div_ceil(tile), e.height.div_ceil(tile));
-        let [classify, shade] = inputs.side.modules();
+        let [classify, shade] = desc.side.modules(desc.modules);
         let tiles = tiles_xy.0 * tiles_xy.1;
-        let words = inputs.max_lights.div_ceil(32).max(1);
+        let words = desc.max_lights.div_ceil(32).max(1);
         let mut slot_of_model = [u32::MAX; TILED_MODELS as usize];
-        for (slot, brdf) in inputs.brdfs.iter().enumerate() {
+        for (slot, brdf) in desc.brdfs.iter().enumerate() {
             slot_of_model[brdf.index() as usize] = slot as u32;
         }
         build(ctx, |t: &mut Self| {
-            let named = [
-                ("tiled-frame-set-layout", FRAME_SET),
-                ("tiled-gbuffer-set-layout", GBUFFER_SET),
-                ("tiled-set-layout", TILED_SET),
-            ];
-            for (i, (name, set)) in named.into_iter().enumerate() {
-                t.set_layouts[i] = create_set_layout(ctx, name, set, compute)?;
+            t.set_layout = create_set_layout(ctx, "tiled-set-layout", TILED_SET, compute)?;
+            let [frame, decode] = desc.layouts;
+            let mut layouts = vec![frame, decode, t.set_layout];
+            if let Some((filler, visibility)) = desc.visibility {
+                layouts.extend([filler, visibility]);
             }
             let push_bytes = size_of::<TiledPush>() as u32;
-            t.pipeline_layout = create_pipeline_layout(
-                ctx,
-                "tiled-pipeline-layout",
-                &t.set_layouts,
-                compute,
-                push_bytes,
-            )?;
-            let module = classify;
-            t.classify = create_compute_pipeline(
-                ctx,
-                "tiled-classify-pipeline",
-                module,
-                t.pipeline_layout,
-                &[],
-            )?;
-            for (slot, brdf) in inputs.brdfs.iter().enumerate() {
-                let module = shade;
+            let name = "tiled-pipeline-layout";
+            t.pipeline_layout = create_pipeline_layout(ctx, name, &layouts, compute, push_bytes)?;
+            let layout = t.pipeline_layout;
+            t.classify =
+                create_compute_pipeline(ctx, "tiled-classify-pipeline", classify, layout, &[])?;
+            for (slot, brdf) in desc.brdfs.iter().enumerate() {
                 let name = format!("tiled-shade-{}-pipeline", brdf.name());
                 let constants = [brdf.index(), slot as u32];
-                let p = create_compute_pipeline(ctx, &name, module, t.pipeline_layout, &constants)?;
+                let p = create_compute_pipeline(ctx, &name, shade, layout, &constants)?;
                 t.shade.push(p);
             }
-            let module = shade;
             let constants = [BRANCH_ON_GBUFFER, MIXED_SLOT as u32];
-            t.branching = create_compute_pipeline(
-                ctx,
-                "tiled-shade-branching-pipeline",
-                module,
-                t.pipeline_layout,
-                &constants,
-            )?;
+            let name = "tiled-shade-branching-pipeline";
+            t.branching = create_compute_pipeline(ctx, name, shade, layout, &constants)?;
             use vk::BufferUsageFlags as U;
             let storage = U::STORAGE_BUFFER;
             let gpu = MemoryLocation::GpuOnly;
@@ -222,46 +213,7 @@ impl TiledLighting {
             t.lists = Buffer::new(ctx, "tiled-lists", lists, storage, gpu)?;
             let mask_bytes = u64::from(tiles) * u64::from(words) * 4;
             t.masks = Buffer::new(ctx, "tiled-light-masks", mask_bytes, storage, gpu)?;
-            let sizes = [
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::UNIFORM_BUFFER)
-                    .descriptor_count(1),
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(4),
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::SAMPLED_IMAGE)
-                    .descriptor_count(3),
-                vk::DescriptorPoolSize::default()
-                    .ty(vk::DescriptorType::STORAGE_IMAGE)
-                    .descriptor_count(1),
-            ];
-            let info = vk::DescriptorPoolCreateInfo::default()
-                .max_sets(3)
-                .pool_sizes(&sizes);
-            t.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
-                .call("vkCreateDescriptorPool")?;
-            ctx.name(t.pool, "tiled-descriptor-pool");
-            let alloc = vk::DescriptorSetAllocateInfo::default()
-                .descriptor_pool(t.pool)
-                .set_layouts(&t.set_layouts);
-            t.sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
-                .call("vkAllocateDescriptorSets")?;
-            for (set, name) in
-                t.sets
-                    .iter()
-                    .zip(["tiled-frame-set", "tiled-gbuffer-set", "tiled-set"])
-            {
-                ctx.name(*set, name);
-            }
-            write_frame_set(ctx, t.sets[0], inputs.frame_uniforms, inputs.lights);
-            write_sampled_images(ctx, t.sets[1], &inputs.gbuffer);
-            write_tiled_set(
-                ctx,
-                t.sets[2],
-                [t.dispatch.handle, t.lists.handle, t.masks.handle],
-                inputs.hdr,
-            );
+            t.create_sets(ctx, desc.frames_in_flight)?;
             t.push = Some(TiledPush {
                 tiles_x: tiles_xy.0,
                 tiles,
@@ -275,14 +227,64 @@ impl TiledLighting {
         })
     }
 
-    /// Records the classification: the G-buffer read by compute shaders, the HDR target
-    /// cleared first with `clear` and left in `GENERAL` for the shade kernels
-    /// ([`TiledLighting::record_shade`], next).
+    /// The pool and every slot's tiled set, its buffers written (the HDR target is written per
+    /// frame, [`TiledLighting::set_target`]).
+    fn create_sets(&mut self, ctx: &Context, slots: u32) -> Result<()> {
+        let sizes = [
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(3 * slots),
+            vk::DescriptorPoolSize::default()
+                .ty(vk::DescriptorType::STORAGE_IMAGE)
+                .descriptor_count(slots),
+        ];
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(slots)
+            .pool_sizes(&sizes);
+        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
+            .call("vkCreateDescriptorPool")?;
+        ctx.name(self.pool, "tiled-descriptor-pool");
+        let layouts = vec![self.set_layout; slots as usize];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(self.pool)
+            .set_layouts(&layouts);
+        self.sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
+            .call("vkAllocateDescriptorSets")?;
+        let buffers = [self.dispatch.handle, self.lists.handle, self.masks.handle];
+        for (i, set) in self.sets.iter().enumerate() {
+            ctx.name(*set, &format!("tiled-set-{i}"));
+            write_tiled_buffers(ctx, *set, buffers);
+        }
+        Ok(())
+    }
+
+    /// Points `slot`'s tiled set at the frame's HDR target (storage, `GENERAL`). The slot's last
+    /// frame has finished, which recording into the slot promises.
+    pub fn set_target(&self, ctx: &Context, slot: u32, hdr: vk::ImageView) {
+        let image = [vk::DescriptorImageInfo::default()
+            .image_view(hdr)
+            .image_layout(vk::ImageLayout::GENERAL)];
+        let write = vk::WriteDescriptorSet::default()
+            .dst_set(self.sets[slot as usize])
+            .dst_binding(3)
+            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+            .image_info(&image);
+        unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+    }
+
+    /// Records the classification with `sets` bound: the G-buffer (or the decode hook's
+    /// images) read by compute shaders, and with `depth_sampled` the depth aspect too, in
+    /// `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL` as the light passes hold it; the HDR target
+    /// (in `sets.slot`'s tiled set, [`TiledLighting::set_target`]) cleared first with `clear`
+    /// and left in `GENERAL` for the shade kernels ([`TiledLighting::record_shade`], next).
+    #[allow(clippy::too_many_arguments)]
     pub fn record_classify(
         &self,
         ctx: &Context,
         cmd: vk::CommandBuffer,
+        sets: &TiledSets,
         targets: &mut LightingTargets,
+        depth_sampled: bool,
         clear: bool,
         mixed: MixedTiles,
     ) {
@@ -298,6 +300,16 @@ impl TiledLighting {
         ctx.begin_label(cmd, "tiled-classify");
         for image in targets.gbuffer.iter_mut() {
             transition(ctx, cmd, image, ImageAccess::ComputeSampled, Contents::Keep);
+        }
+        if depth_sampled {
+            let ds = &mut targets.depth_stencil;
+            transition(
+                ctx,
+                cmd,
+                ds,
+                ImageAccess::ComputeDepthSampled,
+                Contents::Keep,
+            );
         }
         let hdr_contents = if clear {
             Contents::Discard
@@ -329,14 +341,13 @@ impl TiledLighting {
             ),
         );
         unsafe {
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                self.pipeline_layout,
-                0,
-                &self.sets,
-                &[],
-            );
+            let bound = [sets.frame, sets.decode, self.sets[sets.slot as usize]];
+            let compute = vk::PipelineBindPoint::COMPUTE;
+            d.cmd_bind_descriptor_sets(cmd, compute, self.pipeline_layout, 0, &bound, &[]);
+            if let Some(set) = sets.visibility {
+                let layout = self.pipeline_layout;
+                d.cmd_bind_descriptor_sets(cmd, compute, layout, 4, &[set], &[]);
+            }
             d.cmd_push_constants(
                 cmd,
                 self.pipeline_layout,
@@ -405,22 +416,14 @@ fn buffer_barrier(
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &info) };
 }
 
-/// Points the tiled set at its three buffers and the HDR target (storage, `GENERAL`).
-fn write_tiled_set(
-    ctx: &Context,
-    set: vk::DescriptorSet,
-    buffers: [vk::Buffer; 3],
-    hdr: vk::ImageView,
-) {
+/// Points a tiled set at its three buffers.
+fn write_tiled_buffers(ctx: &Context, set: vk::DescriptorSet, buffers: [vk::Buffer; 3]) {
     let infos = buffers.map(|b| {
         [vk::DescriptorBufferInfo::default()
             .buffer(b)
             .range(vk::WHOLE_SIZE)]
     });
-    let image = [vk::DescriptorImageInfo::default()
-        .image_view(hdr)
-        .image_layout(vk::ImageLayout::GENERAL)];
-    let mut writes: Vec<vk::WriteDescriptorSet> = infos
+    let writes: Vec<vk::WriteDescriptorSet> = infos
         .iter()
         .enumerate()
         .map(|(i, info)| {
@@ -431,12 +434,5 @@ fn write_tiled_set(
                 .buffer_info(info)
         })
         .collect();
-    writes.push(
-        vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(3)
-            .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
-            .image_info(&image),
-    );
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }

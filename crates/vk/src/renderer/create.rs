@@ -171,7 +171,6 @@ impl<'c> Renderer<'c> {
             lut_tables: None,
             alpha: None,
             lighting,
-            tiled: Vec::new(),
             extent,
             targets: targets.keep(),
             meshes: meshes.keep(),
@@ -251,9 +250,6 @@ impl Drop for Renderer<'_> {
         }
         if let Some(a) = self.alpha.as_mut() {
             a.destroy(ctx);
-        }
-        for (_, t) in &mut self.tiled {
-            t.destroy(ctx);
         }
         self.maps.destroy(ctx);
         self.mesh_passes.destroy(ctx);

@@ -5,7 +5,7 @@
 use super::{Frame, Renderer};
 use crate::access::LightingTargets;
 use crate::alpha::AlphaInputs;
-use crate::deferred_lighting::LightingFrame;
+use crate::deferred_lighting::{LightingFrame, TiledFrame};
 use crate::error::{Result, VkCall};
 use crate::hooks::HookSets;
 use crate::passes::geometry::{GbufferStencil, MeshInputs};
@@ -136,12 +136,23 @@ impl Renderer<'_> {
         }
         self.timestamps.mark(ctx, cmd, "gbuffer");
         if let Technique::Tiled { mixed, side } = technique {
-            self.tiled_lighting(side)?;
-            let tiled = &self.tiled.iter().find(|(s, _)| *s == side).expect("made").1;
+            let frame = TiledFrame {
+                slot: 0,
+                view,
+                lights: &self.scene.lights,
+                clear_hdr: !emits,
+                side,
+                mixed,
+                hook_sets: HookSets::default(),
+            };
             let mut targets = self.targets.lighting();
-            tiled.record_classify(ctx, cmd, &mut targets, !emits, mixed);
-            self.timestamps.mark(ctx, cmd, "tile-classify");
-            tiled.record_shade(ctx, cmd, mixed);
+            let timestamps = &mut self.timestamps;
+            let classified = |cmd| timestamps.mark(ctx, cmd, "tile-classify");
+            // SAFETY: as for `record` below.
+            unsafe {
+                self.lighting
+                    .record_tiled_with(cmd, &frame, &mut targets, classified)?
+            };
             self.targets.lit(&targets);
             self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
             return Ok(());

@@ -17,13 +17,11 @@ use crate::lut::LutTables;
 use crate::materials::GpuMaterials;
 use crate::meshes::Meshes;
 use crate::passes::geometry::MeshPasses;
-use crate::passes::tiled::{TiledInputs, TiledLighting};
 use crate::passes::tonemap::Tonemap;
 use crate::readback::{FrameImages, ReadbackBuffers};
 use crate::resources::Buffer;
 use crate::targets::Targets;
 use crate::technique::Backend;
-use crate::technique::TileSide;
 use crate::timing::{FrameTimings, Timestamps};
 use ash::vk;
 use histencil_brdf::{Brdf, BrdfId};
@@ -111,8 +109,6 @@ pub struct Renderer<'c> {
     alpha: Option<AlphaLighting<'c>>,
     /// The lighting passes, as an engine records them, into this renderer's targets.
     lighting: DeferredLighting<&'c Context>,
-    /// The tiled technique's passes per tile side, made at its first frame with that side.
-    tiled: Vec<(TileSide, TiledLighting)>,
     extent: vk::Extent2D,
     targets: Targets,
     meshes: Meshes,
@@ -266,27 +262,6 @@ impl<'c> Renderer<'c> {
             )?);
         }
         Ok(self.alpha.as_mut())
-    }
-
-    /// The tiled technique's passes for tiles of `side`, made at its first frame.
-    fn tiled_lighting(&mut self, side: TileSide) -> Result<&TiledLighting> {
-        if !self.tiled.iter().any(|(s, _)| *s == side) {
-            let t = &self.targets;
-            let inputs = TiledInputs {
-                extent: self.extent,
-                side,
-                brdfs: &self.brdfs,
-                max_lights: self.scene.lights.len() as u32,
-                frame_uniforms: self.frame_uniforms.handle,
-                lights: self.lights.handle,
-                gbuffer: [t.gbuffer[0].view, t.gbuffer[1].view, t.gbuffer[2].view],
-                hdr: t.hdr.view,
-            };
-            let made = TiledLighting::new(self.ctx, &inputs)?;
-            self.tiled.push((side, made));
-        }
-        let found = self.tiled.iter().find(|(s, _)| *s == side);
-        Ok(&found.expect("made above").1)
     }
 
     /// Light pipelines created so far.

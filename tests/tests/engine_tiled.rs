@@ -1,0 +1,160 @@
+//! The tiled technique recorded into an engine's frames through `DeferredLighting::record_tiled`:
+//! the engine's own device, images and fences, two frames in flight, lights moving every frame,
+//! both tile sides and both ways of shading mixed tiles. Its last frame must equal histencil's
+//! Renderer lighting the same state with the same technique, bit for bit, and the validation
+//! layer with synchronisation validation must see nothing. A lighting whose HDR format the
+//! kernels cannot store to is refused before anything is recorded.
+
+use ash::vk;
+use histencil_tests::engine::{assert_same_hdr, copy_to_buffer, hdr_floats, lights_at, Engine};
+use histencil_vk::{
+    Context, DeferredLighting, Error, HookSets, LightHooks, LightingDesc, MixedTiles, Readback,
+    Renderer, Technique, TileSide, TiledFrame,
+};
+
+const WIDTH: u32 = 96;
+const HEIGHT: u32 = 64;
+const FRAMES: usize = 5;
+const IN_FLIGHT: usize = 2;
+
+/// The tiling of frame `f`: every side and mixed-tile mode comes round, the last frame's is
+/// 8x8 tiles with mixed tiles per BRDF.
+fn tiling(f: usize) -> (TileSide, MixedTiles) {
+    let side = if f.is_multiple_of(2) {
+        TileSide::Eight
+    } else {
+        TileSide::Sixteen
+    };
+    let mixed = if f % 4 < 2 {
+        MixedTiles::PerBrdf
+    } else {
+        MixedTiles::Branching
+    };
+    (side, mixed)
+}
+
+#[test]
+fn an_engine_records_the_tiled_technique_into_its_frames() {
+    let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
+    assert!(scene.brdfs_in_use().len() >= 3);
+    let engine = Engine::start();
+    let extent = vk::Extent2D {
+        width: WIDTH,
+        height: HEIGHT,
+    };
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let ds_format = ctx.depth_stencil_format().vk();
+        let renderer = Renderer::new(&ctx, scene.clone(), WIDTH, HEIGHT).unwrap();
+        let desc = LightingDesc {
+            layout: *renderer.stencil_layout(),
+            brdfs: renderer.brdfs().to_vec(),
+            extent,
+            depth_stencil_format: ds_format,
+            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+            frames_in_flight: IN_FLIGHT as u32,
+            max_lights: scene.lights.len() as u32,
+            hi_stencil: false,
+            hooks: LightHooks::Builtin,
+        };
+        let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();
+        let images = engine.lighting_targets(extent, ds_format);
+        let readback = engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8);
+        let mut targets = images.refs();
+        let d = &engine.device;
+        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
+        let slots = engine.frame_slots(IN_FLIGHT);
+        let view = scene.camera.view_desc(WIDTH as f32 / HEIGHT as f32);
+        for f in 0..FRAMES {
+            let (pool, cmd, fence) = slots[f % IN_FLIGHT];
+            let lights = lights_at(&scene, f);
+            let (side, mixed) = tiling(f);
+            unsafe {
+                d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+                d.reset_fences(&[fence]).unwrap();
+                d.reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
+                    .unwrap();
+                let begin = vk::CommandBufferBeginInfo::default()
+                    .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+                d.begin_command_buffer(cmd, &begin).unwrap();
+                renderer.record_gbuffer(cmd, &mut targets).unwrap();
+                let frame = TiledFrame {
+                    slot: (f % IN_FLIGHT) as u32,
+                    view: &view,
+                    lights: &lights,
+                    clear_hdr: true,
+                    side,
+                    mixed,
+                    hook_sets: HookSets::default(),
+                };
+                lighting.record_tiled(cmd, &frame, &mut targets).unwrap();
+                if f == FRAMES - 1 {
+                    copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
+                }
+                d.end_command_buffer(cmd).unwrap();
+                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+                d.queue_submit2(queue, &[submit], fence).unwrap();
+            }
+        }
+        let fences: Vec<_> = slots.iter().map(|s| s.2).collect();
+        unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        let engine_hdr = hdr_floats(readback.bytes());
+
+        // histencil's renderer lighting the last frame's state with the same tiling.
+        scene.lights = lights_at(&scene, FRAMES - 1);
+        let mut reference = Renderer::new(&ctx, scene.clone(), WIDTH, HEIGHT).unwrap();
+        let (side, mixed) = tiling(FRAMES - 1);
+        let readback_hdr = Readback {
+            hdr: true,
+            ..Readback::NONE
+        };
+        let expected = reference
+            .render(Technique::Tiled { mixed, side }, readback_hdr)
+            .unwrap();
+        assert_same_hdr(&expected.images.hdr.unwrap().into_raw(), &engine_hdr);
+        drop(reference);
+
+        // The kernels store rgba16f: another HDR format is refused, with nothing recorded.
+        let packed = LightingDesc {
+            hdr_format: vk::Format::B10G11R11_UFLOAT_PACK32,
+            ..desc.clone()
+        };
+        let mut other = DeferredLighting::new(&ctx, &packed).unwrap();
+        let (pool, cmd, _) = slots[0];
+        unsafe {
+            d.reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
+                .unwrap();
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            let lights = lights_at(&scene, 0);
+            let frame = TiledFrame {
+                slot: 0,
+                view: &view,
+                lights: &lights,
+                clear_hdr: true,
+                side: TileSide::Sixteen,
+                mixed: MixedTiles::PerBrdf,
+                hook_sets: HookSets::default(),
+            };
+            let mut refs = images.refs();
+            refs.hdr.format = packed.hdr_format;
+            match other.record_tiled(cmd, &frame, &mut refs) {
+                Err(Error::BadFrame(m)) => assert!(m.contains("rgba16f"), "{m}"),
+                other => panic!("a packed HDR target was not refused: {other:?}"),
+            }
+            d.end_command_buffer(cmd).unwrap();
+        }
+        drop(other);
+
+        // SAFETY: every slot's fence was waited for above.
+        unsafe { lighting.destroy() };
+        drop(renderer);
+        engine.free_frame_slots(&slots);
+        images.free(&engine);
+        engine.free_buffer(readback);
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
+    }
+    engine.destroy().assert_clean();
+}
