@@ -229,6 +229,15 @@ fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
     for (x, (lo, hi)) in costs.iter().zip(intervals) {
         assert!(lo <= *x && *x <= hi, "{c:?}");
     }
+    // The tiled technique's costs are measured too, with their intervals.
+    let tiled = c
+        .tiled
+        .expect("calibrated costs carry the tiled technique's");
+    let tiled_intervals = tiled.interval.expect("measured");
+    for (x, (lo, hi)) in tiled.fields().iter().zip(tiled_intervals) {
+        assert!(x.is_finite() && lo <= *x && *x <= hi, "{tiled:?}");
+    }
+    assert!(tiled.classify_ms > 0.0 && tiled.shade_ms > 0.0, "{tiled:?}");
     let path = output_dir().join("costs.json");
     calibration.write(&path).unwrap();
     let read = read_costs(&path).unwrap();

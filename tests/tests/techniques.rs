@@ -14,7 +14,7 @@ use histencil_brdf::BrdfId;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{
     Backend, CostModel, FlushPolicy, MixedTiles, Readback, Renderer, RendererDesc, Shading,
-    Technique, TileSide,
+    Technique, TileSide, TiledCosts,
 };
 
 const SIZE: u32 = 160;
@@ -233,6 +233,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             branch_tax_per_brdf_ms: 1.0,
             shade_ms: 1.0,
             interval: None,
+            tiled: None,
         };
         let renderer = with_costs(free_stencil);
         assert_eq!(
@@ -245,11 +246,45 @@ fn adaptive_chooses_what_the_cost_model_says() {
             branch_tax_per_brdf_ms: 0.0,
             shade_ms: 1.0,
             interval: None,
+            tiled: None,
         };
         let renderer = with_costs(free_branching);
         assert_eq!(
             plan(&renderer, adaptive),
             plan(&renderer, Technique::Branching { backend, flush })
         );
+        assert_eq!(renderer.resolve(adaptive).unwrap(), adaptive);
+
+        // Costs with free tiles light the frame tiled: the same image as the tiled technique,
+        // classification timed; costs with dear tiles keep the plan.
+        let tiled = Technique::Tiled {
+            mixed: MixedTiles::PerBrdf,
+            side: TileSide::Sixteen,
+        };
+        let tiles = |classify_ms| {
+            Some(TiledCosts {
+                classify_ms,
+                shade_ms: 0.0,
+                interval: None,
+            })
+        };
+        let mut renderer = with_costs(CostModel {
+            tiled: tiles(0.0),
+            ..free_branching
+        });
+        assert_eq!(renderer.resolve(adaptive).unwrap(), tiled);
+        let ldr = Readback {
+            ldr: true,
+            ..Readback::NONE
+        };
+        let frame = renderer.render(adaptive, ldr).unwrap();
+        assert!(frame.timings.pass_ms("tile-classify").is_some());
+        let expected = renderer.render(tiled, ldr).unwrap().images.ldr.unwrap();
+        assert_eq!(frame.images.ldr.unwrap(), expected);
+        let renderer = with_costs(CostModel {
+            tiled: tiles(1e9),
+            ..free_branching
+        });
+        assert_eq!(renderer.resolve(adaptive).unwrap(), adaptive);
     });
 }

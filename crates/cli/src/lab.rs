@@ -289,6 +289,15 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
                 x * 100.0
             ))
     );
+    if let Some(t) = c.tiled {
+        let iv = t.interval.unwrap_or_default();
+        println!(
+            "tiled: classification {:.4} ms [{:.4}, {:.4}] per frame, shade {:.4} ms [{:.4}, \
+             {:.4}] per full-screen light (the adaptive technique lights a frame tiled where \
+             these predict it surely cheaper than its plan)",
+            t.classify_ms, iv[0].0, iv[0].1, t.shade_ms, iv[1].0, iv[1].1
+        );
+    }
     Ok(())
 }
 

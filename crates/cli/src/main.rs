@@ -410,6 +410,11 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             ..desc
         };
         let timings = renderer.measure(timed, args.frames)?;
+        if let Shading::Deferred(technique @ Technique::Adaptive { .. }) = shading {
+            if let resolved @ Technique::Tiled { .. } = renderer.resolve(technique)? {
+                println!("adaptive: the costs predict the whole frame cheaper tiled: {resolved:?}");
+            }
+        }
         let passes: Vec<String> = timings
             .passes
             .iter()

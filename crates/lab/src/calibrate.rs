@@ -14,13 +14,18 @@
 //! The branch tax is branching's extra per full-screen light per extra BRDF, and the shade cost
 //! the 1-BRDF time per full-screen light. Extras are each technique's 3-BRDF time minus its own
 //! 1-BRDF time on the same wall, so what both share (setup, cleanup, the shading itself) cancels.
+//!
+//! The tiled technique's two costs come from its frames on the full-screen wall in 3 BRDFs
+//! (mixed tiles included): the classification pass per frame, and the shading per light.
 
 use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::stats::{median_interval, sample, Interval, Sampled, Sampling};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::{LabError, Result};
-use histencil_model::COST_FIELDS;
-use histencil_vk::{Backend, Context, CostModel, FlushPolicy, Renderer, Technique};
+use histencil_model::{TiledCosts, COST_FIELDS, TILED_FIELDS};
+use histencil_vk::{
+    Backend, Context, CostModel, FlushPolicy, MixedTiles, Renderer, Technique, TileSide,
+};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -51,9 +56,14 @@ struct Kind {
     technique: Technique,
     /// Per-light lighting time of every round.
     per_light_ms: Vec<f64>,
+    /// The tiled classification of every round (per frame; empty for other techniques).
+    classify_ms: Vec<f64>,
 }
 
-/// Measures the four costs at `width` x `height` over interleaved rounds (at least
+/// The costs each round fits: the four of [`COST_FIELDS`], then the two of [`TILED_FIELDS`].
+const FITTED: usize = 6;
+
+/// Measures the six costs at `width` x `height` over interleaved rounds (at least
 /// `sampling.min_rounds`, until each cost's interval is within the target or the budget is
 /// spent); every round fits all four costs from its own frames, and each cost is the median of
 /// those fits with its order-statistic interval. `progress` is told each step.
@@ -70,9 +80,14 @@ pub fn calibrate(
     let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
     let stencil = Technique::Stencil { backend, flush };
     let branching = Technique::Branching { backend, flush };
-    // Full-screen lights: branching and stencil; small lights: stencil. 1 and 3 BRDFs each.
+    let tiled = Technique::Tiled {
+        mixed: MixedTiles::PerBrdf,
+        side: TileSide::Sixteen,
+    };
+    // Full-screen lights: branching, stencil and tiled; small lights: stencil. 1 and 3 BRDFs
+    // each.
     let walls = [
-        (1.0, vec![branching, stencil]),
+        (1.0, vec![branching, stencil, tiled]),
         (SMALL_COVERAGE, vec![stencil]),
     ];
     let mut renderers = Vec::new();
@@ -100,26 +115,28 @@ pub fn calibrate(
                     renderer: renderers.len(),
                     technique: *technique,
                     per_light_ms: Vec::new(),
+                    classify_ms: Vec::new(),
                 });
             }
             renderers.push((renderer, lights));
         }
     }
-    // Kinds in push order: full 1 BRDF (branching, stencil), full 3 (branching, stencil),
-    // small 1 (stencil), small 3 (stencil).
-    let fit = |k: &[Kind], round: usize| -> [f64; 4] {
+    // Kinds in push order: full 1 BRDF (branching, stencil, tiled), full 3 (branching,
+    // stencil, tiled), small 1 (stencil), small 3 (stencil).
+    let fit = |k: &[Kind], round: usize| -> [f64; FITTED] {
         let t = |i: usize| k[i].per_light_ms[round];
-        let (shade, tax) = (t(0), (t(2) - t(0)) / extra_brdfs[0]);
-        let a = (t(3) - t(1)) / extra_brdfs[0];
-        let b = (t(5) - t(4)) / extra_brdfs[1];
+        let (shade, tax) = (t(0), (t(3) - t(0)) / extra_brdfs[0]);
+        let a = (t(4) - t(1)) / extra_brdfs[0];
+        let b = (t(7) - t(6)) / extra_brdfs[1];
         let per_brdf = (a - b) / (1.0 - SMALL_COVERAGE);
-        [(a - per_brdf) / 2.0, per_brdf, tax, shade]
+        let classify = k[5].classify_ms[round];
+        [(a - per_brdf) / 2.0, per_brdf, tax, shade, classify, t(5)]
     };
     let kinds = std::cell::RefCell::new(kinds);
-    let fits = std::cell::RefCell::new(Vec::<[f64; 4]>::new());
+    let fits = std::cell::RefCell::new(Vec::<[f64; FITTED]>::new());
     let widths = || {
         let f = fits.borrow();
-        (0..4)
+        (0..FITTED)
             .map(|i| median_interval(&f.iter().map(|x| x[i]).collect::<Vec<_>>()))
             .map(|iv| iv.relative_half_width())
             .collect()
@@ -134,6 +151,9 @@ pub fn calibrate(
                 let timings = renderer.render(kind.technique, histencil_vk::Readback::NONE)?;
                 let ms = timings.timings.pass_ms("lighting").unwrap_or(0.0);
                 kind.per_light_ms.push(ms / *lights);
+                if let Some(classify) = timings.timings.pass_ms("tile-classify") {
+                    kind.classify_ms.push(classify);
+                }
             }
             fits.borrow_mut().push(fit(&k, round));
             Ok(())
@@ -141,15 +161,21 @@ pub fn calibrate(
         widths,
     )?;
     let fits = fits.into_inner();
-    let intervals: [Interval; 4] =
+    let intervals: [Interval; FITTED] =
         std::array::from_fn(|i| median_interval(&fits.iter().map(|x| x[i]).collect::<Vec<_>>()));
     let m = |i: usize| intervals[i].median.max(0.0);
+    let iv = |i: usize| (intervals[i].lo.max(0.0), intervals[i].hi.max(0.0));
     let costs = CostModel {
         pass_overhead_ms: m(0),
         stencil_per_brdf_ms: m(1),
         branch_tax_per_brdf_ms: m(2),
         shade_ms: m(3),
-        interval: Some(intervals.map(|iv| (iv.lo.max(0.0), iv.hi.max(0.0)))),
+        interval: Some([iv(0), iv(1), iv(2), iv(3)]),
+        tiled: Some(TiledCosts {
+            classify_ms: m(4),
+            shade_ms: m(5),
+            interval: Some([iv(4), iv(5)]),
+        }),
     };
     let measurements = kinds
         .into_inner()
@@ -193,6 +219,21 @@ impl Calibration {
                 .collect();
             out["intervals"] = Value::Object(intervals);
         }
+        if let Some(tiled) = self.costs.tiled {
+            let mut t = serde_json::Map::new();
+            for (name, value) in TILED_FIELDS.iter().zip(tiled.fields()) {
+                t.insert(name.to_string(), json!(value));
+            }
+            if let Some(iv) = tiled.interval {
+                let intervals: serde_json::Map<String, Value> = TILED_FIELDS
+                    .iter()
+                    .zip(iv)
+                    .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
+                    .collect();
+                t.insert("intervals".into(), Value::Object(intervals));
+            }
+            out["tiled"] = Value::Object(t);
+        }
         if let Some(x) = self.costs.crossover_coverage() {
             out["crossover_coverage"] = json!(x);
         }
@@ -228,6 +269,11 @@ mod tests {
             branch_tax_per_brdf_ms: 0.5,
             shade_ms: 2.0,
             interval: Some([(0.0, 0.02), (0.1, 0.3), (0.5, 0.5), (1.5, 2.5)]),
+            tiled: Some(TiledCosts {
+                classify_ms: 0.4,
+                shade_ms: 1.0,
+                interval: Some([(0.3, 0.5), (0.9, 1.2)]),
+            }),
         };
         let calibration = Calibration {
             device: "test".into(),

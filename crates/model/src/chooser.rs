@@ -31,6 +31,10 @@ pub struct CostModel {
     /// The 95 % interval `(lo, hi)` of each cost above, in field order, when the costs were
     /// measured; `None` for costs taken as exact (fitted to the talk's figures).
     pub interval: Option<[(f64, f64); 4]>,
+    /// The tiled technique's costs, when measured on a device (`histencil calibrate`): the
+    /// adaptive technique then lights a frame tiled where that is surely cheaper
+    /// ([`CostModel::prefers_tiled`]). `None` for the talk's consoles, which had no tiles.
+    pub tiled: Option<crate::TiledCosts>,
 }
 
 /// One platform row of the talk's measurements (huge lights, milliseconds).
@@ -85,12 +89,13 @@ impl CostModel {
             branch_tax_per_brdf_ms: per_extra(figures.branching),
             shade_ms: figures.one_brdf,
             interval: None,
+            tiled: None,
         }
     }
 
     /// The costs at one end of their intervals (`hi`: the upper ends), or these costs when they
     /// have none.
-    fn at(&self, hi: bool) -> CostModel {
+    pub(crate) fn at(&self, hi: bool) -> CostModel {
         let Some(iv) = self.interval else {
             return *self;
         };
@@ -101,6 +106,7 @@ impl CostModel {
             branch_tax_per_brdf_ms: pick(2),
             shade_ms: pick(3),
             interval: None,
+            tiled: self.tiled,
         }
     }
 
@@ -216,6 +222,7 @@ mod tests {
             branch_tax_per_brdf_ms: 0.5,
             shade_ms: 2.0,
             interval: None,
+            tiled: None,
         };
         let crossover = exact.crossover_coverage().unwrap();
         let just_above = crossover * 1.05;

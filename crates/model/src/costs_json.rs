@@ -1,9 +1,11 @@
 //! The costs file a calibration writes and the adaptive technique reads: a JSON object whose top
-//! level holds the four costs by name, with an optional `intervals` object of `[lo, hi]` pairs.
+//! level holds the four costs by name, with an optional `intervals` object of `[lo, hi]` pairs,
+//! and optionally the tiled technique's costs as `tiled` (the same shape: `classify_ms`,
+//! `shade_ms` and optional `intervals`).
 //! Other keys (the device, the settings, the measurements) are the writer's and are ignored.
 //! Reading needs no device, so it is fuzzed and tested here.
 
-use crate::CostModel;
+use crate::{CostModel, TiledCosts};
 use serde_json::Value;
 
 /// The costs' names in the file, in [`CostModel::fields`] order.
@@ -36,41 +38,16 @@ impl CostModel {
     pub fn from_json(text: &str) -> Result<CostModel, CostsError> {
         let value: Value =
             serde_json::from_str(text).map_err(|e| CostsError(format!("not JSON: {e}")))?;
-        let mut v = [0.0; 4];
-        for (out, name) in v.iter_mut().zip(COST_FIELDS) {
-            *out = value
-                .get(name)
-                .and_then(Value::as_f64)
-                .filter(|x| x.is_finite() && *x >= 0.0)
-                .ok_or_else(|| {
-                    CostsError(format!("`{name}` must be a finite, non-negative number"))
-                })?;
-        }
-        let interval = match value.get("intervals") {
+        let (v, interval) = costs_and_intervals(&value, COST_FIELDS, "")?;
+        let tiled = match value.get("tiled") {
             None | Some(Value::Null) => None,
-            Some(iv) => {
-                let mut out = [(0.0, 0.0); 4];
-                for ((slot, name), cost) in out.iter_mut().zip(COST_FIELDS).zip(v) {
-                    *slot = iv
-                        .get(name)
-                        .and_then(Value::as_array)
-                        .filter(|p| p.len() == 2)
-                        .and_then(|p| Some((p[0].as_f64()?, p[1].as_f64()?)))
-                        .filter(|(lo, hi)| {
-                            lo.is_finite()
-                                && hi.is_finite()
-                                && 0.0 <= *lo
-                                && *lo <= cost
-                                && cost <= *hi
-                        })
-                        .ok_or_else(|| {
-                            CostsError(format!(
-                                "`intervals.{name}` must be [lo, hi], finite, with \
-                                 0 <= lo <= {name} <= hi"
-                            ))
-                        })?;
-                }
-                Some(out)
+            Some(t) => {
+                let (v, interval) = costs_and_intervals(t, TILED_FIELDS, "tiled.")?;
+                Some(TiledCosts {
+                    classify_ms: v[0],
+                    shade_ms: v[1],
+                    interval,
+                })
             }
         };
         Ok(CostModel {
@@ -79,8 +56,65 @@ impl CostModel {
             branch_tax_per_brdf_ms: v[2],
             shade_ms: v[3],
             interval,
+            tiled,
         })
     }
+}
+
+/// The tiled costs' names in the file's `tiled` object.
+pub const TILED_FIELDS: [&str; 2] = ["classify_ms", "shade_ms"];
+
+impl TiledCosts {
+    /// The two costs in [`TILED_FIELDS`] order.
+    pub fn fields(&self) -> [f64; 2] {
+        [self.classify_ms, self.shade_ms]
+    }
+}
+
+/// The costs `names` of `value`, each finite and non-negative, and their `intervals` when
+/// present; `path` prefixes the names in messages.
+#[allow(clippy::type_complexity)]
+fn costs_and_intervals<const N: usize>(
+    value: &Value,
+    names: [&str; N],
+    path: &str,
+) -> Result<([f64; N], Option<[(f64, f64); N]>), CostsError> {
+    let mut v = [0.0; N];
+    for (out, name) in v.iter_mut().zip(names) {
+        *out = value
+            .get(name)
+            .and_then(Value::as_f64)
+            .filter(|x| x.is_finite() && *x >= 0.0)
+            .ok_or_else(|| {
+                CostsError(format!(
+                    "`{path}{name}` must be a finite, non-negative number"
+                ))
+            })?;
+    }
+    let interval = match value.get("intervals") {
+        None | Some(Value::Null) => None,
+        Some(iv) => {
+            let mut out = [(0.0, 0.0); N];
+            for ((slot, name), cost) in out.iter_mut().zip(names).zip(v) {
+                *slot = iv
+                    .get(name)
+                    .and_then(Value::as_array)
+                    .filter(|p| p.len() == 2)
+                    .and_then(|p| Some((p[0].as_f64()?, p[1].as_f64()?)))
+                    .filter(|(lo, hi)| {
+                        lo.is_finite() && hi.is_finite() && 0.0 <= *lo && *lo <= cost && cost <= *hi
+                    })
+                    .ok_or_else(|| {
+                        CostsError(format!(
+                            "`{path}intervals.{name}` must be [lo, hi], finite, with \
+                             0 <= lo <= {name} <= hi"
+                        ))
+                    })?;
+            }
+            Some(out)
+        }
+    };
+    Ok((v, interval))
 }
 
 #[cfg(test)]
@@ -109,6 +143,28 @@ mod tests {
         ] {
             let err = CostModel::from_json(text).unwrap_err().to_string();
             assert!(err.contains(needle), "{text}: {err}");
+        }
+    }
+
+    #[test]
+    fn tiled_costs_are_optional_and_checked_like_the_others() {
+        let base = r#""pass_overhead_ms": 0, "stencil_per_brdf_ms": 1, "branch_tax_per_brdf_ms": 2, "shade_ms": 3"#;
+        let read = |tiled: &str| CostModel::from_json(&format!("{{{base}, \"tiled\": {tiled}}}"));
+        let costs = read(r#"{"classify_ms": 0.5, "shade_ms": 4, "intervals": {"classify_ms": [0.4, 0.6], "shade_ms": [3, 5]}}"#).unwrap();
+        let tiled = costs.tiled.unwrap();
+        assert_eq!(tiled.fields(), [0.5, 4.0]);
+        assert_eq!(tiled.interval, Some([(0.4, 0.6), (3.0, 5.0)]));
+        assert_eq!(read("null").unwrap().tiled, None);
+        for (tiled, needle) in [
+            ("{}", "`tiled.classify_ms`"),
+            (r#"{"classify_ms": 1, "shade_ms": -2}"#, "`tiled.shade_ms`"),
+            (
+                r#"{"classify_ms": 1, "shade_ms": 2, "intervals": {"classify_ms": [2, 3]}}"#,
+                "`tiled.intervals.classify_ms`",
+            ),
+        ] {
+            let err = read(tiled).unwrap_err().to_string();
+            assert!(err.contains(needle), "{tiled}: {err}");
         }
     }
 }

@@ -62,7 +62,7 @@ pub use deferred_lighting::{
 };
 pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;
-pub use histencil_model::{CostModel, FlushPolicy, TileStats};
+pub use histencil_model::{CostModel, FlushPolicy, TileStats, TiledCosts};
 pub use hooks::{EngineHooks, HookSets, LightHooks, LightModules};
 #[cfg(feature = "tools")]
 pub use image_error::{difference_image, masked_error, MaskedError};

@@ -78,12 +78,15 @@ impl Shading {
         }
     }
 
-    /// Every timed pass the frame's lighting takes: [`Shading::lighting_pass`], after the
-    /// tiled technique's classification (`tile-classify`) for that technique.
+    /// Every timed pass the frame's lighting may take: [`Shading::lighting_pass`], after the
+    /// tiled technique's classification (`tile-classify`) for that technique and for the
+    /// adaptive one, which may light a frame tiled (a frame times only the passes it ran).
     pub fn lighting_passes(self) -> &'static [&'static str] {
         match self {
             Shading::Forward => &["forward"],
-            Shading::Deferred(Technique::Tiled { .. }) => &["tile-classify", "lighting"],
+            Shading::Deferred(Technique::Tiled { .. } | Technique::Adaptive { .. }) => {
+                &["tile-classify", "lighting"]
+            }
             Shading::Deferred(_) => &["lighting"],
         }
     }
@@ -104,7 +107,9 @@ pub enum Technique {
         flush: FlushPolicy,
     },
     /// Stencil or branching per light, whichever the renderer's [`CostModel`] predicts cheaper
-    /// for the light's screen coverage and BRDF count (the talk's "tiny lights? try branching").
+    /// for the light's screen coverage and BRDF count (the talk's "tiny lights? try branching");
+    /// or the whole frame tiled where costs measured on the device predict that surely cheaper
+    /// than the plan ([`crate::Renderer::resolve`]).
     Adaptive {
         backend: Backend,
         flush: FlushPolicy,

@@ -33,7 +33,7 @@ impl Renderer<'_> {
         let deferred = match desc.shading {
             Shading::Forward => None,
             Shading::Deferred(technique) => {
-                let plan = self.plan_in(technique, &view)?;
+                let (technique, plan) = self.resolve_in(technique, &view)?;
                 if technique.brdf_source() == BrdfSource::Table {
                     self.lut_tables()?;
                 }

@@ -4,7 +4,7 @@
 use super::Renderer;
 use crate::error::Result;
 use crate::gpu_types::FrameUniforms;
-use crate::technique::{FrameDesc, Technique};
+use crate::technique::{FrameDesc, MixedTiles, Technique, TileSide};
 use histencil_model::{
     plan_frame, DepthConvention, FarPlane, FramePlan, LightShape, Perspective, PlanError,
     PlanInputs, View, ViewDesc,
@@ -17,6 +17,34 @@ impl Renderer<'_> {
     /// planned light is).
     pub fn plan(&self, technique: Technique) -> Result<FramePlan> {
         self.plan_in(technique, &self.view_desc())
+    }
+
+    /// What a frame of `technique` records: the adaptive technique lights the whole frame
+    /// tiled (16x16 tiles, mixed tiles per BRDF) where its costs predict that surely cheaper
+    /// than its plan ([`histencil_model::CostModel::prefers_tiled`]; never with the talk's
+    /// costs, which have no tiled figures); every other technique is itself.
+    pub fn resolve(&self, technique: Technique) -> Result<Technique> {
+        self.resolve_in(technique, &self.view_desc())
+            .map(|(t, _)| t)
+    }
+
+    /// [`Renderer::resolve`] with `view`, and the plan the frame records unless it is tiled.
+    pub(super) fn resolve_in(
+        &self,
+        technique: Technique,
+        view: &ViewDesc,
+    ) -> Result<(Technique, FramePlan)> {
+        let plan = self.plan_in(technique, view)?;
+        if let Technique::Adaptive { backend, .. } = technique {
+            if self.cost_model(backend).prefers_tiled(&plan) {
+                let tiled = Technique::Tiled {
+                    mixed: MixedTiles::PerBrdf,
+                    side: TileSide::Sixteen,
+                };
+                return Ok((tiled, plan));
+            }
+        }
+        Ok((technique, plan))
     }
 
     pub(super) fn plan_in(&self, technique: Technique, view: &ViewDesc) -> Result<FramePlan> {

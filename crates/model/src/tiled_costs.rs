@@ -1,0 +1,169 @@
+//! The adaptive technique's frame-level choice: the whole frame lit by the tiled technique
+//! (classification, then one dispatch per BRDF over its tiles), or by its plan (each light's
+//! passes, stencil or branching per light as [`CostModel::choose`] decided).
+//!
+//! ```text
+//! planned frame: sum over its lights of  pass_overhead + c * shade + extra(technique, c, n)
+//! tiled frame:   classify + sum over its lights of  c * tiled_shade
+//! ```
+//! `c` is a light's screen coverage, `n` the BRDFs it touches. The tiled kernel pays no extra
+//! per BRDF beyond the pixels' own shading, and a fixed classification per frame; the plan pays
+//! a draw per light and its per-BRDF extras. So many small lights or several BRDFs under large
+//! lights favour tiles, a few lights over one BRDF the plan. As the per-light choice does, tiled
+//! is taken only where its most expensive prediction (upper interval ends) still undercuts the
+//! plan's cheapest; costs without tiled figures (fitted to the talk, whose consoles had no
+//! compute tiles) never choose it.
+
+use crate::frame::FramePlan;
+use crate::CostModel;
+
+/// The tiled technique's costs on one device, in milliseconds; per-screen figures are for a
+/// light covering the whole screen and scale linearly with coverage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TiledCosts {
+    /// Classifying every tile of the frame (BRDFs, depth range, light lists).
+    pub classify_ms: f64,
+    /// Shading one full-screen light in the tiled kernels.
+    pub shade_ms: f64,
+    /// The 95 % interval `(lo, hi)` of each cost above, when measured.
+    pub interval: Option<[(f64, f64); 2]>,
+}
+
+impl TiledCosts {
+    /// The costs at one end of their intervals (`hi`: the upper ends).
+    fn at(&self, hi: bool) -> (f64, f64) {
+        match self.interval {
+            None => (self.classify_ms, self.shade_ms),
+            Some(iv) if hi => (iv[0].1, iv[1].1),
+            Some(iv) => (iv[0].0, iv[1].0),
+        }
+    }
+}
+
+impl CostModel {
+    /// Predicted lighting time of `plan` (its lights' techniques as planned); coverage unknown
+    /// (a plan built from bare requests) counts as the whole screen.
+    pub fn planned_ms(&self, plan: &FramePlan) -> f64 {
+        self.planned_ms_at(plan, false)
+    }
+
+    fn planned_ms_at(&self, plan: &FramePlan, hi: bool) -> f64 {
+        let costs = self.at(hi);
+        plan.lights
+            .iter()
+            .map(|light| {
+                let c = light.coverage.unwrap_or(1.0);
+                let r = &light.request;
+                let n = r.affected.len() as u32;
+                costs.pass_overhead_ms + c * costs.shade_ms + costs.extra_ms(r.technique, c, n)
+            })
+            .sum()
+    }
+
+    /// Predicted lighting time of the same lights with the tiled technique, when these costs
+    /// have tiled figures.
+    pub fn tiled_ms(&self, plan: &FramePlan) -> Option<f64> {
+        self.tiled_ms_at(plan, false)
+    }
+
+    fn tiled_ms_at(&self, plan: &FramePlan, hi: bool) -> Option<f64> {
+        let (classify, shade) = self.tiled?.at(hi);
+        let coverage: f64 = plan.lights.iter().map(|l| l.coverage.unwrap_or(1.0)).sum();
+        Some(classify + coverage * shade)
+    }
+
+    /// Whether the tiled technique lights `plan`'s frame for less at every end of the cost
+    /// intervals: its upper prediction below the plan's lower one.
+    pub fn prefers_tiled(&self, plan: &FramePlan) -> bool {
+        self.tiled_ms_at(plan, true)
+            .is_some_and(|tiled| tiled < self.planned_ms_at(plan, false))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{FlushPolicy, PlannedLight};
+    use crate::plan::{LightCase, LightRequest, LightTechnique};
+    use crate::{Native, PlatformBackend, StencilLayout};
+
+    fn plan(lights: &[(f64, u32, LightTechnique)]) -> FramePlan {
+        let layout = StencilLayout::new(3, 0).unwrap();
+        let lights = lights
+            .iter()
+            .enumerate()
+            .map(|(input, &(c, n, technique))| PlannedLight {
+                input,
+                coverage: Some(c),
+                request: LightRequest {
+                    case: LightCase::Outside,
+                    affected: (0..n).collect(),
+                    technique,
+                },
+            })
+            .collect();
+        let caps = Native.caps();
+        let depth = crate::DepthConvention::Standard;
+        FramePlan::build(&layout, &caps, depth, lights, FlushPolicy::Auto).unwrap()
+    }
+
+    fn costs(tiled: Option<TiledCosts>) -> CostModel {
+        CostModel {
+            pass_overhead_ms: 0.01,
+            stencil_per_brdf_ms: 0.2,
+            branch_tax_per_brdf_ms: 0.5,
+            shade_ms: 1.0,
+            interval: None,
+            tiled,
+        }
+    }
+
+    const TILED: TiledCosts = TiledCosts {
+        classify_ms: 0.5,
+        shade_ms: 1.0,
+        interval: None,
+    };
+
+    #[test]
+    fn the_predictions_add_up_per_light() {
+        let p = plan(&[
+            (0.5, 1, LightTechnique::SingleBrdf),
+            (1.0, 3, LightTechnique::Stencil),
+        ]);
+        let model = costs(Some(TILED));
+        let stencil = 2.0 * (2.0 * 0.01 + 0.2);
+        let planned = (0.01 + 0.5) + (0.01 + 1.0 + stencil);
+        assert!((model.planned_ms(&p) - planned).abs() < 1e-12);
+        assert!((model.tiled_ms(&p).unwrap() - (0.5 + 1.5)).abs() < 1e-12);
+        assert_eq!(costs(None).tiled_ms(&p), None);
+    }
+
+    /// One large light over one BRDF: the classification is not worth it. Many large lights
+    /// over three BRDFs: the plan's per-BRDF passes are.
+    #[test]
+    fn tiles_win_where_the_plan_pays_per_brdf_and_per_light() {
+        let model = costs(Some(TILED));
+        let one = plan(&[(1.0, 1, LightTechnique::SingleBrdf)]);
+        assert!(!model.prefers_tiled(&one));
+        let many: Vec<_> = (0..8).map(|_| (1.0, 3, LightTechnique::Stencil)).collect();
+        assert!(model.prefers_tiled(&plan(&many)));
+        // Without tiled figures (the talk's consoles) it is never chosen.
+        assert!(!costs(None).prefers_tiled(&plan(&many)));
+    }
+
+    /// A difference the intervals cannot resolve stays with the plan.
+    #[test]
+    fn unresolved_differences_stay_planned() {
+        let many: Vec<_> = (0..3).map(|_| (1.0, 3, LightTechnique::Stencil)).collect();
+        let p = plan(&many);
+        let exact = costs(Some(TILED));
+        let (planned, tiled) = (exact.planned_ms(&p), exact.tiled_ms(&p).unwrap());
+        assert!(tiled < planned, "{tiled} {planned}");
+        let wide = costs(Some(TiledCosts {
+            interval: Some([(0.4, 0.6), (0.9, 1.5)]),
+            ..TILED
+        }));
+        assert!(exact.prefers_tiled(&p));
+        assert!(!wide.prefers_tiled(&p));
+    }
+}
