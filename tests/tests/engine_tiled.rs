@@ -1,8 +1,9 @@
 //! The tiled technique recorded into an engine's frames through `DeferredLighting::record_tiled`:
 //! the engine's own device, images and fences, two frames in flight, lights moving every frame,
-//! both tile sides and both ways of shading mixed tiles. Its last frame must equal histencil's
-//! Renderer lighting the same state with the same technique, bit for bit, and the validation
-//! layer with synchronisation validation must see nothing. A lighting whose HDR format the
+//! both tile sides and both ways of shading mixed tiles. Each of its last four frames (every
+//! side and mixed-tile mode) must equal histencil's Renderer lighting the same state with the
+//! same tiling, bit for bit, and the validation layer with synchronisation validation must see
+//! nothing. A lighting whose HDR format the
 //! kernels cannot store to is refused before anything is recorded.
 
 use ash::vk;
@@ -17,8 +18,7 @@ const HEIGHT: u32 = 64;
 const FRAMES: usize = 5;
 const IN_FLIGHT: usize = 2;
 
-/// The tiling of frame `f`: every side and mixed-tile mode comes round, the last frame's is
-/// 8x8 tiles with mixed tiles per BRDF.
+/// The tiling of frame `f`: every side and mixed-tile mode comes round in four frames.
 fn tiling(f: usize) -> (TileSide, MixedTiles) {
     let side = if f.is_multiple_of(2) {
         TileSide::Eight
@@ -35,7 +35,7 @@ fn tiling(f: usize) -> (TileSide, MixedTiles) {
 
 #[test]
 fn an_engine_records_the_tiled_technique_into_its_frames() {
-    let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
     assert!(scene.brdfs_in_use().len() >= 3);
     let engine = Engine::start();
     let extent = vk::Extent2D {
@@ -60,7 +60,12 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
         };
         let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();
         let images = engine.lighting_targets(extent, ds_format);
-        let readback = engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8);
+        // The last four frames' HDR images, one readback each (two frames may be in flight).
+        let captured = FRAMES - 4..FRAMES;
+        let readbacks: Vec<_> = captured
+            .clone()
+            .map(|_| engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8))
+            .collect();
         let mut targets = images.refs();
         let d = &engine.device;
         let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
@@ -89,7 +94,8 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                     hook_sets: HookSets::default(),
                 };
                 lighting.record_tiled(cmd, &frame, &mut targets).unwrap();
-                if f == FRAMES - 1 {
+                if captured.contains(&f) {
+                    let readback = &readbacks[f - captured.start];
                     copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
                 }
                 d.end_command_buffer(cmd).unwrap();
@@ -100,21 +106,22 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
         }
         let fences: Vec<_> = slots.iter().map(|s| s.2).collect();
         unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
-        let engine_hdr = hdr_floats(readback.bytes());
-
-        // histencil's renderer lighting the last frame's state with the same tiling.
-        scene.lights = lights_at(&scene, FRAMES - 1);
-        let mut reference = Renderer::new(&ctx, scene.clone(), WIDTH, HEIGHT).unwrap();
-        let (side, mixed) = tiling(FRAMES - 1);
+        // histencil's renderer lighting each captured frame's state with the same tiling.
         let readback_hdr = Readback {
             hdr: true,
             ..Readback::NONE
         };
-        let expected = reference
-            .render(Technique::Tiled { mixed, side }, readback_hdr)
-            .unwrap();
-        assert_same_hdr(&expected.images.hdr.unwrap().into_raw(), &engine_hdr);
-        drop(reference);
+        for (f, readback) in captured.clone().zip(&readbacks) {
+            let mut lit = scene.clone();
+            lit.lights = lights_at(&scene, f);
+            let mut reference = Renderer::new(&ctx, lit, WIDTH, HEIGHT).unwrap();
+            let (side, mixed) = tiling(f);
+            let expected = reference
+                .render(Technique::Tiled { mixed, side }, readback_hdr)
+                .unwrap();
+            let engine_hdr = hdr_floats(readback.bytes());
+            assert_same_hdr(&expected.images.hdr.unwrap().into_raw(), &engine_hdr);
+        }
 
         // The kernels store rgba16f: another HDR format is refused, with nothing recorded.
         let packed = LightingDesc {
@@ -153,7 +160,9 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
         drop(renderer);
         engine.free_frame_slots(&slots);
         images.free(&engine);
-        engine.free_buffer(readback);
+        for readback in readbacks {
+            engine.free_buffer(readback);
+        }
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
     engine.destroy().assert_clean();

@@ -435,7 +435,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
         {
             println!(
                 "emulated hi-stencil (medians): the platform's technique {:.2} ms + the \
-                 emulator's bookkeeping {bookkeeping:.2} ms (resets, splits, stencil copies, tile \
+                 emulator's bookkeeping {bookkeeping:.2} ms (resets, splits, tile \
                  updates, flush copies) = lighting {lighting:.2} ms",
                 lighting - bookkeeping
             );

@@ -106,7 +106,11 @@ pub fn calibrate(
         for brdfs in [1, 3] {
             progress(&format!("coverage {coverage}, {brdfs} BRDF(s): building"));
             let mut renderer = Renderer::new(ctx, with_brdf_count(&wall, brdfs), width, height)?;
-            for technique in techniques {
+            // Tiled is fitted from the 3-BRDF wall only.
+            let measured = techniques
+                .iter()
+                .filter(|t| brdfs == 3 || !matches!(t, Technique::Tiled { .. }));
+            for technique in measured {
                 for _ in 0..WARM_UP_FRAMES {
                     renderer.render(*technique, histencil_vk::Readback::NONE)?;
                 }
@@ -121,16 +125,16 @@ pub fn calibrate(
             renderers.push((renderer, lights));
         }
     }
-    // Kinds in push order: full 1 BRDF (branching, stencil, tiled), full 3 (branching,
-    // stencil, tiled), small 1 (stencil), small 3 (stencil).
+    // Kinds in push order: full 1 BRDF (branching, stencil), full 3 (branching, stencil,
+    // tiled), small 1 (stencil), small 3 (stencil).
     let fit = |k: &[Kind], round: usize| -> [f64; FITTED] {
         let t = |i: usize| k[i].per_light_ms[round];
-        let (shade, tax) = (t(0), (t(3) - t(0)) / extra_brdfs[0]);
-        let a = (t(4) - t(1)) / extra_brdfs[0];
-        let b = (t(7) - t(6)) / extra_brdfs[1];
+        let (shade, tax) = (t(0), (t(2) - t(0)) / extra_brdfs[0]);
+        let a = (t(3) - t(1)) / extra_brdfs[0];
+        let b = (t(6) - t(5)) / extra_brdfs[1];
         let per_brdf = (a - b) / (1.0 - SMALL_COVERAGE);
-        let classify = k[5].classify_ms[round];
-        [(a - per_brdf) / 2.0, per_brdf, tax, shade, classify, t(5)]
+        let classify = k[4].classify_ms[round];
+        [(a - per_brdf) / 2.0, per_brdf, tax, shade, classify, t(4)]
     };
     let kinds = std::cell::RefCell::new(kinds);
     let fits = std::cell::RefCell::new(Vec::<[f64; FITTED]>::new());

@@ -59,10 +59,13 @@ impl ImageRef {
 
 /// The caller's images a frame is lit in, each with its current state. Recording leaves every
 /// [`ImageRef::state`] as the recorded commands leave the image, for the caller's next barrier:
-/// the G-buffer images sampled by fragment shaders, the depth-stencil and HDR images attached.
+/// after the talk's light passes the G-buffer images sampled by fragment shaders and the
+/// depth-stencil and HDR images attached; after the tiled technique
+/// ([`crate::DeferredLighting::record_tiled`]) the G-buffer images sampled by compute shaders
+/// and the HDR image written by them in `GENERAL`.
 #[derive(Clone, Debug)]
 pub struct LightingTargets {
-    /// The images the decode hook reads, each barriered for fragment-shader reads
+    /// The images the decode hook reads, each barriered for shader reads
     /// (`SHADER_READ_ONLY_OPTIMAL`), usage `SAMPLED`. With histencil's built-in decode: albedo,
     /// normal-depth, material, in [`crate::GBUFFER_FORMATS`]. With an engine's decode hook
     /// ([`crate::LightHooks::Engine`]): the engine's own images, any number and formats, read
@@ -71,11 +74,13 @@ pub struct LightingTargets {
     /// The G-buffer pass's depth and stencil; usage `DEPTH_STENCIL_ATTACHMENT`, with
     /// `SAMPLED` for the hi-stencil emulation (its tile update reads the stencil through a
     /// stencil-aspect view) and where an engine's decode hook reads depth, and `TRANSFER_SRC`
-    /// for 360-like save/restore (which copies the stencil out). With an engine's decode hook the light passes
-    /// attach it in `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`, so the decode may sample its
-    /// depth aspect (through a depth-only view of the engine's).
+    /// for 360-like save/restore (which copies the stencil out). With an engine's decode hook
+    /// the light passes attach it in `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`, so the decode
+    /// may sample its depth aspect (through a depth-only view of the engine's); the tiled
+    /// technique's kernels read it in the same layout.
     pub depth_stencil: ImageRef,
-    /// Where light accumulates; usage `COLOR_ATTACHMENT`.
+    /// Where light accumulates; usage `COLOR_ATTACHMENT`, and `STORAGE` in
+    /// `R16G16B16A16_SFLOAT` for the tiled technique.
     pub hdr: ImageRef,
 }
 

@@ -658,7 +658,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
 
     /// Of the last frame recorded into `slot`, once the GPU has finished it: the time the
     /// hi-stencil emulator spent on bookkeeping a console does not do (resetting its tile
-    /// surface, the split, stencil copy and tile update after each hi-stencil write, the copy
+    /// surface, the split and tile update after each hi-stencil write, the copy
     /// at each flush), in milliseconds; the rest of the lighting is the platform's technique.
     /// `None` when that frame's plan used no hi-stencil (a native plan). Every frame with
     /// hi-stencil writes these timestamps, two per piece of bookkeeping, where rendering is
@@ -757,6 +757,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let inputs = (frame.view, frame.lights, &frame.hook_sets);
         let (frame_set, decode_set) = self.write_slot(frame.slot, inputs, targets)?;
         let ctx: &Context = &self.ctx;
+        // A tiled frame writes neither timer: the slot's last planned frame's times go.
+        let slot = &mut self.slots[frame.slot as usize];
+        slot.timer
+            .prepare(ctx, "lighting-step-timestamps", false, 0)?;
+        slot.emulation
+            .prepare(ctx, "lighting-emulation-timestamps", false, 0)?;
         let tiled = &self
             .tiled
             .iter()

@@ -428,8 +428,10 @@ impl Descriptors {
     /// half way frees what was made.
     pub fn new(ctx: &Context, frame_uniforms: vk::Buffer, lights: vk::Buffer) -> Result<Self> {
         let d = build(ctx, |d: &mut Self| {
-            d.frame_layout =
-                create_set_layout(ctx, "frame-set-layout", FRAME_SET, GRAPHICS_STAGES)?;
+            // The compute stage too: the layout must match the lighting's frame set layout,
+            // whose pipeline layout the simulator's footprint capture binds this set with.
+            let stages = GRAPHICS_STAGES | vk::ShaderStageFlags::COMPUTE;
+            d.frame_layout = create_set_layout(ctx, "frame-set-layout", FRAME_SET, stages)?;
             let sizes = [
                 (vk::DescriptorType::UNIFORM_BUFFER, 1),
                 (vk::DescriptorType::STORAGE_BUFFER, 1),

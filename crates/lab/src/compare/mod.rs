@@ -136,7 +136,7 @@ pub struct Cell {
     /// platform's technique only, without the hi-stencil emulator's bookkeeping.
     pub samples: Vec<f64>,
     /// On the emulated backends, the emulator's bookkeeping in the same rounds (resets, splits,
-    /// stencil copies, tile updates, flush copies: `FrameTimings::bookkeeping_ms`); empty
+    /// tile updates, flush copies: `FrameTimings::bookkeeping_ms`); empty
     /// elsewhere. The whole lighting pass of round `i` is `samples[i] + bookkeeping[i]`.
     pub bookkeeping: Vec<f64>,
     pub error: ImageError,
@@ -286,7 +286,8 @@ impl SizePoint {
         (r, Verdict::of(&r))
     }
 
-    /// Adaptive's time over the better of branching and stencil (1 is ideal).
+    /// Adaptive's time over the better of branching and stencil (1: it chose the better one;
+    /// below 1 where it chose better still, per light or tiled).
     pub fn adaptive_over_best(&self) -> f64 {
         let best = self.branching.median_ms.min(self.stencil.median_ms);
         if best > 0.0 {

@@ -264,7 +264,7 @@ impl CompareReport {
         let mut md = String::from(
             "\nThe PS3-like and 360-like rows time the platform's technique: the lighting pass \
              without the hi-stencil emulator's bookkeeping (resetting its tile surface; after each \
-             hi-stencil write the split, the stencil copy and the tile update; the copy at each \
+             hi-stencil write the split and the tile update; the copy at each \
              flush), which a timestamp on each side of it times apart. Still inside the \
              technique's time: its write draws marking the tiles they touch, and its testing \
              draws reading the tile surface in the fragment shader, where a console tests tiles \

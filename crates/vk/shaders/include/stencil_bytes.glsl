@@ -1,5 +1,5 @@
-// Stencil copied out of the depth-stencil image into a buffer: one byte per pixel, row-major,
-// four pixels to a uint.
+// Stencil copied out of the depth-stencil image into a buffer (the 360-like save before a
+// restore): one byte per pixel, row-major, four pixels to a uint.
 #ifndef STENCIL_BYTES_GLSL
 #define STENCIL_BYTES_GLSL
 

@@ -127,8 +127,8 @@ impl Rendering {
 
 /// The emulator's bookkeeping timed apart from the technique it emulates: a timestamp on each
 /// side of every piece of work a console does not do (resetting the tile surface, ending
-/// rendering, copying the stencil out and re-evaluating tiles after a hi-stencil write, copying
-/// pending tiles to active at a flush), so the `bookkeeping` group is that work and the rest of
+/// rendering and re-evaluating the touched tiles after a hi-stencil write, copying pending
+/// tiles to active at a flush), so the `bookkeeping` group is that work and the rest of
 /// the lighting pass is the platform's technique. What stays inside the technique's draws:
 /// marking touched tiles in a write draw and reading the tile surface in a testing draw, where
 /// hardware tests tiles before shading.

@@ -4,7 +4,7 @@
 use super::Renderer;
 use crate::error::Result;
 use crate::gpu_types::FrameUniforms;
-use crate::technique::{FrameDesc, MixedTiles, Technique, TileSide};
+use crate::technique::{Backend, FrameDesc, MixedTiles, Technique, TileSide};
 use histencil_model::{
     plan_frame, DepthConvention, FarPlane, FramePlan, LightShape, Perspective, PlanError,
     PlanInputs, View, ViewDesc,
@@ -19,10 +19,12 @@ impl Renderer<'_> {
         self.plan_in(technique, &self.view_desc())
     }
 
-    /// What a frame of `technique` records: the adaptive technique lights the whole frame
-    /// tiled (16x16 tiles, mixed tiles per BRDF) where its costs predict that surely cheaper
-    /// than its plan ([`histencil_model::CostModel::prefers_tiled`]; never with the talk's
-    /// costs, which have no tiled figures); every other technique is itself.
+    /// What a frame of `technique` records: the adaptive technique on the native backend lights
+    /// the whole frame tiled (16x16 tiles, mixed tiles per BRDF) where its costs predict that
+    /// surely cheaper than its plan ([`histencil_model::CostModel::prefers_tiled`]; never with
+    /// the talk's costs, which have no tiled figures); on an emulated console backend it keeps
+    /// the console's plan, whose behaviour it is there to show. Every other technique is
+    /// itself.
     pub fn resolve(&self, technique: Technique) -> Result<Technique> {
         self.resolve_in(technique, &self.view_desc())
             .map(|(t, _)| t)
@@ -36,7 +38,7 @@ impl Renderer<'_> {
     ) -> Result<(Technique, FramePlan)> {
         let plan = self.plan_in(technique, view)?;
         if let Technique::Adaptive { backend, .. } = technique {
-            if self.cost_model(backend).prefers_tiled(&plan) {
+            if backend == Backend::Native && self.cost_model(backend).prefers_tiled(&plan) {
                 let tiled = Technique::Tiled {
                     mixed: MixedTiles::PerBrdf,
                     side: TileSide::Sixteen,
