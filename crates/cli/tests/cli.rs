@@ -643,6 +643,9 @@ fn scale_reports_the_town_under_validation() {
         let error = line.rsplit('|').nth(1).unwrap().trim();
         let max: f64 = error.split(" / ").next().unwrap().parse().unwrap();
         assert!(max <= 1.0, "{line}");
+        // The emulated row gives the technique and the emulator's bookkeeping apart.
+        let lighting = line.split('|').nth(3).unwrap();
+        assert_eq!(lighting.contains(" + "), row.contains("PS3-like"), "{line}");
     }
     assert!(
         written.contains("Lighting time over branching's"),
