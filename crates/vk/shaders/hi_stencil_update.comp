@@ -11,15 +11,15 @@
 layout(local_size_x = HI_STENCIL_UPDATE_GROUP) in;
 
 // The stencil the draw left, read in place through a stencil-aspect view.
-layout(set = 0, binding = 0) uniform utexture2D stencil_image;
-layout(set = 0, binding = 1, std430) readonly buffer TouchedList {
+layout(set = 0, binding = 2) uniform utexture2D stencil_image;
+layout(set = 0, binding = 0, std430) readonly buffer TouchedList {
     uint groups;
     uint group_y;
     uint group_z;
     uint count;
     uint tiles[];
 } touched_list;
-layout(set = 0, binding = 2, std430) writeonly buffer Pending {
+layout(set = 0, binding = 1, std430) writeonly buffer Pending {
     uint pending[];
 };
 

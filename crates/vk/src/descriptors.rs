@@ -76,13 +76,13 @@ pub const HI_STENCIL_SET: &[BindingDesc] = &[
     binding(3, BindingKind::StorageBuffer, ""),
     binding(4, BindingKind::StorageBuffer, "touched_list"),
 ];
-/// The tile update's stencil (a stencil-aspect view, read), the list of tiles the write draw
-/// touched (read) and the pending surface (written);
+/// The tile update's list of tiles the write draw touched (read), the pending surface (written)
+/// and the stencil (a stencil-aspect view, read);
 /// see `hi_stencil.rs`.
 pub const HI_STENCIL_UPDATE_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::SampledImage, "stencil_image"),
-    binding(1, BindingKind::StorageBuffer, "touched_list"),
-    binding(2, BindingKind::StorageBuffer, ""),
+    binding(0, BindingKind::StorageBuffer, "touched_list"),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::SampledImage, "stencil_image"),
 ];
 /// Set 1 of the tonemap pipeline (tonemap.frag).
 pub const TONEMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "hdr")];
@@ -350,24 +350,45 @@ pub(crate) fn one_set(
     layout: vk::DescriptorSetLayout,
     sizes: &[(vk::DescriptorType, u32)],
 ) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
+    let (pool, sets) = sets_of(ctx, name, layout, 1, sizes)?;
+    ctx.name(sets[0], name);
+    Ok((pool, sets[0]))
+}
+
+/// A pool named `{name}-pool` and `count` sets of `layout` from it (one per frame in flight),
+/// named `{name}-0`, `{name}-1`, ...; `sizes` are the descriptors of one set. On failure
+/// nothing is left.
+pub(crate) fn sets_of(
+    ctx: &Context,
+    name: &str,
+    layout: vk::DescriptorSetLayout,
+    count: u32,
+    sizes: &[(vk::DescriptorType, u32)],
+) -> Result<(vk::DescriptorPool, Vec<vk::DescriptorSet>)> {
     let sizes: Vec<_> = sizes
         .iter()
-        .map(|&(ty, n)| vk::DescriptorPoolSize::default().ty(ty).descriptor_count(n))
+        .map(|&(ty, n)| {
+            vk::DescriptorPoolSize::default()
+                .ty(ty)
+                .descriptor_count(n * count)
+        })
         .collect();
     let pool_info = vk::DescriptorPoolCreateInfo::default()
-        .max_sets(1)
+        .max_sets(count)
         .pool_sizes(&sizes);
     let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
         .call("vkCreateDescriptorPool")?;
     ctx.name(pool, &format!("{name}-pool"));
-    let layouts = [layout];
+    let layouts = vec![layout; count as usize];
     let alloc = vk::DescriptorSetAllocateInfo::default()
         .descriptor_pool(pool)
         .set_layouts(&layouts);
     match unsafe { ctx.device.allocate_descriptor_sets(&alloc) }.call("vkAllocateDescriptorSets") {
         Ok(sets) => {
-            ctx.name(sets[0], name);
-            Ok((pool, sets[0]))
+            for (i, set) in sets.iter().enumerate() {
+                ctx.name(*set, &format!("{name}-{i}"));
+            }
+            Ok((pool, sets))
         }
         Err(e) => {
             unsafe { ctx.device.destroy_descriptor_pool(pool, None) };

@@ -18,7 +18,7 @@
 use crate::access::{memory_barrier, transition, Contents, ImageAccess, ImageRef};
 use crate::compute::ComputePipeline;
 use crate::context::Context;
-use crate::descriptors::HI_STENCIL_UPDATE_SET;
+use crate::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
 use crate::error::{Result, VkCall};
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::Buffer;
@@ -60,8 +60,8 @@ pub struct HiStencilSurface {
     saved: Buffer,
     update: Option<ComputePipeline>,
     pool: vk::DescriptorPool,
-    /// The update's set of each frame-in-flight slot: that slot's frame's stencil view, the
-    /// touched list and the pending surface.
+    /// The update's set of each frame-in-flight slot: the touched list, the pending surface and
+    /// that slot's frame's stencil view.
     sets: Vec<vk::DescriptorSet>,
     /// The stencil-aspect view of each slot's last depth-stencil image (`prepare_slot`).
     views: Vec<vk::ImageView>,
@@ -153,45 +153,13 @@ impl HiStencilSurface {
         slots: u32,
     ) -> Result<()> {
         let sizes = [
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::SAMPLED_IMAGE)
-                .descriptor_count(slots),
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(2 * slots),
+            (vk::DescriptorType::STORAGE_BUFFER, 2),
+            (vk::DescriptorType::SAMPLED_IMAGE, 1),
         ];
-        let info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(slots)
-            .pool_sizes(&sizes);
-        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
-            .call("vkCreateDescriptorPool")?;
-        ctx.name(self.pool, "hi-stencil-update-pool");
-        let layouts = vec![layout; slots as usize];
-        let alloc = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(self.pool)
-            .set_layouts(&layouts);
-        self.sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
-            .call("vkAllocateDescriptorSets")?;
+        (self.pool, self.sets) = sets_of(ctx, "hi-stencil-update-set", layout, slots, &sizes)?;
         self.views = vec![vk::ImageView::null(); slots as usize];
-        let buffers = [self.touched_list.handle, self.pending.handle].map(|b| {
-            [vk::DescriptorBufferInfo::default()
-                .buffer(b)
-                .range(vk::WHOLE_SIZE)]
-        });
-        for (i, set) in self.sets.iter().enumerate() {
-            ctx.name(*set, &format!("hi-stencil-update-set-{i}"));
-            let writes: Vec<vk::WriteDescriptorSet> = buffers
-                .iter()
-                .enumerate()
-                .map(|(b, info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(*set)
-                        .dst_binding(b as u32 + 1)
-                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                        .buffer_info(info)
-                })
-                .collect();
-            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+        for set in &self.sets {
+            write_storage_buffers(ctx, *set, &[self.touched_list.handle, self.pending.handle]);
         }
         Ok(())
     }
@@ -224,7 +192,7 @@ impl HiStencilSurface {
             .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)];
         let write = vk::WriteDescriptorSet::default()
             .dst_set(set)
-            .dst_binding(0)
+            .dst_binding(2)
             .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
             .image_info(&image);
         unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };

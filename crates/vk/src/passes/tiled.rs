@@ -10,8 +10,10 @@
 
 use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
 use crate::context::Context;
-use crate::descriptors::{create_pipeline_layout, create_set_layout, TILED_SET};
-use crate::error::{Error, Result, VkCall};
+use crate::descriptors::{
+    create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers, TILED_SET,
+};
+use crate::error::{Error, Result};
 use crate::hooks::LightModules;
 use crate::pipelines::create_compute_pipeline;
 use crate::resources::Buffer;
@@ -231,29 +233,13 @@ impl TiledLighting {
     /// frame, [`TiledLighting::set_target`]).
     fn create_sets(&mut self, ctx: &Context, slots: u32) -> Result<()> {
         let sizes = [
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(3 * slots),
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::STORAGE_IMAGE)
-                .descriptor_count(slots),
+            (vk::DescriptorType::STORAGE_BUFFER, 3),
+            (vk::DescriptorType::STORAGE_IMAGE, 1),
         ];
-        let info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(slots)
-            .pool_sizes(&sizes);
-        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
-            .call("vkCreateDescriptorPool")?;
-        ctx.name(self.pool, "tiled-descriptor-pool");
-        let layouts = vec![self.set_layout; slots as usize];
-        let alloc = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(self.pool)
-            .set_layouts(&layouts);
-        self.sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
-            .call("vkAllocateDescriptorSets")?;
+        (self.pool, self.sets) = sets_of(ctx, "tiled-set", self.set_layout, slots, &sizes)?;
         let buffers = [self.dispatch.handle, self.lists.handle, self.masks.handle];
-        for (i, set) in self.sets.iter().enumerate() {
-            ctx.name(*set, &format!("tiled-set-{i}"));
-            write_tiled_buffers(ctx, *set, buffers);
+        for set in &self.sets {
+            write_storage_buffers(ctx, *set, &buffers);
         }
         Ok(())
     }
@@ -414,25 +400,4 @@ fn buffer_barrier(
         .dst_access_mask(dst.1)];
     let info = vk::DependencyInfo::default().memory_barriers(&barrier);
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &info) };
-}
-
-/// Points a tiled set at its three buffers.
-fn write_tiled_buffers(ctx: &Context, set: vk::DescriptorSet, buffers: [vk::Buffer; 3]) {
-    let infos = buffers.map(|b| {
-        [vk::DescriptorBufferInfo::default()
-            .buffer(b)
-            .range(vk::WHOLE_SIZE)]
-    });
-    let writes: Vec<vk::WriteDescriptorSet> = infos
-        .iter()
-        .enumerate()
-        .map(|(i, info)| {
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(i as u32)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .buffer_info(info)
-        })
-        .collect();
-    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
