@@ -437,7 +437,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
                 "emulated hi-stencil (medians): the platform's technique {:.2} ms + the \
                  emulator's bookkeeping {bookkeeping:.2} ms (resets, splits, tile \
                  updates, flush copies) = lighting {lighting:.2} ms",
-                lighting - bookkeeping
+                timings.technique_ms(&["lighting"])
             );
         }
         if let Some(lighting) = &timings.lighting {

@@ -56,13 +56,7 @@ pub fn time_technique(
 ) -> Result<(Timing, Option<Timing>)> {
     let frames = measured(renderer, desc, frames)?;
     let bookkeeping: Option<Vec<f64>> = frames.iter().map(|t| t.bookkeeping_ms).collect();
-    let technique = frames
-        .iter()
-        .map(|t| {
-            let passes: f64 = passes.iter().filter_map(|p| t.pass_ms(p)).sum();
-            passes - t.bookkeeping_ms.unwrap_or(0.0)
-        })
-        .collect();
+    let technique = frames.iter().map(|t| t.technique_ms(passes)).collect();
     Ok((
         Timing::from_samples(technique),
         bookkeeping.map(Timing::from_samples),

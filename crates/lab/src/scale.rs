@@ -172,8 +172,7 @@ pub fn run_scale(
             let t = renderer.render_frame(&FrameDesc::from(shading))?.timings;
             let pass = |name| t.pass_ms(name).unwrap_or(0.0);
             s.0.push(pass("gbuffer"));
-            let lighting: f64 = shading.lighting_passes().iter().map(|p| pass(p)).sum();
-            s.1.push(lighting - t.bookkeeping_ms.unwrap_or(0.0));
+            s.1.push(t.technique_ms(shading.lighting_passes()));
             s.2.push(t.total_ms());
             s.3.extend(t.bookkeeping_ms);
         }

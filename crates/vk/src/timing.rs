@@ -87,11 +87,12 @@ impl FrameTimings {
         self.passes.iter().find(|p| p.0 == name).map(|p| p.1)
     }
 
-    /// The lighting pass without the hi-stencil emulator's bookkeeping: the platform's
-    /// technique (the whole lighting pass on the native backend).
-    pub fn technique_ms(&self) -> Option<f64> {
-        let lighting = self.pass_ms("lighting")?;
-        Some(lighting - self.bookkeeping_ms.unwrap_or(0.0))
+    /// The summed time of `passes` (those the frame ran; [`crate::Shading::lighting_passes`]
+    /// for its lighting) without the hi-stencil emulator's bookkeeping, which lies inside the
+    /// lighting pass: the platform's technique (all of it on the native backend).
+    pub fn technique_ms(&self, passes: &[&str]) -> f64 {
+        let sum: f64 = passes.iter().filter_map(|p| self.pass_ms(p)).sum();
+        sum - self.bookkeeping_ms.unwrap_or(0.0)
     }
 
     /// Per-pass median over frames of the same technique.

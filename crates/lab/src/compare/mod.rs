@@ -551,8 +551,7 @@ pub const MAX_ROUNDS: usize = 400;
 /// on an emulated backend the bookkeeping's.
 fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<(f64, Option<f64>)> {
     let timings = renderer.render(technique, Readback::NONE)?.timings;
-    let classify = timings.pass_ms("tile-classify").unwrap_or(0.0);
-    let own = timings.technique_ms().unwrap_or(0.0) + classify;
+    let own = timings.technique_ms(Shading::Deferred(technique).lighting_passes());
     Ok((own, timings.bookkeeping_ms))
 }
 
