@@ -170,26 +170,45 @@ pub fn median_of_sorted(v: &[f64]) -> f64 {
     }
 }
 
-fn timestamp_pool(ctx: &Context, name: &str, count: u32) -> Result<vk::QueryPool> {
+/// Queries per mark: the mark's own, and a second written right after it so that the first
+/// holds the time where it stands. lavapipe flushes at every timestamp (but a top-of-pipe one)
+/// and then bins it with the draws that follow; it takes its time when that bin is rasterised,
+/// at the next flush. Compute dispatches run at once, outside the bins, so a mark after a
+/// dispatch took the time of the next mark: the dispatches after it were counted before it (the
+/// tiled technique's shading was timed as its classification, 2026-11-26). The second query's
+/// flush rasterises the first's bin at once. On a GPU it is one timestamp more.
+const QUERIES_PER_MARK: u32 = 2;
+
+/// A pool for `marks` marks (`QUERIES_PER_MARK` queries each).
+fn timestamp_pool(ctx: &Context, name: &str, marks: u32) -> Result<vk::QueryPool> {
     let info = vk::QueryPoolCreateInfo::default()
         .query_type(vk::QueryType::TIMESTAMP)
-        .query_count(count);
+        .query_count(marks * QUERIES_PER_MARK);
     let pool = unsafe { ctx.device.create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
     ctx.name(pool, name);
     Ok(pool)
 }
 
-/// A timestamp after all previous work, into query `index`.
-fn write_timestamp(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, index: u32) {
+/// Resets the queries of the first `marks` marks of `pool`.
+fn reset_marks(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, marks: u32) {
     unsafe {
         ctx.device
-            .cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::BOTTOM_OF_PIPE, pool, index)
+            .cmd_reset_query_pool(cmd, pool, 0, marks * QUERIES_PER_MARK)
     };
 }
 
-/// The first `count` timestamps of `pool`, waiting for them.
+/// Mark `index`: a timestamp after all previous work (and its flushing twin).
+fn write_timestamp(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, index: u32) {
+    let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
+    for query in index * QUERIES_PER_MARK..(index + 1) * QUERIES_PER_MARK {
+        unsafe { ctx.device.cmd_write_timestamp2(cmd, bottom, pool, query) };
+    }
+}
+
+/// The times of the first `count` marks of `pool`, waiting for them.
 fn read_ticks(ctx: &Context, pool: vk::QueryPool, count: usize) -> Result<Vec<u64>> {
-    let mut ticks = vec![0u64; count];
+    let per_mark = QUERIES_PER_MARK as usize;
+    let mut ticks = vec![0u64; count * per_mark];
     unsafe {
         ctx.device
             .get_query_pool_results(
@@ -200,7 +219,7 @@ fn read_ticks(ctx: &Context, pool: vk::QueryPool, count: usize) -> Result<Vec<u6
             )
             .call("vkGetQueryPoolResults")?;
     }
-    Ok(ticks)
+    Ok(ticks.into_iter().step_by(per_mark).collect())
 }
 
 pub(crate) struct Timestamps {
@@ -219,10 +238,7 @@ impl Timestamps {
 
     pub fn begin_frame(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         self.names.clear();
-        unsafe {
-            ctx.device
-                .cmd_reset_query_pool(cmd, self.pool, 0, MAX_MARKS)
-        };
+        reset_marks(ctx, cmd, self.pool, MAX_MARKS);
         self.mark(ctx, cmd, "start");
     }
 
@@ -282,10 +298,7 @@ impl StepTimer {
     /// Resets the queries: outside any rendering, as Vulkan requires.
     pub fn reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         self.steps.clear();
-        unsafe {
-            ctx.device
-                .cmd_reset_query_pool(cmd, self.pool, 0, self.capacity)
-        };
+        reset_marks(ctx, cmd, self.pool, self.capacity);
     }
 
     /// The mark the first step is timed from.
