@@ -1,8 +1,9 @@
 //! The tiled technique recorded into an engine's frames through `DeferredLighting::record_tiled`:
 //! the engine's own device, images and fences, two frames in flight, lights moving every frame,
-//! both tile sides and both ways of shading mixed tiles. Each of its last four frames (every
-//! side and mixed-tile mode) must equal histencil's Renderer lighting the same state with the
-//! same tiling, bit for bit, and the validation layer with synchronisation validation must see
+//! both tile sides, both ways of shading mixed tiles and both shapes of the classification. Each
+//! of its last four frames (every side and mixed-tile mode; each side classified both ways) must
+//! equal histencil's Renderer lighting the same state with the same tiling (classified as the
+//! device prefers), bit for bit, and the validation layer with synchronisation validation must see
 //! nothing. A lighting whose HDR format the
 //! kernels cannot store to is refused before anything is recorded.
 
@@ -10,13 +11,22 @@ use ash::vk;
 use histencil_tests::engine::{assert_same_hdr, copy_to_buffer, hdr_floats, lights_at, Engine};
 use histencil_vk::{
     Context, DeferredLighting, Error, HookSets, LightHooks, LightingDesc, MixedTiles, Readback,
-    Renderer, Technique, TileSide, TiledFrame,
+    Renderer, Technique, TileClassify, TileSide, TiledFrame,
 };
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 64;
 const FRAMES: usize = 5;
 const IN_FLIGHT: usize = 2;
+
+/// The classification's shape in frame `f`: each side comes round in both within four frames.
+fn shape(f: usize) -> TileClassify {
+    if matches!(f % 4, 1 | 2) {
+        TileClassify::Workgroup
+    } else {
+        TileClassify::PerInvocation
+    }
+}
 
 /// The tiling of frame `f`: every side and mixed-tile mode comes round in four frames.
 fn tiling(f: usize) -> (TileSide, MixedTiles) {
@@ -91,6 +101,7 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                     clear_hdr: true,
                     side,
                     mixed,
+                    classify: shape(f),
                     hook_sets: HookSets::default(),
                 };
                 lighting.record_tiled(cmd, &frame, &mut targets).unwrap();
@@ -143,6 +154,7 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                 clear_hdr: true,
                 side: TileSide::Sixteen,
                 mixed: MixedTiles::PerBrdf,
+                classify: TileClassify::for_device(ctx.device_type()),
                 hook_sets: HookSets::default(),
             };
             let mut refs = images.refs();

@@ -117,6 +117,7 @@ pub struct Context {
     messenger: vk::DebugUtilsMessengerEXT,
     validation: Arc<ValidationLog>,
     device_name: String,
+    device_type: vk::PhysicalDeviceType,
     pub(crate) depth_stencil_format: vk::Format,
     depth_stencil: DepthStencilFormat,
     /// The depth-stencil format was named when the context was made (not picked for it): the
@@ -367,7 +368,8 @@ impl Context {
         let messenger =
             std::mem::replace(&mut partial.messenger, vk::DebugUtilsMessengerEXT::null());
         // SAFETY: `physical_device` was enumerated from `instance`.
-        let limits = unsafe { instance.get_physical_device_properties(physical_device) }.limits;
+        let props = unsafe { instance.get_physical_device_properties(physical_device) };
+        let limits = props.limits;
         let ctx = Self {
             _entry: Some(entry),
             owned: true,
@@ -381,6 +383,7 @@ impl Context {
             messenger,
             validation,
             device_name,
+            device_type: props.device_type,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
             depth_stencil_named: desc.depth_stencil.is_some(),
@@ -469,6 +472,7 @@ impl Context {
             messenger: vk::DebugUtilsMessengerEXT::null(),
             validation: Arc::new(ValidationLog::default()),
             device_name,
+            device_type: props.device_type,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
             depth_stencil_named,
@@ -542,6 +546,12 @@ impl Context {
     /// The name of the device in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
     pub fn device_name(&self) -> &str {
         &self.device_name
+    }
+
+    /// The kind of device in use (llvmpipe is `CPU`): what some passes shape their work by
+    /// ([`crate::TileClassify::for_device`]).
+    pub fn device_type(&self) -> vk::PhysicalDeviceType {
+        self.device_type
     }
 
     /// The bytes of device memory histencil's objects on this context hold now (what every

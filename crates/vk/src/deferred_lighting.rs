@@ -31,7 +31,7 @@ use crate::passes::tiled::{TiledDesc, TiledLighting, TiledSets};
 use crate::resources::Buffer;
 use crate::targets::GBUFFER_FORMATS;
 use crate::teardown::{Destroy, InFlight};
-use crate::technique::{MixedTiles, TileSide};
+use crate::technique::{MixedTiles, TileClassify, TileSide};
 use crate::timing::{LightingBreakdown, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -108,6 +108,9 @@ pub struct TiledFrame<'a> {
     pub side: TileSide,
     /// What a tile of several BRDFs does.
     pub mixed: MixedTiles,
+    /// How the classification's work is shaped (the same results either way):
+    /// [`TileClassify::for_device`] picks the faster for the device.
+    pub classify: TileClassify,
     /// The engine's sets for its hooks (none with histencil's built-in hooks).
     pub hook_sets: HookSets,
 }
@@ -779,7 +782,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         self.in_flight.mark();
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
-        tiled.record_classify(ctx, cmd, &sets, targets, depth_sampled, clear, mixed);
+        let shape = (mixed, frame.classify);
+        tiled.record_classify(ctx, cmd, &sets, targets, depth_sampled, clear, shape);
         between(cmd);
         tiled.record_shade(ctx, cmd, mixed);
         Ok(())

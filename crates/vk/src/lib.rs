@@ -81,7 +81,7 @@ pub use readback::{FrameImages, Readback};
 pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
 pub use targets::{check_extent, GBUFFER_FORMATS};
-pub use technique::{Backend, FrameDesc, MixedTiles, Shading, Technique, TileSide};
+pub use technique::{Backend, FrameDesc, MixedTiles, Shading, Technique, TileClassify, TileSide};
 #[cfg(feature = "tools")]
 pub use timing::median_of_sorted;
 pub use timing::{FrameTimings, LightingBreakdown, LightmapTimings};

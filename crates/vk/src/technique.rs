@@ -4,7 +4,7 @@
 
 use crate::alpha::AlphaMode;
 use crate::passes::light_pipelines::BrdfSource;
-pub use crate::passes::tiled::{MixedTiles, TileSide};
+pub use crate::passes::tiled::{MixedTiles, TileClassify, TileSide};
 use crate::readback::Readback;
 use histencil_model::{
     CostModel, DepthConvention, FlushPolicy, Native, PlanSettings, PlatformBackend, Ps3Like,

@@ -29,8 +29,8 @@ use histencil::{
     AlphaLightmapsDesc, Backend, BrdfSource, ChoiceSettings, Context, DeferredLighting,
     DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSets, ImageState, LightHooks,
     LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame, MixedTiles,
-    Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice, TileSide,
-    TiledFrame, View, ViewDesc, Viewer,
+    Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice,
+    TileClassify, TileSide, TiledFrame, View, ViewDesc, Viewer,
 };
 // histencil's own renderer, as the reference the engine's frames are compared with.
 use histencil::vk::{AlphaMode, FrameDesc, Readback, Renderer, Shading, Technique};
@@ -420,6 +420,7 @@ fn main() {
                         clear_hdr: true,
                         side,
                         mixed,
+                        classify: TileClassify::for_device(ctx.device_type()),
                         hook_sets: frame.hook_sets,
                     };
                     lighting.record_tiled(slot.cmd, &tiled, &mut targets)

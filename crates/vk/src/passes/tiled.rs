@@ -46,12 +46,13 @@ const BRANCH_ON_GBUFFER: u32 = u32::MAX;
 
 /// The side of the tiled technique's tiles (`TILED_TILE` of the stages it picks): one workgroup
 /// of the classification and of a shade kernel covers one tile.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum TileSide {
     /// 8x8 pixels: fewer wasted invocations on mixed and partly covered tiles, four times the
     /// tiles to classify and list.
     Eight,
     /// 16x16 pixels, as HDRP's classification.
+    #[default]
     Sixteen,
 }
 
@@ -79,6 +80,29 @@ impl TileSide {
     }
 }
 
+/// How the classification's work is shaped on the device (the results are the same bit for
+/// bit; `tile_classify.glsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TileClassify {
+    /// A workgroup per tile, an invocation per pixel, combined in shared memory: GPUs, where
+    /// a tile's pixels are read side by side.
+    Workgroup,
+    /// An invocation per tile, reading the tile's pixels in a loop: CPU rasterisers (llvmpipe),
+    /// which run a workgroup with barriers one invocation at a time, switching at each barrier.
+    PerInvocation,
+}
+
+impl TileClassify {
+    /// The shape for a device of `device_type`: per invocation on a CPU, else a workgroup.
+    pub fn for_device(device_type: vk::PhysicalDeviceType) -> Self {
+        if device_type == vk::PhysicalDeviceType::CPU {
+            TileClassify::PerInvocation
+        } else {
+            TileClassify::Workgroup
+        }
+    }
+}
+
 /// What the tiled technique does with a tile whose pixels use several BRDFs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MixedTiles {
@@ -96,7 +120,10 @@ pub(crate) struct TiledLighting {
     pool: vk::DescriptorPool,
     /// The tiled set of each frame-in-flight slot (its HDR target written per frame).
     sets: Vec<vk::DescriptorSet>,
+    /// The classification, a workgroup per tile.
     classify: vk::Pipeline,
+    /// The classification, an invocation per tile (`PER_INVOCATION`).
+    classify_alone: vk::Pipeline,
     /// The shade kernel of each BRDF slot.
     shade: Vec<vk::Pipeline>,
     /// The branching kernel over mixed tiles.
@@ -106,6 +133,7 @@ pub(crate) struct TiledLighting {
     masks: Buffer,
     push: Option<TiledPush>,
     tiles_xy: (u32, u32),
+    side: TileSide,
 }
 
 /// What a [`TiledLighting`] is made for, inside a [`crate::DeferredLighting`].
@@ -137,10 +165,12 @@ impl Destroy for TiledLighting {
     fn destroy(&mut self, ctx: &Context) {
         let d = &ctx.device;
         unsafe {
-            for p in self.shade.drain(..).chain([self.classify, self.branching]) {
+            let single = [self.classify, self.classify_alone, self.branching];
+            for p in self.shade.drain(..).chain(single) {
                 d.destroy_pipeline(p, None);
             }
             self.classify = vk::Pipeline::null();
+            self.classify_alone = vk::Pipeline::null();
             self.branching = vk::Pipeline::null();
             d.destroy_descriptor_pool(self.pool, None);
             self.pool = vk::DescriptorPool::null();
@@ -189,8 +219,10 @@ impl TiledLighting {
             let name = "tiled-pipeline-layout";
             t.pipeline_layout = create_pipeline_layout(ctx, name, &layouts, compute, push_bytes)?;
             let layout = t.pipeline_layout;
-            t.classify =
-                create_compute_pipeline(ctx, "tiled-classify-pipeline", classify, layout, &[])?;
+            let name = "tiled-classify-pipeline";
+            t.classify = create_compute_pipeline(ctx, name, classify, layout, &[0])?;
+            let name = "tiled-classify-per-invocation-pipeline";
+            t.classify_alone = create_compute_pipeline(ctx, name, classify, layout, &[1])?;
             for (slot, brdf) in desc.brdfs.iter().enumerate() {
                 let name = format!("tiled-shade-{}-pipeline", brdf.name());
                 let constants = [brdf.index(), slot as u32];
@@ -225,6 +257,7 @@ impl TiledLighting {
                 slot_of_model,
             });
             t.tiles_xy = tiles_xy;
+            t.side = desc.side;
             Ok(())
         })
     }
@@ -262,7 +295,8 @@ impl TiledLighting {
     /// images) read by compute shaders, and with `depth_sampled` the depth aspect too, in
     /// `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL` as the light passes hold it; the HDR target
     /// (in `sets.slot`'s tiled set, [`TiledLighting::set_target`]) cleared first with `clear`
-    /// and left in `GENERAL` for the shade kernels ([`TiledLighting::record_shade`], next).
+    /// and left in `GENERAL` for the shade kernels ([`TiledLighting::record_shade`], next);
+    /// the work shaped as `shape` says.
     #[allow(clippy::too_many_arguments)]
     pub fn record_classify(
         &self,
@@ -272,7 +306,7 @@ impl TiledLighting {
         targets: &mut LightingTargets,
         depth_sampled: bool,
         clear: bool,
-        mixed: MixedTiles,
+        (mixed, shape): (MixedTiles, TileClassify),
     ) {
         let d = &ctx.device;
         let push = TiledPush {
@@ -343,8 +377,17 @@ impl TiledLighting {
             );
         }
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.classify);
-            d.cmd_dispatch(cmd, self.tiles_xy.0, self.tiles_xy.1, 1);
+            let (x, y) = self.tiles_xy;
+            let (pipeline, groups) = match shape {
+                TileClassify::Workgroup => (self.classify, (x, y)),
+                // A workgroup of `tile` x `tile` invocations covers as many tiles.
+                TileClassify::PerInvocation => {
+                    let tile = self.side.pixels();
+                    (self.classify_alone, (x.div_ceil(tile), y.div_ceil(tile)))
+                }
+            };
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+            d.cmd_dispatch(cmd, groups.0, groups.1, 1);
         }
         // The lists and masks for the shade kernels, the counts for the indirect dispatches.
         buffer_barrier(

@@ -13,7 +13,7 @@ use crate::passes::light_pipelines::BrdfSource;
 use crate::passes::tonemap::TonemapInputs;
 use crate::readback::Readback;
 use crate::targets::GBUFFER_FORMATS;
-use crate::technique::{FrameDesc, Shading, Technique};
+use crate::technique::{FrameDesc, Shading, Technique, TileClassify};
 use crate::timing::FrameTimings;
 use ash::vk;
 use histencil_model::{DepthConvention, FramePlan, ViewDesc};
@@ -143,6 +143,7 @@ impl Renderer<'_> {
                 clear_hdr: !emits,
                 side,
                 mixed,
+                classify: TileClassify::for_device(ctx.device_type()),
                 hook_sets: HookSets::default(),
             };
             let mut targets = self.targets.lighting();
