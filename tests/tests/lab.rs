@@ -110,6 +110,18 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
             }
             assert!(bookkeeping.iter().all(|b| b.as_f64().unwrap() > 0.0));
         }
+        // Every cell of several BRDFs against its BRDFs alone, paired by round.
+        for cell in cells {
+            let single = cell["single_brdf_samples_ms"].as_array().unwrap();
+            if cell["brdfs"].as_u64().unwrap() == 1 {
+                assert!(single.is_empty() && cell.get("over_single_brdf_ratio").is_none());
+            } else {
+                assert_eq!(single.len(), 2, "{row}");
+                assert!(single.iter().all(|t| t.as_f64().unwrap() > 0.0));
+                assert!(cell["over_single_brdf_ratio"]["median"].as_f64().unwrap() > 0.0);
+                assert!(cell["verdict_against_single_brdf"].is_string());
+            }
+        }
     }
     for row in report
         .rows
@@ -160,6 +172,7 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
         "FLIP",
         "| backend | BRDFs | technique, ms | emulator bookkeeping, ms |",
         "| stencil ps3 | 3 |",
+        "what its BRDFs cost alone",
     ] {
         assert!(md.contains(part), "report.md lacks `{part}`");
     }

@@ -17,11 +17,10 @@ fn extra_models() -> [Brdf; 3] {
     ]
 }
 
-/// `scene` with its objects' BRDFs folded onto `count` models: object `i` takes model
-/// `i % count` of the scene's distinct BRDFs (the first material of each, in object order),
-/// padded with Lambert, Blinn-Phong 32 and Oren-Nayar. Tints are kept. Interleaving spreads
-/// every model over the scene, so a huge light touches all `count`, as in the talk's figures.
-pub fn with_brdf_count(scene: &Scene, count: usize) -> Scene {
+/// The first `count` distinct BRDFs of `scene` (the first material of each, in object order),
+/// padded with Lambert, Blinn-Phong 32 and Oren-Nayar: the models [`with_brdf_count`] folds
+/// the scene's objects onto.
+pub fn brdf_palette(scene: &Scene, count: usize) -> Vec<Brdf> {
     let mut palette: Vec<Brdf> = Vec::new();
     for brdf in scene
         .objects
@@ -33,6 +32,14 @@ pub fn with_brdf_count(scene: &Scene, count: usize) -> Scene {
             palette.push(brdf);
         }
     }
+    palette
+}
+
+/// `scene` with its objects' BRDFs folded onto `count` models ([`brdf_palette`]): object `i`
+/// takes model `i % count`. Tints are kept. Interleaving spreads every model over the scene,
+/// so a huge light touches all `count`, as in the talk's figures.
+pub fn with_brdf_count(scene: &Scene, count: usize) -> Scene {
+    let palette = brdf_palette(scene, count);
     let mut out = scene.clone();
     if palette.is_empty() {
         return out;
@@ -41,6 +48,17 @@ pub fn with_brdf_count(scene: &Scene, count: usize) -> Scene {
         object.material.brdf = palette[i % palette.len()];
     }
     out.name = format!("{}-{}brdf", scene.name, palette.len());
+    out
+}
+
+/// `scene` with every object in `brdf` (tints kept): what each of a folded scene's models costs
+/// alone, on the same pixels and lights.
+pub fn with_one_brdf(scene: &Scene, brdf: Brdf) -> Scene {
+    let mut out = scene.clone();
+    for object in &mut out.objects {
+        object.material.brdf = brdf;
+    }
+    out.name = format!("{}-only-{}", scene.name, brdf.id().name());
     out
 }
 

@@ -6,8 +6,9 @@ mod report;
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, Timing};
 use crate::stats::{median_interval, ratio_interval, sample, Interval, Sampled, Sampling, Verdict};
-use crate::variants::{light_size_scene, with_brdf_count};
+use crate::variants::{brdf_palette, light_size_scene, with_brdf_count, with_one_brdf};
 use crate::Result;
+use histencil_brdf::BrdfId;
 use histencil_scene::Scene;
 use histencil_vk::{
     Backend, Context, CostModel, FlushPolicy, FrameDesc, MixedTiles, Readback, Renderer,
@@ -139,6 +140,12 @@ pub struct Cell {
     /// tile updates, flush copies: `FrameTimings::bookkeeping_ms`); empty
     /// elsewhere. The whole lighting pass of round `i` is `samples[i] + bookkeeping[i]`.
     pub bookkeeping: Vec<f64>,
+    /// With several BRDFs, what the same rounds would have taken if each BRDF cost what it costs
+    /// alone: per round, the row's time on the scene with every object in one of this cell's
+    /// BRDFs, weighted by that BRDF's share of the cell's surface pixels, summed (exact where
+    /// every light covers the screen, as in `huge-lights`). Empty at one BRDF. The cell's time
+    /// over this is what the technique adds per extra BRDF beyond the BRDFs' own arithmetic.
+    pub single_brdf: Vec<f64>,
     pub error: ImageError,
 }
 
@@ -190,6 +197,17 @@ impl Row {
     pub fn overhead_ratio(&self, index: usize) -> (Interval, Verdict) {
         let ratio = ratio_interval(&self.cells[index].samples, &self.cells[0].samples);
         (ratio, Verdict::of(&ratio))
+    }
+
+    /// The time of the cell at `index` over its BRDFs' own cost ([`Cell::single_brdf`]), paired
+    /// by round, with its verdict; `None` at one BRDF.
+    pub fn over_single_brdf(&self, index: usize) -> Option<(Interval, Verdict)> {
+        let cell = &self.cells[index];
+        if cell.single_brdf.is_empty() {
+            return None;
+        }
+        let ratio = ratio_interval(&cell.samples, &cell.single_brdf);
+        Some((ratio, Verdict::of(&ratio)))
     }
 
     /// The largest error over the row's cells, per measure.
@@ -428,6 +446,29 @@ pub fn run_compare(
         }
         renderers.push((brdfs, renderer, errors));
     }
+    // Each BRDF of the widest column alone on the same scene (the first is the 1-BRDF
+    // column's), each warmed up, and every column's share of surface pixels per BRDF: what the
+    // columns would cost if an extra BRDF added only its own arithmetic.
+    let max_count = settings.brdf_counts.iter().copied().max().unwrap_or(1);
+    let palette: Vec<BrdfId> = brdf_palette(&settings.scene, max_count)
+        .iter()
+        .map(|b| b.id())
+        .collect();
+    let mut singles = Vec::new();
+    for brdf in brdf_palette(&settings.scene, max_count).into_iter().skip(1) {
+        progress(&format!("{} alone: warm-up", brdf.id().name()));
+        let mut renderer = new_renderer(with_one_brdf(&settings.scene, brdf))?;
+        for (_, technique) in &rows_spec {
+            lighting_ms(&mut renderer, *technique)?;
+        }
+        singles.push(renderer);
+    }
+    let mut shares = Vec::new();
+    for (_, renderer, _) in &mut renderers {
+        shares.push(pixel_shares(renderer, &palette)?);
+    }
+    let single_samples =
+        std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; singles.len()]);
     let sampling = Sampling {
         min_rounds: frames.max(1),
         target: settings.target_ci,
@@ -459,17 +500,51 @@ pub fn run_compare(
                     bookkeeping[count][row].extend(emulator);
                 }
             }
+            for (single, renderer) in singles.iter_mut().enumerate() {
+                for (row, (_, technique)) in rows_spec.iter().enumerate() {
+                    let (ms, _) = lighting_ms(renderer, *technique)?;
+                    single_samples.borrow_mut()[single][row].push(ms);
+                }
+            }
             Ok(())
         },
         overhead_widths,
     )?;
     let mut samples = samples.into_inner();
+    let single_samples = single_samples.into_inner();
+    // Per column, row and round: the shares of each BRDF times its time alone (the first BRDF
+    // alone is the 1-BRDF column).
+    let single_brdf = |count: usize, row: usize| -> Vec<f64> {
+        if count == 0 {
+            return Vec::new();
+        }
+        let alone = |model: usize| -> &Vec<f64> {
+            match model {
+                0 => &samples[0][row],
+                m => &single_samples[m - 1][row],
+            }
+        };
+        (0..samples[count][row].len())
+            .map(|round| {
+                let weighted = shares[count].iter().enumerate();
+                weighted.map(|(m, share)| share * alone(m)[round]).sum()
+            })
+            .collect()
+    };
+    let single_brdf: Vec<Vec<Vec<f64>>> = (0..renderers.len())
+        .map(|count| {
+            (0..rows_spec.len())
+                .map(|row| single_brdf(count, row))
+                .collect()
+        })
+        .collect();
     for (count, (brdfs, _, errors)) in renderers.iter().enumerate() {
         for (r, (row, error)) in rows.iter_mut().zip(errors).enumerate() {
             row.cells.push(Cell {
                 brdfs: *brdfs,
                 samples: std::mem::take(&mut samples[count][r]),
                 bookkeeping: std::mem::take(&mut bookkeeping[count][r]),
+                single_brdf: single_brdf[count][r].clone(),
                 error: *error,
             });
         }
@@ -553,6 +628,32 @@ fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<(f64, Op
     let timings = renderer.render(technique, Readback::NONE)?.timings;
     let own = timings.technique_ms(Shading::Deferred(technique).lighting_passes());
     Ok((own, timings.bookkeeping_ms))
+}
+
+/// Each of `palette`'s share of the surface pixels `renderer`'s G-buffer holds (zero for a
+/// BRDF it does not use; pixels of BRDFs outside the palette are not counted).
+fn pixel_shares(renderer: &mut Renderer, palette: &[BrdfId]) -> Result<Vec<f64>> {
+    let readback = Readback {
+        brdf_ids: true,
+        ..Readback::NONE
+    };
+    let branching = Technique::Branching {
+        backend: Backend::Native,
+        flush: FlushPolicy::Auto,
+    };
+    let ids = renderer
+        .render(branching, readback)?
+        .images
+        .brdf_ids
+        .unwrap_or_default();
+    let mut counts = vec![0usize; palette.len()];
+    for id in ids.into_iter().flatten() {
+        if let Some(i) = palette.iter().position(|p| *p == id) {
+            counts[i] += 1;
+        }
+    }
+    let total = counts.iter().sum::<usize>().max(1) as f64;
+    Ok(counts.into_iter().map(|c| c as f64 / total).collect())
 }
 
 /// Branching, stencil and adaptive on the native backend, and tiled: the light-size sweep's

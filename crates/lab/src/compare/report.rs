@@ -129,6 +129,7 @@ impl CompareReport {
                 error_text(&row.worst_error())
             );
         }
+        md += &self.single_brdf_markdown();
         md += &self.emulation_markdown();
         md += "\nThe talk (Develop 2012, huge lights, ms):\n\n\
                | platform | 1 BRDF | 2 BRDFs branching | 3 BRDFs branching | 2 BRDFs stencil | 3 BRDFs stencil |\n\
@@ -251,6 +252,47 @@ impl CompareReport {
 
     /// The emulated rows' technique and bookkeeping side by side, each with its interval, and
     /// the technique against native stencil at the same BRDF count, paired by round.
+    /// The table's extra-BRDF columns against what their BRDFs cost alone.
+    fn single_brdf_markdown(&self) -> String {
+        let columns: Vec<usize> = (0..self.rows[0].cells.len())
+            .filter(|&i| self.rows[0].over_single_brdf(i).is_some())
+            .collect();
+        if columns.is_empty() {
+            return String::new();
+        }
+        let mut md = String::from(
+            "\nAn extra BRDF costs its own arithmetic as well as the technique's work: the columns \
+             above give two thirds of the objects costlier BRDFs than the 1-BRDF column's. Below, \
+             each cell against what its BRDFs cost alone: per round, the row's time on the scene \
+             with every object in one BRDF, weighted by that BRDF's share of the cell's surface \
+             pixels (exact where every light covers the screen), paired by round. What is left \
+             is the technique's own cost per extra BRDF (the physical limit is about 0 %).\n\n",
+        );
+        let head: Vec<String> = columns
+            .iter()
+            .map(|&i| brdfs_label(self.rows[0].cells[i].brdfs))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| technique | {} |\n|---|{}",
+            head.join(" | "),
+            "---|".repeat(columns.len())
+        );
+        for row in &self.rows {
+            let cells: Vec<String> = columns
+                .iter()
+                .map(|&i| {
+                    let (r, verdict) = row.over_single_brdf(i).expect("several BRDFs");
+                    let pct = |x: f64| 100.0 * (x - 1.0);
+                    let (m, lo, hi) = (pct(r.median), pct(r.lo), pct(r.hi));
+                    format!("{m:+.1} % [{lo:+.1}, {hi:+.1}], {}", verdict.word())
+                })
+                .collect();
+            let _ = writeln!(md, "| {} | {} |", row.name, cells.join(" | "));
+        }
+        md
+    }
+
     fn emulation_markdown(&self) -> String {
         let native = self.rows.iter().find(|r| r.name == "stencil native");
         let emulated: Vec<&Row> = self
@@ -477,7 +519,7 @@ fn row_json(row: &Row) -> Value {
         .map(|(i, c)| {
             let (ms, pct) = row.overhead(i);
             let (ratio, verdict) = row.overhead_ratio(i);
-            json!({
+            let mut cell = json!({
                 "brdfs": c.brdfs,
                 "lighting": timing_json(&c.lighting()),
                 "lighting_interval_ms": interval_json(&c.interval()),
@@ -487,8 +529,14 @@ fn row_json(row: &Row) -> Value {
                 "overhead_percent": pct,
                 "overhead_ratio": interval_json(&ratio),
                 "verdict_against_1_brdf": verdict.word(),
+                "single_brdf_samples_ms": c.single_brdf,
                 "error": error_json(&c.error),
-            })
+            });
+            if let Some((ratio, verdict)) = row.over_single_brdf(i) {
+                cell["over_single_brdf_ratio"] = interval_json(&ratio);
+                cell["verdict_against_single_brdf"] = json!(verdict.word());
+            }
+            cell
         })
         .collect();
     json!({"technique": row.name, "cells": cells})
