@@ -55,22 +55,24 @@ bool tile_surface(ivec2 px, out uint model, out float depth) {
 #endif
 }
 
-// Pixel `px`'s part in its tile's class, after clearing it when asked: false where it has no
-// surface; else its BRDF slot's bit (0 for a BRDF the frame does not light) and the bits of its
-// linear depth (positive floats order as their bits do).
+// Pixel `px`'s part in its tile's class: false where it has no surface; else its BRDF slot's
+// bit (0 for a BRDF the frame does not light) and the bits of its linear depth (positive floats
+// order as their bits do). Clears the pixel when asked, where no shade kernel will write it
+// (a kernel writes each pixel of a BRDF in the frame once, without reading it, when clearing).
 bool pixel_class(ivec2 px, out uint bit, out uint depth_bits) {
-    if (tiled.clear != 0u) {
-        imageStore(tiled_hdr, px, vec4(0.0));
-    }
     uint model;
     float depth;
-    if (!tile_surface(px, model, depth)) {
-        return false;
+    bit = 0u;
+    bool surface = tile_surface(px, model, depth);
+    if (surface) {
+        uint slot = model < TILED_MODELS ? tiled.slot_of_model[model] : ~0u;
+        bit = slot < 32u ? 1u << slot : 0u;
+        depth_bits = floatBitsToUint(depth);
     }
-    uint slot = model < TILED_MODELS ? tiled.slot_of_model[model] : ~0u;
-    bit = slot < 32u ? 1u << slot : 0u;
-    depth_bits = floatBitsToUint(depth);
-    return true;
+    if (tiled.clear != 0u && bit == 0u) {
+        imageStore(tiled_hdr, px, vec4(0.0));
+    }
+    return surface;
 }
 
 // Whether `light` can light anything in the view-space box [lo, hi]: directional lights reach

@@ -58,7 +58,10 @@ void main() {
             sum += lit;
         }
     }
-    imageStore(tiled_hdr, px, imageLoad(tiled_hdr, px) + vec4(sum, 0.0));
+    // Each pixel is shaded by one kernel (its BRDF's, or the branching one's): over a cleared
+    // target its light is the whole value, and the classification left the pixel unwritten.
+    vec4 under = tiled.clear != 0u ? vec4(0.0) : imageLoad(tiled_hdr, px);
+    imageStore(tiled_hdr, px, under + vec4(sum, 0.0));
 }
 
 #endif

@@ -25,14 +25,15 @@ layout(set = 2, binding = 1, std430) buffer TileLists {
 layout(set = 2, binding = 2, std430) buffer TileLights {
     uint tile_lights[];
 };
-// The HDR target, read and written by the shade pass, cleared by the classification on request.
+// The HDR target: with `clear`, the classification clears the pixels no kernel shades and each
+// kernel writes its pixels once; without, the kernels add onto it.
 layout(set = 2, binding = 3, rgba16f) uniform image2D tiled_hdr;
 
 layout(push_constant) uniform Tiled {
     uint tiles_x; // tiles per row
     uint tiles;   // tiles in the frame
     uint words;   // light mask words per tile
-    uint clear;   // 1: the classification clears the HDR target first
+    uint clear;   // 1: the HDR target is cleared first (its old contents are not read)
     uint mixed;   // the list mixed tiles go to: TILED_MIXED_SLOT (one branching pass), or
                   // TILED_PER_BRDF (each of their BRDFs' lists)
     uint slot_of_model[TILED_MODELS]; // BRDF model id -> stencil slot (or ~0u: not in the frame)
