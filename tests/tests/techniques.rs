@@ -285,6 +285,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
         };
         let frame = renderer.render(native, ldr).unwrap();
         assert!(frame.timings.pass_ms("tile-classify").is_some());
+        assert!(frame.timings.pass_ms("tile-lights").is_some());
         let expected = renderer.render(tiled, ldr).unwrap().images.ldr.unwrap();
         assert_eq!(frame.images.ldr.unwrap(), expected);
         let renderer = with_costs(CostModel {

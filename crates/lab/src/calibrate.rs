@@ -153,7 +153,10 @@ pub fn calibrate(
             for kind in k.iter_mut() {
                 let (renderer, lights) = &mut renderers[kind.renderer];
                 let timings = renderer.render(kind.technique, histencil_vk::Readback::NONE)?;
-                let ms = timings.timings.pass_ms("lighting").unwrap_or(0.0);
+                // A tiled frame's light lists cost per light, as its shading does.
+                let t = &timings.timings;
+                let ms =
+                    t.pass_ms("lighting").unwrap_or(0.0) + t.pass_ms("tile-lights").unwrap_or(0.0);
                 kind.per_light_ms.push(ms / *lights);
                 if let Some(classify) = timings.timings.pass_ms("tile-classify") {
                     kind.classify_ms.push(classify);

@@ -733,11 +733,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &TiledFrame,
         targets: &mut LightingTargets,
     ) -> Result<()> {
-        self.record_tiled_with(cmd, frame, targets, |_| {})
+        self.record_tiled_with(cmd, frame, targets, |_, _| {})
     }
 
-    /// [`DeferredLighting::record_tiled`], calling `between` after the classification is
-    /// recorded and before the shade kernels (the renderer's timestamp between the two).
+    /// [`DeferredLighting::record_tiled`], calling `between` with the pass's name after the
+    /// classification (`tile-classify`) and after the light lists (`tile-lights`), before the
+    /// shade kernels (the renderer's timestamps between them).
     ///
     /// # Safety
     /// As [`DeferredLighting::record_tiled`].
@@ -746,7 +747,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         cmd: vk::CommandBuffer,
         frame: &TiledFrame,
         targets: &mut LightingTargets,
-        between: impl FnOnce(vk::CommandBuffer),
+        mut between: impl FnMut(vk::CommandBuffer, &'static str),
     ) -> Result<()> {
         check_slot_and_lights(&self.desc, frame.slot, frame.lights.len())?;
         check_targets(&self.desc, &frame.hook_sets, targets)?;
@@ -784,7 +785,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = (mixed, frame.classify);
         tiled.record_classify(ctx, cmd, &sets, targets, depth_sampled, clear, shape);
-        between(cmd);
+        between(cmd, "tile-classify");
+        tiled.record_light_lists(ctx, cmd, frame.lights.len() as u32);
+        between(cmd, "tile-lights");
         tiled.record_shade(ctx, cmd, mixed);
         Ok(())
     }

@@ -128,7 +128,8 @@ pub const TILED_SET: &[BindingDesc] = &[
     binding(0, BindingKind::StorageBuffer, ""),
     binding(1, BindingKind::StorageBuffer, ""),
     binding(2, BindingKind::StorageBuffer, ""),
-    binding(3, BindingKind::StorageImage, "tiled_hdr"),
+    binding(3, BindingKind::StorageBuffer, ""),
+    binding(4, BindingKind::StorageImage, "tiled_hdr"),
 ];
 
 /// The pipeline layouts: which sets, in order.
@@ -168,6 +169,7 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("particle.vert", ALPHA_LAYOUT),
     ("particle.frag", ALPHA_LAYOUT),
     ("tile_classify.comp", TILED_LAYOUT),
+    ("tile_lights.comp", TILED_LAYOUT),
     ("tile_shade.comp", TILED_LAYOUT),
     ("tile_classify_8.comp", TILED_LAYOUT),
     ("tile_shade_8.comp", TILED_LAYOUT),

@@ -79,13 +79,14 @@ impl Shading {
     }
 
     /// Every timed pass the frame's lighting may take: [`Shading::lighting_pass`], after the
-    /// tiled technique's classification (`tile-classify`) for that technique and for the
-    /// adaptive one, which may light a frame tiled (a frame times only the passes it ran).
+    /// tiled technique's classification (`tile-classify`) and light lists (`tile-lights`) for
+    /// that technique and for the adaptive one, which may light a frame tiled (a frame times
+    /// only the passes it ran).
     pub fn lighting_passes(self) -> &'static [&'static str] {
         match self {
             Shading::Forward => &["forward"],
             Shading::Deferred(Technique::Tiled { .. } | Technique::Adaptive { .. }) => {
-                &["tile-classify", "lighting"]
+                &["tile-classify", "tile-lights", "lighting"]
             }
             Shading::Deferred(_) => &["lighting"],
         }

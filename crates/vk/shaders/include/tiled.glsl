@@ -21,13 +21,21 @@ layout(set = 2, binding = 1, std430) buffer TileLists {
     uint tile_lists[];
 };
 // Per tile, a bit per light that can reach it (tiled.words words, light i at bit i % 32 of word
-// i / 32), so the shade pass adds the lights in the scene's order, as forward does.
+// i / 32), so the shade pass adds the lights in the scene's order, as forward does. Zeroed
+// before the classification, set by the light lists (tile_lights.comp).
 layout(set = 2, binding = 2, std430) buffer TileLights {
     uint tile_lights[];
 };
+// Per tile, the bits of its surfaces' nearest and farthest linear depth (positive floats order
+// as their bits do), or EMPTY_TILE where it has no surface of a BRDF the frame lights: written
+// by the classification for the light lists.
+layout(set = 2, binding = 3, std430) buffer TileDepths {
+    uvec2 tile_depths[];
+};
+const uvec2 EMPTY_TILE = uvec2(0xFFFFFFFFu, 0u);
 // The HDR target: with `clear`, the classification clears the pixels no kernel shades and each
 // kernel writes its pixels once; without, the kernels add onto it.
-layout(set = 2, binding = 3, rgba16f) uniform image2D tiled_hdr;
+layout(set = 2, binding = 4, rgba16f) uniform image2D tiled_hdr;
 
 layout(push_constant) uniform Tiled {
     uint tiles_x; // tiles per row

@@ -6,7 +6,9 @@
 //! dispatch per BRDF in the frame runs a kernel specialised to that BRDF over its tiles, and each
 //! pixel adds the tile's lights by its own BRDF, once. A tile with pixels of several BRDFs is in
 //! several lists, and each BRDF's kernel shades only its own pixels there.
-//! Shaders: `tile_classify.comp`, `tile_shade.comp`, `include/tiled.glsl`.
+//! The lights each tile's pixels can see are listed between the two: each light is binned into
+//! the tiles of its screen rectangle whose depth range its range sphere reaches.
+//! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
 use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
 use crate::context::Context;
@@ -18,6 +20,7 @@ use crate::hooks::LightModules;
 use crate::pipelines::create_compute_pipeline;
 use crate::resources::Buffer;
 use crate::shader_consts::TILED_MODELS;
+use crate::shaders;
 use crate::teardown::{build, Destroy};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -124,6 +127,8 @@ pub(crate) struct TiledLighting {
     classify: vk::Pipeline,
     /// The classification, an invocation per tile (`PER_INVOCATION`).
     classify_alone: vk::Pipeline,
+    /// The light lists: a workgroup per light over its tiles.
+    light_lists: vk::Pipeline,
     /// The shade kernel of each BRDF slot.
     shade: Vec<vk::Pipeline>,
     /// The branching kernel over mixed tiles.
@@ -131,6 +136,8 @@ pub(crate) struct TiledLighting {
     dispatch: Buffer,
     lists: Buffer,
     masks: Buffer,
+    /// Each tile's depth range, from the classification to the light lists.
+    depths: Buffer,
     push: Option<TiledPush>,
     tiles_xy: (u32, u32),
     side: TileSide,
@@ -165,12 +172,18 @@ impl Destroy for TiledLighting {
     fn destroy(&mut self, ctx: &Context) {
         let d = &ctx.device;
         unsafe {
-            let single = [self.classify, self.classify_alone, self.branching];
+            let single = [
+                self.classify,
+                self.classify_alone,
+                self.light_lists,
+                self.branching,
+            ];
             for p in self.shade.drain(..).chain(single) {
                 d.destroy_pipeline(p, None);
             }
             self.classify = vk::Pipeline::null();
             self.classify_alone = vk::Pipeline::null();
+            self.light_lists = vk::Pipeline::null();
             self.branching = vk::Pipeline::null();
             d.destroy_descriptor_pool(self.pool, None);
             self.pool = vk::DescriptorPool::null();
@@ -183,6 +196,7 @@ impl Destroy for TiledLighting {
         self.dispatch.destroy(ctx);
         self.lists.destroy(ctx);
         self.masks.destroy(ctx);
+        self.depths.destroy(ctx);
     }
 }
 
@@ -223,6 +237,9 @@ impl TiledLighting {
             t.classify = create_compute_pipeline(ctx, name, classify, layout, &[0])?;
             let name = "tiled-classify-per-invocation-pipeline";
             t.classify_alone = create_compute_pipeline(ctx, name, classify, layout, &[1])?;
+            let name = "tiled-light-lists-pipeline";
+            let module = ("tile_lights.comp", shaders::TILE_LIGHTS_COMP);
+            t.light_lists = create_compute_pipeline(ctx, name, module, layout, &[tile])?;
             for (slot, brdf) in desc.brdfs.iter().enumerate() {
                 let name = format!("tiled-shade-{}-pipeline", brdf.name());
                 let constants = [brdf.index(), slot as u32];
@@ -246,7 +263,10 @@ impl TiledLighting {
             let lists = (MIXED_SLOT + 1) as u64 * u64::from(tiles) * 4;
             t.lists = Buffer::new(ctx, "tiled-lists", lists, storage, gpu)?;
             let mask_bytes = u64::from(tiles) * u64::from(words) * 4;
-            t.masks = Buffer::new(ctx, "tiled-light-masks", mask_bytes, storage, gpu)?;
+            let zeroed = storage | U::TRANSFER_DST;
+            t.masks = Buffer::new(ctx, "tiled-light-masks", mask_bytes, zeroed, gpu)?;
+            let depth_bytes = u64::from(tiles) * 8;
+            t.depths = Buffer::new(ctx, "tiled-depth-ranges", depth_bytes, storage, gpu)?;
             t.create_sets(ctx, desc.frames_in_flight)?;
             t.push = Some(TiledPush {
                 tiles_x: tiles_xy.0,
@@ -266,11 +286,16 @@ impl TiledLighting {
     /// frame, [`TiledLighting::set_target`]).
     fn create_sets(&mut self, ctx: &Context, slots: u32) -> Result<()> {
         let sizes = [
-            (vk::DescriptorType::STORAGE_BUFFER, 3),
+            (vk::DescriptorType::STORAGE_BUFFER, 4),
             (vk::DescriptorType::STORAGE_IMAGE, 1),
         ];
         (self.pool, self.sets) = sets_of(ctx, "tiled-set", self.set_layout, slots, &sizes)?;
-        let buffers = [self.dispatch.handle, self.lists.handle, self.masks.handle];
+        let buffers = [
+            self.dispatch.handle,
+            self.lists.handle,
+            self.masks.handle,
+            self.depths.handle,
+        ];
         for set in &self.sets {
             write_storage_buffers(ctx, *set, &buffers);
         }
@@ -285,7 +310,7 @@ impl TiledLighting {
             .image_layout(vk::ImageLayout::GENERAL)];
         let write = vk::WriteDescriptorSet::default()
             .dst_set(self.sets[slot as usize])
-            .dst_binding(3)
+            .dst_binding(4)
             .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
             .image_info(&image);
         unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
@@ -347,12 +372,14 @@ impl TiledLighting {
         let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
         unsafe {
             d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
+            // Every tile's light mask starts empty; the light lists set bits.
+            d.cmd_fill_buffer(cmd, self.masks.handle, 0, vk::WHOLE_SIZE, 0);
         }
         buffer_barrier(
             ctx,
             cmd,
             (
-                vk::PipelineStageFlags2::COPY,
+                vk::PipelineStageFlags2::ALL_TRANSFER,
                 vk::AccessFlags2::TRANSFER_WRITE,
             ),
             (
@@ -389,21 +416,25 @@ impl TiledLighting {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
             d.cmd_dispatch(cmd, groups.0, groups.1, 1);
         }
-        // The lists and masks for the shade kernels, the counts for the indirect dispatches.
-        buffer_barrier(
-            ctx,
-            cmd,
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
-                vk::AccessFlags2::SHADER_STORAGE_READ
-                    | vk::AccessFlags2::SHADER_STORAGE_WRITE
-                    | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-            ),
-        );
+        // The lists and depth ranges for what follows, the counts for the indirect dispatches.
+        after_compute(ctx, cmd);
+        ctx.end_label(cmd);
+    }
+
+    /// Records the light lists of `lights` lights, after [`TiledLighting::record_classify`] in
+    /// the same command buffer (whose sets and push constants stay bound): each light's bit in
+    /// the masks of the tiles it can reach, for [`TiledLighting::record_shade`].
+    pub fn record_light_lists(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: u32) {
+        ctx.begin_label(cmd, "tiled-light-lists");
+        // A workgroup per light, in rows of at most the guaranteed workgroup count.
+        const ROW: u32 = 65535;
+        let groups = (lights.min(ROW), lights.div_ceil(ROW));
+        unsafe {
+            let d = &ctx.device;
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.light_lists);
+            d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+        }
+        after_compute(ctx, cmd);
         ctx.end_label(cmd);
     }
 
@@ -427,6 +458,25 @@ impl TiledLighting {
         }
         ctx.end_label(cmd);
     }
+}
+
+/// Compute writes of the tile buffers made visible to the next compute pass and to the indirect
+/// dispatches.
+fn after_compute(ctx: &Context, cmd: vk::CommandBuffer) {
+    buffer_barrier(
+        ctx,
+        cmd,
+        (
+            vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        ),
+        (
+            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
+            vk::AccessFlags2::SHADER_STORAGE_READ
+                | vk::AccessFlags2::SHADER_STORAGE_WRITE
+                | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+        ),
+    );
 }
 
 /// A global barrier between `src` and `dst` (stage, access) for the tile buffers.

@@ -148,7 +148,7 @@ impl Renderer<'_> {
             };
             let mut targets = self.targets.lighting();
             let timestamps = &mut self.timestamps;
-            let classified = |cmd| timestamps.mark(ctx, cmd, "tile-classify");
+            let classified = |cmd, pass| timestamps.mark(ctx, cmd, pass);
             // SAFETY: as for `record` below.
             unsafe {
                 self.lighting
