@@ -35,7 +35,7 @@ pub fn brdf_palette(scene: &Scene, count: usize) -> Vec<Brdf> {
     palette
 }
 
-/// `scene` with its objects' BRDFs folded onto `count` models ([`brdf_palette`]): object `i`
+/// `scene` with its objects' BRDFs folded onto `count` models (`brdf_palette`): object `i`
 /// takes model `i % count`. Tints are kept. Interleaving spreads every model over the scene,
 /// so a huge light touches all `count`, as in the talk's figures.
 pub fn with_brdf_count(scene: &Scene, count: usize) -> Scene {
