@@ -21,9 +21,9 @@ use crate::CostModel;
 /// light covering the whole screen and scale linearly with coverage.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TiledCosts {
-    /// Classifying every tile of the frame (BRDFs, depth range, light lists).
+    /// Classifying every tile of the frame (BRDFs, depth range).
     pub classify_ms: f64,
-    /// Shading one full-screen light in the tiled kernels.
+    /// One full-screen light in the tiled kernels: its light list and its shading.
     pub shade_ms: f64,
     /// The 95 % interval `(lo, hi)` of each cost above, when measured.
     pub interval: Option<[(f64, f64); 2]>,

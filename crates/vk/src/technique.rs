@@ -123,9 +123,9 @@ pub enum Technique {
         flush: FlushPolicy,
     },
     /// Today's engines' way (Unity HDRP's material tiles, UE5 Substrate's classification,
-    /// Battlefield 3's tiled light lists): a compute pass classifies each 16x16 tile by the
-    /// BRDFs its pixels use and the lights that can reach it, then one indirect dispatch per
-    /// BRDF shades that BRDF's tiles with a kernel specialised to it, each pixel once by its
+    /// Battlefield 3's tiled light lists): a compute pass classifies each tile by the BRDFs
+    /// its pixels use and their depth range, a second lists the lights that can reach each
+    /// tile, then one indirect dispatch per BRDF shades that BRDF's tiles with a kernel specialised to it, each pixel once by its
     /// own BRDF with its tile's lights (`passes/tiled.rs`). No stencil, no hi-stencil: the same
     /// on every platform. `mixed` says how tiles of several BRDFs are shaded, `side` how big a
     /// tile is.

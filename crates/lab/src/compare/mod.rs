@@ -645,7 +645,7 @@ fn pixel_shares(renderer: &mut Renderer, palette: &[BrdfId]) -> Result<Vec<f64>>
         .render(branching, readback)?
         .images
         .brdf_ids
-        .unwrap_or_default();
+        .ok_or_else(|| crate::LabError::Settings("no BRDF ids read back".into()))?;
     let mut counts = vec![0usize; palette.len()];
     for id in ids.into_iter().flatten() {
         if let Some(i) = palette.iter().position(|p| *p == id) {

@@ -250,8 +250,6 @@ impl CompareReport {
         md
     }
 
-    /// The emulated rows' technique and bookkeeping side by side, each with its interval, and
-    /// the technique against native stencil at the same BRDF count, paired by round.
     /// The table's extra-BRDF columns against what their BRDFs cost alone.
     fn single_brdf_markdown(&self) -> String {
         let columns: Vec<usize> = (0..self.rows[0].cells.len())
@@ -262,11 +260,12 @@ impl CompareReport {
         }
         let mut md = String::from(
             "\nAn extra BRDF costs its own arithmetic as well as the technique's work: the columns \
-             above give two thirds of the objects costlier BRDFs than the 1-BRDF column's. Below, \
-             each cell against what its BRDFs cost alone: per round, the row's time on the scene \
-             with every object in one BRDF, weighted by that BRDF's share of the cell's surface \
-             pixels (exact where every light covers the screen), paired by round. What is left \
-             is the technique's own cost per extra BRDF (the physical limit is about 0 %).\n\n",
+             above put (n - 1) / n of the objects in BRDFs other than the 1-BRDF column's, \
+             which may cost more or less per pixel. Below, each cell against what its BRDFs \
+             cost alone: per round, the row's time on the scene with every object in one BRDF, \
+             weighted by that BRDF's share of the cell's surface pixels (exact where every light \
+             covers the screen), paired by round. What is left is what the technique adds for \
+             the cell's extra BRDFs beyond their arithmetic (the physical limit is about 0 %).\n\n",
         );
         let head: Vec<String> = columns
             .iter()
@@ -293,6 +292,8 @@ impl CompareReport {
         md
     }
 
+    /// The emulated rows' technique and bookkeeping side by side, each with its interval, and
+    /// the technique against native stencil at the same BRDF count, paired by round.
     fn emulation_markdown(&self) -> String {
         let native = self.rows.iter().find(|r| r.name == "stencil native");
         let emulated: Vec<&Row> = self

@@ -46,8 +46,9 @@ bool tile_surface(ivec2 px, out uint model, out float depth) {
 
 // Pixel `px`'s part in its tile's class: false where it has no surface; else its BRDF slot's
 // bit (0 for a BRDF the frame does not light) and the bits of its linear depth (positive floats
-// order as their bits do). Clears the pixel when asked, where no shade kernel will write it
-// (a kernel writes each pixel of a BRDF in the frame once, without reading it, when clearing).
+// order as their bits do). Clears the pixel when asked, unless it is of a BRDF in the frame,
+// which its kernel writes once without reading it. (The branching kernel of mixed tiles also
+// writes a mixed tile's pixels of BRDFs not in the frame, after this clear, ordered after it.)
 bool pixel_class(ivec2 px, out uint bit, out uint depth_bits) {
     uint model;
     float depth;

@@ -51,9 +51,10 @@ vec2 framebuffer_point(vec3 v) {
 }
 
 // The tiles [t0, t1) that can hold a pixel whose surface `light` reaches: every tile for a
-// directional light and for one whose range box reaches the eye's plane; else the rectangle
-// round the projected corners of the box round its range sphere (the sphere's projection lies
-// inside), a pixel wider on each side. Outside it a light adds exactly zero.
+// directional light and for one whose range box reaches the eye's plane, none for one wholly
+// behind it (every visible surface is in front); else the rectangle round the projected
+// corners of the box round its range sphere (the sphere's projection lies inside), a pixel
+// wider on each side. Outside it a light adds exactly zero.
 void light_tiles(Light light, out uvec2 t0, out uvec2 t1) {
     t0 = uvec2(0u);
     t1 = uvec2(tiled.tiles_x, tiled.tiles / tiled.tiles_x);
@@ -62,6 +63,10 @@ void light_tiles(Light light, out uvec2 t0, out uvec2 t1) {
     }
     vec3 centre = (frame.view * vec4(light.position_radius.xyz, 1.0)).xyz;
     float r = light.position_radius.w * (1.0 + 1e-4) + 1e-4;
+    if (centre.z - r > 0.0) {
+        t1 = t0;
+        return;
+    }
     if (centre.z + r >= -1e-6) {
         return;
     }

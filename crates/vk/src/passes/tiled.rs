@@ -1,13 +1,13 @@
 //! The tiled technique, the way engines today light many BRDFs (Unity HDRP's material feature
 //! tiles, UE5 Substrate's classification, Battlefield 3's tiled light lists), next to the
 //! talk's: a compute pass classifies each 8x8 or 16x16 tile ([`TileSide`]) of the G-buffer (the
-//! BRDFs its pixels use, their depth range, the lights that can reach them) into one list of
-//! tiles per BRDF with its indirect dispatch arguments, all on the GPU; then one indirect
+//! BRDFs its pixels use, their depth range) into one list of tiles per BRDF with its indirect
+//! dispatch arguments, all on the GPU; then one indirect
 //! dispatch per BRDF in the frame runs a kernel specialised to that BRDF over its tiles, and each
 //! pixel adds the tile's lights by its own BRDF, once. A tile with pixels of several BRDFs is in
 //! several lists, and each BRDF's kernel shades only its own pixels there.
-//! The lights each tile's pixels can see are listed between the two: each light is binned into
-//! the tiles of its screen rectangle whose depth range its range sphere reaches.
+//! The lights each tile's pixels can see are listed between the two passes: each light is binned
+//! into the tiles of its screen rectangle whose depth range its range sphere reaches.
 //! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
 use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
@@ -48,7 +48,8 @@ const PER_BRDF: u32 = u32::MAX;
 const BRANCH_ON_GBUFFER: u32 = u32::MAX;
 
 /// The side of the tiled technique's tiles (`TILED_TILE` of the stages it picks): one workgroup
-/// of the classification and of a shade kernel covers one tile.
+/// of a shade kernel covers one tile, as does one of the classification's in its workgroup
+/// shape ([`TileClassify`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum TileSide {
     /// 8x8 pixels: fewer wasted invocations on mixed and partly covered tiles, four times the
