@@ -158,7 +158,7 @@ pub fn calibrate(
                 let ms =
                     t.pass_ms("lighting").unwrap_or(0.0) + t.pass_ms("tile-lights").unwrap_or(0.0);
                 kind.per_light_ms.push(ms / *lights);
-                if let Some(classify) = timings.timings.pass_ms("tile-classify") {
+                if let Some(classify) = t.pass_ms("tile-classify") {
                     kind.classify_ms.push(classify);
                 }
             }

@@ -783,8 +783,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         self.in_flight.mark();
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
-        let shape = (mixed, frame.classify);
-        tiled.record_classify(ctx, cmd, &sets, targets, depth_sampled, clear, shape);
+        let shape = frame.classify;
+        tiled.record_classify(ctx, cmd, &sets, targets, depth_sampled, clear, mixed, shape);
         between(cmd, "tile-classify");
         tiled.record_light_lists(ctx, cmd, frame.lights.len() as u32);
         between(cmd, "tile-lights");

@@ -450,12 +450,10 @@ pub fn run_compare(
     // column's), each warmed up, and every column's share of surface pixels per BRDF: what the
     // columns would cost if an extra BRDF added only its own arithmetic.
     let max_count = settings.brdf_counts.iter().copied().max().unwrap_or(1);
-    let palette: Vec<BrdfId> = brdf_palette(&settings.scene, max_count)
-        .iter()
-        .map(|b| b.id())
-        .collect();
+    let models = brdf_palette(&settings.scene, max_count);
+    let palette: Vec<BrdfId> = models.iter().map(|b| b.id()).collect();
     let mut singles = Vec::new();
-    for brdf in brdf_palette(&settings.scene, max_count).into_iter().skip(1) {
+    for &brdf in models.iter().skip(1) {
         progress(&format!("{} alone: warm-up", brdf.id().name()));
         let mut renderer = new_renderer(with_one_brdf(&settings.scene, brdf))?;
         for (_, technique) in &rows_spec {
@@ -531,7 +529,7 @@ pub fn run_compare(
             })
             .collect()
     };
-    let single_brdf: Vec<Vec<Vec<f64>>> = (0..renderers.len())
+    let mut single_brdf: Vec<Vec<Vec<f64>>> = (0..renderers.len())
         .map(|count| {
             (0..rows_spec.len())
                 .map(|row| single_brdf(count, row))
@@ -544,7 +542,7 @@ pub fn run_compare(
                 brdfs: *brdfs,
                 samples: std::mem::take(&mut samples[count][r]),
                 bookkeeping: std::mem::take(&mut bookkeeping[count][r]),
-                single_brdf: single_brdf[count][r].clone(),
+                single_brdf: std::mem::take(&mut single_brdf[count][r]),
                 error: *error,
             });
         }

@@ -111,14 +111,13 @@ impl CompareReport {
         md += "## Lighting time against BRDF count\n\n";
         md += "Overheads are against each row's own 1-BRDF time in this run; the error column is \
                the worst over the BRDF counts.\n\n";
-        let counts: Vec<usize> = self.rows[0].cells.iter().map(|c| c.brdfs).collect();
-        let head: Vec<String> = counts.iter().map(|n| brdfs_label(*n)).collect();
-        let _ = writeln!(
-            md,
-            "| technique | {} | error max / mean / FLIP |\n|---|{}---|",
-            head.join(" | "),
-            "---|".repeat(counts.len())
-        );
+        let mut head: Vec<String> = self.rows[0]
+            .cells
+            .iter()
+            .map(|c| brdfs_label(c.brdfs))
+            .collect();
+        head.push("error max / mean / FLIP".into());
+        md += &table_head(&head);
         for row in &self.rows {
             let cells: Vec<String> = (0..row.cells.len()).map(|i| cell_text(row, i)).collect();
             let _ = writeln!(
@@ -271,20 +270,13 @@ impl CompareReport {
             .iter()
             .map(|&i| brdfs_label(self.rows[0].cells[i].brdfs))
             .collect();
-        let _ = writeln!(
-            md,
-            "| technique | {} |\n|---|{}",
-            head.join(" | "),
-            "---|".repeat(columns.len())
-        );
+        md += &table_head(&head);
         for row in &self.rows {
             let cells: Vec<String> = columns
                 .iter()
                 .map(|&i| {
-                    let (r, verdict) = row.over_single_brdf(i).expect("several BRDFs");
-                    let pct = |x: f64| 100.0 * (x - 1.0);
-                    let (m, lo, hi) = (pct(r.median), pct(r.lo), pct(r.hi));
-                    format!("{m:+.1} % [{lo:+.1}, {hi:+.1}], {}", verdict.word())
+                    let (ratio, verdict) = row.over_single_brdf(i).expect("several BRDFs");
+                    percent_text(&ratio, verdict)
                 })
                 .collect();
             let _ = writeln!(md, "| {} | {} |", row.name, cells.join(" | "));
@@ -486,13 +478,22 @@ fn cell_text(row: &Row, i: usize) -> String {
         return t;
     }
     let (ratio, verdict) = row.overhead_ratio(i);
+    format!("{t} ({})", percent_text(&ratio, verdict))
+}
+
+/// A ratio's interval as a change in percent with its verdict: `+12.3 % [+10.1, +14.0], slower`.
+fn percent_text(ratio: &crate::stats::Interval, verdict: Verdict) -> String {
     let pct = |r: f64| 100.0 * (r - 1.0);
+    let (m, lo, hi) = (pct(ratio.median), pct(ratio.lo), pct(ratio.hi));
+    format!("{m:+.1} % [{lo:+.1}, {hi:+.1}], {}", verdict.word())
+}
+
+/// A table's header row, after the `technique` column, and its rule.
+fn table_head(columns: &[String]) -> String {
     format!(
-        "{t} ({:+.1} % [{:+.1}, {:+.1}], {})",
-        pct(ratio.median),
-        pct(ratio.lo),
-        pct(ratio.hi),
-        verdict.word()
+        "| technique | {} |\n|---|{}\n",
+        columns.join(" | "),
+        "---|".repeat(columns.len())
     )
 }
 

@@ -332,7 +332,8 @@ impl TiledLighting {
         targets: &mut LightingTargets,
         depth_sampled: bool,
         clear: bool,
-        (mixed, shape): (MixedTiles, TileClassify),
+        mixed: MixedTiles,
+        shape: TileClassify,
     ) {
         let d = &ctx.device;
         let push = TiledPush {
