@@ -99,6 +99,18 @@ fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
                 let label = format!("{name} {backend:?}");
                 let never = image(&mut renderer, stencil(backend, FlushPolicy::Never), 0);
                 assert_broken(&format!("{label} flush never"), &never, &forward);
+                // Timed frames test tiles in a shader without the statistics' count: the same
+                // failure, pixel for pixel, as the counting shader's.
+                let counted = FrameDesc {
+                    tile_stats: true,
+                    ..FrameDesc::new(stencil(backend, FlushPolicy::Never), Readback::ALL)
+                };
+                let counted = renderer.render_frame(&counted).expect("frame");
+                assert_eq!(
+                    diff(&counted.images.ldr.unwrap(), &never).pixels_differing,
+                    0,
+                    "{label}: the counting shader culls other tiles"
+                );
                 let auto = image(&mut renderer, stencil(backend, FlushPolicy::Auto), 0);
                 assert_close(&format!("hi-{name}-auto"), &auto, &forward, TOLERANCE);
                 // Extra flushes change nothing once every test sees its own mask.

@@ -40,12 +40,16 @@ pub enum BrdfSource {
     Table,
 }
 
-/// Whether a light shader carries the hi-stencil emulation's work: rejecting failing tiles and
-/// counting shaded fragments. Without it the code is specialised away, so the native path does
-/// not pay for shader memory writes (llvmpipe is about 20 % slower with them compiled in).
+/// Which of the hi-stencil emulation's work a light shader carries: rejecting failing tiles, and
+/// counting shaded fragments for the statistics. What a pass does not need is specialised away,
+/// so timed passes carry no shader memory writes (llvmpipe is about 20 % slower with an atomic
+/// compiled in, even where it never runs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TileWork {
     None,
+    /// The emulated hi-stencil test, read-only.
+    Test,
+    /// The test and the statistics' fragment count.
     TestAndCount,
 }
 
@@ -116,25 +120,19 @@ impl LightPipelines {
             ),
             LightShader::Brdf { id, tiles } => (
                 Some(light),
-                Some([id.index(), u32::from(tiles == TileWork::TestAndCount)]),
+                Some([id.index(), tiles.tests(), tiles.counts()]),
                 format!("{}{}", id.name(), tiles.suffix()),
             ),
             LightShader::Branching { tiles } => (
                 Some(light),
-                Some([
-                    BRANCH_ON_GBUFFER,
-                    u32::from(tiles == TileWork::TestAndCount),
-                ]),
+                Some([BRANCH_ON_GBUFFER, tiles.tests(), tiles.counts()]),
                 format!("branching{}", tiles.suffix()),
             ),
             // Constant 0 is unused by the LUT shader; both are given so every light shader
             // specialises the same way.
             LightShader::Lut { tiles } => (
                 Some(("lut_light.frag", self.modules.lut_light)),
-                Some([
-                    BRANCH_ON_GBUFFER,
-                    u32::from(tiles == TileWork::TestAndCount),
-                ]),
+                Some([BRANCH_ON_GBUFFER, tiles.tests(), tiles.counts()]),
                 format!("lut{}", tiles.suffix()),
             ),
         };
@@ -185,8 +183,19 @@ impl TileWork {
     fn suffix(self) -> &'static str {
         match self {
             TileWork::None => "",
-            TileWork::TestAndCount => "-tiles",
+            TileWork::Test => "-tiles",
+            TileWork::TestAndCount => "-tiles-counted",
         }
+    }
+
+    /// `TILE_TEST` of `include/light_tiles.glsl`.
+    fn tests(self) -> u32 {
+        u32::from(self != TileWork::None)
+    }
+
+    /// `TILE_COUNT` of `include/light_tiles.glsl`.
+    fn counts(self) -> u32 {
+        u32::from(self == TileWork::TestAndCount)
     }
 }
 
@@ -198,8 +207,10 @@ pub fn pipeline_key(
     count_stats: bool,
     source: BrdfSource,
 ) -> LightPipelineKey {
-    let tiles = if count_stats || pass.state.tests_hi_stencil() {
+    let tiles = if count_stats {
         TileWork::TestAndCount
+    } else if pass.state.tests_hi_stencil() {
+        TileWork::Test
     } else {
         TileWork::None
     };
@@ -283,7 +294,7 @@ mod tests {
                 .unwrap();
         let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula);
         let shaders: Vec<LightShader> = keys.iter().map(|k| k.1).collect();
-        let tiles = TileWork::TestAndCount;
+        let tiles = TileWork::Test;
         for expected in [
             LightShader::StencilOnly,
             LightShader::TouchTiles,
@@ -299,9 +310,16 @@ mod tests {
             assert!(shaders.contains(&expected), "{expected:?} in {shaders:?}");
         }
         assert!(!shaders.contains(&LightShader::CountTiles));
-        assert!(plan_pipelines(&plan, &brdfs, true, BrdfSource::Formula)
-            .iter()
-            .any(|k| k.1 == LightShader::CountTiles));
+        // Only the statistics runs compile the fragment count in.
+        let counted = plan_pipelines(&plan, &brdfs, true, BrdfSource::Formula);
+        assert!(counted.iter().any(|k| k.1 == LightShader::CountTiles));
+        assert!(counted.iter().all(|k| !matches!(
+            k.1,
+            LightShader::Brdf {
+                tiles: TileWork::Test | TileWork::None,
+                ..
+            }
+        )));
         let table = plan_pipelines(&plan, &brdfs, false, BrdfSource::Table);
         assert!(table.iter().any(|k| matches!(k.1, LightShader::Lut { .. })));
         assert!(!table.iter().any(|k| matches!(
