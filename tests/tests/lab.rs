@@ -5,9 +5,11 @@
 //! the adaptive technique.
 
 use histencil_lab::stats::Sampling;
-use histencil_lab::{calibrate, read_costs, run_compare, run_sweep, CompareSettings, SweepParam};
-use histencil_tests::{output_dir, with_validated_context};
-use histencil_vk::{Backend, Renderer, RendererDesc};
+use histencil_lab::{
+    calibrate, light_size_scene, read_costs, run_compare, run_sweep, CompareSettings, SweepParam,
+};
+use histencil_tests::{lit_fraction, output_dir, with_validated_context};
+use histencil_vk::{Backend, Readback, Renderer, RendererDesc, Shading};
 use serde_json::Value;
 use std::path::Path;
 
@@ -46,6 +48,24 @@ fn assert_png(path: &Path) {
 
 fn read_json(path: &Path) -> Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).expect("valid JSON")
+}
+
+/// The light-size sweep times lit pixels: its forward reference lights about the area its lights
+/// cover (400 discs of 0.1 % each, overlapping; one light reaching the whole wall, where the
+/// Blinn-Phong stripes are dark away from its highlight). Lights in the wall's plane lit nothing.
+#[test]
+fn the_light_size_wall_is_lit() {
+    with_validated_context(|ctx| {
+        for (coverage, at_least) in [(0.001, 0.2), (0.1, 0.4), (1.0, 0.6)] {
+            let scene = light_size_scene(coverage, 16.0 / 9.0);
+            let mut renderer = Renderer::new(ctx, scene, 256, 144).unwrap();
+            let frame = renderer.render(Shading::Forward, Readback::ALL).unwrap();
+            let ldr = frame.images.ldr.unwrap();
+            let lit = lit_fraction(&ldr);
+            println!("coverage {coverage}: {lit:.3} lit");
+            assert!(lit >= at_least, "coverage {coverage}: {lit:.3} lit");
+        }
+    });
 }
 
 #[test]

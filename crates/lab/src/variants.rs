@@ -69,9 +69,14 @@ const WALL_DISTANCE: f32 = 10.0;
 const FOV_Y_DEGREES: f32 = 60.0;
 
 /// A wall of vertical stripes in Lambert, Blinn-Phong and Oren-Nayar, filling the view, lit by
-/// point lights centred on it whose disc each covers `coverage` (0..=1) of the screen. There are
-/// `2 / coverage` of them (at most 400), so the lit area stays about two screens whatever the
-/// size, and only the per-light costs change. Lights at full coverage reach every corner.
+/// point lights in front of it whose range sphere each cuts a disc of `coverage` (0..=1) of the
+/// screen from the wall. There are `2 / coverage` of them (at most 400), so the lit area stays
+/// about two screens whatever the size, and only the per-light costs change. Lights at full
+/// coverage reach every corner.
+///
+/// Each light stands half its disc's radius off the wall (at full coverage, half the visible
+/// wall's height): a light centred on the wall's plane meets every point of it at a
+/// grazing angle, so it would add exactly zero and the sweep would time an unlit wall.
 pub fn light_size_scene(coverage: f64, aspect: f32) -> Scene {
     let coverage = coverage.clamp(1e-4, 1.0) as f32;
     let tan = (FOV_Y_DEGREES.to_radians() * 0.5).tan();
@@ -93,10 +98,14 @@ pub fn light_size_scene(coverage: f64, aspect: f32) -> Scene {
         .collect();
     // Disc radius whose area is `coverage` of the screen (2 half_w x 2 half_h at the wall).
     let disc = (4.0 * half_w * half_h * coverage / std::f32::consts::PI).sqrt();
-    let radius = if coverage >= 1.0 {
-        (half_w * half_w + half_h * half_h).sqrt() * 1.05
+    let (height, radius) = if coverage >= 1.0 {
+        // Far enough and wide enough that the corners keep a visible share of the light.
+        let height = half_h;
+        let corner = half_w * half_w + half_h * half_h + height * height;
+        (height, corner.sqrt() * 1.5)
     } else {
-        disc
+        let height = 0.5 * disc;
+        (height, (disc * disc + height * height).sqrt())
     };
     let count = ((2.0 / coverage).round() as usize).clamp(1, 400);
     let lights = (0..count)
@@ -105,8 +114,10 @@ pub fn light_size_scene(coverage: f64, aspect: f32) -> Scene {
             let u = fract(0.5 + i as f32 * 0.618_034);
             let v = fract(0.5 + i as f32 * 0.754_878);
             let at = Vec3::new((2.0 * u - 1.0) * half_w, (2.0 * v - 1.0) * half_h, 0.0);
-            let centre = if coverage >= 1.0 { Vec3::ZERO } else { at };
-            Light::point(centre, radius, Vec3::splat(0.15 * radius * radius))
+            let foot = if coverage >= 1.0 { Vec3::ZERO } else { at };
+            // About 0.6 of unit radiance at the foot of every light, whatever its size.
+            let intensity = Vec3::splat(0.6 * height * height);
+            Light::point(foot + Vec3::Z * height, radius, intensity)
         })
         .collect();
     Scene {
@@ -165,6 +176,30 @@ mod tests {
                 assert_eq!(touching(2), all, "coverage {coverage}");
                 assert!(touching(3) >= 0.8 * all, "coverage {coverage}");
             }
+        }
+    }
+
+    /// Every light stands in front of the wall (one in its plane meets it edge-on and adds
+    /// nothing), and its range sphere cuts a disc of `coverage` of the visible wall from it.
+    #[test]
+    fn light_size_lights_face_the_wall_and_cut_discs_of_their_coverage() {
+        let aspect = 16.0 / 9.0;
+        let tan = (FOV_Y_DEGREES.to_radians() * 0.5).tan();
+        let wall_area = 4.0 * WALL_DISTANCE * tan * WALL_DISTANCE * tan * aspect;
+        for coverage in [0.001, 0.01, 0.3] {
+            for light in &light_size_scene(coverage, aspect).lights {
+                let height = light.position.z;
+                assert!(height > 0.0, "coverage {coverage}: light at {height}");
+                let disc = light.radius * light.radius - height * height;
+                let cut = std::f32::consts::PI * disc / wall_area;
+                assert!(
+                    (cut / coverage as f32 - 1.0).abs() < 1e-3,
+                    "{cut} for {coverage}"
+                );
+            }
+        }
+        for light in &light_size_scene(1.0, aspect).lights {
+            assert!(light.position.z > 0.0);
         }
     }
 }
