@@ -43,20 +43,33 @@ void main() {
     if (s.brdf != model) {
         return;
     }
+    // The tile's lights in the scene's order (word by word, low bit first), as forward adds
+    // them. The loop tests for another light at its end, and skips empty words in a loop of
+    // its own: llvmpipe runs a loop's body once more, every lane masked off, after the last
+    // lane leaves it, so a light loop entered per mask word (or tested at its top) cost a whole
+    // light evaluation per word. Here the wasted one is a word load, and a light evaluation
+    // only where the tile has no light at all.
+    uint base = tile * tiled.words;
+    uint w = 0u;
+    uint bits = tile_lights[base];
+    while (bits == 0u && w + 1u < tiled.words) {
+        bits = tile_lights[base + ++w];
+    }
     vec3 sum = vec3(0.0);
-    for (uint w = 0u; w < tiled.words; ++w) {
-        uint bits = tile_lights[tile * tiled.words + w];
-        while (bits != 0u) {
-            uint b = uint(findLSB(bits));
+    if (bits != 0u) {
+        do {
+            uint index = w * 32u + uint(findLSB(bits));
             bits &= bits - 1u;
-            uint index = w * 32u + b;
             Light light = lights[index];
             vec3 lit = shade_light_with(light, s, model);
             if (any(greaterThan(lit, vec3(0.0)))) {
                 lit *= light_visibility(index, light, s);
             }
             sum += lit;
-        }
+            while (bits == 0u && w + 1u < tiled.words) {
+                bits = tile_lights[base + ++w];
+            }
+        } while (bits != 0u);
     }
     // Each pixel is shaded by one kernel (its BRDF's, or the branching one's): over a cleared
     // target its light is the whole value, and the classification left the pixel unwritten.
