@@ -168,6 +168,10 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
     assert_eq!(sizes.len(), 3);
     for size in sizes {
         assert!(size["tiled"]["median_ms"].as_f64().unwrap() > 0.0);
+        // The sweep's tiled technique takes the device's tiles: 8x8 on a CPU like lavapipe.
+        let cpu = json["device"].as_str().unwrap().contains("llvmpipe");
+        let side = size["tiled_tile_side"].as_u64();
+        assert_eq!(side, Some(if cpu { 8 } else { 16 }));
         assert_eq!(size["samples_ms"]["tiled"].as_array().unwrap().len(), 2);
     }
     assert_eq!(json["breakdown"].as_array().unwrap().len(), 3);

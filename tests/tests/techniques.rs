@@ -255,11 +255,12 @@ fn adaptive_chooses_what_the_cost_model_says() {
         );
         assert_eq!(renderer.resolve(adaptive).unwrap(), adaptive);
 
-        // Costs with free tiles light the frame tiled: the same image as the tiled technique,
-        // classification timed; costs with dear tiles keep the plan.
+        // Costs with free tiles light the frame tiled (with the device's tiles, 8x8 on
+        // lavapipe): the same image as the tiled technique, classification timed; costs with
+        // dear tiles keep the plan.
         let tiled = Technique::Tiled {
             mixed: MixedTiles::PerBrdf,
-            side: TileSide::Sixteen,
+            side: TileSide::for_device(ctx.device_type()),
         };
         let tiles = |classify_ms| {
             Some(TiledCosts {

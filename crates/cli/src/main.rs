@@ -148,9 +148,10 @@ struct RenderArgs {
     /// figures).
     #[arg(long)]
     costs: Option<PathBuf>,
-    /// The tiled techniques' tile side in pixels.
-    #[arg(long, value_enum, default_value = "16")]
-    tile_size: TileSizeArg,
+    /// The tiled techniques' tile side in pixels (default: the device's, 8 on a CPU rasteriser
+    /// such as lavapipe, else 16).
+    #[arg(long, value_enum)]
+    tile_size: Option<TileSizeArg>,
     /// Time every lighting step and print the talk's pass groups (setup, mask and shade per BRDF,
     /// cleanup) and the most expensive lights. Timestamps between draws cost time of their own.
     #[arg(long)]
@@ -245,14 +246,15 @@ enum FlushArg {
 }
 
 impl RenderArgs {
-    fn tile_side(&self) -> TileSide {
+    fn tile_side(&self, ctx: &Context) -> TileSide {
         match self.tile_size {
-            TileSizeArg::Eight => TileSide::Eight,
-            TileSizeArg::Sixteen => TileSide::Sixteen,
+            Some(TileSizeArg::Eight) => TileSide::Eight,
+            Some(TileSizeArg::Sixteen) => TileSide::Sixteen,
+            None => TileSide::for_device(ctx.device_type()),
         }
     }
 
-    fn shading(&self) -> Shading {
+    fn shading(&self, ctx: &Context) -> Shading {
         // The check's platform vocabulary names the same five backends.
         let backend = match self.backend {
             BackendArg::X360 => Platform::X360,
@@ -274,12 +276,12 @@ impl RenderArgs {
             TechniqueArg::Lut => Technique::Lut { backend, flush }.into(),
             TechniqueArg::Tiled => Technique::Tiled {
                 mixed: MixedTiles::PerBrdf,
-                side: self.tile_side(),
+                side: self.tile_side(ctx),
             }
             .into(),
             TechniqueArg::TiledMixedBranching => Technique::Tiled {
                 mixed: MixedTiles::Branching,
-                side: self.tile_side(),
+                side: self.tile_side(ctx),
             }
             .into(),
             TechniqueArg::Deferred => Technique::DEFERRED.into(),
@@ -354,7 +356,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
         }
     }
     on_device(args.validate, |ctx| {
-        let shading = args.shading();
+        let shading = args.shading(ctx);
         let desc = RendererDesc {
             lut_resolution: args.lut_resolution,
             lightmap_side: args.lightmap_resolution,

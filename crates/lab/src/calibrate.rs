@@ -80,9 +80,10 @@ pub fn calibrate(
     let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
     let stencil = Technique::Stencil { backend, flush };
     let branching = Technique::Branching { backend, flush };
+    // The side the adaptive technique resolves to on this device.
     let tiled = Technique::Tiled {
         mixed: MixedTiles::PerBrdf,
-        side: TileSide::Sixteen,
+        side: TileSide::for_device(ctx.device_type()),
     };
     // Full-screen lights: branching, stencil and tiled; small lights: stencil. 1 and 3 BRDFs
     // each.

@@ -84,8 +84,8 @@ fn stencil(backend: Backend, flush: FlushPolicy) -> Technique {
     Technique::Stencil { backend, flush }
 }
 
-/// The rows, in the table's order.
-fn configurations() -> [(&'static str, Shading); 7] {
+/// The rows, in the table's order; tiled with tiles of `side`.
+fn configurations(side: TileSide) -> [(&'static str, Shading); 7] {
     let auto = FlushPolicy::Auto;
     [
         ("forward (reference)", Shading::Forward),
@@ -108,7 +108,7 @@ fn configurations() -> [(&'static str, Shading); 7] {
             "tiled, native",
             Technique::Tiled {
                 mixed: MixedTiles::PerBrdf,
-                side: TileSide::Sixteen,
+                side,
             }
             .into(),
         ),
@@ -130,7 +130,7 @@ pub fn run_demo(
     };
     let mut frames: Vec<(RgbaImage, Option<StencilView>)> = Vec::new();
     let mut rows = Vec::new();
-    for (label, shading) in configurations() {
+    for (label, shading) in configurations(TileSide::for_device(ctx.device_type())) {
         step(label);
         let passes = shading.lighting_passes();
         let desc = FrameDesc {

@@ -104,7 +104,7 @@ pub struct TiledFrame<'a> {
     pub lights: &'a [Light],
     /// Clear the HDR target to black first; otherwise light adds onto its contents.
     pub clear_hdr: bool,
-    /// The tiles' side.
+    /// The tiles' side: [`TileSide::for_device`] picks the faster measured for the device.
     pub side: TileSide,
     /// What a tile of several BRDFs does.
     pub mixed: MixedTiles,

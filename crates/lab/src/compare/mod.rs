@@ -255,8 +255,10 @@ pub struct SizePoint {
     pub branching: Timing,
     pub stencil: Timing,
     pub adaptive: Timing,
-    /// The tiled technique (16x16 tiles, mixed tiles per BRDF).
+    /// The tiled technique (mixed tiles per BRDF, the device's tile side).
     pub tiled: Timing,
+    /// Its tile side in pixels ([`TileSide::for_device`]).
+    pub tile_side: u32,
     /// The worst of the four techniques' errors against forward.
     pub error: ImageError,
     /// Every round's lighting time of branching, stencil, adaptive and tiled, interleaved.
@@ -554,6 +556,7 @@ pub fn run_compare(
         }
     }
     let aspect = w as f32 / h as f32;
+    let side = TileSide::for_device(ctx.device_type());
     let mut sizes = Vec::new();
     for &coverage in &settings.light_sizes {
         progress(&format!("light size {:.1} %", coverage * 100.0));
@@ -562,7 +565,7 @@ pub fn run_compare(
         let mut renderer = new_renderer(scene)?;
         let reference = frame(&mut renderer, Shading::Forward)?;
         let mut error = ImageError::default();
-        for technique in size_techniques() {
+        for technique in size_techniques(side) {
             error = error.worst(image_error(&frame(&mut renderer, technique)?, &reference));
         }
         // Interleaved, as the table; tracked: every pair's ratio.
@@ -576,7 +579,7 @@ pub fn run_compare(
         let sampled = sample(
             &sampling,
             |_| -> Result<()> {
-                for (i, technique) in size_techniques().into_iter().enumerate() {
+                for (i, technique) in size_techniques(side).into_iter().enumerate() {
                     let (ms, _) = lighting_ms(&mut renderer, technique)?;
                     samples.borrow_mut()[i].push(ms);
                 }
@@ -593,6 +596,7 @@ pub fn run_compare(
             stencil: timings[1],
             adaptive: timings[2],
             tiled: timings[3],
+            tile_side: side.pixels(),
             error,
             samples,
             sampled,
@@ -654,9 +658,9 @@ fn pixel_shares(renderer: &mut Renderer, palette: &[BrdfId]) -> Result<Vec<f64>>
     Ok(counts.into_iter().map(|c| c as f64 / total).collect())
 }
 
-/// Branching, stencil and adaptive on the native backend, and tiled: the light-size sweep's
-/// four.
-fn size_techniques() -> [Technique; 4] {
+/// Branching, stencil and adaptive on the native backend, and tiled with tiles of `side`: the
+/// light-size sweep's four.
+fn size_techniques(side: TileSide) -> [Technique; 4] {
     let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
     [
         Technique::Branching { backend, flush },
@@ -664,7 +668,7 @@ fn size_techniques() -> [Technique; 4] {
         Technique::Adaptive { backend, flush },
         Technique::Tiled {
             mixed: MixedTiles::PerBrdf,
-            side: TileSide::Sixteen,
+            side,
         },
     ]
 }

@@ -188,11 +188,17 @@ impl CompareReport {
                 f.setup, f.mask, f.render, f.cleanup
             );
         }
-        md += "\n## Light size: where branching overtakes stencil\n\n\
-               A striped wall in three BRDFs under lights covering the given fraction of the \
-               screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
-               screens. Native backend; tiled with 16x16 tiles, mixed tiles per BRDF; the error is the worst \
-               of the four techniques.\n\n\
+        let side = self.sizes.first().map_or(16, |p| p.tile_side);
+        let _ = write!(
+            md,
+            "\n## Light size: where branching overtakes stencil\n\n\
+             A striped wall in three BRDFs under lights covering the given fraction of the \
+             screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
+             screens. Native backend; tiled with {side}x{side} tiles (the device's side, \
+             `TileSide::for_device`), mixed tiles per BRDF; the error is the worst of the four \
+             techniques.\n\n"
+        );
+        md += "\
                | coverage | lights | rounds | branching | stencil | adaptive | tiled | stencil / branching | faster | adaptive / best | tiled / best | error max / mean / FLIP |\n\
                |---|---|---|---|---|---|---|---|---|---|---|---|\n";
         for p in &self.sizes {
@@ -571,6 +577,7 @@ fn size_json(p: &SizePoint) -> Value {
         "adaptive_over_best": p.adaptive_over_best(),
         "adaptive_over_best_interval": interval_json(&p.adaptive_over_best_interval()),
         "tiled": timing_json(&p.tiled),
+        "tiled_tile_side": p.tile_side,
         "tiled_over_best": interval_json(&p.tiled_over_best().0),
         "stencil_over_branching": interval_json(&p.stencil_over_branching().0),
         "faster": p.faster(),

@@ -41,7 +41,7 @@ impl Renderer<'_> {
             if backend == Backend::Native && self.cost_model(backend).prefers_tiled(&plan) {
                 let tiled = Technique::Tiled {
                     mixed: MixedTiles::PerBrdf,
-                    side: TileSide::Sixteen,
+                    side: TileSide::for_device(self.ctx.device_type()),
                 };
                 return Ok((tiled, plan));
             }
