@@ -62,9 +62,9 @@ pub enum TileSide {
 
 impl TileSide {
     /// The side for a device of `device_type`: 8x8 on a CPU, else HDRP's 16x16. On llvmpipe
-    /// 8x8 tiles were as fast or faster everywhere measured (half the time with lights of 0.1 %
-    /// of the screen, where a 16x16 tile holds more lights for fewer of its pixels; README);
-    /// on GPUs 16x16 is the common choice, and what histencil has measured there.
+    /// 8x8 tiles were as fast or faster within the noise wherever measured, and clearly faster
+    /// with full-screen lights on a striped wall and on `town` (README); on GPUs 16x16 is the
+    /// common choice, and the two measured within a few per cent on an H200.
     pub fn for_device(device_type: vk::PhysicalDeviceType) -> Self {
         if device_type == vk::PhysicalDeviceType::CPU {
             TileSide::Eight
