@@ -1,6 +1,8 @@
 #version 460
 // Hi-stencil write, second half: one invocation per tile the draw touched (listed by
-// hi_stencil_touch.frag, dispatched indirectly over that list). The tile may pass when any of
+// hi_stencil_touch.frag, dispatched indirectly over that list), or per tile of the frame after
+// a full-screen write, which rasterises every pixel and so touches every tile without a
+// fragment shader to say so (`all_tiles`). The tile may pass when any of
 // its pixels passes the hi-stencil compare on the stencil the draw left:
 // `(stencil & read_mask) OP reference`, as histencil_model::HiStencilState says. No shared
 // memory and no barriers: a CPU rasteriser runs a workgroup with barriers one invocation at a
@@ -30,6 +32,7 @@ layout(push_constant) uniform Update {
     uint width;
     uint height;
     uint tiles_x;
+    uint all_tiles; // 1: every tile of the frame, in order; 0: the touched list's
 } update;
 
 bool compare_passes(uint op, uint a, uint b) {
@@ -47,10 +50,12 @@ bool compare_passes(uint op, uint a, uint b) {
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= touched_list.count) {
+    uint tiles_y = (update.height + HI_STENCIL_TILE - 1u) / HI_STENCIL_TILE;
+    uint count = update.all_tiles != 0u ? update.tiles_x * tiles_y : touched_list.count;
+    if (i >= count) {
         return;
     }
-    uint tile = touched_list.tiles[i];
+    uint tile = update.all_tiles != 0u ? i : touched_list.tiles[i];
     uvec2 origin = uvec2(tile % update.tiles_x, tile / update.tiles_x) * HI_STENCIL_TILE;
     uvec2 end = min(origin + HI_STENCIL_TILE, uvec2(update.width, update.height));
     uint passes = 0u;

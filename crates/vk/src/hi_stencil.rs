@@ -22,7 +22,7 @@ use crate::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
 use crate::error::{Result, VkCall};
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::Buffer;
-use crate::shader_consts::HI_STENCIL_TILE;
+use crate::shader_consts::{HI_STENCIL_TILE, HI_STENCIL_UPDATE_GROUP};
 use crate::shaders;
 use crate::state::compare_op;
 use crate::teardown::{build, Destroy};
@@ -40,6 +40,18 @@ struct UpdatePush {
     width: u32,
     height: u32,
     tiles_x: u32,
+    /// 1: update every tile (after a full-screen write); 0: the listed tiles.
+    all_tiles: u32,
+}
+
+/// Which tiles a hi-stencil write touched, for its update.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TouchedTiles {
+    /// Those its draw listed (`hi_stencil_touch.frag`): a light volume's.
+    Listed,
+    /// Every tile: a full-screen draw rasterises every pixel, so it needs no fragment shader
+    /// to list them (a console's mask pass has none either).
+    All,
 }
 
 /// Words of the statistics buffer (`HiStencilStats` in include/hi_stencil.glsl).
@@ -250,9 +262,9 @@ impl HiStencilSurface {
         };
     }
 
-    /// Outside rendering, after a write draw listed the tiles it touched, in a frame recorded
+    /// Outside rendering, after a write draw touched `touched` tiles, in a frame recorded
     /// into `slot` (prepared with this `depth_stencil`, [`HiStencilSurface::prepare_slot`]):
-    /// retires an unflushed earlier write, then evaluates `hi` on the listed tiles into pending
+    /// retires an unflushed earlier write, then evaluates `hi` on those tiles into pending
     /// state, reading the stencil in place, and empties the list for the next write. Leaves
     /// the depth-stencil image attached-ready.
     pub fn record_update(
@@ -262,6 +274,7 @@ impl HiStencilSurface {
         slot: u32,
         depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
+        touched: TouchedTiles,
     ) {
         if self.unflushed {
             self.record_flush(ctx, cmd);
@@ -275,14 +288,22 @@ impl HiStencilSurface {
             width: self.extent.width,
             height: self.extent.height,
             tiles_x: self.tiles_x,
+            all_tiles: u32::from(touched == TouchedTiles::All),
         };
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
-        unsafe {
-            ctx.device
-                .cmd_dispatch_indirect(cmd, self.touched_list.handle, 0)
-        };
+        match touched {
+            TouchedTiles::Listed => unsafe {
+                ctx.device
+                    .cmd_dispatch_indirect(cmd, self.touched_list.handle, 0)
+            },
+            TouchedTiles::All => {
+                let tiles = self.tiles_x * self.extent.height.div_ceil(HI_STENCIL_TILE);
+                let groups = tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
+                unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
+            }
+        }
         let attached = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
         // The list's counts are read (as dispatch arguments too) before they are zeroed.

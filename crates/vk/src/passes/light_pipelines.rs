@@ -221,7 +221,10 @@ pub fn pipeline_key(
             tiles,
         },
         PassKind::Shade(Shader::Branching) => LightShader::Branching { tiles },
-        _ if pass.state.writes_hi_stencil() => LightShader::TouchTiles,
+        // A full-screen write touches every tile: its update needs no list (`TouchedTiles`).
+        _ if pass.state.writes_hi_stencil() && pass.geometry == Geometry::Volume => {
+            LightShader::TouchTiles
+        }
         _ => LightShader::StencilOnly,
     };
     (pass.geometry, shader)
@@ -289,9 +292,13 @@ mod tests {
             affected: vec![0, 1],
             technique: LightTechnique::Stencil,
         };
-        let plan =
-            FramePlan::from_requests(&layout, &X360Like::default(), &[request], FlushPolicy::Auto)
-                .unwrap();
+        let plan = FramePlan::from_requests(
+            &layout,
+            &X360Like::default(),
+            std::slice::from_ref(&request),
+            FlushPolicy::Auto,
+        )
+        .unwrap();
         let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula);
         let shaders: Vec<LightShader> = keys.iter().map(|k| k.1).collect();
         let tiles = TileWork::Test;
@@ -332,6 +339,21 @@ mod tests {
                 ..
             }
         )));
+        // A viewer inside the light: its hi-stencil writes are full-screen, which touch every
+        // tile, and list none from a fragment shader.
+        let inside = LightRequest {
+            case: LightCase::ViewerInside,
+            ..request
+        };
+        let plan =
+            FramePlan::from_requests(&layout, &X360Like::default(), &[inside], FlushPolicy::Auto)
+                .unwrap();
+        assert!(plan.steps.iter().any(|s| matches!(
+            s,
+            histencil_model::Step::Pass { pass, .. } if pass.state.writes_hi_stencil()
+        )));
+        let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula);
+        assert!(!keys.iter().any(|k| k.1 == LightShader::TouchTiles));
         let table = plan_pipelines(&plan, &brdfs, false, BrdfSource::Table);
         assert!(table.iter().any(|k| matches!(k.1, LightShader::Lut { .. })));
         assert!(!table.iter().any(|k| matches!(

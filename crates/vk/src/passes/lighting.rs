@@ -17,7 +17,7 @@ use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingT
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::hi_stencil::HiStencilSurface;
+use crate::hi_stencil::{HiStencilSurface, TouchedTiles};
 use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
@@ -166,6 +166,16 @@ impl Emulation {
 /// The set index of an engine's visibility hook (hooks/light_visibility.glsl).
 const VISIBILITY_SET_INDEX: u32 = 4;
 
+/// The tiles a hi-stencil write of `geometry` touched: a light volume lists its own from its
+/// fragment shader (`pipeline_key` gives it `hi_stencil_touch.frag`); the full-screen triangle
+/// covers every pixel, so every tile, and runs no fragment shader at all.
+fn touched_tiles(geometry: Geometry) -> TouchedTiles {
+    match geometry {
+        Geometry::Volume => TouchedTiles::Listed,
+        Geometry::FullScreen => TouchedTiles::All,
+    }
+}
+
 /// A stamp per draw that is unique in the frame and never 0 (the cleared `touched` value).
 fn stamp(step: usize, count_draw: bool) -> u32 {
     2 * step as u32 + 1 + u32::from(count_draw)
@@ -249,7 +259,8 @@ impl LightingPass<'_> {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
                         let ds = &mut targets.depth_stencil;
-                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi);
+                        let touched = touched_tiles(pass.geometry);
+                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touched);
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     }
                     ctx.end_label(cmd);
