@@ -28,7 +28,7 @@ use crate::state::compare_op;
 use crate::teardown::{build, Destroy};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use histencil_model::{HiStencilState, TileStats};
+use histencil_model::{CullMode, FramePlan, Geometry, HiStencilState, Step, TileStats};
 
 /// Push constants of `hi_stencil_update.comp`.
 #[repr(C)]
@@ -47,11 +47,63 @@ struct UpdatePush {
 /// Which tiles a hi-stencil write touched, for its update.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TouchedTiles {
-    /// Those its draw listed (`hi_stencil_touch.frag`): a light volume's.
+    /// Those its draw lists (`hi_stencil_touch.frag`): a light volume's.
     Listed,
+    /// Those the light's previous write listed: the same volume with the same faces
+    /// rasterises the same pixels whatever its depth and stencil tests, so its draw needs no
+    /// fragment shader (the talk's mask pass per BRDF of one light).
+    Kept,
     /// Every tile: a full-screen draw rasterises every pixel, so it needs no fragment shader
     /// to list them (a console's mask pass has none either).
     All,
+}
+
+/// How one hi-stencil write learns the tiles it touched, and whether the next write of the
+/// same raster keeps its list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Touch {
+    pub tiles: TouchedTiles,
+    /// The list stays for the next write ([`TouchedTiles::Kept`]) instead of being emptied.
+    pub keep: bool,
+}
+
+/// Per step of `plan`, how its hi-stencil write learns its tiles (`None` where the step writes
+/// none): a full-screen write touches all; a volume write lists its own unless the light's
+/// previous write drew the same volume with the same faces, whose list it keeps.
+pub fn plan_touches(plan: &FramePlan) -> Vec<Option<Touch>> {
+    let mut touches: Vec<Option<Touch>> = vec![None; plan.steps.len()];
+    // The last listing write: its step, light and culled faces.
+    let mut last: Option<(usize, usize, CullMode)> = None;
+    for (index, step) in plan.steps.iter().enumerate() {
+        let Step::Pass { light, pass } = step else {
+            continue;
+        };
+        if !pass.state.writes_hi_stencil() {
+            continue;
+        }
+        let tiles = match pass.geometry {
+            Geometry::FullScreen => {
+                last = None;
+                TouchedTiles::All
+            }
+            Geometry::Volume => {
+                let raster = (*light, pass.state.cull);
+                let previous = last.filter(|&(_, l, c)| (l, c) == raster);
+                last = Some((index, raster.0, raster.1));
+                match previous {
+                    Some((at, ..)) => {
+                        if let Some(t) = touches[at].as_mut() {
+                            t.keep = true;
+                        }
+                        TouchedTiles::Kept
+                    }
+                    None => TouchedTiles::Listed,
+                }
+            }
+        };
+        touches[index] = Some(Touch { tiles, keep: false });
+    }
+    touches
 }
 
 /// Words of the statistics buffer (`HiStencilStats` in include/hi_stencil.glsl).
@@ -262,11 +314,11 @@ impl HiStencilSurface {
         };
     }
 
-    /// Outside rendering, after a write draw touched `touched` tiles, in a frame recorded
+    /// Outside rendering, after a write draw touched tiles as `touch` says, in a frame recorded
     /// into `slot` (prepared with this `depth_stencil`, [`HiStencilSurface::prepare_slot`]):
     /// retires an unflushed earlier write, then evaluates `hi` on those tiles into pending
-    /// state, reading the stencil in place, and empties the list for the next write. Leaves
-    /// the depth-stencil image attached-ready.
+    /// state, reading the stencil in place, and empties the list for the next write unless it
+    /// keeps it. Leaves the depth-stencil image attached-ready.
     pub fn record_update(
         &mut self,
         ctx: &Context,
@@ -274,7 +326,7 @@ impl HiStencilSurface {
         slot: u32,
         depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
-        touched: TouchedTiles,
+        touch: Touch,
     ) {
         if self.unflushed {
             self.record_flush(ctx, cmd);
@@ -288,13 +340,13 @@ impl HiStencilSurface {
             width: self.extent.width,
             height: self.extent.height,
             tiles_x: self.tiles_x,
-            all_tiles: u32::from(touched == TouchedTiles::All),
+            all_tiles: u32::from(touch.tiles == TouchedTiles::All),
         };
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
-        match touched {
-            TouchedTiles::Listed => unsafe {
+        match touch.tiles {
+            TouchedTiles::Listed | TouchedTiles::Kept => unsafe {
                 ctx.device
                     .cmd_dispatch_indirect(cmd, self.touched_list.handle, 0)
             },
@@ -306,10 +358,12 @@ impl HiStencilSurface {
         }
         let attached = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
-        // The list's counts are read (as dispatch arguments too) before they are zeroed.
-        memory_barrier(ctx, cmd);
-        self.clear_list(ctx, cmd);
-        memory_barrier(ctx, cmd);
+        if !touch.keep {
+            // The list's counts are read (as dispatch arguments too) before they are zeroed.
+            memory_barrier(ctx, cmd);
+            self.clear_list(ctx, cmd);
+            memory_barrier(ctx, cmd);
+        }
         self.unflushed = true;
     }
 
@@ -345,6 +399,75 @@ impl HiStencilSurface {
             tiles_culled: u64::from(words[1]),
             fragments_shaded: u64::from(words[2]),
             flushes: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use histencil_model::{FlushPolicy, LightCase, LightRequest, LightTechnique, Ps3Like};
+    use histencil_model::{StencilLayout, X360Like};
+
+    fn writes(plan: &FramePlan) -> Vec<(usize, CullMode, Geometry, Touch)> {
+        plan.steps
+            .iter()
+            .zip(plan_touches(plan))
+            .filter_map(|(step, touch)| match step {
+                Step::Pass { light, pass } => {
+                    assert_eq!(touch.is_some(), pass.state.writes_hi_stencil());
+                    touch.map(|t| (*light, pass.state.cull, pass.geometry, t))
+                }
+                _ => {
+                    assert!(touch.is_none());
+                    None
+                }
+            })
+            .collect()
+    }
+
+    /// A volume write lists its tiles unless the light's previous write drew the same faces,
+    /// whose list that write kept; a full-screen write touches all.
+    #[test]
+    fn writes_keep_a_list_only_for_the_same_lights_same_faces() {
+        let layout = StencilLayout::new(3, 0).unwrap();
+        let request = |case| LightRequest {
+            case,
+            affected: vec![0, 1, 2],
+            technique: LightTechnique::Stencil,
+        };
+        let requests = [
+            request(LightCase::Outside),
+            request(LightCase::Outside),
+            request(LightCase::ViewerInside),
+        ];
+        for plan in [
+            FramePlan::from_requests(&layout, &Ps3Like, &requests, FlushPolicy::Auto).unwrap(),
+            FramePlan::from_requests(&layout, &X360Like::default(), &requests, FlushPolicy::Auto)
+                .unwrap(),
+        ] {
+            let writes = writes(&plan);
+            assert!(writes.iter().any(|w| w.3.tiles == TouchedTiles::Kept));
+            for (i, &(light, cull, geometry, touch)) in writes.iter().enumerate() {
+                let next = writes.get(i + 1);
+                let same = |w: &(usize, CullMode, Geometry, Touch)| {
+                    (w.0, w.1, w.2) == (light, cull, Geometry::Volume)
+                };
+                match geometry {
+                    Geometry::FullScreen => assert_eq!(touch.tiles, TouchedTiles::All),
+                    Geometry::Volume => {
+                        let kept = i > 0 && same(&writes[i - 1]);
+                        let expected = if kept {
+                            TouchedTiles::Kept
+                        } else {
+                            TouchedTiles::Listed
+                        };
+                        assert_eq!(touch.tiles, expected, "write {i}");
+                    }
+                }
+                let keeps = geometry == Geometry::Volume && next.is_some_and(same);
+                assert_eq!(touch.keep, keeps, "write {i}");
+            }
         }
     }
 }

@@ -3,6 +3,7 @@
 
 use crate::context::Context;
 use crate::error::Result;
+use crate::hi_stencil::{plan_touches, TouchedTiles};
 use crate::hooks::LightModules;
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::shaders;
@@ -200,12 +201,14 @@ impl TileWork {
 }
 
 /// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs; with `count_stats`
-/// every light shader counts its fragments.
+/// every light shader counts its fragments; `lists_tiles`: a hi-stencil write that lists the
+/// tiles it touches from its fragment shader ([`crate::hi_stencil::plan_touches`]).
 pub fn pipeline_key(
     pass: &Pass,
     brdfs: &[BrdfId],
     count_stats: bool,
     source: BrdfSource,
+    lists_tiles: bool,
 ) -> LightPipelineKey {
     let tiles = if count_stats {
         TileWork::TestAndCount
@@ -221,10 +224,7 @@ pub fn pipeline_key(
             tiles,
         },
         PassKind::Shade(Shader::Branching) => LightShader::Branching { tiles },
-        // A full-screen write touches every tile: its update needs no list (`TouchedTiles`).
-        _ if pass.state.writes_hi_stencil() && pass.geometry == Geometry::Volume => {
-            LightShader::TouchTiles
-        }
+        _ if lists_tiles => LightShader::TouchTiles,
         _ => LightShader::StencilOnly,
     };
     (pass.geometry, shader)
@@ -243,10 +243,12 @@ pub fn plan_pipelines(
             keys.push(key);
         }
     };
-    for step in &plan.steps {
+    let touches = plan_touches(plan);
+    for (step, touch) in plan.steps.iter().zip(touches) {
         match step {
             Step::Pass { pass, .. } => {
-                add(pipeline_key(pass, brdfs, count_tiles, source));
+                let lists = touch.is_some_and(|t| t.tiles == TouchedTiles::Listed);
+                add(pipeline_key(pass, brdfs, count_tiles, source, lists));
                 if count_tiles && pass.state.tests_hi_stencil() {
                     add((pass.geometry, LightShader::CountTiles));
                 }

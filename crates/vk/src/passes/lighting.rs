@@ -17,7 +17,7 @@ use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingT
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::hi_stencil::{HiStencilSurface, TouchedTiles};
+use crate::hi_stencil::{plan_touches, HiStencilSurface, Touch, TouchedTiles};
 use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
@@ -166,16 +166,6 @@ impl Emulation {
 /// The set index of an engine's visibility hook (hooks/light_visibility.glsl).
 const VISIBILITY_SET_INDEX: u32 = 4;
 
-/// The tiles a hi-stencil write of `geometry` touched: a light volume lists its own from its
-/// fragment shader (`pipeline_key` gives it `hi_stencil_touch.frag`); the full-screen triangle
-/// covers every pixel, so every tile, and runs no fragment shader at all.
-fn touched_tiles(geometry: Geometry) -> TouchedTiles {
-    match geometry {
-        Geometry::Volume => TouchedTiles::Listed,
-        Geometry::FullScreen => TouchedTiles::All,
-    }
-}
-
 /// A stamp per draw that is unique in the frame and never 0 (the cleared `touched` value).
 fn stamp(step: usize, count_draw: bool) -> u32 {
     2 * step as u32 + 1 + u32::from(count_draw)
@@ -241,6 +231,7 @@ impl LightingPass<'_> {
             t.start(ctx, cmd);
         }
         let mut current_light = None;
+        let touches = plan_touches(self.plan);
         for (index, step) in self.plan.steps.iter().enumerate() {
             match step {
                 Step::Pass { light, pass } => {
@@ -254,13 +245,14 @@ impl LightingPass<'_> {
                     }
                     let scene_light = self.plan.lights[*light].input as u32;
                     ctx.begin_label(cmd, &pass.label());
-                    self.record_pass(targets, &mut rendering, index, pass, scene_light)?;
+                    let touch = touches[index];
+                    self.record_pass(targets, &mut rendering, index, pass, scene_light, touch)?;
                     if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
                         let ds = &mut targets.depth_stencil;
-                        let touched = touched_tiles(pass.geometry);
-                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touched);
+                        let touch = touches[index].expect("every write has its touch");
+                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touch);
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     }
                     ctx.end_label(cmd);
@@ -324,6 +316,7 @@ impl LightingPass<'_> {
         step: usize,
         pass: &Pass,
         scene_light: u32,
+        touch: Option<Touch>,
     ) -> Result<()> {
         let state = &pass.state;
         if state.tests_hi_stencil() && state.writes_stencil() {
@@ -368,7 +361,8 @@ impl LightingPass<'_> {
             flags,
             bit: 0,
         };
-        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source);
+        let lists = touch.is_some_and(|t| t.tiles == TouchedTiles::Listed);
+        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source, lists);
         self.draw(key, state, pass.geometry, push);
         Ok(())
     }
