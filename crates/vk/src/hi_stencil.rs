@@ -7,7 +7,9 @@
 //! (`hi_stencil_touch.frag`), rendering ends, and `hi_stencil_update.comp`, dispatched
 //! indirectly over that list, re-evaluates the listed tiles into `pending`, reading the stencil
 //! where it is through a stencil-aspect view: a small light's write costs its own tiles, not
-//! the screen's, and nothing is copied. A flush, or the next write while one is unflushed (the latest
+//! the screen's, and nothing is copied. Two writes need no listing fragment shader
+//! ([`plan_touches`]): a full-screen one touches every tile, and one that draws the same
+//! volume with the same faces as its light's previous write touches that write's tiles. A flush, or the next write while one is unflushed (the latest
 //! point hardware could retire it), copies `pending` to `active`. Testing draws reject
 //! fragments of failing tiles in the light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
 //!
