@@ -202,7 +202,7 @@ impl TileWork {
 
 /// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs; with `count_stats`
 /// every light shader counts its fragments; `lists_tiles`: a hi-stencil write that lists the
-/// tiles it touches from its fragment shader ([`crate::hi_stencil::plan_touches`]).
+/// tiles it touches from its fragment shader (`hi_stencil::plan_touches`).
 pub fn pipeline_key(
     pass: &Pass,
     brdfs: &[BrdfId],
