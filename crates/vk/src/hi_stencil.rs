@@ -9,8 +9,9 @@
 //! where it is through a stencil-aspect view: a small light's write costs its own tiles, not
 //! the screen's, and nothing is copied. Two writes need no listing fragment shader
 //! ([`plan_touches`]): a full-screen one touches every tile, and one that draws the same
-//! volume with the same faces as its light's previous write touches that write's tiles. A flush, or the next write while one is unflushed (the latest
-//! point hardware could retire it), copies `pending` to `active`. Testing draws reject
+//! volume with the same faces as its light's previous write touches that write's tiles. A
+//! flush, or the next write while one is unflushed (the latest point hardware could retire
+//! it), copies `pending` to `active`. Testing draws reject
 //! fragments of failing tiles in the light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
 //!
 //! Statistics are optional because counting needs extra draws and atomics: with them on, each
@@ -74,7 +75,7 @@ pub struct Touch {
 /// previous write drew the same volume with the same faces, whose list it keeps.
 pub fn plan_touches(plan: &FramePlan) -> Vec<Option<Touch>> {
     let mut touches: Vec<Option<Touch>> = vec![None; plan.steps.len()];
-    // The last listing write: its step, light and culled faces.
+    // The last volume write since the last full-screen one: its step, light and culled faces.
     let mut last: Option<(usize, usize, CullMode)> = None;
     for (index, step) in plan.steps.iter().enumerate() {
         let Step::Pass { light, pass } = step else {
