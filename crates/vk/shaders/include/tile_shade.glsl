@@ -18,6 +18,14 @@ const uint BRANCH_ON_GBUFFER = 0xFFFFFFFFu;
 layout(constant_id = 0) const uint SHADED_BRDF = 0u;
 layout(constant_id = 1) const uint SHADED_SLOT = 0u;
 
+// Advances `w` past empty mask words of the tile whose masks start at `base`, loading each into
+// `bits`, and stops at the last word.
+void skip_empty_words(uint base, inout uint w, inout uint bits) {
+    while (bits == 0u && w + 1u < tiled.words) {
+        bits = tile_lights[base + ++w];
+    }
+}
+
 void main() {
     uint tile = tile_lists[SHADED_SLOT * tiled.tiles + gl_WorkGroupID.x];
     uvec2 origin = uvec2(tile % tiled.tiles_x, tile / tiled.tiles_x) * TILED_TILE;
@@ -52,9 +60,7 @@ void main() {
     uint base = tile * tiled.words;
     uint w = 0u;
     uint bits = tile_lights[base];
-    while (bits == 0u && w + 1u < tiled.words) {
-        bits = tile_lights[base + ++w];
-    }
+    skip_empty_words(base, w, bits);
     vec3 sum = vec3(0.0);
     if (bits != 0u) {
         do {
@@ -66,9 +72,7 @@ void main() {
                 lit *= light_visibility(index, light, s);
             }
             sum += lit;
-            while (bits == 0u && w + 1u < tiled.words) {
-                bits = tile_lights[base + ++w];
-            }
+            skip_empty_words(base, w, bits);
         } while (bits != 0u);
     }
     // Each pixel is shaded by one kernel (its BRDF's, or the branching one's): over a cleared

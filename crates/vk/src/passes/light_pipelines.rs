@@ -3,7 +3,7 @@
 
 use crate::context::Context;
 use crate::error::Result;
-use crate::hi_stencil::{plan_touches, TouchedTiles};
+use crate::hi_stencil::{plan_touches, Touch, TouchedTiles};
 use crate::hooks::LightModules;
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::shaders;
@@ -201,14 +201,14 @@ impl TileWork {
 }
 
 /// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs; with `count_stats`
-/// every light shader counts its fragments; `lists_tiles`: a hi-stencil write that lists the
-/// tiles it touches from its fragment shader (`hi_stencil::plan_touches`).
+/// every light shader counts its fragments; `touch` is how a hi-stencil write learns its tiles
+/// (`hi_stencil::plan_touches`): one that lists them does so from its fragment shader.
 pub fn pipeline_key(
     pass: &Pass,
     brdfs: &[BrdfId],
     count_stats: bool,
     source: BrdfSource,
-    lists_tiles: bool,
+    touch: Option<Touch>,
 ) -> LightPipelineKey {
     let tiles = if count_stats {
         TileWork::TestAndCount
@@ -224,7 +224,7 @@ pub fn pipeline_key(
             tiles,
         },
         PassKind::Shade(Shader::Branching) => LightShader::Branching { tiles },
-        _ if lists_tiles => LightShader::TouchTiles,
+        _ if touch.is_some_and(|t| t.tiles == TouchedTiles::Listed) => LightShader::TouchTiles,
         _ => LightShader::StencilOnly,
     };
     (pass.geometry, shader)
@@ -247,8 +247,7 @@ pub fn plan_pipelines(
     for (step, touch) in plan.steps.iter().zip(touches) {
         match step {
             Step::Pass { pass, .. } => {
-                let lists = touch.is_some_and(|t| t.tiles == TouchedTiles::Listed);
-                add(pipeline_key(pass, brdfs, count_tiles, source, lists));
+                add(pipeline_key(pass, brdfs, count_tiles, source, touch));
                 if count_tiles && pass.state.tests_hi_stencil() {
                     add((pass.geometry, LightShader::CountTiles));
                 }

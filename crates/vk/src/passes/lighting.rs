@@ -17,7 +17,7 @@ use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingT
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::hi_stencil::{plan_touches, HiStencilSurface, Touch, TouchedTiles};
+use crate::hi_stencil::{plan_touches, HiStencilSurface, Touch};
 use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
@@ -251,7 +251,7 @@ impl LightingPass<'_> {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
                         let ds = &mut targets.depth_stencil;
-                        let touch = touches[index].expect("every write has its touch");
+                        let touch = touch.expect("every write has its touch");
                         hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touch);
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     }
@@ -361,8 +361,7 @@ impl LightingPass<'_> {
             flags,
             bit: 0,
         };
-        let lists = touch.is_some_and(|t| t.tiles == TouchedTiles::Listed);
-        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source, lists);
+        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source, touch);
         self.draw(key, state, pass.geometry, push);
         Ok(())
     }
