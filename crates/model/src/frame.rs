@@ -4,7 +4,7 @@
 use crate::backend::PlatformCaps;
 use crate::layout::StencilLayout;
 use crate::plan::{plan_light, LightCase, LightRequest, LightTechnique, Pass, PlanError};
-use crate::view::DepthConvention;
+use crate::view::{DepthConvention, NdcRect};
 
 /// When pending hi-stencil state is made visible to later tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -47,6 +47,11 @@ pub struct PlannedLight {
     /// The estimated fraction of the screen its volume covers (1 for lights reaching the near
     /// plane and for full-screen lights); `None` for plans built from bare requests.
     pub coverage: Option<f64>,
+    /// A rectangle holding every pixel its volume mesh can rasterise: the screen rectangle of
+    /// the sphere that bounds the mesh. `None` where nothing smaller than the screen is known
+    /// (plans from bare requests, full-screen lights, a bound reaching the eye plane). The GPU
+    /// hi-stencil emulation looks for the tiles a write touched only inside it.
+    pub screen_rect: Option<NdcRect>,
     /// Its case, the BRDF slots it touches and the technique chosen for it.
     pub request: LightRequest,
 }
@@ -60,6 +65,7 @@ impl PlannedLight {
             .map(|(input, request)| Self {
                 input,
                 coverage: None,
+                screen_rect: None,
                 request,
             })
             .collect()

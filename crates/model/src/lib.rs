@@ -80,4 +80,4 @@ pub use state::{
 pub use synthetic::{SyntheticDesc, SyntheticFrame};
 pub use tiled_costs::TiledCosts;
 pub use tiles::{TileStats, TileSurface};
-pub use view::{DepthConvention, FarPlane, Perspective, View, ViewDesc, ViewError};
+pub use view::{DepthConvention, FarPlane, NdcRect, Perspective, View, ViewDesc, ViewError};

@@ -301,8 +301,8 @@ pub fn plan_frame(
         if affected.is_empty() {
             continue;
         }
-        let (case, coverage) = match shape.volume_bound() {
-            None => (LightCase::FullScreen, 1.0),
+        let (case, coverage, screen_rect) = match shape.volume_bound() {
+            None => (LightCase::FullScreen, 1.0, None),
             Some(bound) => {
                 if view.culls_sphere(bound.0, bound.1) {
                     continue;
@@ -312,7 +312,7 @@ pub fn plan_frame(
                     LightCase::Outside => view.sphere_coverage(bound.0, bound.1),
                     _ => 1.0,
                 };
-                (case, coverage)
+                (case, coverage, view.sphere_rect(bound.0, bound.1))
             }
         };
         let technique = match settings.technique {
@@ -325,6 +325,7 @@ pub fn plan_frame(
         lights.push(PlannedLight {
             input: index,
             coverage: Some(coverage),
+            screen_rect,
             request: LightRequest {
                 case,
                 affected,

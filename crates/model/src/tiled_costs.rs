@@ -95,6 +95,7 @@ mod tests {
             .map(|(input, &(c, n, technique))| PlannedLight {
                 input,
                 coverage: Some(c),
+                screen_rect: None,
                 request: LightRequest {
                     case: LightCase::Outside,
                     affected: (0..n).collect(),

@@ -262,13 +262,15 @@ impl View {
         })
     }
 
-    /// The fraction of the screen a sphere covers: the ellipse inscribed in its exact screen
-    /// bounding rectangle, clipped to the screen; 1 when the sphere reaches the eye plane.
-    pub(crate) fn sphere_coverage(&self, centre: DVec3, radius: f64) -> f64 {
+    /// The exact screen bounding rectangle of a sphere in normalised device coordinates (not
+    /// clipped to the screen); `None` when the sphere reaches the eye plane, where its
+    /// projection is unbounded. Every point of the sphere projects inside it, so it bounds
+    /// whatever a volume inside the sphere rasterises, near-plane clipping or not.
+    pub(crate) fn sphere_rect(&self, centre: DVec3, radius: f64) -> Option<NdcRect> {
         let m = self.world_to_clip;
         let w = m.row(3);
         let centre4 = centre.extend(1.0);
-        let extent = |row: DVec4| -> Option<(f64, f64)> {
+        let extent = |row: DVec4| -> Option<[f64; 2]> {
             // The planes through the sphere's tangents where clip row / w = t: solve
             // (u - t v)^2 = r^2 |a - t b|^2 for t.
             let (a, b) = (row.truncate(), w.truncate());
@@ -281,14 +283,33 @@ impl View {
             let qb = u * v - r2 * a.dot(b);
             let qc = u * u - r2 * a.length_squared();
             let root = (qb * qb - qa * qc).max(0.0).sqrt();
-            Some(((qb - root) / qa, (qb + root) / qa))
+            Some([(qb - root) / qa, (qb + root) / qa])
         };
-        let (Some(x), Some(y)) = (extent(m.row(0)), extent(m.row(1))) else {
+        let x = extent(m.row(0))?;
+        let y = extent(m.row(1))?;
+        Some(NdcRect {
+            min: [x[0], y[0]],
+            max: [x[1], y[1]],
+        })
+    }
+
+    /// The fraction of the screen a sphere covers: the ellipse inscribed in its exact screen
+    /// bounding rectangle, clipped to the screen; 1 when the sphere reaches the eye plane.
+    pub(crate) fn sphere_coverage(&self, centre: DVec3, radius: f64) -> f64 {
+        let Some(rect) = self.sphere_rect(centre, radius) else {
             return 1.0;
         };
-        let clipped = |(lo, hi): (f64, f64)| (hi.min(1.0) - lo.max(-1.0)).max(0.0);
-        (std::f64::consts::FRAC_PI_4 * clipped(x) * clipped(y) / 4.0).min(1.0)
+        let clipped = |axis: usize| (rect.max[axis].min(1.0) - rect.min[axis].max(-1.0)).max(0.0);
+        (std::f64::consts::FRAC_PI_4 * clipped(0) * clipped(1) / 4.0).min(1.0)
     }
+}
+
+/// A rectangle in normalised device coordinates: x from -1 (left) to 1 (right), y from -1 (the
+/// framebuffer's first row) to 1, as Vulkan's viewport maps them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NdcRect {
+    pub min: [f64; 2],
+    pub max: [f64; 2],
 }
 
 #[cfg(test)]
@@ -351,6 +372,50 @@ mod tests {
             let (corner, _) = view.ray([1.0, -1.0]);
             // Vulkan's y is down: the top right corner of the screen.
             assert!(corner[0] > 0.0 && corner[1] > 0.0, "{corner:?}");
+        }
+    }
+
+    /// Every point of a sphere in front of the eye plane projects inside its rectangle, and
+    /// each side of the rectangle is reached (it is the tight bound); a sphere reaching the eye
+    /// plane has none.
+    #[test]
+    fn sphere_rectangles_hold_the_sphere_tightly() {
+        for (depth, far) in CONVENTIONS {
+            let view = camera(depth, far);
+            let cases = [
+                (DVec3::new(0.0, 0.0, -5.0), 1.0),
+                (DVec3::new(3.0, -1.0, 2.0), 2.5),
+                // Crosses the near plane (z = 4.9) but not the eye plane (z = 5).
+                (DVec3::new(0.2, 0.1, 4.0), 0.95),
+                (DVec3::new(-8.0, 6.0, -30.0), 4.0),
+            ];
+            for (centre, radius) in cases {
+                let rect = view
+                    .sphere_rect(centre, radius)
+                    .expect("in front of the eye");
+                let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+                for i in 0..200 {
+                    for j in 0..=100 {
+                        let (theta, phi) = (i as f64 * 0.031_415_9, j as f64 * 0.031_415_9);
+                        let dir =
+                            DVec3::new(phi.sin() * theta.cos(), phi.sin() * theta.sin(), phi.cos());
+                        let clip = view.world_to_clip * (centre + dir * radius).extend(1.0);
+                        let ndc = [clip.x / clip.w, clip.y / clip.w];
+                        for a in 0..2 {
+                            let slack = 1e-9 * (1.0 + ndc[a].abs());
+                            assert!(ndc[a] >= rect.min[a] - slack && ndc[a] <= rect.max[a] + slack);
+                            lo[a] = lo[a].min(ndc[a]);
+                            hi[a] = hi[a].max(ndc[a]);
+                        }
+                    }
+                }
+                for a in 0..2 {
+                    let size = rect.max[a] - rect.min[a];
+                    assert!(lo[a] - rect.min[a] < 0.01 * size, "{centre} axis {a}");
+                    assert!(rect.max[a] - hi[a] < 0.01 * size, "{centre} axis {a}");
+                }
+            }
+            assert!(view.sphere_rect(DVec3::new(0.0, 0.0, 4.5), 0.6).is_none());
         }
     }
 

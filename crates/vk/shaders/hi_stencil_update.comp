@@ -1,29 +1,26 @@
 #version 460
-// Hi-stencil write, second half: one invocation per tile the draw touched (listed by
-// hi_stencil_touch.frag, dispatched indirectly over that list), or per tile of the frame after
-// a full-screen write, which rasterises every pixel and so touches every tile without a
-// fragment shader to say so (`all_tiles`). The tile may pass when any of
-// its pixels passes the hi-stencil compare on the stencil the draw left:
-// `(stencil & read_mask) OP reference`, as histencil_model::HiStencilState says. No shared
-// memory and no barriers: a CPU rasteriser runs a workgroup with barriers one invocation at a
-// time, switching between them at each barrier.
+// Hi-stencil write, second half: one invocation per tile of the rectangle that holds the
+// write's volume on screen. A tile the volume rasterised (one of its pixels holds the write's
+// marker in the touch image, which hi_stencil.rs drew the volume into) is re-evaluated into
+// the pending surface; the others keep their state. After a full-screen write, which rasterises
+// every pixel without a touch draw to say so, `marker` is 0 and every tile of the rectangle
+// (the frame) is re-evaluated. The tile may pass when any of its pixels passes the hi-stencil
+// compare on the stencil the write left: `(stencil & read_mask) OP reference`, as
+// histencil_model::HiStencilState says. No shared memory and no barriers: a CPU rasteriser
+// runs a workgroup with barriers one invocation at a time, switching between them at each
+// barrier.
 #extension GL_EXT_samplerless_texture_functions : require
 #include "generated.glsl"
 
 layout(local_size_x = HI_STENCIL_UPDATE_GROUP) in;
 
-// The stencil the draw left, read in place through a stencil-aspect view.
-layout(set = 0, binding = 2) uniform utexture2D stencil_image;
-layout(set = 0, binding = 0, std430) readonly buffer TouchedList {
-    uint groups;
-    uint group_y;
-    uint group_z;
-    uint count;
-    uint tiles[];
-} touched_list;
-layout(set = 0, binding = 1, std430) writeonly buffer Pending {
+layout(set = 0, binding = 0, std430) writeonly buffer Pending {
     uint pending[];
 };
+// Where the write's volume rasterised: its marker's depth (16-bit codes, read back as floats).
+layout(set = 0, binding = 1) uniform texture2D touch_depth;
+// The stencil the write left, read in place through a stencil-aspect view.
+layout(set = 0, binding = 2) uniform utexture2D stencil_image;
 
 layout(push_constant) uniform Update {
     uint compare;   // VkCompareOp
@@ -32,7 +29,11 @@ layout(push_constant) uniform Update {
     uint width;
     uint height;
     uint tiles_x;
-    uint all_tiles; // 1: every tile of the frame, in order; 0: the touched list's
+    uint rect_x;    // the rectangle's first tile, in tiles
+    uint rect_y;
+    uint rect_width;
+    uint rect_tiles;
+    uint marker;    // the write's 16-bit code; 0: every tile of the rectangle was touched
 } update;
 
 bool compare_passes(uint op, uint a, uint b) {
@@ -48,16 +49,31 @@ bool compare_passes(uint op, uint a, uint b) {
     }
 }
 
+// Whether a pixel of the tile holds the marker. Codes are two apart (hi_stencil.rs), so a depth
+// rounded either way by the device still matches its own code only.
+bool touched(uvec2 origin, uvec2 end) {
+    for (uint y = origin.y; y < end.y; ++y) {
+        for (uint x = origin.x; x < end.x; ++x) {
+            float code = texelFetch(touch_depth, ivec2(x, y), 0).r * 65535.0;
+            if (abs(code - float(update.marker)) < 1.5) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    uint tiles_y = (update.height + HI_STENCIL_TILE - 1u) / HI_STENCIL_TILE;
-    uint count = update.all_tiles != 0u ? update.tiles_x * tiles_y : touched_list.count;
-    if (i >= count) {
+    if (i >= update.rect_tiles) {
         return;
     }
-    uint tile = update.all_tiles != 0u ? i : touched_list.tiles[i];
-    uvec2 origin = uvec2(tile % update.tiles_x, tile / update.tiles_x) * HI_STENCIL_TILE;
+    uvec2 at = uvec2(update.rect_x + i % update.rect_width, update.rect_y + i / update.rect_width);
+    uvec2 origin = at * HI_STENCIL_TILE;
     uvec2 end = min(origin + HI_STENCIL_TILE, uvec2(update.width, update.height));
+    if (update.marker != 0u && !touched(origin, end)) {
+        return;
+    }
     uint passes = 0u;
     for (uint y = origin.y; y < end.y && passes == 0u; ++y) {
         for (uint x = origin.x; x < end.x; ++x) {
@@ -68,5 +84,5 @@ void main() {
             }
         }
     }
-    pending[tile] = passes;
+    pending[at.y * update.tiles_x + at.x] = passes;
 }

@@ -74,14 +74,12 @@ pub const HI_STENCIL_SET: &[BindingDesc] = &[
     binding(1, BindingKind::StorageBuffer, ""),
     binding(2, BindingKind::StorageBuffer, "hi_stats"),
     binding(3, BindingKind::StorageBuffer, ""),
-    binding(4, BindingKind::StorageBuffer, "touched_list"),
 ];
-/// The tile update's list of tiles the write draw touched (read), the pending surface (written)
-/// and the stencil (a stencil-aspect view, read);
-/// see `hi_stencil.rs`.
+/// The tile update's pending surface (written), touch image (read) and stencil (a
+/// stencil-aspect view, read); see `hi_stencil.rs`.
 pub const HI_STENCIL_UPDATE_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, "touched_list"),
-    binding(1, BindingKind::StorageBuffer, ""),
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::SampledImage, "touch_depth"),
     binding(2, BindingKind::SampledImage, "stencil_image"),
 ];
 /// Set 1 of the tonemap pipeline (tonemap.frag).
@@ -153,7 +151,6 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("light_volume.vert", LIGHTING_LAYOUT),
     ("deferred_light.frag", LIGHTING_LAYOUT),
     ("lut_light.frag", LIGHTING_LAYOUT),
-    ("hi_stencil_touch.frag", LIGHTING_LAYOUT),
     ("hi_stencil_count.frag", LIGHTING_LAYOUT),
     ("restore_preserved.frag", LIGHTING_LAYOUT),
     ("footprint.frag", LIGHTING_LAYOUT),

@@ -3,35 +3,41 @@
 //!
 //! The coarse surface is one word per [`HI_STENCIL_TILE`]-pixel tile, in two buffers: `pending`
 //! (what write-enabled draws evaluated) and `active` (what testing draws see). A hi-stencil
-//! write is a *split pass*: the draw marks the tiles it rasterises and lists each once
-//! (`hi_stencil_touch.frag`), rendering ends, and `hi_stencil_update.comp`, dispatched
-//! indirectly over that list, re-evaluates the listed tiles into `pending`, reading the stencil
-//! where it is through a stencil-aspect view: a small light's write costs its own tiles, not
-//! the screen's, and nothing is copied. Two writes need no listing fragment shader
-//! ([`plan_touches`]): a full-screen one touches every tile, and one that draws the same
-//! volume with the same faces as its light's previous write touches that write's tiles. A
+//! write is a *split pass*: the write draw itself is the platform's (the same stencil-only
+//! pipeline as native), rendering ends, and the emulator learns which tiles it rasterised by
+//! drawing the same volume with the same faces once more, without a fragment shader, into a
+//! depth-only *touch image* whose viewport pins every fragment's depth to a marker unique to
+//! the write (a fragment shader with a side effect would run for every covered pixel, which a
+//! CPU rasteriser pays for many times over a depth-only draw). `hi_stencil_update.comp` then
+//! looks at the tiles of the light's screen rectangle (`PlannedLight::screen_rect`) and
+//! re-evaluates into `pending` those holding the marker, reading the stencil where it is
+//! through a stencil-aspect view: a small light's write costs its own tiles, not the screen's,
+//! and nothing is copied. Two writes need no touch draw ([`plan_touches`]): a full-screen one
+//! touches every tile, and one that draws the same volume with the same faces as its light's
+//! previous write touches that write's tiles, whose marker is still in the touch image. A
 //! flush, or the next write while one is unflushed (the latest point hardware could retire
-//! it), copies `pending` to `active`. Testing draws reject
-//! fragments of failing tiles in the light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
+//! it), copies `pending` to `active`. Testing draws reject fragments of failing tiles in the
+//! light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
 //!
 //! Statistics are optional because counting needs extra draws and atomics: with them on, each
 //! testing draw is preceded by `hi_stencil_count.frag` over the same geometry, and light shaders
 //! count the fragments they shade.
 
-use crate::access::{memory_barrier, transition, Contents, ImageAccess, ImageRef};
+use crate::access::{access_info, memory_barrier, transition, Contents, ImageAccess, ImageRef};
 use crate::compute::ComputePipeline;
 use crate::context::Context;
 use crate::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
 use crate::error::{Result, VkCall};
+use crate::passes::{attachment, Load};
 use crate::readback::{copy_image_to_buffer, host_readable};
-use crate::resources::Buffer;
+use crate::resources::{Buffer, Image};
 use crate::shader_consts::{HI_STENCIL_TILE, HI_STENCIL_UPDATE_GROUP};
 use crate::shaders;
 use crate::state::compare_op;
 use crate::teardown::{build, Destroy};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use histencil_model::{CullMode, FramePlan, Geometry, HiStencilState, Step, TileStats};
+use histencil_model::{CullMode, FramePlan, Geometry, HiStencilState, NdcRect, Step, TileStats};
 
 /// Push constants of `hi_stencil_update.comp`.
 #[repr(C)]
@@ -43,40 +49,44 @@ struct UpdatePush {
     width: u32,
     height: u32,
     tiles_x: u32,
-    /// 1: update every tile (after a full-screen write); 0: the listed tiles.
-    all_tiles: u32,
+    /// The tiles looked at: `rect_x, rect_y` the first, `rect_width` per row.
+    rect_x: u32,
+    rect_y: u32,
+    rect_width: u32,
+    rect_tiles: u32,
+    /// The touch image's code of the write's marker; 0: every tile of the rectangle was touched.
+    marker: u32,
 }
+
+/// The touch image's format: depth-only, the one every Vulkan device renders to and samples.
+pub const TOUCH_FORMAT: vk::Format = vk::Format::D16_UNORM;
+
+/// Markers are even codes of the 16-bit touch image, so a depth the device rounds either way
+/// still reads back as its own marker and never as a neighbour's; 0 is the cleared image.
+const MARKER_STEP: u32 = 2;
+const MAX_MARKER: u32 = u16::MAX as u32 - 1;
 
 /// Which tiles a hi-stencil write touched, for its update.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TouchedTiles {
-    /// Those its draw lists (`hi_stencil_touch.frag`): a light volume's.
+    /// Those its volume rasterises, drawn into the touch image: a light volume's.
     Listed,
-    /// Those the light's previous write listed: the same volume with the same faces
-    /// rasterises the same pixels whatever its depth and stencil tests, so its draw needs no
-    /// fragment shader (the talk's mask pass per BRDF of one light).
+    /// Those the light's previous write touched: the same volume with the same faces
+    /// rasterises the same pixels whatever its depth and stencil tests, so its marker serves
+    /// (the talk's mask pass per BRDF of one light).
     Kept,
-    /// Every tile: a full-screen draw rasterises every pixel, so it needs no fragment shader
-    /// to list them (a console's mask pass has none either).
+    /// Every tile: a full-screen draw rasterises every pixel (a console's mask pass has no
+    /// fragment shader either).
     All,
 }
 
-/// How one hi-stencil write learns the tiles it touched, and whether the next write of the
-/// same raster keeps its list.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Touch {
-    pub tiles: TouchedTiles,
-    /// The list stays for the next write ([`TouchedTiles::Kept`]) instead of being emptied.
-    pub keep: bool,
-}
-
 /// Per step of `plan`, how its hi-stencil write learns its tiles (`None` where the step writes
-/// none): a full-screen write touches all; a volume write lists its own unless the light's
-/// previous write drew the same volume with the same faces, whose list it keeps.
-pub fn plan_touches(plan: &FramePlan) -> Vec<Option<Touch>> {
-    let mut touches: Vec<Option<Touch>> = vec![None; plan.steps.len()];
-    // The last volume write since the last full-screen one: its step, light and culled faces.
-    let mut last: Option<(usize, usize, CullMode)> = None;
+/// none): a full-screen write touches all; a volume write draws its own unless the light's
+/// previous write drew the same volume with the same faces, whose tiles it keeps.
+pub fn plan_touches(plan: &FramePlan) -> Vec<Option<TouchedTiles>> {
+    let mut touches = vec![None; plan.steps.len()];
+    // The light and culled faces of the last volume write since the last full-screen one.
+    let mut last: Option<(usize, CullMode)> = None;
     for (index, step) in plan.steps.iter().enumerate() {
         let Step::Pass { light, pass } = step else {
             continue;
@@ -84,29 +94,90 @@ pub fn plan_touches(plan: &FramePlan) -> Vec<Option<Touch>> {
         if !pass.state.writes_hi_stencil() {
             continue;
         }
-        let tiles = match pass.geometry {
+        touches[index] = Some(match pass.geometry {
             Geometry::FullScreen => {
                 last = None;
                 TouchedTiles::All
             }
             Geometry::Volume => {
                 let raster = (*light, pass.state.cull);
-                let previous = last.filter(|&(_, l, c)| (l, c) == raster);
-                last = Some((index, raster.0, raster.1));
-                match previous {
-                    Some((at, ..)) => {
-                        if let Some(t) = touches[at].as_mut() {
-                            t.keep = true;
-                        }
-                        TouchedTiles::Kept
-                    }
-                    None => TouchedTiles::Listed,
+                let previous = last.replace(raster);
+                if previous == Some(raster) {
+                    TouchedTiles::Kept
+                } else {
+                    TouchedTiles::Listed
                 }
             }
-        };
-        touches[index] = Some(Touch { tiles, keep: false });
+        });
     }
     touches
+}
+
+/// A rectangle of tiles: the first tile's column and row, and the size in tiles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileRect {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// The tiles of a frame of `extent` that hold every pixel inside `ndc` (the whole frame for
+/// `None`), with a pixel to spare on each side for the GPU's single-precision transforms.
+pub fn tile_rect(extent: vk::Extent2D, ndc: Option<NdcRect>) -> TileRect {
+    let tiles = [extent.width, extent.height].map(|n| n.div_ceil(HI_STENCIL_TILE));
+    let Some(ndc) = ndc else {
+        return TileRect {
+            x: 0,
+            y: 0,
+            width: tiles[0],
+            height: tiles[1],
+        };
+    };
+    let finite = ndc.min.iter().chain(&ndc.max).all(|v| v.is_finite());
+    if !finite {
+        return tile_rect(extent, None);
+    }
+    let size = [extent.width, extent.height].map(f64::from);
+    let span = |axis: usize| -> (u32, u32) {
+        let pixel = |v: f64| (v + 1.0) * 0.5 * size[axis];
+        let (lo, hi) = (pixel(ndc.min[axis]) - 1.0, pixel(ndc.max[axis]) + 1.0);
+        if !(lo < size[axis] && hi >= 0.0) {
+            return (0, 0);
+        }
+        let tile = |p: f64| (p.max(0.0) as u32 / HI_STENCIL_TILE).min(tiles[axis] - 1);
+        let (first, last) = (tile(lo), tile(hi));
+        (first, last + 1 - first)
+    };
+    let ((x, width), (y, height)) = (span(0), span(1));
+    if width == 0 || height == 0 {
+        return TileRect {
+            x: 0,
+            y: 0,
+            width: 0,
+            height: 0,
+        };
+    }
+    TileRect {
+        x,
+        y,
+        width,
+        height,
+    }
+}
+
+/// Points `binding` of an update set at a view of a depth-stencil image read in
+/// `DEPTH_STENCIL_READ_ONLY_OPTIMAL` (the touch image; the frame's stencil).
+fn write_read_only_view(ctx: &Context, set: vk::DescriptorSet, binding: u32, view: vk::ImageView) {
+    let image = [vk::DescriptorImageInfo::default()
+        .image_view(view)
+        .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)];
+    let write = vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(binding)
+        .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+        .image_info(&image);
+    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
 }
 
 /// Words of the statistics buffer (`HiStencilStats` in include/hi_stencil.glsl).
@@ -119,15 +190,17 @@ pub struct HiStencilSurface {
     tiles_x: u32,
     active: Buffer,
     pending: Buffer,
+    /// The stamp of the last statistics draw that covered each tile (`hi_stencil_count.frag`).
     touched: Buffer,
-    /// The tiles the current write draw touched, behind the update's indirect dispatch
-    /// arguments and their count (`HiStencilTouchedList` in include/hi_stencil.glsl).
-    touched_list: Buffer,
+    /// Where the last volume writes rasterised, as their markers' depths (the module doc).
+    touch: Image,
+    /// The code of the marker the last touch draw wrote; 0 before the first of a frame.
+    marker: u32,
     stats: Buffer,
     saved: Buffer,
     update: Option<ComputePipeline>,
     pool: vk::DescriptorPool,
-    /// The update's set of each frame-in-flight slot: the touched list, the pending surface and
+    /// The update's set of each frame-in-flight slot: the touch image, the pending surface and
     /// that slot's frame's stencil view.
     sets: Vec<vk::DescriptorSet>,
     /// The stencil-aspect view of each slot's last depth-stencil image (`prepare_slot`).
@@ -135,9 +208,6 @@ pub struct HiStencilSurface {
     /// A write since the last flush has not become active yet (see the module doc).
     unflushed: bool,
 }
-
-/// The touched list's header: the update's dispatch arguments and the tile count.
-const LIST_HEADER_BYTES: u64 = 16;
 
 /// Bytes of a buffer holding one stencil byte per pixel, rounded up to whole words.
 fn stencil_bytes(extent: vk::Extent2D) -> u64 {
@@ -161,12 +231,12 @@ impl Destroy for HiStencilSurface {
             &mut self.active,
             &mut self.pending,
             &mut self.touched,
-            &mut self.touched_list,
             &mut self.stats,
             &mut self.saved,
         ] {
             b.destroy(ctx);
         }
+        self.touch.destroy(ctx);
     }
 }
 
@@ -187,9 +257,9 @@ impl HiStencilSurface {
             let pending_usage = storage | U::TRANSFER_SRC;
             h.pending = gpu("hi-stencil-pending", tile_bytes, pending_usage)?;
             h.touched = gpu("hi-stencil-touched", tile_bytes, storage)?;
-            let list_bytes = LIST_HEADER_BYTES + tile_bytes;
-            let list_usage = storage | U::INDIRECT_BUFFER;
-            h.touched_list = gpu("hi-stencil-touched-list", list_bytes, list_usage)?;
+            use vk::ImageUsageFlags as I;
+            let touch_usage = I::DEPTH_STENCIL_ATTACHMENT | I::SAMPLED;
+            h.touch = Image::new(ctx, "hi-stencil-touch", TOUCH_FORMAT, extent, touch_usage)?;
             h.stats = Buffer::new(
                 ctx,
                 "hi-stencil-stats",
@@ -211,7 +281,7 @@ impl HiStencilSurface {
         })
     }
 
-    /// The pool and every slot's update set, with the touched list and pending surface written
+    /// The pool and every slot's update set, with the touch image and pending surface written
     /// (the stencil view is written per frame).
     fn create_sets(
         &mut self,
@@ -220,13 +290,14 @@ impl HiStencilSurface {
         slots: u32,
     ) -> Result<()> {
         let sizes = [
-            (vk::DescriptorType::STORAGE_BUFFER, 2),
-            (vk::DescriptorType::SAMPLED_IMAGE, 1),
+            (vk::DescriptorType::STORAGE_BUFFER, 1),
+            (vk::DescriptorType::SAMPLED_IMAGE, 2),
         ];
         (self.pool, self.sets) = sets_of(ctx, "hi-stencil-update-set", layout, slots, &sizes)?;
         self.views = vec![vk::ImageView::null(); slots as usize];
-        for set in &self.sets {
-            write_storage_buffers(ctx, *set, &[self.touched_list.handle, self.pending.handle]);
+        for &set in &self.sets {
+            write_storage_buffers(ctx, set, &[self.pending.handle]);
+            write_read_only_view(ctx, set, 1, self.touch.view);
         }
         Ok(())
     }
@@ -254,26 +325,17 @@ impl HiStencilSurface {
             );
         *view = unsafe { ctx.device.create_image_view(&info, None) }.call("vkCreateImageView")?;
         ctx.name(*view, &format!("hi-stencil-stencil-view-{slot}"));
-        let image = [vk::DescriptorImageInfo::default()
-            .image_view(*view)
-            .image_layout(vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL)];
-        let write = vk::WriteDescriptorSet::default()
-            .dst_set(set)
-            .dst_binding(2)
-            .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-            .image_info(&image);
-        unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+        write_read_only_view(ctx, set, 2, *view);
         Ok(())
     }
 
     /// The buffers of set 2 of the light pipelines (`HI_STENCIL_SET`), in binding order.
-    pub fn light_set_buffers(&self) -> [vk::Buffer; 5] {
+    pub fn light_set_buffers(&self) -> [vk::Buffer; 4] {
         [
             self.active.handle,
             self.touched.handle,
             self.stats.handle,
             self.saved.handle,
-            self.touched_list.handle,
         ]
     }
 
@@ -289,9 +351,10 @@ impl HiStencilSurface {
             d.cmd_fill_buffer(cmd, self.touched.handle, 0, vk::WHOLE_SIZE, 0);
             d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
         }
-        self.clear_list(ctx, cmd);
         memory_barrier(ctx, cmd);
         self.unflushed = false;
+        // The touch image is cleared by the frame's first touch draw.
+        self.marker = 0;
     }
 
     /// Outside rendering: pending state becomes active.
@@ -307,21 +370,66 @@ impl HiStencilSurface {
         self.unflushed = false;
     }
 
-    /// Empties the touched list: no update workgroups (y = z = 1), no tiles.
-    fn clear_list(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        let header: [u32; 4] = [0, 1, 1, 0];
-        let bytes = bytemuck::bytes_of(&header);
-        unsafe {
-            ctx.device
-                .cmd_update_buffer(cmd, self.touched_list.handle, 0, bytes)
+    /// Outside rendering, after a volume write draw: begins rendering into the touch image
+    /// alone with a new marker as every fragment's depth, and sets the viewport and scissor.
+    /// The caller draws the write's volume with the touch pipeline
+    /// (`LightShader::TouchTiles`) and the write's faces, then calls [`Self::end_touch`].
+    pub fn begin_touch(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        // The image is cleared at the frame's first touch and whenever the markers run out;
+        // only the last marker is ever looked for.
+        let clear = self.marker == 0 || self.marker == MAX_MARKER;
+        self.marker = if clear {
+            MARKER_STEP
+        } else {
+            self.marker + MARKER_STEP
         };
+        let (load, contents) = if clear {
+            let zero = vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 0.0,
+                    stencil: 0,
+                },
+            };
+            (Load::Clear(zero), Contents::Discard)
+        } else {
+            (Load::Keep, Contents::Keep)
+        };
+        let access = ImageAccess::DepthStencilAttachment;
+        transition(ctx, cmd, &mut self.touch, access, contents);
+        let depth = attachment(&self.touch, self.touch.state.layout, load);
+        let area = vk::Rect2D::default().extent(self.extent);
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .depth_attachment(&depth);
+        // Depth clamping (light volume pipelines clamp) pins every fragment to min_depth.
+        let marker = self.marker as f32 / f32::from(u16::MAX);
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: self.extent.width as f32,
+            height: self.extent.height as f32,
+            min_depth: marker,
+            max_depth: marker,
+        };
+        unsafe {
+            ctx.device.cmd_begin_rendering(cmd, &info);
+            ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+            ctx.device.cmd_set_scissor(cmd, 0, &[area]);
+        }
     }
 
-    /// Outside rendering, after a write draw touched tiles as `touch` says, in a frame recorded
-    /// into `slot` (prepared with this `depth_stencil`, [`HiStencilSurface::prepare_slot`]):
-    /// retires an unflushed earlier write, then evaluates `hi` on those tiles into pending
-    /// state, reading the stencil in place, and empties the list for the next write unless it
-    /// keeps it. Leaves the depth-stencil image attached-ready.
+    /// Ends the touch draw's rendering.
+    pub fn end_touch(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+    }
+
+    /// Outside rendering, after a write draw touched tiles as `touch` says, inside `rect`, in a
+    /// frame recorded into `slot` (prepared with this `depth_stencil`,
+    /// [`HiStencilSurface::prepare_slot`]): retires an unflushed earlier write, then evaluates
+    /// `hi` on those tiles into pending state, reading the stencil in place. Leaves the
+    /// depth-stencil image attached-ready.
+    #[allow(clippy::too_many_arguments)]
     pub fn record_update(
         &mut self,
         ctx: &Context,
@@ -329,13 +437,39 @@ impl HiStencilSurface {
         slot: u32,
         depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
-        touch: Touch,
+        touch: TouchedTiles,
+        rect: TileRect,
     ) {
         if self.unflushed {
             self.record_flush(ctx, cmd);
         }
+        self.unflushed = true;
+        let rect_tiles = rect.width * rect.height;
+        if rect_tiles == 0 {
+            // The volume lies off screen: it rasterised nothing.
+            return;
+        }
         let stencil_read = ImageAccess::ComputeDepthStencilSampled;
         transition(ctx, cmd, depth_stencil, stencil_read, Contents::Keep);
+        // The update's set holds the touch image whether or not this update looks at it, so it
+        // is always in the layout the set names (its contents are kept only after a touch draw).
+        let (read_layout, ..) = access_info(stencil_read);
+        if self.touch.state.layout != read_layout {
+            let drawn = self.touch.state.layout != vk::ImageLayout::UNDEFINED;
+            let contents = if drawn {
+                Contents::Keep
+            } else {
+                Contents::Discard
+            };
+            transition(ctx, cmd, &mut self.touch, stencil_read, contents);
+        }
+        let marker = match touch {
+            TouchedTiles::All => 0,
+            TouchedTiles::Listed | TouchedTiles::Kept => {
+                assert_ne!(self.marker, 0, "a kept write follows a touch draw");
+                self.marker
+            }
+        };
         let push = UpdatePush {
             compare: compare_op(hi.compare).as_raw() as u32,
             reference: u32::from(hi.reference),
@@ -343,31 +477,19 @@ impl HiStencilSurface {
             width: self.extent.width,
             height: self.extent.height,
             tiles_x: self.tiles_x,
-            all_tiles: u32::from(touch.tiles == TouchedTiles::All),
+            rect_x: rect.x,
+            rect_y: rect.y,
+            rect_width: rect.width,
+            rect_tiles,
+            marker,
         };
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
-        match touch.tiles {
-            TouchedTiles::Listed | TouchedTiles::Kept => unsafe {
-                ctx.device
-                    .cmd_dispatch_indirect(cmd, self.touched_list.handle, 0)
-            },
-            TouchedTiles::All => {
-                let tiles = self.tiles_x * self.extent.height.div_ceil(HI_STENCIL_TILE);
-                let groups = tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
-                unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
-            }
-        }
+        let groups = rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
+        unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
         let attached = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
-        if !touch.keep {
-            // The list's counts are read (as dispatch arguments too) before they are zeroed.
-            memory_barrier(ctx, cmd);
-            self.clear_list(ctx, cmd);
-            memory_barrier(ctx, cmd);
-        }
-        self.unflushed = true;
     }
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
@@ -412,7 +534,7 @@ mod tests {
     use histencil_model::{FlushPolicy, LightCase, LightRequest, LightTechnique, Ps3Like};
     use histencil_model::{StencilLayout, X360Like};
 
-    fn writes(plan: &FramePlan) -> Vec<(usize, CullMode, Geometry, Touch)> {
+    fn writes(plan: &FramePlan) -> Vec<(usize, CullMode, Geometry, TouchedTiles)> {
         plan.steps
             .iter()
             .zip(plan_touches(plan))
@@ -429,10 +551,10 @@ mod tests {
             .collect()
     }
 
-    /// A volume write lists its tiles unless the light's previous write drew the same faces,
-    /// whose list that write kept; a full-screen write touches all.
+    /// A volume write draws its tiles unless the light's previous write drew the same faces,
+    /// whose tiles it keeps; a full-screen write touches all.
     #[test]
-    fn writes_keep_a_list_only_for_the_same_lights_same_faces() {
+    fn writes_keep_tiles_only_for_the_same_lights_same_faces() {
         let layout = StencilLayout::new(3, 0).unwrap();
         let request = |case| LightRequest {
             case,
@@ -450,27 +572,57 @@ mod tests {
                 .unwrap(),
         ] {
             let writes = writes(&plan);
-            assert!(writes.iter().any(|w| w.3.tiles == TouchedTiles::Kept));
+            assert!(writes.iter().any(|w| w.3 == TouchedTiles::Kept));
             for (i, &(light, cull, geometry, touch)) in writes.iter().enumerate() {
-                let next = writes.get(i + 1);
-                let same = |w: &(usize, CullMode, Geometry, Touch)| {
-                    (w.0, w.1, w.2) == (light, cull, Geometry::Volume)
-                };
-                match geometry {
-                    Geometry::FullScreen => assert_eq!(touch.tiles, TouchedTiles::All),
+                let expected = match geometry {
+                    Geometry::FullScreen => TouchedTiles::All,
                     Geometry::Volume => {
-                        let kept = i > 0 && same(&writes[i - 1]);
-                        let expected = if kept {
+                        let previous = i.checked_sub(1).map(|p| writes[p]);
+                        let same = previous
+                            .is_some_and(|w| (w.0, w.1, w.2) == (light, cull, Geometry::Volume));
+                        if same {
                             TouchedTiles::Kept
                         } else {
                             TouchedTiles::Listed
-                        };
-                        assert_eq!(touch.tiles, expected, "write {i}");
+                        }
                     }
-                }
-                let keeps = geometry == Geometry::Volume && next.is_some_and(same);
-                assert_eq!(touch.keep, keeps, "write {i}");
+                };
+                assert_eq!(touch, expected, "write {i}");
             }
         }
+    }
+
+    fn ndc(min: [f64; 2], max: [f64; 2]) -> Option<NdcRect> {
+        Some(NdcRect { min, max })
+    }
+
+    /// Tile rectangles hold every pixel of their NDC rectangle with a pixel to spare, clamp to
+    /// the frame, and are empty only off screen; unknown or broken rectangles mean the frame.
+    #[test]
+    fn tile_rectangles_hold_their_pixels_and_clamp_to_the_frame() {
+        let extent = vk::Extent2D {
+            width: 100,
+            height: 60,
+        };
+        let frame = TileRect {
+            x: 0,
+            y: 0,
+            width: 13,
+            height: 8,
+        };
+        assert_eq!(tile_rect(extent, None), frame);
+        assert_eq!(tile_rect(extent, ndc([f64::NAN, 0.0], [1.0, 1.0])), frame);
+        assert_eq!(tile_rect(extent, ndc([-5.0, -5.0], [5.0, 5.0])), frame);
+        // Pixels 50..=58 across (NDC 0 to 0.16), rows 30..=33: with a pixel to spare, tiles
+        // 6..=7 across and 3..=4 down.
+        let r = tile_rect(extent, ndc([0.0, 0.0], [0.16, 0.1]));
+        assert_eq!((r.x, r.width, r.y, r.height), (6, 2, 3, 2));
+        // Exactly on a tile edge: the spare pixel reaches the tile before.
+        let r = tile_rect(extent, ndc([-0.68, -1.0], [-0.6, -0.9]));
+        assert_eq!((r.x, r.width, r.y, r.height), (1, 2, 0, 1));
+        let off = tile_rect(extent, ndc([1.1, 0.0], [2.0, 0.5]));
+        assert_eq!(off.width * off.height, 0);
+        let above = tile_rect(extent, ndc([0.0, -3.0], [0.5, -1.1]));
+        assert_eq!(above.width * above.height, 0);
     }
 }

@@ -268,10 +268,18 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&DYNAMIC_STATES);
     let has_depth = desc.depth_stencil_format != vk::Format::UNDEFINED;
+    // A depth-only format (the hi-stencil touch image) has no stencil attachment.
+    let has_stencil =
+        crate::access::aspect_of(desc.depth_stencil_format).contains(vk::ImageAspectFlags::STENCIL);
+    let stencil_format = if has_stencil {
+        desc.depth_stencil_format
+    } else {
+        vk::Format::UNDEFINED
+    };
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(desc.color_formats)
         .depth_attachment_format(desc.depth_stencil_format)
-        .stencil_attachment_format(desc.depth_stencil_format);
+        .stencil_attachment_format(stencil_format);
     let mut info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)

@@ -13,7 +13,7 @@ pub const LIGHT_KINDS: [(&str, u32); 3] = [
 pub const HI_STENCIL_TILE: u32 = 8;
 
 /// Tiles per workgroup of the hi-stencil tile update (GLSL `HI_STENCIL_UPDATE_GROUP`): one
-/// invocation per tile a write draw touched, listed by that draw (`hi_stencil_touch.frag`). Read by build.rs.
+/// invocation per tile of the rectangle holding a write's volume. Read by build.rs.
 #[allow(dead_code)]
 pub const HI_STENCIL_UPDATE_GROUP: u32 = 64;
 

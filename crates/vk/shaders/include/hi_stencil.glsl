@@ -11,7 +11,7 @@
 layout(set = 2, binding = 0, std430) readonly buffer HiStencilActive {
     uint active_tiles[];
 };
-// The stamp of the last draw that covered each tile.
+// The stamp of the last statistics draw that covered each tile (hi_stencil_count.frag).
 layout(set = 2, binding = 1, std430) buffer HiStencilTouched {
     uint touched_tiles[];
 };
@@ -26,17 +26,6 @@ layout(set = 2, binding = 2, std430) buffer HiStencilStats {
 layout(set = 2, binding = 3, std430) readonly buffer SavedStencil {
     uint saved_stencil[];
 };
-
-// The tiles the current write draw touched, each once, for the tile update's indirect dispatch:
-// its workgroup count (HI_STENCIL_UPDATE_GROUP tiles each) and y = z = 1, then the count.
-// hi_stencil.rs zeroes the counts after each update.
-layout(set = 2, binding = 4, std430) buffer HiStencilTouchedList {
-    uint groups;
-    uint group_y;
-    uint group_z;
-    uint count;
-    uint tiles[];
-} touched_list;
 
 uint hi_stencil_tile() {
     uint tiles_x = (uint(frame.viewport.x) + HI_STENCIL_TILE - 1u) / HI_STENCIL_TILE;

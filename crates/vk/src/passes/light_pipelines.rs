@@ -3,7 +3,7 @@
 
 use crate::context::Context;
 use crate::error::Result;
-use crate::hi_stencil::{plan_touches, Touch, TouchedTiles};
+use crate::hi_stencil::{plan_touches, TouchedTiles, TOUCH_FORMAT};
 use crate::hooks::LightModules;
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::shaders;
@@ -17,7 +17,8 @@ use std::collections::HashMap;
 pub enum LightShader {
     /// No fragment shader: stencil and depth only.
     StencilOnly,
-    /// Marks the hi-stencil tiles the draw covers (`hi_stencil_touch.frag`).
+    /// No fragment shader, into the hi-stencil emulation's depth-only touch image: where a
+    /// write's volume rasterises (`crate::hi_stencil`).
     TouchTiles,
     /// Counts tiles a hi-stencil test covers and rejects (`hi_stencil_count.frag`).
     CountTiles,
@@ -104,11 +105,7 @@ impl LightPipelines {
         let light = ("deferred_light.frag", self.modules.deferred_light);
         let (fragment, specialization, shader_name) = match shader {
             LightShader::StencilOnly => (None, None, "stencil".to_owned()),
-            LightShader::TouchTiles => (
-                Some(("hi_stencil_touch.frag", shaders::HI_STENCIL_TOUCH_FRAG)),
-                None,
-                "touch-tiles".to_owned(),
-            ),
+            LightShader::TouchTiles => (None, None, "touch-tiles".to_owned()),
             LightShader::CountTiles => (
                 Some(("hi_stencil_count.frag", shaders::HI_STENCIL_COUNT_FRAG)),
                 None,
@@ -143,6 +140,12 @@ impl LightPipelines {
             Geometry::FullScreen => "fullscreen",
         };
         let hdr = [self.hdr_format];
+        let touch = shader == LightShader::TouchTiles;
+        let (color_formats, depth_stencil_format): (&[vk::Format], _) = if touch {
+            (&[], TOUCH_FORMAT)
+        } else {
+            (&hdr, self.depth_stencil_format)
+        };
         let pipeline = create_pipeline(
             ctx,
             &PipelineDesc {
@@ -151,10 +154,10 @@ impl LightPipelines {
                 fragment,
                 layout: self.layout,
                 vertex_input,
-                color_formats: &hdr,
+                color_formats,
                 color_writes: shades,
                 blend: if shades { Blend::Additive } else { Blend::Off },
-                depth_stencil_format: self.depth_stencil_format,
+                depth_stencil_format,
                 // Back faces beyond the far plane clamp to depth 1, behind every surface.
                 depth_clamp: geometry == Geometry::Volume,
                 specialization: specialization.as_ref().map_or(&[], |c| c.as_slice()),
@@ -201,14 +204,13 @@ impl TileWork {
 }
 
 /// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs; with `count_stats`
-/// every light shader counts its fragments; `touch` is how a hi-stencil write learns its tiles
-/// (`hi_stencil::plan_touches`): one that lists them does so from its fragment shader.
+/// every light shader counts its fragments. A hi-stencil write draws as native does: the
+/// emulator's touch draw that follows it is its own ([`LightShader::TouchTiles`]).
 pub fn pipeline_key(
     pass: &Pass,
     brdfs: &[BrdfId],
     count_stats: bool,
     source: BrdfSource,
-    touch: Option<Touch>,
 ) -> LightPipelineKey {
     let tiles = if count_stats {
         TileWork::TestAndCount
@@ -224,7 +226,6 @@ pub fn pipeline_key(
             tiles,
         },
         PassKind::Shade(Shader::Branching) => LightShader::Branching { tiles },
-        _ if touch.is_some_and(|t| t.tiles == TouchedTiles::Listed) => LightShader::TouchTiles,
         _ => LightShader::StencilOnly,
     };
     (pass.geometry, shader)
@@ -247,7 +248,10 @@ pub fn plan_pipelines(
     for (step, touch) in plan.steps.iter().zip(touches) {
         match step {
             Step::Pass { pass, .. } => {
-                add(pipeline_key(pass, brdfs, count_tiles, source, touch));
+                add(pipeline_key(pass, brdfs, count_tiles, source));
+                if touch == Some(TouchedTiles::Listed) {
+                    add((Geometry::Volume, LightShader::TouchTiles));
+                }
                 if count_tiles && pass.state.tests_hi_stencil() {
                     add((pass.geometry, LightShader::CountTiles));
                 }

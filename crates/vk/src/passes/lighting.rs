@@ -17,7 +17,7 @@ use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingT
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::hi_stencil::{plan_touches, HiStencilSurface, Touch};
+use crate::hi_stencil::{plan_touches, tile_rect, HiStencilSurface, TouchedTiles};
 use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
@@ -25,8 +25,8 @@ use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
-    DepthState, FaceStencil, FramePlan, Geometry, Pass, PassKind, PassState, Shader, StencilOp,
-    Step,
+    CompareOp, DepthState, FaceStencil, FramePlan, Geometry, Pass, PassKind, PassState, Shader,
+    StencilOp, Step,
 };
 use histencil_scene::Light;
 
@@ -126,12 +126,12 @@ impl Rendering {
 }
 
 /// The emulator's bookkeeping timed apart from the technique it emulates: a timestamp on each
-/// side of every piece of work a console does not do (resetting the tile surface, ending
-/// rendering and re-evaluating the touched tiles after a hi-stencil write, copying pending
-/// tiles to active at a flush), so the `bookkeeping` group is that work and the rest of
-/// the lighting pass is the platform's technique. What stays inside the technique's draws:
-/// marking touched tiles in a write draw and reading the tile surface in a testing draw, where
-/// hardware tests tiles before shading.
+/// side of every piece of work a console does not do (resetting the tile surface; after a
+/// hi-stencil write, ending rendering, drawing its volume into the touch image and
+/// re-evaluating the tiles it touched; copying pending tiles to active at a flush), so the
+/// `bookkeeping` group is that work and the rest of the lighting pass is the platform's
+/// technique. What stays inside the technique's draws: reading the tile surface in a testing
+/// draw, where hardware tests tiles before shading.
 pub(crate) struct Emulation;
 
 impl Emulation {
@@ -245,14 +245,21 @@ impl LightingPass<'_> {
                     }
                     let scene_light = self.plan.lights[*light].input as u32;
                     ctx.begin_label(cmd, &pass.label());
-                    let touch = touches[index];
-                    self.record_pass(targets, &mut rendering, index, pass, scene_light, touch)?;
+                    self.record_pass(targets, &mut rendering, index, pass, scene_light)?;
                     if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
+                        let touch = touches[index].expect("every write has its touch");
+                        if touch == TouchedTiles::Listed {
+                            self.record_touch(hi_stencil, pass, scene_light);
+                        }
+                        let screen = match pass.geometry {
+                            Geometry::Volume => self.plan.lights[*light].screen_rect,
+                            Geometry::FullScreen => None,
+                        };
+                        let rect = tile_rect(self.extent, screen);
                         let ds = &mut targets.depth_stencil;
-                        let touch = touch.expect("every write has its touch");
-                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touch);
+                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touch, rect);
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     }
                     ctx.end_label(cmd);
@@ -316,7 +323,6 @@ impl LightingPass<'_> {
         step: usize,
         pass: &Pass,
         scene_light: u32,
-        touch: Option<Touch>,
     ) -> Result<()> {
         let state = &pass.state;
         if state.tests_hi_stencil() && state.writes_stencil() {
@@ -361,9 +367,34 @@ impl LightingPass<'_> {
             flags,
             bit: 0,
         };
-        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source, touch);
+        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source);
         self.draw(key, state, pass.geometry, push);
         Ok(())
+    }
+
+    /// Outside rendering, after a volume's hi-stencil write: draws the same volume with the
+    /// same faces into the touch image, so the update finds the tiles the write rasterised.
+    /// No depth or stencil test: every covered pixel counts, whatever the write's tests did.
+    fn record_touch(&self, hi_stencil: &mut HiStencilSurface, pass: &Pass, scene_light: u32) {
+        hi_stencil.begin_touch(self.ctx, self.cmd);
+        let state = PassState {
+            cull: pass.state.cull,
+            depth: DepthState {
+                compare: Some(CompareOp::Always),
+                write: true,
+            },
+            front: None,
+            back: None,
+            color_write: false,
+            hi_stencil: None,
+        };
+        let push = LightDrawPush {
+            light_index: scene_light,
+            ..Default::default()
+        };
+        let key = (Geometry::Volume, LightShader::TouchTiles);
+        self.draw(key, &state, Geometry::Volume, push);
+        hi_stencil.end_touch(self.ctx, self.cmd);
     }
 
     /// Writes the saved preserved bits of `mask` back: one pass zeroes them, then one pass per
