@@ -437,8 +437,8 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
         {
             println!(
                 "emulated hi-stencil (medians): the platform's technique {:.2} ms + the \
-                 emulator's bookkeeping {bookkeeping:.2} ms (resets, splits, tile \
-                 updates, flush copies) = lighting {lighting:.2} ms",
+                 emulator's bookkeeping {bookkeeping:.2} ms (resets, splits, touch draws, \
+                 tile updates, flush copies) = lighting {lighting:.2} ms",
                 timings.technique_ms(&["lighting"])
             );
         }

@@ -264,7 +264,7 @@ impl DemoReport {
         let mut out = format!(
             "{}x{}, device {}; lighting time: median (spread) of {} frames, on the emulated \
              backends the platform's technique and then the emulator's bookkeeping (hi-stencil \
-             resets, splits, tile updates, flush copies); error against \
+             resets, splits, touch draws, tile updates, flush copies); error against \
              forward: 8-bit max / mean, mean FLIP; engine bits 0x{DEMO_PATTERN:02X}\n\n",
             self.width, self.height, self.device, self.frames
         );

@@ -662,8 +662,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
 
     /// Of the last frame recorded into `slot`, once the GPU has finished it: the time the
     /// hi-stencil emulator spent on bookkeeping a console does not do (resetting its tile
-    /// surface, the split and tile update after each hi-stencil write, the copy
-    /// at each flush), in milliseconds; the rest of the lighting is the platform's technique.
+    /// surface; after each hi-stencil write the split, the touch draw and the tile update; the
+    /// copy at each flush), in milliseconds; the rest of the lighting is the platform's technique.
     /// `None` when that frame's plan used no hi-stencil (a native plan). Every frame with
     /// hi-stencil writes these timestamps, two per piece of bookkeeping, where rendering is
     /// split anyway. Waits for the query results.

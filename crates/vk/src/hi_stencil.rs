@@ -66,6 +66,16 @@ pub const TOUCH_FORMAT: vk::Format = vk::Format::D16_UNORM;
 const MARKER_STEP: u32 = 2;
 const MAX_MARKER: u32 = u16::MAX as u32 - 1;
 
+/// The marker after `marker` (0: none yet), and whether the touch image must be cleared whole
+/// first: before the first marker, and when they run out and start again.
+fn next_marker(marker: u32) -> (u32, bool) {
+    if marker == 0 || marker >= MAX_MARKER {
+        (MARKER_STEP, true)
+    } else {
+        (marker + MARKER_STEP, false)
+    }
+}
+
 /// Which tiles a hi-stencil write touched, for its update.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TouchedTiles {
@@ -120,6 +130,22 @@ pub struct TileRect {
     pub y: u32,
     pub width: u32,
     pub height: u32,
+}
+
+impl TileRect {
+    /// Its pixels in a frame of `extent`.
+    pub fn pixels(self, extent: vk::Extent2D) -> vk::Rect2D {
+        let (x, y) = (self.x * HI_STENCIL_TILE, self.y * HI_STENCIL_TILE);
+        let width = (self.width * HI_STENCIL_TILE).min(extent.width.saturating_sub(x));
+        let height = (self.height * HI_STENCIL_TILE).min(extent.height.saturating_sub(y));
+        vk::Rect2D {
+            offset: vk::Offset2D {
+                x: x as i32,
+                y: y as i32,
+            },
+            extent: vk::Extent2D { width, height },
+        }
+    }
 }
 
 /// The tiles of a frame of `extent` that hold every pixel inside `ndc` (the whole frame for
@@ -194,7 +220,7 @@ pub struct HiStencilSurface {
     touched: Buffer,
     /// Where the last volume writes rasterised, as their markers' depths (the module doc).
     touch: Image,
-    /// The code of the marker the last touch draw wrote; 0 before the first of a frame.
+    /// The code of the marker the last touch draw wrote; 0 before the first.
     marker: u32,
     stats: Buffer,
     saved: Buffer,
@@ -353,8 +379,6 @@ impl HiStencilSurface {
         }
         memory_barrier(ctx, cmd);
         self.unflushed = false;
-        // The touch image is cleared by the frame's first touch draw.
-        self.marker = 0;
     }
 
     /// Outside rendering: pending state becomes active.
@@ -371,33 +395,32 @@ impl HiStencilSurface {
     }
 
     /// Outside rendering, after a volume write draw: begins rendering into the touch image
-    /// alone with a new marker as every fragment's depth, and sets the viewport and scissor.
-    /// The caller draws the write's volume with the touch pipeline
-    /// (`LightShader::TouchTiles`) and the write's faces, then calls [`Self::end_touch`].
-    pub fn begin_touch(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
-        // The image is cleared at the frame's first touch and whenever the markers run out;
-        // only the last marker is ever looked for.
-        let clear = self.marker == 0 || self.marker == MAX_MARKER;
-        self.marker = if clear {
-            MARKER_STEP
-        } else {
-            self.marker + MARKER_STEP
-        };
-        let (load, contents) = if clear {
+    /// alone, over `rect` (where the write's volume lies), with a new marker as every
+    /// fragment's depth, and sets the viewport and scissor. The caller draws the write's volume
+    /// with the touch pipeline (`LightShader::TouchTiles`) and the write's faces, then calls
+    /// [`Self::end_touch`].
+    pub fn begin_touch(&mut self, ctx: &Context, cmd: vk::CommandBuffer, rect: TileRect) {
+        // Markers run on across frames, and the image is cleared whole only before the first
+        // and when they run out, so no pixel outside this draw's area can hold its marker.
+        // A CPU rasteriser pays for a rendering's whole area, so the draw renders its
+        // rectangle only.
+        let clear;
+        (self.marker, clear) = next_marker(self.marker);
+        let whole = vk::Rect2D::default().extent(self.extent);
+        let (load, contents, area) = if clear {
             let zero = vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
                     depth: 0.0,
                     stencil: 0,
                 },
             };
-            (Load::Clear(zero), Contents::Discard)
+            (Load::Clear(zero), Contents::Discard, whole)
         } else {
-            (Load::Keep, Contents::Keep)
+            (Load::Keep, Contents::Keep, rect.pixels(self.extent))
         };
         let access = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, &mut self.touch, access, contents);
         let depth = attachment(&self.touch, self.touch.state.layout, load);
-        let area = vk::Rect2D::default().extent(self.extent);
         let info = vk::RenderingInfo::default()
             .render_area(area)
             .layer_count(1)
@@ -592,6 +615,25 @@ mod tests {
         }
     }
 
+    /// Markers are even, non-zero 16-bit codes, each new until they run out, and the image
+    /// is cleared whole exactly when a code could come round again.
+    #[test]
+    fn markers_are_new_even_codes_until_a_whole_clear() {
+        let (mut marker, mut clears, mut count) = (0, 0, 0);
+        let mut seen = std::collections::HashSet::new();
+        while clears < 2 {
+            let (next, clear) = next_marker(marker);
+            if clear {
+                clears += 1;
+                seen.clear();
+            }
+            assert!(next > 0 && next <= u32::from(u16::MAX) && next % MARKER_STEP == 0);
+            assert!(seen.insert(next), "{next} came round without a clear");
+            (marker, count) = (next, count + 1);
+        }
+        assert_eq!(count, MAX_MARKER / MARKER_STEP + 1);
+    }
+
     fn ndc(min: [f64; 2], max: [f64; 2]) -> Option<NdcRect> {
         Some(NdcRect { min, max })
     }
@@ -624,5 +666,18 @@ mod tests {
         assert_eq!(off.width * off.height, 0);
         let above = tile_rect(extent, ndc([0.0, -3.0], [0.5, -1.1]));
         assert_eq!(above.width * above.height, 0);
+        // In pixels, the last column and row of tiles stop at the frame's edge.
+        let edge = frame.pixels(extent);
+        assert_eq!((edge.offset.x, edge.offset.y), (0, 0));
+        assert_eq!((edge.extent.width, edge.extent.height), (100, 60));
+        let corner = TileRect {
+            x: 12,
+            y: 6,
+            width: 1,
+            height: 2,
+        };
+        let corner = corner.pixels(extent);
+        assert_eq!((corner.offset.x, corner.offset.y), (96, 48));
+        assert_eq!((corner.extent.width, corner.extent.height), (4, 12));
     }
 }

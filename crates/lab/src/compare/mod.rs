@@ -137,7 +137,7 @@ pub struct Cell {
     /// platform's technique only, without the hi-stencil emulator's bookkeeping.
     pub samples: Vec<f64>,
     /// On the emulated backends, the emulator's bookkeeping in the same rounds (resets, splits,
-    /// tile updates, flush copies: `FrameTimings::bookkeeping_ms`); empty
+    /// touch draws, tile updates, flush copies: `FrameTimings::bookkeeping_ms`); empty
     /// elsewhere. The whole lighting pass of round `i` is `samples[i] + bookkeeping[i]`.
     pub bookkeeping: Vec<f64>,
     /// With several BRDFs, what the same rounds would have taken if each BRDF cost what it costs

@@ -17,7 +17,7 @@ use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingT
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::hi_stencil::{plan_touches, tile_rect, HiStencilSurface, TouchedTiles};
+use crate::hi_stencil::{plan_touches, tile_rect, HiStencilSurface, TileRect, TouchedTiles};
 use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
@@ -250,14 +250,14 @@ impl LightingPass<'_> {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
                         let touch = touches[index].expect("every write has its touch");
-                        if touch == TouchedTiles::Listed {
-                            self.record_touch(hi_stencil, pass, scene_light);
-                        }
                         let screen = match pass.geometry {
                             Geometry::Volume => self.plan.lights[*light].screen_rect,
                             Geometry::FullScreen => None,
                         };
                         let rect = tile_rect(self.extent, screen);
+                        if touch == TouchedTiles::Listed && rect.width * rect.height > 0 {
+                            self.record_touch(hi_stencil, pass, scene_light, rect);
+                        }
                         let ds = &mut targets.depth_stencil;
                         hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touch, rect);
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
@@ -375,8 +375,14 @@ impl LightingPass<'_> {
     /// Outside rendering, after a volume's hi-stencil write: draws the same volume with the
     /// same faces into the touch image, so the update finds the tiles the write rasterised.
     /// No depth or stencil test: every covered pixel counts, whatever the write's tests did.
-    fn record_touch(&self, hi_stencil: &mut HiStencilSurface, pass: &Pass, scene_light: u32) {
-        hi_stencil.begin_touch(self.ctx, self.cmd);
+    fn record_touch(
+        &self,
+        hi_stencil: &mut HiStencilSurface,
+        pass: &Pass,
+        scene_light: u32,
+        rect: TileRect,
+    ) {
+        hi_stencil.begin_touch(self.ctx, self.cmd, rect);
         let state = PassState {
             cull: pass.state.cull,
             depth: DepthState {
