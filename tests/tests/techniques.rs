@@ -165,7 +165,7 @@ fn check(scene_name: &str) {
         }
         // Only the BRDFs in use get shaders: per BRDF and geometry (volume, and full screen for
         // the directional light) one pipeline with and one without the hi-stencil emulation's
-        // tile work, plus branching, LUT, stencil-only and tile-marking ones.
+        // tile work, plus branching, LUT, stencil-only and hi-stencil touch ones.
         let brdfs = renderer.brdfs().len();
         assert!(
             renderer.light_pipeline_count() <= 2 * (2 * brdfs + 5),

@@ -130,6 +130,14 @@ impl LightShape {
         }
     }
 
+    /// The sphere (centre, radius) that holds the volume mesh histencil draws for the light:
+    /// what the planner culls by and takes its screen rectangle from
+    /// ([`PlannedLight::screen_rect`](crate::PlannedLight::screen_rect)). `None` for a
+    /// directional light, which is drawn full-screen.
+    pub fn volume_sphere(&self) -> Option<([f64; 3], f64)> {
+        self.volume_bound().map(|(centre, radius)| (centre.into(), radius))
+    }
+
     /// A sphere containing the volume mesh histencil draws for the light.
     fn volume_bound(&self) -> Option<(DVec3, f64)> {
         match *self {

@@ -49,8 +49,8 @@ bool compare_passes(uint op, uint a, uint b) {
     }
 }
 
-// Whether a pixel of the tile holds the marker. Codes are two apart (hi_stencil.rs), so a depth
-// rounded either way by the device still matches its own code only.
+// Whether a pixel of the tile holds the marker: a code within one of it (Vulkan lets a device
+// store a depth as either neighbouring code; markers are four apart, hi_stencil.rs).
 bool touched(uvec2 origin, uvec2 end) {
     for (uint y = origin.y; y < end.y; ++y) {
         for (uint x = origin.x; x < end.x; ++x) {

@@ -5,6 +5,12 @@
 
 layout(location = 0) in vec3 in_position;
 
+// The hi-stencil emulation draws a write's volume again, in another pipeline, to find the
+// pixels the write rasterised: both must place every vertex identically. Both run this module
+// unchanged; `precise` forbids contracting its arithmetic differently per pipeline (`invariant`
+// would say more, but lavapipe 22.3 warns on the SPIR-V glslang emits for it).
+precise gl_Position;
+
 void main() {
     Light light = lights[light_draw.light_index];
     vec3 center = light.position_radius.xyz;

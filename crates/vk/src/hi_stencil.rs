@@ -61,13 +61,15 @@ struct UpdatePush {
 /// The touch image's format: depth-only, the one every Vulkan device renders to and samples.
 pub const TOUCH_FORMAT: vk::Format = vk::Format::D16_UNORM;
 
-/// Markers are even codes of the 16-bit touch image, so a depth the device rounds either way
-/// still reads back as its own marker and never as a neighbour's; 0 is the cleared image.
-const MARKER_STEP: u32 = 2;
-const MAX_MARKER: u32 = u16::MAX as u32 - 1;
+/// Markers are codes of the 16-bit touch image four apart. Vulkan lets a device store a depth
+/// as either neighbouring code of its exact value, so marker `m` is stored as `m - 1`, `m` or
+/// `m + 1`, and the update takes a code within one of `m` as `m`'s: no two markers, nor a marker
+/// and the cleared image's 0, can then be taken for each other.
+const MARKER_STEP: u32 = 4;
+const MAX_MARKER: u32 = (u16::MAX as u32 - 1) / MARKER_STEP * MARKER_STEP;
 
-/// The marker after `marker` (0: none yet), and whether the touch image must be cleared whole
-/// first: before the first marker, and when they run out and start again.
+/// The marker after `marker` (0: none yet this frame), and whether the touch image must be
+/// cleared whole first: before the frame's first marker, and when they run out and start again.
 fn next_marker(marker: u32) -> (u32, bool) {
     if marker == 0 || marker >= MAX_MARKER {
         (MARKER_STEP, true)
@@ -79,8 +81,8 @@ fn next_marker(marker: u32) -> (u32, bool) {
 /// Which tiles a hi-stencil write touched, for its update.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TouchedTiles {
-    /// Those its volume rasterises, drawn into the touch image: a light volume's.
-    Listed,
+    /// Those its volume rasterises, drawn again into the touch image: a light volume's.
+    Drawn,
     /// Those the light's previous write touched: the same volume with the same faces
     /// rasterises the same pixels whatever its depth and stencil tests, so its marker serves
     /// (the talk's mask pass per BRDF of one light).
@@ -115,7 +117,7 @@ pub fn plan_touches(plan: &FramePlan) -> Vec<Option<TouchedTiles>> {
                 if previous == Some(raster) {
                     TouchedTiles::Kept
                 } else {
-                    TouchedTiles::Listed
+                    TouchedTiles::Drawn
                 }
             }
         });
@@ -123,8 +125,16 @@ pub fn plan_touches(plan: &FramePlan) -> Vec<Option<TouchedTiles>> {
     touches
 }
 
-/// A rectangle of tiles: the first tile's column and row, and the size in tiles.
+/// The tiles a hi-stencil write touched: how its update learns them, and the rectangle they lie
+/// in (the light's on screen, or the frame).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WriteTiles {
+    pub touched: TouchedTiles,
+    pub rect: TileRect,
+}
+
+/// A rectangle of tiles: the first tile's column and row, and the size in tiles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TileRect {
     pub x: u32,
     pub y: u32,
@@ -133,6 +143,19 @@ pub struct TileRect {
 }
 
 impl TileRect {
+    /// Every tile of a frame of `extent`.
+    pub fn frame(extent: vk::Extent2D) -> Self {
+        Self {
+            width: extent.width.div_ceil(HI_STENCIL_TILE),
+            height: extent.height.div_ceil(HI_STENCIL_TILE),
+            ..Self::default()
+        }
+    }
+
+    pub fn is_empty(self) -> bool {
+        self.width == 0 || self.height == 0
+    }
+
     /// Its pixels in a frame of `extent`.
     pub fn pixels(self, extent: vk::Extent2D) -> vk::Rect2D {
         let (x, y) = (self.x * HI_STENCIL_TILE, self.y * HI_STENCIL_TILE);
@@ -151,20 +174,12 @@ impl TileRect {
 /// The tiles of a frame of `extent` that hold every pixel inside `ndc` (the whole frame for
 /// `None`), with a pixel to spare on each side for the GPU's single-precision transforms.
 pub fn tile_rect(extent: vk::Extent2D, ndc: Option<NdcRect>) -> TileRect {
-    let tiles = [extent.width, extent.height].map(|n| n.div_ceil(HI_STENCIL_TILE));
-    let Some(ndc) = ndc else {
-        return TileRect {
-            x: 0,
-            y: 0,
-            width: tiles[0],
-            height: tiles[1],
-        };
+    let frame = TileRect::frame(extent);
+    let Some(ndc) = ndc.filter(|r| r.min.iter().chain(&r.max).all(|v| v.is_finite())) else {
+        return frame;
     };
-    let finite = ndc.min.iter().chain(&ndc.max).all(|v| v.is_finite());
-    if !finite {
-        return tile_rect(extent, None);
-    }
     let size = [extent.width, extent.height].map(f64::from);
+    let tiles = [frame.width, frame.height];
     let span = |axis: usize| -> (u32, u32) {
         let pixel = |v: f64| (v + 1.0) * 0.5 * size[axis];
         let (lo, hi) = (pixel(ndc.min[axis]) - 1.0, pixel(ndc.max[axis]) + 1.0);
@@ -176,19 +191,16 @@ pub fn tile_rect(extent: vk::Extent2D, ndc: Option<NdcRect>) -> TileRect {
         (first, last + 1 - first)
     };
     let ((x, width), (y, height)) = (span(0), span(1));
-    if width == 0 || height == 0 {
-        return TileRect {
-            x: 0,
-            y: 0,
-            width: 0,
-            height: 0,
-        };
-    }
-    TileRect {
+    let rect = TileRect {
         x,
         y,
         width,
         height,
+    };
+    if rect.is_empty() {
+        TileRect::default()
+    } else {
+        rect
     }
 }
 
@@ -220,7 +232,7 @@ pub struct HiStencilSurface {
     touched: Buffer,
     /// Where the last volume writes rasterised, as their markers' depths (the module doc).
     touch: Image,
-    /// The code of the marker the last touch draw wrote; 0 before the first.
+    /// The code of the marker the last touch draw wrote; 0 before the frame's first.
     marker: u32,
     stats: Buffer,
     saved: Buffer,
@@ -379,6 +391,9 @@ impl HiStencilSurface {
         }
         memory_barrier(ctx, cmd);
         self.unflushed = false;
+        // The frame's first touch draw clears the touch image whole, so no frame depends on
+        // what an earlier one (recorded, perhaps never submitted) left there.
+        self.marker = 0;
     }
 
     /// Outside rendering: pending state becomes active.
@@ -400,10 +415,9 @@ impl HiStencilSurface {
     /// with the touch pipeline (`LightShader::TouchTiles`) and the write's faces, then calls
     /// [`Self::end_touch`].
     pub fn begin_touch(&mut self, ctx: &Context, cmd: vk::CommandBuffer, rect: TileRect) {
-        // Markers run on across frames, and the image is cleared whole only before the first
-        // and when they run out, so no pixel outside this draw's area can hold its marker.
-        // A CPU rasteriser pays for a rendering's whole area, so the draw renders its
-        // rectangle only.
+        // The image is cleared whole at the frame's first touch draw and when the markers run
+        // out, so no pixel outside this draw's area can hold its marker, and the draw renders
+        // its rectangle only (a CPU rasteriser pays for a rendering's whole area).
         let clear;
         (self.marker, clear) = next_marker(self.marker);
         let whole = vk::Rect2D::default().extent(self.extent);
@@ -447,12 +461,10 @@ impl HiStencilSurface {
         unsafe { ctx.device.cmd_end_rendering(cmd) };
     }
 
-    /// Outside rendering, after a write draw touched tiles as `touch` says, inside `rect`, in a
-    /// frame recorded into `slot` (prepared with this `depth_stencil`,
-    /// [`HiStencilSurface::prepare_slot`]): retires an unflushed earlier write, then evaluates
-    /// `hi` on those tiles into pending state, reading the stencil in place. Leaves the
-    /// depth-stencil image attached-ready.
-    #[allow(clippy::too_many_arguments)]
+    /// Outside rendering, after a write draw touched `tiles`, in a frame recorded into `slot`
+    /// (prepared with this `depth_stencil`, [`HiStencilSurface::prepare_slot`]): retires an
+    /// unflushed earlier write, then evaluates `hi` on those tiles into pending state, reading
+    /// the stencil in place. Leaves the depth-stencil image attached-ready.
     pub fn record_update(
         &mut self,
         ctx: &Context,
@@ -460,15 +472,15 @@ impl HiStencilSurface {
         slot: u32,
         depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
-        touch: TouchedTiles,
-        rect: TileRect,
+        tiles: WriteTiles,
     ) {
         if self.unflushed {
             self.record_flush(ctx, cmd);
         }
         self.unflushed = true;
+        let WriteTiles { touched, rect } = tiles;
         let rect_tiles = rect.width * rect.height;
-        if rect_tiles == 0 {
+        if rect.is_empty() {
             // The volume lies off screen: it rasterised nothing.
             return;
         }
@@ -486,9 +498,9 @@ impl HiStencilSurface {
             };
             transition(ctx, cmd, &mut self.touch, stencil_read, contents);
         }
-        let marker = match touch {
+        let marker = match touched {
             TouchedTiles::All => 0,
-            TouchedTiles::Listed | TouchedTiles::Kept => {
+            TouchedTiles::Drawn | TouchedTiles::Kept => {
                 assert_ne!(self.marker, 0, "a kept write follows a touch draw");
                 self.marker
             }
@@ -606,7 +618,7 @@ mod tests {
                         if same {
                             TouchedTiles::Kept
                         } else {
-                            TouchedTiles::Listed
+                            TouchedTiles::Drawn
                         }
                     }
                 };
@@ -615,8 +627,9 @@ mod tests {
         }
     }
 
-    /// Markers are even, non-zero 16-bit codes, each new until they run out, and the image
-    /// is cleared whole exactly when a code could come round again.
+    /// Markers are 16-bit codes four apart, never within one of 0 or of 65535's overflow, each
+    /// new until they run out, and the image is cleared whole exactly when a code could come
+    /// round again.
     #[test]
     fn markers_are_new_even_codes_until_a_whole_clear() {
         let (mut marker, mut clears, mut count) = (0, 0, 0);
@@ -627,7 +640,7 @@ mod tests {
                 clears += 1;
                 seen.clear();
             }
-            assert!(next > 0 && next <= u32::from(u16::MAX) && next % MARKER_STEP == 0);
+            assert!(next > 1 && next < u32::from(u16::MAX) && next % MARKER_STEP == 0);
             assert!(seen.insert(next), "{next} came round without a clear");
             (marker, count) = (next, count + 1);
         }

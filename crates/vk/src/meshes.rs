@@ -249,4 +249,43 @@ mod tests {
         assert!(radial > 1.0 && radial <= VOLUME_OVERSHOOT, "{radial}");
         assert!(axial > 1.0 && axial <= VOLUME_OVERSHOOT, "{axial}");
     }
+
+    /// Every vertex of a light's volume, placed as `light_volume.vert` places it, lies in the
+    /// planner's sphere for that light: the hi-stencil emulation looks for the pixels a volume
+    /// rasterised only inside that sphere's screen rectangle.
+    #[test]
+    fn placed_volumes_lie_in_the_planners_sphere() {
+        use histencil_model::{LightShape, MAX_SPOT_ANGLE};
+        let (position, range) = ([1.0, -2.0, 3.0], 2.5f32);
+        let inside = |shape: LightShape, placed: &dyn Fn([f32; 3]) -> [f64; 3], mesh: &Mesh| {
+            let (centre, radius) = shape.volume_sphere().expect("a volume");
+            for v in &mesh.vertices {
+                let p = glam::DVec3::from(placed(v.position));
+                let d = p.distance(glam::DVec3::from(centre));
+                assert!(d <= radius * (1.0 + 1e-9), "{shape:?}: {d} > {radius}");
+            }
+        };
+        let origin = glam::DVec3::from(position.map(f64::from));
+        let sphere = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
+        let point = LightShape::Point { position, range };
+        let scaled = |p: [f32; 3]| (origin + glam::Vec3::from(p).as_dvec3() * f64::from(range)).into();
+        inside(point, &scaled, &sphere);
+        let cone = light_cone(CONE_SIDES);
+        for degrees in [0.5f32, 5.0, 20.0, 45.0, 60.0, 70.0, 79.9] {
+            let outer_angle = degrees.to_radians().min(MAX_SPOT_ANGLE);
+            // Along +Z, as the shader places a cone on its light's axis.
+            let shape = LightShape::Spot {
+                position,
+                direction: [0.0, 0.0, 1.0],
+                range,
+                outer_angle,
+            };
+            let r = range * outer_angle.tan();
+            let placed = |p: [f32; 3]| {
+                let local = glam::Vec3::new(p[0] * r, p[1] * r, p[2] * range);
+                (origin + local.as_dvec3()).into()
+            };
+            inside(shape, &placed, &cone);
+        }
+    }
 }

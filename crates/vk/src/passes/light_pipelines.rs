@@ -249,7 +249,7 @@ pub fn plan_pipelines(
         match step {
             Step::Pass { pass, .. } => {
                 add(pipeline_key(pass, brdfs, count_tiles, source));
-                if touch == Some(TouchedTiles::Listed) {
+                if touch == Some(TouchedTiles::Drawn) {
                     add((Geometry::Volume, LightShader::TouchTiles));
                 }
                 if count_tiles && pass.state.tests_hi_stencil() {
@@ -345,7 +345,7 @@ mod tests {
             }
         )));
         // A viewer inside the light: its hi-stencil writes are full-screen, which touch every
-        // tile, and list none from a fragment shader.
+        // tile, and need no touch draw.
         let inside = LightRequest {
             case: LightCase::ViewerInside,
             ..request

@@ -17,7 +17,7 @@ use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingT
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::hi_stencil::{plan_touches, tile_rect, HiStencilSurface, TileRect, TouchedTiles};
+use crate::hi_stencil::{plan_touches, tile_rect, HiStencilSurface, TouchedTiles, WriteTiles};
 use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
@@ -25,8 +25,8 @@ use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
-    CompareOp, DepthState, FaceStencil, FramePlan, Geometry, Pass, PassKind, PassState, Shader,
-    StencilOp, Step,
+    CompareOp, DepthState, FaceStencil, FramePlan, Geometry, HiStencilState, Pass, PassKind,
+    PassState, Shader, StencilOp, Step,
 };
 use histencil_scene::Light;
 
@@ -249,17 +249,9 @@ impl LightingPass<'_> {
                     if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
-                        let touch = touches[index].expect("every write has its touch");
-                        let screen = match pass.geometry {
-                            Geometry::Volume => self.plan.lights[*light].screen_rect,
-                            Geometry::FullScreen => None,
-                        };
-                        let rect = tile_rect(self.extent, screen);
-                        if touch == TouchedTiles::Listed && rect.width * rect.height > 0 {
-                            self.record_touch(hi_stencil, pass, scene_light, rect);
-                        }
-                        let ds = &mut targets.depth_stencil;
-                        hi_stencil.record_update(ctx, cmd, self.slot, ds, &hi, touch, rect);
+                        let touched = touches[index].expect("every write has its touch");
+                        let write = (*light, pass, &hi, touched);
+                        self.record_write_tiles(targets, hi_stencil, write);
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     }
                     ctx.end_label(cmd);
@@ -372,35 +364,45 @@ impl LightingPass<'_> {
         Ok(())
     }
 
-    /// Outside rendering, after a volume's hi-stencil write: draws the same volume with the
-    /// same faces into the touch image, so the update finds the tiles the write rasterised.
-    /// No depth or stencil test: every covered pixel counts, whatever the write's tests did.
-    fn record_touch(
+    /// Outside rendering, after the hi-stencil write `hi` of plan light `light`'s `pass`: the
+    /// emulator's bookkeeping. A volume write that learns its tiles by drawing
+    /// ([`TouchedTiles::Drawn`]) draws the same volume with the same faces into the touch
+    /// image, with no depth or stencil test (every covered pixel counts, whatever the write's
+    /// tests did); then the tile update re-evaluates the touched tiles of the light's screen
+    /// rectangle.
+    fn record_write_tiles(
         &self,
+        targets: &mut LightingTargets,
         hi_stencil: &mut HiStencilSurface,
-        pass: &Pass,
-        scene_light: u32,
-        rect: TileRect,
+        (light, pass, hi, touched): (usize, &Pass, &HiStencilState, TouchedTiles),
     ) {
-        hi_stencil.begin_touch(self.ctx, self.cmd, rect);
-        let state = PassState {
-            cull: pass.state.cull,
-            depth: DepthState {
-                compare: Some(CompareOp::Always),
-                write: true,
-            },
-            front: None,
-            back: None,
-            color_write: false,
-            hi_stencil: None,
+        let screen = match pass.geometry {
+            Geometry::Volume => self.plan.lights[light].screen_rect,
+            Geometry::FullScreen => None,
         };
-        let push = LightDrawPush {
-            light_index: scene_light,
-            ..Default::default()
-        };
-        let key = (Geometry::Volume, LightShader::TouchTiles);
-        self.draw(key, &state, Geometry::Volume, push);
-        hi_stencil.end_touch(self.ctx, self.cmd);
+        let rect = tile_rect(self.extent, screen);
+        if touched == TouchedTiles::Drawn && !rect.is_empty() {
+            hi_stencil.begin_touch(self.ctx, self.cmd, rect);
+            let state = PassState {
+                cull: pass.state.cull,
+                depth: DepthState {
+                    compare: Some(CompareOp::Always),
+                    write: true,
+                },
+                color_write: false,
+                ..FULLSCREEN
+            };
+            let push = LightDrawPush {
+                light_index: self.plan.lights[light].input as u32,
+                ..Default::default()
+            };
+            let key = (Geometry::Volume, LightShader::TouchTiles);
+            self.draw(key, &state, Geometry::Volume, push);
+            hi_stencil.end_touch(self.ctx, self.cmd);
+        }
+        let (ctx, ds) = (self.ctx, &mut targets.depth_stencil);
+        let tiles = WriteTiles { touched, rect };
+        hi_stencil.record_update(ctx, self.cmd, self.slot, ds, hi, tiles);
     }
 
     /// Writes the saved preserved bits of `mask` back: one pass zeroes them, then one pass per
