@@ -135,7 +135,8 @@ impl LightShape {
     /// ([`PlannedLight::screen_rect`](crate::PlannedLight::screen_rect)). `None` for a
     /// directional light, which is drawn full-screen.
     pub fn volume_sphere(&self) -> Option<([f64; 3], f64)> {
-        self.volume_bound().map(|(centre, radius)| (centre.into(), radius))
+        self.volume_bound()
+            .map(|(centre, radius)| (centre.into(), radius))
     }
 
     /// A sphere containing the volume mesh histencil draws for the light.

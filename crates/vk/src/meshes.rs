@@ -268,7 +268,8 @@ mod tests {
         let origin = glam::DVec3::from(position.map(f64::from));
         let sphere = light_sphere(SPHERE_SEGMENTS, SPHERE_RINGS);
         let point = LightShape::Point { position, range };
-        let scaled = |p: [f32; 3]| (origin + glam::Vec3::from(p).as_dvec3() * f64::from(range)).into();
+        let scaled =
+            |p: [f32; 3]| (origin + glam::Vec3::from(p).as_dvec3() * f64::from(range)).into();
         inside(point, &scaled, &sphere);
         let cone = light_cone(CONE_SIDES);
         for degrees in [0.5f32, 5.0, 20.0, 45.0, 60.0, 70.0, 79.9] {
