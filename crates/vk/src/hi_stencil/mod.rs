@@ -1,23 +1,23 @@
 //! Console hi-stencil, emulated on the GPU exactly as `histencil_model::TileSurface` specifies,
 //! so the CPU simulator is an oracle for it.
 //!
-//! The coarse surface is one word per [`HI_STENCIL_TILE`]-pixel tile, in two buffers: `pending`
-//! (what write-enabled draws evaluated) and `active` (what testing draws see). A hi-stencil
-//! write is a *split pass*: the write draw itself is the platform's (the same stencil-only
-//! pipeline as native), rendering ends, and the emulator learns which tiles it rasterised by
-//! drawing the same volume with the same faces once more, without a fragment shader, into a
-//! depth-only *touch image* whose viewport pins every fragment's depth to a marker unique to
-//! the write (a fragment shader with a side effect would run for every covered pixel, which a
-//! CPU rasteriser pays for many times over a depth-only draw). `hi_stencil_update.comp` then
-//! looks at the tiles of the light's screen rectangle (`PlannedLight::screen_rect`) and
-//! re-evaluates into `pending` those holding the marker, reading the stencil where it is
-//! through a stencil-aspect view: a small light's write costs its own tiles, not the screen's,
-//! and nothing is copied. Two writes need no touch draw ([`plan_touches`], in `touch.rs` with
-//! the other pure rules): a full-screen one touches every tile, and one that draws the same
-//! volume with the same faces as its light's previous write touches that write's tiles, whose
-//! marker is still in the touch image. A flush, or the next write while one is unflushed (the
-//! latest point hardware could retire it), copies `pending` to `active`. Testing draws reject fragments of failing tiles in the
-//! light shader (`LIGHT_DRAW_HI_STENCIL_TEST`).
+//! The coarse surface is one word per `HI_STENCIL_TILE`-pixel tile (8x8), in two buffers: `pending`
+//! (what write-enabled draws evaluated) and `active` (what testing draws see). A hi-stencil write
+//! is a *split pass*: the write draw itself is the platform's (the same stencil-only pipeline as
+//! native), rendering ends, and the emulator learns which tiles it rasterised by drawing the same
+//! volume with the same faces once more, without a fragment shader, into a depth-only *touch image*
+//! whose viewport pins every fragment's depth to a marker unique to the write (a fragment shader
+//! with a side effect would run for every covered pixel, which a CPU rasteriser pays for many times
+//! over a depth-only draw). `hi_stencil_update.comp` then looks at the tiles of the light's screen
+//! rectangle (`PlannedLight::screen_rect`) and re-evaluates into `pending` those holding the
+//! marker, reading the stencil where it is through a stencil-aspect view: a small light's write
+//! costs its own tiles, not the screen's, and nothing is copied. Two writes need no touch draw
+//! ([`plan_touches`], in `touch.rs` with the other pure rules): a full-screen one touches every
+//! tile, and one that draws the same volume with the same faces as its light's previous write
+//! touches that write's tiles, whose marker is still in the touch image. A flush, or the next write
+//! while one is unflushed (the latest point hardware could retire it), copies `pending` to
+//! `active`. Testing draws reject fragments of failing tiles in the light shader
+//! (`LIGHT_DRAW_HI_STENCIL_TEST`).
 //!
 //! Statistics are optional because counting needs extra draws and atomics: with them on, each
 //! testing draw is preceded by `hi_stencil_count.frag` over the same geometry, and light shaders
@@ -28,10 +28,10 @@ use crate::compute::ComputePipeline;
 use crate::context::Context;
 use crate::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
 use crate::error::{Result, VkCall};
-use crate::passes::{attachment, Load};
+use crate::passes::{depth_stencil_attachment, Load};
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::{Buffer, Image};
-use crate::shader_consts::{HI_STENCIL_TILE, HI_STENCIL_UPDATE_GROUP};
+use crate::shader_consts::HI_STENCIL_UPDATE_GROUP;
 use crate::shaders;
 use crate::state::compare_op;
 use crate::teardown::{build, Destroy};
@@ -144,9 +144,8 @@ impl HiStencilSurface {
     /// The surface for `extent`, with an update set for each of `slots` frames in flight; a
     /// failure half way frees what was made.
     pub fn new(ctx: &Context, extent: vk::Extent2D, slots: u32) -> Result<Self> {
-        let tiles_x = extent.width.div_ceil(HI_STENCIL_TILE);
-        let tiles_y = extent.height.div_ceil(HI_STENCIL_TILE);
-        let tile_bytes = u64::from(tiles_x * tiles_y) * 4;
+        let frame = TileRect::frame(extent);
+        let (tiles_x, tile_bytes) = (frame.width, u64::from(frame.width * frame.height) * 4);
         use vk::BufferUsageFlags as U;
         let gpu = |name, size, usage| Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly);
         let storage = U::STORAGE_BUFFER | U::TRANSFER_DST;
@@ -296,7 +295,7 @@ impl HiStencilSurface {
         };
         let access = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, &mut self.touch, access, contents);
-        let depth = attachment(&self.touch, self.touch.state.layout, load);
+        let depth = depth_stencil_attachment(&self.touch, load);
         let info = vk::RenderingInfo::default()
             .render_area(area)
             .layer_count(1)

@@ -43,7 +43,7 @@ pub(crate) fn depth_stencil_attachment(
     )
 }
 
-pub(crate) fn attachment(
+fn attachment(
     image: &ImageRef,
     layout: vk::ImageLayout,
     load: Load,

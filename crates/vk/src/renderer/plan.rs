@@ -21,8 +21,7 @@ impl Renderer<'_> {
 
     /// What a frame of `technique` records: the adaptive technique on the native backend lights
     /// the whole frame tiled (the device's tiles, [`crate::TileSide::for_device`]; mixed tiles
-    /// per BRDF) where its costs predict that
-    /// surely cheaper than its plan ([`histencil_model::CostModel::prefers_tiled`]; never with
+    /// per BRDF) where its costs predict that surely cheaper than its plan ([`histencil_model::CostModel::prefers_tiled`]; never with
     /// the talk's costs, which have no tiled figures); on an emulated console backend it keeps
     /// the console's plan, whose behaviour it is there to show. Every other technique is
     /// itself.
