@@ -11,11 +11,13 @@
 //! and a summary. `histencil check` is a thin wrapper over [`run_check`].
 
 pub mod judge;
+pub mod lists;
 pub mod matrix;
 pub mod report;
 mod run;
+pub mod runner;
 
 pub use run::{
-    planned_cases, run_check, CaseResult, CheckError, CheckOptions, CheckReport, CheckScene,
+    planned_cases, run_check, CaseResult, CheckError, CheckOptions, CheckReport, CheckScene, Event,
     InjectedFault, Outcome, ACCEPTED_BEST_PRACTICES,
 };

@@ -3,15 +3,16 @@
 //! every case rendered, judged and given the validation messages that arrived while it ran.
 
 use crate::judge::{self, ImageVerdict, StencilInputs, ALPHA_LIGHTMAP, ALPHA_PROBE};
+use crate::lists::AcceptedMessages;
 use crate::matrix::{self, Case, Config, Expect, KnownWrong, Platform, SceneNeeds};
 use histencil_model::FlushPolicy;
 use histencil_scene::Scene;
 use histencil_vk::{
-    AlphaMode, Context, ContextDesc, DepthStencilFormat, FrameDesc, Readback, Renderer, Shading,
-    SimulatorInputs, Technique, ValidationLog, ValidationMessage,
+    AlphaMode, Context, ContextDesc, DepthStencilFormat, DriverInfo, FrameDesc, Readback, Renderer,
+    Shading, SimulatorInputs, Technique, ValidationLog, ValidationMessage,
 };
 use image::{GrayImage, RgbaImage};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -49,20 +50,30 @@ pub const ACCEPTED_BEST_PRACTICES: [(&str, &str); 1] = [(
      target SPIR-V 1.3 so that naga can validate them",
 )];
 
-/// The messages since `mark`, less the accepted best-practices ones (returned as a count).
-fn messages_since(log: &ValidationLog, mark: usize) -> (Vec<ValidationMessage>, usize) {
-    let (accepted, failing): (Vec<_>, Vec<_>) = log
-        .since(mark)
-        .into_iter()
-        .partition(|m| ACCEPTED_BEST_PRACTICES.iter().any(|(id, _)| m.id == *id));
+/// The messages since `mark`, less the accepted ones (histencil's best-practices ones and the
+/// user's `--accept-messages`), which are returned as a count.
+fn messages_since(
+    log: &ValidationLog,
+    mark: usize,
+    user: &AcceptedMessages,
+) -> (Vec<ValidationMessage>, usize) {
+    let (accepted, failing): (Vec<_>, Vec<_>) = log.since(mark).into_iter().partition(|m| {
+        ACCEPTED_BEST_PRACTICES.iter().any(|(id, _)| m.id == *id) || user.accepts(&m.id)
+    });
     (failing, accepted.len())
 }
 
 /// A deliberate defect, for proving that the check can fail (tests and `--inject-fault`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum InjectedFault {
     /// Every case on a hi-stencil backend is rendered without flushes, whatever it says.
     DropFlushes,
+    /// Cases whose `scene/case` name contains this never finish (a hung device, as a runner
+    /// sees one): the runner's `--timeout` must end them.
+    Hang(String),
+    /// Cases whose `scene/case` name contains this abort the process (a driver crash, as a
+    /// runner sees one).
+    Crash(String),
 }
 
 /// How to run the matrix.
@@ -76,7 +87,25 @@ pub struct CheckOptions {
     pub out: Option<PathBuf>,
     /// Only cases whose `scene/case` name contains this.
     pub filter: Option<String>,
+    /// Only the cases named here (`scene/case`), after `filter`: a runner's case list.
+    pub only: Option<HashSet<String>>,
+    /// Validation messages the user accepts: counted per case, never failing it.
+    pub accepted: AcceptedMessages,
     pub inject: Option<InjectedFault>,
+}
+
+/// What [`run_check`] tells its caller as it goes.
+pub enum Event<'a> {
+    /// A context was made for the next cases: the device and its driver.
+    Context {
+        device: &'a str,
+        driver: &'a DriverInfo,
+    },
+    /// A case (`scene/case`) begins; a group's first case begins before the group's setup
+    /// (renderer and forward reference), which counts as its time.
+    Started(&'a str),
+    /// A case, a canary or a teardown ended, with the number of cases planned.
+    Finished(&'a CaseResult, usize),
 }
 
 /// How a case ended.
@@ -85,6 +114,8 @@ pub enum Outcome {
     Passed,
     Failed(String),
     Skipped(String),
+    /// The validation layer did not report the canary's deliberate invalid calls.
+    Muted(String),
 }
 
 /// One case's result, with every number it was judged on.
@@ -130,6 +161,8 @@ impl CaseResult {
 #[derive(Clone, Debug)]
 pub struct CheckReport {
     pub device: String,
+    /// The driver and validation layer of the last context the run made.
+    pub driver: DriverInfo,
     pub best_practices: bool,
     pub quick: bool,
     pub results: Vec<CaseResult>,
@@ -137,8 +170,9 @@ pub struct CheckReport {
 }
 
 impl CheckReport {
+    /// Failed cases, a muted validation layer included.
     pub fn failed(&self) -> usize {
-        self.count(|o| matches!(o, Outcome::Failed(_)))
+        self.count(|o| matches!(o, Outcome::Failed(_) | Outcome::Muted(_)))
     }
 
     pub fn skipped(&self) -> usize {
@@ -182,7 +216,12 @@ pub fn planned_cases(
             for size in matrix::resolutions(options.quick) {
                 for case in matrix::cases(needs, format, size) {
                     let full = format!("{}/{}", scene.name, case.name());
-                    if options.filter.as_ref().is_none_or(|f| full.contains(f)) {
+                    if options.filter.as_ref().is_none_or(|f| full.contains(f))
+                        && options
+                            .only
+                            .as_ref()
+                            .is_none_or(|only| only.contains(&full))
+                    {
                         planned.push((index, case));
                     }
                 }
@@ -192,8 +231,12 @@ pub fn planned_cases(
     Ok(planned)
 }
 
-/// Runs the matrix. `progress` sees every result as it is made, with the number of cases
-/// planned (teardowns come on top).
+/// Runs the matrix. `progress` sees each case begin and every result as it is made, with the
+/// number of cases planned (canaries and teardowns come on top).
+///
+/// Each context first runs the validation canary ([`Context::validation_canary`]): its result
+/// is the case `device/canary-<format>`, [`Outcome::Muted`] where the layer did not report every
+/// deliberate call.
 ///
 /// # Errors
 /// No Vulkan device or no validation layer. Everything a case can do wrong (a renderer error
@@ -201,15 +244,18 @@ pub fn planned_cases(
 pub fn run_check(
     scenes: &[CheckScene],
     options: &CheckOptions,
-    mut progress: impl FnMut(&CaseResult, usize),
+    mut progress: impl FnMut(Event),
 ) -> Result<CheckReport, CheckError> {
     let start = Instant::now();
     let planned = planned_cases(scenes, options)?;
     let total = planned.len();
     let mut results: Vec<CaseResult> = Vec::new();
     let mut device = String::new();
-    let mut emit = |result: CaseResult, results: &mut Vec<CaseResult>| {
-        progress(&result, total);
+    let mut driver = DriverInfo::default();
+    let progress = std::cell::RefCell::new(&mut progress);
+    let started = |name: &str| (progress.borrow_mut())(Event::Started(name));
+    let emit = |result: CaseResult, results: &mut Vec<CaseResult>| {
+        (progress.borrow_mut())(Event::Finished(&result, total));
         results.push(result);
     };
     for format in DepthStencilFormat::ALL {
@@ -236,7 +282,29 @@ pub fn run_check(
             Err(e) => return Err(e.into()),
         };
         device = ctx.device_name().to_owned();
+        driver = ctx.driver().clone();
+        (progress.borrow_mut())(Event::Context {
+            device: &device,
+            driver: &driver,
+        });
         let log = ctx.validation_log();
+        let canary_start = Instant::now();
+        let canary = ctx.validation_canary();
+        let mut r = CaseResult::new(
+            "device",
+            format!("canary-{}", format.vk_name().to_lowercase()),
+            None,
+        );
+        r.seconds = canary_start.elapsed().as_secs_f64();
+        r.note = Some(canary.to_string());
+        if !canary.heard() {
+            r.outcome = Outcome::Muted(format!(
+                "validation-layer-muted: {canary}; a message-id filter, a duplicate-message \
+                 limit or disabled checks (VK_LAYER_* variables, vk_layer_settings.txt) are in \
+                 force, so no validation verdict of this run can be trusted"
+            ));
+        }
+        emit(r, &mut results);
         // Group by scene and resolution, in plan order: one renderer each.
         let mut groups: Vec<((usize, u32, u32), Vec<Case>)> = Vec::new();
         for (scene, case) in mine {
@@ -254,7 +322,7 @@ pub fn run_check(
                 size: (width, height),
                 options,
             };
-            group.run(&cases, &mut |r| emit(r, &mut results));
+            group.run(&cases, &started, &mut |r| emit(r, &mut results));
         }
         let mark = log.len();
         let teardown_start = Instant::now();
@@ -264,7 +332,7 @@ pub fn run_check(
             format!("teardown-{}", format.vk_name().to_lowercase()),
             None,
         );
-        (r.validation, r.accepted) = messages_since(&log, mark);
+        (r.validation, r.accepted) = messages_since(&log, mark, &options.accepted);
         r.seconds = teardown_start.elapsed().as_secs_f64();
         if let Some(first) = r.validation.first() {
             r.outcome = Outcome::Failed(format!(
@@ -277,6 +345,7 @@ pub fn run_check(
     }
     Ok(CheckReport {
         device,
+        driver,
         best_practices: options.best_practices,
         quick: options.quick,
         results,
@@ -308,11 +377,15 @@ const IMAGES: Readback = Readback {
 };
 
 impl Group<'_> {
-    fn run(&self, cases: &[Case], emit: &mut dyn FnMut(CaseResult)) {
+    fn run(&self, cases: &[Case], started: &dyn Fn(&str), emit: &mut dyn FnMut(CaseResult)) {
         let start = Instant::now();
         let mark = self.log.len();
+        if let Some(first) = cases.first() {
+            started(&self.full_name(first));
+        }
         let setup = self.setup(cases);
-        let (setup_messages, setup_accepted) = messages_since(self.log, mark);
+        let (setup_messages, setup_accepted) =
+            messages_since(self.log, mark, &self.options.accepted);
         let (mut renderer, references) = match setup {
             Ok(built) if setup_messages.is_empty() => built,
             outcome => {
@@ -339,8 +412,12 @@ impl Group<'_> {
         let mut simulated: HashMap<u8, Result<SimulatorInputs, String>> = HashMap::new();
         // Accepted messages of the setup count towards the group's first case.
         let mut setup_accepted = setup_accepted;
-        for case in cases {
+        for (i, case) in cases.iter().enumerate() {
             let start = Instant::now();
+            if i > 0 {
+                started(&self.full_name(case));
+            }
+            self.inject_runner_fault(case);
             let mut r = match case.config {
                 None => self.reference(case, &references, setup_seconds),
                 Some(config) => self.case(case, config, &mut renderer, &references, &mut simulated),
@@ -350,6 +427,25 @@ impl Group<'_> {
             }
             r.accepted += std::mem::take(&mut setup_accepted);
             emit(r);
+        }
+    }
+
+    fn full_name(&self, case: &Case) -> String {
+        format!("{}/{}", self.scene.name, case.name())
+    }
+
+    /// `--inject-fault hang=` and `crash=`: what a hung or crashing driver does to a runner.
+    fn inject_runner_fault(&self, case: &Case) {
+        match &self.options.inject {
+            Some(InjectedFault::Hang(part)) if self.full_name(case).contains(part.as_str()) => {
+                loop {
+                    std::thread::sleep(std::time::Duration::from_secs(3600));
+                }
+            }
+            Some(InjectedFault::Crash(part)) if self.full_name(case).contains(part.as_str()) => {
+                std::process::abort()
+            }
+            _ => {}
         }
     }
 
@@ -431,7 +527,7 @@ impl Group<'_> {
         };
         let mark = self.log.len();
         let frame = renderer.render_frame(&desc);
-        (r.validation, r.accepted) = messages_since(self.log, mark);
+        (r.validation, r.accepted) = messages_since(self.log, mark, &self.options.accepted);
         let frame = match frame {
             Ok(frame) => frame,
             Err(e) => {

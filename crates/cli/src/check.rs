@@ -1,17 +1,41 @@
-//! `histencil check`: the validation-CI matrix (histencil-check) with a progress bar, its
-//! reports written, and an exit code a CI system reads: 0 all passed, 1 any failure, 2 a usage
-//! error (bad arguments, an unknown or malformed scene, an output that cannot be written).
+//! `histencil check`: the validation-CI matrix (histencil-check) as a CI runner. The parent
+//! plans the cases (scenes, `--filter`, `--caselist`, `--shard`, `--skips`), runs them in worker
+//! processes (`--jobs`, `--timeout`; a worker is this program with the hidden `--worker` flag)
+//! whose environment cannot mute the validation layer, applies `--baseline` and `--flakes`,
+//! streams `results.csv`, and writes `failures.csv`, JUnit and JSON at the end or when stopped
+//! by SIGINT/SIGTERM. `histencil check merge` joins shards' JSON reports.
+//!
+//! Exit codes: 0 nothing fails; 1 a case fails (a regression, crash, timeout, muted validation
+//! layer or unexpected pass); 2 usage error; 3 no Vulkan device or no validation layer; 4 no
+//! case selected; 5 stopped before the end (a signal) with nothing failing so far.
 
-use anyhow::Result;
-use histencil_check::{CheckOptions, CheckScene, InjectedFault, Outcome};
+use anyhow::{Context as _, Result};
+use histencil_check::lists::{AcceptedMessages, Baseline, Patterns, Shard, Status};
+use histencil_check::report::{self, Record, RunReport};
+use histencil_check::runner::{self, PlannedCase, RunnerOptions};
+use histencil_check::{CheckOptions, CheckScene, Event, InjectedFault};
 use histencil_scene::DefaultLights;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
+use std::collections::HashSet;
+use std::ffi::OsString;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// Exit codes apart, as a CI script reads them.
+const EXIT_FAILING: u8 = 1;
+const EXIT_USAGE: u8 = 2;
+const EXIT_NO_DEVICE: u8 = runner::NO_DEVICE_EXIT as u8;
+const EXIT_NO_CASES: u8 = 4;
+const EXIT_INCOMPLETE: u8 = 5;
 
 #[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct CheckArgs {
+    #[command(subcommand)]
+    command: Option<CheckCommand>,
     /// An embedded scene or a `.gltf` / `.glb` file; repeat for several (default: every
     /// embedded scene).
     #[arg(long = "scene")]
@@ -19,17 +43,18 @@ pub struct CheckArgs {
     /// Resolutions 1x1, 7x5 and 257x129 only; the full run adds 1280x720.
     #[arg(long)]
     quick: bool,
-    /// Print the matrix (scene, case, expectation) without running it.
+    /// Print the cases selected (scene, case, expectation) without running them.
     #[arg(long)]
     list: bool,
     /// Write JUnit XML here (a testsuite per scene, a testcase per configuration).
     #[arg(long)]
     junit: Option<PathBuf>,
-    /// Write every case's numbers here as JSON.
+    /// Write every case's numbers here as JSON (what `check merge` joins).
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Where failing cases write -actual.png, -expected.png, -difference.png, -stencil.png and
-    /// -validation.txt, in a folder per scene.
+    /// The run's folder: results.csv (streamed as cases finish), failures.csv (in --baseline
+    /// format), each failing case's images and messages in a folder per scene, and workers/
+    /// (case lists and logs).
     #[arg(long, default_value = "out/check")]
     out: PathBuf,
     /// Enable the validation layer's best-practices checks too.
@@ -38,24 +63,111 @@ pub struct CheckArgs {
     /// Run only the cases whose `scene/case` name contains this.
     #[arg(long)]
     filter: Option<String>,
-    /// Break the renderer on purpose, to see the check fail (for tests of the check itself).
-    #[arg(long, value_enum, hide = true)]
-    inject_fault: Option<FaultArg>,
+    /// Run exactly the cases named in this file (a `scene/case` per line, or a results.csv or
+    /// failures.csv).
+    #[arg(long)]
+    caselist: Option<PathBuf>,
+    /// Run one shard of the cases, K of N (from 1), by a stable hash of each case's name.
+    #[arg(long, value_parser = Shard::parse)]
+    shard: Option<Shard>,
+    /// Worker processes at once (default: the machine's cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Seconds a case may run (a group's first case includes the group's setup) before its
+    /// worker is killed and the case ends as Timeout.
+    #[arg(long, default_value_t = 300.0)]
+    timeout: f64,
+    /// Stop after this many failing cases.
+    #[arg(long)]
+    max_fails: Option<usize>,
+    /// At most this many cases per worker process: a fresh process bounds a driver's growth.
+    #[arg(long, default_value_t = 100)]
+    cases_per_worker: usize,
+    /// Expected results, `scene/case,Status` per line (Fail, Crash or Timeout; `#` comments):
+    /// a failure listed is ExpectedFail, a listed case that passes is UnexpectedPass.
+    #[arg(long)]
+    baseline: Option<PathBuf>,
+    /// Regular expressions (one per line) of cases not to run; repeat for several files.
+    #[arg(long)]
+    skips: Vec<PathBuf>,
+    /// Regular expressions (one per line) of cases known to be flaky: a failure is a Flake.
+    #[arg(long)]
+    flakes: Vec<PathBuf>,
+    /// An unexpected pass does not fail the run (it is still reported).
+    #[arg(long)]
+    allow_unexpected_pass: bool,
+    /// Validation messages to accept: `MESSAGE-ID reason` per line. Accepted messages are
+    /// counted per case in the reports, never dropped silently.
+    #[arg(long)]
+    accept_messages: Option<PathBuf>,
+    /// Break the renderer on purpose, to see the check fail (tests of the check itself):
+    /// `drop-flushes`, `hang=PART` or `crash=PART` (cases whose name contains PART).
+    #[arg(long, hide = true, value_parser = parse_fault)]
+    inject_fault: Option<InjectedFault>,
+    /// Run the cases in this process and report them on stdout, a line each (what the runner
+    /// starts; the environment is not cleaned here).
+    #[arg(long, hide = true)]
+    worker: bool,
 }
 
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum FaultArg {
-    /// Render every hi-stencil case without flushes.
-    DropFlushes,
+#[derive(clap::Subcommand)]
+enum CheckCommand {
+    /// Join the JSON reports of several shards into one JUnit, JSON and summary; the exit code
+    /// is the joined run's.
+    Merge(MergeArgs),
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// The shards' JSON reports.
+    #[arg(required = true)]
+    reports: Vec<PathBuf>,
+    #[arg(long)]
+    junit: Option<PathBuf>,
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
+fn parse_fault(text: &str) -> Result<InjectedFault, String> {
+    match text.split_once('=') {
+        None if text == "drop-flushes" => Ok(InjectedFault::DropFlushes),
+        Some(("hang", part)) if !part.is_empty() => Ok(InjectedFault::Hang(part.to_owned())),
+        Some(("crash", part)) if !part.is_empty() => Ok(InjectedFault::Crash(part.to_owned())),
+        _ => Err(format!(
+            "`{text}`: expected drop-flushes, hang=PART or crash=PART"
+        )),
+    }
 }
 
 /// A usage error: printed and exit code 2.
 fn usage(e: impl std::fmt::Display) -> ExitCode {
     eprintln!("histencil: {e:#}");
-    ExitCode::from(2)
+    ExitCode::from(EXIT_USAGE)
 }
 
+/// The validation layer's settings that can silence it, by their environment variables: every
+/// `VK_LAYER_*` setting variable (message-id filter, duplicate limit, disables, report flags,
+/// debug action, a settings file's path...), the newer `VK_KHRONOS_VALIDATION_*` spellings, and
+/// the loader's switch that disables layers. `VK_LAYER_PATH` (where layers are found) stays.
+fn muting_variable(name: &str) -> bool {
+    (name.starts_with("VK_LAYER_") && name != "VK_LAYER_PATH")
+        || name.starts_with("VK_KHRONOS_VALIDATION_")
+        || name == "VK_LOADER_LAYERS_DISABLE"
+}
+
+/// The settings file the workers' layer reads instead of any `vk_layer_settings.txt` in the
+/// working folder or named by the user's `VK_LAYER_SETTINGS_PATH`: the layer's defaults, with
+/// duplicate limiting off and synchronisation validation on.
+const PINNED_SETTINGS: &str = "\
+# Written by histencil check: the validation layer settings its verdict rests on.
+khronos_validation.enable_message_limit = false
+khronos_validation.validate_sync = true
+";
+
 pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
+    if let Some(CheckCommand::Merge(merge_args)) = &args.command {
+        return merge(merge_args);
+    }
     let names = if args.scenes.is_empty() {
         histencil_scene::EMBEDDED
             .iter()
@@ -71,20 +183,96 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
             Err(e) => return usage(e),
         }
     }
+    let accepted = match &args.accept_messages {
+        Some(path) => match AcceptedMessages::load(path) {
+            Ok(a) => a,
+            Err(e) => return usage(e),
+        },
+        None => AcceptedMessages::default(),
+    };
+    let only = match &args.caselist {
+        Some(path) => match histencil_check::lists::load_caselist(path) {
+            Ok(names) => Some(names.into_iter().collect::<HashSet<_>>()),
+            Err(e) => return usage(e),
+        },
+        None => None,
+    };
     let options = CheckOptions {
         quick: args.quick,
         best_practices: args.best_practices,
         out: Some(args.out.clone()),
         filter: args.filter.clone(),
-        inject: args.inject_fault.map(|f| match f {
-            FaultArg::DropFlushes => InjectedFault::DropFlushes,
-        }),
+        only,
+        accepted,
+        inject: args.inject_fault.clone(),
     };
-    if args.list {
-        return match list(&scenes, &options) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => usage(e),
+    if args.worker {
+        return worker(&scenes, &options);
+    }
+    let mut skips = Patterns::default();
+    for path in &args.skips {
+        match Patterns::load(path) {
+            Ok(p) => skips.extend(p),
+            Err(e) => return usage(e),
+        }
+    }
+    let planned = match histencil_check::planned_cases(&scenes, &options) {
+        Ok(p) => p,
+        Err(e) => return usage(e),
+    };
+    let (mut cases, mut skipped) = (Vec::new(), Vec::new());
+    for (scene, case) in &planned {
+        let planned = PlannedCase {
+            scene: scenes[*scene].name.clone(),
+            case: case.name(),
+            group: format!(
+                "{}/{}x{}-{}",
+                scenes[*scene].name,
+                case.width,
+                case.height,
+                case.format.vk_name()
+            ),
+            pixels: u64::from(case.width) * u64::from(case.height),
         };
+        let full = planned.full_name();
+        if args.shard.is_some_and(|s| !s.holds(&full)) {
+            continue;
+        }
+        if skips.matches(&full) {
+            skipped.push(Record {
+                scene: planned.scene.clone(),
+                name: planned.case.clone(),
+                status: Status::Skip,
+                seconds: 0.0,
+                reason: Some("skipped by --skips".into()),
+                failure_type: None,
+                details: String::new(),
+                data: serde_json::Value::Null,
+            });
+            continue;
+        }
+        cases.push((planned, format!("{:?}", case.expect)));
+    }
+    if args.list {
+        for (c, expect) in &cases {
+            println!("{}\t{}\t{expect}", c.scene, c.case);
+        }
+        println!(
+            "{} cases ({} scenes{}; a format the device lacks is skipped when run)",
+            cases.len(),
+            scenes.len(),
+            args.shard
+                .map(|s| format!(", shard {}/{}", s.index, s.count))
+                .unwrap_or_default()
+        );
+        return ExitCode::SUCCESS;
+    }
+    if cases.is_empty() {
+        eprintln!(
+            "histencil: no case selected (scenes, --filter, --caselist, --shard and --skips \
+             leave none)"
+        );
+        return ExitCode::from(EXIT_NO_CASES);
     }
     let outputs = [args.junit.as_ref(), args.json.as_ref()];
     for path in outputs.into_iter().flatten() {
@@ -95,75 +283,266 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     if let Err(e) = histencil_vk::check_output_dir(&args.out) {
         return usage(e);
     }
-    match run(args, &scenes, &options) {
+    let baseline = match &args.baseline {
+        Some(path) => match Baseline::load(path) {
+            Ok(b) => b,
+            Err(e) => return usage(e),
+        },
+        None => Baseline::default(),
+    };
+    let mut flakes = Patterns::default();
+    for path in &args.flakes {
+        match Patterns::load(path) {
+            Ok(p) => flakes.extend(p),
+            Err(e) => return usage(e),
+        }
+    }
+    let cases: Vec<PlannedCase> = cases.into_iter().map(|(c, _)| c).collect();
+    match run(args, &options, cases, skipped, baseline, flakes) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("histencil: {e:#}");
-            ExitCode::FAILURE
+            ExitCode::from(EXIT_NO_DEVICE)
         }
     }
 }
 
-fn list(scenes: &[CheckScene], options: &CheckOptions) -> Result<()> {
-    let planned = histencil_check::planned_cases(scenes, options)?;
-    for (scene, case) in &planned {
-        println!(
-            "{}\t{}\t{:?}",
-            scenes[*scene].name,
-            case.name(),
-            case.expect
+/// Set by SIGINT and SIGTERM; the runner stops, keeps what finished and writes its reports.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::SeqCst);
+}
+
+fn run(
+    args: &CheckArgs,
+    options: &CheckOptions,
+    cases: Vec<PlannedCase>,
+    skipped: Vec<Record>,
+    baseline: Baseline,
+    flakes: Patterns,
+) -> Result<ExitCode> {
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let settings_path = args.out.join("vk_layer_settings.txt");
+    std::fs::write(&settings_path, PINNED_SETTINGS)?;
+    let settings_path = std::fs::canonicalize(&settings_path)?;
+    let cleared: Vec<(String, String)> = std::env::vars()
+        .filter(|(name, _)| muting_variable(name))
+        .collect();
+    for (name, value) in &cleared {
+        eprintln!(
+            "histencil check: {name}={value} is not passed to the workers: the validation \
+             settings the verdict rests on are pinned (use --accept-messages to accept a \
+             message)"
         );
     }
-    println!(
-        "{} cases ({} scenes; a format the device lacks is skipped when run)",
-        planned.len(),
-        scenes.len()
+    let mut settings = vec![
+        "duplicate-message limit: off (enable_message_limit = false)".to_owned(),
+        "message-id filter: none".to_owned(),
+        "synchronisation validation: on".to_owned(),
+        format!("settings file: {}", settings_path.display()),
+    ];
+    settings.extend(
+        cleared
+            .iter()
+            .map(|(n, v)| format!("cleared from the environment: {n}={v}")),
     );
-    Ok(())
+    // The worker: this program with the same scene and matrix arguments.
+    let mut worker_args: Vec<OsString> = Vec::new();
+    if std::env::args_os().any(|a| a == "--no-default-lights") {
+        worker_args.push("--no-default-lights".into());
+    }
+    worker_args.extend(["check".into(), "--worker".into()]);
+    for scene in &args.scenes {
+        worker_args.extend(["--scene".into(), scene.into()]);
+    }
+    if args.quick {
+        worker_args.push("--quick".into());
+    }
+    if args.best_practices {
+        worker_args.push("--best-practices".into());
+    }
+    worker_args.extend(["--out".into(), args.out.clone().into_os_string()]);
+    if let Some(path) = &args.accept_messages {
+        worker_args.extend(["--accept-messages".into(), path.clone().into_os_string()]);
+    }
+    if let Some(fault) = &args.inject_fault {
+        let text = match fault {
+            InjectedFault::DropFlushes => "drop-flushes".to_owned(),
+            InjectedFault::Hang(p) => format!("hang={p}"),
+            InjectedFault::Crash(p) => format!("crash={p}"),
+        };
+        worker_args.extend(["--inject-fault".into(), text.into()]);
+    }
+    // SAFETY: installing async-signal-safe handlers (they only store an atomic) before the
+    // workers' threads start.
+    unsafe {
+        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        std::thread::spawn(move || loop {
+            if STOP.load(Ordering::SeqCst) {
+                stop.store(true, Ordering::SeqCst);
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        });
+    }
+    let jobs = args.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let runner_options = RunnerOptions {
+        program: std::env::current_exe().context("finding this program for its workers")?,
+        args: worker_args,
+        env_remove: cleared.iter().map(|(n, _)| n.clone()).collect(),
+        env_set: vec![(
+            "VK_LAYER_SETTINGS_PATH".into(),
+            settings_path.clone().into_os_string(),
+        )],
+        jobs,
+        timeout: Duration::from_secs_f64(args.timeout.max(0.001)),
+        max_fails: args.max_fails,
+        cases_per_worker: args.cases_per_worker,
+        baseline,
+        flakes,
+        out: args.out.clone(),
+        stop,
+        progress_every: Duration::from_secs(if std::io::stderr().is_terminal() {
+            2
+        } else {
+            10
+        }),
+    };
+    let mut report = RunReport {
+        settings,
+        accepted: options.accepted.accepted.clone(),
+        best_practices: args.best_practices,
+        quick: args.quick,
+        shards: args
+            .shard
+            .map(|s| vec![format!("{}/{}", s.index, s.count)])
+            .unwrap_or_default(),
+        allow_unexpected_pass: args.allow_unexpected_pass,
+        ..RunReport::default()
+    };
+    let selected = cases.len() + skipped.len();
+    eprintln!(
+        "histencil check: {selected} cases, {jobs} worker(s), timeout {:.0} s; results stream \
+         to {}",
+        args.timeout,
+        args.out.join("results.csv").display()
+    );
+    runner::run(&cases, skipped, &runner_options, &mut report)?;
+    // The device and driver as the workers' canaries and teardowns reported them.
+    if let Some(first) = report.records.iter().find(|r| r.scene == "device") {
+        report.device = first.data["device"].as_str().unwrap_or("").to_owned();
+        report.driver = first.data["driver"].as_str().unwrap_or("").to_owned();
+    }
+    write_reports(args.junit.as_ref(), args.json.as_ref(), &report)?;
+    print!("{}", report::summary(&report));
+    Ok(exit_code(&report))
 }
 
-fn run(args: &CheckArgs, scenes: &[CheckScene], options: &CheckOptions) -> Result<ExitCode> {
-    // A bar on a terminal; nothing when stderr is a log file.
-    let bar = ProgressBar::with_draw_target(
-        None,
-        if std::io::stderr().is_terminal() {
-            ProgressDrawTarget::stderr()
-        } else {
-            ProgressDrawTarget::hidden()
-        },
-    )
-    .with_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
-            .expect("valid template"),
-    );
-    let (mut failed, mut done) = (0, 0u64);
-    let report = histencil_check::run_check(scenes, options, |result, total| {
-        bar.set_length(total as u64);
-        if result.case.is_some() {
-            done += 1;
-        }
-        if let Outcome::Failed(why) = &result.outcome {
-            failed += 1;
-            bar.suspend(|| eprintln!("FAILED {}/{}: {why}", result.scene, result.name));
-        }
-        bar.set_position(done);
-        bar.set_message(format!("{failed} failed; {}/{}", result.scene, result.name));
-    });
-    bar.finish_and_clear();
-    let report = report?;
-    if let Some(path) = &args.junit {
-        histencil_vk::write_atomically(path, histencil_check::report::junit(&report).as_bytes())?;
+/// What a worker prints on stderr before it exits with [`EXIT_NO_DEVICE`].
+const NO_DEVICE_MARK: &str = "histencil check worker: no device";
+
+fn exit_code(report: &RunReport) -> ExitCode {
+    if !report.failing().is_empty() {
+        ExitCode::from(EXIT_FAILING)
+    } else if report.incomplete.is_some() {
+        ExitCode::from(EXIT_INCOMPLETE)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn write_reports(
+    junit: Option<&PathBuf>,
+    json: Option<&PathBuf>,
+    report: &RunReport,
+) -> Result<()> {
+    if let Some(path) = junit {
+        histencil_vk::write_atomically(path, report::junit(report).as_bytes())?;
         println!("wrote {}", path.display());
     }
-    if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&histencil_check::report::json(&report))?;
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&report::json(report))?;
         histencil_vk::write_atomically(path, text.as_bytes())?;
         println!("wrote {}", path.display());
     }
-    print!("{}", histencil_check::report::summary(&report));
-    Ok(if report.failed() == 0 {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::FAILURE
-    })
+    Ok(())
+}
+
+/// `--worker`: the cases in this process, a line per event on stdout (see the runner), and the
+/// process's peak memory at the end.
+fn worker(scenes: &[CheckScene], options: &CheckOptions) -> ExitCode {
+    let stdout = std::io::stdout();
+    let line = |text: String| {
+        let mut out = stdout.lock();
+        let _ = writeln!(out, "{text}");
+        let _ = out.flush();
+    };
+    let mut device = (String::new(), String::new());
+    let report = histencil_check::run_check(scenes, options, |event| match event {
+        Event::Context {
+            device: name,
+            driver,
+        } => device = (name.to_owned(), driver.to_string()),
+        Event::Started(name) => line(format!("start {name}")),
+        Event::Finished(result, _) => {
+            let mut record = Record::from_result(result);
+            if record.scene == "device" {
+                // The runner names the device and driver from its device rows.
+                record.data["device"] = serde_json::json!(device.0);
+                record.data["driver"] = serde_json::json!(device.1);
+            }
+            line(format!("result {}", record.to_json()));
+        }
+    });
+    if let Some(peak) = own_peak_mib() {
+        line(format!("peak {peak:.1}"));
+    }
+    match report {
+        Ok(_) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{NO_DEVICE_MARK}: {e}");
+            ExitCode::from(EXIT_NO_DEVICE)
+        }
+    }
+}
+
+fn own_peak_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    Some(line.split_whitespace().nth(1)?.parse::<f64>().ok()? / 1024.0)
+}
+
+fn merge(args: &MergeArgs) -> ExitCode {
+    let mut runs = Vec::new();
+    for path in &args.reports {
+        let parsed = std::fs::read_to_string(path)
+            .map_err(|e| e.to_string())
+            .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+            .and_then(|v| report::from_json(&v));
+        match parsed {
+            Ok(run) => runs.push(run),
+            Err(e) => return usage(format!("{}: {e}", path.display())),
+        }
+    }
+    let merged = match report::merge(runs) {
+        Ok(m) => m,
+        Err(e) => return usage(e),
+    };
+    if let Err(e) = write_reports(args.junit.as_ref(), args.json.as_ref(), &merged) {
+        eprintln!("histencil: {e:#}");
+        return ExitCode::FAILURE;
+    }
+    print!("{}", report::summary(&merged));
+    exit_code(&merged)
 }

@@ -60,7 +60,7 @@ enum Command {
     /// The validation-CI matrix: every technique, backend, flush policy, preserved pattern,
     /// depth format and resolution a scene needs, under the validation layer, judged against
     /// forward; JUnit XML and JSON reports. Exit 0 all passed, 1 any failure, 2 usage error.
-    Check(check::CheckArgs),
+    Check(Box<check::CheckArgs>),
     /// Evaluate BRDF cases from a CSV file (id,brdf,params,N,T,V,L) into `id,value`.
     BrdfEval(BrdfEvalArgs),
     /// Print the error of the BRDF look-up tables against resolution and the error the G-buffer

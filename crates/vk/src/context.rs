@@ -13,6 +13,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+/// The longest histencil waits for the device to finish a submission before it gives up with
+/// `VK_TIMEOUT` as the error: a hung or lost device is an error, never an endless wait. Far
+/// above any frame's time on a CPU rasteriser (the longest, 1280x720 `town` on lavapipe, takes
+/// seconds).
+pub(crate) const FENCE_TIMEOUT_NS: u64 = 300_000_000_000;
 
 /// The depth-stencil formats the renderer can use: both have the 8 stencil bits the talk's
 /// layouts need. The depth precision differs (float against 24-bit fixed point), and engines
@@ -118,6 +123,7 @@ pub struct Context {
     validation: Arc<ValidationLog>,
     device_name: String,
     device_type: vk::PhysicalDeviceType,
+    driver: crate::driver::DriverInfo,
     pub(crate) depth_stencil_format: vk::Format,
     depth_stencil: DepthStencilFormat,
     /// The depth-stencil format was named when the context was made (not picked for it): the
@@ -253,19 +259,28 @@ impl Context {
                 .any(|e| e.extension_name_as_c_str() == Ok(name))
         };
         let debug_utils = has_ext(ash::ext::debug_utils::NAME) || desc.validation;
+        let mut layer_text = None;
+        let mut layer_settings_ext = false;
         if desc.validation {
             let layers = unsafe { entry.enumerate_instance_layer_properties() }
                 .call("vkEnumerateInstanceLayerProperties")?;
-            if !layers
+            let Some(layer) = layers
                 .iter()
-                .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
-            {
+                .find(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+            else {
                 return Err(Error::Loading(
                     "validation requested but VK_LAYER_KHRONOS_validation is not installed \
                      (tools/setup installs vulkan-validationlayers)"
                         .into(),
                 ));
-            }
+            };
+            layer_text = Some(crate::driver::layer_version(layer));
+            let layer_exts =
+                unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+                    .call("vkEnumerateInstanceExtensionProperties")?;
+            layer_settings_ext = layer_exts
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::layer_settings::NAME));
         }
 
         let app_name = c"histencil";
@@ -288,6 +303,31 @@ impl Context {
             layers.push(VALIDATION_LAYER.as_ptr());
             extensions.push(ash::ext::validation_features::NAME.as_ptr());
         }
+        // The settings a validation verdict rests on, pinned where the layer takes settings
+        // through the API (VK_EXT_layer_settings, layers from 1.3.268 on): no duplicate-message
+        // limit, synchronisation validation on. The layer lets its environment variables
+        // override these; `histencil check` clears them for its workers, and its canary
+        // ([`Context::validation_canary`]) proves what is in force.
+        let (off, on): (vk::Bool32, vk::Bool32) = (vk::FALSE, vk::TRUE);
+        // ash's `values` counts bytes; a BOOL32 setting holds one value.
+        let bool_setting = |name: &'static CStr, value: &vk::Bool32| {
+            let mut setting = vk::LayerSettingEXT::default()
+                .layer_name(VALIDATION_LAYER)
+                .setting_name(name)
+                .ty(vk::LayerSettingTypeEXT::BOOL32);
+            setting.value_count = 1;
+            setting.p_values = (value as *const vk::Bool32).cast();
+            setting
+        };
+        let pinned = [
+            bool_setting(c"enable_message_limit", &off),
+            bool_setting(c"validate_sync", &on),
+        ];
+        let mut layer_settings = vk::LayerSettingsCreateInfoEXT::default().settings(&pinned);
+        let pin_settings = desc.validation && layer_settings_ext;
+        if pin_settings {
+            extensions.push(ash::ext::layer_settings::NAME.as_ptr());
+        }
         let validation = Arc::new(ValidationLog::default());
         // SAFETY: the context keeps `validation` until after it destroys the messenger.
         let messenger_info = unsafe { ValidationLog::messenger_create_info(&validation) };
@@ -301,6 +341,9 @@ impl Context {
             instance_info = instance_info
                 .push_next(&mut validation_features)
                 .push_next(&mut messenger_for_create);
+        }
+        if pin_settings {
+            instance_info = instance_info.push_next(&mut layer_settings);
         }
         let instance =
             unsafe { entry.create_instance(&instance_info, None) }.call("vkCreateInstance")?;
@@ -370,6 +413,8 @@ impl Context {
         // SAFETY: `physical_device` was enumerated from `instance`.
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
         let limits = props.limits;
+        // SAFETY: as above; the instance asks for Vulkan 1.3.
+        let driver = unsafe { crate::driver::driver_info(&instance, physical_device, layer_text) };
         let ctx = Self {
             _entry: Some(entry),
             owned: true,
@@ -384,6 +429,7 @@ impl Context {
             validation,
             device_name,
             device_type: props.device_type,
+            driver,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
             depth_stencil_named: desc.depth_stencil.is_some(),
@@ -459,6 +505,8 @@ impl Context {
             .unwrap_or_default();
         let debug_device =
             debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
+        // SAFETY: the caller's promise; histencil requires Vulkan 1.3.
+        let driver = unsafe { crate::driver::driver_info(&instance, physical_device, None) };
         Ok(Self {
             _entry: None,
             owned: false,
@@ -473,6 +521,7 @@ impl Context {
             validation: Arc::new(ValidationLog::default()),
             device_name,
             device_type: props.device_type,
+            driver,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
             depth_stencil_named,
@@ -546,6 +595,12 @@ impl Context {
     /// The name of the device in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
     pub fn device_name(&self) -> &str {
         &self.device_name
+    }
+
+    /// The driver as Vulkan names it (name, build, conformance) and the validation layer's
+    /// version: what tells two builds of one driver apart where [`Context::device_name`] cannot.
+    pub fn driver(&self) -> &crate::driver::DriverInfo {
+        &self.driver
     }
 
     /// The kind of device in use (llvmpipe is `CPU`): what some passes shape their work by

@@ -18,6 +18,7 @@ mod context;
 mod debug;
 mod deferred_lighting;
 pub mod descriptors;
+mod driver;
 mod error;
 pub mod gpu_types;
 mod hi_stencil;
@@ -60,6 +61,7 @@ pub use debug::{ValidationLog, ValidationMessage};
 pub use deferred_lighting::{
     gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, TiledFrame,
 };
+pub use driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
 pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;
 pub use histencil_model::{CostModel, FlushPolicy, TileStats, TiledCosts};

@@ -45,7 +45,7 @@ pub(crate) fn submit_once(
                 .call("vkQueueSubmit2")?;
             // Creation waits for its own one-off work, as buffer creation does; frames never
             // come through here.
-            d.wait_for_fences(&[fence], true, u64::MAX)
+            d.wait_for_fences(&[fence], true, crate::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")
         }
     })();

@@ -206,7 +206,7 @@ impl Renderer<'_> {
                 .queue_submit2(ctx.queue, &[submit], self.fence)
                 .call("vkQueueSubmit2")?;
             ctx.device
-                .wait_for_fences(&[self.fence], true, u64::MAX)
+                .wait_for_fences(&[self.fence], true, crate::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")?;
             ctx.device
                 .reset_fences(&[self.fence])

@@ -1,0 +1,410 @@
+//! `histencil check` as a CI runner, each behaviour proved on lavapipe by making it happen: the
+//! validation canary fails a worker whose layer is muted and passes under the runner, which pins
+//! the layer's settings; shards partition the matrix; a hung case ends as `Timeout` and a crashed
+//! one as `Crash` while the run goes on; a baseline turns a known failure green and an unexpected
+//! pass red; flakes are told apart; a case list reruns exactly its cases; shards merge; SIGTERM
+//! leaves reports of what finished; and each exit code means one thing.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_histencil");
+
+fn command(args: &[&str]) -> Command {
+    let mut c = Command::new(BIN);
+    c.arg("check").args(args).env(
+        "HISTENCIL_DEVICE",
+        std::env::var("HISTENCIL_DEVICE").unwrap_or_else(|_| "llvmpipe".into()),
+    );
+    c
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+fn fresh_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("histencil-runner-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// `scene/case,Status` of a run's results.csv, comments left out.
+fn statuses(out: &Path) -> Vec<(String, String)> {
+    read(&out.join("results.csv"))
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let mut parts = l.split(',');
+            (
+                parts.next().unwrap().to_owned(),
+                parts.next().unwrap().to_owned(),
+            )
+        })
+        .collect()
+}
+
+/// A small slice: `brdfs-3` at 7x5 in D32S8 (the reference and 58 lighting cases).
+const SLICE: [&str; 5] = ["--quick", "--scene", "brdfs-3", "--filter", "d32s8-7x5"];
+
+#[test]
+fn the_canary_fails_a_muted_worker_and_the_runner_pins_the_layer() {
+    let dir = fresh_dir("canary");
+    let list = dir.join("one.txt");
+    std::fs::write(&list, "brdfs-3/forward-reference-d32s8-1x1\n").unwrap();
+    let worker = |var: &str, value: &str| {
+        let o = command(&["--worker", "--quick", "--scene", "brdfs-3", "--caselist"])
+            .arg(&list)
+            .arg("--out")
+            .arg(dir.join("worker"))
+            .env(var, value)
+            .output()
+            .unwrap();
+        let canary = String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .find(|l| l.contains("canary-d32_sfloat_s8_uint"))
+            .unwrap_or_else(|| panic!("no canary line: {}", text(&o)))
+            .to_owned();
+        canary
+    };
+    // Unmuted: every deliberate call reported.
+    let heard = worker("HISTENCIL_UNRELATED", "1");
+    assert!(heard.contains("\"status\":\"Pass\""), "{heard}");
+    assert!(heard.contains("12 of 12 deliberate"), "{heard}");
+    // A message-id filter and a duplicate limit, as a CI machine's environment may set them.
+    let filtered = worker(
+        "VK_LAYER_MESSAGE_ID_FILTER",
+        "VUID-VkBufferCreateInfo-size-00912",
+    );
+    assert!(
+        filtered.contains("\"status\":\"ValidationLayerMuted\""),
+        "{filtered}"
+    );
+    assert!(filtered.contains("0 of 12 deliberate"), "{filtered}");
+    let limited = worker("VK_LAYER_DUPLICATE_MESSAGE_LIMIT", "3");
+    assert!(limited.contains("3 of 12 deliberate"), "{limited}");
+
+    // The runner under the same environment, from a folder whose vk_layer_settings.txt filters
+    // the canary too: its workers see neither, and the run passes with the settings reported.
+    let cwd = dir.join("cwd");
+    std::fs::create_dir_all(&cwd).unwrap();
+    std::fs::write(
+        cwd.join("vk_layer_settings.txt"),
+        "khronos_validation.message_id_filter = VUID-VkBufferCreateInfo-size-00912\n",
+    )
+    .unwrap();
+    let out = dir.join("run");
+    let json = dir.join("run.json");
+    let o = command(&["--quick", "--scene", "brdfs-3", "--caselist"])
+        .arg(&list)
+        .arg("--out")
+        .arg(&out)
+        .arg("--json")
+        .arg(&json)
+        .current_dir(&cwd)
+        .env(
+            "VK_LAYER_MESSAGE_ID_FILTER",
+            "VUID-VkBufferCreateInfo-size-00912",
+        )
+        .env("VK_LAYER_DUPLICATE_MESSAGE_LIMIT", "3")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let report: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
+    let settings = report["validation_settings"].to_string();
+    assert!(
+        settings.contains("cleared from the environment: VK_LAYER_MESSAGE_ID_FILTER="),
+        "{settings}"
+    );
+    assert!(
+        report["driver"].as_str().unwrap().contains("Mesa"),
+        "{report}"
+    );
+    let canary = report["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "canary-d32_sfloat_s8_uint")
+        .unwrap();
+    assert_eq!(canary["status"], "Pass", "{canary}");
+}
+
+#[test]
+fn four_shards_hold_every_case_once() {
+    let list = |extra: &[&str]| -> BTreeSet<String> {
+        let o = command(&[&["--list", "--quick", "--scene", "default"][..], extra].concat())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter(|l| l.contains('\t'))
+            .map(str::to_owned)
+            .collect()
+    };
+    let all = list(&[]);
+    let mut union = BTreeSet::new();
+    for k in 1..=4 {
+        let shard = list(&["--shard", &format!("{k}/4")]);
+        assert!(
+            shard.len() > all.len() / 8,
+            "shard {k} holds {}",
+            shard.len()
+        );
+        for case in shard {
+            assert!(union.insert(case.clone()), "{case} is in two shards");
+        }
+    }
+    assert_eq!(union, all);
+}
+
+#[test]
+fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
+    let dir = fresh_dir("faults");
+    let hung = "stencil-x360-auto-p00-lightmap-d32s8-7x5";
+    let crashed = "branching-ps3-auto-pA0-lightmap-d32s8-7x5";
+    let out = dir.join("out");
+    let json = dir.join("run.json");
+    let o = command(&SLICE)
+        .args(["--jobs", "2", "--timeout", "4", "--inject-fault"])
+        .arg(format!("hang={hung}"))
+        .arg("--out")
+        .arg(&out)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let results = statuses(&out);
+    let status = |name: &str| {
+        results
+            .iter()
+            .find(|(n, _)| n == &format!("brdfs-3/{name}"))
+            .map(|(_, s)| s.clone())
+    };
+    assert_eq!(status(hung).as_deref(), Some("Timeout"), "{results:?}");
+    // Every other case ran and passed: 59 cases, one timed out.
+    let passed = results.iter().filter(|(_, s)| s == "Pass").count();
+    assert_eq!(passed, 58 + 2, "{results:?}");
+    let report: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
+    assert!(report["workers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w["end"] == "timeout"));
+    assert!(report["workers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|w| w["peak_mib"].as_f64().is_some_and(|m| m > 1.0)));
+
+    // A crash: the case in flight is Crash, the rest of its batch runs in a new worker.
+    let out = dir.join("crash");
+    let o = command(&SLICE)
+        .args(["--jobs", "2", "--inject-fault"])
+        .arg(format!("crash={crashed}"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let results = statuses(&out);
+    let crashes: Vec<&(String, String)> = results.iter().filter(|(_, s)| s != "Pass").collect();
+    assert_eq!(
+        crashes,
+        [&(format!("brdfs-3/{crashed}"), "Crash".to_owned())],
+        "{results:?}"
+    );
+
+    // failures.csv is a baseline: with it, the same crash is expected and the run is green.
+    let baseline = dir.join("baseline.txt");
+    std::fs::copy(out.join("failures.csv"), &baseline).unwrap();
+    let o = command(&SLICE)
+        .args(["--jobs", "2", "--inject-fault"])
+        .arg(format!("crash={crashed}"))
+        .arg("--baseline")
+        .arg(&baseline)
+        .arg("--out")
+        .arg(dir.join("expected"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(text(&o).contains("1 ExpectedFail"), "{}", text(&o));
+
+    // Without the fault, the baseline's crash is an unexpected pass: red unless allowed.
+    let unexpected = |allow: bool| {
+        let mut c = command(&SLICE);
+        c.arg("--baseline")
+            .arg(&baseline)
+            .arg("--out")
+            .arg(dir.join("fixed"));
+        if allow {
+            c.arg("--allow-unexpected-pass");
+        }
+        c.output().unwrap()
+    };
+    let o = unexpected(false);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("1 UnexpectedPass"), "{}", text(&o));
+    assert_eq!(unexpected(true).status.code(), Some(0));
+
+    // A flake pattern makes the crash a flake; a case list reruns exactly the failures.
+    let flakes = dir.join("flakes.txt");
+    std::fs::write(
+        &flakes,
+        "# known to crash now and then\nbranching-ps3-auto\n",
+    )
+    .unwrap();
+    let o = command(&SLICE)
+        .args(["--inject-fault"])
+        .arg(format!("crash={crashed}"))
+        .arg("--flakes")
+        .arg(&flakes)
+        .arg("--caselist")
+        .arg(out.join("failures.csv"))
+        .arg("--out")
+        .arg(dir.join("flaky"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let flaky = statuses(&dir.join("flaky"));
+    let matrix: Vec<_> = flaky
+        .iter()
+        .filter(|(n, _)| n.starts_with("brdfs-3/"))
+        .collect();
+    assert_eq!(
+        matrix,
+        [&(format!("brdfs-3/{crashed}"), "Flake".to_owned())]
+    );
+}
+
+#[test]
+fn shards_merge_into_one_report() {
+    let dir = fresh_dir("merge");
+    let mut jsons = Vec::new();
+    for k in 1..=2 {
+        let json = dir.join(format!("shard-{k}.json"));
+        let o = command(&["--quick", "--scene", "brdfs-3", "--filter", "d32s8-1x1"])
+            .arg("--shard")
+            .arg(format!("{k}/2"))
+            .arg("--out")
+            .arg(dir.join(format!("shard-{k}")))
+            .arg("--json")
+            .arg(&json)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+        jsons.push(json);
+    }
+    let (junit, json) = (dir.join("merged.xml"), dir.join("merged.json"));
+    let o = Command::new(BIN)
+        .args(["check", "merge"])
+        .args(&jsons)
+        .arg("--junit")
+        .arg(&junit)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let merged: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
+    let names: BTreeSet<String> = merged["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["scene"] == "brdfs-3")
+        .map(|c| c["name"].as_str().unwrap().to_owned())
+        .collect();
+    assert_eq!(names.len(), 1 + 58, "{names:?}");
+    assert_eq!(merged["shards"], serde_json::json!(["1/2", "2/2"]));
+    assert!(read(&junit).contains("<testsuite name=\"brdfs-3\" tests=\"59\""));
+    // A shard merged twice is refused.
+    let o = Command::new(BIN)
+        .args(["check", "merge"])
+        .args([&jsons[0], &jsons[0]])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+}
+
+#[test]
+fn sigterm_leaves_reports_of_what_finished() {
+    let dir = fresh_dir("sigterm");
+    let (out, junit, json) = (dir.join("out"), dir.join("junit.xml"), dir.join("run.json"));
+    // The sixth case hangs and the timeout is long: the run cannot finish on its own.
+    let mut child = command(&SLICE)
+        .args(["--jobs", "1", "--inject-fault", "hang=stencil-ps3-always"])
+        .arg("--out")
+        .arg(&out)
+        .arg("--junit")
+        .arg(&junit)
+        .arg("--json")
+        .arg(&json)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let results = out.join("results.csv");
+    let start = std::time::Instant::now();
+    while statuses_if_any(&results) < 3 {
+        assert!(start.elapsed().as_secs() < 120, "no results streamed");
+        std::thread::sleep(std::time::Duration::from_millis(200));
+    }
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let code = child.wait().unwrap().code();
+    assert_eq!(code, Some(5), "stopped early with nothing failing: exit 5");
+    let xml = read(&junit);
+    assert!(xml.ends_with("</testsuites>\n"), "{xml}");
+    assert!(xml.contains("name=\"incomplete\""), "{xml}");
+    let report: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
+    let finished = report["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["scene"] == "brdfs-3")
+        .count();
+    assert!(finished >= 3, "{report}");
+    assert_eq!(
+        xml.matches("<testcase ").count(),
+        report["cases"].as_array().unwrap().len()
+    );
+}
+
+fn statuses_if_any(results: &Path) -> usize {
+    std::fs::read_to_string(results)
+        .map(|t| t.lines().filter(|l| l.starts_with("brdfs-3/")).count())
+        .unwrap_or(0)
+}
+
+#[test]
+fn exit_codes_tell_usage_no_cases_and_bad_lists_apart() {
+    let dir = fresh_dir("codes");
+    let o = command(&["--quick", "--scene", "brdfs-3", "--filter", "no-such-case"])
+        .arg("--out")
+        .arg(dir.join("none"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(4), "{}", text(&o));
+    let bad = dir.join("bad-baseline.txt");
+    std::fs::write(&bad, "brdfs-3/x,ValidationLayerMuted\n").unwrap();
+    for args in [
+        vec!["--baseline", bad.to_str().unwrap()],
+        vec!["--shard", "3/2"],
+        vec!["--inject-fault", "melt"],
+    ] {
+        let o = command(&[&SLICE[..], &args].concat()).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o));
+        assert!(!text(&o).contains("panicked"), "{}", text(&o));
+    }
+}
