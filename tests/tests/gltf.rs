@@ -41,6 +41,47 @@ fn a_gltf_with_two_brdfs_renders_and_matches_forward() {
     });
 }
 
+/// A glTF whose only mesh is translucent, lit by one point light: the renderer's stencil layout
+/// keeps one BRDF slot with no surfaces, and the planner gets one empty list for it (an error
+/// before: "brdf_bounds has 0 entries, but the stencil layout has 1 BRDFs"). Every technique
+/// renders it, alike to forward.
+#[test]
+fn a_translucent_only_gltf_renders_with_every_technique() {
+    let (mut doc, bin) = test_gltf("blinn_phong");
+    // The pane, the warm point light (moved in front of the pane's lit side) and the camera:
+    // no box, no floor.
+    doc["scenes"][0]["nodes"] = json!([2, 3, 6]);
+    doc["nodes"][3]["translation"] = json!([1.2, 1.2, 2.4]);
+    let path = write("translucent-only", &doc, &bin);
+    let scene = load_scene(path.to_str().unwrap()).expect("it imports");
+    assert_eq!(
+        (
+            scene.objects.len(),
+            scene.alpha_objects.len(),
+            scene.lights.len()
+        ),
+        (0, 1, 1)
+    );
+    let ldr = Readback {
+        ldr: true,
+        ..Readback::NONE
+    };
+    with_validated_context(|ctx| {
+        let mut renderer = Renderer::new(ctx, scene, 64, 64).unwrap();
+        let frame = |r: &mut Renderer, t: Shading| r.render(t, ldr).unwrap().images.ldr.unwrap();
+        let forward = frame(&mut renderer, Shading::Forward);
+        assert!(lit_fraction(&forward) > 0.01, "the pane is lit");
+        for backend in [Backend::Ps3, Backend::Native] {
+            let stencil = Technique::Stencil {
+                backend,
+                flush: FlushPolicy::Auto,
+            };
+            let deferred = frame(&mut renderer, stencil.into());
+            assert_close("translucent-only-vs-forward", &deferred, &forward, 1);
+        }
+    });
+}
+
 #[test]
 fn broken_gltf_files_give_the_documented_errors() {
     let (doc, bin) = test_gltf("blinn_phong");

@@ -52,6 +52,10 @@ pub struct CheckArgs {
     /// Write every case's numbers here as JSON (what `check merge` joins).
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Write the summary here too, headed by the command line and the date (UTC): a run's
+    /// figures as the runner wrote them, for a document to include.
+    #[arg(long)]
+    summary: Option<PathBuf>,
     /// The run's folder: results.csv (streamed as cases finish), failures.csv (in --baseline
     /// format), each failing case's images and messages in a folder per scene, and workers/
     /// (case lists and logs).
@@ -274,7 +278,11 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         );
         return ExitCode::from(EXIT_NO_CASES);
     }
-    let outputs = [args.junit.as_ref(), args.json.as_ref()];
+    let outputs = [
+        args.junit.as_ref(),
+        args.json.as_ref(),
+        args.summary.as_ref(),
+    ];
     for path in outputs.into_iter().flatten() {
         if let Err(e) = histencil_vk::check_output_file(path) {
             return usage(e);
@@ -445,12 +453,48 @@ fn run(
         report.driver = first.data["driver"].as_str().unwrap_or("").to_owned();
     }
     write_reports(args.junit.as_ref(), args.json.as_ref(), &report)?;
-    print!("{}", report::summary(&report));
+    let summary = report::summary(&report);
+    if let Some(path) = &args.summary {
+        let command: Vec<String> = std::env::args().skip(1).collect();
+        let text = format!(
+            "$ histencil {}
+# {}
+{summary}",
+            command.join(" "),
+            utc_now()
+        );
+        histencil_vk::write_atomically(path, text.as_bytes())?;
+        println!("wrote {}", path.display());
+    }
+    print!("{summary}");
     Ok(exit_code(&report))
 }
 
 /// What a worker prints on stderr before it exits with [`EXIT_NO_DEVICE`].
 const NO_DEVICE_MARK: &str = "histencil check worker: no device";
+
+/// The date and time now, UTC, as `YYYY-MM-DD HH:MM UTC`.
+fn utc_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs()) as i64;
+    let (days, rest) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    // Howard Hinnant's days-to-civil: the proleptic Gregorian date of a day count.
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02} {:02}:{:02} UTC",
+        rest / 3600,
+        rest % 3600 / 60
+    )
+}
 
 fn exit_code(report: &RunReport) -> ExitCode {
     if !report.failing().is_empty() {

@@ -36,6 +36,9 @@ const SMALL_COVERAGE: f64 = 0.01;
 #[derive(Clone, Debug)]
 pub struct Calibration {
     pub device: String,
+    /// The driver as Vulkan names it (name, build, conformance) and the validation layer: two
+    /// builds of one driver share a device name.
+    pub driver: String,
     pub width: u32,
     pub height: u32,
     /// Rounds taken (each renders one frame of every measured kind, interleaved).
@@ -192,6 +195,7 @@ pub fn calibrate(
         .collect();
     Ok(Calibration {
         device: ctx.device_name().to_owned(),
+        driver: ctx.driver().to_string(),
         width,
         height,
         frames: sampled.rounds,
@@ -207,6 +211,7 @@ impl Calibration {
     pub fn json(&self) -> Value {
         let mut out = json!({
             "device": self.device,
+            "driver": self.driver,
             "settings": {"width": self.width, "height": self.height, "frames": self.frames,
                          "warm_up_frames": WARM_UP_FRAMES},
             "measurements": self.measurements.iter().map(|(what, t)| json!({
@@ -285,6 +290,7 @@ mod tests {
         };
         let calibration = Calibration {
             device: "test".into(),
+            driver: "test driver".into(),
             width: 64,
             height: 64,
             frames: 1,

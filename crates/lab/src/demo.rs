@@ -48,6 +48,9 @@ pub struct DemoRow {
 
 pub struct DemoReport {
     pub device: String,
+    /// The driver as Vulkan names it (name, build, conformance) and the validation layer: two
+    /// builds of one driver share a device name.
+    pub driver: String,
     pub width: u32,
     pub height: u32,
     pub frames: usize,
@@ -236,6 +239,7 @@ pub fn run_demo(
     }
     Ok(DemoReport {
         device: ctx.device_name().to_owned(),
+        driver: ctx.driver().to_string(),
         width: settings.width,
         height: settings.height,
         frames: settings.frames,
@@ -262,11 +266,11 @@ impl DemoReport {
     /// The table, in plain text.
     pub fn table(&self) -> String {
         let mut out = format!(
-            "{}x{}, device {}; lighting time: median (spread) of {} frames, on the emulated \
+            "{}x{}, device {} ({}); lighting time: median (spread) of {} frames, on the emulated \
              backends the platform's technique and then the emulator's bookkeeping (hi-stencil \
              resets, splits, touch draws, tile updates, flush copies); error against \
              forward: 8-bit max / mean, mean FLIP; engine bits 0x{DEMO_PATTERN:02X}\n\n",
-            self.width, self.height, self.device, self.frames
+            self.width, self.height, self.device, self.driver, self.frames
         );
         let _ = writeln!(
             out,

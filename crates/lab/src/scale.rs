@@ -93,6 +93,9 @@ pub struct ScaleRow {
 
 pub struct ScaleReport {
     pub device: String,
+    /// The driver as Vulkan names it (name, build, conformance) and the validation layer: two
+    /// builds of one driver share a device name.
+    pub driver: String,
     pub width: u32,
     pub height: u32,
     pub rounds: usize,
@@ -208,6 +211,7 @@ pub fn run_scale(
         .collect();
     Ok(ScaleReport {
         device: ctx.device_name().to_owned(),
+        driver: ctx.driver().to_string(),
         width: settings.width,
         height: settings.height,
         rounds,
@@ -230,9 +234,9 @@ impl ScaleReport {
     pub fn markdown(&self) -> String {
         let s = &self.size;
         let mut out = format!(
-            "{}x{} on {}; {} rounds, one frame of each technique per round; times are GPU \
+            "{}x{} on {} ({}); {} rounds, one frame of each technique per round; times are GPU \
              timestamps, median (min-max) in ms\n\n",
-            self.width, self.height, self.device, self.rounds
+            self.width, self.height, self.device, self.driver, self.rounds
         );
         let _ = writeln!(
             out,

@@ -94,6 +94,9 @@ pub struct SweepPoint {
 #[derive(Clone, Debug)]
 pub struct SweepReport {
     pub device: String,
+    /// The driver as Vulkan names it (name, build, conformance) and the validation layer: two
+    /// builds of one driver share a device name.
+    pub driver: String,
     pub param: SweepParam,
     pub scene: String,
     pub width: u32,
@@ -275,6 +278,7 @@ pub fn run_sweep(
     }
     Ok(SweepReport {
         device: ctx.device_name().to_owned(),
+        driver: ctx.driver().to_string(),
         param,
         scene: name,
         width,
@@ -432,6 +436,7 @@ impl SweepReport {
             .collect();
         json!({
             "device": self.device,
+            "driver": self.driver,
             "param": self.param.name(),
             "settings": {"scene": self.scene, "width": self.width, "height": self.height,
                          "frames": self.frames, "warm_up_frames": WARM_UP_FRAMES},

@@ -322,6 +322,9 @@ impl SizePoint {
 #[derive(Clone, Debug)]
 pub struct CompareReport {
     pub device: String,
+    /// The driver as Vulkan names it (name, build, conformance) and the validation layer: two
+    /// builds of one driver share a device name.
+    pub driver: String,
     pub scene: String,
     pub scene_lights: usize,
     pub width: u32,
@@ -604,6 +607,7 @@ pub fn run_compare(
     }
     Ok(CompareReport {
         device: ctx.device_name().to_owned(),
+        driver: ctx.driver().to_string(),
         scene: settings.scene.name.clone(),
         scene_lights: settings.scene.lights.len(),
         width: w,

@@ -35,6 +35,7 @@ impl CompareReport {
         let c = &self.costs;
         let mut out = json!({
             "device": self.device,
+            "driver": self.driver,
             "settings": {
                 "scene": self.scene,
                 "scene_lights": self.scene_lights,
@@ -81,7 +82,7 @@ impl CompareReport {
         let mut md = String::new();
         let _ = writeln!(
             md,
-            "# histencil compare\n\nDevice: **{}**. Scene `{}` ({} lights) at {}x{}. Lighting-pass \
+            "# histencil compare\n\nDevice: **{}** ({}). Scene `{}` ({} lights) at {}x{}. Lighting-pass \
              GPU time over at least {} rounds after a warm-up frame; each round renders one frame of every \
              technique at every BRDF count in turn, so background load hits all alike. Table: \
              median [95 % interval of the median, order statistics; below 6 rounds no interval \
@@ -89,7 +90,8 @@ impl CompareReport {
              the per-round ratios to the row's 1-BRDF time, with their interval, and a verdict \
              only where the interval excludes 0 (else indistinguishable). Error against the \
              forward reference of the same scene: 8-bit max / mean, and mean FLIP.\n",
-            self.device, self.scene, self.scene_lights, self.width, self.height, self.frames
+            self.device, self.driver, self.scene, self.scene_lights, self.width, self.height,
+            self.frames
         );
         let t = &self.sampled;
         if let Some(n) = &self.lp_num_threads {

@@ -53,7 +53,10 @@ impl Renderer<'_> {
         let settings = technique.plan_settings(|backend| self.cost_model(backend));
         let view = View::new(view).map_err(PlanError::from)?;
         let shapes: Vec<LightShape> = self.scene.lights.iter().map(|l| l.shape()).collect();
-        let brdf_bounds = self.scene.brdf_bounds(&self.brdfs);
+        let mut brdf_bounds = self.scene.brdf_bounds(&self.brdfs);
+        // A scene with no opaque surface (only translucent ones) still has a one-slot stencil
+        // layout, whose slot has no surfaces: one empty list, as the planner asks of every slot.
+        brdf_bounds.resize(self.stencil_layout.brdfs_in_use() as usize, Vec::new());
         let inputs = PlanInputs {
             lights: &shapes,
             brdf_bounds: &brdf_bounds,
