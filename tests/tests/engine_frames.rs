@@ -266,7 +266,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
         ];
         for bad in &bad_descs {
             let err = DeferredLighting::new(&ctx, bad).err().expect("refused");
-            assert!(matches!(err, histencil_vk::Error::BadFrame(_)), "{err}");
+            assert!(matches!(err, histencil_vk::Error::BadSetup(_)), "{err}");
         }
 
         let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();
@@ -316,7 +316,31 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
         let mut orthographic = view;
         orthographic.view_to_clip[2][3] = 0.0;
         orthographic.view_to_clip[3][3] = 1.0;
+        // Planned for the orthographic view itself, so that the projection check speaks.
+        let orthographic_plan = plan_frame(
+            &layout,
+            &PlanInputs {
+                lights: &shapes,
+                brdf_bounds: &bounds,
+                view: &View::new(&orthographic).unwrap(),
+            },
+            &PlanSettings {
+                technique: TechniqueChoice::Stencil,
+                caps: Backend::Native.platform().caps(),
+                flush: FlushPolicy::Auto,
+            },
+        )
+        .unwrap();
         let few_lights = &scene.lights[..2];
+        // A plan made before the camera moved, the projection changed or a light moved: each
+        // recorded without an error and lit the frame wrong (the case: the camera moved
+        // inside a spot light's volume, its light missing from most of the floor).
+        let mut moved_camera = view;
+        moved_camera.world_to_view[3][0] += 0.25;
+        let mut zoomed = view;
+        zoomed.view_to_clip[0][0] *= 1.1;
+        let mut moved_lights = scene.lights.clone();
+        moved_lights[1].position.y += 0.5;
         let cases: Vec<(&str, LightingFrame, LightingTargets)> = vec![
             ("slot", LightingFrame { slot: 2, ..frame }, targets.clone()),
             (
@@ -339,6 +363,31 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
                 "perspective",
                 LightingFrame {
                     view: &orthographic,
+                    plan: &orthographic_plan,
+                    ..frame
+                },
+                targets.clone(),
+            ),
+            (
+                "another camera position or orientation",
+                LightingFrame {
+                    view: &moved_camera,
+                    ..frame
+                },
+                targets.clone(),
+            ),
+            (
+                "another projection",
+                LightingFrame {
+                    view: &zoomed,
+                    ..frame
+                },
+                targets.clone(),
+            ),
+            (
+                "light 1 moved or changed shape",
+                LightingFrame {
+                    lights: &moved_lights,
                     ..frame
                 },
                 targets.clone(),
@@ -642,6 +691,9 @@ fn a_lighting_in_another_depth_format_than_the_context_was_lent_is_refused() {
             text.contains("D24_UNORM_S8_UINT") && text.contains("D32_SFLOAT_S8_UINT"),
             "{text}"
         );
+        // A creation mistake, said as one (it read "bad lighting frame" before).
+        assert!(matches!(err, histencil_vk::Error::BadSetup(_)), "{err}");
+        assert!(text.starts_with("bad lighting setup: "), "{text}");
         assert_eq!(ctx.memory_in_use(), in_use);
         let named = LightingDesc {
             depth_stencil_format: vk::Format::D32_SFLOAT_S8_UINT,

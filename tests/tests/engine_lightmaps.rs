@@ -443,7 +443,7 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
             },
         ] {
             let err = AlphaLightmaps::new(&ctx, &bad).err().expect("refused");
-            assert!(matches!(err, Error::BadFrame(_)), "{err}");
+            assert!(matches!(err, Error::BadSetup(_)), "{err}");
         }
         let mut lightmaps = AlphaLightmaps::new(
             &ctx,

@@ -482,8 +482,42 @@ pub fn from_json(v: &Value) -> Result<RunReport, String> {
 }
 
 /// Several shards' runs as one: their cases in order, device rows (canaries, teardowns) kept
-/// per shard, the slowest shard's time. Shards of different devices or drivers are refused.
+/// per shard, the slowest shard's time. Shards of different devices or drivers are refused, and
+/// so is a set of shards with one missing (a shard whose job died before writing its report
+/// would otherwise leave a green merge) or one twice.
 pub fn merge(runs: Vec<RunReport>) -> Result<RunReport, String> {
+    let shards: Vec<(u32, u32)> = runs
+        .iter()
+        .flat_map(|r| &r.shards)
+        .map(|s| {
+            crate::lists::Shard::parse(s)
+                .map(|s| (s.index, s.count))
+                .map_err(|e| format!("a report names {e}"))
+        })
+        .collect::<Result<_, _>>()?;
+    if let Some(&(_, count)) = shards.first() {
+        if shards.iter().any(|&(_, n)| n != count) || runs.iter().any(|r| r.shards.is_empty()) {
+            return Err("the reports are shards of different splits (or some not a shard)".into());
+        }
+        if let Some(&(k, _)) = shards
+            .iter()
+            .enumerate()
+            .find(|(i, s)| shards[..*i].contains(s))
+            .map(|(_, s)| s)
+        {
+            return Err(format!("shard {k}/{count} is given twice"));
+        }
+        let missing: Vec<String> = (1..=count)
+            .filter(|k| !shards.iter().any(|&(i, _)| i == *k))
+            .map(|k| format!("{k}/{count}"))
+            .collect();
+        if !missing.is_empty() {
+            return Err(format!(
+                "shard {} missing: no report of it",
+                missing.join(", ")
+            ));
+        }
+    }
     let mut runs = runs.into_iter();
     let mut merged = runs.next().ok_or("nothing to merge")?;
     for run in runs {
@@ -769,6 +803,16 @@ mod tests {
         let (mut a, mut b) = (report(), report());
         a.records.truncate(1);
         b.records.remove(0);
-        assert_eq!(merge(vec![a, b]).unwrap().records, report().records);
+        assert_eq!(
+            merge(vec![a.clone(), b.clone()]).unwrap().records,
+            report().records
+        );
+        // Shards: all of them, once each.
+        a.shards = vec!["1/3".into()];
+        b.shards = vec!["3/3".into()];
+        let err = merge(vec![a.clone(), b.clone()]).unwrap_err();
+        assert!(err.contains("shard 2/3 missing"), "{err}");
+        b.shards = vec!["1/3".into()];
+        assert!(merge(vec![a, b]).is_err());
     }
 }

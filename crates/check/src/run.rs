@@ -72,7 +72,7 @@ pub enum InjectedFault {
     /// sees one): the runner's `--timeout` must end them.
     Hang(String),
     /// Cases whose `scene/case` name contains this abort the process (a driver crash, as a
-    /// runner sees one).
+    /// runner sees one); `device/teardown-<format>` names a context's destruction.
     Crash(String),
 }
 
@@ -326,12 +326,15 @@ pub fn run_check(
         }
         let mark = log.len();
         let teardown_start = Instant::now();
+        let teardown = format!("teardown-{}", format.vk_name().to_lowercase());
+        if let Some(InjectedFault::Crash(part)) = &options.inject {
+            // A driver that crashes destroying its device, after every case reported.
+            if format!("device/{teardown}").contains(part.as_str()) {
+                std::process::abort();
+            }
+        }
         drop(ctx);
-        let mut r = CaseResult::new(
-            "device",
-            format!("teardown-{}", format.vk_name().to_lowercase()),
-            None,
-        );
+        let mut r = CaseResult::new("device", teardown, None);
         (r.validation, r.accepted) = messages_since(&log, mark, &options.accepted);
         r.seconds = teardown_start.elapsed().as_secs_f64();
         if let Some(first) = r.validation.first() {

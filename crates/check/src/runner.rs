@@ -297,17 +297,28 @@ impl Run<'_> {
                 handles.push(scope.spawn(move || work(queue, options, halt, &tx)));
             }
             drop(tx);
+            let mut written = Ok(());
             loop {
                 match rx.recv_timeout(Duration::from_millis(200)) {
-                    Ok(Message::Record(r)) if r.scene == "device" => self.fold_device(r),
+                    Ok(Message::Record(r)) if r.scene == "device" => {
+                        // A failing device row (a muted canary, leaks at teardown) is streamed
+                        // at once: a killed job's results.csv must not read all green.
+                        if r.status.is_failure() && written.is_ok() {
+                            written = self.results.write_all(report::results_line(&r).as_bytes());
+                        }
+                        self.fold_device(r);
+                    }
                     Ok(Message::Record(r)) => {
                         let r = classify(r);
-                        self.results
-                            .write_all(report::results_line(&r).as_bytes())?;
                         self.done += 1;
                         if rerun {
+                            // The final results.csv has the verdict of both runs.
                             eprintln!("rerun: {}", line(&r));
                         } else {
+                            if written.is_ok() {
+                                written =
+                                    self.results.write_all(report::results_line(&r).as_bytes());
+                            }
                             self.failed(&r);
                         }
                         records.insert(r.full_name(), r);
@@ -315,6 +326,10 @@ impl Run<'_> {
                     Ok(Message::Worker(w)) => self.workers.push(w),
                     Err(mpsc::RecvTimeoutError::Timeout) => {}
                     Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                }
+                if written.is_err() {
+                    // Nothing more can be streamed: stop the workers, then say why.
+                    self.halt.store(true, Ordering::SeqCst);
                 }
                 if last_progress.elapsed() >= self.options.progress_every {
                     last_progress = Instant::now();
@@ -330,11 +345,21 @@ impl Run<'_> {
             for h in handles {
                 h.join().expect("a worker thread panicked")?;
             }
-            Ok(())
+            written
         });
         self.queue_ids
             .store(queue.next_id.load(Ordering::SeqCst), Ordering::SeqCst);
         started?;
+        // Every case of a pass that ran to its end has a record: one that has none was lost
+        // between runner and worker, and is a failure, never a silent gap in the reports.
+        if !self.halted() {
+            for case in cases {
+                records.entry(case.full_name()).or_insert_with(|| {
+                    let why = "no worker reported it (lost between the runner and its worker)";
+                    lost(case, Status::Crash, why.into(), 0.0)
+                });
+            }
+        }
         Ok(records)
     }
 
@@ -437,8 +462,16 @@ fn run_worker(
         .stdout(Stdio::piped())
         .stderr(std::fs::File::create(&log_path)?);
     // Its own process group: a terminal's Ctrl-C reaches the runner, which stops the workers
-    // itself, instead of killing them mid-case (they would read as crashes).
+    // itself, instead of killing them mid-case (they would read as crashes). And it dies with
+    // the runner: a runner killed outright (a CI job's hard timeout) leaves no worker behind.
     std::os::unix::process::CommandExt::process_group(&mut command, 0);
+    // SAFETY: prctl is async-signal-safe and touches nothing of the parent's.
+    unsafe {
+        std::os::unix::process::CommandExt::pre_exec(&mut command, || {
+            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
+            Ok(())
+        });
+    }
     for name in &options.env_remove {
         command.env_remove(name);
     }
@@ -447,7 +480,7 @@ fn run_worker(
     }
     let mut child = command.spawn()?;
     let stdout = child.stdout.take().expect("piped");
-    let (ltx, lrx) = mpsc::channel::<String>();
+    let (ltx, lines) = mpsc::channel::<String>();
     std::thread::spawn(move || {
         for line in BufReader::new(stdout).lines() {
             let Ok(line) = line else { break };
@@ -456,98 +489,70 @@ fn run_worker(
             }
         }
     });
-    let mut pending: Vec<PlannedCase> = batch.to_vec();
-    let mut in_flight: Option<(PlannedCase, Instant)> = None;
-    let mut last_event = Instant::now();
-    let mut info = WorkerInfo {
-        cases: 0,
-        peak_mib: None,
-        end: "ok".into(),
-    };
-    let take = |pending: &mut Vec<PlannedCase>, name: &str| {
-        pending
-            .iter()
-            .position(|c| c.full_name() == name)
-            .map(|i| pending.remove(i))
+    let mut worker = Worker {
+        id,
+        child,
+        pending: batch.to_vec(),
+        in_flight: None,
+        last_event: Instant::now(),
+        info: WorkerInfo {
+            cases: 0,
+            peak_mib: None,
+            end: "ok".into(),
+        },
+        tx,
     };
     loop {
         if halt.load(Ordering::SeqCst) || options.stop.load(Ordering::SeqCst) {
-            info.peak_mib = peak_mib(child.id()).or(info.peak_mib);
-            let _ = child.kill();
-            let _ = child.wait();
-            info.end = "stopped".into();
-            return Ok((info, Vec::new()));
+            worker.kill();
+            worker.info.end = "stopped".into();
+            return Ok((worker.info, Vec::new()));
         }
-        match lrx.recv_timeout(Duration::from_millis(100)) {
-            Ok(line) => {
-                last_event = Instant::now();
-                let (verb, rest) = line.split_once(' ').unwrap_or((line.as_str(), ""));
-                match verb {
-                    "start" => in_flight = take(&mut pending, rest).map(|c| (c, Instant::now())),
-                    "result" => {
-                        let Some(r) = serde_json::from_str(rest)
-                            .ok()
-                            .and_then(|v: Value| Record::from_json(&v))
-                        else {
-                            continue;
-                        };
-                        if r.scene != "device" {
-                            info.cases += 1;
-                            let name = r.full_name();
-                            if in_flight
-                                .as_ref()
-                                .is_some_and(|(c, _)| c.full_name() == name)
-                            {
-                                in_flight = None;
-                            } else {
-                                take(&mut pending, &name);
-                            }
-                        }
-                        let _ = tx.send(Message::Record(r));
-                    }
-                    "peak" => info.peak_mib = rest.trim().parse().ok(),
-                    _ => {}
-                }
-            }
+        match lines.recv_timeout(Duration::from_millis(100)) {
+            Ok(line) => worker.handle(&line),
             Err(mpsc::RecvTimeoutError::Timeout) => {
-                let since = in_flight.as_ref().map_or(last_event, |(_, t)| *t);
+                let since = worker
+                    .in_flight
+                    .as_ref()
+                    .map_or(worker.last_event, |(_, t)| *t);
                 if since.elapsed() < options.timeout {
                     continue;
                 }
-                info.peak_mib = peak_mib(child.id()).or(info.peak_mib);
-                let _ = child.kill();
-                let _ = child.wait();
-                info.end = "timeout".into();
-                // A worker stuck between cases (making its device, tearing it down) is charged
-                // to the next case, so that every timeout ends one case and the run moves on.
-                let case = in_flight
-                    .map(|(c, _)| c)
-                    .or_else(|| (!pending.is_empty()).then(|| pending.remove(0)));
-                if let Some(case) = case {
-                    let reason = format!(
-                        "ran past the {:.0} s timeout; its worker was killed",
-                        options.timeout.as_secs_f64()
-                    );
-                    let seconds = since.elapsed().as_secs_f64();
-                    let _ = tx.send(Message::Record(lost(
-                        &case,
-                        Status::Timeout,
-                        reason,
-                        seconds,
-                    )));
+                // What arrived as the limit passed counts.
+                while let Ok(line) = lines.try_recv() {
+                    worker.handle(&line);
                 }
-                return Ok((info, pending));
+                let since = worker
+                    .in_flight
+                    .as_ref()
+                    .map_or(worker.last_event, |(_, t)| *t);
+                if since.elapsed() < options.timeout {
+                    continue;
+                }
+                worker.kill();
+                worker.info.end = "timeout".into();
+                let reason = format!(
+                    "ran past the {:.0} s timeout; its worker was killed",
+                    options.timeout.as_secs_f64()
+                );
+                worker.charge(Status::Timeout, reason, since);
+                return Ok((worker.info, worker.pending));
             }
             Err(mpsc::RecvTimeoutError::Disconnected) => {
-                let status = child.wait()?;
-                if status.success() && pending.is_empty() && in_flight.is_none() {
-                    return Ok((info, pending));
+                // The group's other processes, if the worker started any, go with it; before
+                // the worker is reaped, while its pid still names the group.
+                // SAFETY: signalling the worker's own process group.
+                unsafe { libc::kill(-(worker.child.id() as i32), libc::SIGKILL) };
+                let status = worker.child.wait()?;
+                if status.success() && worker.pending.is_empty() && worker.in_flight.is_none() {
+                    return Ok((worker.info, worker.pending));
                 }
-                if status.code() == Some(NO_DEVICE_EXIT) && info.cases == 0 {
-                    return Err(std::io::Error::other(format!(
-                        "a worker found no Vulkan device or no validation layer{}",
+                if status.code() == Some(NO_DEVICE_EXIT) && worker.info.cases == 0 {
+                    return Err(std::io::Error::other(NoDevice(format!(
+                        "a worker found no Vulkan device, no validation layer or not the \
+                         expected driver{}",
                         log_tail(&log_path)
-                    )));
+                    ))));
                 }
                 let how = match (
                     status.code(),
@@ -557,20 +562,129 @@ fn run_worker(
                     (None, Some(signal)) => format!("signal {signal}"),
                     _ => "an unknown status".to_owned(),
                 };
-                info.end = format!("crash: {how}");
-                let case = in_flight
-                    .or_else(|| (!pending.is_empty()).then(|| (pending.remove(0), last_event)));
-                if let Some((case, t)) = case {
-                    let reason = format!(
-                        "its worker died with {how} while it ran{}",
-                        log_tail(&log_path)
-                    );
-                    let seconds = t.elapsed().as_secs_f64();
-                    let _ = tx.send(Message::Record(lost(&case, Status::Crash, reason, seconds)));
-                }
-                return Ok((info, pending));
+                worker.info.end = format!("crash: {how}");
+                let reason = format!("its worker died with {how}{}", log_tail(&log_path));
+                let since = worker.last_event;
+                worker.charge(Status::Crash, reason, since);
+                return Ok((worker.info, worker.pending));
             }
         }
+    }
+}
+
+/// The error a run ends with when a worker has no device, no validation layer, or not the
+/// driver `--expect-driver` names: nothing can run.
+#[derive(Debug)]
+pub struct NoDevice(pub String);
+
+impl std::fmt::Display for NoDevice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for NoDevice {}
+
+/// One worker process as its thread follows it.
+struct Worker<'a> {
+    id: usize,
+    child: std::process::Child,
+    /// The batch's cases not yet begun.
+    pending: Vec<PlannedCase>,
+    in_flight: Option<(PlannedCase, Instant)>,
+    last_event: Instant,
+    info: WorkerInfo,
+    tx: &'a mpsc::Sender<Message>,
+}
+
+impl Worker<'_> {
+    fn take(&mut self, name: &str) -> Option<PlannedCase> {
+        let i = self.pending.iter().position(|c| c.full_name() == name)?;
+        Some(self.pending.remove(i))
+    }
+
+    /// One line of the worker's protocol. A case is never dropped: one begun and not reported
+    /// before the next begins, or whose report cannot be read, is a crash of its own.
+    fn handle(&mut self, line: &str) {
+        self.last_event = Instant::now();
+        let (verb, rest) = line.split_once(' ').unwrap_or((line, ""));
+        match verb {
+            "start" => {
+                if let Some((case, t)) = self.in_flight.take() {
+                    let why = "its worker began another case without reporting this one";
+                    self.lose(&case, Status::Crash, why.into(), t);
+                }
+                self.in_flight = self.take(rest).map(|c| (c, Instant::now()));
+            }
+            "result" => {
+                let parsed = serde_json::from_str(rest)
+                    .ok()
+                    .and_then(|v: Value| Record::from_json(&v));
+                let Some(r) = parsed else {
+                    if let Some((case, t)) = self.in_flight.take() {
+                        let why = "its worker's report of it could not be read";
+                        self.lose(&case, Status::Crash, why.into(), t);
+                    }
+                    return;
+                };
+                if r.scene != "device" {
+                    self.info.cases += 1;
+                    let name = r.full_name();
+                    if self
+                        .in_flight
+                        .as_ref()
+                        .is_some_and(|(c, _)| c.full_name() == name)
+                    {
+                        self.in_flight = None;
+                    } else {
+                        self.take(&name);
+                    }
+                }
+                let _ = self.tx.send(Message::Record(r));
+            }
+            "peak" => self.info.peak_mib = rest.trim().parse().ok(),
+            _ => {}
+        }
+    }
+
+    fn lose(&self, case: &PlannedCase, status: Status, reason: String, since: Instant) {
+        let seconds = since.elapsed().as_secs_f64();
+        let _ = self
+            .tx
+            .send(Message::Record(lost(case, status, reason, seconds)));
+    }
+
+    /// A crash or timeout charged to the case in flight; else to the next case of the batch (a
+    /// worker that died making its device), so that every failure ends a case and the run moves
+    /// on; else, with its batch done (tearing its device down), to the worker's own device row,
+    /// so that a crash or hang at teardown fails the run too.
+    fn charge(&mut self, status: Status, reason: String, since: Instant) {
+        if let Some((case, t)) = self.in_flight.take() {
+            self.lose(&case, status, reason, t);
+        } else if !self.pending.is_empty() {
+            let case = self.pending.remove(0);
+            self.lose(&case, status, format!("before it began: {reason}"), since);
+        } else {
+            let _ = self.tx.send(Message::Record(Record {
+                scene: "device".into(),
+                name: format!("worker-{}", self.id),
+                status,
+                seconds: since.elapsed().as_secs_f64(),
+                failure_type: Some(status.name().to_lowercase()),
+                details: format!("after its last case: {reason}\n"),
+                reason: Some(format!("after its last case: {reason}")),
+                data: Value::Null,
+            }));
+        }
+    }
+
+    /// Kills the worker's whole process group and reaps it, its peak memory read first.
+    fn kill(&mut self) {
+        self.info.peak_mib = peak_mib(self.child.id()).or(self.info.peak_mib);
+        // SAFETY: signalling the worker's own process group (it leads it).
+        unsafe { libc::kill(-(self.child.id() as i32), libc::SIGKILL) };
+        let _ = self.child.kill();
+        let _ = self.child.wait();
     }
 }
 

@@ -6,8 +6,10 @@
 //! by SIGINT/SIGTERM. `histencil check merge` joins shards' JSON reports.
 //!
 //! Exit codes: 0 nothing fails; 1 a case fails (a regression, crash, timeout, muted validation
-//! layer or unexpected pass); 2 usage error; 3 no Vulkan device or no validation layer; 4 no
-//! case selected; 5 stopped before the end (a signal) with nothing failing so far.
+//! layer or unexpected pass); 2 usage error; 3 no Vulkan device, no validation layer, or not the
+//! driver `--expect-driver` names; 4 no case selected; 5 stopped before the end (a signal) with
+//! nothing failing so far; 6 the runner itself failed (its files could not be written, a worker
+//! could not be started).
 
 use anyhow::{Context as _, Result};
 use histencil_check::lists::{AcceptedMessages, Baseline, Patterns, Shard, Status};
@@ -30,6 +32,7 @@ const EXIT_USAGE: u8 = 2;
 const EXIT_NO_DEVICE: u8 = runner::NO_DEVICE_EXIT as u8;
 const EXIT_NO_CASES: u8 = 4;
 const EXIT_INCOMPLETE: u8 = 5;
+const EXIT_RUNNER: u8 = 6;
 
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true)]
@@ -97,6 +100,11 @@ pub struct CheckArgs {
     /// Regular expressions (one per line) of cases known to be flaky: a failure is a Flake.
     #[arg(long)]
     flakes: Vec<PathBuf>,
+    /// Refuse to run (exit 3) unless the driver line (`VkPhysicalDeviceDriverProperties`'
+    /// name and build, e.g. `Mesa 25.0.7`) contains this: a CI job meant for one driver cannot
+    /// pass on another that the loader picked instead.
+    #[arg(long)]
+    expect_driver: Option<String>,
     /// An unexpected pass does not fail the run (it is still reported).
     #[arg(long)]
     allow_unexpected_pass: bool,
@@ -211,7 +219,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         inject: args.inject_fault.clone(),
     };
     if args.worker {
-        return worker(&scenes, &options);
+        return worker(&scenes, &options, args.expect_driver.as_deref());
     }
     let mut skips = Patterns::default();
     for path in &args.skips {
@@ -310,7 +318,15 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("histencil: {e:#}");
-            ExitCode::from(EXIT_NO_DEVICE)
+            let no_device = e
+                .downcast_ref::<std::io::Error>()
+                .and_then(|e| e.get_ref())
+                .is_some_and(|e| e.is::<runner::NoDevice>());
+            ExitCode::from(if no_device {
+                EXIT_NO_DEVICE
+            } else {
+                EXIT_RUNNER
+            })
         }
     }
 }
@@ -374,6 +390,9 @@ fn run(
     worker_args.extend(["--out".into(), args.out.clone().into_os_string()]);
     if let Some(path) = &args.accept_messages {
         worker_args.extend(["--accept-messages".into(), path.clone().into_os_string()]);
+    }
+    if let Some(driver) = &args.expect_driver {
+        worker_args.extend(["--expect-driver".into(), driver.into()]);
     }
     if let Some(fault) = &args.inject_fault {
         let text = match fault {
@@ -525,7 +544,7 @@ fn write_reports(
 
 /// `--worker`: the cases in this process, a line per event on stdout (see the runner), and the
 /// process's peak memory at the end.
-fn worker(scenes: &[CheckScene], options: &CheckOptions) -> ExitCode {
+fn worker(scenes: &[CheckScene], options: &CheckOptions, expect_driver: Option<&str>) -> ExitCode {
     let stdout = std::io::stdout();
     let line = |text: String| {
         let mut out = stdout.lock();
@@ -537,7 +556,17 @@ fn worker(scenes: &[CheckScene], options: &CheckOptions) -> ExitCode {
         Event::Context {
             device: name,
             driver,
-        } => device = (name.to_owned(), driver.to_string()),
+        } => {
+            device = (name.to_owned(), driver.to_string());
+            if let Some(expected) = expect_driver.filter(|e| !device.1.contains(e)) {
+                eprintln!(
+                    "{NO_DEVICE_MARK}: the driver is `{}`, not the `{expected}` --expect-driver \
+                     names",
+                    device.1
+                );
+                std::process::exit(i32::from(EXIT_NO_DEVICE));
+            }
+        }
         Event::Started(name) => line(format!("start {name}")),
         Event::Finished(result, _) => {
             let mut record = Record::from_result(result);

@@ -59,7 +59,9 @@ enum Command {
     Calibrate(lab::CalibrateArgs),
     /// The validation-CI matrix: every technique, backend, flush policy, preserved pattern,
     /// depth format and resolution a scene needs, under the validation layer, judged against
-    /// forward; JUnit XML and JSON reports. Exit 0 all passed, 1 any failure, 2 usage error.
+    /// forward, run in worker processes with baselines, shards and timeouts; results.csv,
+    /// failures.csv, JUnit XML and JSON. Exit 0 nothing fails, 1 a case fails, 2 usage error,
+    /// 3 no device or layer, 4 no case selected, 5 stopped by a signal, 6 runner error.
     Check(Box<check::CheckArgs>),
     /// Evaluate BRDF cases from a CSV file (id,brdf,params,N,T,V,L) into `id,value`.
     BrdfEval(BrdfEvalArgs),

@@ -226,6 +226,48 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
         "{results:?}"
     );
 
+    // A crash tearing the device down, after every case reported, fails the run as the worker's
+    // own device row: the cases all passed, the verdict does not.
+    let o = command(&SLICE)
+        .args(["--jobs", "1", "--inject-fault", "crash=device/teardown-d32"])
+        .arg("--out")
+        .arg(dir.join("teardown"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let teardown = statuses(&dir.join("teardown"));
+    assert!(
+        teardown
+            .iter()
+            .any(|(n, s)| n.starts_with("device/worker-") && s == "Crash"),
+        "{teardown:?}"
+    );
+    let passed = teardown
+        .iter()
+        .filter(|(n, s)| n.starts_with("brdfs-3/") && s == "Pass");
+    assert_eq!(passed.count(), 59, "{teardown:?}");
+
+    // --max-fails stops the run at the first failing case, and says so.
+    let json = dir.join("max-fails.json");
+    let o = command(&SLICE)
+        .args(["--jobs", "1", "--max-fails", "1", "--inject-fault"])
+        .arg(format!("crash={crashed}"))
+        .arg("--out")
+        .arg(dir.join("max-fails"))
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let report: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
+    assert!(
+        report["incomplete"]
+            .as_str()
+            .unwrap()
+            .contains("--max-fails"),
+        "{report}"
+    );
+
     // failures.csv is a baseline: with it, the same crash is expected and the run is green.
     let baseline = dir.join("baseline.txt");
     std::fs::copy(out.join("failures.csv"), &baseline).unwrap();
@@ -328,13 +370,19 @@ fn shards_merge_into_one_report() {
     assert_eq!(names.len(), 1 + 58, "{names:?}");
     assert_eq!(merged["shards"], serde_json::json!(["1/2", "2/2"]));
     assert!(read(&junit).contains("<testsuite name=\"brdfs-3\" tests=\"59\""));
-    // A shard merged twice is refused.
-    let o = Command::new(BIN)
-        .args(["check", "merge"])
-        .args([&jsons[0], &jsons[0]])
-        .output()
-        .unwrap();
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    // A shard given twice, or one missing (its job died before writing its report), is refused.
+    for (shards, why) in [
+        (vec![&jsons[0], &jsons[0]], "twice"),
+        (vec![&jsons[0]], "shard 2/2 missing"),
+    ] {
+        let o = Command::new(BIN)
+            .args(["check", "merge"])
+            .args(shards)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+        assert!(text(&o).contains(why), "{}", text(&o));
+    }
 }
 
 #[test]
@@ -398,6 +446,15 @@ fn exit_codes_tell_usage_no_cases_and_bad_lists_apart() {
     assert_eq!(o.status.code(), Some(4), "{}", text(&o));
     let bad = dir.join("bad-baseline.txt");
     std::fs::write(&bad, "brdfs-3/x,ValidationLayerMuted\n").unwrap();
+    // A job meant for another driver refuses to run.
+    let o = command(&SLICE)
+        .args(["--expect-driver", "Mesa 99.9"])
+        .arg("--out")
+        .arg(dir.join("driver"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    assert!(text(&o).contains("not the `Mesa 99.9`"), "{}", text(&o));
     for args in [
         vec!["--baseline", bad.to_str().unwrap()],
         vec!["--shard", "3/2"],

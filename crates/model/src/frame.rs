@@ -81,6 +81,10 @@ pub struct FramePlan {
     /// see are not here.
     pub lights: Vec<PlannedLight>,
     pub steps: Vec<Step>,
+    /// The view, lights and layout [`crate::plan_frame`] made this plan for, which the lighting
+    /// holds every frame against; `None` for a plan built by hand from requests, which names no
+    /// view.
+    pub made_for: Option<Box<crate::planner::PlannedFor>>,
 }
 
 impl FramePlan {
@@ -109,6 +113,7 @@ impl FramePlan {
             depth,
             lights,
             steps,
+            made_for: None,
         })
     }
 

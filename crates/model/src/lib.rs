@@ -70,8 +70,8 @@ pub use plan::{
     Shader,
 };
 pub use planner::{
-    plan_frame, Aabb, LightShape, PlanInputs, PlanSettings, TechniqueChoice, MAX_SPOT_ANGLE,
-    VOLUME_OVERSHOOT,
+    plan_frame, Aabb, LightShape, PlanInputs, PlanSettings, PlannedFor, TechniqueChoice,
+    MAX_SPOT_ANGLE, VOLUME_OVERSHOOT,
 };
 pub use sim::{LightShading, SimResult, Simulator, SoftTarget, NOT_SHADED};
 pub use state::{

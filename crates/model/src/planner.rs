@@ -20,7 +20,7 @@ use crate::chooser::CostModel;
 use crate::frame::{FlushPolicy, FramePlan, PlannedLight};
 use crate::layout::StencilLayout;
 use crate::plan::{LightCase, LightRequest, LightTechnique, PlanError};
-use crate::view::View;
+use crate::view::{View, ViewDesc};
 use glam::DVec3;
 
 /// How far histencil's light-volume meshes may reach beyond the light's range: they contain the
@@ -342,7 +342,79 @@ pub fn plan_frame(
             },
         });
     }
-    FramePlan::build(layout, &settings.caps, view.depth(), lights, settings.flush)
+    let mut plan = FramePlan::build(layout, &settings.caps, view.depth(), lights, settings.flush)?;
+    plan.made_for = Some(Box::new(PlannedFor {
+        view: *view.desc(),
+        lights: inputs.lights.to_vec(),
+        layout: *layout,
+    }));
+    Ok(plan)
+}
+
+/// What [`plan_frame`] made a plan for: the view, every light's shape in input order, and the
+/// stencil layout. A plan's passes, volumes and light cases are right for these only: a plan
+/// made before the camera moved or a light was added, recorded with the new view, lit the frame
+/// wrong without any error. The lighting compares every frame with this
+/// ([`PlannedFor::difference`]) and refuses one that differs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedFor {
+    pub view: ViewDesc,
+    pub lights: Vec<LightShape>,
+    pub layout: StencilLayout,
+}
+
+impl PlannedFor {
+    /// The first way a frame's view, lights or layout differ from what the plan was made for,
+    /// in words; `None` when they are the same bit for bit. Costs a comparison per matrix
+    /// element and per light: nothing next to recording the frame.
+    pub fn difference(
+        &self,
+        view: &ViewDesc,
+        lights: impl ExactSizeIterator<Item = LightShape>,
+        layout: &StencilLayout,
+    ) -> Option<String> {
+        let replan = "plan again with the frame's view and lights";
+        if *layout != self.layout {
+            return Some(format!(
+                "the plan was made for stencil layout {:?}, the lighting has {layout:?}",
+                self.layout
+            ));
+        }
+        if view.depth != self.view.depth {
+            return Some(format!(
+                "the plan was made for {:?} depth, the frame's view is {:?}",
+                self.view.depth, view.depth
+            ));
+        }
+        if view.world_to_view != self.view.world_to_view {
+            return Some(format!(
+                "the plan was made for another camera position or orientation (its \
+                 world-to-view matrix differs): {replan}"
+            ));
+        }
+        if view.view_to_clip != self.view.view_to_clip {
+            return Some(format!(
+                "the plan was made for another projection (its view-to-clip matrix differs): \
+                 {replan}"
+            ));
+        }
+        if lights.len() != self.lights.len() {
+            return Some(format!(
+                "the plan was made for {} lights, the frame has {}: {replan}",
+                self.lights.len(),
+                lights.len()
+            ));
+        }
+        for (index, (light, planned)) in lights.zip(&self.lights).enumerate() {
+            if light != *planned {
+                return Some(format!(
+                    "light {index} moved or changed shape since the plan was made \
+                     ({light:?}, planned as {planned:?}): {replan}"
+                ));
+            }
+        }
+        None
+    }
 }
 
 #[cfg(test)]
@@ -386,6 +458,56 @@ mod tests {
         min: [-1.0; 3],
         max: [1.0; 3],
     };
+
+    /// A plan knows what it was made for, and names the first way a frame differs from it.
+    #[test]
+    fn a_plan_names_how_a_frame_differs_from_what_it_was_made_for() {
+        let light = LightShape::Point {
+            position: [0.0, 0.0, 0.0],
+            range: 2.0,
+        };
+        let bounds = [vec![UNIT], vec![]];
+        let plan = plan(&[light, light], &bounds).unwrap();
+        let made_for = plan.made_for.as_deref().expect("plan_frame records it");
+        let (desc, layout) = (*view().desc(), StencilLayout::new(2, 0).unwrap());
+        let same = || [light, light].into_iter();
+        assert_eq!(made_for.difference(&desc, same(), &layout), None);
+        let mut moved = desc;
+        moved.world_to_view[3][2] -= 1.0;
+        let mut zoomed = desc;
+        zoomed.view_to_clip[1][1] *= 2.0;
+        let far = LightShape::Point {
+            position: [0.0, 0.0, 1.0],
+            range: 2.0,
+        };
+        let other_layout = StencilLayout::new(3, 0).unwrap();
+        let cases = [
+            (
+                made_for.difference(&moved, same(), &layout),
+                "camera position",
+            ),
+            (made_for.difference(&zoomed, same(), &layout), "projection"),
+            (
+                made_for.difference(&desc, [light].into_iter(), &layout),
+                "made for 2 lights, the frame has 1",
+            ),
+            (
+                made_for.difference(&desc, [light, far].into_iter(), &layout),
+                "light 1 moved",
+            ),
+            (
+                made_for.difference(&desc, same(), &other_layout),
+                "stencil layout",
+            ),
+        ];
+        for (difference, expected) in cases {
+            let text = difference.unwrap_or_else(|| panic!("{expected}: no difference seen"));
+            assert!(text.contains(expected), "{expected}: {text}");
+        }
+        // A plan built by hand names no view: nothing to hold a frame to.
+        let hand = FramePlan::from_requests(&layout, &Native, &[], FlushPolicy::Auto).unwrap();
+        assert!(hand.made_for.is_none());
+    }
 
     /// Every kind of bad light and bad box is an error naming it, never a panic or a plan.
     #[test]

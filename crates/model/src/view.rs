@@ -140,6 +140,8 @@ pub struct View {
     /// The near-plane rectangle's corners, counter-clockwise on screen from (-1, -1).
     near_corners: [DVec3; 4],
     infinite_far: bool,
+    /// The matrices it was made from: what a plan records it was made for.
+    desc: ViewDesc,
 }
 
 impl View {
@@ -189,7 +191,13 @@ impl View {
             depth: desc.depth,
             near_corners,
             infinite_far,
+            desc: *desc,
         })
+    }
+
+    /// The engine's matrices this view was made from.
+    pub fn desc(&self) -> &ViewDesc {
+        &self.desc
     }
 
     pub fn depth(&self) -> DepthConvention {

@@ -230,13 +230,14 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// ([`DeferredLighting::prepare`]). A failure half way frees what was made.
     ///
     /// # Errors
-    /// [`Error::BadFrame`] for a zero extent, a depth format without stencil, no frames in
-    /// flight or too many BRDFs for the layout; Vulkan and allocation errors.
+    /// [`Error::BadSetup`] for a zero extent, a depth format without stencil, no frames in
+    /// flight, too many BRDFs for the layout, or a depth-stencil format other than the one the
+    /// context was lent with; Vulkan and allocation errors.
     pub fn new(ctx: C, desc: &LightingDesc) -> Result<Self> {
         check_desc(desc)?;
         desc.hooks.check(&ctx)?;
         if ctx.depth_stencil_named && desc.depth_stencil_format != ctx.depth_stencil_format {
-            return Err(bad(format!(
+            return Err(bad_setup(format!(
                 "depth-stencil format {:?}, but the context was lent {:?} \
                  (BorrowedDevice::depth_stencil): name one format, or leave the context's None",
                 desc.depth_stencil_format, ctx.depth_stencil_format
@@ -408,24 +409,31 @@ fn bad(message: String) -> Error {
     Error::BadFrame(message)
 }
 
+fn bad_setup(message: String) -> Error {
+    Error::BadSetup(message)
+}
+
 fn check_desc(desc: &LightingDesc) -> Result<()> {
     let e = desc.extent;
     if e.width == 0 || e.height == 0 {
-        return Err(bad(format!("a {}x{} lighting extent", e.width, e.height)));
+        return Err(bad_setup(format!(
+            "a {}x{} lighting extent",
+            e.width, e.height
+        )));
     }
     if !crate::access::aspect_of(desc.depth_stencil_format).contains(vk::ImageAspectFlags::STENCIL)
     {
-        return Err(bad(format!(
+        return Err(bad_setup(format!(
             "depth format {:?} has no stencil for the BRDF ids",
             desc.depth_stencil_format
         )));
     }
     if desc.frames_in_flight == 0 {
-        return Err(bad("frames_in_flight must be at least 1".into()));
+        return Err(bad_setup("frames_in_flight must be at least 1".into()));
     }
     let slots = desc.layout.brdfs_in_use() as usize;
     if desc.brdfs.len() > slots {
-        return Err(bad(format!(
+        return Err(bad_setup(format!(
             "{} BRDFs for a stencil layout with {slots} BRDF slots",
             desc.brdfs.len()
         )));
@@ -479,6 +487,14 @@ fn check_frame(
             "the plan is for {:?} depth, the view is {:?}",
             frame.plan.depth, frame.view.depth
         )));
+    }
+    // A plan made for another view or other lights records without complaint and lights the
+    // frame wrong: hold it to what it was made for.
+    if let Some(made_for) = &frame.plan.made_for {
+        let shapes = frame.lights.iter().map(|l| l.shape());
+        if let Some(difference) = made_for.difference(frame.view, shapes, &desc.layout) {
+            return Err(bad(difference));
+        }
     }
     check_targets(desc, &frame.hook_sets, targets)
 }

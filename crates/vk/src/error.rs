@@ -53,9 +53,14 @@ pub enum Error {
     Lightmap(#[from] histencil_alpha::LayoutError),
     #[error("{count} distinct materials; the G-buffer indexes at most {max}")]
     TooManyMaterials { count: usize, max: usize },
-    /// A frame or lighting description that does not fit (an engine's input).
+    /// A frame that does not fit its lighting or lightmaps (an engine's input at record time).
     #[error("bad lighting frame: {0}")]
     BadFrame(String),
+    /// A description or hooks refused at creation (an engine's input when it makes a
+    /// [`crate::DeferredLighting`], [`crate::AlphaLightmaps`] or [`crate::EngineHooks`]): said
+    /// as such, not as a frame's fault.
+    #[error("bad lighting setup: {0}")]
+    BadSetup(String),
     #[error("not supported yet: {0}")]
     Unsupported(&'static str),
     #[error("cannot write `{path}`: {message}")]

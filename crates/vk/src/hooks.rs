@@ -78,7 +78,7 @@ impl EngineHooks {
     /// module is checked to be SPIR-V.
     ///
     /// # Errors
-    /// [`Error::BadFrame`] when a module is not SPIR-V (wrong length or magic number).
+    /// [`Error::BadSetup`] when a module is not SPIR-V (wrong length or magic number).
     ///
     /// # Safety
     /// The layouts are live, from the device of every context a lighting is made on with these
@@ -92,7 +92,7 @@ impl EngineHooks {
         visibility_layout: Option<vk::DescriptorSetLayout>,
     ) -> Result<Self> {
         for (name, spirv) in modules.named() {
-            spirv_words(spirv).map_err(|e| Error::BadFrame(format!("{name}: {e}")))?;
+            spirv_words(spirv).map_err(|e| Error::BadSetup(format!("{name}: {e}")))?;
         }
         Ok(Self {
             modules,
@@ -150,7 +150,7 @@ impl LightHooks {
             4
         };
         if sets > ctx.max_bound_descriptor_sets {
-            return Err(Error::BadFrame(format!(
+            return Err(Error::BadSetup(format!(
                 "a visibility hook binds set 4, and this device binds at most {} sets",
                 ctx.max_bound_descriptor_sets
             )));

@@ -141,9 +141,10 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// frees what was made.
     ///
     /// # Errors
-    /// [`Error::BadFrame`] for no frames in flight or a depth-stencil atlas format; Vulkan and
+    /// [`Error::BadSetup`] for no frames in flight or a depth-stencil atlas format; Vulkan and
     /// allocation errors.
     pub fn new(ctx: C, desc: &AlphaLightmapsDesc) -> Result<Self> {
+        let bad = |message: String| Error::BadSetup(message);
         if desc.frames_in_flight == 0 {
             return Err(bad("frames_in_flight must be at least 1".into()));
         }
