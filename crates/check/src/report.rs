@@ -412,7 +412,7 @@ pub fn json(report: &RunReport) -> Value {
     })
 }
 
-/// A run read back from [`json`]'s output, or why it is not one.
+/// A run read back from [`json()`]'s output, or why it is not one.
 pub fn from_json(v: &Value) -> Result<RunReport, String> {
     let cases = v
         .get("cases")
