@@ -405,6 +405,43 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     }
 }
 
+impl<C: Deref<Target = Context>> DeferredLighting<C> {
+    /// Makes the lighting fit targets of a new `extent`, keeping every pipeline (viewport and
+    /// scissor are dynamic state; the tile side, not the extent, shapes the tiled kernels): the
+    /// hi-stencil tile surface and the tiled technique's tile buffers are made anew, nothing
+    /// else. A resize to the same extent does nothing; a failure leaves the lighting as it was.
+    ///
+    /// # Errors
+    /// [`Error::BadSetup`] for a zero extent; allocation errors.
+    ///
+    /// # Safety
+    /// The GPU has finished every command buffer this lighting recorded into (wait for your
+    /// frames in flight first, as for any resize of your own targets).
+    pub unsafe fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
+        if extent.width == 0 || extent.height == 0 {
+            return Err(bad_setup(format!(
+                "a {}x{} lighting extent",
+                extent.width, extent.height
+            )));
+        }
+        if extent == self.desc.extent {
+            return Ok(());
+        }
+        let ctx: &Context = &self.ctx;
+        if self.desc.hi_stencil {
+            let surface = self.hi_stencil.as_mut().expect("made with the lighting");
+            surface.resize(ctx, extent)?;
+            let buffers = surface.light_set_buffers();
+            write_storage_buffers(ctx, self.hi_stencil_set, &buffers);
+        }
+        for (_, tiled) in &mut self.tiled {
+            tiled.resize(ctx, extent)?;
+        }
+        self.desc.extent = extent;
+        Ok(())
+    }
+}
+
 fn bad(message: String) -> Error {
     Error::BadFrame(message)
 }
@@ -589,9 +626,15 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         prepare_pipelines(ctx, &mut self.pipelines, plan, brdfs, count_stats, source)
     }
 
-    /// Light pipelines created so far.
+    /// Light pipelines created so far (kept across [`DeferredLighting::resize`]).
     pub fn pipeline_count(&self) -> usize {
         self.pipelines.count()
+    }
+
+    /// The tiled technique's pipelines created so far, over every tile side used (kept across
+    /// [`DeferredLighting::resize`]).
+    pub fn tiled_pipeline_count(&self) -> usize {
+        self.tiled.iter().map(|(_, t)| t.pipeline_count()).sum()
     }
 
     /// Records `frame`'s lighting into `cmd` against `targets`, and leaves each target's state

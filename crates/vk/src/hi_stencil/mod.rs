@@ -180,6 +180,48 @@ impl HiStencilSurface {
         })
     }
 
+    /// The surface for a new `extent`: the tile surfaces, the touch image and the saved-stencil
+    /// buffer made anew, the update pipeline and sets kept (the sets re-pointed). A failure
+    /// leaves the surface as it was. The GPU has finished every frame that used it.
+    pub fn resize(&mut self, ctx: &Context, extent: vk::Extent2D) -> Result<()> {
+        let frame = TileRect::frame(extent);
+        let (tiles_x, tile_bytes) = (frame.width, u64::from(frame.width * frame.height) * 4);
+        use vk::BufferUsageFlags as U;
+        let gpu = |name, size, usage| Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly);
+        let storage = U::STORAGE_BUFFER | U::TRANSFER_DST;
+        let mut fresh = Self::default();
+        let made = (|| -> Result<()> {
+            fresh.active = gpu("hi-stencil-active", tile_bytes, storage)?;
+            fresh.pending = gpu("hi-stencil-pending", tile_bytes, storage | U::TRANSFER_SRC)?;
+            fresh.touched = gpu("hi-stencil-touched", tile_bytes, storage)?;
+            use vk::ImageUsageFlags as I;
+            let touch_usage = I::DEPTH_STENCIL_ATTACHMENT | I::SAMPLED;
+            fresh.touch = Image::new(ctx, "hi-stencil-touch", TOUCH_FORMAT, extent, touch_usage)?;
+            fresh.saved = gpu("saved-stencil", stencil_bytes(extent), storage)?;
+            Ok(())
+        })();
+        if let Err(e) = made {
+            fresh.destroy(ctx);
+            return Err(e);
+        }
+        std::mem::swap(&mut self.active, &mut fresh.active);
+        std::mem::swap(&mut self.pending, &mut fresh.pending);
+        std::mem::swap(&mut self.touched, &mut fresh.touched);
+        std::mem::swap(&mut self.touch, &mut fresh.touch);
+        std::mem::swap(&mut self.saved, &mut fresh.saved);
+        // `fresh` holds the old extent's objects now, and nothing else.
+        fresh.destroy(ctx);
+        self.extent = extent;
+        self.tiles_x = tiles_x;
+        self.marker = 0;
+        self.unflushed = false;
+        for &set in &self.sets {
+            write_storage_buffers(ctx, set, &[self.pending.handle]);
+            write_read_only_view(ctx, set, 1, self.touch.view);
+        }
+        Ok(())
+    }
+
     /// The pool and every slot's update set, with the touch image and pending surface written
     /// (the stencil view is written per frame).
     fn create_sets(

@@ -295,6 +295,63 @@ impl TiledLighting {
         })
     }
 
+    /// The tile buffers for a new `extent`, the pipelines and sets kept (the sets re-pointed);
+    /// a failure leaves the buffers as they were. The GPU has finished every frame that used
+    /// them.
+    pub fn resize(&mut self, ctx: &Context, extent: vk::Extent2D) -> Result<()> {
+        let tile = self.side.pixels();
+        let tiles_xy = (extent.width.div_ceil(tile), extent.height.div_ceil(tile));
+        let tiles = tiles_xy.0 * tiles_xy.1;
+        let push = self.push.as_mut().expect("made with the lighting");
+        use vk::BufferUsageFlags as U;
+        let (storage, gpu) = (U::STORAGE_BUFFER, MemoryLocation::GpuOnly);
+        let lists = (MIXED_SLOT + 1) as u64 * u64::from(tiles) * 4;
+        let mut lists = Buffer::new(ctx, "tiled-lists", lists, storage, gpu)?;
+        let mask_bytes = u64::from(tiles) * u64::from(push.words) * 4;
+        let zeroed = storage | U::TRANSFER_DST;
+        let masks = Buffer::new(ctx, "tiled-light-masks", mask_bytes, zeroed, gpu);
+        let depths = masks.and_then(|masks| {
+            let depths = Buffer::new(
+                ctx,
+                "tiled-depth-ranges",
+                u64::from(tiles) * 8,
+                storage,
+                gpu,
+            );
+            match depths {
+                Ok(depths) => Ok((masks, depths)),
+                Err(e) => {
+                    let mut masks = masks;
+                    masks.destroy(ctx);
+                    Err(e)
+                }
+            }
+        });
+        let (mut masks, mut depths) = match depths {
+            Ok(made) => made,
+            Err(e) => {
+                lists.destroy(ctx);
+                return Err(e);
+            }
+        };
+        std::mem::swap(&mut self.lists, &mut lists);
+        std::mem::swap(&mut self.masks, &mut masks);
+        std::mem::swap(&mut self.depths, &mut depths);
+        for mut old in [lists, masks, depths] {
+            old.destroy(ctx);
+        }
+        push.tiles_x = tiles_xy.0;
+        push.tiles = tiles;
+        self.tiles_xy = tiles_xy;
+        self.write_sets(ctx);
+        Ok(())
+    }
+
+    /// The pipelines this technique holds.
+    pub fn pipeline_count(&self) -> usize {
+        4 + self.shade.len()
+    }
+
     /// The pool and every slot's tiled set, its buffers written (the HDR target is written per
     /// frame, [`TiledLighting::set_target`]).
     fn create_sets(&mut self, ctx: &Context, slots: u32) -> Result<()> {
@@ -303,6 +360,12 @@ impl TiledLighting {
             (vk::DescriptorType::STORAGE_IMAGE, 1),
         ];
         (self.pool, self.sets) = sets_of(ctx, "tiled-set", self.set_layout, slots, &sizes)?;
+        self.write_sets(ctx);
+        Ok(())
+    }
+
+    /// Points every slot's tiled set at the tile buffers.
+    fn write_sets(&self, ctx: &Context) {
         let buffers = [
             self.dispatch.handle,
             self.lists.handle,
@@ -312,7 +375,6 @@ impl TiledLighting {
         for set in &self.sets {
             write_storage_buffers(ctx, *set, &buffers);
         }
-        Ok(())
     }
 
     /// Points `slot`'s tiled set at the frame's HDR target (storage, `GENERAL`). The slot's last
