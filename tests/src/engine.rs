@@ -115,6 +115,7 @@ impl Engine {
             debug_utils: true,
             depth_stencil: None,
             memory_budget: None,
+            pipeline_cache: None,
         }
     }
 

@@ -102,6 +102,11 @@ pub struct BorrowedDevice {
     pub depth_stencil: Option<DepthStencilFormat>,
     /// As [`ContextDesc::memory_budget`]: the share of the engine's memory histencil may take.
     pub memory_budget: Option<u64>,
+    /// The engine's pipeline cache, for every pipeline histencil makes on this device (light
+    /// volumes, the tiled kernels, the hi-stencil emulation, lightmaps): warm from an earlier
+    /// run or lighting, it spares their compilation. `None`: no cache. The engine keeps it, and
+    /// its external synchronisation: histencil creates pipelines only inside its own calls.
+    pub pipeline_cache: Option<vk::PipelineCache>,
 }
 
 /// One Vulkan device and what hangs off it. Dropping an owned context waits for the device, frees
@@ -124,6 +129,9 @@ pub struct Context {
     device_name: String,
     device_type: vk::PhysicalDeviceType,
     driver: crate::driver::DriverInfo,
+    /// Every pipeline's cache: the engine's (borrowed), or histencil's own on an owned device,
+    /// so that a second renderer or lighting on one context reuses the first's compilations.
+    pub(crate) pipeline_cache: vk::PipelineCache,
     pub(crate) depth_stencil_format: vk::Format,
     depth_stencil: DepthStencilFormat,
     /// The depth-stencil format was named when the context was made (not picked for it): the
@@ -415,6 +423,11 @@ impl Context {
         let limits = props.limits;
         // SAFETY: as above; the instance asks for Vulkan 1.3.
         let driver = unsafe { crate::driver::driver_info(&instance, physical_device, layer_text) };
+        // A cache of histencil's own, destroyed with the device; without one (a driver that
+        // refuses) pipelines are made uncached.
+        let pipeline_cache =
+            unsafe { device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default(), None) }
+                .unwrap_or_default();
         let ctx = Self {
             _entry: Some(entry),
             owned: true,
@@ -430,6 +443,7 @@ impl Context {
             device_name,
             device_type: props.device_type,
             driver,
+            pipeline_cache,
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
             depth_stencil_named: desc.depth_stencil.is_some(),
@@ -440,6 +454,9 @@ impl Context {
             memory: MemoryAccount::new(desc.memory_budget),
         };
         ctx.name(ctx.device.handle(), "histencil-device");
+        if ctx.pipeline_cache != vk::PipelineCache::null() {
+            ctx.name(ctx.pipeline_cache, "histencil-pipeline-cache");
+        }
         ctx.name(ctx.queue, "graphics-queue");
         Ok(ctx)
     }
@@ -479,6 +496,7 @@ impl Context {
             debug_utils,
             depth_stencil,
             memory_budget,
+            pipeline_cache,
         } = lent;
         // SAFETY: the caller's promise that `physical_device` belongs to `instance`.
         let missing = unsafe { REQUIREMENTS.missing(&instance, physical_device) };
@@ -522,6 +540,7 @@ impl Context {
             device_name,
             device_type: props.device_type,
             driver,
+            pipeline_cache: pipeline_cache.unwrap_or_default(),
             depth_stencil_format: depth_stencil.vk(),
             depth_stencil,
             depth_stencil_named,
@@ -595,6 +614,12 @@ impl Context {
     /// The name of the device in use, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
     pub fn device_name(&self) -> &str {
         &self.device_name
+    }
+
+    /// The pipeline cache every pipeline on this context is made with: the engine's
+    /// ([`BorrowedDevice::pipeline_cache`]), histencil's own on an owned device, or null.
+    pub fn pipeline_cache(&self) -> vk::PipelineCache {
+        self.pipeline_cache
     }
 
     /// The driver as Vulkan names it (name, build, conformance) and the validation layer's
@@ -678,6 +703,8 @@ impl Drop for Context {
             // The allocator frees its memory blocks; it must go before the device. An owned
             // context never hands its allocator out, so this is the last reference.
             ManuallyDrop::drop(&mut self.allocator);
+            self.device
+                .destroy_pipeline_cache(self.pipeline_cache, None);
             self.device.destroy_device(None);
             if let Some(di) = &self.debug_instance {
                 if self.messenger != vk::DebugUtilsMessengerEXT::null() {

@@ -103,7 +103,7 @@ pub(crate) fn create_compute_pipeline(
         .layout(layout)];
     let created = unsafe {
         ctx.device
-            .create_compute_pipelines(vk::PipelineCache::null(), &info, None)
+            .create_compute_pipelines(ctx.pipeline_cache, &info, None)
     };
     unsafe { ctx.device.destroy_shader_module(shader, None) };
     let pipeline = created
@@ -296,7 +296,7 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     }
     let result = unsafe {
         ctx.device
-            .create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
+            .create_graphics_pipelines(ctx.pipeline_cache, &[info], None)
     };
     unsafe {
         ctx.device.destroy_shader_module(vertex_module, None);

@@ -153,6 +153,7 @@ impl Gpu {
             depth_stencil: Some(DepthStencilFormat::D32S8),
             // The most of this engine's memory histencil's lighting and lightmaps may hold.
             memory_budget: Some(256 << 20),
+            pipeline_cache: None,
         }
     }
 
