@@ -239,6 +239,25 @@ impl Engine {
         (pool, cmd)
     }
 
+    /// Ends `cmd` (from [`Engine::command_buffer`]), submits it, waits for the queue and frees
+    /// its pool.
+    ///
+    /// # Safety
+    /// `cmd` is recording on this device, and `pool` is its pool.
+    pub unsafe fn submit_and_wait(&self, pool: vk::CommandPool, cmd: vk::CommandBuffer) {
+        let d = &self.device;
+        unsafe {
+            d.end_command_buffer(cmd).unwrap();
+            let queue = d.get_device_queue(self.queue_family, 0);
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], vk::Fence::null())
+                .unwrap();
+            d.queue_wait_idle(queue).unwrap();
+            d.destroy_command_pool(pool, None);
+        }
+    }
+
     /// `count` frame slots: a command pool and buffer each, and a fence made signalled (the
     /// first wait on a slot passes).
     pub fn frame_slots(

@@ -44,7 +44,6 @@ fn an_engines_pipeline_cache_serves_every_lighting_on_its_device() {
             hooks: LightHooks::Builtin,
         };
         let view = scene.camera.view_desc(1.5);
-        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
         for _ in 0..2 {
             let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();
             let images = engine.lighting_targets(desc.extent, ds_format);
@@ -67,13 +66,7 @@ fn an_engines_pipeline_cache_serves_every_lighting_on_its_device() {
                 };
                 lighting.record_tiled(cmd, &frame, &mut targets).unwrap();
                 copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
-                d.end_command_buffer(cmd).unwrap();
-                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-                d.queue_submit2(queue, &[submit], vk::Fence::null())
-                    .unwrap();
-                d.queue_wait_idle(queue).unwrap();
-                d.destroy_command_pool(pool, None);
+                engine.submit_and_wait(pool, cmd);
             }
             assert!(lighting.tiled_pipeline_count() > 0);
             // SAFETY: its frame was waited for.

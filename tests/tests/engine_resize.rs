@@ -63,7 +63,6 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
         .unwrap();
         let (side, mixed) = (TileSide::Sixteen, MixedTiles::PerBrdf);
         let d = &engine.device;
-        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
         // One frame at `size`: the renderer's G-buffer, then the lighting (tiled or the plan),
         // submitted and waited for; its HDR image as floats.
         let frame = |lighting: &mut DeferredLighting<&Context>,
@@ -105,13 +104,7 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
                     lighting.record(cmd, &frame, &mut targets).unwrap();
                 }
                 copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
-                d.end_command_buffer(cmd).unwrap();
-                let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-                let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-                d.queue_submit2(queue, &[submit], vk::Fence::null())
-                    .unwrap();
-                d.queue_wait_idle(queue).unwrap();
-                d.destroy_command_pool(pool, None);
+                engine.submit_and_wait(pool, cmd);
             }
             let hdr = hdr_floats(readback.bytes());
             images.free(&engine);
