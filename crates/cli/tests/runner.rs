@@ -175,8 +175,9 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
     let crashed = "branching-ps3-auto-pA0-lightmap-d32s8-7x5";
     let out = dir.join("out");
     let json = dir.join("run.json");
+    // 10 s: far above a real case here (a group's setup included) on a loaded 2-core machine.
     let o = command(&SLICE)
-        .args(["--jobs", "2", "--timeout", "4", "--inject-fault"])
+        .args(["--jobs", "2", "--timeout", "10", "--inject-fault"])
         .arg(format!("hang={hung}"))
         .arg("--out")
         .arg(&out)
