@@ -568,13 +568,12 @@ pub fn failures_csv(report: &RunReport) -> String {
             continue;
         }
         let status = match r.status {
-            Status::ExpectedFail => r
-                .reason
-                .as_deref()
-                .and_then(|why| why.strip_prefix("expected "))
-                .and_then(|rest| rest.split(|c: char| !c.is_alphanumeric()).next())
-                .and_then(Status::parse)
-                .unwrap_or(Status::Fail),
+            // The failure it was expected as, from the kind the worker or runner gave it.
+            Status::ExpectedFail => match r.failure_type.as_deref() {
+                Some("crash") => Status::Crash,
+                Some("timeout") => Status::Timeout,
+                _ => Status::Fail,
+            },
             s if s.is_failure() => s,
             _ => continue,
         };
@@ -794,6 +793,7 @@ mod tests {
         let mut r = report();
         r.records[2].status = Status::ExpectedFail;
         r.records[2].reason = Some("expected Crash (baseline)".into());
+        r.records[2].failure_type = Some("crash".into());
         let csv = failures_csv(&r);
         let baseline = crate::lists::Baseline::parse(&csv, "failures.csv").unwrap();
         assert_eq!(baseline.expected.len(), 2, "{csv}");

@@ -43,8 +43,9 @@ pub struct RunnerOptions {
     pub flakes: Patterns,
     /// Where `results.csv`, `failures.csv`, the batches' case lists and the workers' logs go.
     pub out: PathBuf,
-    /// Set from outside (SIGINT, SIGTERM) to stop: workers are killed, what finished is kept.
-    pub stop: Arc<AtomicBool>,
+    /// Set from outside (a SIGINT or SIGTERM handler) to stop: workers are killed, what
+    /// finished is kept.
+    pub stop: &'static AtomicBool,
     /// A progress line this often (cases done of total, failing so far, elapsed).
     pub progress_every: Duration,
 }
@@ -511,21 +512,14 @@ fn run_worker(
         match lines.recv_timeout(Duration::from_millis(100)) {
             Ok(line) => worker.handle(&line),
             Err(mpsc::RecvTimeoutError::Timeout) => {
-                let since = worker
-                    .in_flight
-                    .as_ref()
-                    .map_or(worker.last_event, |(_, t)| *t);
-                if since.elapsed() < options.timeout {
+                if worker.since().elapsed() < options.timeout {
                     continue;
                 }
                 // What arrived as the limit passed counts.
                 while let Ok(line) = lines.try_recv() {
                     worker.handle(&line);
                 }
-                let since = worker
-                    .in_flight
-                    .as_ref()
-                    .map_or(worker.last_event, |(_, t)| *t);
+                let since = worker.since();
                 if since.elapsed() < options.timeout {
                     continue;
                 }
@@ -598,6 +592,11 @@ struct Worker<'a> {
 }
 
 impl Worker<'_> {
+    /// Where the timeout counts from: the case in flight's start, else the last line heard.
+    fn since(&self) -> Instant {
+        self.in_flight.as_ref().map_or(self.last_event, |(_, t)| *t)
+    }
+
     fn take(&mut self, name: &str) -> Option<PlannedCase> {
         let i = self.pending.iter().position(|c| c.full_name() == name)?;
         Some(self.pending.remove(i))

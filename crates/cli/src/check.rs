@@ -23,7 +23,6 @@ use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::Duration;
 
 /// Exit codes apart, as a CI script reads them.
@@ -408,17 +407,6 @@ fn run(
         libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
         libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
     }
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        std::thread::spawn(move || loop {
-            if STOP.load(Ordering::SeqCst) {
-                stop.store(true, Ordering::SeqCst);
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        });
-    }
     let jobs = args.jobs.unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map(|n| n.get())
@@ -439,7 +427,7 @@ fn run(
         baseline,
         flakes,
         out: args.out.clone(),
-        stop,
+        stop: &STOP,
         progress_every: Duration::from_secs(if std::io::stderr().is_terminal() {
             2
         } else {
