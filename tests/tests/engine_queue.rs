@@ -9,8 +9,8 @@ use histencil_brdf::BrdfId;
 use histencil_model::StencilLayout;
 use histencil_tests::engine::Engine;
 use histencil_vk::{
-    AlphaLightmaps, AlphaLightmapsDesc, BorrowedDevice, Context, DeferredLighting, EngineHooks,
-    LightHooks, LightModules, LightingDesc, LutTables,
+    AlphaLightmaps, AlphaLightmapsDesc, BorrowedDevice, Context, DeferredLighting, LightHooks,
+    LightingDesc, LutTables,
 };
 use std::sync::Arc;
 
@@ -150,32 +150,4 @@ fn the_parts_can_move_between_threads() {
     fn shared<T: Send + Sync>() {}
     shared::<Context>();
     sendable::<EngineRenderer>();
-}
-
-#[test]
-fn engine_hooks_that_are_not_spirv_are_refused() {
-    let modules = LightModules {
-        deferred_light: b"#version 460\nvoid main() {}\n",
-        ..LightModules::BUILTIN
-    };
-    // SAFETY: refused before the (null) layouts could be used.
-    let err = unsafe { EngineHooks::new(modules, vk::DescriptorSetLayout::null(), None) }
-        .expect_err("GLSL source is not SPIR-V");
-    assert!(
-        err.to_string().contains("deferred_light: not SPIR-V"),
-        "{err}"
-    );
-    // Every module is checked, the tiled kernels too.
-    let modules = LightModules {
-        tile_shade_8: &[0x03, 0x02, 0x23, 0x07, 0],
-        ..LightModules::BUILTIN
-    };
-    // SAFETY: as above.
-    let err = unsafe { EngineHooks::new(modules, vk::DescriptorSetLayout::null(), None) }
-        .expect_err("five bytes are not SPIR-V");
-    assert!(err.to_string().contains("tile_shade_8"), "{err}");
-    // SAFETY: as above; histencil's own modules are SPIR-V.
-    let ok =
-        unsafe { EngineHooks::new(LightModules::BUILTIN, vk::DescriptorSetLayout::null(), None) };
-    assert!(ok.is_ok());
 }

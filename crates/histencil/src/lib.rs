@@ -39,10 +39,10 @@ pub use histencil_model::{
 // The device, the lighting, the hooks.
 pub use histencil_vk::{
     aspect_of, gbuffer_stencil_reference, Backend, BorrowedDevice, BrdfSource, Context,
-    DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks, Error, HookSets,
-    ImageRef, ImageState, LightHooks, LightModules, LightingBreakdown, LightingDesc, LightingFrame,
-    LightingTargets, LutTables, MixedTiles, Result, TileClassify, TileSide, TileStats, TiledFrame,
-    ValidationLog, ValidationMessage, GBUFFER_FORMATS, REQUIREMENTS,
+    DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks, Error, HookSetLayout,
+    HookSets, ImageRef, ImageState, LightHooks, LightModules, LightingBreakdown, LightingDesc,
+    LightingFrame, LightingTargets, LutTables, MixedTiles, Result, TileClassify, TileSide,
+    TileStats, TiledFrame, ValidationLog, ValidationMessage, GBUFFER_FORMATS, REQUIREMENTS,
 };
 
 // Lightmaps for translucent entities.

@@ -277,7 +277,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             ("hi-stencil-set-layout", HI_STENCIL_SET),
             ("lut-set-layout", LUT_SET),
         ];
-        let hooks = self.desc.hooks;
+        let hooks = &self.desc.hooks;
         let builtin = matches!(hooks, LightHooks::Builtin);
         for (i, (name, set)) in named.into_iter().enumerate() {
             if i == 1 && !builtin {
@@ -591,9 +591,20 @@ fn check_targets(
         for ((image, name), format) in targets.gbuffer.iter().zip(names).zip(GBUFFER_FORMATS) {
             expect(name, image, format)?;
         }
-    } else {
-        for (i, image) in targets.gbuffer.iter().enumerate() {
-            expect(&format!("surface image {i}"), image, image.format)?;
+    } else if let LightHooks::Engine(engine) = &desc.hooks {
+        // The decode reads these through the engine's set; the lighting barriers each one for
+        // the light shaders' reads, so one left out would be read in whatever layout it was.
+        let formats = &engine.surface_formats;
+        if targets.gbuffer.len() != formats.len() {
+            return Err(bad(format!(
+                "{} surface images in LightingTargets::gbuffer, and the engine's decode hook \
+                 reads {} (EngineHooks::new's surface formats)",
+                targets.gbuffer.len(),
+                formats.len()
+            )));
+        }
+        for (i, (image, format)) in targets.gbuffer.iter().zip(formats).enumerate() {
+            expect(&format!("surface image {i}"), image, *format)?;
         }
     }
     expect(
@@ -811,6 +822,11 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ) -> Result<()> {
         check_slot_and_lights(&self.desc, frame.slot, frame.lights.len())?;
         check_targets(&self.desc, &frame.hook_sets, targets)?;
+        if let Some(why) = self.desc.hooks.tiled_refusal() {
+            return Err(bad(format!(
+                "the tiled technique's kernels cannot bind the hooks: {why}"
+            )));
+        }
         if self.desc.hdr_format != vk::Format::R16G16B16A16_SFLOAT {
             return Err(bad(format!(
                 "the tiled technique stores light as rgba16f, and the HDR target is {:?}",
@@ -858,7 +874,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             return Ok(());
         }
         let ctx: &Context = &self.ctx;
-        let hooks = self.desc.hooks;
+        let hooks = &self.desc.hooks;
         let [frame, gbuffer, _, filler] = self.set_layouts;
         let decode = match hooks {
             LightHooks::Builtin => gbuffer,

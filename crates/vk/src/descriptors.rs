@@ -177,15 +177,12 @@ pub(crate) const GRAPHICS_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::f
     vk::ShaderStageFlags::VERTEX.as_raw() | vk::ShaderStageFlags::FRAGMENT.as_raw(),
 );
 
-/// A named set layout with every binding of `set` visible to `stages`.
-pub(crate) fn create_set_layout(
-    ctx: &Context,
-    name: &str,
+/// The Vulkan bindings of `set`, each visible to `stages`.
+pub(crate) fn layout_bindings(
     set: &[BindingDesc],
     stages: vk::ShaderStageFlags,
-) -> Result<vk::DescriptorSetLayout> {
-    let bindings: Vec<_> = set
-        .iter()
+) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+    set.iter()
         .map(|b| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(b.binding)
@@ -193,7 +190,17 @@ pub(crate) fn create_set_layout(
                 .descriptor_count(1)
                 .stage_flags(stages)
         })
-        .collect();
+        .collect()
+}
+
+/// A named set layout with every binding of `set` visible to `stages`.
+pub(crate) fn create_set_layout(
+    ctx: &Context,
+    name: &str,
+    set: &[BindingDesc],
+    stages: vk::ShaderStageFlags,
+) -> Result<vk::DescriptorSetLayout> {
+    let bindings = layout_bindings(set, stages);
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
     let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
         .call("vkCreateDescriptorSetLayout")?;

@@ -10,8 +10,10 @@
 //! frame from [`HookSets`]. Why build time: see `histencil_build`.
 
 use crate::context::Context;
+use crate::descriptors::{layout_bindings, GBUFFER_SET, GRAPHICS_STAGES};
 use crate::error::{Error, Result};
 use crate::shaders;
+use crate::spirv_bindings::{reflect_bindings, Resource};
 use ash::vk;
 use std::io::Cursor;
 
@@ -54,7 +56,7 @@ impl LightModules {
 }
 
 /// Where a lighting's shaders get surfaces and visibility from (fixed for its life).
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub enum LightHooks {
     /// histencil's G-buffer ([`crate::GBUFFER_FORMATS`], written through `gbuffer_write.glsl`),
     /// every light unshadowed.
@@ -64,42 +66,219 @@ pub enum LightHooks {
     Engine(EngineHooks),
 }
 
-/// An engine's compiled hooks and the descriptor set layouts their resources are bound with.
+/// A descriptor set layout of the engine's and the bindings it was created from: Vulkan cannot
+/// be asked what a layout holds, so the engine says, and histencil holds its hooks' SPIR-V to it.
 #[derive(Clone, Copy, Debug)]
+pub struct HookSetLayout<'a> {
+    /// The layout, created by the engine from `bindings`.
+    pub layout: vk::DescriptorSetLayout,
+    /// The `pBindings` the layout was created with.
+    pub bindings: &'a [vk::DescriptorSetLayoutBinding<'a>],
+}
+
+/// An engine's compiled hooks, the descriptor set layouts their resources are bound with, and
+/// the images its decode hook reads.
+#[derive(Clone, Debug)]
 pub struct EngineHooks {
     pub(crate) modules: LightModules,
     pub(crate) decode_layout: vk::DescriptorSetLayout,
     pub(crate) visibility_layout: Option<vk::DescriptorSetLayout>,
+    /// The formats of the images the decode hook reads, in [`crate::LightingTargets::gbuffer`]
+    /// order.
+    pub(crate) surface_formats: Vec<vk::Format>,
+    /// Why the tiled technique's kernels cannot bind these layouts, if they cannot (a binding
+    /// the kernels read is not visible to the compute stage).
+    pub(crate) tiled_refusal: Option<String>,
 }
 
 impl EngineHooks {
     /// The engine's light shaders (from `histencil_build`), its decode hook's set layout (set 1)
-    /// and, when its visibility hook reads resources, that hook's set layout (set 4). Every
-    /// module is checked to be SPIR-V.
+    /// and, when its visibility hook reads resources, that hook's set layout (set 4), and the
+    /// formats of the images the decode reads (which the engine then passes, in that order, as
+    /// [`crate::LightingTargets::gbuffer`], so that each frame barriers them for the light
+    /// shaders' reads).
+    ///
+    /// Every resource each module declares in sets 1 and 4 is held to the layout's bindings:
+    /// the binding exists, its descriptor type serves the shader's resource, its count covers
+    /// the shader's array, and it is visible to the module's stage (to the compute stage only
+    /// where the tiled technique is recorded: without it [`crate::DeferredLighting::record_tiled`]
+    /// is refused, not crashed). Sets 0, 2 and 3 are histencil's: a module must declare there what
+    /// histencil's own declares.
     ///
     /// # Errors
-    /// [`Error::BadSetup`] when a module is not SPIR-V (wrong length or magic number).
+    /// [`Error::BadSetup`] naming the module, set, binding and types when a module is not SPIR-V,
+    /// reads a binding its layout lacks or declares differently, or reads set 4 without a
+    /// visibility layout.
     ///
     /// # Safety
-    /// The layouts are live, from the device of every context a lighting is made on with these
-    /// hooks, and outlive those lightings; they declare the bindings the hooks' GLSL reads, for
-    /// the fragment stage, and for the compute stage too where the lighting records the tiled
-    /// technique ([`crate::DeferredLighting::record_tiled`]); the modules were compiled by `histencil_build` from this version of
-    /// histencil-vk's shaders.
+    /// The layouts are live, created from exactly the bindings given, on the device of every
+    /// context a lighting is made on with these hooks, and outlive those lightings; the modules
+    /// were compiled by `histencil_build` from this version of histencil-vk's shaders.
     pub unsafe fn new(
         modules: LightModules,
-        decode_layout: vk::DescriptorSetLayout,
-        visibility_layout: Option<vk::DescriptorSetLayout>,
+        decode: HookSetLayout,
+        visibility: Option<HookSetLayout>,
+        surface_formats: &[vk::Format],
     ) -> Result<Self> {
-        for (name, spirv) in modules.named() {
-            spirv_words(spirv).map_err(|e| Error::BadSetup(format!("{name}: {e}")))?;
-        }
+        let layouts = HookLayouts {
+            decode: decode.bindings,
+            visibility: visibility.map(|v| v.bindings),
+        };
+        let tiled_refusal = check_modules(&modules, &layouts)?;
         Ok(Self {
             modules,
-            decode_layout,
-            visibility_layout,
+            decode_layout: decode.layout,
+            visibility_layout: visibility.map(|v| v.layout),
+            surface_formats: surface_formats.to_vec(),
+            tiled_refusal,
         })
     }
+}
+
+/// The bindings of sets 1 and 4, as the layouts were made.
+pub(crate) struct HookLayouts<'a> {
+    pub decode: &'a [vk::DescriptorSetLayoutBinding<'a>],
+    pub visibility: Option<&'a [vk::DescriptorSetLayoutBinding<'a>]>,
+}
+
+/// The set an engine's decode hook binds its resources in.
+pub const DECODE_SET: u32 = 1;
+/// The set an engine's visibility hook binds its resources in.
+pub const VISIBILITY_SET: u32 = 4;
+
+/// Holds every module's declared resources to the layouts (histencil's own modules for sets 0,
+/// 2 and 3). Returns why the tiled kernels cannot be used with them, if they cannot.
+pub(crate) fn check_modules(
+    modules: &LightModules,
+    layouts: &HookLayouts,
+) -> Result<Option<String>> {
+    let mut tiled_refusal = None;
+    for ((name, spirv), (_, own)) in modules
+        .named()
+        .into_iter()
+        .zip(LightModules::BUILTIN.named())
+    {
+        let setup = |e: String| Error::BadSetup(format!("{name}: {e}"));
+        let reflected = spirv_words(spirv)
+            .and_then(|w| reflect_bindings(&w))
+            .map_err(setup)?;
+        let histencils = spirv_words(own)
+            .and_then(|w| reflect_bindings(&w))
+            .expect("histencil's own modules are SPIR-V");
+        for resource in &reflected.resources {
+            let declared = match resource.set {
+                DECODE_SET => Some(("the decode layout (set 1)", layouts.decode)),
+                VISIBILITY_SET => layouts
+                    .visibility
+                    .map(|b| ("the visibility layout (set 4)", b)),
+                _ => None,
+            };
+            let problem = match declared {
+                Some((layout, bindings)) => {
+                    match check_binding(resource, bindings, reflected.stages) {
+                        Ok(()) => continue,
+                        Err(Mismatch::Stage(stages))
+                            if reflected.stages == vk::ShaderStageFlags::COMPUTE =>
+                        {
+                            let why = format!(
+                                "{name} (the tiled technique) reads {} and {layout} makes it \
+                             visible to {stages:?} only, not COMPUTE",
+                                resource_words(resource)
+                            );
+                            tiled_refusal.get_or_insert(why);
+                            continue;
+                        }
+                        Err(m) => {
+                            format!("{}, and {layout} {}", resource_words(resource), m.words())
+                        }
+                    }
+                }
+                None if resource.set == VISIBILITY_SET => format!(
+                    "{}, and the hooks have no visibility layout",
+                    resource_words(resource)
+                ),
+                None if histencils
+                    .resources
+                    .iter()
+                    .any(|r| same_slot(r, resource) && r.kind == resource.kind) =>
+                {
+                    continue
+                }
+                None => format!(
+                    "{}, and set {} is histencil's: a decode hook binds set {DECODE_SET}, a \
+                     visibility hook set {VISIBILITY_SET}",
+                    resource_words(resource),
+                    resource.set
+                ),
+            };
+            return Err(setup(format!("reads {problem}")));
+        }
+    }
+    Ok(tiled_refusal)
+}
+
+fn same_slot(a: &Resource, b: &Resource) -> bool {
+    (a.set, a.binding) == (b.set, b.binding)
+}
+
+/// "set 1 binding 3 (`shadow_atlas`), a sampled image (texture2D)".
+fn resource_words(r: &Resource) -> String {
+    let name = if r.name.is_empty() {
+        String::new()
+    } else {
+        format!(" (`{}`)", r.name)
+    };
+    let array = match r.count {
+        1 => String::new(),
+        0 => " in a runtime-sized array".to_owned(),
+        n => format!(" in an array of {n}"),
+    };
+    format!(
+        "set {} binding {}{name}, {}{array}",
+        r.set,
+        r.binding,
+        r.kind.describe()
+    )
+}
+
+/// How a layout's binding fails a module's resource.
+enum Mismatch {
+    Missing,
+    Type(vk::DescriptorType),
+    Count(u32),
+    Stage(vk::ShaderStageFlags),
+}
+
+impl Mismatch {
+    fn words(&self) -> String {
+        match self {
+            Mismatch::Missing => "has no such binding".into(),
+            Mismatch::Type(ty) => format!("declares it {ty:?}"),
+            Mismatch::Count(n) => format!("declares {n} descriptors there"),
+            Mismatch::Stage(s) => format!("makes it visible to {s:?} only"),
+        }
+    }
+}
+
+fn check_binding(
+    resource: &Resource,
+    bindings: &[vk::DescriptorSetLayoutBinding],
+    stages: vk::ShaderStageFlags,
+) -> std::result::Result<(), Mismatch> {
+    let b = bindings
+        .iter()
+        .find(|b| b.binding == resource.binding)
+        .ok_or(Mismatch::Missing)?;
+    if !resource.kind.accepts(b.descriptor_type) {
+        return Err(Mismatch::Type(b.descriptor_type));
+    }
+    if b.descriptor_count < resource.count.max(1) {
+        return Err(Mismatch::Count(b.descriptor_count));
+    }
+    if !b.stage_flags.contains(stages) {
+        return Err(Mismatch::Stage(b.stage_flags));
+    }
+    Ok(())
 }
 
 /// The SPIR-V words of `bytes`, or why they are not SPIR-V.
@@ -143,7 +322,20 @@ impl LightHooks {
 
     /// Refuses hooks the device cannot bind: a visibility set is the fifth set of the light
     /// pipelines' layout, and Vulkan only guarantees four.
+    /// With histencil's built-in decode, also holds histencil's own light modules to its
+    /// G-buffer layout by the check engines' hooks get ([`EngineHooks::new`]).
     pub(crate) fn check(&self, ctx: &Context) -> Result<()> {
+        if let LightHooks::Builtin = self {
+            let stages = GRAPHICS_STAGES | vk::ShaderStageFlags::COMPUTE;
+            let gbuffer = layout_bindings(GBUFFER_SET, stages);
+            let layouts = HookLayouts {
+                decode: &gbuffer,
+                visibility: None,
+            };
+            if let Some(why) = check_modules(&LightModules::BUILTIN, &layouts)? {
+                return Err(Error::BadSetup(why));
+            }
+        }
         let sets = if self.visibility_layout().is_some() {
             5
         } else {
@@ -156,6 +348,14 @@ impl LightHooks {
             )));
         }
         Ok(())
+    }
+
+    /// Why the tiled technique cannot be recorded with these hooks, if it cannot.
+    pub(crate) fn tiled_refusal(&self) -> Option<&str> {
+        match self {
+            LightHooks::Builtin => None,
+            LightHooks::Engine(e) => e.tiled_refusal.as_deref(),
+        }
     }
 
     /// Checks a frame's sets against the hooks.

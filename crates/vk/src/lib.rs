@@ -37,6 +37,7 @@ mod renderer;
 mod requirements;
 mod resources;
 mod shader_consts;
+mod spirv_bindings;
 pub mod state;
 mod targets;
 mod teardown;
@@ -65,7 +66,9 @@ pub use driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
 pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;
 pub use histencil_model::{CostModel, FlushPolicy, TileStats, TiledCosts};
-pub use hooks::{EngineHooks, HookSets, LightHooks, LightModules};
+pub use hooks::{
+    EngineHooks, HookSetLayout, HookSets, LightHooks, LightModules, DECODE_SET, VISIBILITY_SET,
+};
 #[cfg(feature = "tools")]
 pub use image_error::{difference_image, masked_error, MaskedError};
 pub use lut::{LutEvaluator, LutTables};
@@ -82,6 +85,7 @@ pub use passes::light_pipelines::BrdfSource;
 pub use readback::{FrameImages, Readback};
 pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
 pub use requirements::{DeviceRequirements, REQUIREMENTS};
+pub use spirv_bindings::{reflect_bindings, ModuleBindings, Resource, ResourceKind};
 pub use targets::{check_extent, GBUFFER_FORMATS};
 pub use technique::{Backend, FrameDesc, MixedTiles, Shading, Technique, TileClassify, TileSide};
 #[cfg(feature = "tools")]

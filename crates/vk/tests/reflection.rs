@@ -80,3 +80,35 @@ fn reflected_bindings_match_rust_layouts() {
         "only {checked} bindings reflected: is reflection working?"
     );
 }
+
+/// histencil-vk's own SPIR-V reader (which `EngineHooks::new` holds an engine's hooks with)
+/// agrees with naga on every module: the same set, binding, kind and name, nothing more.
+#[test]
+fn the_run_time_reader_agrees_with_naga() {
+    use histencil_vk::ResourceKind;
+    let mut compared = 0;
+    for (name, spirv) in shaders::ALL {
+        let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv)).unwrap();
+        let ours = histencil_vk::reflect_bindings(&words).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut theirs = reflected_bindings(name, spirv);
+        theirs.sort_by_key(|(set, binding, ..)| (*set, *binding));
+        let ours: Vec<_> = ours
+            .resources
+            .iter()
+            .map(|r| {
+                let kind = match r.kind {
+                    ResourceKind::UniformBuffer => BindingKind::UniformBuffer,
+                    ResourceKind::StorageBuffer => BindingKind::StorageBuffer,
+                    ResourceKind::SampledImage => BindingKind::SampledImage,
+                    ResourceKind::StorageImage => BindingKind::StorageImage,
+                    ResourceKind::Sampler => BindingKind::Sampler,
+                    other => panic!("{name}: histencil declares no {other:?}"),
+                };
+                (r.set, r.binding, kind, r.name.clone())
+            })
+            .collect();
+        assert_eq!(ours, theirs, "{name}");
+        compared += ours.len();
+    }
+    assert!(compared >= 50, "only {compared} bindings compared");
+}

@@ -523,13 +523,11 @@ pub fn graphics_pipeline(
     pipeline
 }
 
-/// A descriptor set layout with one descriptor per binding: binding `i` of type and stages
-/// `bindings[i]`.
-pub fn set_layout(
-    d: &ash::Device,
+/// One descriptor per binding: binding `i` of type and stages `bindings[i]`.
+pub fn layout_bindings(
     bindings: &[(vk::DescriptorType, vk::ShaderStageFlags)],
-) -> vk::DescriptorSetLayout {
-    let bindings: Vec<_> = bindings
+) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+    bindings
         .iter()
         .enumerate()
         .map(|(i, (ty, stages))| {
@@ -539,7 +537,14 @@ pub fn set_layout(
                 .descriptor_count(1)
                 .stage_flags(*stages)
         })
-        .collect();
+        .collect()
+}
+
+/// A descriptor set layout of `bindings` ([`layout_bindings`]).
+pub fn set_layout(
+    d: &ash::Device,
+    bindings: &[vk::DescriptorSetLayoutBinding],
+) -> vk::DescriptorSetLayout {
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
     unsafe { d.create_descriptor_set_layout(&info, None) }.expect("set layout")
 }

@@ -5,8 +5,8 @@
 //! where the engine keeps them.
 
 use crate::device::{
-    allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, set_layout, Gpu,
-    GpuMesh, PipelineSpec,
+    allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, layout_bindings,
+    set_layout, Gpu, GpuMesh, PipelineSpec,
 };
 use crate::world::World;
 use ash::vk;
@@ -281,6 +281,8 @@ impl GBufferPass {
 /// its depth-stencil image, one set per frame in flight (the images are the same every frame).
 pub struct CompactDecode {
     pub set_layout: vk::DescriptorSetLayout,
+    /// What `set_layout` was made from, for histencil's check of the decode hook.
+    pub bindings: Vec<vk::DescriptorSetLayoutBinding<'static>>,
     pool: vk::DescriptorPool,
     pub sets: Vec<vk::DescriptorSet>,
 }
@@ -299,7 +301,8 @@ impl CompactDecode {
             vk::DescriptorType::SAMPLED_IMAGE,
             vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE,
         );
-        let set_layout = set_layout(d, &[sampled; 3]);
+        let bindings = layout_bindings(&[sampled; 3]);
+        let set_layout = set_layout(d, &bindings);
         let (pool, sets) = allocate_sets(d, set_layout, in_flight, &[sampled.0; 3]);
         // The layouts the images are in while histencil's light passes read them.
         let color = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
@@ -330,6 +333,7 @@ impl CompactDecode {
         }
         Self {
             set_layout,
+            bindings,
             pool,
             sets,
         }

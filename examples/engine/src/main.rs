@@ -27,9 +27,9 @@ use histencil::vk::gpu_types::FrameUniforms;
 use histencil::{
     mesh_bounds, plan_entities, plan_frame, AlphaEntity, AlphaEntityKind, AlphaLightmaps,
     AlphaLightmapsDesc, Backend, BrdfSource, ChoiceSettings, Context, DeferredLighting,
-    DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSets, ImageState, LightHooks,
-    LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame, MixedTiles,
-    Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice,
+    DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSetLayout, HookSets, ImageState,
+    LightHooks, LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame,
+    MixedTiles, Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice,
     TileClassify, TileSide, TiledFrame, View, ViewDesc, Viewer,
 };
 // histencil's own renderer, as the reference the engine's frames are compared with.
@@ -188,12 +188,29 @@ fn main() {
     let gbuffer_refs: Vec<_> = gbuffer.iter().map(|g| g.target).collect();
     let decode = CompactDecode::new(&gpu, IN_FLIGHT, &gbuffer_refs, depth_view);
     let mut shadow = shadow::ShadowMap::new(&gpu, IN_FLIGHT);
-    // SAFETY: the decode and shadow set layouts are the engine's, on the lent device, and are
-    // destroyed after the lighting; LIGHT_MODULES come from histencil_build of this
-    // histencil-vk.
-    let hooks =
-        unsafe { EngineHooks::new(LIGHT_MODULES, decode.set_layout, Some(shadow.set_layout)) }
-            .expect("the engine's light shaders");
+    // The hooks are held to the layouts they bind (set, binding, type, stage) and the decode to
+    // the G-buffer images it reads.
+    let decode_layout = HookSetLayout {
+        layout: decode.set_layout,
+        bindings: &decode.bindings,
+    };
+    let shadow_layout = HookSetLayout {
+        layout: shadow.set_layout,
+        bindings: &shadow.bindings,
+    };
+    let surface_formats = gbuffer_pass.kind.formats();
+    // SAFETY: the decode and shadow set layouts are the engine's, made from those bindings on
+    // the lent device, and are destroyed after the lighting; LIGHT_MODULES come from
+    // histencil_build of this histencil-vk.
+    let hooks = unsafe {
+        EngineHooks::new(
+            LIGHT_MODULES,
+            decode_layout,
+            Some(shadow_layout),
+            surface_formats,
+        )
+    }
+    .expect("the engine's light shaders");
     let mut lighting = DeferredLighting::new(
         &ctx,
         &LightingDesc {

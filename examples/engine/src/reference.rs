@@ -5,8 +5,8 @@
 //! G-buffer nor its shadows, so the engine holds its deferred lighting to this.
 
 use crate::device::{
-    allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, set_layout,
-    Buffer, Gpu, GpuMesh, Image, PipelineSpec,
+    allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, layout_bindings,
+    set_layout, Buffer, Gpu, GpuMesh, Image, PipelineSpec,
 };
 use crate::gbuffer::{DrawPush, DEPTH_FORMAT};
 use crate::world::World;
@@ -44,13 +44,13 @@ impl ForwardReference {
         let both = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let frame_layout = set_layout(
             d,
-            &[
+            &layout_bindings(&[
                 (vk::DescriptorType::UNIFORM_BUFFER, both),
                 (
                     vk::DescriptorType::STORAGE_BUFFER,
                     vk::ShaderStageFlags::FRAGMENT,
                 ),
-            ],
+            ]),
         );
         let empty_layout = set_layout(d, &[]);
         let push = [vk::PushConstantRange::default()

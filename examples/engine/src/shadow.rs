@@ -3,8 +3,8 @@
 //! depth-compare sampler over the map and a block with the light's matrix, index and bias.
 
 use crate::device::{
-    allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, set_layout,
-    Buffer, Gpu, GpuMesh, Image, PipelineSpec,
+    allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, layout_bindings,
+    set_layout, Buffer, Gpu, GpuMesh, Image, PipelineSpec,
 };
 use crate::world::World;
 use ash::vk;
@@ -56,6 +56,8 @@ pub struct ShadowMap {
     unit_box: GpuMesh,
     /// Set 4 of histencil's light pipelines (and the forward reference's).
     pub set_layout: vk::DescriptorSetLayout,
+    /// What `set_layout` was made from, for histencil's check of the visibility hook.
+    pub bindings: Vec<vk::DescriptorSetLayoutBinding<'static>>,
     pool: vk::DescriptorPool,
     /// Per frame in flight: the block and the set.
     pub blocks: Vec<Buffer>,
@@ -141,7 +143,8 @@ impl ShadowMap {
             vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
             vk::DescriptorType::UNIFORM_BUFFER,
         ];
-        let set_layout = set_layout(d, &[(types[0], stage), (types[1], stage)]);
+        let bindings = layout_bindings(&[(types[0], stage), (types[1], stage)]);
+        let set_layout = set_layout(d, &bindings);
         let (pool, sets) = allocate_sets(d, set_layout, in_flight, &types);
         let blocks: Vec<Buffer> = (0..in_flight)
             .map(|i| {
@@ -182,6 +185,7 @@ impl ShadowMap {
             pipeline,
             unit_box: gpu.mesh("shadow-box", &histencil::scene::unit_box()),
             set_layout,
+            bindings,
             pool,
             blocks,
             sets,

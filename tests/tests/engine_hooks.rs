@@ -1,0 +1,350 @@
+//! An engine's hooks are held to the set layouts it binds them with and to the images its
+//! decode reads: a hook reading a binding its layout lacks (which crashed lavapipe's pipeline
+//! creation before, exit 139) is refused when the hooks are made, naming the module, set,
+//! binding and types; surface images left out of a frame or in another format are refused when
+//! it is recorded; a layout the tiled kernels cannot bind refuses the tiled technique. And an
+//! engine's own decode set, described rightly, lights the frame bit for bit as histencil's own.
+
+use ash::vk;
+use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
+use histencil_tests::engine::{copy_to_buffer, hdr_floats, Engine};
+use histencil_vk::{
+    Backend, BrdfSource, Context, DeferredLighting, EngineHooks, Error, HookSetLayout, HookSets,
+    LightHooks, LightModules, LightingDesc, LightingFrame, MixedTiles, Renderer, TileClassify,
+    TileSide, TiledFrame,
+};
+
+/// The bindings of histencil's own decode (`include/gbuffer.glsl`: three sampled images), as an
+/// engine that binds that decode's resources itself declares them, visible to `stages`.
+fn gbuffer_bindings(stages: vk::ShaderStageFlags) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+    (0..3)
+        .map(|binding| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(binding)
+                .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                .descriptor_count(1)
+                .stage_flags(stages)
+        })
+        .collect()
+}
+
+const ALL_LIGHT_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
+    vk::ShaderStageFlags::FRAGMENT.as_raw() | vk::ShaderStageFlags::COMPUTE.as_raw(),
+);
+
+/// `EngineHooks::new` with histencil's modules (or `modules`) and a null decode layout of
+/// `bindings`: every refusal below comes before any handle is used.
+fn hooks(
+    modules: LightModules,
+    bindings: &[vk::DescriptorSetLayoutBinding],
+) -> Result<EngineHooks, Error> {
+    let decode = HookSetLayout {
+        layout: vk::DescriptorSetLayout::null(),
+        bindings,
+    };
+    // SAFETY: refused, or never used to make a lighting.
+    unsafe { EngineHooks::new(modules, decode, None, &histencil_vk::GBUFFER_FORMATS) }
+}
+
+fn refusal(result: Result<EngineHooks, Error>) -> String {
+    match result {
+        Err(e @ Error::BadSetup(_)) => e.to_string(),
+        other => panic!("expected a setup error, got {other:?}"),
+    }
+}
+
+/// `spirv` with every `OpDecorate ... DescriptorSet 1` made `set`: the decode hook's resources
+/// moved to another set, as a hook written for another layout would have them.
+fn moved_to_set(spirv: &[u8], set: u32) -> &'static [u8] {
+    let mut words = ash::util::read_spv(&mut std::io::Cursor::new(spirv)).unwrap();
+    let mut at = 5;
+    let mut moved = 0;
+    while at < words.len() {
+        let (count, opcode) = ((words[at] >> 16) as usize, words[at] & 0xffff);
+        if opcode == 71 && count == 4 && words[at + 2] == 34 && words[at + 3] == 1 {
+            words[at + 3] = set;
+            moved += 1;
+        }
+        at += count;
+    }
+    assert!(moved > 0, "the module has no set 1 resources");
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    Box::leak(bytes.into_boxed_slice())
+}
+
+#[test]
+fn hooks_that_are_not_spirv_are_refused() {
+    let bindings = gbuffer_bindings(ALL_LIGHT_STAGES);
+    let modules = LightModules {
+        deferred_light: b"#version 460\nvoid main() {}\n",
+        ..LightModules::BUILTIN
+    };
+    let err = refusal(hooks(modules, &bindings));
+    assert!(err.contains("deferred_light: not SPIR-V"), "{err}");
+    // Every module is checked, the tiled kernels too.
+    let modules = LightModules {
+        tile_shade_8: &[0x03, 0x02, 0x23, 0x07, 0],
+        ..LightModules::BUILTIN
+    };
+    assert!(refusal(hooks(modules, &bindings)).contains("tile_shade_8"));
+    hooks(LightModules::BUILTIN, &bindings).expect("histencil's own decode, rightly described");
+}
+
+#[test]
+fn a_hook_that_reads_what_its_layout_lacks_is_refused_naming_set_binding_and_type() {
+    let good = gbuffer_bindings(ALL_LIGHT_STAGES);
+    let expect = |bindings: &[vk::DescriptorSetLayoutBinding], words: &str| {
+        let err = refusal(hooks(LightModules::BUILTIN, bindings));
+        assert!(err.contains(words), "{err}\nshould say: {words}");
+    };
+    // The case that crashed: a binding the layout does not have.
+    expect(
+        &good[..2],
+        "deferred_light: reads set 1 binding 2 (`gbuffer_material`), a sampled image \
+         (texture2D), and the decode layout (set 1) has no such binding",
+    );
+    let mut wrong_type = good.clone();
+    wrong_type[1].descriptor_type = vk::DescriptorType::STORAGE_BUFFER;
+    expect(&wrong_type, "binding 1 (`gbuffer_normal_depth`), a sampled image (texture2D), and the decode layout (set 1) declares it STORAGE_BUFFER");
+    let mut no_descriptors = good.clone();
+    no_descriptors[0].descriptor_count = 0;
+    expect(&no_descriptors, "declares 0 descriptors there");
+    let mut vertex_only = good.clone();
+    vertex_only[0].stage_flags = vk::ShaderStageFlags::VERTEX;
+    expect(&vertex_only, "makes it visible to VERTEX only");
+    // A combined image sampler serves a separate sampled image (Vulkan's interface rules).
+    let mut combined = good.clone();
+    combined[2].descriptor_type = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+    hooks(LightModules::BUILTIN, &combined).expect("a combined image sampler serves");
+
+    // A hook whose resources sit in set 4 with no visibility layout, and one in histencil's sets.
+    for (set, words) in [
+        (4, "set 4 binding 0 (`gbuffer_albedo`), a sampled image (texture2D), and the hooks have no visibility layout"),
+        (2, "set 2 binding 0 (`gbuffer_albedo`), a sampled image (texture2D), and set 2 is histencil's"),
+    ] {
+        let modules = LightModules {
+            lut_light: moved_to_set(LightModules::BUILTIN.lut_light, set),
+            ..LightModules::BUILTIN
+        };
+        let err = refusal(hooks(modules, &good));
+        assert!(err.starts_with("bad lighting setup: lut_light: reads"), "{err}");
+        assert!(err.contains(words), "{err}");
+    }
+}
+
+#[test]
+fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
+    let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
+    scene.normalise_lights();
+    let engine = Engine::start();
+    let (width, height) = (48, 32);
+    let extent = vk::Extent2D { width, height };
+    let d = &engine.device;
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let ds_format = ctx.depth_stencil_format().vk();
+        let renderer = Renderer::new(&ctx, scene.clone(), width, height).unwrap();
+        let layout = *renderer.stencil_layout();
+        let brdfs = renderer.brdfs().to_vec();
+        // The engine's decode layout: histencil's decode, fragment stage only (no tiled).
+        let bindings = gbuffer_bindings(vk::ShaderStageFlags::FRAGMENT);
+        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+        let set_layout = unsafe { d.create_descriptor_set_layout(&info, None) }.unwrap();
+        let decode = HookSetLayout {
+            layout: set_layout,
+            bindings: &bindings,
+        };
+        // SAFETY: the layout is made from `bindings`, on the lent device, and outlives the
+        // lighting; the modules are histencil-vk's own.
+        let hooks = unsafe {
+            EngineHooks::new(
+                LightModules::BUILTIN,
+                decode,
+                None,
+                &histencil_vk::GBUFFER_FORMATS,
+            )
+        }
+        .unwrap();
+        let desc = |hooks| LightingDesc {
+            layout,
+            brdfs: brdfs.clone(),
+            extent,
+            depth_stencil_format: ds_format,
+            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+            frames_in_flight: 1,
+            max_lights: scene.lights.len() as u32,
+            hi_stencil: true,
+            hooks,
+        };
+        let mut engines = DeferredLighting::new(&ctx, &desc(LightHooks::Engine(hooks))).unwrap();
+        let mut histencils = DeferredLighting::new(&ctx, &desc(LightHooks::Builtin)).unwrap();
+        let view = scene.camera.view_desc(width as f32 / height as f32);
+        let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
+        let bounds = scene.brdf_bounds(&brdfs);
+        let inputs = PlanInputs {
+            lights: &shapes,
+            brdf_bounds: &bounds,
+            view: &View::new(&view).unwrap(),
+        };
+        let settings = PlanSettings {
+            technique: TechniqueChoice::Stencil,
+            caps: Backend::Ps3.platform().caps(),
+            flush: FlushPolicy::Auto,
+        };
+        let plan = plan_frame(&layout, &inputs, &settings).unwrap();
+
+        // The engine's decode set: its three G-buffer images.
+        let images = engine.lighting_targets(extent, ds_format);
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::SAMPLED_IMAGE)
+            .descriptor_count(3)];
+        let pool_info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(1)
+            .pool_sizes(&sizes);
+        let set_pool = unsafe { d.create_descriptor_pool(&pool_info, None) }.unwrap();
+        let layouts = [set_layout];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(set_pool)
+            .set_layouts(&layouts);
+        let decode_set = unsafe { d.allocate_descriptor_sets(&alloc) }.unwrap()[0];
+        let infos: Vec<[vk::DescriptorImageInfo; 1]> = images
+            .gbuffer
+            .iter()
+            .map(|g| {
+                [vk::DescriptorImageInfo::default()
+                    .image_view(g.view)
+                    .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
+            })
+            .collect();
+        let writes: Vec<_> = infos
+            .iter()
+            .enumerate()
+            .map(|(i, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(decode_set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                    .image_info(info)
+            })
+            .collect();
+        unsafe { d.update_descriptor_sets(&writes, &[]) };
+
+        // One frame: the G-buffer, then `lighting` with `hook_sets`, the HDR image read back.
+        let readback = engine.readback_buffer(u64::from(width * height) * 8);
+        let lit = |lighting: &mut DeferredLighting<&Context>, hook_sets: HookSets| {
+            let mut targets = images.refs();
+            let (pool, cmd) = engine.command_buffer();
+            let frame = LightingFrame {
+                slot: 0,
+                view: &view,
+                lights: &scene.lights,
+                plan: &plan,
+                clear_hdr: true,
+                timestamps: false,
+                brdf_source: BrdfSource::Formula,
+                tile_stats: false,
+                hook_sets,
+            };
+            // SAFETY: recording on the lent device; each frame is waited for.
+            unsafe {
+                d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                    .unwrap();
+                renderer.record_gbuffer(cmd, &mut targets).unwrap();
+                lighting.record(cmd, &frame, &mut targets).unwrap();
+                copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
+                engine.submit_and_wait(pool, cmd);
+            }
+            hdr_floats(readback.bytes())
+        };
+        let theirs = lit(
+            &mut engines,
+            HookSets {
+                decode: Some(decode_set),
+                visibility: None,
+            },
+        );
+        let ours = lit(&mut histencils, HookSets::default());
+        assert!(ours.iter().filter(|v| **v > 0.0).count() > ours.len() / 8);
+        assert!(
+            ours.iter()
+                .zip(&theirs)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "the engine's decode set lit the frame differently"
+        );
+
+        // Misuse, each refused before anything is recorded.
+        let (pool, cmd) = engine.command_buffer();
+        unsafe { d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()) }.unwrap();
+        let hook_sets = HookSets {
+            decode: Some(decode_set),
+            visibility: None,
+        };
+        let frame = LightingFrame {
+            slot: 0,
+            view: &view,
+            lights: &scene.lights,
+            plan: &plan,
+            clear_hdr: true,
+            timestamps: false,
+            brdf_source: BrdfSource::Formula,
+            tile_stats: false,
+            hook_sets,
+        };
+        let mut refused = |mut targets: histencil_vk::LightingTargets, words: &str| {
+            // SAFETY: refused before any command is recorded.
+            let err = unsafe { engines.record(cmd, &frame, &mut targets) }.unwrap_err();
+            assert!(matches!(err, Error::BadFrame(_)), "{err:?}");
+            assert!(
+                err.to_string().contains(words),
+                "{err}\nshould say: {words}"
+            );
+        };
+        let mut left_out = images.refs();
+        left_out.gbuffer.clear();
+        refused(
+            left_out,
+            "0 surface images in LightingTargets::gbuffer, and the engine's decode hook reads 3",
+        );
+        let mut swapped = images.refs();
+        swapped.gbuffer.swap(0, 1);
+        refused(
+            swapped,
+            "surface image 0 is R32G32B32A32_SFLOAT, the lighting expects R16G16B16A16_SFLOAT",
+        );
+        let tiled = TiledFrame {
+            slot: 0,
+            view: &view,
+            lights: &scene.lights,
+            clear_hdr: true,
+            side: TileSide::Sixteen,
+            mixed: MixedTiles::PerBrdf,
+            classify: TileClassify::for_device(ctx.device_type()),
+            hook_sets,
+        };
+        // SAFETY: refused before any command is recorded.
+        let err = unsafe { engines.record_tiled(cmd, &tiled, &mut images.refs()) }.unwrap_err();
+        assert!(
+            err.to_string().contains("tile_classify (the tiled technique) reads set 1 binding 0 (`gbuffer_albedo`), a sampled image (texture2D) and the decode layout (set 1) makes it visible to FRAGMENT only, not COMPUTE"),
+            "{err}"
+        );
+        assert_eq!(
+            engines.tiled_pipeline_count(),
+            0,
+            "refused before any kernel was made"
+        );
+        unsafe {
+            d.end_command_buffer(cmd).unwrap();
+            d.destroy_command_pool(pool, None);
+            // SAFETY: every frame was waited for.
+            engines.destroy();
+            histencils.destroy();
+            d.destroy_descriptor_pool(set_pool, None);
+            d.destroy_descriptor_set_layout(set_layout, None);
+        }
+        images.free(&engine);
+        engine.free_buffer(readback);
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
+    }
+    engine.destroy().assert_clean();
+}
