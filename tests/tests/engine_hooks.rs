@@ -348,3 +348,44 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
     }
     engine.destroy().assert_clean();
 }
+
+/// One numbering: an engine names BRDF ids (its materials, its decode hook's `Surface::brdf`)
+/// and takes each draw's stencil reference from the lighting's description, so the slot in
+/// stencil and the id in the G-buffer cannot disagree; a BRDF in two slots is refused.
+#[test]
+fn an_engine_names_brdfs_and_the_lighting_gives_their_stencil_slots() {
+    use histencil_brdf::BrdfId;
+    use histencil_model::StencilLayout;
+    histencil_tests::with_validated_context(|ctx| {
+        let brdfs = vec![BrdfId::Ggx, BrdfId::Lambert, BrdfId::KajiyaKay];
+        let layout = StencilLayout::new(3, 0).unwrap();
+        let mut desc = LightingDesc {
+            layout,
+            brdfs: brdfs.clone(),
+            extent: vk::Extent2D {
+                width: 16,
+                height: 16,
+            },
+            depth_stencil_format: ctx.depth_stencil_format().vk(),
+            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+            frames_in_flight: 1,
+            max_lights: 4,
+            hi_stencil: false,
+            hooks: LightHooks::Builtin,
+        };
+        for (slot, brdf) in brdfs.iter().enumerate() {
+            assert_eq!(
+                desc.stencil_reference(*brdf),
+                histencil_vk::gbuffer_stencil_reference(&layout, slot as u32)
+            );
+        }
+        assert_eq!(desc.stencil_reference(BrdfId::PennerSkin), None, "not one of its BRDFs");
+        desc.brdfs = vec![BrdfId::Ggx, BrdfId::Lambert, BrdfId::Ggx];
+        let err = DeferredLighting::new(ctx, &desc).err().expect("a BRDF in two slots");
+        assert!(
+            err.to_string()
+                .contains("Ggx is in BRDF slots 0 and 2: one slot per BRDF"),
+            "{err}"
+        );
+    });
+}

@@ -1,13 +1,19 @@
 //! histencil-scene: scenes as plain data (what a glTF importer fills), the embedded scenes, meshes
 //! and light volumes, bounds, and what a frame needs from a scene.
+//!
+//! Feature `gltf` (on by default): the glTF importer and its image decoders. An engine lighting
+//! its own frames needs the types alone (lights, materials, bounds), so histencil-vk and the
+//! `histencil` front door take this crate without it: no gltf, serde_json, base64 or image.
 
 mod alpha;
 mod alpha_scenes;
 mod embedded;
+#[cfg(feature = "gltf")]
 mod import;
 mod light_rig;
 mod mesh;
 mod shading;
+mod tangents;
 mod texture;
 mod town;
 mod types;
@@ -15,6 +21,7 @@ mod types;
 pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICES};
 pub use alpha_scenes::{glass_sphere, smoke_volume};
 pub use embedded::{embedded, embedded_names, EMBEDDED};
+#[cfg(feature = "gltf")]
 pub use import::{
     import_gltf, import_gltf_noted, load_gltf, load_gltf_noted, load_scene, load_scene_noted,
     material_from_gltf, ImportError, Imported, MaterialError, MAX_DECODED_IMAGE_BYTES,

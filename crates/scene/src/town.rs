@@ -4,7 +4,7 @@
 //! seeds, so the scene is the same on every machine and needs no asset download.
 
 use crate::embedded::SplitMix;
-use crate::import::tangents::{self, Space};
+use crate::tangents::{self, Space};
 use crate::{
     uv_transform, Camera, Light, LightKind, Material, MaterialMaps, Mesh, Object, Scene, Shape,
     TextureImage, TextureRef, Vertex,

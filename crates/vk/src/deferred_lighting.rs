@@ -66,6 +66,22 @@ pub struct LightingDesc {
     pub hooks: LightHooks,
 }
 
+impl LightingDesc {
+    /// The stencil slot of `brdf`: its index in [`LightingDesc::brdfs`].
+    pub fn slot_of(&self, brdf: BrdfId) -> Option<u32> {
+        self.brdfs.iter().position(|b| *b == brdf).map(|i| i as u32)
+    }
+
+    /// The stencil reference and write mask with which the engine's G-buffer pass draws a
+    /// surface of `brdf` ([`gbuffer_stencil_reference`] of its slot); `None` for a BRDF the
+    /// lighting is not made with (its pixels would match no light pass). One numbering for the
+    /// engine: its materials and its decode hook (`Surface::brdf`) name BRDF ids, and the slot
+    /// a BRDF's pixels carry in stencil comes from here, so the two cannot disagree.
+    pub fn stencil_reference(&self, brdf: BrdfId) -> Option<(u8, u8)> {
+        gbuffer_stencil_reference(&self.layout, self.slot_of(brdf)?)
+    }
+}
+
 /// One frame's lighting.
 #[derive(Clone, Copy, Debug)]
 pub struct LightingFrame<'a> {
@@ -467,6 +483,14 @@ fn check_desc(desc: &LightingDesc) -> Result<()> {
     }
     if desc.frames_in_flight == 0 {
         return Err(bad_setup("frames_in_flight must be at least 1".into()));
+    }
+    for (slot, brdf) in desc.brdfs.iter().enumerate() {
+        if let Some(first) = desc.brdfs[..slot].iter().position(|b| b == brdf) {
+            return Err(bad_setup(format!(
+                "{brdf:?} is in BRDF slots {first} and {slot}: one slot per BRDF, so that a BRDF id \
+                 names one slot"
+            )));
+        }
     }
     let slots = desc.layout.brdfs_in_use() as usize;
     if desc.brdfs.len() > slots {

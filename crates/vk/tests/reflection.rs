@@ -36,6 +36,24 @@ fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, S
         .collect()
 }
 
+/// naga validates every module (a second reader beside the driver's and the validation layer's).
+/// Here and not in the build script: an engine building histencil compiles no shader
+/// translator for it.
+#[test]
+fn naga_validates_every_module() {
+    for (name, spirv) in shaders::ALL {
+        let module =
+            naga::front::spv::parse_u8_slice(spirv, &naga::front::spv::Options::default())
+                .unwrap_or_else(|e| panic!("naga cannot parse {name}: {e:?}"));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("naga rejects {name}: {e:?}"));
+    }
+}
+
 #[test]
 fn every_module_has_a_layout_and_every_layout_a_module() {
     for (name, _) in shaders::ALL {

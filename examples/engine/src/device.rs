@@ -545,7 +545,7 @@ pub fn set_layout(
     d: &ash::Device,
     bindings: &[vk::DescriptorSetLayoutBinding],
 ) -> vk::DescriptorSetLayout {
-    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(bindings);
     unsafe { d.create_descriptor_set_layout(&info, None) }.expect("set layout")
 }
 

@@ -10,8 +10,7 @@ use crate::device::{
 };
 use crate::world::World;
 use ash::vk;
-use histencil::model::StencilLayout;
-use histencil::vk::{gbuffer_stencil_reference, ImageRef, ImageState, GBUFFER_FORMATS};
+use histencil::vk::{ImageRef, ImageState, LightingDesc, GBUFFER_FORMATS};
 
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT_S8_UINT;
 
@@ -186,7 +185,7 @@ impl GBufferPass {
         cmd: vk::CommandBuffer,
         camera_set: vk::DescriptorSet,
         world: &World,
-        layout: &StencilLayout,
+        lighting: &LightingDesc,
         gbuffer: &mut [ImageRef],
         depth_stencil: &mut ImageRef,
     ) {
@@ -248,8 +247,10 @@ impl GBufferPass {
                 &[],
             );
             for (i, object) in world.objects.iter().enumerate() {
-                let (reference, mask) = gbuffer_stencil_reference(layout, world.slot(object))
-                    .expect("every object's slot is in the layout");
+                // By BRDF id, as the decode hook names it: histencil gives the slot.
+                let (reference, mask) = lighting
+                    .stencil_reference(object.brdf.id())
+                    .expect("every object's BRDF is the lighting's");
                 d.cmd_set_stencil_reference(cmd, faces, u32::from(reference | object.stencil));
                 d.cmd_set_stencil_write_mask(cmd, faces, u32::from(mask | ENGINE_MASK));
                 let push = DrawPush::new(object, i);

@@ -11,7 +11,7 @@ use ash::vk;
 use histencil::{
     BrdfSource, Context, DeferredLighting, HookSets, ImageRef, LightingFrame, LightingTargets,
 };
-use histencil::{FramePlan, Light, StencilLayout, ViewDesc};
+use histencil::{FramePlan, Light, ViewDesc};
 
 /// One G-buffer layout: the pass that writes it, its images, the lighting that reads them.
 pub struct Layout<'a, 'c> {
@@ -28,7 +28,6 @@ pub struct Frame<'a> {
     pub fence: vk::Fence,
     pub camera_set: vk::DescriptorSet,
     pub world: &'a World,
-    pub layout: &'a StencilLayout,
     pub view: &'a ViewDesc,
     pub lights: &'a [Light],
     pub plan: &'a FramePlan,
@@ -65,7 +64,7 @@ pub unsafe fn time(
                 frame.cmd,
                 frame.camera_set,
                 frame.world,
-                frame.layout,
+                l.lighting.desc(),
                 &mut targets.gbuffer,
                 &mut targets.depth_stencil,
             );

@@ -393,7 +393,7 @@ fn main() {
                 slot.cmd,
                 slot.camera_set,
                 &world,
-                &layout,
+                lighting.desc(),
                 &mut targets.gbuffer,
                 &mut targets.depth_stencil,
             );
@@ -576,7 +576,6 @@ fn main() {
             fence: slot.fence,
             camera_set: slot.camera_set,
             world: &world,
-            layout: &layout,
             view: &view,
             lights: &lights,
             plan: &plan,

@@ -22,7 +22,6 @@ mod document;
 mod images;
 mod material;
 mod notes;
-pub(crate) mod tangents;
 mod uv_layout;
 
 use buffers::ReadLimit;
@@ -32,6 +31,7 @@ pub use images::{MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES};
 
 pub use material::{material_from_gltf, MaterialError};
 
+use crate::tangents;
 use crate::{
     uv_transform, AlphaObject, Camera, Light, LightKind, MaterialMaps, Mesh, Object, Scene,
     SceneError, Shape, Vertex, UV_IDENTITY,

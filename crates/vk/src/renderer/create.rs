@@ -46,7 +46,8 @@ fn distinct_materials(scene: &Scene) -> (Vec<Brdf>, Vec<u32>) {
     (materials, indices)
 }
 
-/// The stencil slot of BRDF `id`: its index among the BRDFs in use.
+/// The stencil slot of BRDF `id`: its index among the BRDFs in use (as
+/// [`crate::LightingDesc::slot_of`] numbers them).
 fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
     brdfs
         .iter()
