@@ -128,7 +128,10 @@ fn shader_fingerprint(shader_dir: &Path, generated: &str) -> String {
     for path in paths {
         let relative = path.strip_prefix(shader_dir).unwrap();
         // `/` on every platform, so a package made on one verifies on another.
-        let name: Vec<_> = relative.components().map(|c| c.as_os_str().to_string_lossy()).collect();
+        let name: Vec<_> = relative
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy())
+            .collect();
         eat(name.join("/").as_bytes());
         eat(&std::fs::read(&path).unwrap());
     }

@@ -379,9 +379,15 @@ fn an_engine_names_brdfs_and_the_lighting_gives_their_stencil_slots() {
                 histencil_vk::gbuffer_stencil_reference(&layout, slot as u32)
             );
         }
-        assert_eq!(desc.stencil_reference(BrdfId::PennerSkin), None, "not one of its BRDFs");
+        assert_eq!(
+            desc.stencil_reference(BrdfId::PennerSkin),
+            None,
+            "not one of its BRDFs"
+        );
         desc.brdfs = vec![BrdfId::Ggx, BrdfId::Lambert, BrdfId::Ggx];
-        let err = DeferredLighting::new(ctx, &desc).err().expect("a BRDF in two slots");
+        let err = DeferredLighting::new(ctx, &desc)
+            .err()
+            .expect("a BRDF in two slots");
         assert!(
             err.to_string()
                 .contains("Ggx is in BRDF slots 0 and 2: one slot per BRDF"),

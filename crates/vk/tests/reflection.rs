@@ -42,9 +42,8 @@ fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, S
 #[test]
 fn naga_validates_every_module() {
     for (name, spirv) in shaders::ALL {
-        let module =
-            naga::front::spv::parse_u8_slice(spirv, &naga::front::spv::Options::default())
-                .unwrap_or_else(|e| panic!("naga cannot parse {name}: {e:?}"));
+        let module = naga::front::spv::parse_u8_slice(spirv, &naga::front::spv::Options::default())
+            .unwrap_or_else(|e| panic!("naga cannot parse {name}: {e:?}"));
         naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
             naga::valid::Capabilities::all(),
