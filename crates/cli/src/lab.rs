@@ -43,6 +43,57 @@ pub struct CompareArgs {
     out: PathBuf,
     #[command(flatten)]
     sampling: SamplingArgs,
+    /// Run this many busy threads beside the measurement: the same run under contention, to
+    /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
+    #[arg(long, default_value_t = 0)]
+    beside_load: usize,
+    #[command(subcommand)]
+    command: Option<CompareCommand>,
+}
+
+#[derive(clap::Subcommand)]
+enum CompareCommand {
+    /// Put several `compare` runs (devices, drivers, or one device quiet and loaded) side by
+    /// side: one table and one plot, the device and driver named in each column. Exits 1 when
+    /// a decided verdict reverses between two runs of one device and driver.
+    Merge(CompareMergeArgs),
+}
+
+#[derive(clap::Args)]
+struct CompareMergeArgs {
+    /// The runs' output folders (each holding the report.json `compare` wrote).
+    #[arg(required = true, num_args = 2..)]
+    runs: Vec<PathBuf>,
+    /// Where merged.md, merged.json and merged-lighting.png go.
+    #[arg(long, default_value = "out/compare-merged")]
+    out: PathBuf,
+}
+
+fn compare_merge(args: &CompareMergeArgs) -> Result<()> {
+    histencil_vk::check_output_dir(&args.out)?;
+    let reports = args
+        .runs
+        .iter()
+        .map(|dir| histencil_lab::compare::merge::DeviceReport::read(dir))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let merged = histencil_lab::compare::merge::Merged::new(reports)?;
+    for path in merged.write(&args.out)? {
+        println!("wrote {}", path.display());
+    }
+    print!("{}", merged.markdown());
+    let reversed = merged.same_device_reversals();
+    if !reversed.is_empty() {
+        bail!(
+            "{} decided verdict(s) reversed between runs of one device and driver: {}",
+            reversed.len(),
+            reversed
+                .iter()
+                .map(|(what, _, _)| what.as_str())
+                .collect::<Vec<_>>()
+                .join("; ")
+        );
+    }
+    Ok(())
 }
 
 /// How long a measurement samples (compare, calibrate).
@@ -188,6 +239,9 @@ fn steady_llvmpipe() {
 }
 
 pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
+    if let Some(CompareCommand::Merge(merge)) = &args.command {
+        return compare_merge(merge);
+    }
     steady_llvmpipe();
     histencil_vk::check_output_dir(&args.out)?;
     if let Some(bad) = args
@@ -198,6 +252,14 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
         bail!("--light-sizes: {bad} is not a percentage in (0, 100]");
     }
     let sampling = args.sampling.sampling(args.run.frames)?;
+    let least = histencil_lab::stats::MIN_VERDICT_ROUNDS;
+    if sampling.max_rounds < least {
+        eprintln!(
+            "histencil compare: {} rounds decide no verdict (every one needs {least}): give \
+             --frames {least} or more, or --target-ci",
+            sampling.max_rounds
+        );
+    }
     let mut settings =
         CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
     settings.target_ci = sampling.target;
@@ -205,6 +267,7 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     settings.scene = crate::load_scene_arg(&args.scene, lights)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;
+    settings.beside_load = args.beside_load;
     let report = on_device(args.run.validate, |ctx| {
         Ok(with_spinner(|step| {
             histencil_lab::run_compare(ctx, &settings, step)

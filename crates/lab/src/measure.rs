@@ -100,3 +100,41 @@ pub fn frame(renderer: &mut Renderer, desc: impl Into<FrameDesc>) -> Result<Rgba
     let images = renderer.render_frame(&desc)?.images;
     Ok(images.ldr.expect("the LDR frame was asked for"))
 }
+
+/// Busy threads that spin until dropped: a measurement run under contention on purpose, to test
+/// whether its verdicts survive a change of conditions (`compare --beside-load`).
+pub struct BusyThreads {
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    threads: Vec<std::thread::JoinHandle<()>>,
+}
+
+impl BusyThreads {
+    /// Starts `count` spinning threads (none for 0).
+    pub fn start(count: usize) -> Self {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let stop = std::sync::Arc::new(AtomicBool::new(false));
+        let threads = (0..count)
+            .map(|_| {
+                let stop = stop.clone();
+                std::thread::spawn(move || {
+                    let mut x = 1u64;
+                    while !stop.load(Ordering::Relaxed) {
+                        for _ in 0..10_000 {
+                            x = std::hint::black_box(x.wrapping_mul(6364136223846793005) + 1);
+                        }
+                    }
+                })
+            })
+            .collect();
+        Self { stop, threads }
+    }
+}
+
+impl Drop for BusyThreads {
+    fn drop(&mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+    }
+}

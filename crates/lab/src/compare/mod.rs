@@ -1,6 +1,7 @@
 //! `histencil compare`: the talk's lighting-time table on this device, with every figure's error
 //! against the forward reference rendered in the same run.
 
+pub mod merge;
 mod report;
 
 use crate::image_error::{image_error, ImageError};
@@ -35,6 +36,9 @@ pub struct CompareSettings {
     pub brdf_counts: Vec<usize>,
     /// Screen coverages of the light-size sweep, 0..=1.
     pub light_sizes: Vec<f64>,
+    /// Busy threads run beside the measurement (`compare --beside-load`): the same run under
+    /// contention, for the quiet-against-loaded test of the verdicts (`compare merge`).
+    pub beside_load: usize,
 }
 
 impl CompareSettings {
@@ -50,6 +54,7 @@ impl CompareSettings {
             costs: None,
             brdf_counts: vec![1, 2, 3],
             light_sizes: vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0],
+            beside_load: 0,
         }
     }
 }
@@ -273,13 +278,13 @@ impl SizePoint {
         (r, Verdict::of(&r))
     }
 
-    /// Which is faster where the data can tell: `"stencil"`, `"branching"` or
-    /// `"indistinguishable"`.
+    /// Which is faster where the data can tell: `"stencil"`, `"branching"`, `"within ±5 %"`
+    /// or `"undecided"` ([`Verdict`]).
     pub fn faster(&self) -> &'static str {
         match self.stencil_over_branching().1 {
             Verdict::Faster => "stencil",
             Verdict::Slower => "branching",
-            Verdict::Indistinguishable => "indistinguishable",
+            other => other.word(),
         }
     }
 
@@ -295,7 +300,7 @@ impl SizePoint {
     }
 
     /// Tiled's time over the better (by median) of branching and stencil, paired by round, and
-    /// its verdict (faster, slower, or indistinguishable).
+    /// its verdict ([`Verdict`]).
     pub fn tiled_over_best(&self) -> (Interval, Verdict) {
         let best = if self.branching.median_ms <= self.stencil.median_ms {
             &self.samples[0]
@@ -340,6 +345,8 @@ pub struct CompareReport {
     /// `LP_NUM_THREADS` when the run started: llvmpipe's rasteriser threads, which decide how
     /// noisy its timings are (README, "Measured").
     pub lp_num_threads: Option<String>,
+    /// Busy threads that ran beside the measurement ([`CompareSettings::beside_load`]).
+    pub beside_load: usize,
     /// The costs the adaptive rows used.
     pub costs: CostModel,
     pub costs_calibrated: bool,
@@ -362,9 +369,10 @@ impl CompareReport {
 }
 
 impl CompareReport {
-    /// What the intervals let one say about the crossover: the smallest swept coverage from
-    /// which stencil is faster at every larger size with intervals that exclude a tie, and the
-    /// largest up to which branching is, likewise. Between them the data cannot place it.
+    /// The crossover as a band: the smallest swept coverage from which stencil is faster
+    /// (beyond the margin, [`Verdict`]) at every larger size, and the largest up to which
+    /// branching is, likewise. Between them the techniques are within the margin or the data
+    /// cannot say.
     pub fn crossover_bounds(&self) -> (Option<f64>, Option<f64>) {
         let verdicts: Vec<(f64, Verdict)> = self
             .sizes
@@ -419,6 +427,8 @@ pub fn run_compare(
         ));
     }
     let (w, h, frames) = (settings.width, settings.height, settings.frames);
+    // Spins until the report is made, when it drops.
+    let _load = crate::measure::BusyThreads::start(settings.beside_load);
     let new_renderer = |scene: Scene| -> Result<Renderer> {
         let desc = RendererDesc {
             cost_model: settings.costs,
@@ -619,6 +629,7 @@ pub fn run_compare(
         sampled: table_sampled,
         target_ci: settings.target_ci,
         lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+        beside_load: settings.beside_load,
         costs: costs.expect("at least one BRDF count"),
         costs_calibrated: settings.costs.is_some(),
     })
@@ -719,21 +730,24 @@ fn breakdown(
 #[cfg(test)]
 mod tests {
     use super::{stencil_wins_from, sure_bounds};
-    use crate::stats::Verdict::{Faster, Indistinguishable, Slower};
+    use crate::stats::Verdict::{Faster, Slower, Undecided, Within};
 
     #[test]
     fn the_crossover_bounds_rest_on_separated_intervals_only() {
         let v = [
             (0.001, Slower),
             (0.01, Slower),
-            (0.1, Indistinguishable),
+            (0.03, Undecided),
+            (0.1, Within),
             (0.3, Faster),
             (1.0, Faster),
         ];
         assert_eq!(sure_bounds(&v), (Some(0.3), Some(0.01)));
-        // A tie at the largest size: stencil is never surely faster for good.
+        // A tie at the largest size: stencil is never surely faster for good; the band
+        // between the bounds holds the undecided and the within-margin sizes.
+        assert_eq!(sure_bounds(&[(0.1, Faster), (1.0, Within)]), (None, None));
         assert_eq!(
-            sure_bounds(&[(0.1, Faster), (1.0, Indistinguishable)]),
+            sure_bounds(&[(0.1, Faster), (1.0, Undecided)]),
             (None, None)
         );
         assert_eq!(

@@ -5,7 +5,7 @@ use super::{Breakdown, CompareReport, Row, SizePoint};
 use crate::image_error::ImageError;
 use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis, Series};
-use crate::stats::{median_interval, ratio_interval, Verdict};
+use crate::stats::{median_interval, ratio_interval, Verdict, MARGIN, MIN_VERDICT_ROUNDS};
 use crate::{write_file, Result};
 use histencil_model::TalkFigures;
 use serde_json::{json, Value};
@@ -75,6 +75,7 @@ impl CompareReport {
         if let Some(n) = &self.lp_num_threads {
             out["settings"]["environment"] = json!({ "LP_NUM_THREADS": n });
         }
+        out["settings"]["beside_load_threads"] = json!(self.beside_load);
         out
     }
 
@@ -87,15 +88,24 @@ impl CompareReport {
              technique at every BRDF count in turn, so background load hits all alike. Table: \
              median [95 % interval of the median, order statistics; below 6 rounds no interval \
              reaches 95 % and the whole range is shown]; overheads are the median of \
-             the per-round ratios to the row's 1-BRDF time, with their interval, and a verdict \
-             only where the interval excludes 0 (else indistinguishable). Error against the \
-             forward reference of the same scene: 8-bit max / mean, and mean FLIP.\n",
+             the per-round ratios to the row's 1-BRDF time, with their interval. Verdicts have \
+             a practical margin of ±{:.0} %: faster or slower only where the whole interval lies \
+             beyond it, \"within ±{:.0} %\" where it lies wholly inside, \"undecided\" otherwise \
+             and below {} rounds. Error against the forward reference of the same scene: 8-bit \
+             max / mean, and mean FLIP.\n",
             self.device, self.driver, self.scene, self.scene_lights, self.width, self.height,
-            self.frames
+            self.frames, 100.0 * MARGIN, 100.0 * MARGIN, MIN_VERDICT_ROUNDS
         );
         let t = &self.sampled;
         if let Some(n) = &self.lp_num_threads {
             let _ = writeln!(md, "Environment: `LP_NUM_THREADS={n}`.\n");
+        }
+        if self.beside_load > 0 {
+            let _ = writeln!(
+                md,
+                "Conditions: {} busy threads ran beside the measurement (`--beside-load`).\n",
+                self.beside_load
+            );
         }
         let _ = writeln!(
             md,
@@ -242,8 +252,9 @@ impl CompareReport {
         let _ = writeln!(
             md,
             "\nStencil stays faster than branching from {measured} by the medians; with the \
-             intervals, branching is surely faster up to {} and stencil surely faster from {} \
-             (in between the data cannot place the crossover). The adaptive technique's cost \
+             intervals and the ±5 % margin, branching is faster up to {} and stencil faster \
+             from {}: the crossover lies in the band between (its sizes are within the margin or \
+             undecided). The adaptive technique's cost \
              model ({}) puts the change at {model}.",
             pct(branching_until, "no swept size"),
             pct(stencil_from, "no swept size on"),

@@ -1,0 +1,679 @@
+//! `histencil compare merge DIR...`: several devices' `compare` reports in one table and one
+//! plot, because a platform comparison compares platforms.
+//!
+//! Runs on different devices share no round, so their times cannot be paired the way one run
+//! pairs its techniques. Each device therefore keeps its own figures: the median lighting time
+//! with its 95 % interval, and the overhead of n BRDFs over one (a ratio paired by round within
+//! that device's run) with its verdict. Across devices the table says only which is lower where
+//! the two intervals do not overlap, and "overlap" where they do.
+//!
+//! Verdicts that reverse (faster in one report, slower in another) are listed: across devices a
+//! finding, between two runs of one device and driver under different conditions (quiet, and
+//! beside a load: `compare --beside-load`) a failure of the verdicts themselves, which
+//! [`Merged::same_device_reversals`] gives the CLI to exit non-zero on.
+
+use crate::plot::{self, Axis, Series};
+use crate::stats::{Interval, Verdict};
+use crate::{write_file, LabError, Result};
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// One technique at one BRDF count, as one device's report gives it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MergedCell {
+    pub brdfs: usize,
+    pub lighting: Interval,
+    /// Against the technique's 1-BRDF time in the same run; none at one BRDF.
+    pub overhead: Option<(Interval, String)>,
+}
+
+/// One light size of a device's sweep: stencil's time over branching's, paired by round.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MergedSize {
+    pub coverage: f64,
+    pub stencil_over_branching: Interval,
+    pub faster: String,
+}
+
+/// What the merge takes from one device's `report.json`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeviceReport {
+    pub dir: PathBuf,
+    pub device: String,
+    pub driver: String,
+    pub scene: String,
+    pub width: u64,
+    pub height: u64,
+    pub rounds: u64,
+    /// Busy threads beside the run (0: quiet; absent in reports from before the option).
+    pub beside_load: u64,
+    /// `(technique, cells by BRDF count)`.
+    pub rows: Vec<(String, Vec<MergedCell>)>,
+    pub sizes: Vec<MergedSize>,
+}
+
+/// Where in `report.json` a value was missing or of the wrong type.
+fn field<'a>(file: &Path, v: &'a Value, path: &str) -> Result<&'a Value> {
+    let mut at = v;
+    for key in path.split('.') {
+        at = match key.parse::<usize>() {
+            Ok(i) => at.get(i),
+            Err(_) => at.get(key),
+        }
+        .ok_or_else(|| bad(file, format!("has no {path}")))?;
+    }
+    Ok(at)
+}
+
+fn bad(file: &Path, problem: String) -> LabError {
+    LabError::Settings(format!("{}: {problem}", file.display()))
+}
+
+fn number(file: &Path, v: &Value, path: &str) -> Result<f64> {
+    field(file, v, path)?
+        .as_f64()
+        .filter(|x| x.is_finite())
+        .ok_or_else(|| bad(file, format!("{path} is not a finite number")))
+}
+
+fn text(file: &Path, v: &Value, path: &str) -> Result<String> {
+    field(file, v, path)?
+        .as_str()
+        .map(str::to_owned)
+        .ok_or_else(|| bad(file, format!("{path} is not a string")))
+}
+
+fn interval(file: &Path, v: &Value, path: &str) -> Result<Interval> {
+    Ok(Interval {
+        lo: number(file, v, &format!("{path}.lo"))?,
+        median: number(file, v, &format!("{path}.median"))?,
+        hi: number(file, v, &format!("{path}.hi"))?,
+        samples: number(file, v, &format!("{path}.samples"))? as usize,
+    })
+}
+
+fn array<'a>(file: &Path, v: &'a Value, path: &str) -> Result<&'a Vec<Value>> {
+    field(file, v, path)?
+        .as_array()
+        .ok_or_else(|| bad(file, format!("{path} is not a list")))
+}
+
+impl DeviceReport {
+    /// Reads `dir/report.json`, as `histencil compare` wrote it.
+    ///
+    /// # Errors
+    /// [`LabError::Settings`] naming the file and the first value missing or malformed.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let file = dir.join("report.json");
+        let bytes = std::fs::read(&file).map_err(|e| bad(&file, format!("cannot read it: {e}")))?;
+        let v: Value =
+            serde_json::from_slice(&bytes).map_err(|e| bad(&file, format!("is not JSON: {e}")))?;
+        let mut rows = Vec::new();
+        for (r, row) in array(&file, &v, "rows")?.iter().enumerate() {
+            let name = text(&file, row, "technique")?;
+            let mut cells = Vec::new();
+            for c in 0..array(&file, row, "cells")?.len() {
+                let at = |k: &str| format!("rows.{r}.cells.{c}.{k}");
+                let brdfs = number(&file, &v, &at("brdfs"))? as usize;
+                let overhead = if c == 0 {
+                    None
+                } else {
+                    let ratio = interval(&file, &v, &at("overhead_ratio"))?;
+                    Some((ratio, text(&file, &v, &at("verdict_against_1_brdf"))?))
+                };
+                cells.push(MergedCell {
+                    brdfs,
+                    lighting: interval(&file, &v, &at("lighting_interval_ms"))?,
+                    overhead,
+                });
+            }
+            rows.push((name, cells));
+        }
+        let mut sizes = Vec::new();
+        for (i, _) in array(&file, &v, "light_sizes")?.iter().enumerate() {
+            let at = |k: &str| format!("light_sizes.{i}.{k}");
+            sizes.push(MergedSize {
+                coverage: number(&file, &v, &at("coverage"))?,
+                stencil_over_branching: interval(&file, &v, &at("stencil_over_branching"))?,
+                faster: text(&file, &v, &at("faster"))?,
+            });
+        }
+        Ok(Self {
+            dir: dir.to_owned(),
+            device: text(&file, &v, "device")?,
+            driver: text(&file, &v, "driver")?,
+            scene: text(&file, &v, "settings.scene")?,
+            width: number(&file, &v, "settings.width")? as u64,
+            height: number(&file, &v, "settings.height")? as u64,
+            rounds: number(&file, &v, "table_sampling.rounds")? as u64,
+            beside_load: v["settings"]["beside_load_threads"].as_u64().unwrap_or(0),
+            rows,
+            sizes,
+        })
+    }
+
+    /// `llvmpipe (LLVM 15.0.6, 256 bits), Mesa 22.3.6`: device and the driver's first part,
+    /// and the load beside the run if any.
+    fn label(&self) -> String {
+        let driver = self.driver.split(';').next().unwrap_or(&self.driver).trim();
+        match self.beside_load {
+            0 => format!("{}, {driver}", self.device),
+            n => format!("{}, {driver}, beside {n} busy threads", self.device),
+        }
+    }
+
+    /// Every decided verdict of the report, keyed by what it is about.
+    fn verdicts(&self) -> Vec<(String, Verdict)> {
+        let mut out = Vec::new();
+        for (name, cells) in &self.rows {
+            for c in cells {
+                if let Some((_, word)) = &c.overhead {
+                    out.push((
+                        format!("{name} at {} BRDFs over 1", c.brdfs),
+                        verdict_of(word),
+                    ));
+                }
+            }
+        }
+        for s in &self.sizes {
+            let v = match s.faster.as_str() {
+                "stencil" => Verdict::Faster,
+                "branching" => Verdict::Slower,
+                other => verdict_of(other),
+            };
+            out.push((
+                format!(
+                    "stencil over branching at {} % light size",
+                    100.0 * s.coverage
+                ),
+                v,
+            ));
+        }
+        out
+    }
+
+    /// The workload, which every merged report must share.
+    fn workload(&self) -> (String, u64, u64, Vec<(String, Vec<usize>)>) {
+        let shape = self
+            .rows
+            .iter()
+            .map(|(n, cells)| (n.clone(), cells.iter().map(|c| c.brdfs).collect()))
+            .collect();
+        (self.scene.clone(), self.width, self.height, shape)
+    }
+}
+
+/// Several devices' reports of one workload.
+#[derive(Clone, Debug)]
+pub struct Merged {
+    pub reports: Vec<DeviceReport>,
+}
+
+impl Merged {
+    /// Refuses fewer than two reports, and reports of different workloads (scene, size,
+    /// techniques, BRDF counts) or light sizes, or the same device and driver twice.
+    ///
+    /// # Errors
+    /// [`LabError::Settings`] naming the report that differs and how.
+    pub fn new(reports: Vec<DeviceReport>) -> Result<Self> {
+        let Some(first) = reports.first() else {
+            return Err(LabError::Settings(
+                "compare merge needs report folders".into(),
+            ));
+        };
+        if reports.len() < 2 {
+            return Err(LabError::Settings(
+                "compare merge puts two or more devices side by side; got one report".into(),
+            ));
+        }
+        for (i, r) in reports.iter().enumerate().skip(1) {
+            if r.workload() != first.workload() {
+                let (s, w, h, _) = r.workload();
+                return Err(LabError::Settings(format!(
+                    "{} measured scene `{s}` at {w}x{h} with techniques {:?}, {} `{}` at {}x{} \
+                     with {:?}: merge runs of one workload (the same compare options)",
+                    r.dir.display(),
+                    r.rows.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+                    first.dir.display(),
+                    first.scene,
+                    first.width,
+                    first.height,
+                    first.rows.iter().map(|(n, _)| n).collect::<Vec<_>>(),
+                )));
+            }
+            let coverages =
+                |r: &DeviceReport| r.sizes.iter().map(|s| s.coverage).collect::<Vec<_>>();
+            if coverages(r) != coverages(first) {
+                return Err(LabError::Settings(format!(
+                    "{} swept light sizes {:?}, {} {:?}",
+                    r.dir.display(),
+                    coverages(r),
+                    first.dir.display(),
+                    coverages(first)
+                )));
+            }
+            if let Some(j) = reports[..i].iter().position(|o| {
+                (&o.device, &o.driver, o.beside_load) == (&r.device, &r.driver, r.beside_load)
+            }) {
+                return Err(LabError::Settings(format!(
+                    "{} and {} are the same device, driver and load ({}): one report per device \
+                     or condition",
+                    reports[j].dir.display(),
+                    r.dir.display(),
+                    r.label()
+                )));
+            }
+        }
+        Ok(Self { reports })
+    }
+
+    /// Every verdict decided one way in one report and the other way in another:
+    /// `(what, report a, report b)`.
+    pub fn reversals(&self) -> Vec<(String, usize, usize)> {
+        let all: Vec<Vec<(String, Verdict)>> = self.reports.iter().map(|r| r.verdicts()).collect();
+        let mut out = Vec::new();
+        for a in 0..all.len() {
+            for b in a + 1..all.len() {
+                for ((what, va), (_, vb)) in all[a].iter().zip(&all[b]) {
+                    if va.reverses(*vb) {
+                        out.push((what.clone(), a, b));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The reversals between two runs of one device and driver (different loads): a verdict
+    /// that a change of conditions turned around, which the margin exists to prevent.
+    pub fn same_device_reversals(&self) -> Vec<(String, usize, usize)> {
+        let same =
+            |a: &DeviceReport, b: &DeviceReport| (&a.device, &a.driver) == (&b.device, &b.driver);
+        self.reversals()
+            .into_iter()
+            .filter(|(_, a, b)| same(&self.reports[*a], &self.reports[*b]))
+            .collect()
+    }
+
+    /// The tables, in Markdown.
+    pub fn markdown(&self) -> String {
+        let first = &self.reports[0];
+        let mut md = format!(
+            "# histencil compare: devices side by side\n\nScene `{}` at {}x{}. Each device's own \
+             `histencil compare` run: the median lighting time with its 95 % interval over that \
+             run's rounds, and the overhead of n BRDFs over one, paired by round within the run, \
+             with its verdict. Runs on different devices share no round, so no verdict is drawn \
+             across devices: the last column names the lower where the devices' intervals do \
+             not overlap.\n\n| device | driver | table rounds | report |\n|---|---|---|---|\n",
+            first.scene, first.width, first.height
+        );
+        for r in &self.reports {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | `{}` |",
+                r.device,
+                r.driver,
+                r.rounds,
+                r.dir.display()
+            );
+        }
+        md += "\n## Lighting time against BRDF count\n\n| technique | BRDFs |";
+        for r in &self.reports {
+            let _ = write!(md, " {} |", r.label());
+        }
+        md += " lower |\n|---|---|";
+        md += &"---|".repeat(self.reports.len() + 1);
+        md += "\n";
+        for (t, (name, cells)) in first.rows.iter().enumerate() {
+            for (c, cell) in cells.iter().enumerate() {
+                let _ = write!(md, "| {name} | {} |", cell.brdfs);
+                let here: Vec<&MergedCell> = self.reports.iter().map(|r| &r.rows[t].1[c]).collect();
+                for m in &here {
+                    let _ = write!(md, " {} |", cell_text(m));
+                }
+                let _ = writeln!(md, " {} |", self.lower(|r| r.rows[t].1[c].lighting));
+            }
+        }
+        if !first.sizes.is_empty() {
+            md += "\n## Stencil over branching per light size\n\nBelow 1 stencil is faster; the \
+                   verdict is each run's own.\n\n| light size |";
+            for r in &self.reports {
+                let _ = write!(md, " {} |", r.label());
+            }
+            md += "\n|---|";
+            md += &"---|".repeat(self.reports.len());
+            md += "\n";
+            for (s, size) in first.sizes.iter().enumerate() {
+                let _ = write!(md, "| {} % |", 100.0 * size.coverage);
+                for r in &self.reports {
+                    let p = &r.sizes[s];
+                    let i = &p.stencil_over_branching;
+                    let _ = write!(
+                        md,
+                        " {:.3} [{:.3}, {:.3}] {} |",
+                        i.median, i.lo, i.hi, p.faster
+                    );
+                }
+                md += "\n";
+            }
+        }
+        let reversals = self.reversals();
+        let decided: usize = self
+            .reports
+            .iter()
+            .map(|r| r.verdicts().iter().filter(|(_, v)| v.decided()).count())
+            .sum();
+        let _ = writeln!(
+            md,
+            "\n## Verdicts that reverse\n\n{} of {decided} decided verdicts (faster, slower or \
+             within ±5 %, over all reports) are decided the opposite way in another report.\n",
+            reversals.len()
+        );
+        for (what, a, b) in &reversals {
+            let _ = writeln!(
+                md,
+                "- {what}: {} in {}, {} in {}",
+                verdict_word(&self.reports[*a], what),
+                self.reports[*a].label(),
+                verdict_word(&self.reports[*b], what),
+                self.reports[*b].label()
+            );
+        }
+        md
+    }
+
+    /// Which device's interval lies wholly below every other's, or "overlap".
+    fn lower(&self, of: impl Fn(&DeviceReport) -> Interval) -> String {
+        let intervals: Vec<Interval> = self.reports.iter().map(&of).collect();
+        let below_all = |i: usize| {
+            intervals
+                .iter()
+                .enumerate()
+                .all(|(j, o)| j == i || intervals[i].hi < o.lo)
+        };
+        match (0..intervals.len()).find(|&i| below_all(i)) {
+            Some(i) => self.reports[i].device.clone(),
+            None => "overlap".into(),
+        }
+    }
+
+    /// Every figure of the merge.
+    pub fn json(&self) -> Value {
+        let reports: Vec<Value> = self
+            .reports
+            .iter()
+            .map(|r| {
+                json!({
+                    "dir": r.dir.display().to_string(),
+                    "device": r.device,
+                    "driver": r.driver,
+                    "rounds": r.rounds,
+                    "rows": r.rows.iter().map(|(name, cells)| json!({
+                        "technique": name,
+                        "cells": cells.iter().map(|c| {
+                            let mut cell = json!({
+                                "brdfs": c.brdfs,
+                                "lighting_interval_ms": interval_json(&c.lighting),
+                            });
+                            if let Some((ratio, verdict)) = &c.overhead {
+                                cell["overhead_ratio"] = interval_json(ratio);
+                                cell["verdict_against_1_brdf"] = json!(verdict);
+                            }
+                            cell
+                        }).collect::<Vec<_>>(),
+                    })).collect::<Vec<_>>(),
+                    "light_sizes": r.sizes.iter().map(|s| json!({
+                        "coverage": s.coverage,
+                        "stencil_over_branching": interval_json(&s.stencil_over_branching),
+                        "faster": s.faster,
+                    })).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        let first = &self.reports[0];
+        json!({
+            "scene": first.scene,
+            "width": first.width,
+            "height": first.height,
+            "devices": reports,
+        })
+    }
+
+    /// Lighting time against BRDF count, one line per technique and device.
+    fn plot(&self, path: &Path) -> Result<()> {
+        let series: Vec<Series> = self
+            .reports
+            .iter()
+            .flat_map(|r| {
+                r.rows.iter().map(move |(name, cells)| Series {
+                    name: format!("{name} ({})", r.device),
+                    points: cells
+                        .iter()
+                        .map(|c| (c.brdfs as f64, c.lighting.median))
+                        .collect(),
+                    bars: cells
+                        .iter()
+                        .map(|c| (c.lighting.lo, c.lighting.hi))
+                        .collect(),
+                })
+            })
+            .collect();
+        plot::line_chart(
+            path,
+            "Lighting time against BRDF count, devices side by side",
+            Axis {
+                label: "BRDFs in use",
+                log: false,
+            },
+            Axis {
+                label: "lighting ms",
+                log: true,
+            },
+            &series,
+        )
+    }
+
+    /// Writes `merged.md`, `merged.json` and `merged-lighting.png` into `dir`.
+    ///
+    /// # Errors
+    /// I/O and plotting errors.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let md = dir.join("merged.md");
+        write_file(&md, self.markdown().as_bytes())?;
+        let js = dir.join("merged.json");
+        crate::write_json(&js, &self.json())?;
+        let png = dir.join("merged-lighting.png");
+        self.plot(&png)?;
+        Ok(vec![md, js, png])
+    }
+}
+
+/// A verdict from its word in a report.
+fn verdict_of(word: &str) -> Verdict {
+    [Verdict::Faster, Verdict::Slower, Verdict::Within]
+        .into_iter()
+        .find(|v| v.word() == word)
+        .unwrap_or(Verdict::Undecided)
+}
+
+fn verdict_word(r: &DeviceReport, what: &str) -> &'static str {
+    r.verdicts()
+        .into_iter()
+        .find(|(w, _)| w == what)
+        .map_or("?", |(_, v)| v.word())
+}
+
+fn interval_json(i: &Interval) -> Value {
+    json!({"median": i.median, "lo": i.lo, "hi": i.hi, "samples": i.samples})
+}
+
+/// `1.234 ms [1.2, 1.3]`, and over one BRDF `(+3.2 % [+1.1, +5.0], slower)`.
+fn cell_text(c: &MergedCell) -> String {
+    let i = &c.lighting;
+    let t = format!("{:.3} ms [{:.3}, {:.3}]", i.median, i.lo, i.hi);
+    match &c.overhead {
+        None => t,
+        Some((r, verdict)) => {
+            let pct = |x: f64| 100.0 * (x - 1.0);
+            format!(
+                "{t} ({:+.1} % [{:+.1}, {:+.1}], {verdict})",
+                pct(r.median),
+                pct(r.lo),
+                pct(r.hi)
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(dir: &str, device: &str, driver: &str, scene: &str) -> DeviceReport {
+        let i = |m: f64| Interval {
+            lo: m * 0.9,
+            median: m,
+            hi: m * 1.1,
+            samples: 10,
+        };
+        DeviceReport {
+            dir: dir.into(),
+            device: device.into(),
+            driver: driver.into(),
+            scene: scene.into(),
+            width: 320,
+            height: 180,
+            rounds: 10,
+            beside_load: 0,
+            rows: vec![(
+                "stencil".into(),
+                vec![
+                    MergedCell {
+                        brdfs: 1,
+                        lighting: i(1.0),
+                        overhead: None,
+                    },
+                    MergedCell {
+                        brdfs: 2,
+                        lighting: i(if device == "slow" { 3.0 } else { 1.05 }),
+                        overhead: Some((i(1.05), "within ±5 %".into())),
+                    },
+                ],
+            )],
+            sizes: vec![MergedSize {
+                coverage: 0.01,
+                stencil_over_branching: i(0.9),
+                faster: "undecided".into(),
+            }],
+        }
+    }
+
+    #[test]
+    fn merging_refuses_what_is_not_one_workload_on_two_devices() {
+        let a = report("a", "fast", "Mesa 22.3", "huge-lights");
+        let err = |reports| Merged::new(reports).unwrap_err().to_string();
+        assert!(err(vec![a.clone()]).contains("two or more devices"));
+        assert!(
+            err(vec![a.clone(), report("b", "fast", "Mesa 25.0", "town")])
+                .contains("merge runs of one workload")
+        );
+        assert!(err(vec![
+            a.clone(),
+            report("b", "fast", "Mesa 22.3", "huge-lights")
+        ])
+        .contains("the same device, driver and load"));
+        let mut other_sizes = report("b", "slow", "Mesa 25.0", "huge-lights");
+        other_sizes.sizes[0].coverage = 0.1;
+        assert!(err(vec![a.clone(), other_sizes]).contains("swept light sizes"));
+    }
+
+    #[test]
+    fn the_merged_table_names_every_device_and_the_lower_only_where_intervals_part() {
+        let merged = Merged::new(vec![
+            report("a", "fast", "Mesa 22.3; conformance 1.3", "huge-lights"),
+            report("b", "slow", "Mesa 25.0; conformance 1.3", "huge-lights"),
+        ])
+        .unwrap();
+        let md = merged.markdown();
+        assert!(
+            md.contains(
+                "| stencil | 1 | 1.000 ms [0.900, 1.100] | 1.000 ms [0.900, 1.100] | overlap |"
+            ),
+            "{md}"
+        );
+        assert!(md.contains("| stencil | 2 |"), "{md}");
+        assert!(
+            md.contains("3.000 ms [2.700, 3.300] (+5.0 % [-5.5, +15.5], within ±5 %) | fast |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("fast, Mesa 22.3") && md.contains("slow, Mesa 25.0"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| 1 % | 0.900 [0.810, 0.990] undecided |"),
+            "{md}"
+        );
+        assert_eq!(merged.json()["devices"].as_array().unwrap().len(), 2);
+    }
+
+    #[test]
+    fn a_verdict_turned_around_by_load_on_one_device_is_a_same_device_reversal() {
+        let quiet = report("q", "fast", "Mesa 22.3", "huge-lights");
+        let mut loaded = report("l", "fast", "Mesa 22.3", "huge-lights");
+        loaded.beside_load = 2;
+        let mut q = quiet.clone();
+        q.sizes[0].faster = "branching".into();
+        loaded.sizes[0].faster = "within ±5 %".into();
+        let merged = Merged::new(vec![q.clone(), loaded.clone()]).unwrap();
+        assert!(
+            merged.same_device_reversals().is_empty(),
+            "within the margin is no reversal"
+        );
+        loaded.sizes[0].faster = "stencil".into();
+        let merged = Merged::new(vec![q.clone(), loaded.clone()]).unwrap();
+        let reversed = merged.same_device_reversals();
+        assert_eq!(reversed.len(), 1, "{reversed:?}");
+        assert_eq!(reversed[0].0, "stencil over branching at 1 % light size");
+        let md = merged.markdown();
+        assert!(md.contains("1 of 4 decided verdicts"), "{md}");
+        assert!(
+            md.contains(
+                "slower in fast, Mesa 22.3, faster in fast, Mesa 22.3, beside 2 busy threads"
+            ),
+            "{md}"
+        );
+        // Across devices a reversal is a finding, not a failure.
+        let mut other = loaded.clone();
+        other.device = "slow".into();
+        other.beside_load = 0;
+        let merged = Merged::new(vec![q, other]).unwrap();
+        assert_eq!(
+            (
+                merged.reversals().len(),
+                merged.same_device_reversals().len()
+            ),
+            (1, 0)
+        );
+    }
+
+    #[test]
+    fn a_report_missing_a_value_is_refused_naming_it() {
+        let dir = std::env::temp_dir().join(format!("histencil-merge-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("report.json"),
+            br#"{"rows": [], "light_sizes": []}"#,
+        )
+        .unwrap();
+        let err = DeviceReport::read(&dir).unwrap_err().to_string();
+        assert!(err.contains("report.json: has no device"), "{err}");
+        std::fs::write(dir.join("report.json"), b"{").unwrap();
+        assert!(DeviceReport::read(&dir)
+            .unwrap_err()
+            .to_string()
+            .contains("is not JSON"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
