@@ -187,6 +187,46 @@ pub struct DemoArgs {
 }
 
 #[derive(clap::Args)]
+pub struct TodaysGpusArgs {
+    /// The scenes, embedded or `.gltf` / `.glb` files.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "default,huge-lights,town"
+    )]
+    scenes: Vec<String>,
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    #[arg(long, default_value_t = 360)]
+    height: u32,
+    /// Output directory: todays-gpus.md and todays-gpus.json.
+    #[arg(long, default_value = "out/todays-gpus")]
+    out: PathBuf,
+    /// Run under the validation layer; any message fails the run.
+    #[arg(long)]
+    validate: bool,
+}
+
+pub fn todays_gpus(args: &TodaysGpusArgs, lights: DefaultLights) -> Result<()> {
+    histencil_vk::check_output_dir(&args.out)?;
+    let scenes = args
+        .scenes
+        .iter()
+        .map(|s| crate::load_scene_arg(s, lights))
+        .collect::<Result<Vec<_>>>()?;
+    let report = on_device(args.validate, |ctx| {
+        Ok(with_spinner(|step| {
+            histencil_lab::todays_gpus::run_todays_gpus(ctx, &scenes, args.width, args.height, step)
+        })?)
+    })?;
+    for path in report.write(&args.out)? {
+        println!("wrote {}", path.display());
+    }
+    print!("{}", report.markdown());
+    Ok(())
+}
+
+#[derive(clap::Args)]
 pub struct ScaleArgs {
     /// An embedded scene or a `.gltf` / `.glb` file.
     #[arg(long, default_value = "town")]

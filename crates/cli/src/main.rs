@@ -47,6 +47,11 @@ enum Command {
     /// platform backend, the per-BRDF breakdown, a light-size sweep, each next to its error
     /// against forward; writes report.md, report.json and PNG plots.
     Compare(lab::CompareArgs),
+    /// The talk's questions asked of today's GPUs: per platform (the consoles, AMD's GFX9-11
+    /// pretests and GFX12 AND/OR tiles as modelled from AMD's driver sources, native Vulkan)
+    /// whether the engine's bits break culling, what flush or reset it needs, how many BRDFs it
+    /// culls hierarchically, and the simulator's tiles and fragments on frames captured here.
+    TodaysGpus(lab::TodaysGpusArgs),
     /// A scene at scale (default: the generated `town`): load time and device memory, then
     /// G-buffer, lighting and frame time of stencil (native, PS3-like) and branching next to
     /// forward, each with its error; writes a markdown report.
@@ -675,6 +680,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => lab::compare(args, lights),
         Command::Demo(args) => lab::demo(args, lights),
         Command::Scale(args) => lab::scale(args, lights),
+        Command::TodaysGpus(args) => lab::todays_gpus(args, lights),
         Command::Sweep(args) => lab::sweep(args, lights),
         Command::Calibrate(args) => lab::calibrate(args),
         Command::BrdfEval(args) => brdf_eval(args),

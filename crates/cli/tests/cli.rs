@@ -653,3 +653,48 @@ fn scale_reports_the_town_under_validation() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `todays-gpus` under validation: the table names every platform, the 360-like backend without
+/// zeroing loses lights to the engine's bits (the talk's failure), no other platform does, and
+/// the AMD models cull tiles while shading exactly what native shades.
+#[test]
+fn todays_gpus_asks_the_talks_questions_of_every_platform() {
+    let dir = std::env::temp_dir().join(format!("histencil-todays-gpus-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let (ok, stdout, stderr) = histencil(&[
+        "todays-gpus",
+        "--scenes",
+        "default",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--validate",
+        "--out",
+        out,
+    ]);
+    assert!(ok, "{stderr}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("todays-gpus.json")).unwrap()).unwrap();
+    let platforms = json["platforms"].as_array().unwrap();
+    assert_eq!(platforms.len(), 6, "{stdout}");
+    let scene = |i: usize| &platforms[i]["scenes"][0];
+    let needed = scene(5)["fragments_the_frame_needs"].as_u64().unwrap();
+    for (i, p) in platforms.iter().enumerate() {
+        let effect = scene(i)["engine_bits"].as_str().unwrap();
+        let name = p["platform"].as_str().unwrap();
+        assert_eq!(effect == "breaks", i == 0, "{name}: {effect}");
+        if i > 0 {
+            let shaded = scene(i)["with_engine_bits"]["fragments_shaded"].as_u64();
+            assert_eq!(shaded, Some(needed), "{name}");
+        }
+    }
+    for amd in [3, 4] {
+        let culled = scene(amd)["with_engine_bits"]["tiles_culled"]
+            .as_u64()
+            .unwrap();
+        assert!(culled > 0, "{}", platforms[amd]["platform"]);
+    }
+    assert!(stdout.contains("| amd-andor (GFX12) | no |"), "{stdout}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

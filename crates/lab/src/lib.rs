@@ -26,6 +26,7 @@ mod plot;
 pub mod scale;
 pub mod stats;
 pub mod sweep;
+pub mod todays_gpus;
 mod variants;
 
 pub use alpha_reference::AlphaReference;

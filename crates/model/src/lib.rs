@@ -41,7 +41,12 @@
 //! that should pass, so the 360-like backend zeroes those bits as it goes (setup and cleanup
 //! write `!brdf_mask`), optionally saving and restoring them. The PS3's hi-stencil has a read
 //! mask and leaves them alone. Native Vulkan has per-pixel compare masks and nothing to emulate.
+//! Today's AMD GPUs ([`amd`], modelled from AMD's driver sources, not measured on AMD hardware)
+//! keep hierarchical stencil on their own, with no plan step: two masked pretests per frame
+//! (GFX9-11) or each tile's AND and OR of its stencil values (GFX12); they run the native plan,
+//! and [`Simulator::run_with`] counts what they would reject.
 
+pub mod amd;
 mod backend;
 mod chooser;
 mod costs_json;

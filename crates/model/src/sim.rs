@@ -2,11 +2,12 @@
 //! hi-stencil emulation of [`TileSurface`], and records which pass shaded which pixel.
 //! It is the oracle for the GPU implementation: the same plan, the same state values.
 
+use crate::amd::{tile_values, TileHierarchy};
 use crate::footprint::Footprint;
 use crate::frame::{FramePlan, Step};
 use crate::layout::StencilLayout;
 use crate::plan::{Geometry, Pass, PassKind, Shader};
-use crate::state::CullMode;
+use crate::state::{CompareOp, CullMode, StencilOp};
 use crate::tiles::{TileStats, TileSurface};
 
 /// Depth and stencil of the frame after the G-buffer pass.
@@ -81,18 +82,51 @@ impl Simulator {
         plan: &FramePlan,
         footprints: &[Footprint],
     ) -> SimResult {
+        self.run_on(target, plan, footprints, None)
+    }
+
+    /// [`Simulator::run`] on a GPU whose own hierarchical stencil (`hierarchy`, built here from
+    /// the target's stencil) rejects the tiles of stencil-testing draws without any plan step:
+    /// the AMD platforms ([`crate::amd`]), which run the native plan. Their rejections are
+    /// counted in the stats as hi-stencil tests and culls; what is shaded and the stencil left
+    /// are the same as without it, since a model rejects only tiles where nothing passes.
+    ///
+    /// # Panics
+    /// As [`Simulator::run`].
+    pub fn run_with(
+        &self,
+        target: &mut SoftTarget,
+        plan: &FramePlan,
+        footprints: &[Footprint],
+        hierarchy: &mut dyn TileHierarchy,
+    ) -> SimResult {
+        self.run_on(target, plan, footprints, Some(hierarchy))
+    }
+
+    fn run_on<'a>(
+        &self,
+        target: &'a mut SoftTarget,
+        plan: &FramePlan,
+        footprints: &[Footprint],
+        mut hierarchy: Option<&'a mut (dyn TileHierarchy + 'a)>,
+    ) -> SimResult {
         assert!(
             footprints.iter().all(|f| f.depth() == plan.depth),
             "footprints and plan follow different depth conventions"
         );
         let tiles = TileSurface::new(target.width, target.height, self.tile_size);
+        if let Some(h) = hierarchy.as_deref_mut() {
+            crate::amd::begin(h, &target.stencil, target.width, &tiles);
+        }
         let mut run = Run {
             layout: self.layout,
             tile_stamp: vec![u32::MAX; tiles.tile_count()],
+            rejected: vec![false; tiles.tile_count()],
             tiles,
             stats: TileStats::default(),
             touched: Vec::new(),
             target,
+            hierarchy,
         };
         let mut lights: Vec<LightShading> = footprints.iter().map(LightShading::new).collect();
         let mut culling_bit_left = vec![false; footprints.len()];
@@ -149,6 +183,10 @@ struct Run<'a> {
     /// The step that last touched each tile, so each draw counts a tile once.
     tile_stamp: Vec<u32>,
     touched: Vec<usize>,
+    /// The GPU's own hierarchical stencil, if the platform has one ([`Simulator::run_with`]).
+    hierarchy: Option<&'a mut (dyn TileHierarchy + 'a)>,
+    /// Per tile, whether `hierarchy` rejected it for the current draw.
+    rejected: Vec<bool>,
 }
 
 impl Run<'_> {
@@ -178,6 +216,11 @@ impl Run<'_> {
         };
         let face = state.stencil_for(front_facing);
         let hi_test = state.tests_hi_stencil();
+        // The GPU's own hierarchy tests draws that test stencil and whose stencil-fail op keeps
+        // the value (a rejected tile runs no stencil op at all).
+        let auto_test = self.hierarchy.is_some()
+            && !hi_test
+            && face.is_some_and(|f| f.compare != CompareOp::Always && f.fail == StencilOp::Keep);
         let hi_write = state.hi_stencil.filter(|h| h.write);
         self.touched.clear();
         for y in footprint.y0..footprint.y0 + footprint.height {
@@ -201,8 +244,16 @@ impl Run<'_> {
                         self.stats.tiles_tested += 1;
                         self.stats.tiles_culled += u64::from(!self.tiles.passes(tile));
                     }
+                    if let (true, Some(h), Some(f)) = (auto_test, self.hierarchy.as_deref(), face) {
+                        self.rejected[tile] = !h.may_pass(tile, &f);
+                        self.stats.tiles_tested += 1;
+                        self.stats.tiles_culled += u64::from(self.rejected[tile]);
+                    }
                 }
                 if hi_test && !self.tiles.passes(tile) {
+                    continue;
+                }
+                if auto_test && self.rejected[tile] {
                     continue;
                 }
                 let i = self.target.index(x, y);
@@ -223,6 +274,17 @@ impl Run<'_> {
                     };
                     shading.step[local] = step;
                     self.stats.fragments_shaded += 1;
+                }
+            }
+        }
+        // The hierarchy sees every tile this draw may have written.
+        if let Some(h) = self.hierarchy.as_deref_mut() {
+            if state.writes_stencil() {
+                let (width, height) = (self.target.width, self.target.height);
+                for &tile in &self.touched {
+                    let values =
+                        tile_values(&self.target.stencil, width, height, &self.tiles, tile);
+                    h.written(tile, &values);
                 }
             }
         }

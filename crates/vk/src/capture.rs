@@ -51,6 +51,23 @@ impl SimulatorInputs {
         let result = simulator.run(&mut target, plan, &self.footprints);
         (result, target)
     }
+
+    /// [`SimulatorInputs::predict_plan`] on a GPU whose own hierarchical stencil rejects tiles
+    /// (`histencil_model::amd`; built from the captured G-buffer stencil): what it would cull of
+    /// `plan`, the native plan.
+    pub fn predict_with(
+        &self,
+        plan: &FramePlan,
+        hierarchy: &mut dyn histencil_model::amd::TileHierarchy,
+    ) -> (SimResult, SoftTarget) {
+        let simulator = Simulator {
+            layout: self.layout,
+            tile_size: self.tile_size,
+        };
+        let mut target = self.target.clone();
+        let result = simulator.run_with(&mut target, plan, &self.footprints, hierarchy);
+        (result, target)
+    }
 }
 
 /// "No face here" in the captured depth images.

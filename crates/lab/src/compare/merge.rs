@@ -153,13 +153,11 @@ impl DeviceReport {
         })
     }
 
-    /// `llvmpipe (LLVM 15.0.6, 256 bits), Mesa 22.3.6`: device and the driver's first part,
-    /// and the load beside the run if any.
-    fn label(&self) -> String {
-        let driver = self.driver.split(';').next().unwrap_or(&self.driver).trim();
+    /// The conditions of the run: "quiet", or the load beside it.
+    fn conditions(&self) -> String {
         match self.beside_load {
-            0 => format!("{}, {driver}", self.device),
-            n => format!("{}, {driver}, beside {n} busy threads", self.device),
+            0 => "quiet".into(),
+            n => format!("beside {n} busy threads"),
         }
     }
 
@@ -257,11 +255,13 @@ impl Merged {
                 (&o.device, &o.driver, o.beside_load) == (&r.device, &r.driver, r.beside_load)
             }) {
                 return Err(LabError::Settings(format!(
-                    "{} and {} are the same device, driver and load ({}): one report per device \
-                     or condition",
+                    "{} and {} are the same device, driver and load ({}, {}, {}): one report per \
+                     device or condition",
                     reports[j].dir.display(),
                     r.dir.display(),
-                    r.label()
+                    r.device,
+                    r.driver,
+                    r.conditions()
                 )));
             }
         }
@@ -304,23 +304,26 @@ impl Merged {
              `histencil compare` run: the median lighting time with its 95 % interval over that \
              run's rounds, and the overhead of n BRDFs over one, paired by round within the run, \
              with its verdict. Runs on different devices share no round, so no verdict is drawn \
-             across devices: the last column names the lower where the devices' intervals do \
-             not overlap.\n\n| device | driver | table rounds | report |\n|---|---|---|---|\n",
+             across runs: the last column names the lower where the runs' intervals do not \
+             overlap.\n\n| run | device | driver | conditions | table rounds | report |\n\
+             |---|---|---|---|---|---|\n",
             first.scene, first.width, first.height
         );
-        for r in &self.reports {
+        for (i, r) in self.reports.iter().enumerate() {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | `{}` |",
+                "| run {} | {} | {} | {} | {} | `{}` |",
+                i + 1,
                 r.device,
                 r.driver,
+                r.conditions(),
                 r.rounds,
                 r.dir.display()
             );
         }
         md += "\n## Lighting time against BRDF count\n\n| technique | BRDFs |";
-        for r in &self.reports {
-            let _ = write!(md, " {} |", r.label());
+        for i in 0..self.reports.len() {
+            let _ = write!(md, " run {} |", i + 1);
         }
         md += " lower |\n|---|---|";
         md += &"---|".repeat(self.reports.len() + 1);
@@ -338,8 +341,8 @@ impl Merged {
         if !first.sizes.is_empty() {
             md += "\n## Stencil over branching per light size\n\nBelow 1 stencil is faster; the \
                    verdict is each run's own.\n\n| light size |";
-            for r in &self.reports {
-                let _ = write!(md, " {} |", r.label());
+            for i in 0..self.reports.len() {
+                let _ = write!(md, " run {} |", i + 1);
             }
             md += "\n|---|";
             md += &"---|".repeat(self.reports.len());
@@ -373,11 +376,11 @@ impl Merged {
         for (what, a, b) in &reversals {
             let _ = writeln!(
                 md,
-                "- {what}: {} in {}, {} in {}",
+                "- {what}: {} in run {}, {} in run {}",
                 verdict_word(&self.reports[*a], what),
-                self.reports[*a].label(),
+                a + 1,
                 verdict_word(&self.reports[*b], what),
-                self.reports[*b].label()
+                b + 1
             );
         }
         md
@@ -393,7 +396,7 @@ impl Merged {
                 .all(|(j, o)| j == i || intervals[i].hi < o.lo)
         };
         match (0..intervals.len()).find(|&i| below_all(i)) {
-            Some(i) => self.reports[i].device.clone(),
+            Some(i) => format!("run {}", i + 1),
             None => "overlap".into(),
         }
     }
@@ -409,6 +412,7 @@ impl Merged {
                     "device": r.device,
                     "driver": r.driver,
                     "rounds": r.rounds,
+                    "conditions": r.conditions(),
                     "rows": r.rows.iter().map(|(name, cells)| json!({
                         "technique": name,
                         "cells": cells.iter().map(|c| {
@@ -604,11 +608,11 @@ mod tests {
         );
         assert!(md.contains("| stencil | 2 |"), "{md}");
         assert!(
-            md.contains("3.000 ms [2.700, 3.300] (+5.0 % [-5.5, +15.5], within ±5 %) | fast |"),
+            md.contains("3.000 ms [2.700, 3.300] (+5.0 % [-5.5, +15.5], within ±5 %) | run 1 |"),
             "{md}"
         );
         assert!(
-            md.contains("fast, Mesa 22.3") && md.contains("slow, Mesa 25.0"),
+            md.contains("| run 2 | slow | Mesa 25.0; conformance 1.3 | quiet | 10 | `b` |"),
             "{md}"
         );
         assert!(
@@ -639,9 +643,8 @@ mod tests {
         let md = merged.markdown();
         assert!(md.contains("1 of 4 decided verdicts"), "{md}");
         assert!(
-            md.contains(
-                "slower in fast, Mesa 22.3, faster in fast, Mesa 22.3, beside 2 busy threads"
-            ),
+            md.contains("slower in run 1, faster in run 2")
+                && md.contains("| run 2 | fast | Mesa 22.3 | beside 2 busy threads |"),
             "{md}"
         );
         // Across devices a reversal is a finding, not a failure.

@@ -1,0 +1,316 @@
+//! "The talk on today's GPUs": the talk's questions re-asked of every platform, with the CPU
+//! simulator as the judge. Each scene's frame is rendered on the device (its G-buffer stencil,
+//! with the engine's bits 0xA0, and every light's footprint as the rasteriser made it:
+//! `Renderer::simulator_inputs`), then each platform's plan runs on those inputs in the
+//! simulator: the consoles' plans with their hi-stencil, the native plan bare, and the native
+//! plan on the two AMD models (`histencil_model::amd`, modelled from AMD's driver sources, not
+//! measured on AMD hardware). The counts are the simulator's, so they are the same on every
+//! device; what a tile culled saves in time needs the hardware itself.
+//!
+//! Questions: do the engine's bits break culling (the 360's problem: lights lost), only weaken
+//! it (fewer tiles culled), or neither; what flush or reset the platform needs; how many BRDFs
+//! are culled hierarchically; and tiles tested and culled and fragments shaded per scene.
+
+use crate::{write_file, Result};
+use histencil_model::amd::{
+    choose_pretests, slot_tile_counts, AndOrTiles, PretestTiles, TileHierarchy,
+};
+use histencil_model::{FlushPolicy, TileStats, TileSurface};
+use histencil_scene::Scene;
+use histencil_vk::{Backend, Context, FrameDesc, Renderer, SimulatorInputs, Technique};
+use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The engine's bits, as in the talk's 360 story (and `demo`, `check`).
+pub const ENGINE_BITS: u8 = 0xA0;
+
+/// One platform as the table describes it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Platform {
+    X360NoZeroing,
+    X360,
+    Ps3,
+    AmdPretest,
+    AmdAndOr,
+    Native,
+}
+
+impl Platform {
+    pub const ALL: [Platform; 6] = [
+        Platform::X360NoZeroing,
+        Platform::X360,
+        Platform::Ps3,
+        Platform::AmdPretest,
+        Platform::AmdAndOr,
+        Platform::Native,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Platform::X360NoZeroing => "360-like, engine bits kept (the talk's failure)",
+            Platform::X360 => "360-like, zeroing (the talk's fix)",
+            Platform::Ps3 => "PS3-like",
+            Platform::AmdPretest => "amd-pretest (GFX9-11 with pretests, as PAL allows)",
+            Platform::AmdAndOr => "amd-andor (GFX12)",
+            Platform::Native => {
+                "native: no hierarchical stencil through Vulkan (RADV and AMDVLK on GFX9-11, Intel, Adreno)"
+            }
+        }
+    }
+
+    /// What the platform needs between a hierarchy write and a test, and what a change costs.
+    pub fn flush_or_reset(self) -> &'static str {
+        match self {
+            Platform::X360NoZeroing | Platform::X360 | Platform::Ps3 => {
+                "a flush between each mask pass's hi-stencil write and the shade passes testing it"
+            }
+            Platform::AmdPretest => {
+                "none within the frame (pretests bound before the G-buffer); changing one needs an \
+                 initialisation barrier and a rewrite of the whole stencil"
+            }
+            Platform::AmdAndOr => {
+                "none (updated as stencil is written); reset to the full range after any layout \
+                 that does not keep it, which this frame never uses"
+            }
+            Platform::Native => "none",
+        }
+    }
+
+    /// How many BRDFs the hierarchy can cull by their id.
+    pub fn brdfs_culled(self) -> &'static str {
+        match self {
+            Platform::X360NoZeroing | Platform::X360 | Platform::Ps3 => {
+                "every BRDF a light touches (a mask pass and a flush each)"
+            }
+            Platform::AmdPretest => {
+                "2 by their id (the two pretests, on the two rarest BRDFs); the others per pixel \
+                 only"
+            }
+            Platform::AmdAndOr => "any, wherever a tile's known bits contradict the BRDF's id",
+            Platform::Native => "0 (per pixel only)",
+        }
+    }
+
+    fn technique(self) -> Technique {
+        let backend = match self {
+            Platform::X360NoZeroing => Backend::X360 {
+                zero_preserved: false,
+                save_restore: false,
+            },
+            Platform::X360 => Backend::X360 {
+                zero_preserved: true,
+                save_restore: false,
+            },
+            Platform::Ps3 => Backend::Ps3,
+            Platform::AmdPretest | Platform::AmdAndOr | Platform::Native => Backend::Native,
+        };
+        Technique::Stencil {
+            backend,
+            flush: FlushPolicy::Auto,
+        }
+    }
+}
+
+/// The simulator's counts for one platform on one scene, with and without the engine's bits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneCounts {
+    pub with_bits: TileStats,
+    pub without_bits: TileStats,
+    /// Fragments the native plan shades with the engine's bits: what every correct platform
+    /// shades.
+    pub expected_fragments: u64,
+}
+
+impl SceneCounts {
+    /// "breaks" (fewer fragments shaded than the frame needs: lights lost), "weakens" (fewer
+    /// tiles culled than without the bits) or "no".
+    pub fn engine_bits_effect(&self) -> &'static str {
+        if self.with_bits.fragments_shaded != self.expected_fragments {
+            "breaks"
+        } else if self.with_bits.tiles_culled < self.without_bits.tiles_culled {
+            "weakens"
+        } else {
+            "no"
+        }
+    }
+}
+
+/// Every platform on every scene.
+#[derive(Clone, Debug)]
+pub struct TodaysGpusReport {
+    pub device: String,
+    pub driver: String,
+    pub width: u32,
+    pub height: u32,
+    pub tile_size: u32,
+    pub scenes: Vec<String>,
+    /// Per platform ([`Platform::ALL`] order), per scene.
+    pub counts: Vec<(Platform, Vec<SceneCounts>)>,
+}
+
+/// The simulator's counts of `platform` on `inputs` (captured with some engine bits).
+fn counts_of(
+    renderer: &Renderer,
+    inputs: &SimulatorInputs,
+    platform: Platform,
+) -> Result<TileStats> {
+    let plan = renderer.plan(platform.technique())?;
+    let target = &inputs.target;
+    let tiles = TileSurface::new(target.width, target.height, inputs.tile_size);
+    let mut hierarchy: Box<dyn TileHierarchy> = match platform {
+        Platform::AmdPretest => {
+            let counts = slot_tile_counts(&inputs.layout, &target.stencil, target.width, &tiles);
+            Box::new(PretestTiles::new(choose_pretests(&inputs.layout, &counts)))
+        }
+        Platform::AmdAndOr => Box::new(AndOrTiles::new()),
+        _ => return Ok(inputs.predict_plan(&plan).0.stats),
+    };
+    Ok(inputs.predict_with(&plan, hierarchy.as_mut()).0.stats)
+}
+
+/// Runs every platform on every scene at `width` x `height`.
+///
+/// # Errors
+/// Rendering and capture errors (a device without a 32-bit float depth buffer cannot capture).
+pub fn run_todays_gpus(
+    ctx: &Context,
+    scenes: &[Scene],
+    width: u32,
+    height: u32,
+    progress: &mut dyn FnMut(&str),
+) -> Result<TodaysGpusReport> {
+    let mut counts: Vec<(Platform, Vec<SceneCounts>)> =
+        Platform::ALL.iter().map(|p| (*p, Vec::new())).collect();
+    let mut tile_size = 0;
+    for scene in scenes {
+        progress(&scene.name);
+        let renderer = &mut Renderer::new(ctx, scene.clone(), width, height)?;
+        let capture = |renderer: &mut Renderer, bits: u8| {
+            let desc = FrameDesc {
+                preserved_pattern: bits,
+                ..FrameDesc::from(Platform::Native.technique())
+            };
+            renderer.simulator_inputs(desc)
+        };
+        let with_bits = capture(renderer, ENGINE_BITS)?;
+        let without_bits = capture(renderer, 0)?;
+        tile_size = with_bits.tile_size;
+        let native = counts_of(renderer, &with_bits, Platform::Native)?;
+        for (platform, per_scene) in counts.iter_mut() {
+            per_scene.push(SceneCounts {
+                with_bits: counts_of(renderer, &with_bits, *platform)?,
+                without_bits: counts_of(renderer, &without_bits, *platform)?,
+                expected_fragments: native.fragments_shaded,
+            });
+        }
+    }
+    Ok(TodaysGpusReport {
+        device: ctx.device_name().to_owned(),
+        driver: ctx.driver().to_string(),
+        width,
+        height,
+        tile_size,
+        scenes: scenes.iter().map(|s| s.name.clone()).collect(),
+        counts,
+    })
+}
+
+impl TodaysGpusReport {
+    pub fn markdown(&self) -> String {
+        let mut md = format!(
+            "# The talk on today's GPUs\n\nWritten by `histencil todays-gpus`. Every count is the \
+             CPU simulator's, running each platform's plan on frames captured on **{}** ({}): \
+             each scene's G-buffer stencil, with the engine's bits 0x{ENGINE_BITS:02X} in the \
+             preserved bits, and its lights' footprints, at {}x{}, {}x{} tiles. The AMD rows are \
+             modelled from AMD's driver sources (PAL; `crates/model/src/amd.rs` names the file \
+             and line of each rule), not measured on AMD hardware. \"Engine bits\": *breaks* \
+             where fewer fragments are shaded than the frame needs (lights lost), *weakens* \
+             where fewer tiles are culled than without the bits, *no* otherwise.\n\n",
+            self.device, self.driver, self.width, self.height, self.tile_size, self.tile_size
+        );
+        md += "| platform | engine bits break culling? | flush / reset needed | BRDFs culled hierarchically |";
+        for s in &self.scenes {
+            let _ = write!(md, " `{s}`: tiles culled / tested, fragments shaded |");
+        }
+        md += "\n|---|---|---|---|";
+        md += &"---|".repeat(self.scenes.len());
+        md += "\n";
+        for (platform, per_scene) in &self.counts {
+            let effects: Vec<&str> = per_scene
+                .iter()
+                .map(SceneCounts::engine_bits_effect)
+                .collect();
+            let effect = ["breaks", "weakens", "no"]
+                .into_iter()
+                .find(|e| effects.contains(e))
+                .unwrap_or("no");
+            let _ = write!(
+                md,
+                "| {} | {effect} | {} | {} |",
+                platform.name(),
+                platform.flush_or_reset(),
+                platform.brdfs_culled()
+            );
+            for c in per_scene {
+                let s = &c.with_bits;
+                let pct = if s.tiles_tested > 0 {
+                    format!(
+                        " ({:.0} %)",
+                        100.0 * s.tiles_culled as f64 / s.tiles_tested as f64
+                    )
+                } else {
+                    String::new()
+                };
+                let _ = write!(
+                    md,
+                    " {} / {}{pct}, {} |",
+                    s.tiles_culled, s.tiles_tested, s.fragments_shaded
+                );
+            }
+            md += "\n";
+        }
+        md += "\nNot yet in this table: the per-extra-BRDF cost of the talk's technique and of \
+               the depth-id technique, which need timings on the hardware itself.\n";
+        md
+    }
+
+    pub fn json(&self) -> Value {
+        let stats = |s: &TileStats| {
+            json!({"tiles_tested": s.tiles_tested, "tiles_culled": s.tiles_culled,
+                   "fragments_shaded": s.fragments_shaded, "flushes": s.flushes})
+        };
+        json!({
+            "device": self.device,
+            "driver": self.driver,
+            "width": self.width,
+            "height": self.height,
+            "tile_size": self.tile_size,
+            "engine_bits": ENGINE_BITS,
+            "scenes": self.scenes,
+            "platforms": self.counts.iter().map(|(p, per_scene)| json!({
+                "platform": p.name(),
+                "flush_or_reset": p.flush_or_reset(),
+                "brdfs_culled": p.brdfs_culled(),
+                "scenes": per_scene.iter().map(|c| json!({
+                    "with_engine_bits": stats(&c.with_bits),
+                    "without_engine_bits": stats(&c.without_bits),
+                    "fragments_the_frame_needs": c.expected_fragments,
+                    "engine_bits": c.engine_bits_effect(),
+                })).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+        })
+    }
+
+    /// Writes `todays-gpus.md` and `todays-gpus.json` into `dir`.
+    ///
+    /// # Errors
+    /// I/O errors.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>> {
+        let md = dir.join("todays-gpus.md");
+        write_file(&md, self.markdown().as_bytes())?;
+        let js = dir.join("todays-gpus.json");
+        crate::write_json(&js, &self.json())?;
+        Ok(vec![md, js])
+    }
+}
