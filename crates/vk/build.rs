@@ -125,6 +125,8 @@ fn shader_fingerprint(shader_dir: &Path, generated: &str) -> String {
         }
     };
     eat(histencil_build::GLSLC_OPTIONS.join(" ").as_bytes());
+    // How this script compiles (include order, which files are stages) is part of the output.
+    eat(include_bytes!("build.rs"));
     for path in paths {
         let relative = path.strip_prefix(shader_dir).unwrap();
         // `/` on every platform, so a package made on one verifies on another.

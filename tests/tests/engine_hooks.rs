@@ -87,6 +87,16 @@ fn hooks_that_are_not_spirv_are_refused() {
         ..LightModules::BUILTIN
     };
     assert!(refusal(hooks(modules, &bindings)).contains("tile_shade_8"));
+    // A module of another stage in a slot: no entry point for the pipeline that takes it.
+    let modules = LightModules {
+        deferred_light: LightModules::BUILTIN.tile_shade,
+        ..LightModules::BUILTIN
+    };
+    let err = refusal(hooks(modules, &bindings));
+    assert!(
+        err.contains("deferred_light: a module of stage COMPUTE, where histencil's deferred_light is FRAGMENT"),
+        "{err}"
+    );
     hooks(LightModules::BUILTIN, &bindings).expect("histencil's own decode, rightly described");
 }
 

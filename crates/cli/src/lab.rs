@@ -45,8 +45,8 @@ pub struct CompareArgs {
     sampling: SamplingArgs,
     /// Run this many busy threads beside the measurement: the same run under contention, to
     /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
-    #[arg(long, default_value_t = 0)]
-    beside_load: usize,
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
+    beside_load: u16,
     #[command(subcommand)]
     command: Option<CompareCommand>,
 }
@@ -307,7 +307,7 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     settings.scene = crate::load_scene_arg(&args.scene, lights)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;
-    settings.beside_load = args.beside_load;
+    settings.beside_load = usize::from(args.beside_load);
     let report = on_device(args.run.validate, |ctx| {
         Ok(with_spinner(|step| {
             histencil_lab::run_compare(ctx, &settings, step)

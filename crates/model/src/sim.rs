@@ -92,7 +92,8 @@ impl Simulator {
     /// are the same as without it, since a model rejects only tiles where nothing passes.
     ///
     /// # Panics
-    /// As [`Simulator::run`].
+    /// As [`Simulator::run`], and for a plan with hi-stencil state, flushes or a preserved-bits
+    /// save and restore (a console's plan): the hierarchy follows stencil written by draws only.
     pub fn run_with(
         &self,
         target: &mut SoftTarget,
@@ -100,6 +101,13 @@ impl Simulator {
         footprints: &[Footprint],
         hierarchy: &mut dyn TileHierarchy,
     ) -> SimResult {
+        assert!(
+            plan.steps.iter().all(|step| match step {
+                Step::Pass { pass, .. } => pass.state.hi_stencil.is_none(),
+                _ => false,
+            }),
+            "run_with runs plans without hi-stencil steps (the native plan)"
+        );
         self.run_on(target, plan, footprints, Some(hierarchy))
     }
 

@@ -165,6 +165,14 @@ pub(crate) fn check_modules(
         let histencils = spirv_words(own)
             .and_then(|w| reflect_bindings(&w))
             .expect("histencil's own modules are SPIR-V");
+        // The pipeline takes the module as its stage: a module of another stage, or none,
+        // would reach pipeline creation with no entry point for it.
+        if reflected.stages != histencils.stages {
+            return Err(setup(format!(
+                "a module of stage {:?}, where histencil's {name} is {:?} (from                  histencil_build's modules of this version?)",
+                reflected.stages, histencils.stages
+            )));
+        }
         for resource in &reflected.resources {
             let declared = match resource.set {
                 DECODE_SET => Some(("the decode layout (set 1)", layouts.decode)),

@@ -242,18 +242,32 @@ pub fn reflect_bindings(words: &[u32]) -> Result<ModuleBindings, String> {
         let Some(Type::Pointer { pointee, .. }) = types.get(&pointer).copied() else {
             return Err(format!("{}: its type is not a pointer", what()));
         };
-        // Arrays of resources: the element says what, the length how many.
-        let (element, count) = match types.get(&pointee).copied() {
-            Some(Type::Array { element, length_id }) => {
-                let length = constants
-                    .get(&length_id)
-                    .copied()
-                    .ok_or_else(|| format!("{}: an array of unknown length", what()))?;
-                (element, length)
+        // Arrays of resources (of arrays): the innermost element says what, the lengths' product
+        // how many; 0 for a runtime-sized array.
+        let (mut element, mut count) = (pointee, 1u32);
+        loop {
+            match types.get(&element).copied() {
+                Some(Type::Array {
+                    element: e,
+                    length_id,
+                }) => {
+                    let length = constants.get(&length_id).copied().ok_or_else(|| {
+                        format!(
+                            "{}: an array whose length is not a plain constant (a \
+                             specialization constant?)",
+                            what()
+                        )
+                    })?;
+                    count = count.saturating_mul(length);
+                    element = e;
+                }
+                Some(Type::RuntimeArray { element: e }) => {
+                    count = 0;
+                    element = e;
+                }
+                _ => break,
             }
-            Some(Type::RuntimeArray { element }) => (element, 0),
-            _ => (pointee, 1),
-        };
+        }
         let kind = match (class, types.get(&element).copied()) {
             (CLASS_STORAGE_BUFFER, Some(Type::Struct)) => ResourceKind::StorageBuffer,
             (CLASS_UNIFORM, Some(Type::Struct)) if buffer_blocks.contains(&element) => {

@@ -161,25 +161,23 @@ impl DeviceReport {
         }
     }
 
-    /// Every decided verdict of the report, keyed by what it is about.
+    /// Every verdict of the report, keyed by what it is about, decided again from its interval
+    /// by this version's rule ([`Verdict::of`]) whatever word the report stored: a report
+    /// written under another rule is judged as the others are.
     fn verdicts(&self) -> Vec<(String, Verdict)> {
         let mut out = Vec::new();
         for (name, cells) in &self.rows {
             for c in cells {
-                if let Some((_, word)) = &c.overhead {
+                if let Some((ratio, _)) = &c.overhead {
                     out.push((
                         format!("{name} at {} BRDFs over 1", c.brdfs),
-                        verdict_of(word),
+                        Verdict::of(ratio),
                     ));
                 }
             }
         }
         for s in &self.sizes {
-            let v = match s.faster.as_str() {
-                "stencil" => Verdict::Faster,
-                "branching" => Verdict::Slower,
-                other => verdict_of(other),
-            };
+            let v = Verdict::of(&s.stencil_over_branching);
             out.push((
                 format!(
                     "stencil over branching at {} % light size",
@@ -285,6 +283,24 @@ impl Merged {
         out
     }
 
+    /// How many pairs of runs' verdicts on the same thing are both decided, and how many of
+    /// those differ (reversals included).
+    pub fn decided_pairs(&self) -> (usize, usize) {
+        let all: Vec<Vec<(String, Verdict)>> = self.reports.iter().map(|r| r.verdicts()).collect();
+        let (mut pairs, mut differing) = (0, 0);
+        for a in 0..all.len() {
+            for b in a + 1..all.len() {
+                for ((_, va), (_, vb)) in all[a].iter().zip(&all[b]) {
+                    if va.decided() && vb.decided() {
+                        pairs += 1;
+                        differing += usize::from(va != vb);
+                    }
+                }
+            }
+        }
+        (pairs, differing)
+    }
+
     /// The reversals between two runs of one device and driver (different loads): a verdict
     /// that a change of conditions turned around, which the margin exists to prevent.
     pub fn same_device_reversals(&self) -> Vec<(String, usize, usize)> {
@@ -350,28 +366,27 @@ impl Merged {
             for (s, size) in first.sizes.iter().enumerate() {
                 let _ = write!(md, "| {} % |", 100.0 * size.coverage);
                 for r in &self.reports {
-                    let p = &r.sizes[s];
-                    let i = &p.stencil_over_branching;
-                    let _ = write!(
-                        md,
-                        " {:.3} [{:.3}, {:.3}] {} |",
-                        i.median, i.lo, i.hi, p.faster
-                    );
+                    let i = &r.sizes[s].stencil_over_branching;
+                    let faster = match Verdict::of(i) {
+                        Verdict::Faster => "stencil",
+                        Verdict::Slower => "branching",
+                        other => other.word(),
+                    };
+                    let _ = write!(md, " {:.3} [{:.3}, {:.3}] {faster} |", i.median, i.lo, i.hi);
                 }
                 md += "\n";
             }
         }
         let reversals = self.reversals();
-        let decided: usize = self
-            .reports
-            .iter()
-            .map(|r| r.verdicts().iter().filter(|(_, v)| v.decided()).count())
-            .sum();
+        let (pairs, differing) = self.decided_pairs();
         let _ = writeln!(
             md,
-            "\n## Verdicts that reverse\n\n{} of {decided} decided verdicts (faster, slower or \
-             within ±5 %, over all reports) are decided the opposite way in another report.\n",
-            reversals.len()
+            "\n## Verdicts that reverse\n\nOf {pairs} pairs of runs' verdicts on the same \
+             thing that are both decided (faster, slower or within ±5 %), {} reverse (faster \
+             in one run, slower in another) and {} differ otherwise (within ±5 % in one, \
+             faster or slower in another).\n",
+            reversals.len(),
+            differing - reversals.len()
         );
         for (what, a, b) in &reversals {
             let _ = writeln!(
@@ -493,14 +508,6 @@ impl Merged {
     }
 }
 
-/// A verdict from its word in a report.
-fn verdict_of(word: &str) -> Verdict {
-    [Verdict::Faster, Verdict::Slower, Verdict::Within]
-        .into_iter()
-        .find(|v| v.word() == word)
-        .unwrap_or(Verdict::Undecided)
-}
-
 fn verdict_word(r: &DeviceReport, what: &str) -> &'static str {
     r.verdicts()
         .into_iter()
@@ -518,7 +525,8 @@ fn cell_text(c: &MergedCell) -> String {
     let t = format!("{:.3} ms [{:.3}, {:.3}]", i.median, i.lo, i.hi);
     match &c.overhead {
         None => t,
-        Some((r, verdict)) => {
+        Some((r, _)) => {
+            let verdict = Verdict::of(r).word();
             let pct = |x: f64| 100.0 * (x - 1.0);
             format!(
                 "{t} ({:+.1} % [{:+.1}, {:+.1}], {verdict})",
@@ -608,7 +616,7 @@ mod tests {
         );
         assert!(md.contains("| stencil | 2 |"), "{md}");
         assert!(
-            md.contains("3.000 ms [2.700, 3.300] (+5.0 % [-5.5, +15.5], within ±5 %) | run 1 |"),
+            md.contains("3.000 ms [2.700, 3.300] (+5.0 % [-5.5, +15.5], undecided) | run 1 |"),
             "{md}"
         );
         assert!(
@@ -624,27 +632,43 @@ mod tests {
 
     #[test]
     fn a_verdict_turned_around_by_load_on_one_device_is_a_same_device_reversal() {
-        let quiet = report("q", "fast", "Mesa 22.3", "huge-lights");
+        let interval = |lo, median, hi| Interval {
+            lo,
+            median,
+            hi,
+            samples: 10,
+        };
+        let mut q = report("q", "fast", "Mesa 22.3", "huge-lights");
         let mut loaded = report("l", "fast", "Mesa 22.3", "huge-lights");
         loaded.beside_load = 2;
-        let mut q = quiet.clone();
-        q.sizes[0].faster = "branching".into();
-        loaded.sizes[0].faster = "within ±5 %".into();
+        // The verdicts come from the intervals, whatever word a report stored.
+        q.sizes[0].stencil_over_branching = interval(1.1, 1.2, 1.3);
+        q.sizes[0].faster = "stencil".into();
+        loaded.sizes[0].stencil_over_branching = interval(0.96, 1.0, 1.04);
         let merged = Merged::new(vec![q.clone(), loaded.clone()]).unwrap();
         assert!(
             merged.same_device_reversals().is_empty(),
             "within the margin is no reversal"
         );
-        loaded.sizes[0].faster = "stencil".into();
+        assert!(
+            merged.markdown().contains("Of 1 pairs"),
+            "{}",
+            merged.markdown()
+        );
+        assert!(merged
+            .markdown()
+            .contains("0 reverse (faster in one run, slower in another) and 1 differ otherwise"));
+        loaded.sizes[0].stencil_over_branching = interval(0.7, 0.8, 0.9);
         let merged = Merged::new(vec![q.clone(), loaded.clone()]).unwrap();
         let reversed = merged.same_device_reversals();
         assert_eq!(reversed.len(), 1, "{reversed:?}");
         assert_eq!(reversed[0].0, "stencil over branching at 1 % light size");
         let md = merged.markdown();
-        assert!(md.contains("1 of 4 decided verdicts"), "{md}");
+        assert!(md.contains("1 reverse"), "{md}");
         assert!(
             md.contains("slower in run 1, faster in run 2")
-                && md.contains("| run 2 | fast | Mesa 22.3 | beside 2 busy threads |"),
+                && md.contains("| run 2 | fast | Mesa 22.3 | beside 2 busy threads |")
+                && md.contains("| 1 % | 1.200 [1.100, 1.300] branching |"),
             "{md}"
         );
         // Across devices a reversal is a finding, not a failure.
