@@ -7,8 +7,7 @@
 //! ratio of medians, with the device. `cargo bench -p histencil-tests --bench engine_resize`.
 
 use ash::vk;
-use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
-use histencil_tests::engine::Engine;
+use histencil_tests::engine::{stencil_plan, Engine};
 use histencil_vk::{Backend, Context, DeferredLighting, LightHooks, LightingDesc};
 use std::time::Instant;
 
@@ -36,22 +35,7 @@ fn main() {
             hooks: LightHooks::Builtin,
         };
         let view = scene.camera.view_desc(16.0 / 9.0);
-        let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
-        let bounds = scene.brdf_bounds(&brdfs);
-        let plan = plan_frame(
-            &layout,
-            &PlanInputs {
-                lights: &shapes,
-                brdf_bounds: &bounds,
-                view: &View::new(&view).unwrap(),
-            },
-            &PlanSettings {
-                technique: TechniqueChoice::Stencil,
-                caps: Backend::Ps3.platform().caps(),
-                flush: FlushPolicy::Auto,
-            },
-        )
-        .unwrap();
+        let plan = stencil_plan(&scene, &layout, &brdfs, &view, Backend::Ps3);
         let sizes = [(320, 180), (640, 360)];
         let mut lighting = DeferredLighting::new(&ctx, &desc(sizes[0])).unwrap();
         lighting.prepare(&plan).unwrap();

@@ -515,3 +515,49 @@ pub fn assert_same_hdr(expected: &[f32], engine: &[f32]) {
         .count();
     assert_eq!(differing, 0, "channels differ from the renderer's frame");
 }
+
+/// The stencil technique's plan of `scene`'s lights and BRDF bounds for `view` on `backend`,
+/// as an engine makes it each frame (`plan_frame`), in `layout` with the BRDF slots `brdfs`.
+pub fn stencil_plan(
+    scene: &histencil_scene::Scene,
+    layout: &histencil_model::StencilLayout,
+    brdfs: &[histencil_brdf::BrdfId],
+    view: &histencil_model::ViewDesc,
+    backend: histencil_vk::Backend,
+) -> histencil_model::FramePlan {
+    use histencil_model::{FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
+    let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
+    let bounds = scene.brdf_bounds(brdfs);
+    let inputs = PlanInputs {
+        lights: &shapes,
+        brdf_bounds: &bounds,
+        view: &View::new(view).expect("a valid view"),
+    };
+    let settings = PlanSettings {
+        technique: TechniqueChoice::Stencil,
+        caps: backend.platform().caps(),
+        flush: FlushPolicy::Auto,
+    };
+    histencil_model::plan_frame(layout, &inputs, &settings).expect("a plan")
+}
+
+/// A frame of `plan` in slot 0 with the HDR target cleared, formula BRDFs, no timestamps or
+/// statistics, and `hook_sets`.
+pub fn plain_frame<'a>(
+    view: &'a histencil_model::ViewDesc,
+    lights: &'a [histencil_scene::Light],
+    plan: &'a histencil_model::FramePlan,
+    hook_sets: histencil_vk::HookSets,
+) -> histencil_vk::LightingFrame<'a> {
+    histencil_vk::LightingFrame {
+        slot: 0,
+        view,
+        lights,
+        plan,
+        clear_hdr: true,
+        timestamps: false,
+        brdf_source: histencil_vk::BrdfSource::Formula,
+        tile_stats: false,
+        hook_sets,
+    }
+}

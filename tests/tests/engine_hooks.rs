@@ -6,12 +6,10 @@
 //! engine's own decode set, described rightly, lights the frame bit for bit as histencil's own.
 
 use ash::vk;
-use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
-use histencil_tests::engine::{copy_to_buffer, hdr_floats, Engine};
+use histencil_tests::engine::{copy_to_buffer, hdr_floats, plain_frame, stencil_plan, Engine};
 use histencil_vk::{
-    Backend, BrdfSource, Context, DeferredLighting, EngineHooks, Error, HookSetLayout, HookSets,
-    LightHooks, LightModules, LightingDesc, LightingFrame, MixedTiles, Renderer, TileClassify,
-    TileSide, TiledFrame,
+    Backend, Context, DeferredLighting, EngineHooks, Error, HookSetLayout, HookSets, LightHooks,
+    LightModules, LightingDesc, MixedTiles, Renderer, TileClassify, TileSide, TiledFrame,
 };
 
 /// The bindings of histencil's own decode (`include/gbuffer.glsl`: three sampled images), as an
@@ -190,19 +188,7 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         let mut engines = DeferredLighting::new(&ctx, &desc(LightHooks::Engine(hooks))).unwrap();
         let mut histencils = DeferredLighting::new(&ctx, &desc(LightHooks::Builtin)).unwrap();
         let view = scene.camera.view_desc(width as f32 / height as f32);
-        let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
-        let bounds = scene.brdf_bounds(&brdfs);
-        let inputs = PlanInputs {
-            lights: &shapes,
-            brdf_bounds: &bounds,
-            view: &View::new(&view).unwrap(),
-        };
-        let settings = PlanSettings {
-            technique: TechniqueChoice::Stencil,
-            caps: Backend::Ps3.platform().caps(),
-            flush: FlushPolicy::Auto,
-        };
-        let plan = plan_frame(&layout, &inputs, &settings).unwrap();
+        let plan = stencil_plan(&scene, &layout, &brdfs, &view, Backend::Ps3);
 
         // The engine's decode set: its three G-buffer images.
         let images = engine.lighting_targets(extent, ds_format);
@@ -245,17 +231,7 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         let lit = |lighting: &mut DeferredLighting<&Context>, hook_sets: HookSets| {
             let mut targets = images.refs();
             let (pool, cmd) = engine.command_buffer();
-            let frame = LightingFrame {
-                slot: 0,
-                view: &view,
-                lights: &scene.lights,
-                plan: &plan,
-                clear_hdr: true,
-                timestamps: false,
-                brdf_source: BrdfSource::Formula,
-                tile_stats: false,
-                hook_sets,
-            };
+            let frame = plain_frame(&view, &scene.lights, &plan, hook_sets);
             // SAFETY: recording on the lent device; each frame is waited for.
             unsafe {
                 d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
@@ -290,17 +266,7 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
             decode: Some(decode_set),
             visibility: None,
         };
-        let frame = LightingFrame {
-            slot: 0,
-            view: &view,
-            lights: &scene.lights,
-            plan: &plan,
-            clear_hdr: true,
-            timestamps: false,
-            brdf_source: BrdfSource::Formula,
-            tile_stats: false,
-            hook_sets,
-        };
+        let frame = plain_frame(&view, &scene.lights, &plan, hook_sets);
         let mut refused = |mut targets: histencil_vk::LightingTargets, words: &str| {
             // SAFETY: refused before any command is recorded.
             let err = unsafe { engines.record(cmd, &frame, &mut targets) }.unwrap_err();

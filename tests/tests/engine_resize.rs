@@ -5,11 +5,13 @@
 //! buffers resized), under the validation layer with synchronisation validation.
 
 use ash::vk;
-use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
-use histencil_tests::engine::{assert_same_hdr, copy_to_buffer, hdr_floats, Engine};
+use histencil_model::FlushPolicy;
+use histencil_tests::engine::{
+    assert_same_hdr, copy_to_buffer, hdr_floats, plain_frame, stencil_plan, Engine,
+};
 use histencil_vk::{
-    Backend, BrdfSource, Context, DeferredLighting, HookSets, LightHooks, LightingDesc,
-    LightingFrame, MixedTiles, Readback, Renderer, Technique, TileClassify, TileSide, TiledFrame,
+    Backend, Context, DeferredLighting, HookSets, LightHooks, LightingDesc, MixedTiles, Readback,
+    Renderer, Technique, TileClassify, TileSide, TiledFrame,
 };
 
 #[test]
@@ -45,22 +47,7 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
         )
         .unwrap();
         let view = scene.camera.view_desc(1.5);
-        let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
-        let bounds = scene.brdf_bounds(&brdfs);
-        let plan = plan_frame(
-            &layout,
-            &PlanInputs {
-                lights: &shapes,
-                brdf_bounds: &bounds,
-                view: &View::new(&view).unwrap(),
-            },
-            &PlanSettings {
-                technique: TechniqueChoice::Stencil,
-                caps: Backend::Ps3.platform().caps(),
-                flush: FlushPolicy::Auto,
-            },
-        )
-        .unwrap();
+        let plan = stencil_plan(&scene, &layout, &brdfs, &view, Backend::Ps3);
         let (side, mixed) = (TileSide::Sixteen, MixedTiles::PerBrdf);
         let d = &engine.device;
         // One frame at `size`: the renderer's G-buffer, then the lighting (tiled or the plan),
@@ -90,17 +77,7 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
                     };
                     lighting.record_tiled(cmd, &frame, &mut targets).unwrap();
                 } else {
-                    let frame = LightingFrame {
-                        slot: 0,
-                        view: &view,
-                        lights: &scene.lights,
-                        plan: &plan,
-                        clear_hdr: true,
-                        timestamps: false,
-                        brdf_source: BrdfSource::Formula,
-                        tile_stats: false,
-                        hook_sets: HookSets::default(),
-                    };
+                    let frame = plain_frame(&view, &scene.lights, &plan, HookSets::default());
                     lighting.record(cmd, &frame, &mut targets).unwrap();
                 }
                 copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
