@@ -696,5 +696,10 @@ fn todays_gpus_asks_the_talks_questions_of_every_platform() {
         assert!(culled > 0, "{}", platforms[amd]["platform"]);
     }
     assert!(stdout.contains("| amd-andor (GFX12) | no |"), "{stdout}");
+    // The depth-id model: a pass per BRDF in the frame, every surface pixel shaded once.
+    let depth_id = &json["depth_id"][0];
+    assert!(depth_id["passes"].as_u64().unwrap() >= 1, "{depth_id}");
+    let shaded = depth_id["stats"]["fragments_shaded"].as_u64().unwrap();
+    assert!(shaded > 0 && shaded <= 96 * 64, "{depth_id}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

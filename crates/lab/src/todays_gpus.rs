@@ -15,6 +15,7 @@ use crate::{write_file, Result};
 use histencil_model::amd::{
     choose_pretests, slot_tile_counts, AndOrTiles, PretestTiles, TileHierarchy,
 };
+use histencil_model::depth_id::{depth_id_stats, pixel_ids};
 use histencil_model::{FlushPolicy, TileStats, TileSurface};
 use histencil_scene::Scene;
 use histencil_vk::{Backend, Context, FrameDesc, Renderer, SimulatorInputs, Technique};
@@ -147,6 +148,9 @@ pub struct TodaysGpusReport {
     pub scenes: Vec<String>,
     /// Per platform ([`Platform::ALL`] order), per scene.
     pub counts: Vec<(Platform, Vec<SceneCounts>)>,
+    /// Per scene: the depth-id technique's passes (BRDFs in the frame) and what a hierarchical
+    /// depth would cull of them (`histencil_model::depth_id`), with the engine's bits.
+    pub depth_id: Vec<(usize, TileStats)>,
 }
 
 /// The simulator's counts of `platform` on `inputs` (captured with some engine bits).
@@ -183,6 +187,7 @@ pub fn run_todays_gpus(
     let mut counts: Vec<(Platform, Vec<SceneCounts>)> =
         Platform::ALL.iter().map(|p| (*p, Vec::new())).collect();
     let mut tile_size = 0;
+    let mut depth_id = Vec::new();
     for scene in scenes {
         progress(&scene.name);
         let renderer = &mut Renderer::new(ctx, scene.clone(), width, height)?;
@@ -197,6 +202,7 @@ pub fn run_todays_gpus(
         let without_bits = capture(renderer, 0)?;
         tile_size = with_bits.tile_size;
         let native = counts_of(renderer, &with_bits, Platform::Native)?;
+        depth_id.push(depth_id_counts(&with_bits));
         for (platform, per_scene) in counts.iter_mut() {
             per_scene.push(SceneCounts {
                 with_bits: counts_of(renderer, &with_bits, *platform)?,
@@ -213,7 +219,22 @@ pub fn run_todays_gpus(
         tile_size,
         scenes: scenes.iter().map(|s| s.name.clone()).collect(),
         counts,
+        depth_id,
     })
+}
+
+/// The depth-id technique on the captured frame: one pass per BRDF slot present.
+fn depth_id_counts(inputs: &SimulatorInputs) -> (usize, TileStats) {
+    let target = &inputs.target;
+    let layout = &inputs.layout;
+    let slots = target.stencil.iter().map(|s| layout.brdf_slot(*s));
+    let ids = pixel_ids(slots, &target.depth, inputs.plan.depth.far());
+    let mut passes: Vec<u16> = ids.iter().copied().filter(|&id| id > 0).collect();
+    passes.sort_unstable();
+    passes.dedup();
+    let tiles = TileSurface::new(target.width, target.height, inputs.tile_size);
+    let stats = depth_id_stats(&ids, target.width, &tiles, &passes);
+    (passes.len(), stats)
 }
 
 impl TodaysGpusReport {
@@ -270,6 +291,25 @@ impl TodaysGpusReport {
             }
             md += "\n";
         }
+        md += "\n## What engines ship instead: depth-id\n\nBevy's deferred lighting: each pixel's \
+               lighting-pass id (here its BRDF slot + 1) copied into a 16-bit depth target, one \
+               full-screen pass per id with compare EQUAL, each pixel looping over its tile's \
+               lights. A GPU's hierarchical depth keeps each tile's id range and rejects the \
+               tiles whose range excludes the pass's id; llvmpipe has none, so these rejections \
+               are modelled (`histencil_model::depth_id`), on the same captured frames. No \
+               flush, no stencil bits, the engine's bits untouched; an id range is not a set, so \
+               a tile holding ids 1 and 3 is not rejected for 2.\n\n| scene | passes | tiles \
+               culled / tested | fragments shaded |\n|---|---|---|---|\n";
+        for (scene, (passes, s)) in self.scenes.iter().zip(&self.depth_id) {
+            let _ = writeln!(
+                md,
+                "| `{scene}` | {passes} | {} / {} ({:.0} %) | {} |",
+                s.tiles_culled,
+                s.tiles_tested,
+                100.0 * s.tiles_culled as f64 / s.tiles_tested.max(1) as f64,
+                s.fragments_shaded
+            );
+        }
         md += "\nNot yet in this table: the per-extra-BRDF cost of the talk's technique and of \
                the depth-id technique, which need timings on the hardware itself.\n";
         md
@@ -288,6 +328,9 @@ impl TodaysGpusReport {
             "tile_size": self.tile_size,
             "engine_bits": ENGINE_BITS,
             "scenes": self.scenes,
+            "depth_id": self.depth_id.iter().map(|(passes, s)| json!({
+                "passes": passes, "stats": stats(s),
+            })).collect::<Vec<_>>(),
             "platforms": self.counts.iter().map(|(p, per_scene)| json!({
                 "platform": p.name(),
                 "flush_or_reset": p.flush_or_reset(),

@@ -50,6 +50,7 @@ pub mod amd;
 mod backend;
 mod chooser;
 mod costs_json;
+pub mod depth_id;
 mod footprint;
 mod frame;
 mod layout;
