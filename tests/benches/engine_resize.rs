@@ -7,8 +7,8 @@
 //! ratio of medians, with the device. `cargo bench -p histencil-tests --bench engine_resize`.
 
 use ash::vk;
-use histencil_tests::engine::{stencil_plan, Engine};
-use histencil_vk::{Backend, Context, DeferredLighting, LightHooks, LightingDesc};
+use histencil_tests::engine::{lighting_desc, stencil_plan, Engine};
+use histencil_vk::{Backend, Context, DeferredLighting, LightingDesc};
 use std::time::Instant;
 
 const ROUNDS: usize = 9;
@@ -23,16 +23,11 @@ fn main() {
         let brdfs = scene.brdfs_in_use();
         let layout = histencil_model::StencilLayout::new(brdfs.len() as u32, 0).unwrap();
         let extent = |(width, height)| vk::Extent2D { width, height };
+        let ds_format = ctx.depth_stencil_format().vk();
+        let lights = scene.lights.len();
         let desc = |size| LightingDesc {
-            layout,
-            brdfs: brdfs.clone(),
-            extent: extent(size),
-            depth_stencil_format: ctx.depth_stencil_format().vk(),
-            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
             frames_in_flight: 2,
-            max_lights: scene.lights.len() as u32,
-            hi_stencil: true,
-            hooks: LightHooks::Builtin,
+            ..lighting_desc(layout, brdfs.clone(), extent(size), ds_format, lights)
         };
         let view = scene.camera.view_desc(16.0 / 9.0);
         let plan = stencil_plan(&scene, &layout, &brdfs, &view, Backend::Ps3);

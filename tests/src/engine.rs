@@ -561,3 +561,25 @@ pub fn plain_frame<'a>(
         hook_sets,
     }
 }
+
+/// The lighting the engine tests make unless they say otherwise: histencil's own hooks, an
+/// RGBA16F HDR target, one frame in flight, the hi-stencil emulation on.
+pub fn lighting_desc(
+    layout: histencil_model::StencilLayout,
+    brdfs: Vec<histencil_brdf::BrdfId>,
+    extent: vk::Extent2D,
+    depth_stencil_format: vk::Format,
+    max_lights: usize,
+) -> histencil_vk::LightingDesc {
+    histencil_vk::LightingDesc {
+        layout,
+        brdfs,
+        extent,
+        depth_stencil_format,
+        hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+        frames_in_flight: 1,
+        max_lights: max_lights as u32,
+        hi_stencil: true,
+        hooks: histencil_vk::LightHooks::Builtin,
+    }
+}

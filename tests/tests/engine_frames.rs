@@ -8,7 +8,7 @@
 use ash::vk;
 use histencil_model::{plan_frame, FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
 use histencil_tests::engine::{
-    assert_same_hdr, barrier, copy_to_buffer, hdr_floats, lights_at, Engine,
+    assert_same_hdr, barrier, copy_to_buffer, hdr_floats, lighting_desc, lights_at, Engine,
 };
 use histencil_vk::{
     Backend, BrdfSource, Context, DeferredLighting, HookSets, ImageState, LightHooks, LightingDesc,
@@ -515,14 +515,7 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             native_only
                 .record(cmd, &frame, &mut t)
                 .expect("a native plan");
-            d.end_command_buffer(cmd).unwrap();
-            let queue = d.get_device_queue(engine.queue_family, 0);
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            d.queue_submit2(queue, &[submit], vk::Fence::null())
-                .unwrap();
-            d.queue_wait_idle(queue).unwrap();
-            d.destroy_command_pool(pool, None);
+            engine.submit_and_wait(pool, cmd);
         }
         // No emulation, no counters: no statistics rather than zeros.
         assert_eq!(native_only.tile_stats(frame.plan), None);
@@ -558,17 +551,13 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
         let plan = renderer.plan(technique).unwrap();
         let mut lighting = DeferredLighting::new(
             &ctx,
-            &LightingDesc {
-                layout: *renderer.stencil_layout(),
-                brdfs: renderer.brdfs().to_vec(),
+            &lighting_desc(
+                *renderer.stencil_layout(),
+                renderer.brdfs().to_vec(),
                 extent,
-                depth_stencil_format: ds_format,
-                hdr_format: vk::Format::R16G16B16A16_SFLOAT,
-                frames_in_flight: 1,
-                max_lights: scene.lights.len() as u32,
-                hi_stencil: true,
-                hooks: LightHooks::Builtin,
-            },
+                ds_format,
+                scene.lights.len(),
+            ),
         )
         .unwrap();
         // SAFETY: the renderer's tables outlive the one frame below, which is waited for.
@@ -598,14 +587,7 @@ fn an_engine_records_the_lut_technique_and_counts_tiles() {
             renderer.record_gbuffer(cmd, &mut targets).unwrap();
             lighting.record(cmd, &frame, &mut targets).unwrap();
             copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
-            d.end_command_buffer(cmd).unwrap();
-            let queue = d.get_device_queue(engine.queue_family, 0);
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            d.queue_submit2(queue, &[submit], vk::Fence::null())
-                .unwrap();
-            d.queue_wait_idle(queue).unwrap();
-            d.destroy_command_pool(pool, None);
+            engine.submit_and_wait(pool, cmd);
         }
         let ours = hdr_floats(readback.bytes());
         let stats = lighting.tile_stats(&plan).expect("made with hi-stencil");

@@ -6,7 +6,9 @@
 //! engine's own decode set, described rightly, lights the frame bit for bit as histencil's own.
 
 use ash::vk;
-use histencil_tests::engine::{copy_to_buffer, hdr_floats, plain_frame, stencil_plan, Engine};
+use histencil_tests::engine::{
+    copy_to_buffer, hdr_floats, lighting_desc, plain_frame, stencil_plan, Engine,
+};
 use histencil_vk::{
     Backend, Context, DeferredLighting, EngineHooks, Error, HookSetLayout, HookSets, LightHooks,
     LightModules, LightingDesc, MixedTiles, Renderer, TileClassify, TileSide, TiledFrame,
@@ -175,15 +177,8 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         }
         .unwrap();
         let desc = |hooks| LightingDesc {
-            layout,
-            brdfs: brdfs.clone(),
-            extent,
-            depth_stencil_format: ds_format,
-            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
-            frames_in_flight: 1,
-            max_lights: scene.lights.len() as u32,
-            hi_stencil: true,
             hooks,
+            ..lighting_desc(layout, brdfs.clone(), extent, ds_format, scene.lights.len())
         };
         let mut engines = DeferredLighting::new(&ctx, &desc(LightHooks::Engine(hooks))).unwrap();
         let mut histencils = DeferredLighting::new(&ctx, &desc(LightHooks::Builtin)).unwrap();
@@ -335,19 +330,19 @@ fn an_engine_names_brdfs_and_the_lighting_gives_their_stencil_slots() {
     histencil_tests::with_validated_context(|ctx| {
         let brdfs = vec![BrdfId::Ggx, BrdfId::Lambert, BrdfId::KajiyaKay];
         let layout = StencilLayout::new(3, 0).unwrap();
+        let extent = vk::Extent2D {
+            width: 16,
+            height: 16,
+        };
         let mut desc = LightingDesc {
-            layout,
-            brdfs: brdfs.clone(),
-            extent: vk::Extent2D {
-                width: 16,
-                height: 16,
-            },
-            depth_stencil_format: ctx.depth_stencil_format().vk(),
-            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
-            frames_in_flight: 1,
-            max_lights: 4,
             hi_stencil: false,
-            hooks: LightHooks::Builtin,
+            ..lighting_desc(
+                layout,
+                brdfs.clone(),
+                extent,
+                ctx.depth_stencil_format().vk(),
+                4,
+            )
         };
         for (slot, brdf) in brdfs.iter().enumerate() {
             assert_eq!(

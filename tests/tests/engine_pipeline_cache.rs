@@ -6,10 +6,10 @@
 //! (the 32-byte header alone after 17 pipelines), so it is not measured here.
 
 use ash::vk;
-use histencil_tests::engine::{copy_to_buffer, Engine};
+use histencil_tests::engine::{copy_to_buffer, lighting_desc, Engine};
 use histencil_vk::{
-    BorrowedDevice, Context, DeferredLighting, HookSets, LightHooks, LightingDesc, MixedTiles,
-    Renderer, TileClassify, TileSide, TiledFrame,
+    BorrowedDevice, Context, DeferredLighting, HookSets, MixedTiles, Renderer, TileClassify,
+    TileSide, TiledFrame,
 };
 
 #[test]
@@ -32,17 +32,13 @@ fn an_engines_pipeline_cache_serves_every_lighting_on_its_device() {
         assert_eq!(ctx.pipeline_cache(), cache);
         let ds_format = ctx.depth_stencil_format().vk();
         let renderer = Renderer::new(&ctx, scene.clone(), width, height).unwrap();
-        let desc = LightingDesc {
-            layout: *renderer.stencil_layout(),
-            brdfs: renderer.brdfs().to_vec(),
-            extent: vk::Extent2D { width, height },
-            depth_stencil_format: ds_format,
-            hdr_format: vk::Format::R16G16B16A16_SFLOAT,
-            frames_in_flight: 1,
-            max_lights: scene.lights.len() as u32,
-            hi_stencil: true,
-            hooks: LightHooks::Builtin,
-        };
+        let desc = lighting_desc(
+            *renderer.stencil_layout(),
+            renderer.brdfs().to_vec(),
+            vk::Extent2D { width, height },
+            ds_format,
+            scene.lights.len(),
+        );
         let view = scene.camera.view_desc(1.5);
         for _ in 0..2 {
             let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();

@@ -7,11 +7,11 @@
 use ash::vk;
 use histencil_model::FlushPolicy;
 use histencil_tests::engine::{
-    assert_same_hdr, copy_to_buffer, hdr_floats, plain_frame, stencil_plan, Engine,
+    assert_same_hdr, copy_to_buffer, hdr_floats, lighting_desc, plain_frame, stencil_plan, Engine,
 };
 use histencil_vk::{
-    Backend, Context, DeferredLighting, HookSets, LightHooks, LightingDesc, MixedTiles, Readback,
-    Renderer, Technique, TileClassify, TileSide, TiledFrame,
+    Backend, Context, DeferredLighting, HookSets, MixedTiles, Readback, Renderer, Technique,
+    TileClassify, TileSide, TiledFrame,
 };
 
 #[test]
@@ -33,17 +33,13 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
         let brdfs = small_renderer.brdfs().to_vec();
         let mut lighting = DeferredLighting::new(
             &ctx,
-            &LightingDesc {
+            &lighting_desc(
                 layout,
-                brdfs: brdfs.clone(),
-                extent: extent(small),
-                depth_stencil_format: ds_format,
-                hdr_format: vk::Format::R16G16B16A16_SFLOAT,
-                frames_in_flight: 1,
-                max_lights: scene.lights.len() as u32,
-                hi_stencil: true,
-                hooks: LightHooks::Builtin,
-            },
+                brdfs.clone(),
+                extent(small),
+                ds_format,
+                scene.lights.len(),
+            ),
         )
         .unwrap();
         let view = scene.camera.view_desc(1.5);
