@@ -269,36 +269,28 @@ impl Merged {
     /// Every verdict decided one way in one report and the other way in another:
     /// `(what, report a, report b)`.
     pub fn reversals(&self) -> Vec<(String, usize, usize)> {
+        self.decided_both()
+            .into_iter()
+            .filter(|p| p.2.reverses(p.4))
+            .map(|(what, a, _, b, _)| (what, a, b))
+            .collect()
+    }
+
+    /// Every pair of runs' verdicts on the same thing that both decided:
+    /// `(what, run a, its verdict, run b, its verdict)`.
+    fn decided_both(&self) -> Vec<(String, usize, Verdict, usize, Verdict)> {
         let all: Vec<Vec<(String, Verdict)>> = self.reports.iter().map(|r| r.verdicts()).collect();
         let mut out = Vec::new();
         for a in 0..all.len() {
             for b in a + 1..all.len() {
                 for ((what, va), (_, vb)) in all[a].iter().zip(&all[b]) {
-                    if va.reverses(*vb) {
-                        out.push((what.clone(), a, b));
+                    if va.decided() && vb.decided() {
+                        out.push((what.clone(), a, *va, b, *vb));
                     }
                 }
             }
         }
         out
-    }
-
-    /// How many pairs of runs' verdicts on the same thing are both decided, and how many of
-    /// those differ (reversals included).
-    pub fn decided_pairs(&self) -> (usize, usize) {
-        let all: Vec<Vec<(String, Verdict)>> = self.reports.iter().map(|r| r.verdicts()).collect();
-        let (mut pairs, mut differing) = (0, 0);
-        for a in 0..all.len() {
-            for b in a + 1..all.len() {
-                for ((_, va), (_, vb)) in all[a].iter().zip(&all[b]) {
-                    if va.decided() && vb.decided() {
-                        pairs += 1;
-                        differing += usize::from(va != vb);
-                    }
-                }
-            }
-        }
-        (pairs, differing)
     }
 
     /// The reversals between two runs of one device and driver (different loads): a verdict
@@ -377,8 +369,10 @@ impl Merged {
                 md += "\n";
             }
         }
-        let reversals = self.reversals();
-        let (pairs, differing) = self.decided_pairs();
+        let decided = self.decided_both();
+        let reversals: Vec<_> = decided.iter().filter(|p| p.2.reverses(p.4)).collect();
+        let differing = decided.iter().filter(|p| p.2 != p.4).count();
+        let pairs = decided.len();
         let _ = writeln!(
             md,
             "\n## Verdicts that reverse\n\nOf {pairs} pairs of runs' verdicts on the same \
@@ -388,13 +382,13 @@ impl Merged {
             reversals.len(),
             differing - reversals.len()
         );
-        for (what, a, b) in &reversals {
+        for (what, a, va, b, vb) in &reversals {
             let _ = writeln!(
                 md,
                 "- {what}: {} in run {}, {} in run {}",
-                verdict_word(&self.reports[*a], what),
+                va.word(),
                 a + 1,
-                verdict_word(&self.reports[*b], what),
+                vb.word(),
                 b + 1
             );
         }
@@ -506,13 +500,6 @@ impl Merged {
         self.plot(&png)?;
         Ok(vec![md, js, png])
     }
-}
-
-fn verdict_word(r: &DeviceReport, what: &str) -> &'static str {
-    r.verdicts()
-        .into_iter()
-        .find(|(w, _)| w == what)
-        .map_or("?", |(_, v)| v.word())
 }
 
 fn interval_json(i: &Interval) -> Value {
