@@ -16,7 +16,7 @@ use histencil_model::amd::{
     choose_pretests, slot_tile_counts, AndOrTiles, PretestTiles, TileHierarchy,
 };
 use histencil_model::depth_id::{depth_id_stats, pixel_ids};
-use histencil_model::{FlushPolicy, TileStats, TileSurface};
+use histencil_model::{FlushPolicy, FramePlan, TileStats, TileSurface};
 use histencil_scene::Scene;
 use histencil_vk::{Backend, Context, FrameDesc, Renderer, SimulatorInputs, Technique};
 use serde_json::{json, Value};
@@ -154,12 +154,7 @@ pub struct TodaysGpusReport {
 }
 
 /// The simulator's counts of `platform` on `inputs` (captured with some engine bits).
-fn counts_of(
-    renderer: &Renderer,
-    inputs: &SimulatorInputs,
-    platform: Platform,
-) -> Result<TileStats> {
-    let plan = renderer.plan(platform.technique())?;
+fn counts_of(inputs: &SimulatorInputs, platform: Platform, plan: &FramePlan) -> TileStats {
     let target = &inputs.target;
     let tiles = TileSurface::new(target.width, target.height, inputs.tile_size);
     let mut hierarchy: Box<dyn TileHierarchy> = match platform {
@@ -168,9 +163,9 @@ fn counts_of(
             Box::new(PretestTiles::new(choose_pretests(&inputs.layout, &counts)))
         }
         Platform::AmdAndOr => Box::new(AndOrTiles::new()),
-        _ => return Ok(inputs.predict_plan(&plan).0.stats),
+        _ => return inputs.predict_plan(plan).0.stats,
     };
-    Ok(inputs.predict_with(&plan, hierarchy.as_mut()).0.stats)
+    inputs.predict_with(plan, hierarchy.as_mut()).0.stats
 }
 
 /// Runs every platform on every scene at `width` x `height`.
@@ -201,12 +196,19 @@ pub fn run_todays_gpus(
         let with_bits = capture(renderer, ENGINE_BITS)?;
         let without_bits = capture(renderer, 0)?;
         tile_size = with_bits.tile_size;
-        let native = counts_of(renderer, &with_bits, Platform::Native)?;
         depth_id.push(depth_id_counts(&with_bits));
-        for (platform, per_scene) in counts.iter_mut() {
+        // The plans follow the lights and the view, not the engine's bits: one per platform.
+        let plans = Platform::ALL
+            .iter()
+            .map(|p| renderer.plan(p.technique()))
+            .collect::<histencil_vk::Result<Vec<FramePlan>>>()?;
+        let native_at = Platform::ALL.iter().position(|p| *p == Platform::Native);
+        let native_plan = &plans[native_at.expect("native is a platform")];
+        let native = counts_of(&with_bits, Platform::Native, native_plan);
+        for ((platform, per_scene), plan) in counts.iter_mut().zip(&plans) {
             per_scene.push(SceneCounts {
-                with_bits: counts_of(renderer, &with_bits, *platform)?,
-                without_bits: counts_of(renderer, &without_bits, *platform)?,
+                with_bits: counts_of(&with_bits, *platform, plan),
+                without_bits: counts_of(&without_bits, *platform, plan),
                 expected_fragments: native.fragments_shaded,
             });
         }
