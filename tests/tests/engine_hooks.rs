@@ -299,6 +299,14 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
             err.to_string().contains("tile_classify (the tiled technique) reads set 1 binding 0 (`gbuffer_albedo`), a sampled image (texture2D) and the decode layout (set 1) makes it visible to FRAGMENT only, not COMPUTE"),
             "{err}"
         );
+        // The depth-id technique classifies with the same kernels: refused the same way.
+        // SAFETY: refused before any command is recorded.
+        let err = unsafe { engines.record_depth_id(cmd, &tiled, &mut images.refs()) }.unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("tile_classify (the tiled technique) reads set 1 binding 0"),
+            "{err}"
+        );
         assert_eq!(
             engines.tiled_pipeline_count(),
             0,

@@ -1,10 +1,11 @@
-//! The tiled technique recorded into an engine's frames through `DeferredLighting::record_tiled`:
-//! the engine's own device, images and fences, two frames in flight, lights moving every frame,
-//! both tile sides, both ways of shading mixed tiles and both shapes of the classification. Each
-//! of its last four frames (every side and mixed-tile mode; each side classified both ways) must
-//! equal histencil's Renderer lighting the same state with the same tiling (classified as the
-//! device prefers), bit for bit, and the validation layer with synchronisation validation must see
-//! nothing. A lighting whose HDR format the
+//! The tiled technique recorded into an engine's frames through `DeferredLighting::record_tiled`,
+//! and the depth-id technique through `record_depth_id`: the engine's own device, images and
+//! fences, two frames in flight, lights moving every frame, both tile sides, both ways of shading
+//! mixed tiles, both shapes of the classification, and both techniques. Each of its last six
+//! frames (every side with every mixed-tile mode and with depth ids; each side classified both
+//! ways) must equal histencil's Renderer lighting the same state with the same technique
+//! (classified as the device prefers), bit for bit, and the validation layer with
+//! synchronisation validation must see nothing. A lighting whose HDR format the
 //! kernels cannot store to is refused before anything is recorded.
 
 use ash::vk;
@@ -16,7 +17,7 @@ use histencil_vk::{
 
 const WIDTH: u32 = 96;
 const HEIGHT: u32 = 64;
-const FRAMES: usize = 5;
+const FRAMES: usize = 7;
 const IN_FLIGHT: usize = 2;
 
 /// The classification's shape in frame `f`: each side comes round in both within four frames.
@@ -28,17 +29,18 @@ fn shape(f: usize) -> TileClassify {
     }
 }
 
-/// The tiling of frame `f`: every side and mixed-tile mode comes round in four frames.
-fn tiling(f: usize) -> (TileSide, MixedTiles) {
+/// The technique of frame `f`: tiled with each mixed-tile mode, or depth ids (`None`), each with
+/// both sides, within six frames.
+fn tiling(f: usize) -> (TileSide, Option<MixedTiles>) {
     let side = if f.is_multiple_of(2) {
         TileSide::Eight
     } else {
         TileSide::Sixteen
     };
-    let mixed = if f % 4 < 2 {
-        MixedTiles::PerBrdf
-    } else {
-        MixedTiles::Branching
+    let mixed = match f % 6 {
+        0 | 1 => Some(MixedTiles::PerBrdf),
+        2 | 3 => Some(MixedTiles::Branching),
+        _ => None,
     };
     (side, mixed)
 }
@@ -70,8 +72,8 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
         };
         let mut lighting = DeferredLighting::new(&ctx, &desc).unwrap();
         let images = engine.lighting_targets(extent, ds_format);
-        // The last four frames' HDR images, one readback each (two frames may be in flight).
-        let captured = FRAMES - 4..FRAMES;
+        // The last six frames' HDR images, one readback each (two frames may be in flight).
+        let captured = FRAMES - 6..FRAMES;
         let readbacks: Vec<_> = captured
             .clone()
             .map(|_| engine.readback_buffer(u64::from(WIDTH * HEIGHT) * 8))
@@ -100,11 +102,14 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                     lights: &lights,
                     clear_hdr: true,
                     side,
-                    mixed,
+                    mixed: mixed.unwrap_or(MixedTiles::PerBrdf),
                     classify: shape(f),
                     hook_sets: HookSets::default(),
                 };
-                lighting.record_tiled(cmd, &frame, &mut targets).unwrap();
+                match mixed {
+                    Some(_) => lighting.record_tiled(cmd, &frame, &mut targets).unwrap(),
+                    None => lighting.record_depth_id(cmd, &frame, &mut targets).unwrap(),
+                }
                 if captured.contains(&f) {
                     let readback = &readbacks[f - captured.start];
                     copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
@@ -126,10 +131,11 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
             let mut lit = scene.clone();
             lit.lights = lights_at(&scene, f);
             let mut reference = Renderer::new(&ctx, lit, WIDTH, HEIGHT).unwrap();
-            let (side, mixed) = tiling(f);
-            let expected = reference
-                .render(Technique::Tiled { mixed, side }, readback_hdr)
-                .unwrap();
+            let technique = match tiling(f) {
+                (side, Some(mixed)) => Technique::Tiled { mixed, side },
+                (side, None) => Technique::DepthId { side },
+            };
+            let expected = reference.render(technique, readback_hdr).unwrap();
             let engine_hdr = hdr_floats(readback.bytes());
             assert_same_hdr(&expected.images.hdr.unwrap().into_raw(), &engine_hdr);
         }
@@ -162,6 +168,19 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
             match other.record_tiled(cmd, &frame, &mut refs) {
                 Err(Error::BadFrame(m)) => assert!(m.contains("rgba16f"), "{m}"),
                 other => panic!("a packed HDR target was not refused: {other:?}"),
+            }
+            match other.record_depth_id(cmd, &frame, &mut refs) {
+                Err(Error::BadFrame(m)) => assert!(m.contains("rgba16f"), "{m}"),
+                other => panic!("a packed HDR target was not refused by depth-id: {other:?}"),
+            }
+            // Depth ids give each BRDF a pass of its own: no kernel branches over mixed tiles.
+            let branching = TiledFrame {
+                mixed: MixedTiles::Branching,
+                ..frame
+            };
+            match lighting.record_depth_id(cmd, &branching, &mut images.refs()) {
+                Err(Error::BadFrame(m)) => assert!(m.contains("a pass of its own"), "{m}"),
+                other => panic!("depth-id with branching mixed tiles was accepted: {other:?}"),
             }
             d.end_command_buffer(cmd).unwrap();
         }

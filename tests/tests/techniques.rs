@@ -131,6 +131,16 @@ fn check(scene_name: &str) {
                 "{scene_name}: 8x8 tiles"
             );
         }
+        // The depth-id technique finds each BRDF's pixels by a depth test instead of tile
+        // lists, and adds the same lights the same way: the tiled image, with either tile.
+        for side in [TileSide::Sixteen, TileSide::Eight] {
+            let (image, _) = against_forward("depth-id", Technique::DepthId { side }, TOLERANCE);
+            assert_eq!(
+                diff(&tiled, &image).pixels_differing,
+                0,
+                "{scene_name}: depth-id with {side:?} tiles"
+            );
+        }
         // The LUT technique is approximate: its own tolerance, at the default resolution, with
         // hi-stencil (ps3) and without (native). It has no table for glTF's metallic-roughness
         // BRDF, and says so.

@@ -43,13 +43,15 @@ pub const GLSLC_OPTIONS: [&str; 4] = [
 pub const HOOK_FILES: [&str; 2] = ["surface_decode.glsl", "light_visibility.glsl"];
 
 /// The light shaders that call the hooks, compiled per engine.
-pub const HOOKED_STAGES: [&str; 6] = [
+pub const HOOKED_STAGES: [&str; 8] = [
     "deferred_light.frag",
     "lut_light.frag",
     "tile_classify.comp",
     "tile_shade.comp",
     "tile_classify_8.comp",
     "tile_shade_8.comp",
+    "depth_id_copy.frag",
+    "depth_id_shade.frag",
 ];
 
 /// Why the light shaders could not be compiled.

@@ -40,16 +40,20 @@ pub enum Lighting {
     /// Tile classification and one dispatch per BRDF (16x16 tiles, mixed tiles per BRDF); no
     /// stencil, so one configuration, like deferred.
     Tiled,
+    /// Bevy's depth ids: one full-screen pass per BRDF selected by depth compare EQUAL, lights
+    /// from 16x16 tiles' lists; one configuration, like tiled.
+    DepthId,
 }
 
 impl Lighting {
-    pub const ALL: [Lighting; 6] = [
+    pub const ALL: [Lighting; 7] = [
         Lighting::Stencil,
         Lighting::Branching,
         Lighting::Deferred,
         Lighting::Adaptive,
         Lighting::Lut,
         Lighting::Tiled,
+        Lighting::DepthId,
     ];
 
     pub fn name(self) -> &'static str {
@@ -60,6 +64,7 @@ impl Lighting {
             Lighting::Adaptive => "adaptive",
             Lighting::Lut => "lut",
             Lighting::Tiled => "tiled",
+            Lighting::DepthId => "depth-id",
         }
     }
 }
@@ -198,6 +203,9 @@ impl Config {
                 mixed: MixedTiles::PerBrdf,
                 side: TileSide::Sixteen,
             },
+            Lighting::DepthId => Technique::DepthId {
+                side: TileSide::Sixteen,
+            },
         }
     }
 }
@@ -227,7 +235,7 @@ impl Case {
             Some(c) => {
                 let lighting = match c.lighting {
                     Lighting::Deferred => "deferred".to_owned(),
-                    Lighting::Tiled => "tiled".to_owned(),
+                    Lighting::Tiled | Lighting::DepthId => c.lighting.name().to_owned(),
                     l => format!("{}-{}-{}", l.name(), c.platform.name(), flush_name(c.flush)),
                 };
                 let pattern = if c.pattern == 0 {
@@ -292,8 +300,11 @@ pub fn resolutions(quick: bool) -> Vec<(u32, u32)> {
 fn lighting_configs(pattern: u8, alpha: AlphaMode) -> Vec<Config> {
     let mut configs = Vec::new();
     for lighting in Lighting::ALL {
-        // Neither uses stencil or hi-stencil: one configuration on the native backend.
-        if lighting == Lighting::Deferred || lighting == Lighting::Tiled {
+        // None uses stencil or hi-stencil: one configuration on the native backend.
+        if matches!(
+            lighting,
+            Lighting::Deferred | Lighting::Tiled | Lighting::DepthId
+        ) {
             configs.push(Config {
                 lighting,
                 platform: Platform::Native,
@@ -462,8 +473,8 @@ mod tests {
     fn the_matrix_holds_what_a_scene_needs_and_nothing_else() {
         let room = cases(ROOM, DepthStencilFormat::D32S8, (257, 129));
         // Per pattern: stencil, adaptive, lut 7 each (x360, save-restore, ps3 with two flushes,
-        // native with one), branching 6 (not on native), deferred 1, tiled 1.
-        let lighting = 3 * 7 + 6 + 1 + 1;
+        // native with one), branching 6 (not on native), deferred 1, tiled 1, depth-id 1.
+        let lighting = 3 * 7 + 6 + 1 + 1 + 1;
         let known_wrong = 3;
         assert_eq!(room.len(), 1 + 2 * lighting + known_wrong);
         assert!(room

@@ -205,6 +205,10 @@ enum TechniqueArg {
     Tiled,
     /// As tiled, with a tile of several BRDFs shaded once by one kernel branching per pixel.
     TiledMixedBranching,
+    /// Bevy's: each pixel's BRDF as a 16-bit depth id, one full-screen pass per BRDF with
+    /// depth compare EQUAL, each pixel adding the lights of its --tile-size tile. The tiled
+    /// image, bit for bit.
+    DepthId,
     Deferred,
     Forward,
 }
@@ -288,6 +292,10 @@ impl RenderArgs {
             .into(),
             TechniqueArg::TiledMixedBranching => Technique::Tiled {
                 mixed: MixedTiles::Branching,
+                side: self.tile_side(ctx),
+            }
+            .into(),
+            TechniqueArg::DepthId => Technique::DepthId {
                 side: self.tile_side(ctx),
             }
             .into(),

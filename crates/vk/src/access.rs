@@ -124,6 +124,9 @@ pub enum ImageAccess {
     ComputeSampled,
     /// Read and written by compute shaders as a storage image.
     ComputeStorage,
+    /// Read and written by fragment shaders as a storage image (the depth-id technique's shade
+    /// passes).
+    FragmentStorage,
     /// Depth and stencil read-only, the stencil read by compute shaders through a
     /// stencil-aspect view (the hi-stencil tile update).
     ComputeDepthStencilSampled,
@@ -171,6 +174,11 @@ pub fn access_info(
         ImageAccess::ComputeStorage => (
             vk::ImageLayout::GENERAL,
             S::COMPUTE_SHADER,
+            A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+        ),
+        ImageAccess::FragmentStorage => (
+            vk::ImageLayout::GENERAL,
+            S::FRAGMENT_SHADER,
             A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
         ),
         ImageAccess::ComputeDepthStencilSampled => (

@@ -25,9 +25,10 @@ use crate::gpu_types::{FrameUniforms, GpuLight, PUSH_CONSTANT_BYTES};
 use crate::hi_stencil::HiStencilSurface;
 use crate::hooks::{HookSets, LightHooks};
 use crate::meshes::LightVolumes;
+use crate::passes::depth_id::{DepthIdDesc, DepthIdPass};
 use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
 use crate::passes::lighting::{Emulation, LightingPass};
-use crate::passes::tiled::{TiledDesc, TiledLighting, TiledSets};
+use crate::passes::tiled::{TiledDesc, TiledLighting, TiledSets, TiledShade};
 use crate::resources::Buffer;
 use crate::targets::GBUFFER_FORMATS;
 use crate::teardown::{Destroy, InFlight};
@@ -225,6 +226,8 @@ pub struct DeferredLighting<C: Deref<Target = Context>> {
     pipelines: LightPipelines,
     /// The tiled technique per tile side, made at its first frame with that side.
     tiled: Vec<(TileSide, TiledLighting)>,
+    /// The depth-id technique per tile side, made at its first frame with that side.
+    depth_id: Vec<(TileSide, DepthIdPass)>,
     in_flight: InFlight,
 }
 
@@ -272,6 +275,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             hi_stencil: None,
             volumes: None,
             tiled: Vec::new(),
+            depth_id: Vec::new(),
             in_flight: InFlight::default(),
             pipelines: LightPipelines::new(
                 vk::PipelineLayout::null(),
@@ -452,6 +456,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         for (_, tiled) in &mut self.tiled {
             tiled.resize(ctx, extent)?;
+        }
+        for (_, depth_id) in &mut self.depth_id {
+            depth_id.resize(ctx, extent)?;
         }
         self.desc.extent = extent;
         Ok(())
@@ -666,10 +673,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         self.pipelines.count()
     }
 
-    /// The tiled technique's pipelines created so far, over every tile side used (kept across
-    /// [`DeferredLighting::resize`]).
+    /// The tiled and depth-id techniques' pipelines created so far, over every tile side used
+    /// (kept across [`DeferredLighting::resize`]).
     pub fn tiled_pipeline_count(&self) -> usize {
-        self.tiled.iter().map(|(_, t)| t.pipeline_count()).sum()
+        let tiled = self.tiled.iter().map(|(_, t)| t.pipeline_count());
+        let depth_id = self.depth_id.iter().map(|(_, p)| p.pipeline_count());
+        tiled.chain(depth_id).sum()
     }
 
     /// Records `frame`'s lighting into `cmd` against `targets`, and leaves each target's state
@@ -828,7 +837,34 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &TiledFrame,
         targets: &mut LightingTargets,
     ) -> Result<()> {
-        self.record_tiled_with(cmd, frame, targets, |_, _| {})
+        self.record_tiled_with(cmd, frame, targets, TiledShade::Kernels, |_, _| {})
+    }
+
+    /// Records `frame` lit by the depth-id technique, as Bevy's deferred renderer lights its
+    /// lighting passes (`crate::passes::depth_id`): the tiled technique's classification and
+    /// light lists, then each pixel's BRDF slot copied into a 16-bit depth image and one
+    /// full-screen pass per BRDF drawn at its slot's depth with compare EQUAL, each pixel adding
+    /// its tile's lights. The same image as [`DeferredLighting::record_tiled`], bit for bit;
+    /// what differs is how a BRDF's pixels are found, which a GPU's hierarchical depth speeds
+    /// up. Leaves the HDR target in `GENERAL`, written by fragment shaders, and the G-buffer (or
+    /// the decode hook's images) read by fragment shaders; with an engine's decode hook the
+    /// depth-stencil image's depth read by them, in `DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL`.
+    ///
+    /// # Errors
+    /// As [`DeferredLighting::record_tiled`], and [`Error::BadFrame`] for
+    /// [`MixedTiles::Branching`]: each BRDF has its own pass here, so no tile is shaded by one
+    /// kernel branching per pixel.
+    ///
+    /// # Safety
+    /// As [`DeferredLighting::record_tiled`], and the hook resources are readable by fragment
+    /// shaders too.
+    pub unsafe fn record_depth_id(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &TiledFrame,
+        targets: &mut LightingTargets,
+    ) -> Result<()> {
+        self.record_tiled_with(cmd, frame, targets, TiledShade::DepthId, |_, _| {})
     }
 
     /// [`DeferredLighting::record_tiled`], calling `between` with the pass's name after the
@@ -842,8 +878,16 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         cmd: vk::CommandBuffer,
         frame: &TiledFrame,
         targets: &mut LightingTargets,
+        shade: TiledShade,
         mut between: impl FnMut(vk::CommandBuffer, &'static str),
     ) -> Result<()> {
+        if shade == TiledShade::DepthId && frame.mixed == MixedTiles::Branching {
+            return Err(bad(
+                "the depth-id technique shades each BRDF in a pass of its own: \
+                 MixedTiles::Branching is the tiled kernels' (record_tiled)"
+                    .to_owned(),
+            ));
+        }
         check_slot_and_lights(&self.desc, frame.slot, frame.lights.len())?;
         check_targets(&self.desc, &frame.hook_sets, targets)?;
         if let Some(why) = self.desc.hooks.tiled_refusal() {
@@ -858,6 +902,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             )));
         }
         self.prepare_tiled(frame.side)?;
+        if shade == TiledShade::DepthId {
+            self.prepare_depth_id(frame.side)?;
+        }
         let inputs = (frame.view, frame.lights, &frame.hook_sets);
         let (frame_set, decode_set) = self.write_slot(frame.slot, inputs, targets)?;
         let ctx: &Context = &self.ctx;
@@ -888,7 +935,59 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         between(cmd, "tile-classify");
         tiled.record_light_lists(ctx, cmd, frame.lights.len() as u32);
         between(cmd, "tile-lights");
-        tiled.record_shade(ctx, cmd, mixed);
+        match shade {
+            TiledShade::Kernels => tiled.record_shade(ctx, cmd, mixed),
+            TiledShade::DepthId => {
+                let side = frame.side;
+                let (_, pass) = self
+                    .depth_id
+                    .iter_mut()
+                    .find(|(s, _)| *s == side)
+                    .expect("made");
+                let bound = (
+                    [frame_set, decode_set, tiled.set(frame.slot)],
+                    sets.visibility,
+                );
+                let push = tiled.push_bytes(clear, mixed);
+                pass.record(ctx, cmd, frame.slot, bound, &push, targets, depth_sampled);
+            }
+        }
+        Ok(())
+    }
+
+    /// The set layout the decode hook binds at set 1: histencil's G-buffer's, or the engine's.
+    fn decode_layout(&self) -> vk::DescriptorSetLayout {
+        match &self.desc.hooks {
+            LightHooks::Builtin => self.set_layouts[1],
+            LightHooks::Engine(engine) => engine.decode_layout,
+        }
+    }
+
+    /// Makes the depth-id technique's pipelines and id images for tiles of `side`, if not yet
+    /// made (after the tiled technique's for that side, whose set layout it binds).
+    fn prepare_depth_id(&mut self, side: TileSide) -> Result<()> {
+        if self.depth_id.iter().any(|(s, _)| *s == side) {
+            return Ok(());
+        }
+        let tiled = &self.tiled.iter().find(|(s, _)| *s == side).expect("made").1;
+        let hooks = &self.desc.hooks;
+        let [frame, _, _, filler] = self.set_layouts;
+        let decode = self.decode_layout();
+        let mut set_layouts = vec![frame, decode, tiled.set_layout()];
+        if let Some(visibility) = hooks.visibility_layout() {
+            set_layouts.extend([filler, visibility]);
+        }
+        let desc = DepthIdDesc {
+            extent: self.desc.extent,
+            tile_side: side.pixels(),
+            brdfs: &self.desc.brdfs,
+            frames_in_flight: self.desc.frames_in_flight,
+            modules: &hooks.modules(),
+            set_layouts: &set_layouts,
+            push_bytes: TiledLighting::PUSH_BYTES,
+        };
+        let made = DepthIdPass::new(&self.ctx, &desc)?;
+        self.depth_id.push((side, made));
         Ok(())
     }
 
@@ -899,11 +998,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         let ctx: &Context = &self.ctx;
         let hooks = &self.desc.hooks;
-        let [frame, gbuffer, _, filler] = self.set_layouts;
-        let decode = match hooks {
-            LightHooks::Builtin => gbuffer,
-            LightHooks::Engine(engine) => engine.decode_layout,
-        };
+        let [frame, _, _, filler] = self.set_layouts;
+        let decode = self.decode_layout();
         let desc = TiledDesc {
             extent: self.desc.extent,
             side,
@@ -995,6 +1091,9 @@ impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
         self.pipelines.destroy(ctx);
         for (_, t) in &mut self.tiled {
             t.destroy(ctx);
+        }
+        for (_, p) in &mut self.depth_id {
+            p.destroy(ctx);
         }
         for slot in &mut self.slots {
             slot.uniforms.destroy(ctx);

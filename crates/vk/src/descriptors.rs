@@ -170,6 +170,8 @@ pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
     ("tile_shade.comp", TILED_LAYOUT),
     ("tile_classify_8.comp", TILED_LAYOUT),
     ("tile_shade_8.comp", TILED_LAYOUT),
+    ("depth_id_copy.frag", TILED_LAYOUT),
+    ("depth_id_shade.frag", TILED_LAYOUT),
 ];
 
 /// The stages of the graphics passes: every binding and push constant is visible to both.

@@ -19,7 +19,8 @@ use std::io::Cursor;
 
 /// The SPIR-V of the light shaders that call the hooks: `deferred_light.frag` (the talk's
 /// per-BRDF and branching shaders, by specialisation), `lut_light.frag` (the LUT technique) and
-/// the tiled technique's classification and shade kernels for 16x16 and 8x8 tiles.
+/// the tiled technique's classification and shade kernels for 16x16 and 8x8 tiles, and the
+/// depth-id technique's id copy and shade pass (`depth_id_copy.frag`, `depth_id_shade.frag`).
 /// `histencil_build::compile_light_shaders` writes this as an expression for `include!`.
 #[derive(Clone, Copy, Debug)]
 pub struct LightModules {
@@ -29,6 +30,8 @@ pub struct LightModules {
     pub tile_shade: &'static [u8],
     pub tile_classify_8: &'static [u8],
     pub tile_shade_8: &'static [u8],
+    pub depth_id_copy: &'static [u8],
+    pub depth_id_shade: &'static [u8],
 }
 
 impl LightModules {
@@ -40,10 +43,12 @@ impl LightModules {
         tile_shade: shaders::TILE_SHADE_COMP,
         tile_classify_8: shaders::TILE_CLASSIFY_8_COMP,
         tile_shade_8: shaders::TILE_SHADE_8_COMP,
+        depth_id_copy: shaders::DEPTH_ID_COPY_FRAG,
+        depth_id_shade: shaders::DEPTH_ID_SHADE_FRAG,
     };
 
     /// Each module with its name, for checks and messages.
-    fn named(&self) -> [(&'static str, &'static [u8]); 6] {
+    fn named(&self) -> [(&'static str, &'static [u8]); 8] {
         [
             ("deferred_light", self.deferred_light),
             ("lut_light", self.lut_light),
@@ -51,6 +56,8 @@ impl LightModules {
             ("tile_shade", self.tile_shade),
             ("tile_classify_8", self.tile_classify_8),
             ("tile_shade_8", self.tile_shade_8),
+            ("depth_id_copy", self.depth_id_copy),
+            ("depth_id_shade", self.depth_id_shade),
         ]
     }
 }

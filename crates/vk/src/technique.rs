@@ -85,9 +85,9 @@ impl Shading {
     pub fn lighting_passes(self) -> &'static [&'static str] {
         match self {
             Shading::Forward => &["forward"],
-            Shading::Deferred(Technique::Tiled { .. } | Technique::Adaptive { .. }) => {
-                &["tile-classify", "tile-lights", "lighting"]
-            }
+            Shading::Deferred(
+                Technique::Tiled { .. } | Technique::DepthId { .. } | Technique::Adaptive { .. },
+            ) => &["tile-classify", "tile-lights", "lighting"],
             Shading::Deferred(_) => &["lighting"],
         }
     }
@@ -130,6 +130,12 @@ pub enum Technique {
     /// on every platform. `mixed` says how tiles of several BRDFs are shaded, `side` how big a
     /// tile is.
     Tiled { mixed: MixedTiles, side: TileSide },
+    /// What Bevy's deferred renderer ships instead of stencil ids: each pixel's BRDF slot copied
+    /// into a 16-bit depth image, then one full-screen pass per BRDF drawn at its slot's depth
+    /// with compare EQUAL, so hierarchical depth rejects other BRDFs' tiles; each pixel adds
+    /// its tile's lights from the tiled technique's light lists (`passes/depth_id.rs`). The
+    /// same image as [`Technique::Tiled`], bit for bit. `side` is the light lists' tile.
+    DepthId { side: TileSide },
 }
 
 impl Technique {
@@ -152,7 +158,7 @@ impl Technique {
             Technique::Lut { backend, flush } => (TechniqueChoice::Branching, backend, flush),
             // Not planned: the classification decides on the GPU. The branching plan is what
             // the statistics and checks of a plan see.
-            Technique::Tiled { .. } => (
+            Technique::Tiled { .. } | Technique::DepthId { .. } => (
                 TechniqueChoice::Branching,
                 Backend::Native,
                 FlushPolicy::Auto,
@@ -163,6 +169,12 @@ impl Technique {
             caps: backend.platform().caps(),
             flush,
         }
+    }
+
+    /// Whether frames of this technique record a lighting plan (the tiled and depth-id
+    /// techniques classify on the GPU instead: no plan steps, no hi-stencil).
+    pub fn records_plan(self) -> bool {
+        !matches!(self, Technique::Tiled { .. } | Technique::DepthId { .. })
     }
 
     pub(crate) fn brdf_source(self) -> BrdfSource {

@@ -84,12 +84,19 @@ fn plan(
 
 /// The frame lit by the tiled technique, through the same hooks: the first captured one.
 const TILED_FRAME: usize = FRAMES - 2;
+/// The frame lit by the depth-id technique (Bevy's), through the same hooks: the last one.
+const DEPTH_ID_FRAME: usize = FRAMES - 1;
 
-/// How frame `f` is lit: planned, on its backend, or tiled.
+/// How frame `f` is lit: planned, on its backend, tiled, or by depth ids.
 fn technique(f: usize) -> Technique {
     if f == TILED_FRAME {
         return Technique::Tiled {
             mixed: MixedTiles::PerBrdf,
+            side: TileSide::Sixteen,
+        };
+    }
+    if f == DEPTH_ID_FRAME {
+        return Technique::DepthId {
             side: TileSide::Sixteen,
         };
     }
@@ -427,20 +434,25 @@ fn main() {
             // SAFETY: the command buffer is recording on the engine's device; the images' states
             // are the ones the engine's own barriers left; this slot's last frame has finished.
             // The tiled frame's kernels read the same hooks (their sets include the compute
-            // stage) and write the HDR image as storage.
+            // stage) and write the HDR image as storage; so do the depth-id frame's classification
+            // and its full-screen passes' fragment shaders.
+            let tiled = |side, mixed| TiledFrame {
+                slot: frame.slot,
+                view: &view,
+                lights: &lights,
+                clear_hdr: true,
+                side,
+                mixed,
+                classify: TileClassify::for_device(ctx.device_type()),
+                hook_sets: frame.hook_sets,
+            };
             match technique(f) {
                 Technique::Tiled { mixed, side } => {
-                    let tiled = TiledFrame {
-                        slot: frame.slot,
-                        view: &view,
-                        lights: &lights,
-                        clear_hdr: true,
-                        side,
-                        mixed,
-                        classify: TileClassify::for_device(ctx.device_type()),
-                        hook_sets: frame.hook_sets,
-                    };
-                    lighting.record_tiled(slot.cmd, &tiled, &mut targets)
+                    lighting.record_tiled(slot.cmd, &tiled(side, mixed), &mut targets)
+                }
+                Technique::DepthId { side } => {
+                    let frame = tiled(side, MixedTiles::PerBrdf);
+                    lighting.record_depth_id(slot.cmd, &frame, &mut targets)
                 }
                 _ => lighting.record(slot.cmd, &frame, &mut targets),
             }
@@ -741,7 +753,7 @@ fn main() {
     println!(
         "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward, \
          engine stencil bits {}, {messages} validation messages, G-buffer {bytes} bytes per \
-         pixel, {SHADOWED_LIGHTS} shadowed lights, frame {TILED_FRAME} tiled through the hooks",
+         pixel, {SHADOWED_LIGHTS} shadowed lights, frame {TILED_FRAME} tiled and frame {DEPTH_ID_FRAME} by depth ids through the hooks",
         if intact { "intact" } else { "NOT intact" }
     );
     let alpha_ok = alpha_worst <= ALPHA_TOLERANCE && alpha_pixels > 0;

@@ -130,6 +130,12 @@ pub fn table_rows() -> Vec<(&'static str, Technique)> {
                 side: TileSide::Eight,
             },
         ),
+        (
+            "depth-id",
+            Technique::DepthId {
+                side: TileSide::Sixteen,
+            },
+        ),
     ]
 }
 

@@ -16,6 +16,7 @@
 #include "frame.glsl"
 #include "surface_decode.glsl"
 #include "tiled.glsl"
+#include "pixel_surface.glsl"
 
 layout(local_size_x = TILED_TILE, local_size_y = TILED_TILE) in;
 
@@ -26,23 +27,6 @@ shared uint tile_brdfs;
 // Linear depths as float bits: positive floats order as their bits do.
 shared uint tile_near;
 shared uint tile_far;
-
-// The BRDF model id and linear depth of the surface under pixel `px`; false where none.
-bool tile_surface(ivec2 px, out uint model, out float depth) {
-#ifdef HISTENCIL_BUILTIN_DECODE
-    depth = texelFetch(gbuffer_normal_depth, px, 0).w;
-    model = uint(texelFetch(gbuffer_material, px, 0).w);
-    return depth > 0.0;
-#else
-    Surface s;
-    if (!decode_surface(vec2(px) + 0.5, s)) {
-        return false;
-    }
-    model = s.brdf;
-    depth = max(-(frame.view * vec4(s.position, 1.0)).z, 0.0);
-    return true;
-#endif
-}
 
 // Pixel `px`'s part in its tile's class: false where it has no surface; else its BRDF slot's
 // bit (0 for a BRDF the frame does not light) and the bits of its linear depth (positive floats
@@ -55,7 +39,7 @@ bool pixel_class(ivec2 px, out uint bit, out uint depth_bits) {
     bit = 0u;
     bool surface = tile_surface(px, model, depth);
     if (surface) {
-        uint slot = model < TILED_MODELS ? tiled.slot_of_model[model] : ~0u;
+        uint slot = slot_of_model(model);
         bit = slot < 32u ? 1u << slot : 0u;
         depth_bits = floatBitsToUint(depth);
     }

@@ -7,6 +7,7 @@
 //! per-frame recording (`lighting.rs`) and the light pipelines it creates per plan
 //! (`light_pipelines.rs`) live here and belong to `DeferredLighting`.
 
+pub(crate) mod depth_id;
 pub mod geometry;
 pub mod light_pipelines;
 pub mod lighting;

@@ -128,6 +128,16 @@ pub enum MixedTiles {
     Branching,
 }
 
+/// How the tiled classification's tiles are shaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TiledShade {
+    /// One indirect compute dispatch per BRDF over its tiles (the tiled technique).
+    Kernels,
+    /// One full-screen pass per BRDF selected by a depth id (the depth-id technique,
+    /// `passes/depth_id.rs`).
+    DepthId,
+}
+
 #[derive(Default)]
 pub(crate) struct TiledLighting {
     /// The tiled set's layout (set 2); sets 0, 1, 3 and 4 are the lighting's.
@@ -236,7 +246,9 @@ impl TiledLighting {
             slot_of_model[brdf.index() as usize] = slot as u32;
         }
         build(ctx, |t: &mut Self| {
-            t.set_layout = create_set_layout(ctx, "tiled-set-layout", TILED_SET, compute)?;
+            // The depth-id technique's fragment shaders bind it too (`passes/depth_id.rs`).
+            let stages = compute | vk::ShaderStageFlags::FRAGMENT;
+            t.set_layout = create_set_layout(ctx, "tiled-set-layout", TILED_SET, stages)?;
             let [frame, decode] = desc.layouts;
             let mut layouts = vec![frame, decode, t.set_layout];
             if let Some((filler, visibility)) = desc.visibility {
@@ -347,6 +359,37 @@ impl TiledLighting {
         Ok(())
     }
 
+    /// The push constants of a frame that clears the HDR target with `clear` and shades mixed
+    /// tiles as `mixed` says.
+    fn push(&self, clear: bool, mixed: MixedTiles) -> TiledPush {
+        TiledPush {
+            clear: u32::from(clear),
+            mixed: match mixed {
+                MixedTiles::PerBrdf => PER_BRDF,
+                MixedTiles::Branching => MIXED_SLOT as u32,
+            },
+            ..self.push.expect("made")
+        }
+    }
+
+    /// [`TiledLighting::push`] as the bytes a shader reads.
+    pub fn push_bytes(&self, clear: bool, mixed: MixedTiles) -> Vec<u8> {
+        bytemuck::bytes_of(&self.push(clear, mixed)).to_vec()
+    }
+
+    /// The tiled set layout (set 2), visible to compute and fragment shaders.
+    pub fn set_layout(&self) -> vk::DescriptorSetLayout {
+        self.set_layout
+    }
+
+    /// Frame-in-flight `slot`'s tiled set.
+    pub fn set(&self, slot: u32) -> vk::DescriptorSet {
+        self.sets[slot as usize]
+    }
+
+    /// The bytes of the push constants.
+    pub const PUSH_BYTES: u32 = size_of::<TiledPush>() as u32;
+
     /// The pipelines this technique holds.
     pub fn pipeline_count(&self) -> usize {
         4 + self.shade.len()
@@ -410,14 +453,7 @@ impl TiledLighting {
         shape: TileClassify,
     ) {
         let d = &ctx.device;
-        let push = TiledPush {
-            clear: u32::from(clear),
-            mixed: match mixed {
-                MixedTiles::PerBrdf => PER_BRDF,
-                MixedTiles::Branching => MIXED_SLOT as u32,
-            },
-            ..self.push.expect("made")
-        };
+        let push = self.push(clear, mixed);
         ctx.begin_label(cmd, "tiled-classify");
         for image in targets.gbuffer.iter_mut() {
             transition(ctx, cmd, image, ImageAccess::ComputeSampled, Contents::Keep);

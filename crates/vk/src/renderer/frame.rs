@@ -10,10 +10,11 @@ use crate::error::{Result, VkCall};
 use crate::hooks::HookSets;
 use crate::passes::geometry::{GbufferStencil, MeshInputs};
 use crate::passes::light_pipelines::BrdfSource;
+use crate::passes::tiled::TiledShade;
 use crate::passes::tonemap::TonemapInputs;
 use crate::readback::Readback;
 use crate::targets::GBUFFER_FORMATS;
-use crate::technique::{FrameDesc, Shading, Technique, TileClassify};
+use crate::technique::{FrameDesc, MixedTiles, Shading, Technique, TileClassify};
 use crate::timing::FrameTimings;
 use ash::vk;
 use histencil_model::{DepthConvention, FramePlan, ViewDesc};
@@ -76,9 +77,7 @@ impl Renderer<'_> {
         self.readback.record(ctx, cmd, &mut self.targets, readback);
         self.submit_and_wait()?;
         let mut timings = self.timestamps.read(ctx)?;
-        let planned = deferred
-            .as_ref()
-            .filter(|(t, _)| !matches!(t, Technique::Tiled { .. }));
+        let planned = deferred.as_ref().filter(|(t, _)| t.records_plan());
         if desc.pass_timing && planned.is_some() {
             timings.lighting = self.lighting.step_timings(0)?;
         }
@@ -90,7 +89,7 @@ impl Renderer<'_> {
         }
         let images = self.readback.read(readback)?;
         let tile_stats = match &deferred {
-            Some((t, plan)) if desc.tile_stats && !matches!(t, Technique::Tiled { .. }) => {
+            Some((t, plan)) if desc.tile_stats && t.records_plan() => {
                 self.lighting.tile_stats(plan)
             }
             _ => None,
@@ -135,7 +134,12 @@ impl Renderer<'_> {
             self.targets.lit(&targets);
         }
         self.timestamps.mark(ctx, cmd, "gbuffer");
-        if let Technique::Tiled { mixed, side } = technique {
+        let tiled = match technique {
+            Technique::Tiled { mixed, side } => Some((mixed, side, TiledShade::Kernels)),
+            Technique::DepthId { side } => Some((MixedTiles::PerBrdf, side, TiledShade::DepthId)),
+            _ => None,
+        };
+        if let Some((mixed, side, shade)) = tiled {
             let frame = TiledFrame {
                 slot: 0,
                 view,
@@ -152,7 +156,7 @@ impl Renderer<'_> {
             // SAFETY: as for `record` below.
             unsafe {
                 self.lighting
-                    .record_tiled_with(cmd, &frame, &mut targets, classified)?
+                    .record_tiled_with(cmd, &frame, &mut targets, shade, classified)?
             };
             self.targets.lit(&targets);
             self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
