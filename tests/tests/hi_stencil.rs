@@ -9,7 +9,9 @@
 
 use histencil_model::DepthConvention;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
-use histencil_vk::{Backend, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique};
+use histencil_vk::{
+    Backend, FlushPolicy, FrameDesc, Readback, Renderer, Shading, Technique, TileSide,
+};
 use image::RgbaImage;
 
 const SIZE: u32 = 160;
@@ -236,4 +238,50 @@ fn assert_simulated(renderer: &mut Renderer, desc: &FrameDesc, what: &str) {
         .filter(|(a, b)| a != b)
         .count();
     assert_eq!(wrong, 0, "{what}: stencil differs at {wrong} pixels");
+}
+
+/// The depth-id technique's ids, as the GPU writes them into its id image, are the ones the
+/// model makes from the G-buffer's stencil and depth, in every depth convention (the id image
+/// has a convention of its own, the same in all): the hierarchical-depth statistics of the two
+/// agree, and every surface pixel is shaded once.
+#[test]
+fn depth_id_statistics_from_the_gpus_ids_equal_the_models() {
+    let conventions = [
+        (DepthConvention::Standard, false),
+        (DepthConvention::Reversed, false),
+        (DepthConvention::Reversed, true),
+        (DepthConvention::Standard, true),
+    ];
+    for name in ["default", "brdfs-3", "inside"] {
+        let scene = histencil_scene::embedded(name).unwrap();
+        with_validated_context(|ctx| {
+            let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
+            for (depth, infinite_far) in conventions {
+                let what = format!("{name} {depth:?} infinite far {infinite_far}");
+                let desc = FrameDesc {
+                    tile_stats: true,
+                    depth,
+                    infinite_far,
+                    ..FrameDesc::new(
+                        Technique::DepthId {
+                            side: TileSide::Eight,
+                        },
+                        Readback::NONE,
+                    )
+                };
+                let inputs = renderer.simulator_inputs(desc).expect("inputs");
+                let stats = renderer.render_frame(&desc).expect("frame").tile_stats;
+                let stats = stats.expect("statistics were asked for");
+                println!("{what}: {stats:?}");
+                assert_eq!(stats, inputs.predict_depth_id(), "{what}");
+                let far = inputs.plan.depth.far();
+                let surface = inputs.target.depth.iter().filter(|d| **d != far).count();
+                assert_eq!(
+                    stats.fragments_shaded, surface as u64,
+                    "{what}: shaded once"
+                );
+                assert!(stats.tiles_culled > 0, "{what}: nothing rejected");
+            }
+        });
+    }
 }

@@ -7,7 +7,7 @@ use histencil_check::matrix::Platform;
 use histencil_scene::{with_default_lights, DefaultLights};
 use histencil_vk::{
     AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, ImageKind, MixedTiles, Readback,
-    Renderer, RendererDesc, Shading, Technique, TileSide,
+    Renderer, RendererDesc, Shading, Technique, TileSide, TileStats,
 };
 use image::DynamicImage;
 use std::path::PathBuf;
@@ -530,14 +530,41 @@ fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
         bail!("--stats needs a deferred technique: the forward reference has no lighting passes");
     }
     let inputs = renderer.simulator_inputs(*desc)?;
-    let predicted = inputs.predict().0.stats;
+    let depth_id = matches!(desc.shading, Shading::Deferred(Technique::DepthId { .. }));
+    let predicted = if depth_id {
+        inputs.predict_depth_id()
+    } else {
+        inputs.predict().0.stats
+    };
     let counted = FrameDesc {
         tile_stats: true,
         readback: Readback::NONE,
         ..*desc
     };
     let frame = renderer.render_frame(&counted)?;
-    let gpu = frame.tile_stats.expect("statistics were asked for");
+    let Some(gpu) = frame.tile_stats else {
+        bail!("--stats: the tiled technique has no stencil or depth tests to count");
+    };
+    let agrees = |gpu: TileStats| {
+        if gpu == predicted {
+            "agrees".to_owned()
+        } else {
+            format!("predicts {predicted:?}")
+        }
+    };
+    if depth_id {
+        // llvmpipe has no hierarchical depth: the rejections are the model's, on the GPU's ids.
+        println!(
+            "depth-id, hierarchical depth modelled on the GPU's id image ({0}x{0}-pixel tiles): \
+             {1} tile tests, {2} rejected, {3} fragments shaded; the model from the G-buffer {4}",
+            inputs.tile_size,
+            gpu.tiles_tested,
+            gpu.tiles_culled,
+            gpu.fragments_shaded,
+            agrees(gpu)
+        );
+        return Ok(());
+    }
     println!(
         "hi-stencil ({}x{}-pixel tiles): {} tiles tested, {} culled, {} fragments shaded, {} flushes; \
          simulator {}",
@@ -547,11 +574,7 @@ fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
         gpu.tiles_culled,
         gpu.fragments_shaded,
         gpu.flushes,
-        if gpu == predicted {
-            "agrees".to_owned()
-        } else {
-            format!("predicts {predicted:?}")
-        }
+        agrees(gpu)
     );
     Ok(())
 }

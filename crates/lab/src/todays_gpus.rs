@@ -15,7 +15,6 @@ use crate::{write_file, Result};
 use histencil_model::amd::{
     choose_pretests, slot_tile_counts, AndOrTiles, PretestTiles, TileHierarchy,
 };
-use histencil_model::depth_id::{depth_id_stats, pixel_ids};
 use histencil_model::{FlushPolicy, FramePlan, TileStats, TileSurface};
 use histencil_scene::Scene;
 use histencil_vk::{Backend, Context, FrameDesc, Renderer, SimulatorInputs, Technique};
@@ -196,7 +195,8 @@ pub fn run_todays_gpus(
         let with_bits = capture(renderer, ENGINE_BITS)?;
         let without_bits = capture(renderer, 0)?;
         tile_size = with_bits.tile_size;
-        depth_id.push(depth_id_counts(&with_bits));
+        let passes = with_bits.layout.brdfs_in_use() as usize;
+        depth_id.push((passes, with_bits.predict_depth_id()));
         // The plans follow the lights and the view, not the engine's bits: one per platform.
         let plans = Platform::ALL
             .iter()
@@ -223,20 +223,6 @@ pub fn run_todays_gpus(
         counts,
         depth_id,
     })
-}
-
-/// The depth-id technique on the captured frame: one pass per BRDF slot present.
-fn depth_id_counts(inputs: &SimulatorInputs) -> (usize, TileStats) {
-    let target = &inputs.target;
-    let layout = &inputs.layout;
-    let slots = target.stencil.iter().map(|s| layout.brdf_slot(*s));
-    let ids = pixel_ids(slots, &target.depth, inputs.plan.depth.far());
-    let mut passes: Vec<u16> = ids.iter().copied().filter(|&id| id > 0).collect();
-    passes.sort_unstable();
-    passes.dedup();
-    let tiles = TileSurface::new(target.width, target.height, inputs.tile_size);
-    let stats = depth_id_stats(&ids, target.width, &tiles, &passes);
-    (passes.len(), stats)
 }
 
 impl TodaysGpusReport {

@@ -4,16 +4,27 @@
 //! lighting pass as a full-screen triangle at its id's depth with compare EQUAL
 //! (`bevy_pbr/src/deferred/mod.rs`), so the hierarchical depth, which keeps each tile's depth
 //! range, rejects the tiles whose range excludes the pass's id before any fragment runs. Here
-//! the ids are BRDF slot + 1 (0 where no surface was drawn) and the tiles 8x8; llvmpipe has no
-//! hierarchical depth, so this is a model of what such a GPU would reject, not a measurement.
+//! the ids are what histencil-vk's depth-id technique writes into its 16-bit id image (BRDF
+//! slot + 1, and the clear value [`NO_SURFACE`] where no surface was drawn) and the tiles 8x8;
+//! llvmpipe has no hierarchical depth, so this is a model of what such a GPU would reject, not a
+//! measurement. It runs on the GPU's own id image (`Frame::tile_stats` of a depth-id frame) and
+//! on ids made from the G-buffer's stencil and depth ([`pixel_ids`]), which must agree.
 
 use crate::tiles::{TileStats, TileSurface};
 
-/// Each pixel's id: its BRDF slot + 1, or 0 where `depth` is `far` (no surface).
+/// The id of a pixel with no surface: the id image's clear value, depth 1.
+pub const NO_SURFACE: u16 = u16::MAX;
+
+/// The id of BRDF slot `slot`: `slot + 1`, so that no slot is 0 or [`NO_SURFACE`].
+pub fn slot_id(slot: u32) -> u16 {
+    slot as u16 + 1
+}
+
+/// Each pixel's id: its BRDF slot's [`slot_id`], or [`NO_SURFACE`] where `depth` is `far`.
 pub fn pixel_ids(slots: impl Iterator<Item = u32>, depth: &[f32], far: f32) -> Vec<u16> {
     slots
         .zip(depth)
-        .map(|(slot, d)| if *d == far { 0 } else { slot as u16 + 1 })
+        .map(|(slot, d)| if *d == far { NO_SURFACE } else { slot_id(slot) })
         .collect()
 }
 
@@ -44,17 +55,24 @@ mod tests {
 
     #[test]
     fn a_pass_culls_the_tiles_whose_id_range_excludes_it() {
-        // Two 2x2 tiles side by side: ids {1, 1, 1, 1} and {0, 2, 3, 3}.
+        // Two 2x2 tiles side by side: ids {1, 1, 1, 1} and {none, 2, 3, 3}.
         let tiles = TileSurface::new(4, 2, 2);
-        let ids = [1, 1, 0, 2, 1, 1, 3, 3];
+        let none = NO_SURFACE;
+        let ids = [1, 1, none, 2, 1, 1, 3, 3];
         let stats = depth_id_stats(&ids, 4, &tiles, &[1, 2, 3]);
         assert_eq!(stats.tiles_tested, 6);
-        // Id 1: the second tile's range 0..=3 includes 1 (a range, not a set): not culled.
-        // Id 2 and 3: the first tile (1..=1) is culled.
-        assert_eq!(stats.tiles_culled, 2);
+        // Id 1: the second tile's range 2..=none excludes it: culled. Id 2 and 3: the first
+        // tile (1..=1) is culled, the second's range holds them.
+        assert_eq!(stats.tiles_culled, 3);
         assert_eq!(stats.fragments_shaded, 7, "every surface pixel once");
+        // A range, not a set: ids 1 and 3 in a tile keep a pass of id 2 testing it.
+        let stats = depth_id_stats(&[1, 3], 2, &TileSurface::new(2, 1, 2), &[2]);
+        assert_eq!((stats.tiles_culled, stats.fragments_shaded), (0, 0));
         let far = 1.0;
         let depth = [0.5, far, 0.2];
-        assert_eq!(pixel_ids([0, 0, 2].into_iter(), &depth, far), vec![1, 0, 3]);
+        assert_eq!(
+            pixel_ids([0, 0, 2].into_iter(), &depth, far),
+            vec![1, none, 3]
+        );
     }
 }

@@ -39,6 +39,21 @@ impl SimulatorInputs {
         self.predict_plan(&self.plan)
     }
 
+    /// The depth-id technique's statistics as the model predicts them from the captured
+    /// G-buffer (each pixel's id from its stencil's BRDF slot, none where its depth is far):
+    /// one full-screen pass per BRDF slot of the layout, as `Technique::DepthId` draws, against
+    /// 8x8 tiles of hierarchical depth (`histencil_model::depth_id`). A depth-id frame's
+    /// `Frame::tile_stats`, the same model on the GPU's own id image, must agree.
+    pub fn predict_depth_id(&self) -> histencil_model::TileStats {
+        use histencil_model::depth_id::{depth_id_stats, pixel_ids, slot_id};
+        let target = &self.target;
+        let slots = target.stencil.iter().map(|s| self.layout.brdf_slot(*s));
+        let ids = pixel_ids(slots, &target.depth, self.plan.depth.far());
+        let tiles = histencil_model::TileSurface::new(target.width, target.height, self.tile_size);
+        let passes: Vec<u16> = (0..self.layout.brdfs_in_use()).map(slot_id).collect();
+        depth_id_stats(&ids, target.width, &tiles, &passes)
+    }
+
     /// [`SimulatorInputs::predict`] for another plan of the same lights (the same planned light
     /// indices, e.g. another backend or flush policy): the captured footprints serve every plan
     /// of a frame, so one capture answers for all of them.

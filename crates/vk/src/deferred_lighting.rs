@@ -955,6 +955,23 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         Ok(())
     }
 
+    /// Records a copy of frame-in-flight `slot`'s depth-id image for tiles of `side`, as its
+    /// last depth-id frame left it, into `buffer` (2 bytes per pixel).
+    pub(crate) fn copy_depth_ids(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        side: TileSide,
+        slot: u32,
+        buffer: &Buffer,
+    ) {
+        let (_, pass) = self
+            .depth_id
+            .iter_mut()
+            .find(|(s, _)| *s == side)
+            .expect("a depth-id frame was recorded");
+        pass.copy_ids(&self.ctx, cmd, slot, buffer);
+    }
+
     /// The set layout the decode hook binds at set 1: histencil's G-buffer's, or the engine's.
     fn decode_layout(&self) -> vk::DescriptorSetLayout {
         match &self.desc.hooks {

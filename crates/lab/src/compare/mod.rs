@@ -13,7 +13,7 @@ use histencil_brdf::BrdfId;
 use histencil_scene::Scene;
 use histencil_vk::{
     Backend, Context, CostModel, FlushPolicy, FrameDesc, MixedTiles, Readback, Renderer,
-    RendererDesc, Shading, Technique, TileSide,
+    RendererDesc, Shading, Technique, TileSide, TileStats,
 };
 
 /// What a comparison run measures.
@@ -356,6 +356,10 @@ pub struct CompareReport {
     /// The costs the adaptive rows used.
     pub costs: CostModel,
     pub costs_calibrated: bool,
+    /// Per BRDF count, what a GPU's hierarchical depth would make of the depth-id row's ids
+    /// (`histencil_model::depth_id`, on the id image the GPU wrote): llvmpipe has none, so its
+    /// times include no rejection.
+    pub depth_id: Vec<(usize, TileStats)>,
 }
 
 impl CompareReport {
@@ -456,6 +460,7 @@ pub fn run_compare(
     // then the timed rounds, interleaved: one frame of every technique at every BRDF count
     // per round, so that a burst of background load lands on all of them alike.
     let mut renderers = Vec::new();
+    let mut depth_id = Vec::new();
     for &brdfs in &settings.brdf_counts {
         let mut renderer = new_renderer(with_brdf_count(&settings.scene, brdfs))?;
         costs.get_or_insert(renderer.cost_model(Backend::Native));
@@ -465,6 +470,7 @@ pub fn run_compare(
         for (_, technique) in &rows_spec {
             errors.push(image_error(&frame(&mut renderer, *technique)?, &reference));
         }
+        depth_id.push((brdfs, depth_id_stats(&mut renderer)?));
         renderers.push((brdfs, renderer, errors));
     }
     // Each BRDF of the widest column alone on the same scene (the first is the 1-BRDF
@@ -638,7 +644,22 @@ pub fn run_compare(
         beside_load: settings.beside_load,
         costs: costs.expect("at least one BRDF count"),
         costs_calibrated: settings.costs.is_some(),
+        depth_id,
     })
+}
+
+/// The depth-id row's frame counted: the model's hierarchical depth on the GPU's id image.
+fn depth_id_stats(renderer: &mut Renderer) -> Result<TileStats> {
+    let (_, technique) = table_rows()
+        .into_iter()
+        .find(|(name, _)| *name == "depth-id")
+        .expect("a depth-id row");
+    let desc = FrameDesc {
+        tile_stats: true,
+        ..FrameDesc::from(technique)
+    };
+    let stats = renderer.render_frame(&desc)?.tile_stats;
+    Ok(stats.expect("a depth-id frame counts"))
 }
 
 /// The most rounds one measurement set takes, whatever its target and budget.

@@ -24,7 +24,8 @@ use crate::error::Result;
 use crate::hooks::LightModules;
 use crate::passes::{depth_stencil_attachment, Load};
 use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::resources::Image;
+use crate::readback::copy_image_to_buffer;
+use crate::resources::{Buffer, Image};
 use crate::shaders;
 use crate::state::apply;
 use crate::teardown::{build, Destroy};
@@ -35,10 +36,10 @@ use histencil_model::{CompareOp, CullMode, DepthState, PassState};
 /// The id image's format: every Vulkan device renders to 16-bit unorm depth.
 pub const ID_FORMAT: vk::Format = vk::Format::D16_UNORM;
 
-/// The id image's code of BRDF slot `slot`: `slot + 1`, so that no slot is the clear value 0
-/// or 1 (`depth_id_copy.frag` writes `(slot + 1) / 65535`).
+/// The id image's code of BRDF slot `slot` (`depth_id_copy.frag` writes `(slot + 1) / 65535`):
+/// the model's, which reads the image back (`histencil_model::depth_id`).
 pub fn depth_code(slot: usize) -> u16 {
-    slot as u16 + 1
+    histencil_model::depth_id::slot_id(slot as u32)
 }
 
 /// The depth a slot's shade pass draws at: its code as a unorm value, computed as the copy
@@ -96,7 +97,9 @@ fn id_images(ctx: &Context, extent: vk::Extent2D, slots: u32) -> Result<Vec<Imag
     let mut images = Vec::new();
     for slot in 0..slots {
         let name = format!("depth-id-image-{slot}");
-        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
+        // Copied out for the statistics (`Renderer::depth_id_stats`).
+        let usage =
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
         match Image::new(ctx, &name, ID_FORMAT, extent, usage) {
             Ok(image) => images.push(image),
             Err(e) => {
@@ -162,6 +165,13 @@ impl DepthIdPass {
             old.destroy(ctx);
         }
         Ok(())
+    }
+
+    /// Records a copy of frame-in-flight `slot`'s id image (as its last frame left it) into
+    /// `buffer`, 2 bytes per pixel, for [`crate::Renderer`]'s statistics.
+    pub fn copy_ids(&mut self, ctx: &Context, cmd: vk::CommandBuffer, slot: u32, buffer: &Buffer) {
+        let image = &mut self.ids[slot as usize];
+        copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, buffer);
     }
 
     /// The pipelines this pass holds.

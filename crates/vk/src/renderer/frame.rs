@@ -92,6 +92,9 @@ impl Renderer<'_> {
             Some((t, plan)) if desc.tile_stats && t.records_plan() => {
                 self.lighting.tile_stats(plan)
             }
+            Some((Technique::DepthId { side }, _)) if desc.tile_stats => {
+                Some(self.depth_id_stats(*side)?)
+            }
             _ => None,
         };
         Ok(Frame {

@@ -6,9 +6,10 @@ use crate::error::Result;
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::Buffer;
 use crate::shader_consts::HI_STENCIL_TILE;
-use crate::technique::FrameDesc;
+use crate::technique::{FrameDesc, TileSide};
 use ash::vk;
-use histencil_model::{Footprint, SoftTarget};
+use histencil_model::depth_id::{depth_id_stats, slot_id};
+use histencil_model::{Footprint, SoftTarget, TileStats, TileSurface};
 
 impl Renderer<'_> {
     /// The CPU simulator's inputs for the deferred frame `desc`, captured from the GPU: the
@@ -90,6 +91,33 @@ impl Renderer<'_> {
         capture.destroy(ctx);
         depth.destroy(ctx);
         stencil.destroy(ctx);
+        result
+    }
+}
+
+impl Renderer<'_> {
+    /// The depth-id statistics of the depth-id frame just rendered with tiles of `side`: its id
+    /// image as the GPU wrote it, read back, and the model's hierarchical depth run on it
+    /// (`histencil_model::depth_id_stats`, 8x8 tiles): every BRDF slot's full-screen pass tests
+    /// every tile, rejects those whose id range excludes its id, and shades its own pixels.
+    /// llvmpipe has no hierarchical depth: the rejections are what such a GPU would make of
+    /// these ids, the fragments what any GPU's EQUAL test shades.
+    pub(super) fn depth_id_stats(&mut self, side: TileSide) -> Result<TileStats> {
+        let ctx = self.ctx;
+        let (width, height) = (self.extent.width, self.extent.height);
+        let pixels = u64::from(width) * u64::from(height);
+        let mut ids = Buffer::readback(ctx, "depth-id-readback", pixels * 2)?;
+        let result = (|| {
+            let cmd = self.begin_commands()?;
+            self.lighting.copy_depth_ids(cmd, side, 0, &ids);
+            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
+            self.submit_and_wait()?;
+            let ids: &[u16] = bytemuck::cast_slice(ids.read());
+            let tiles = TileSurface::new(width, height, HI_STENCIL_TILE);
+            let passes: Vec<u16> = (0..self.brdfs.len() as u32).map(slot_id).collect();
+            Ok(depth_id_stats(ids, width, &tiles, &passes))
+        })();
+        ids.destroy(ctx);
         result
     }
 }
