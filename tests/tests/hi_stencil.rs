@@ -159,6 +159,17 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
                 flush: auto,
             },
         ),
+        // AMD's own hierarchies, no plan step driving them: the GPU's tiles evaluated before
+        // each stencil-testing draw, the model's run beside the native plan (`run_with`).
+        ("amd-pretest", stencil(Backend::AmdPretest, auto)),
+        ("amd-andor", stencil(Backend::AmdAndOr, auto)),
+        (
+            "branching-amd-andor",
+            Technique::Branching {
+                backend: Backend::AmdAndOr,
+                flush: auto,
+            },
+        ),
     ];
     for name in ["default", "brdfs-3", "near-far", "inside"] {
         let scene = histencil_scene::embedded(name).unwrap();
@@ -194,6 +205,8 @@ fn reversed_and_infinite_far_frames_equal_the_simulators() {
             "x360-flush-always",
             stencil(x360(true, false), FlushPolicy::Always),
         ),
+        ("amd-pretest", stencil(Backend::AmdPretest, auto)),
+        ("amd-andor", stencil(Backend::AmdAndOr, auto)),
     ];
     let conventions = [
         ("reversed", DepthConvention::Reversed, false),
@@ -222,10 +235,12 @@ fn reversed_and_infinite_far_frames_equal_the_simulators() {
 }
 
 /// Asserts that the GPU frame `desc` leaves the stencil and the tile statistics that the
-/// simulator predicts from the GPU's own inputs.
+/// simulator predicts from the GPU's own inputs (on the AMD platforms, with the model of the
+/// GPU's hierarchy).
 fn assert_simulated(renderer: &mut Renderer, desc: &FrameDesc, what: &str) {
     let inputs = renderer.simulator_inputs(*desc).expect("inputs");
-    let (sim, predicted) = inputs.predict();
+    let backend = desc.shading.technique().expect("deferred").backend();
+    let (sim, predicted) = inputs.predict_on(backend);
     let frame = renderer.render_frame(desc).expect("frame");
     let stats = frame.tile_stats.expect("statistics were asked for");
     println!("{what}: {stats:?}");

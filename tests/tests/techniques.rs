@@ -33,6 +33,9 @@ fn techniques() -> Vec<(&'static str, Technique)> {
         ("branching", Technique::DEFERRED),
         ("stencil-native", stencil(Backend::Native)),
         ("stencil-ps3", stencil(Backend::Ps3)),
+        // AMD's hierarchies reject only tiles where no pixel passes: as exact as native.
+        ("stencil-amd-pretest", stencil(Backend::AmdPretest)),
+        ("stencil-amd-andor", stencil(Backend::AmdAndOr)),
         (
             "stencil-x360",
             stencil(Backend::X360 {

@@ -77,6 +77,10 @@ pub enum Platform {
     X360SaveRestore,
     Ps3,
     Native,
+    /// AMD GFX9-11 with pretests (modelled from AMD's driver sources).
+    AmdPretest,
+    /// AMD GFX12's AND/OR tiles (modelled from AMD's driver sources).
+    AmdAndOr,
 }
 
 impl Platform {
@@ -95,6 +99,8 @@ impl Platform {
             Platform::X360SaveRestore => "x360-save-restore",
             Platform::Ps3 => "ps3",
             Platform::Native => "native",
+            Platform::AmdPretest => "amd-pretest",
+            Platform::AmdAndOr => "amd-andor",
         }
     }
 
@@ -114,12 +120,18 @@ impl Platform {
             },
             Platform::Ps3 => Backend::Ps3,
             Platform::Native => Backend::Native,
+            Platform::AmdPretest => Backend::AmdPretest,
+            Platform::AmdAndOr => Backend::AmdAndOr,
         }
     }
 
-    /// Whether the backend emulates hi-stencil (and so has flushes to vary).
+    /// Whether the backend emulates a console's hi-stencil (and so has flushes to vary; AMD's
+    /// hierarchies follow stencil writes by themselves).
     pub fn has_hi_stencil(self) -> bool {
-        self != Platform::Native
+        matches!(
+            self,
+            Platform::X360 | Platform::X360NoZeroing | Platform::X360SaveRestore | Platform::Ps3
+        )
     }
 }
 

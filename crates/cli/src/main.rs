@@ -247,6 +247,11 @@ enum BackendArg {
     X360SaveRestore,
     Ps3,
     Native,
+    /// AMD GFX9-11 with two hierarchical-stencil pretests, modelled from AMD's driver sources
+    /// (not measured on AMD hardware): the native plan, the GPU's tiles emulated.
+    AmdPretest,
+    /// AMD GFX12's per-tile AND/OR of the stencil, modelled likewise.
+    AmdAndor,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -273,6 +278,8 @@ impl RenderArgs {
             BackendArg::X360SaveRestore => Platform::X360SaveRestore,
             BackendArg::Ps3 => Platform::Ps3,
             BackendArg::Native => Platform::Native,
+            BackendArg::AmdPretest => Platform::AmdPretest,
+            BackendArg::AmdAndor => Platform::AmdAndOr,
         }
         .backend();
         let flush = match self.flush {
@@ -531,10 +538,10 @@ fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
     }
     let inputs = renderer.simulator_inputs(*desc)?;
     let depth_id = matches!(desc.shading, Shading::Deferred(Technique::DepthId { .. }));
-    let predicted = if depth_id {
-        inputs.predict_depth_id()
-    } else {
-        inputs.predict().0.stats
+    let predicted = match desc.shading.technique() {
+        _ if depth_id => inputs.predict_depth_id(),
+        Some(technique) => inputs.predict_on(technique.backend()).0.stats,
+        None => inputs.predict().0.stats,
     };
     let counted = FrameDesc {
         tile_stats: true,

@@ -128,7 +128,7 @@ impl Pretest {
 
     /// Whether every stencil value passing `face` passes this pretest, so that a tile where this
     /// pretest may not pass holds no pixel passing `face`.
-    fn implied_by(&self, face: &FaceStencil) -> bool {
+    pub fn implied_by(&self, face: &FaceStencil) -> bool {
         self.compare == CompareOp::Equal
             && face.compare == CompareOp::Equal
             && self.mask & !face.compare_mask == 0

@@ -9,6 +9,14 @@
 // histencil_model::HiStencilState says. No shared memory and no barriers: a CPU rasteriser
 // runs a workgroup with barriers one invocation at a time, switching between them at each
 // barrier.
+//
+// The same pass evaluates AMD's hierarchies (histencil_model::amd) before a draw that tests
+// stencil, from the stencil as it is then (each tile's state there is exact for its current
+// values: made from the G-buffer's stencil and updated in every tile a draw writes): `mode` 1,
+// GFX9-11's pretests (the tile may pass unless one of the `tests` pretests implied by the draw's
+// test, each an EQUAL of `(stencil & mask)` against its value, has no passing pixel); `mode` 2,
+// GFX12's AND and OR of the tile's values (the tile may pass unless a known bit contradicts the
+// draw's test). Either writes `pending` over the whole rectangle, made active at once.
 #extension GL_EXT_samplerless_texture_functions : require
 #include "generated.glsl"
 
@@ -34,7 +42,15 @@ layout(push_constant) uniform Update {
     uint rect_width;
     uint rect_tiles;
     uint marker;    // the write's 16-bit code; 0: every tile of the rectangle was touched
+    uint mode;      // 0: console hi-stencil; 1: AMD pretests; 2: AMD AND/OR (see above)
+    uint tests;     // mode 1: pretests to hold (0 to 2): (read_mask, reference), (mask2, value2)
+    uint mask2;
+    uint value2;
 } update;
+
+const uint MODE_CONSOLE = 0u;
+const uint MODE_PRETESTS = 1u;
+const uint MODE_AND_OR = 2u;
 
 bool compare_passes(uint op, uint a, uint b) {
     switch (op) {
@@ -63,6 +79,56 @@ bool touched(uvec2 origin, uvec2 end) {
     return false;
 }
 
+// Whether some pixel of the tile passes `(stencil & mask) OP reference`.
+bool some_pixel_passes(uvec2 origin, uvec2 end, uint op, uint mask, uint reference) {
+    for (uint y = origin.y; y < end.y; ++y) {
+        for (uint x = origin.x; x < end.x; ++x) {
+            uint stencil = texelFetch(stencil_image, ivec2(x, y), 0).r;
+            if (compare_passes(op, stencil & mask, reference)) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+// GFX12: whether a stencil test `(reference & mask) OP (stencil & mask)` may pass somewhere in a
+// tile whose values have this AND and OR (histencil_model::AndOrTiles::may_pass).
+bool and_or_may_pass(uint and_bits, uint or_bits, uint op, uint mask, uint reference) {
+    uint known_one = and_bits & mask;
+    uint known_zero = ~or_bits & mask;
+    uint r = reference & mask;
+    if (op == 2u) { // EQUAL: every masked bit as the reference has it
+        return (r & known_zero) == 0u && (~r & mask & known_one) == 0u;
+    }
+    if (op == 5u) { // NOT_EQUAL: fails only where every masked bit is known and equal
+        return (known_one | known_zero) != mask || known_one != r;
+    }
+    // The ordered compares: the masked value lies between the known ones and the complement of
+    // the known zeros.
+    uint hi = mask & ~known_zero;
+    for (uint v = known_one; v <= hi; ++v) {
+        if (compare_passes(op, r, v)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// The tile's AND and OR of its stencil values, evaluated against the draw's test.
+bool tile_and_or_may_pass(uvec2 origin, uvec2 end) {
+    uint and_bits = 0xFFu;
+    uint or_bits = 0u;
+    for (uint y = origin.y; y < end.y; ++y) {
+        for (uint x = origin.x; x < end.x; ++x) {
+            uint stencil = texelFetch(stencil_image, ivec2(x, y), 0).r;
+            and_bits &= stencil;
+            or_bits |= stencil;
+        }
+    }
+    return and_or_may_pass(and_bits, or_bits, update.compare, update.read_mask, update.reference);
+}
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= update.rect_tiles) {
@@ -74,15 +140,21 @@ void main() {
     if (update.marker != 0u && !touched(origin, end)) {
         return;
     }
-    uint passes = 0u;
-    for (uint y = origin.y; y < end.y && passes == 0u; ++y) {
-        for (uint x = origin.x; x < end.x; ++x) {
-            uint stencil = texelFetch(stencil_image, ivec2(x, y), 0).r;
-            if (compare_passes(update.compare, stencil & update.read_mask, update.reference)) {
-                passes = 1u;
-                break;
-            }
-        }
+    bool passes;
+    switch (update.mode) {
+    case MODE_PRETESTS:
+        passes = (update.tests < 1u
+                  || some_pixel_passes(origin, end, 2u, update.read_mask, update.reference))
+              && (update.tests < 2u
+                  || some_pixel_passes(origin, end, 2u, update.mask2, update.value2));
+        break;
+    case MODE_AND_OR:
+        passes = tile_and_or_may_pass(origin, end);
+        break;
+    default:
+        passes = some_pixel_passes(
+            origin, end, update.compare, update.read_mask, update.reference);
+        break;
     }
-    pending[at.y * update.tiles_x + at.x] = passes;
+    pending[at.y * update.tiles_x + at.x] = passes ? 1u : 0u;
 }

@@ -39,6 +39,33 @@ impl SimulatorInputs {
         self.predict_plan(&self.plan)
     }
 
+    /// [`SimulatorInputs::predict`] on `backend`: on the AMD platforms, the native plan run
+    /// with the model of the GPU's own hierarchy ([`SimulatorInputs::predict_with`]), GFX9-11's
+    /// pretests chosen from the captured stencil as the renderer chooses them
+    /// (`Renderer::amd_pretests`); elsewhere as captured.
+    pub fn predict_on(&self, backend: crate::Backend) -> (SimResult, SoftTarget) {
+        use histencil_model::amd::{AndOrTiles, PretestTiles};
+        match backend {
+            crate::Backend::AmdAndOr => self.predict_with(&self.plan, &mut AndOrTiles::new()),
+            crate::Backend::AmdPretest => {
+                let mut tiles = PretestTiles::new(self.amd_pretests());
+                self.predict_with(&self.plan, &mut tiles)
+            }
+            _ => self.predict(),
+        }
+    }
+
+    /// The pretests a GFX9-11 frame of this G-buffer binds (`histencil_model::amd`).
+    pub fn amd_pretests(
+        &self,
+    ) -> [Option<histencil_model::amd::Pretest>; histencil_model::amd::PRETEST_SLOTS] {
+        use histencil_model::amd::{choose_pretests, slot_tile_counts};
+        let t = &self.target;
+        let tiles = histencil_model::TileSurface::new(t.width, t.height, self.tile_size);
+        let counts = slot_tile_counts(&self.layout, &t.stencil, t.width, &tiles);
+        choose_pretests(&self.layout, &counts)
+    }
+
     /// The depth-id technique's statistics as the model predicts them from the captured
     /// G-buffer (each pixel's id from its stencil's BRDF slot, none where its depth is far):
     /// one full-screen pass per BRDF slot of the layout, as `Technique::DepthId` draws, against

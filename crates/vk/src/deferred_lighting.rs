@@ -22,7 +22,7 @@ use crate::descriptors::{
 };
 use crate::error::{Error, Result, VkCall};
 use crate::gpu_types::{FrameUniforms, GpuLight, PUSH_CONSTANT_BYTES};
-use crate::hi_stencil::HiStencilSurface;
+use crate::hi_stencil::{GpuHierarchy, HiStencilSurface};
 use crate::hooks::{HookSets, LightHooks};
 use crate::meshes::LightVolumes;
 use crate::passes::depth_id::{DepthIdDesc, DepthIdPass};
@@ -655,7 +655,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// Creates every light pipeline `plan` uses, so the first frame that needs them does not
     /// compile them while recording.
     pub fn prepare(&mut self, plan: &FramePlan) -> Result<()> {
-        self.prepare_for(plan, false, BrdfSource::Formula)
+        self.prepare_for(plan, false, BrdfSource::Formula, false)
     }
 
     fn prepare_for(
@@ -663,9 +663,11 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         plan: &FramePlan,
         count_stats: bool,
         source: BrdfSource,
+        hierarchy: bool,
     ) -> Result<()> {
         let (ctx, brdfs) = (&*self.ctx, &self.desc.brdfs);
-        prepare_pipelines(ctx, &mut self.pipelines, plan, brdfs, count_stats, source)
+        let pipelines = &mut self.pipelines;
+        prepare_pipelines(ctx, pipelines, plan, brdfs, count_stats, source, hierarchy)
     }
 
     /// Light pipelines created so far (kept across [`DeferredLighting::resize`]).
@@ -707,8 +709,28 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &LightingFrame,
         targets: &mut LightingTargets,
     ) -> Result<()> {
+        self.record_emulating(cmd, frame, targets, None)
+    }
+
+    /// [`DeferredLighting::record`], emulating `hierarchy`, the hierarchical stencil of an AMD
+    /// GPU (`crate::hi_stencil::amd`), which needs [`LightingDesc::hi_stencil`].
+    ///
+    /// # Safety
+    /// As [`DeferredLighting::record`].
+    pub(crate) unsafe fn record_emulating(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightingFrame,
+        targets: &mut LightingTargets,
+        hierarchy: Option<GpuHierarchy>,
+    ) -> Result<()> {
         let (count_stats, source) = (frame.tile_stats, frame.brdf_source);
         check_frame(&self.desc, frame, targets)?;
+        if hierarchy.is_some() && !self.desc.hi_stencil {
+            return Err(Error::Unsupported(
+                "an AMD hierarchy's emulation from a lighting made without hi-stencil",
+            ));
+        }
         if count_stats && !self.desc.hi_stencil {
             return Err(Error::Unsupported(
                 "hi-stencil statistics from a lighting made without hi-stencil",
@@ -719,7 +741,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 "the LUT technique before its tables exist",
             ));
         }
-        self.prepare_for(frame.plan, count_stats, source)?;
+        self.prepare_for(frame.plan, count_stats, source, hierarchy.is_some())?;
         let inputs = (frame.view, frame.lights, &frame.hook_sets);
         let (frame_set, decode_set) = self.write_slot(frame.slot, inputs, targets)?;
         let ctx: &Context = &self.ctx;
@@ -728,8 +750,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let name = "lighting-step-timestamps";
         slot.timer.prepare(ctx, name, frame.timestamps, steps)?;
         let name = "lighting-emulation-timestamps";
-        let emulated = needs_hi_stencil(frame.plan);
-        let marks = Emulation::marks(frame.plan);
+        let emulated = needs_hi_stencil(frame.plan) || hierarchy.is_some();
+        let marks = Emulation::marks(frame.plan, hierarchy.as_ref());
         slot.emulation.prepare(ctx, name, emulated, marks)?;
         let mut sets = vec![frame_set, decode_set, self.hi_stencil_set];
         if source == BrdfSource::Table {
@@ -752,9 +774,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             clear_hdr: frame.clear_hdr,
             depth_sampled: self.desc.hooks.samples_depth(),
             slot: frame.slot,
+            hierarchy,
         };
         let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
-        if writes_hi_stencil(frame.plan) {
+        if writes_hi_stencil(frame.plan) || hierarchy.is_some() {
             hi_stencil.prepare_slot(ctx, frame.slot, &targets.depth_stencil)?;
         }
         let timer = slot.timer.active();

@@ -25,6 +25,13 @@ pub enum Backend {
     Ps3,
     /// Plain Vulkan: no hi-stencil.
     Native,
+    /// AMD GFX9-11 (Vega, RDNA 1-3) with two hierarchical-stencil pretests bound, as AMD's
+    /// driver layer PAL allows and no Vulkan driver does (`histencil_model::amd`): the native
+    /// plan, with the GPU's per-tile may-pass bits emulated (`crate::hi_stencil::amd`).
+    AmdPretest,
+    /// AMD GFX12 (RDNA 4): the native plan, with the GPU's per-tile AND and OR of the stencil
+    /// emulated.
+    AmdAndOr,
 }
 
 impl Backend {
@@ -39,7 +46,15 @@ impl Backend {
             }),
             Backend::Ps3 => Box::new(Ps3Like),
             Backend::Native => Box::new(Native),
+            Backend::AmdPretest => Box::new(histencil_model::amd::AmdPretest),
+            Backend::AmdAndOr => Box::new(histencil_model::amd::AmdAndOr),
         }
+    }
+
+    /// Whether the GPU keeps a hierarchical stencil of its own, which no plan step drives (the
+    /// AMD platforms).
+    pub fn has_gpu_hierarchy(self) -> bool {
+        matches!(self, Backend::AmdPretest | Backend::AmdAndOr)
     }
 }
 
@@ -175,6 +190,18 @@ impl Technique {
     /// techniques classify on the GPU instead: no plan steps, no hi-stencil).
     pub fn records_plan(self) -> bool {
         !matches!(self, Technique::Tiled { .. } | Technique::DepthId { .. })
+    }
+
+    /// The platform behaviour the frame's plan follows (native for the tiled and depth-id
+    /// techniques, which have none).
+    pub fn backend(self) -> Backend {
+        match self {
+            Technique::Stencil { backend, .. }
+            | Technique::Branching { backend, .. }
+            | Technique::Adaptive { backend, .. }
+            | Technique::Lut { backend, .. } => backend,
+            Technique::Tiled { .. } | Technique::DepthId { .. } => Backend::Native,
+        }
     }
 
     pub(crate) fn brdf_source(self) -> BrdfSource {

@@ -39,7 +39,10 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_model::{HiStencilState, TileStats};
 
+mod amd;
 mod touch;
+
+pub use amd::{GpuHierarchy, TileTest};
 
 use touch::next_marker;
 pub use touch::{plan_touches, tile_rect, TileRect, TouchedTiles, WriteTiles};
@@ -61,6 +64,12 @@ struct UpdatePush {
     rect_tiles: u32,
     /// The touch image's code of the write's marker; 0: every tile of the rectangle was touched.
     marker: u32,
+    /// What is evaluated: [`TileTest`]'s mode.
+    mode: u32,
+    /// Mode 1: how many pretests, the first in `read_mask` / `reference`, the second here.
+    tests: u32,
+    mask2: u32,
+    value2: u32,
 }
 
 /// The touch image's format: depth-only, the one every Vulkan device renders to and samples.
@@ -420,12 +429,95 @@ impl HiStencilSurface {
             rect_width: rect.width,
             rect_tiles,
             marker,
+            mode: 0,
+            tests: 0,
+            mask2: 0,
+            value2: 0,
         };
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
         let groups = rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
         unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
+        let attached = ImageAccess::DepthStencilAttachment;
+        transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
+    }
+
+    /// Outside rendering, before a draw of a frame recorded into `slot` that tests stencil, on
+    /// a platform whose GPU keeps its own hierarchy (AMD's, [`TileTest`]): evaluates `test` on
+    /// every tile of `rect` from the stencil as it is now, and makes that the active surface the
+    /// draw's light shader and statistics read. Each tile's hierarchy state is exact for its
+    /// current values on such a GPU (made from the G-buffer pass's stencil, updated wherever a
+    /// draw writes), so evaluating it here from the values is evaluating the state. Leaves the
+    /// depth-stencil image attached-ready.
+    pub fn record_evaluate(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        slot: u32,
+        depth_stencil: &mut ImageRef,
+        test: TileTest,
+        rect: TileRect,
+    ) {
+        if rect.is_empty() {
+            return;
+        }
+        let stencil_read = ImageAccess::ComputeDepthStencilSampled;
+        transition(ctx, cmd, depth_stencil, stencil_read, Contents::Keep);
+        let (read_layout, ..) = access_info(stencil_read);
+        if self.touch.state.layout != read_layout {
+            // Bound by the set, never read here (marker 0).
+            let drawn = self.touch.state.layout != vk::ImageLayout::UNDEFINED;
+            let contents = if drawn {
+                Contents::Keep
+            } else {
+                Contents::Discard
+            };
+            transition(ctx, cmd, &mut self.touch, stencil_read, contents);
+        }
+        let rect_tiles = rect.width * rect.height;
+        let (mode, tests, first, second, compare) = match test {
+            TileTest::Pretests(p) => {
+                let held: Vec<(u8, u8)> = p.into_iter().flatten().collect();
+                let pair = |i: usize| held.get(i).map_or((0, 0), |(m, v)| (*m, v & m));
+                (1, held.len() as u32, pair(0), pair(1), 0)
+            }
+            TileTest::AndOr {
+                compare,
+                mask,
+                reference,
+            } => (
+                2,
+                0,
+                (mask, reference),
+                (0, 0),
+                compare_op(compare).as_raw() as u32,
+            ),
+        };
+        let push = UpdatePush {
+            compare,
+            reference: u32::from(first.1),
+            read_mask: u32::from(first.0),
+            width: self.extent.width,
+            height: self.extent.height,
+            tiles_x: self.tiles_x,
+            rect_x: rect.x,
+            rect_y: rect.y,
+            rect_width: rect.width,
+            rect_tiles,
+            marker: 0,
+            mode,
+            tests,
+            mask2: u32::from(second.0),
+            value2: u32::from(second.1),
+        };
+        let set = self.sets[slot as usize];
+        let update = self.update.as_ref().expect("made with the surface");
+        update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
+        let groups = rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
+        unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
+        // The tiles outside `rect` are not the draw's: active there is whatever it was.
+        self.record_flush(ctx, cmd);
         let attached = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
     }

@@ -206,15 +206,19 @@ impl TileWork {
 /// The pipeline of a planned pass. `brdfs` maps stencil slots to BRDFs; with `count_stats`
 /// every light shader counts its fragments. A hi-stencil write draws as native does: the
 /// emulator's touch draw that follows it is its own ([`LightShader::TouchTiles`]).
+///
+/// `hierarchy`: the GPU keeps its own hierarchical stencil (the AMD platforms), which may test
+/// any pass, so every light shader can reject tiles.
 pub fn pipeline_key(
     pass: &Pass,
     brdfs: &[BrdfId],
     count_stats: bool,
     source: BrdfSource,
+    hierarchy: bool,
 ) -> LightPipelineKey {
     let tiles = if count_stats {
         TileWork::TestAndCount
-    } else if pass.state.tests_hi_stencil() {
+    } else if pass.state.tests_hi_stencil() || hierarchy {
         TileWork::Test
     } else {
         TileWork::None
@@ -231,12 +235,15 @@ pub fn pipeline_key(
     (pass.geometry, shader)
 }
 
-/// Every pipeline a plan uses, each once, in first-use order; `count_tiles` adds the statistics draws of hi-stencil tests.
+/// Every pipeline a plan uses, each once, in first-use order; `count_tiles` adds the statistics
+/// draws of hi-stencil tests; `hierarchy` as for [`pipeline_key`] (with `count_tiles`, every
+/// pass may take a statistics draw).
 pub fn plan_pipelines(
     plan: &FramePlan,
     brdfs: &[BrdfId],
     count_tiles: bool,
     source: BrdfSource,
+    hierarchy: bool,
 ) -> Vec<LightPipelineKey> {
     let mut keys = Vec::new();
     let mut add = |key| {
@@ -248,11 +255,11 @@ pub fn plan_pipelines(
     for (step, touch) in plan.steps.iter().zip(touches) {
         match step {
             Step::Pass { pass, .. } => {
-                add(pipeline_key(pass, brdfs, count_tiles, source));
+                add(pipeline_key(pass, brdfs, count_tiles, source, hierarchy));
                 if touch == Some(TouchedTiles::Drawn) {
                     add((Geometry::Volume, LightShader::TouchTiles));
                 }
-                if count_tiles && pass.state.tests_hi_stencil() {
+                if count_tiles && (pass.state.tests_hi_stencil() || hierarchy) {
                     add((pass.geometry, LightShader::CountTiles));
                 }
             }
@@ -274,8 +281,9 @@ pub fn prepare_pipelines(
     brdfs: &[BrdfId],
     count_tiles: bool,
     source: BrdfSource,
+    hierarchy: bool,
 ) -> Result<()> {
-    for key in plan_pipelines(plan, brdfs, count_tiles, source) {
+    for key in plan_pipelines(plan, brdfs, count_tiles, source, hierarchy) {
         pipelines.prepare(ctx, key)?;
     }
     Ok(())
@@ -304,7 +312,7 @@ mod tests {
             FlushPolicy::Auto,
         )
         .unwrap();
-        let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula);
+        let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula, false);
         let shaders: Vec<LightShader> = keys.iter().map(|k| k.1).collect();
         let tiles = TileWork::Test;
         for expected in [
@@ -335,7 +343,7 @@ mod tests {
             }
         )));
         // Only the statistics runs compile the fragment count in.
-        let counted = plan_pipelines(&plan, &brdfs, true, BrdfSource::Formula);
+        let counted = plan_pipelines(&plan, &brdfs, true, BrdfSource::Formula, false);
         assert!(counted.iter().any(|k| k.1 == LightShader::CountTiles));
         assert!(counted.iter().all(|k| !matches!(
             k.1,
@@ -357,9 +365,9 @@ mod tests {
             s,
             histencil_model::Step::Pass { pass, .. } if pass.state.writes_hi_stencil()
         )));
-        let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula);
+        let keys = plan_pipelines(&plan, &brdfs, false, BrdfSource::Formula, false);
         assert!(!keys.iter().any(|k| k.1 == LightShader::TouchTiles));
-        let table = plan_pipelines(&plan, &brdfs, false, BrdfSource::Table);
+        let table = plan_pipelines(&plan, &brdfs, false, BrdfSource::Table, false);
         assert!(table.iter().any(|k| matches!(k.1, LightShader::Lut { .. })));
         assert!(!table.iter().any(|k| matches!(
             k.1,

@@ -17,7 +17,9 @@ use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingT
 use crate::context::Context;
 use crate::error::{Error, Result};
 use crate::gpu_types::LightDrawPush;
-use crate::hi_stencil::{plan_touches, tile_rect, HiStencilSurface, TouchedTiles, WriteTiles};
+use crate::hi_stencil::{
+    plan_touches, tile_rect, GpuHierarchy, HiStencilSurface, TouchedTiles, WriteTiles,
+};
 use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use crate::state::{apply, FULLSCREEN};
@@ -72,6 +74,10 @@ pub struct LightingPass<'a> {
     pub depth_sampled: bool,
     /// The frame-in-flight slot, whose hi-stencil update set reads this frame's stencil.
     pub slot: u32,
+    /// On the AMD platforms, the GPU's own hierarchy the emulation follows
+    /// (`crate::hi_stencil::amd`): evaluated before every pass it tests, which then rejects
+    /// the tiles it rules out.
+    pub hierarchy: Option<GpuHierarchy>,
 }
 
 /// Whether the HDR and depth-stencil attachments are bound. Hi-stencil writes, flushes and the
@@ -141,13 +147,16 @@ impl Emulation {
     pub const BOOKKEEPING: &'static str = "bookkeeping";
 
     /// Timestamps `plan` needs after the start mark: one after the reset, two per hi-stencil
-    /// write and flush, one at the end.
-    pub fn marks(plan: &FramePlan) -> u32 {
+    /// write and flush and per evaluation of `hierarchy`, one at the end.
+    pub fn marks(plan: &FramePlan, hierarchy: Option<&GpuHierarchy>) -> u32 {
         let ops = plan
             .steps
             .iter()
             .filter(|step| match step {
-                Step::Pass { pass, .. } => pass.state.hi_stencil.is_some_and(|h| h.write),
+                Step::Pass { pass, .. } => {
+                    pass.state.hi_stencil.is_some_and(|h| h.write)
+                        || hierarchy.is_some_and(|h| h.test_for(pass).is_some())
+                }
                 Step::FlushHiStencil => true,
                 _ => false,
             })
@@ -245,7 +254,17 @@ impl LightingPass<'_> {
                     }
                     let scene_light = self.plan.lights[*light].input as u32;
                     ctx.begin_label(cmd, &pass.label());
-                    self.record_pass(targets, &mut rendering, index, pass, scene_light)?;
+                    let test = self.hierarchy.as_ref().and_then(|h| h.test_for(pass));
+                    if let Some(test) = test {
+                        Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
+                        rendering.close(self);
+                        let rect = tile_rect(self.extent, self.screen_rect(*light, pass));
+                        let ds = &mut targets.depth_stencil;
+                        hi_stencil.record_evaluate(ctx, cmd, self.slot, ds, test, rect);
+                        Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
+                    }
+                    let tested = test.is_some();
+                    self.record_pass(targets, &mut rendering, index, pass, scene_light, tested)?;
                     if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
@@ -306,7 +325,17 @@ impl LightingPass<'_> {
         Ok(())
     }
 
-    /// One planned pass: the statistics draw of a hi-stencil test and the pass's own draw (the
+    /// Where plan light `light`'s `pass` lies on screen: its light's rectangle for a volume,
+    /// `None` (the whole frame) for a full-screen pass.
+    fn screen_rect(&self, light: usize, pass: &Pass) -> Option<histencil_model::NdcRect> {
+        match pass.geometry {
+            Geometry::Volume => self.plan.lights[light].screen_rect,
+            Geometry::FullScreen => None,
+        }
+    }
+
+    /// One planned pass: the statistics draw of a hi-stencil test (a console's, or with
+    /// `hierarchy_tested` the GPU hierarchy's the caller evaluated) and the pass's own draw (the
     /// caller updates the tiles of a hi-stencil write).
     fn record_pass(
         &self,
@@ -315,8 +344,12 @@ impl LightingPass<'_> {
         step: usize,
         pass: &Pass,
         scene_light: u32,
+        hierarchy_tested: bool,
     ) -> Result<()> {
         let state = &pass.state;
+        // A hierarchy's rejected tile holds no fragment passing the stencil test, so a pass that
+        // also writes stencil writes nothing there either: only a console's test, which rules
+        // on state written by another pass, could diverge.
         if state.tests_hi_stencil() && state.writes_stencil() {
             // The light shader rejects tiles after early depth / stencil tests, which would
             // already have written stencil: the emulation would diverge from the model.
@@ -326,7 +359,7 @@ impl LightingPass<'_> {
         }
         let shades = matches!(pass.kind, PassKind::Shade(_));
         let mut flags = 0;
-        if state.tests_hi_stencil() {
+        if state.tests_hi_stencil() || hierarchy_tested {
             flags |= LIGHT_DRAW_HI_STENCIL_TEST;
             if self.count_stats {
                 rendering.split(self);
@@ -359,7 +392,8 @@ impl LightingPass<'_> {
             flags,
             bit: 0,
         };
-        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source);
+        let tests = self.hierarchy.is_some();
+        let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source, tests);
         self.draw(key, state, pass.geometry, push);
         Ok(())
     }
@@ -376,11 +410,7 @@ impl LightingPass<'_> {
         hi_stencil: &mut HiStencilSurface,
         (light, pass, hi, touched): (usize, &Pass, &HiStencilState, TouchedTiles),
     ) {
-        let screen = match pass.geometry {
-            Geometry::Volume => self.plan.lights[light].screen_rect,
-            Geometry::FullScreen => None,
-        };
-        let rect = tile_rect(self.extent, screen);
+        let rect = tile_rect(self.extent, self.screen_rect(light, pass));
         if touched == TouchedTiles::Drawn && !rect.is_empty() {
             hi_stencil.begin_touch(self.ctx, self.cmd, rect);
             let state = PassState {

@@ -7,6 +7,7 @@ use crate::access::LightingTargets;
 use crate::alpha::AlphaInputs;
 use crate::deferred_lighting::{LightingFrame, TiledFrame};
 use crate::error::{Result, VkCall};
+use crate::hi_stencil::GpuHierarchy;
 use crate::hooks::HookSets;
 use crate::passes::geometry::{GbufferStencil, MeshInputs};
 use crate::passes::light_pipelines::BrdfSource;
@@ -41,11 +42,18 @@ impl Renderer<'_> {
                 Some((technique, plan))
             }
         };
+        let hierarchy = match &deferred {
+            Some((technique, _)) => self.gpu_hierarchy(desc, *technique)?,
+            None => None,
+        };
         let cmd = self.begin_commands()?;
         self.timestamps.begin_frame(ctx, cmd);
         match &deferred {
             None => self.record_forward_pass(desc),
-            Some((technique, plan)) => self.record_deferred(desc, *technique, &view, plan)?,
+            Some((technique, plan)) => {
+                let lit = (*technique, hierarchy);
+                self.record_deferred(desc, lit, &view, plan)?
+            }
         }
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
@@ -117,11 +125,12 @@ impl Renderer<'_> {
     }
 
     /// The deferred frame's passes: the G-buffer, emission into the HDR target, and the
-    /// lighting of `plan` through [`crate::DeferredLighting`].
+    /// lighting of `plan` through [`crate::DeferredLighting`], by `technique` and on an AMD
+    /// platform emulating `hierarchy`.
     fn record_deferred(
         &mut self,
         desc: &FrameDesc,
-        technique: Technique,
+        (technique, hierarchy): (Technique, Option<GpuHierarchy>),
         view: &ViewDesc,
         plan: &FramePlan,
     ) -> Result<()> {
@@ -179,7 +188,10 @@ impl Renderer<'_> {
         let mut targets = self.targets.lighting();
         // SAFETY: `cmd` records on this context's device; the targets' states are the ones this
         // renderer tracks; it waits for every frame, so slot 0 is free.
-        unsafe { self.lighting.record(cmd, &frame, &mut targets)? };
+        unsafe {
+            self.lighting
+                .record_emulating(cmd, &frame, &mut targets, hierarchy)?
+        };
         self.targets.lit(&targets);
         self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
         Ok(())

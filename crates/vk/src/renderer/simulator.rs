@@ -3,11 +3,13 @@
 use super::Renderer;
 use crate::capture::{FootprintCapture, SimulatorInputs};
 use crate::error::Result;
+use crate::hi_stencil::GpuHierarchy;
 use crate::readback::{copy_image_to_buffer, host_readable};
 use crate::resources::Buffer;
 use crate::shader_consts::HI_STENCIL_TILE;
-use crate::technique::{FrameDesc, TileSide};
+use crate::technique::{Backend, FrameDesc, Technique, TileSide};
 use ash::vk;
+use histencil_model::amd::{choose_pretests, slot_tile_counts, Pretest, PRETEST_SLOTS};
 use histencil_model::depth_id::{depth_id_stats, slot_id};
 use histencil_model::{Footprint, SoftTarget, TileStats, TileSurface};
 
@@ -118,6 +120,51 @@ impl Renderer<'_> {
             Ok(depth_id_stats(ids, width, &tiles, &passes))
         })();
         ids.destroy(ctx);
+        result
+    }
+}
+
+impl Renderer<'_> {
+    /// The hierarchy the deferred frame `desc` lit by `technique` emulates: on the AMD
+    /// platforms the GPU's own ([`crate::Backend::has_gpu_hierarchy`]), none elsewhere. GFX9-11
+    /// binds its pretests before the G-buffer pass: [`Renderer::amd_pretests`].
+    pub(super) fn gpu_hierarchy(
+        &mut self,
+        desc: &FrameDesc,
+        technique: Technique,
+    ) -> Result<Option<GpuHierarchy>> {
+        if !technique.records_plan() {
+            return Ok(None);
+        }
+        Ok(match technique.backend() {
+            Backend::AmdAndOr => Some(GpuHierarchy::AndOr),
+            Backend::AmdPretest => Some(GpuHierarchy::Pretests(self.amd_pretests(desc)?)),
+            _ => None,
+        })
+    }
+
+    /// The two pretests an AMD GFX9-11 frame binds (`histencil_model::amd::choose_pretests`),
+    /// from how many 8x8 tiles of the frame's own G-buffer stencil hold each BRDF slot: a
+    /// G-buffer pass of `desc`, read back, before the frame (an engine would use the previous
+    /// frame's). The simulator's oracle makes the same choice from its captured stencil.
+    pub fn amd_pretests(&mut self, desc: &FrameDesc) -> Result<[Option<Pretest>; PRETEST_SLOTS]> {
+        let ctx = self.ctx;
+        let (width, height) = (self.extent.width, self.extent.height);
+        let pixels = u64::from(width) * u64::from(height);
+        let mut stencil = Buffer::readback(ctx, "pretest-stencil-readback", pixels)?;
+        let result = (|| {
+            let cmd = self.begin_commands()?;
+            self.record_gbuffer_pass(desc);
+            let image = &mut self.targets.depth_stencil;
+            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
+            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
+            self.submit_and_wait()?;
+            let layout = &self.stencil_layout;
+            let tiles = TileSurface::new(width, height, HI_STENCIL_TILE);
+            let counts = slot_tile_counts(layout, stencil.read(), width, &tiles);
+            Ok(choose_pretests(layout, &counts))
+        })();
+        stencil.destroy(ctx);
         result
     }
 }
