@@ -90,6 +90,33 @@ fn x360_without_zeroing_loses_lights_on_preserved_bits_and_the_fixes_restore_the
     }
 }
 
+/// The 360's failure asked of AMD's GFX12 tiles: with the tests' read mask they cull around
+/// the engine's bits and stay exact; compared on every bit (the rule broken on purpose), the
+/// engine's bits reject whole tiles of light. Pretests mask the BRDF field: exact either way.
+#[test]
+fn amd_hierarchies_keep_engine_bits_out_of_culling_and_breaking_the_read_mask_loses_lights() {
+    for name in ["default", "brdfs-6"] {
+        let scene = histencil_scene::embedded(name).unwrap();
+        with_validated_context(|ctx| {
+            let mut renderer = Renderer::new(ctx, scene.clone(), SIZE, SIZE).expect("renderer");
+            let forward = image(&mut renderer, Shading::Forward, 0);
+            let auto = FlushPolicy::Auto;
+            let unmasked = stencil(Backend::AmdAndOrUnmasked, auto);
+            let clean = image(&mut renderer, unmasked, 0);
+            assert_close(&format!("amd-{name}-no-pattern"), &clean, &forward, TOLERANCE);
+            let broken = image(&mut renderer, unmasked, PATTERN);
+            assert_broken(&format!("{name} amd-andor unmasked"), &broken, &forward);
+            for (label, backend) in [
+                ("andor", Backend::AmdAndOr),
+                ("pretest", Backend::AmdPretest),
+            ] {
+                let fixed = image(&mut renderer, stencil(backend, auto), PATTERN);
+                assert_close(&format!("amd-{name}-{label}"), &fixed, &forward, TOLERANCE);
+            }
+        });
+    }
+}
+
 #[test]
 fn without_flushes_stale_tiles_are_culled_and_auto_flushing_is_exact() {
     for name in ["default", "brdfs-3"] {
@@ -163,6 +190,9 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
         // each stencil-testing draw, the model's run beside the native plan (`run_with`).
         ("amd-pretest", stencil(Backend::AmdPretest, auto)),
         ("amd-andor", stencil(Backend::AmdAndOr, auto)),
+        // The rule broken on purpose: the engine's bits reject whole tiles of light, on the
+        // GPU as in the model.
+        ("amd-andor-unmasked", stencil(Backend::AmdAndOrUnmasked, auto)),
         (
             "branching-amd-andor",
             Technique::Branching {
@@ -240,7 +270,7 @@ fn reversed_and_infinite_far_frames_equal_the_simulators() {
 fn assert_simulated(renderer: &mut Renderer, desc: &FrameDesc, what: &str) {
     let inputs = renderer.simulator_inputs(*desc).expect("inputs");
     let backend = desc.shading.technique().expect("deferred").backend();
-    let (sim, predicted) = inputs.predict_on(backend);
+    let (sim, predicted) = inputs.predict_on(&inputs.plan, backend);
     let frame = renderer.render_frame(desc).expect("frame");
     let stats = frame.tile_stats.expect("statistics were asked for");
     println!("{what}: {stats:?}");

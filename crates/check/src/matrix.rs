@@ -81,6 +81,8 @@ pub enum Platform {
     AmdPretest,
     /// AMD GFX12's AND/OR tiles (modelled from AMD's driver sources).
     AmdAndOr,
+    /// GFX12's tiles ignoring a test's read mask: only as a known-wrong case.
+    AmdAndOrUnmasked,
 }
 
 impl Platform {
@@ -101,6 +103,7 @@ impl Platform {
             Platform::Native => "native",
             Platform::AmdPretest => "amd-pretest",
             Platform::AmdAndOr => "amd-andor",
+            Platform::AmdAndOrUnmasked => "amd-andor-unmasked",
         }
     }
 
@@ -122,6 +125,7 @@ impl Platform {
             Platform::Native => Backend::Native,
             Platform::AmdPretest => Backend::AmdPretest,
             Platform::AmdAndOr => Backend::AmdAndOr,
+            Platform::AmdAndOrUnmasked => Backend::AmdAndOrUnmasked,
         }
     }
 
@@ -160,6 +164,9 @@ pub enum KnownWrong {
     PreservedBitsNotZeroed,
     /// No hi-stencil flushes: shade passes read another pass's stale tile state.
     StaleHiStencil,
+    /// GFX12's AND/OR tiles compared without the tests' read mask: the engine's preserved bits
+    /// contradict the BRDF tests' references and whole tiles of light are rejected.
+    AndOrReadMaskIgnored,
 }
 
 impl KnownWrong {
@@ -169,6 +176,9 @@ impl KnownWrong {
                 "360-like hi-stencil reads the preserved bits it does not zero"
             }
             KnownWrong::StaleHiStencil => "shade passes read stale hi-stencil without flushes",
+            KnownWrong::AndOrReadMaskIgnored => {
+                "AMD GFX12 AND/OR tiles compared without the read mask reject tiles for the engine bits"
+            }
         }
     }
 }
@@ -346,6 +356,18 @@ fn lighting_configs(pattern: u8, alpha: AlphaMode) -> Vec<Config> {
                 });
             }
         }
+        // AMD's own hierarchies (modelled), on the talk's technique they cull for.
+        if lighting == Lighting::Stencil {
+            for platform in [Platform::AmdPretest, Platform::AmdAndOr] {
+                configs.push(Config {
+                    lighting,
+                    platform,
+                    flush: FlushPolicy::Auto,
+                    pattern,
+                    alpha,
+                });
+            }
+        }
     }
     configs
 }
@@ -420,6 +442,16 @@ pub fn cases(
                 Some(config),
                 Expect::Wrong(KnownWrong::PreservedBitsNotZeroed),
             ));
+            let config = talk(
+                Platform::AmdAndOrUnmasked,
+                FlushPolicy::Auto,
+                pattern,
+                exact_alpha,
+            );
+            out.push(case(
+                Some(config),
+                Expect::Wrong(KnownWrong::AndOrReadMaskIgnored),
+            ));
         }
         for platform in [Platform::Ps3, Platform::X360] {
             let config = talk(platform, FlushPolicy::Never, pattern, exact_alpha);
@@ -437,6 +469,7 @@ pub fn corrected(config: Config) -> Config {
     Config {
         platform: match config.platform {
             Platform::X360NoZeroing => Platform::X360,
+            Platform::AmdAndOrUnmasked => Platform::AmdAndOr,
             p => p,
         },
         flush: FlushPolicy::Auto,
@@ -485,9 +518,10 @@ mod tests {
     fn the_matrix_holds_what_a_scene_needs_and_nothing_else() {
         let room = cases(ROOM, DepthStencilFormat::D32S8, (257, 129));
         // Per pattern: stencil, adaptive, lut 7 each (x360, save-restore, ps3 with two flushes,
-        // native with one), branching 6 (not on native), deferred 1, tiled 1, depth-id 1.
-        let lighting = 3 * 7 + 6 + 1 + 1 + 1;
-        let known_wrong = 3;
+        // native with one), branching 6 (not on native), deferred 1, tiled 1, depth-id 1, and
+        // stencil on the two AMD platforms.
+        let lighting = 3 * 7 + 6 + 1 + 1 + 1 + 2;
+        let known_wrong = 4;
         assert_eq!(room.len(), 1 + 2 * lighting + known_wrong);
         assert!(room
             .iter()

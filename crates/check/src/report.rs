@@ -88,6 +88,9 @@ fn case_json(r: &CaseResult) -> Value {
                 "known-wrong: preserved bits not zeroed".to_owned()
             }
             Expect::Wrong(KnownWrong::StaleHiStencil) => "known-wrong: stale hi-stencil".to_owned(),
+            Expect::Wrong(KnownWrong::AndOrReadMaskIgnored) => {
+                "known-wrong: AND/OR without the read mask".to_owned()
+            }
         };
         let mut v = json!({
             "format": case.format.vk_name(),

@@ -673,7 +673,7 @@ fn predict(
     technique: Technique,
 ) -> histencil_vk::Result<(histencil_model::SimResult, Vec<u8>)> {
     let plan = renderer.plan(technique)?;
-    let (result, target) = inputs.predict_plan(&plan);
+    let (result, target) = inputs.predict_on(&plan, technique.backend());
     Ok((result, target.stencil))
 }
 

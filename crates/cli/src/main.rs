@@ -252,6 +252,8 @@ enum BackendArg {
     AmdPretest,
     /// AMD GFX12's per-tile AND/OR of the stencil, modelled likewise.
     AmdAndor,
+    /// GFX12's tiles ignoring a test's read mask: engine bits break culling (known-wrong).
+    AmdAndorUnmasked,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -280,6 +282,7 @@ impl RenderArgs {
             BackendArg::Native => Platform::Native,
             BackendArg::AmdPretest => Platform::AmdPretest,
             BackendArg::AmdAndor => Platform::AmdAndOr,
+            BackendArg::AmdAndorUnmasked => Platform::AmdAndOrUnmasked,
         }
         .backend();
         let flush = match self.flush {
@@ -540,7 +543,7 @@ fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
     let depth_id = matches!(desc.shading, Shading::Deferred(Technique::DepthId { .. }));
     let predicted = match desc.shading.technique() {
         _ if depth_id => inputs.predict_depth_id(),
-        Some(technique) => inputs.predict_on(technique.backend()).0.stats,
+        Some(technique) => inputs.predict_on(&inputs.plan, technique.backend()).0.stats,
         None => inputs.predict().0.stats,
     };
     let counted = FrameDesc {

@@ -12,10 +12,7 @@
 //! are culled hierarchically; and tiles tested and culled and fragments shaded per scene.
 
 use crate::{write_file, Result};
-use histencil_model::amd::{
-    choose_pretests, slot_tile_counts, AndOrTiles, PretestTiles, TileHierarchy,
-};
-use histencil_model::{FlushPolicy, FramePlan, TileStats, TileSurface};
+use histencil_model::{FlushPolicy, FramePlan, TileStats};
 use histencil_scene::Scene;
 use histencil_vk::{Backend, Context, FrameDesc, Renderer, SimulatorInputs, Technique};
 use serde_json::{json, Value};
@@ -103,7 +100,9 @@ impl Platform {
                 save_restore: false,
             },
             Platform::Ps3 => Backend::Ps3,
-            Platform::AmdPretest | Platform::AmdAndOr | Platform::Native => Backend::Native,
+            Platform::AmdPretest => Backend::AmdPretest,
+            Platform::AmdAndOr => Backend::AmdAndOr,
+            Platform::Native => Backend::Native,
         };
         Technique::Stencil {
             backend,
@@ -154,17 +153,8 @@ pub struct TodaysGpusReport {
 
 /// The simulator's counts of `platform` on `inputs` (captured with some engine bits).
 fn counts_of(inputs: &SimulatorInputs, platform: Platform, plan: &FramePlan) -> TileStats {
-    let target = &inputs.target;
-    let tiles = TileSurface::new(target.width, target.height, inputs.tile_size);
-    let mut hierarchy: Box<dyn TileHierarchy> = match platform {
-        Platform::AmdPretest => {
-            let counts = slot_tile_counts(&inputs.layout, &target.stencil, target.width, &tiles);
-            Box::new(PretestTiles::new(choose_pretests(&inputs.layout, &counts)))
-        }
-        Platform::AmdAndOr => Box::new(AndOrTiles::new()),
-        _ => return inputs.predict_plan(plan).0.stats,
-    };
-    inputs.predict_with(plan, hierarchy.as_mut()).0.stats
+    let backend = platform.technique().backend();
+    inputs.predict_on(plan, backend).0.stats
 }
 
 /// Runs every platform on every scene at `width` x `height`.

@@ -244,11 +244,24 @@ pub fn slot_tile_counts(
 pub struct AndOrTiles {
     and: Vec<u8>,
     or: Vec<u8>,
+    /// The rule broken on purpose (a known-wrong case): a test's read mask ignored, every
+    /// bit compared, as the 360's hi-stencil did.
+    unmasked: bool,
 }
 
 impl AndOrTiles {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// AND/OR tiles that compare all 8 bits whatever a test's read mask: with engine bits in
+    /// the preserved stencil bits, tiles are rejected that hold passing pixels (lights lost), the
+    /// 360's failure on today's hierarchy. A known-wrong case, not a GPU.
+    pub fn unmasked() -> Self {
+        Self {
+            unmasked: true,
+            ..Self::default()
+        }
     }
 
     /// Back to the full range (AND 0, OR 0xFF), as on return from a layout that does not keep
@@ -270,7 +283,11 @@ impl TileHierarchy for AndOrTiles {
     }
 
     fn may_pass(&self, tile: usize, face: &FaceStencil) -> bool {
-        let m = face.compare_mask;
+        let m = if self.unmasked {
+            0xFF
+        } else {
+            face.compare_mask
+        };
         let (known_one, known_zero) = (self.and[tile] & m, !self.or[tile] & m);
         let reference = face.reference & m;
         match face.compare {

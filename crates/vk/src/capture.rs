@@ -39,19 +39,22 @@ impl SimulatorInputs {
         self.predict_plan(&self.plan)
     }
 
-    /// [`SimulatorInputs::predict`] on `backend`: on the AMD platforms, the native plan run
-    /// with the model of the GPU's own hierarchy ([`SimulatorInputs::predict_with`]), GFX9-11's
+    /// [`SimulatorInputs::predict_plan`] of `plan` on `backend`: on the AMD platforms, with
+    /// the model of the GPU's own hierarchy ([`SimulatorInputs::predict_with`]), GFX9-11's
     /// pretests chosen from the captured stencil as the renderer chooses them
-    /// (`Renderer::amd_pretests`); elsewhere as captured.
-    pub fn predict_on(&self, backend: crate::Backend) -> (SimResult, SoftTarget) {
+    /// (`Renderer::amd_pretests`).
+    pub fn predict_on(&self, plan: &FramePlan, backend: crate::Backend) -> (SimResult, SoftTarget) {
         use histencil_model::amd::{AndOrTiles, PretestTiles};
         match backend {
-            crate::Backend::AmdAndOr => self.predict_with(&self.plan, &mut AndOrTiles::new()),
+            crate::Backend::AmdAndOr => self.predict_with(plan, &mut AndOrTiles::new()),
+            crate::Backend::AmdAndOrUnmasked => {
+                self.predict_with(plan, &mut AndOrTiles::unmasked())
+            }
             crate::Backend::AmdPretest => {
                 let mut tiles = PretestTiles::new(self.amd_pretests());
-                self.predict_with(&self.plan, &mut tiles)
+                self.predict_with(plan, &mut tiles)
             }
-            _ => self.predict(),
+            _ => self.predict_plan(plan),
         }
     }
 

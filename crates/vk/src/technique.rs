@@ -32,6 +32,10 @@ pub enum Backend {
     /// AMD GFX12 (RDNA 4): the native plan, with the GPU's per-tile AND and OR of the stencil
     /// emulated.
     AmdAndOr,
+    /// GFX12's tiles with a rule broken on purpose (a known-wrong case, no GPU): a test's read
+    /// mask ignored, so engine bits in the preserved stencil bits reject tiles that hold
+    /// passing pixels, the 360's failure (`histencil_model::amd::AndOrTiles::unmasked`).
+    AmdAndOrUnmasked,
 }
 
 impl Backend {
@@ -47,14 +51,19 @@ impl Backend {
             Backend::Ps3 => Box::new(Ps3Like),
             Backend::Native => Box::new(Native),
             Backend::AmdPretest => Box::new(histencil_model::amd::AmdPretest),
-            Backend::AmdAndOr => Box::new(histencil_model::amd::AmdAndOr),
+            Backend::AmdAndOr | Backend::AmdAndOrUnmasked => {
+                Box::new(histencil_model::amd::AmdAndOr)
+            }
         }
     }
 
     /// Whether the GPU keeps a hierarchical stencil of its own, which no plan step drives (the
     /// AMD platforms).
     pub fn has_gpu_hierarchy(self) -> bool {
-        matches!(self, Backend::AmdPretest | Backend::AmdAndOr)
+        matches!(
+            self,
+            Backend::AmdPretest | Backend::AmdAndOr | Backend::AmdAndOrUnmasked
+        )
     }
 }
 

@@ -33,8 +33,9 @@ pub enum GpuHierarchy {
     /// GFX9-11 with these pretests bound before the G-buffer pass
     /// (`histencil_model::amd::choose_pretests`).
     Pretests([Option<Pretest>; PRETEST_SLOTS]),
-    /// GFX12's AND/OR tiles.
-    AndOr,
+    /// GFX12's AND/OR tiles; without `read_mask`, the known-wrong case that compares every
+    /// bit whatever the test's read mask (`histencil_model::amd::AndOrTiles::unmasked`).
+    AndOr { read_mask: bool },
 }
 
 impl GpuHierarchy {
@@ -65,9 +66,9 @@ impl GpuHierarchy {
                     .map(|p| (p.mask, p.value));
                 TileTest::Pretests([implied.next(), implied.next()])
             }
-            GpuHierarchy::AndOr => TileTest::AndOr {
+            GpuHierarchy::AndOr { read_mask } => TileTest::AndOr {
                 compare: face.compare,
-                mask: face.compare_mask,
+                mask: if *read_mask { face.compare_mask } else { 0xFF },
                 reference: face.reference,
             },
         }

@@ -163,9 +163,11 @@ impl<'c> Renderer<'c> {
         self.desc.cost_model.unwrap_or_else(|| {
             let figures = match backend {
                 Backend::X360 { .. } => TalkFigures::X360,
-                Backend::Ps3 | Backend::Native | Backend::AmdPretest | Backend::AmdAndOr => {
-                    TalkFigures::PS3
-                }
+                Backend::Ps3
+                | Backend::Native
+                | Backend::AmdPretest
+                | Backend::AmdAndOr
+                | Backend::AmdAndOrUnmasked => TalkFigures::PS3,
             };
             CostModel::from_talk(&figures, ASSUMED_DRAW_OVERHEAD_MS)
         })

@@ -137,7 +137,8 @@ impl Renderer<'_> {
             return Ok(None);
         }
         Ok(match technique.backend() {
-            Backend::AmdAndOr => Some(GpuHierarchy::AndOr),
+            Backend::AmdAndOr => Some(GpuHierarchy::AndOr { read_mask: true }),
+            Backend::AmdAndOrUnmasked => Some(GpuHierarchy::AndOr { read_mask: false }),
             Backend::AmdPretest => Some(GpuHierarchy::Pretests(self.amd_pretests(desc)?)),
             _ => None,
         })
