@@ -105,8 +105,8 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
 
     let json = read_json(&dir.join("report.json"));
     let numbers = count_finite_numbers(&json, "report");
-    // 9 rows x 3 counts x (4 timing + 2 overhead + 3 error + 1) numbers at least.
-    assert!(numbers > 9 * 3 * 10, "{numbers} numbers");
+    // 12 rows x 3 counts x (4 timing + 2 overhead + 3 error + 1) numbers at least.
+    assert!(numbers > 12 * 3 * 10, "{numbers} numbers");
     let rows = json["rows"].as_array().unwrap();
     let names: Vec<&str> = rows
         .iter()
@@ -119,11 +119,14 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
             "stencil x360",
             "stencil ps3",
             "stencil native",
+            "stencil amd-pretest",
+            "stencil amd-andor",
             "lut",
             "adaptive",
             "tiled",
             "tiled, mixed branching",
-            "tiled 8x8"
+            "tiled 8x8",
+            "depth-id"
         ]
     );
     for row in rows {
@@ -136,7 +139,13 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
         // The emulated backends' bookkeeping is sampled apart, every round, wherever the plan
         // uses hi-stencil (with several BRDFs; one BRDF under lights that hold the camera needs
         // none); nothing else has any.
-        let emulated = row["technique"] == "stencil x360" || row["technique"] == "stencil ps3";
+        let emulated = [
+            "stencil x360",
+            "stencil ps3",
+            "stencil amd-pretest",
+            "stencil amd-andor",
+        ]
+        .contains(&row["technique"].as_str().unwrap());
         for cell in cells {
             let bookkeeping = cell["bookkeeping_samples_ms"].as_array().unwrap();
             let several = cell["brdfs"].as_u64().unwrap() > 1;
@@ -187,7 +196,8 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
         assert_eq!(size["tiled_tile_side"].as_u64(), Some(u64::from(side)));
         assert_eq!(size["samples_ms"]["tiled"].as_array().unwrap().len(), 2);
     }
-    assert_eq!(json["breakdown"].as_array().unwrap().len(), 3);
+    // The stencil rows' breakdowns: the consoles', native's and AMD's.
+    assert_eq!(json["breakdown"].as_array().unwrap().len(), 5);
     assert!(json["device"].as_str().unwrap().contains("llvmpipe") || !json["device"].is_null());
 
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
@@ -374,10 +384,12 @@ fn the_demo_shows_each_failure_next_to_a_fix_that_matches_forward() {
     };
     let report =
         with_validated_context(|ctx| histencil_lab::run_demo(ctx, settings, &mut |_| {}).unwrap());
-    assert_eq!(report.failures.len(), 2);
+    assert_eq!(report.failures.len(), 3);
     // Each row's technique time, and the emulator's apart on the emulated backends only.
     for row in &report.rows {
-        let emulated = row.label.contains("PS3-like") || row.label.contains("360-like");
+        let emulated = ["PS3-like", "360-like", "AMD"]
+            .iter()
+            .any(|p| row.label.contains(p));
         assert_eq!(row.bookkeeping.is_some(), emulated, "{}", row.label);
         assert!(row.time.median_ms > 0.0, "{}", row.label);
     }

@@ -87,8 +87,8 @@ fn stencil(backend: Backend, flush: FlushPolicy) -> Technique {
     Technique::Stencil { backend, flush }
 }
 
-/// The rows, in the table's order; tiled with tiles of `side`.
-fn configurations(side: TileSide) -> [(&'static str, Shading); 7] {
+/// The rows, in the table's order; tiled and depth-id with tiles of `side`.
+fn configurations(side: TileSide) -> [(&'static str, Shading); 10] {
     let auto = FlushPolicy::Auto;
     [
         ("forward (reference)", Shading::Forward),
@@ -108,12 +108,24 @@ fn configurations(side: TileSide) -> [(&'static str, Shading); 7] {
             .into(),
         ),
         (
+            "stencil, AMD GFX9-11 pretests (modelled)",
+            stencil(Backend::AmdPretest, auto).into(),
+        ),
+        (
+            "stencil, AMD GFX12 AND/OR (modelled)",
+            stencil(Backend::AmdAndOr, auto).into(),
+        ),
+        (
             "tiled, native",
             Technique::Tiled {
                 mixed: MixedTiles::PerBrdf,
                 side,
             }
             .into(),
+        ),
+        (
+            "depth-id (Bevy's), native",
+            Technique::DepthId { side }.into(),
         ),
     ]
 }
@@ -158,16 +170,22 @@ pub fn run_demo(
                     .count();
                 (kept, surfaces.count() - kept)
             });
-        let tiles = match shading {
-            Shading::Deferred(Technique::Stencil { backend, .. }) if backend != Backend::Native => {
-                let counted = FrameDesc {
-                    tile_stats: true,
-                    readback: Readback::NONE,
-                    ..desc
-                };
-                renderer.render_frame(&counted)?.tile_stats
-            }
-            _ => None,
+        // Hierarchical stencil emulated (consoles, AMD), or the depth ids' hierarchical depth
+        // modelled on the GPU's ids.
+        let counts = match shading {
+            Shading::Deferred(Technique::Stencil { backend, .. }) => backend != Backend::Native,
+            Shading::Deferred(Technique::DepthId { .. }) => true,
+            _ => false,
+        };
+        let tiles = if counts {
+            let counted = FrameDesc {
+                tile_stats: true,
+                readback: Readback::NONE,
+                ..desc
+            };
+            renderer.render_frame(&counted)?.tile_stats
+        } else {
+            None
         };
         rows.push(DemoRow {
             label,
@@ -196,15 +214,20 @@ pub fn run_demo(
     };
     let no_zeroing = failure(&mut renderer, stencil(X360_NO_ZEROING, FlushPolicy::Auto))?;
     let never = failure(&mut renderer, stencil(Backend::Ps3, FlushPolicy::Never))?;
+    let unmasked = failure(
+        &mut renderer,
+        stencil(Backend::AmdAndOrUnmasked, FlushPolicy::Auto),
+    )?;
     // Rows by technique, not by their place in the table.
     let row = |shading: Shading| {
         rows.iter()
             .position(|r| r.shading == shading)
             .expect("every technique shown is a row")
     };
-    let (x360_row, ps3_row) = (
+    let (x360_row, ps3_row, andor_row) = (
         row(stencil(X360, FlushPolicy::Auto).into()),
         row(stencil(Backend::Ps3, FlushPolicy::Auto).into()),
+        row(stencil(Backend::AmdAndOr, FlushPolicy::Auto).into()),
     );
     let forward = frames[row(Shading::Forward)].0.clone();
     let x360 = frames[x360_row].0.clone();
@@ -219,6 +242,13 @@ pub fn run_demo(
         FailureAndFix {
             failure: ("FAIL PS3-like, no hi-stencil flush".to_owned(), never),
             fix: ("fix: flush before each test".to_owned(), ps3),
+        },
+        FailureAndFix {
+            failure: ("FAIL AMD AND/OR without read mask".to_owned(), unmasked),
+            fix: (
+                "fix: the test's read mask".to_owned(),
+                frames[andor_row].0.clone(),
+            ),
         },
     ];
     let mut tiles = vec![
@@ -268,18 +298,21 @@ impl DemoReport {
         let mut out = format!(
             "{}x{}, device {} ({}); lighting time: median (spread) of {} frames, on the emulated \
              backends the platform's technique and then the emulator's bookkeeping (hi-stencil \
-             resets, splits, touch draws, tile updates, flush copies); error against \
-             forward: 8-bit max / mean, mean FLIP; engine bits 0x{DEMO_PATTERN:02X}\n\n",
+             resets, splits, touch draws, tile updates, flush copies; on AMD's, each tested \
+             draw's tile evaluation); error against forward: 8-bit max / mean, mean FLIP; the \
+             AMD rows are modelled from AMD's driver sources, not measured on AMD hardware, and \
+             depth-id's culled tiles are a GPU's hierarchical depth modelled on the ids this \
+             device wrote; engine bits 0x{DEMO_PATTERN:02X}\n\n",
             self.width, self.height, self.device, self.driver, self.frames
         );
         let _ = writeln!(
             out,
-            "{:<34} {:>18} {:>18} {:>22} {:>28} {:>22}",
+            "{:<42} {:>18} {:>18} {:>22} {:>28} {:>22}",
             "technique, backend",
             "lighting ms",
             "emulator ms",
             "error (max/mean/FLIP)",
-            "hi-stencil tiles culled",
+            "hierarchy: tiles culled",
             "engine bits kept"
         );
         for row in &self.rows {
@@ -304,7 +337,7 @@ impl DemoReport {
             });
             let _ = writeln!(
                 out,
-                "{:<34} {:>18} {:>18} {:>22} {:>28} {:>22}",
+                "{:<42} {:>18} {:>18} {:>22} {:>28} {:>22}",
                 row.label, time, bookkeeping, error, tiles, preserved
             );
         }

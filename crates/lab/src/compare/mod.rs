@@ -95,6 +95,22 @@ pub fn table_rows() -> Vec<(&'static str, Technique)> {
                 flush,
             },
         ),
+        // AMD's hierarchies, modelled from AMD's driver sources and emulated: the native plan
+        // with the tiles a GFX9-11 (pretests) or GFX12 (AND/OR) GPU would reject rejected.
+        (
+            "stencil amd-pretest",
+            Technique::Stencil {
+                backend: Backend::AmdPretest,
+                flush,
+            },
+        ),
+        (
+            "stencil amd-andor",
+            Technique::Stencil {
+                backend: Backend::AmdAndOr,
+                flush,
+            },
+        ),
         (
             "lut",
             Technique::Lut {

@@ -350,11 +350,13 @@ impl CompareReport {
             return String::new();
         };
         let mut md = String::from(
-            "\nThe PS3-like and 360-like rows time the platform's technique: the lighting pass \
+            "\nThe PS3-like, 360-like and AMD rows time the platform's technique: the lighting pass \
              without the hi-stencil emulator's bookkeeping (resetting its tile surface; after each \
              hi-stencil write the split, the touch draw that finds the tiles it rasterised and \
-             the tile update; the copy at each flush), which a timestamp on each side of it \
-             times apart. Still inside the technique's time: its testing draws reading the tile \
+             the tile update; the copy at each flush; on AMD's, before each draw that tests \
+             stencil, the split and the evaluation of its tiles), which a timestamp on each side \
+             of it times apart. The AMD rows are modelled from AMD's driver sources, not \
+             measured on AMD hardware. Still inside the technique's time: its testing draws reading the tile \
              surface in the fragment shader, where a console tests tiles before shading.\n\n\
              | backend | BRDFs | technique, ms | emulator bookkeeping, ms | bookkeeping / whole | \
              whole lighting, ms | stencil native, ms | technique / native |\n\
