@@ -103,7 +103,12 @@ fn amd_hierarchies_keep_engine_bits_out_of_culling_and_breaking_the_read_mask_lo
             let auto = FlushPolicy::Auto;
             let unmasked = stencil(Backend::AmdAndOrUnmasked, auto);
             let clean = image(&mut renderer, unmasked, 0);
-            assert_close(&format!("amd-{name}-no-pattern"), &clean, &forward, TOLERANCE);
+            assert_close(
+                &format!("amd-{name}-no-pattern"),
+                &clean,
+                &forward,
+                TOLERANCE,
+            );
             let broken = image(&mut renderer, unmasked, PATTERN);
             assert_broken(&format!("{name} amd-andor unmasked"), &broken, &forward);
             for (label, backend) in [
@@ -192,7 +197,10 @@ fn gpu_stencil_and_tile_statistics_equal_the_simulators() {
         ("amd-andor", stencil(Backend::AmdAndOr, auto)),
         // The rule broken on purpose: the engine's bits reject whole tiles of light, on the
         // GPU as in the model.
-        ("amd-andor-unmasked", stencil(Backend::AmdAndOrUnmasked, auto)),
+        (
+            "amd-andor-unmasked",
+            stencil(Backend::AmdAndOrUnmasked, auto),
+        ),
         (
             "branching-amd-andor",
             Technique::Branching {
