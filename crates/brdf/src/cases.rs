@@ -9,12 +9,16 @@ use crate::vector::V3;
 /// One evaluation: a BRDF and its directions `[N, T, V, L]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Case {
+    /// What a failure names: the model, its parameters and the directions' hard case.
     pub label: String,
+    /// The model and parameters under test.
     pub brdf: Brdf,
+    /// `[N, T, V, L]` in f64; the f32 spellings get them rounded ([`Case::dirs_f32`]).
     pub dirs: [V3<f64>; 4],
 }
 
 impl Case {
+    /// The directions rounded to f32, as the f32 and GLSL spellings receive them.
     pub fn dirs_f32(&self) -> [V3<f32>; 4] {
         self.dirs.map(|d| d.map(|x| x as f32))
     }

@@ -18,9 +18,11 @@ use half::f16;
 /// How the G-buffer stores the normal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NormalEncoding {
+    /// Three f32 components, histencil's own G-buffer: no error beyond f32 rounding.
     Float32,
     /// Octahedral, each of the two components as a `bits`-bit snorm.
     Octahedral {
+        /// Snorm bits per component (2 to 16 make sense; 8 and 10 are the usual).
         bits: u32,
     },
 }
@@ -28,6 +30,7 @@ pub enum NormalEncoding {
 /// How the G-buffer stores the material parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamEncoding {
+    /// Half floats, histencil's RGBA16F material target.
     Float16,
     /// 8-bit unorm through the warp of each parameter (see the module doc).
     Unorm8,
@@ -194,14 +197,20 @@ pub fn encoding_directions(count: usize) -> Vec<[V3<f64>; 4]> {
 /// relative to its peak over the set.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EncodingError {
+    /// The largest error over the points.
     pub max_abs: f64,
+    /// The mean error over the points.
     pub mean_abs: f64,
+    /// The largest reference value over the points: the scale the errors are read against.
     pub peak: f64,
     /// The largest angle (degrees) between a normal and its stored version.
     pub max_normal_degrees: f64,
 }
 
 impl EncodingError {
+    /// Round-trips the normal (per point) and the parameters through the encodings and compares
+    /// the f64 value with the stored inputs against the value with the exact ones, at `directions`
+    /// (`[N, T, V, L]` each, e.g. [`encoding_directions`]).
     pub fn measure(
         brdf: Brdf,
         normals: NormalEncoding,

@@ -13,10 +13,13 @@ use std::io::{Read, Write};
 /// Why a case file could not be read at all (a bad row is a [`RowError`] instead).
 #[derive(Debug, thiserror::Error)]
 pub enum CaseFileError {
+    /// The header line could not be read (not CSV, or not UTF-8).
     #[error("reading the CSV header: {0}")]
     Header(csv::Error),
+    /// A required column is absent; the message lists the columns the file must have.
     #[error("the CSV has no `{0}` column (columns: id,brdf,params,N,T,V,L)")]
     MissingColumn(&'static str),
+    /// The results could not be written.
     #[error("writing the results: {0}")]
     Write(#[from] csv::Error),
 }
@@ -24,16 +27,22 @@ pub enum CaseFileError {
 /// One parsed row: its id, BRDF and directions `[N, T, V, L]`.
 #[derive(Debug)]
 pub struct Row {
+    /// The row's `id` column, echoed in the output so results can be joined to the cases.
     pub id: String,
+    /// The model and its parameters from `brdf` and `params`.
     pub brdf: Brdf,
+    /// `[N, T, V, L]`; a vector the model does not read and the row left empty is zero.
     pub dirs: [V3<f64>; 4],
 }
 
 /// A row that could not be parsed; `row` counts data rows from 1.
 #[derive(Debug)]
 pub struct RowError {
+    /// The data row's number, from 1 (the header not counted).
     pub row: usize,
+    /// The row's `id`, empty when the record itself could not be read.
     pub id: String,
+    /// What was wrong, in the terms of the file (column and value).
     pub message: String,
 }
 

@@ -27,6 +27,8 @@
 //!
 //! [`BrdfId`] is the renderer's list of shading models stored in the G-buffer and stencil.
 
+#![warn(missing_docs)]
+
 pub mod cases;
 pub mod encoding;
 pub mod eval_csv;

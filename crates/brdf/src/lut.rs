@@ -66,6 +66,7 @@ impl LutAxes {
         }
     }
 
+    /// The parameterisation a model's table is baked over: the fewest angles its value depends on.
     pub fn of(brdf: &Brdf) -> Self {
         match brdf {
             Brdf::Lambert { .. } => LutAxes::CosLight,
@@ -79,6 +80,7 @@ impl LutAxes {
         }
     }
 
+    /// How many axes the table has (1 to 3).
     pub fn dimensions(self) -> usize {
         match self {
             LutAxes::CosLight => 1,
@@ -175,6 +177,7 @@ impl LutAxes {
 /// Why a table could not be built.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum LutError {
+    /// The resolution is outside `2..=`[`Lut::MAX_RESOLUTION`].
     #[error("LUT resolution {0} is out of range (2..={max})", max = Lut::MAX_RESOLUTION)]
     Resolution(u32),
     /// A table holds `f / tint`, which the shader multiplies by the pixel's tint; a model with a
@@ -189,7 +192,9 @@ pub enum LutError {
 /// A baked table for one material.
 #[derive(Clone, Debug)]
 pub struct Lut {
+    /// The material the table was baked from.
     pub brdf: Brdf,
+    /// What the table's axes are ([`LutAxes::of`] the material).
     pub axes: LutAxes,
     /// Grid points per axis.
     pub resolution: u32,
@@ -317,13 +322,17 @@ pub fn report_directions(count: usize) -> Vec<[V3<f64>; 4]> {
 /// BRDF's value (`f_r * cos`), worst channel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LutAccuracy {
+    /// The largest error over the set.
     pub max_abs: f64,
+    /// The mean error over the set.
     pub mean_abs: f64,
     /// The largest reference value over the set: the scale the errors are read against.
     pub peak: f64,
 }
 
 impl LutAccuracy {
+    /// Looks the table up at every shading point of `directions` (`[N, T, V, L]` each) and
+    /// compares with [`Brdf::reference`](crate::Brdf::reference).
     pub fn measure(lut: &Lut, directions: &[[V3<f64>; 4]]) -> Self {
         let (mut max_abs, mut sum, mut peak) = (0f64, 0f64, 0f64);
         for dirs in directions {

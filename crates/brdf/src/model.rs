@@ -9,7 +9,9 @@ use serde_json::{Map, Value};
 /// A BRDF's value in two parts: `f_r * cos(theta_L) = tint * tinted + white`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parts<R> {
+    /// The part the surface's colour scales, per RGB channel.
     pub tinted: [R; 3],
+    /// The part added untinted (glTF's dielectric specular); 0 for every other model.
     pub white: R,
 }
 
@@ -43,39 +45,61 @@ impl<R: Real> Parts<R> {
 /// A BRDF model and its parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Brdf {
+    /// Lambert's diffuse, albedo `rho`.
     Lambert {
+        /// Albedo in [0, 1].
         rho: f64,
     },
+    /// Normalized Blinn-Phong, the talk's specular.
     BlinnPhong {
+        /// The cosine power `n`, 0 to 1e4.
         exponent: f64,
     },
+    /// Oren-Nayar's rough diffuse with the inter-reflection term (1994).
     OrenNayarFull {
+        /// Albedo in [0, 1].
         rho: f64,
+        /// Slope deviation in radians, 0 to pi/2.
         sigma: f64,
     },
+    /// Oren-Nayar's qualitative model: the cheaper form, without inter-reflection.
     OrenNayarQualitative {
+        /// Albedo in [0, 1].
         rho: f64,
+        /// Slope deviation in radians, 0 to pi/2.
         sigma: f64,
     },
     /// `alpha` is the GGX alpha (perceptual roughness squared).
     Ggx {
+        /// GGX alpha, 0 to 1 (clamped below to [`GGX_MIN_ALPHA`](crate::GGX_MIN_ALPHA)).
         alpha: f64,
+        /// Schlick Fresnel at normal incidence (0.04 when parsed without it).
         f0: f64,
+        /// Schlick Fresnel at grazing incidence (1 when parsed without it).
         f90: f64,
     },
+    /// Kajiya-Kay hair and fibre, shaded along the tangent T.
     KajiyaKay {
+        /// Diffuse weight.
         kd: f64,
+        /// Specular weight.
         ks: f64,
+        /// Specular exponent, 0 to 1e4.
         p: f64,
     },
+    /// Penner's pre-integrated skin: wraps light past the terminator by the surface's curvature.
     PennerSkin {
+        /// Albedo in [0, 1].
         rho: f64,
+        /// Curvature in 1/mm (a radius of `r` mm is `1 / r`); 0 is flat skin.
         curvature_per_mm: f64,
     },
     /// glTF's metallic-roughness BRDF; `alpha` is roughness squared. Its base colour is the
     /// surface's tint, which it does not simply scale ([`Brdf::eval_parts`]).
     GltfMetalRough {
+        /// Roughness squared, 0 to 1.
         alpha: f64,
+        /// 0 for a dielectric, 1 for a metal.
         metallic: f64,
     },
 }
@@ -94,29 +118,45 @@ pub const MODEL_NAMES: [&str; 8] = {
 /// Why a BRDF description was refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum BrdfError {
+    /// The name is none of [`MODEL_NAMES`].
     #[error("unknown BRDF `{0}` (known: {names})", names = MODEL_NAMES.join(", "))]
     UnknownModel(String),
+    /// A parameter the model does not take.
     #[error("{model}: unknown parameter `{param}` (accepted: {accepted})")]
     UnknownParam {
+        /// The model's name.
         model: &'static str,
+        /// The parameter given.
         param: String,
+        /// The parameters the model takes, comma-separated.
         accepted: String,
     },
+    /// A parameter the model needs was not given.
     #[error("{model}: missing parameter `{param}`")]
     MissingParam {
+        /// The model's name.
         model: &'static str,
+        /// The parameter missing.
         param: &'static str,
     },
+    /// A parameter outside its [`Range`] or not a number.
     #[error("{model}: parameter `{param}` must be {rule}, got {value}")]
     BadParam {
+        /// The model's name.
         model: &'static str,
+        /// The parameter refused.
         param: &'static str,
+        /// What the range allows, in words.
         rule: String,
+        /// The value given, as written.
         value: String,
     },
+    /// Two spellings of the same parameter were given (`alpha` and `perceptual_roughness`, ...).
     #[error("{model}: give exactly one of {options}")]
     Ambiguous {
+        /// The model's name.
         model: &'static str,
+        /// The spellings, of which exactly one is wanted.
         options: &'static str,
     },
 }
@@ -192,7 +232,9 @@ impl<'a> Params<'a> {
 /// all hold parameters to these.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Range {
+    /// The smallest value accepted.
     pub min: f64,
+    /// The largest value accepted ([`f64::MAX`] where there is no physical bound).
     pub max: f64,
 }
 
@@ -215,7 +257,8 @@ impl Range {
     }
 }
 
-/// The parameter ranges, one per quantity (README "BRDF parameters").
+/// The parameter ranges, one per quantity (the book's glTF chapter, `docs/src/gltf.md`, lists
+/// them under "Numbers that reach the GPU").
 pub mod ranges {
     use super::Range;
     /// Albedo of Lambert, Oren-Nayar and skin: energy conservation bounds it by 1.
@@ -387,6 +430,7 @@ impl Brdf {
         self.id().index()
     }
 
+    /// The model's name as [`Brdf::parse`] accepts it and the case files write it.
     pub fn name(&self) -> &'static str {
         MODEL_NAMES[self.model_index() as usize]
     }

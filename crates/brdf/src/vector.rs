@@ -12,6 +12,7 @@ pub(crate) fn c<R: Real>(x: f64) -> R {
     R::from(x).expect("f64 constants convert to f32 and f64")
 }
 
+/// A 3-vector in working precision: `[x, y, z]`, the shape GLSL's `vec3` and the case files use.
 pub type V3<R> = [R; 3];
 
 pub(crate) fn dot<R: Real>(a: V3<R>, b: V3<R>) -> R {
