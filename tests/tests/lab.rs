@@ -195,6 +195,8 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
         // The sweep's tiled technique takes the device's tiles (8x8 on lavapipe).
         assert_eq!(size["tiled_tile_side"].as_u64(), Some(u64::from(side)));
         assert_eq!(size["samples_ms"]["tiled"].as_array().unwrap().len(), 2);
+        assert!(size["depth_id"]["median_ms"].as_f64().unwrap() > 0.0);
+        assert_eq!(size["samples_ms"]["depth_id"].as_array().unwrap().len(), 2);
     }
     // The stencil rows' breakdowns: the consoles', native's and AMD's.
     assert_eq!(json["breakdown"].as_array().unwrap().len(), 5);
@@ -216,6 +218,7 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
         "ms, +",
         "Light size",
         "tiled / best",
+        "depth-id / tiled",
         "FLIP",
         "| backend | BRDFs | technique, ms | emulator bookkeeping, ms |",
         "| stencil ps3 | 3 |",

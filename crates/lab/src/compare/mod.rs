@@ -284,12 +284,15 @@ pub struct SizePoint {
     pub adaptive: Timing,
     /// The tiled technique (mixed tiles per BRDF, the device's tile side).
     pub tiled: Timing,
-    /// Its tile side in pixels ([`TileSide::for_device`]).
+    /// The depth-id technique, with the tiled technique's light lists of the same tile side.
+    pub depth_id: Timing,
+    /// Their tile side in pixels ([`TileSide::for_device`]).
     pub tile_side: u32,
-    /// The worst of the four techniques' errors against forward.
+    /// The worst of the five techniques' errors against forward.
     pub error: ImageError,
-    /// Every round's lighting time of branching, stencil, adaptive and tiled, interleaved.
-    pub samples: [Vec<f64>; 4],
+    /// Every round's lighting time of branching, stencil, adaptive, tiled and depth-id,
+    /// interleaved.
+    pub samples: [Vec<f64>; 5],
     pub sampled: Sampled,
 }
 
@@ -324,12 +327,28 @@ impl SizePoint {
     /// Tiled's time over the better (by median) of branching and stencil, paired by round, and
     /// its verdict ([`Verdict`]).
     pub fn tiled_over_best(&self) -> (Interval, Verdict) {
+        self.over_best(3)
+    }
+
+    /// Depth-id's time over the better of branching and stencil, as [`SizePoint::tiled_over_best`].
+    pub fn depth_id_over_best(&self) -> (Interval, Verdict) {
+        self.over_best(4)
+    }
+
+    /// Depth-id's time over tiled's, paired by round: what finding a BRDF's pixels by a depth
+    /// test costs against tile lists, on this device.
+    pub fn depth_id_over_tiled(&self) -> (Interval, Verdict) {
+        let r = ratio_interval(&self.samples[4], &self.samples[3]);
+        (r, Verdict::of(&r))
+    }
+
+    fn over_best(&self, technique: usize) -> (Interval, Verdict) {
         let best = if self.branching.median_ms <= self.stencil.median_ms {
             &self.samples[0]
         } else {
             &self.samples[1]
         };
-        let r = ratio_interval(&self.samples[3], best);
+        let r = ratio_interval(&self.samples[technique], best);
         (r, Verdict::of(&r))
     }
 
@@ -610,10 +629,10 @@ pub fn run_compare(
             error = error.worst(image_error(&frame(&mut renderer, technique)?, &reference));
         }
         // Interleaved, as the table; tracked: every pair's ratio.
-        let samples = std::cell::RefCell::new([vec![], vec![], vec![], vec![]]);
+        let samples = std::cell::RefCell::new([vec![], vec![], vec![], vec![], vec![]]);
         let pair_widths = || {
             let s = samples.borrow();
-            [(1, 0), (2, 0), (2, 1), (3, 0), (3, 1)]
+            [(1, 0), (2, 0), (2, 1), (3, 0), (3, 1), (4, 3)]
                 .map(|(a, b)| ratio_interval(&s[a], &s[b]).relative_half_width())
                 .to_vec()
         };
@@ -637,6 +656,7 @@ pub fn run_compare(
             stencil: timings[1],
             adaptive: timings[2],
             tiled: timings[3],
+            depth_id: timings[4],
             tile_side: side.pixels(),
             error,
             samples,
@@ -716,9 +736,9 @@ fn pixel_shares(renderer: &mut Renderer, palette: &[BrdfId]) -> Result<Vec<f64>>
     Ok(counts.into_iter().map(|c| c as f64 / total).collect())
 }
 
-/// Branching, stencil and adaptive on the native backend, and tiled with tiles of `side`: the
-/// light-size sweep's four.
-fn size_techniques(side: TileSide) -> [Technique; 4] {
+/// Branching, stencil and adaptive on the native backend, and tiled and depth-id with tiles of
+/// `side`: the light-size sweep's five.
+fn size_techniques(side: TileSide) -> [Technique; 5] {
     let (backend, flush) = (Backend::Native, FlushPolicy::Auto);
     [
         Technique::Branching { backend, flush },
@@ -728,6 +748,7 @@ fn size_techniques(side: TileSide) -> [Technique; 4] {
             mixed: MixedTiles::PerBrdf,
             side,
         },
+        Technique::DepthId { side },
     ]
 }
 

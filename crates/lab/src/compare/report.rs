@@ -213,20 +213,21 @@ impl CompareReport {
             "\n## Light size: where branching overtakes stencil\n\n\
              A striped wall in three BRDFs under lights covering the given fraction of the \
              screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
-             screens. Native backend; tiled with {side}x{side} tiles (the device's side, \
-             `TileSide::for_device`), mixed tiles per BRDF; the error is the worst of the four \
-             techniques.\n\n"
+             screens. Native backend; tiled and depth-id with {side}x{side} tiles (the device's \
+             side, `TileSide::for_device`), tiled's mixed tiles per BRDF; the error is the worst \
+             of the five techniques.\n\n"
         );
         md += "\
-               | coverage | lights | rounds | branching | stencil | adaptive | tiled | stencil / branching | faster | adaptive / best | tiled / best | error max / mean / FLIP |\n\
-               |---|---|---|---|---|---|---|---|---|---|---|---|\n";
+               | coverage | lights | rounds | branching | stencil | adaptive | tiled | depth-id | stencil / branching | faster | adaptive / best | tiled / best | depth-id / tiled | error max / mean / FLIP |\n\
+               |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         for p in &self.sizes {
             let (ratio, _) = p.stencil_over_branching();
             let best = p.adaptive_over_best_interval();
             let (tiled, tiled_verdict) = p.tiled_over_best();
+            let (depth_id, depth_id_verdict) = p.depth_id_over_tiled();
             let _ = writeln!(
                 md,
-                "| {:.1} % | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} |",
+                "| {:.1} % | {} | {} ({}) | {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} ({}) | {} |",
                 p.coverage * 100.0,
                 p.lights,
                 p.sampled.rounds,
@@ -235,11 +236,14 @@ impl CompareReport {
                 interval_text(&median_interval(&p.samples[1])),
                 interval_text(&median_interval(&p.samples[2])),
                 interval_text(&median_interval(&p.samples[3])),
+                interval_text(&median_interval(&p.samples[4])),
                 ratio_text(&ratio),
                 p.faster(),
                 ratio_text(&best),
                 ratio_text(&tiled),
                 tiled_verdict.word(),
+                ratio_text(&depth_id),
+                depth_id_verdict.word(),
                 error_text(&p.error)
             );
         }
@@ -432,7 +436,7 @@ impl CompareReport {
 
     fn plot_sizes(&self, path: &Path) -> Result<()> {
         // Per light: each technique's median and interval over the size point's rounds.
-        let series = ["branching", "stencil", "adaptive", "tiled"]
+        let series = ["branching", "stencil", "adaptive", "tiled", "depth-id"]
             .into_iter()
             .enumerate()
             .map(|(i, name)| {
@@ -627,6 +631,9 @@ fn size_json(p: &SizePoint) -> Value {
         "tiled": timing_json(&p.tiled),
         "tiled_tile_side": p.tile_side,
         "tiled_over_best": interval_json(&p.tiled_over_best().0),
+        "depth_id": timing_json(&p.depth_id),
+        "depth_id_over_best": interval_json(&p.depth_id_over_best().0),
+        "depth_id_over_tiled": interval_json(&p.depth_id_over_tiled().0),
         "stencil_over_branching": interval_json(&p.stencil_over_branching().0),
         "faster": p.faster(),
         "samples_ms": {
@@ -634,6 +641,7 @@ fn size_json(p: &SizePoint) -> Value {
             "stencil": p.samples[1],
             "adaptive": p.samples[2],
             "tiled": p.samples[3],
+            "depth_id": p.samples[4],
         },
         "sampling": sampled_json(&p.sampled),
         "error": error_json(&p.error),
