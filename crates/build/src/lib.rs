@@ -25,6 +25,8 @@
 //! An engine that generates hooks at run time can run the same `glslc` command and hand the
 //! SPIR-V to `histencil::LightModules` itself.
 
+#![warn(missing_docs)]
+
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -65,7 +67,12 @@ pub enum BuildError {
     /// `glslc` could not be run.
     NoGlslc(String),
     /// `glslc` rejected a stage compiled with the hooks.
-    Compile { stage: String, message: String },
+    Compile {
+        /// The stage's file name, one of [`HOOKED_STAGES`].
+        stage: String,
+        /// glslc's error output, which names the hook file and line at fault.
+        message: String,
+    },
     /// Writing the outputs failed.
     Io(String),
 }
