@@ -115,12 +115,16 @@ pub const PRETEST_SLOTS: usize = 2;
 /// One HiS pretest: `(value & mask) OP (stencil & mask)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Pretest {
+    /// How the pretest's value compares with the masked stencil.
     pub compare: CompareOp,
+    /// The bits compared.
     pub mask: u8,
+    /// The value the masked stencil is compared with.
     pub value: u8,
 }
 
 impl Pretest {
+    /// Whether one pixel's stencil passes the pretest, as the hardware would evaluate it.
     pub fn passes(&self, stencil: u8) -> bool {
         self.compare
             .test(self.value & self.mask, stencil & self.mask)
@@ -139,12 +143,14 @@ impl Pretest {
 /// GFX9-11's pretests and their per-tile may-pass / may-fail bits.
 #[derive(Clone, Debug)]
 pub struct PretestTiles {
+    /// The frame's pretests (at most two); `None` for an unused slot.
     pub pretests: [Option<Pretest>; PRETEST_SLOTS],
     may_pass: Vec<[bool; PRETEST_SLOTS]>,
     may_fail: Vec<[bool; PRETEST_SLOTS]>,
 }
 
 impl PretestTiles {
+    /// A hierarchy with these pretests and no tiles evaluated yet.
     pub fn new(pretests: [Option<Pretest>; PRETEST_SLOTS]) -> Self {
         Self {
             pretests,
@@ -250,6 +256,7 @@ pub struct AndOrTiles {
 }
 
 impl AndOrTiles {
+    /// AND/OR tiles that honour each test's read mask, as GFX12 does.
     pub fn new() -> Self {
         Self::default()
     }

@@ -29,6 +29,8 @@ pub struct PlatformCaps {
 pub trait PlatformBackend {
     /// A short kebab-case name for reports ("360-like").
     fn name(&self) -> &'static str;
+    /// The platform's stencil behaviour as data: what the planner reads instead of branching on
+    /// the platform.
     fn caps(&self) -> PlatformCaps;
 }
 

@@ -40,20 +40,26 @@ pub struct CostModel {
 /// One platform row of the talk's measurements (huge lights, milliseconds).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TalkFigures {
+    /// Lighting time with one BRDF, the talk's baseline.
     pub one_brdf: f64,
     /// Lighting time with 2 and 3 BRDFs compiled into the branching shader.
     pub branching: [f64; 2],
     /// Lighting time with 2 and 3 BRDFs drawn with the stencil technique.
     pub stencil: [f64; 2],
-    /// Per-BRDF cost breakdown: setup, mask, render (a lower bound), cleanup.
+    /// Per-BRDF cost breakdown: setup, mask, render (a lower bound), cleanup. This one: the
+    /// setup pass of one BRDF.
     pub setup: f64,
+    /// The mask pass of one BRDF.
     pub mask: f64,
+    /// The render pass of one BRDF (a lower bound).
     pub render: f64,
+    /// The cleanup pass of one BRDF.
     pub cleanup: f64,
 }
 
 impl TalkFigures {
-    /// "Solving some common problems in a modern deferred rendering engine", Develop 2012.
+    /// The Xbox 360's row of "Solving some common problems in a modern deferred rendering
+    /// engine", Develop 2012.
     pub const X360: Self = Self {
         one_brdf: 1.85,
         branching: [2.1, 2.35],
@@ -63,6 +69,7 @@ impl TalkFigures {
         render: 0.036,
         cleanup: 0.022,
     };
+    /// The PS3's row of the same talk.
     pub const PS3: Self = Self {
         one_brdf: 1.9,
         branching: [2.48, 2.8],

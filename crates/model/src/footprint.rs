@@ -29,9 +29,13 @@ impl Span {
 /// A light's coverage: a rectangle of the frame and one optional span per pixel in it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Footprint {
+    /// Left edge of the rectangle, in pixels.
     pub x0: u32,
+    /// Top edge of the rectangle, in pixels.
     pub y0: u32,
+    /// Width of the rectangle, in pixels.
     pub width: u32,
+    /// Height of the rectangle, in pixels.
     pub height: u32,
     spans: Vec<Option<Span>>,
     full_screen: bool,
@@ -90,6 +94,7 @@ impl Footprint {
         self
     }
 
+    /// The depth convention the spans are in.
     pub fn depth(&self) -> DepthConvention {
         self.depth
     }
@@ -137,6 +142,7 @@ impl Footprint {
         })
     }
 
+    /// Where the volume crosses pixel (x, y)'s ray; `None` outside the rectangle or the volume.
     pub fn span(&self, x: u32, y: u32) -> Option<Span> {
         if x < self.x0 || y < self.y0 || x >= self.x0 + self.width || y >= self.y0 + self.height {
             return None;
@@ -174,6 +180,7 @@ impl Footprint {
         }
     }
 
+    /// Whether the light has no volume (drawn as the full-screen triangle).
     pub fn is_full_screen(&self) -> bool {
         self.full_screen
     }

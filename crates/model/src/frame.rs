@@ -18,16 +18,29 @@ pub enum FlushPolicy {
     Never,
 }
 
+/// One thing the frame's lighting does, in order: what the recorder replays and the simulator
+/// runs.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Step {
     /// A pass of light `light` (its index in [`FramePlan::lights`]).
-    Pass { light: usize, pass: Pass },
+    Pass {
+        /// The light's index in [`FramePlan::lights`].
+        light: usize,
+        /// The draw and its full state.
+        pass: Pass,
+    },
     /// Pending hi-stencil state becomes active.
     FlushHiStencil,
     /// Copies the bits of `mask` aside before lighting.
-    SavePreserved { mask: u8 },
+    SavePreserved {
+        /// The engine's bits ([`StencilLayout::engine_mask`]).
+        mask: u8,
+    },
     /// Writes the saved bits back; costs one full-screen pass per bit of `mask`.
-    RestorePreserved { mask: u8 },
+    RestorePreserved {
+        /// The bits saved by the matching [`Step::SavePreserved`].
+        mask: u8,
+    },
 }
 
 impl Step {
@@ -80,6 +93,7 @@ pub struct FramePlan {
     /// The lights drawn, in drawing order; lights that touch nothing or that the view cannot
     /// see are not here.
     pub lights: Vec<PlannedLight>,
+    /// Every pass, flush and save / restore, in the order they run.
     pub steps: Vec<Step>,
     /// The view, lights and layout [`crate::plan_frame`] made this plan for, which the lighting
     /// holds every frame against; `None` for a plan built by hand from requests, which names no
@@ -142,10 +156,12 @@ impl FramePlan {
         )
     }
 
+    /// The passes alone, in order, without flushes or save / restore.
     pub fn passes(&self) -> impl Iterator<Item = &Pass> {
         self.steps.iter().filter_map(Step::pass)
     }
 
+    /// How many hi-stencil flushes the flush policy inserted.
     pub fn flushes(&self) -> usize {
         self.steps
             .iter()

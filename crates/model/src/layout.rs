@@ -33,38 +33,59 @@ pub struct StencilBits {
 /// A layout that cannot be built.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum LayoutError {
+    /// No BRDF in use: there would be nothing to light.
     #[error("a scene must use at least one BRDF")]
     NoBrdfs,
+    /// The culling bit, the BRDF field and the bits the engine reserved need more than 8 bits.
     #[error(
         "stencil layout needs {requested_bits} bits (1 culling + {brdf_bits} BRDF for {brdfs} BRDFs \
          + {reserved} reserved preserved), but stencil has 8"
     )]
     TooManyBits {
+        /// Bits asked for in all.
         requested_bits: u32,
+        /// Bits the BRDF field needs.
         brdf_bits: u32,
+        /// BRDFs in use.
         brdfs: u32,
+        /// Bits the engine asked to keep.
         reserved: u32,
     },
+    /// The engine placed the culling bit outside the byte.
     #[error("the culling bit must be one of bits 0 to 7, got bit {0}")]
     CullingBitOutsideByte(u32),
+    /// The BRDF field, placed from the engine's shift, does not fit in the byte.
     #[error(
         "{brdfs} BRDFs need {brdf_bits} BRDF bits, which from bit {shift} run past bit 7 of the \
          stencil byte"
     )]
     BrdfFieldOutsideByte {
+        /// BRDFs in use.
         brdfs: u32,
+        /// Bits the BRDF field needs.
         brdf_bits: u32,
+        /// The field's lowest bit, as the engine placed it.
         shift: u32,
     },
+    /// The engine placed the culling bit inside the BRDF field.
     #[error("the culling bit {culling_bit} lies inside the BRDF field {brdf_mask:#04x}")]
-    CullingInBrdfField { culling_bit: u32, brdf_mask: u8 },
+    CullingInBrdfField {
+        /// The culling bit's index.
+        culling_bit: u32,
+        /// The BRDF field, as a mask.
+        brdf_mask: u8,
+    },
+    /// The engine declared bits of its own that histencil's bits use.
     #[error(
         "the engine's bits {engine_mask:#04x} overlap histencil's: culling {culling_mask:#04x}, \
          BRDF {brdf_mask:#04x}"
     )]
     EngineBitsOverlap {
+        /// The bits the engine declared its own.
         engine_mask: u8,
+        /// Where the culling bit sits.
         culling_mask: u8,
+        /// Where the BRDF field sits.
         brdf_mask: u8,
     },
 }
@@ -83,6 +104,23 @@ impl StencilLayout {
     /// The talk's layout for `brdfs_in_use` BRDFs: culling bit 0, `ceil(log2(n))` BRDF bits from
     /// bit 1, and every bit above them the engine's. The engine asks that at least
     /// `reserved_preserved_bits` bits stay its own; not fitting is an error.
+    ///
+    /// ```
+    /// use histencil_model::StencilLayout;
+    ///
+    /// // Five BRDFs need three bits: culling at bit 0, the BRDF field at bits 1 to 3, and the
+    /// // engine keeps bits 4 to 7 (it asked for at least two).
+    /// let layout = StencilLayout::new(5, 2)?;
+    /// assert_eq!(layout.culling_mask(), 0x01);
+    /// assert_eq!(layout.brdf_mask(), 0x0e);
+    /// assert_eq!(layout.engine_mask(), 0xf0);
+    /// // The G-buffer pass writes BRDF slot 3 as stencil 0x06; the lighting reads it back.
+    /// assert_eq!(layout.brdf_reference(3), 0x06);
+    /// assert_eq!(layout.brdf_slot(0xf6), 3);
+    /// // Nine BRDFs need four bits: with five of the engine's, the byte overflows.
+    /// assert!(StencilLayout::new(9, 5).is_err());
+    /// # Ok::<(), histencil_model::LayoutError>(())
+    /// ```
     pub fn new(brdfs_in_use: u32, reserved_preserved_bits: u32) -> Result<Self, LayoutError> {
         if brdfs_in_use == 0 {
             return Err(LayoutError::NoBrdfs);
@@ -152,10 +190,12 @@ impl StencilLayout {
         (((1u32 << bits) - 1) << shift) as u8
     }
 
+    /// How many BRDFs the field tells apart.
     pub fn brdfs_in_use(&self) -> u32 {
         self.brdfs_in_use
     }
 
+    /// Width of the BRDF field: `ceil(log2(brdfs_in_use))`, 0 for one BRDF.
     pub fn brdf_bits(&self) -> u32 {
         self.brdf_bits
     }
@@ -170,10 +210,12 @@ impl StencilLayout {
         self.brdf_bits > 0
     }
 
+    /// The culling bit, as a mask.
     pub fn culling_mask(&self) -> u8 {
         self.culling_mask
     }
 
+    /// The BRDF field, as a mask.
     pub fn brdf_mask(&self) -> u8 {
         Self::field(self.brdf_bits, self.brdf_shift)
     }

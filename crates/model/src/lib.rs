@@ -21,7 +21,6 @@
 //! `0xF0`. The BRDF field's width is derived from the number of BRDFs a scene uses, never
 //! hard-coded; an engine that keeps its own data in some stencil bits puts the culling bit and the
 //! BRDF field wherever its bits are not ([`StencilLayout::with_positions`]).
-
 //!
 //! # What this crate decides
 //! - [`plan_frame`]: the whole frame's plan from plain inputs an engine has at hand
@@ -45,6 +44,8 @@
 //! keep hierarchical stencil on their own, with no plan step: two masked pretests per frame
 //! (GFX9-11) or each tile's AND and OR of its stencil values (GFX12); they run the native plan,
 //! and [`Simulator::run_with`] counts what they would reject.
+
+#![warn(missing_docs)]
 
 pub mod amd;
 mod backend;

@@ -58,9 +58,11 @@ pub enum LightTechnique {
 /// What one light needs.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct LightRequest {
+    /// How its volume meets the camera, which decides the faces and depth tests of its passes.
     pub case: LightCase,
     /// BRDF slots whose objects the light can reach. Empty: the light draws nothing.
     pub affected: Vec<u32>,
+    /// How its BRDFs are separated.
     pub technique: LightTechnique,
 }
 
@@ -99,10 +101,15 @@ pub enum PassKind {
     Cleanup,
 }
 
+/// One draw of a light: its role, what it rasterises and the whole pipeline and stencil state
+/// it runs with, so a recorder translates it without deciding anything.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Pass {
+    /// The pass's role: setup, mask, shade, cleanup.
     pub kind: PassKind,
+    /// The light's volume or the full-screen triangle.
     pub geometry: Geometry,
+    /// Culling, depth, stencil and hi-stencil state.
     pub state: PassState,
 }
 
@@ -124,25 +131,52 @@ impl Pass {
 /// A request that cannot be planned: a caller bug that is reported, not a panic.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum PlanError {
+    /// A light names a BRDF slot the layout does not have.
     #[error("BRDF slot {slot} is not in the layout ({brdfs} BRDFs in use)")]
-    SlotOutOfRange { slot: u32, brdfs: u32 },
+    SlotOutOfRange {
+        /// The slot named.
+        slot: u32,
+        /// BRDFs in the layout.
+        brdfs: u32,
+    },
     /// `PlanInputs::brdf_bounds` must hold one list (possibly empty) per BRDF slot of the
     /// layout: fewer would light the missing BRDFs' surfaces with nothing and say nothing.
     #[error(
         "brdf_bounds has {bounds} entries, but the stencil layout has {brdfs} BRDFs: give one \
          list of world boxes per BRDF slot, empty for a BRDF with no surfaces"
     )]
-    BoundsCount { bounds: usize, brdfs: u32 },
+    BoundsCount {
+        /// Lists given.
+        bounds: usize,
+        /// BRDFs in the layout.
+        brdfs: u32,
+    },
+    /// [`LightTechnique::SingleBrdf`] was asked for a light that reaches several BRDFs.
     #[error("single-BRDF technique asked for a light affecting {count} BRDFs")]
-    SingleWithManyBrdfs { count: usize },
+    SingleWithManyBrdfs {
+        /// BRDFs the light reaches.
+        count: usize,
+    },
+    /// A light's shape cannot be planned with (not finite, a zero direction, a range not above
+    /// 0, ...).
     #[error("light {index}: {problem}")]
-    BadLight { index: usize, problem: &'static str },
-    #[error("bounds {index} of BRDF slot {slot}: {problem}")]
-    BadBounds {
-        slot: u32,
+    BadLight {
+        /// The light's index in [`PlanInputs::lights`](crate::PlanInputs::lights).
         index: usize,
+        /// What is wrong with it.
         problem: &'static str,
     },
+    /// A world box is not finite or has a min corner above its max.
+    #[error("bounds {index} of BRDF slot {slot}: {problem}")]
+    BadBounds {
+        /// The BRDF slot whose list holds the box.
+        slot: u32,
+        /// The box's index in that list.
+        index: usize,
+        /// What is wrong with it.
+        problem: &'static str,
+    },
+    /// The view's matrices or description were refused.
     #[error("view: {0}")]
     View(#[from] crate::view::ViewError),
 }

@@ -35,7 +35,9 @@ pub const MAX_SPOT_ANGLE: f32 = 80.0 * std::f32::consts::PI / 180.0;
 /// An axis-aligned box in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The corner with the smallest coordinates.
     pub min: [f32; 3],
+    /// The corner with the largest coordinates; no coordinate below `min`'s.
     pub max: [f32; 3],
 }
 
@@ -64,13 +66,22 @@ impl Aabb {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LightShape {
     /// Lights the sphere of `range` around `position`.
-    Point { position: [f32; 3], range: f32 },
+    Point {
+        /// World position.
+        position: [f32; 3],
+        /// World distance past which the light gives nothing; above 0.
+        range: f32,
+    },
     /// Lights the cone from `position` along `direction` (need not be unit length) with
     /// half-angle `outer_angle` (radians, below [`MAX_SPOT_ANGLE`]), up to `range`.
     Spot {
+        /// World position of the apex.
         position: [f32; 3],
+        /// The cone's axis, any non-zero length.
         direction: [f32; 3],
+        /// World distance along the axis past which the light gives nothing; above 0.
         range: f32,
+        /// Half-angle of the cone, radians, above 0 and below [`MAX_SPOT_ANGLE`].
         outer_angle: f32,
     },
     /// Lights everything; drawn full-screen.
@@ -185,19 +196,24 @@ pub enum TechniqueChoice {
 /// Everything the planner reads: plain values an engine has at hand.
 #[derive(Clone, Copy, Debug)]
 pub struct PlanInputs<'a> {
+    /// Every light's volume, in the engine's order: [`PlannedLight::input`] and the lighting's
+    /// per-light data refer to this order.
     pub lights: &'a [LightShape],
     /// Per BRDF slot (the layout's), the world boxes of the objects with that BRDF: one box per
     /// object, or one around them all. Slots past the end have no objects.
     pub brdf_bounds: &'a [Vec<Aabb>],
+    /// The camera the frame is drawn with: the frustum culls lights and decides each one's case.
     pub view: &'a View,
 }
 
 /// How the frame is to be drawn: plain values, one per frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlanSettings {
+    /// How each light's BRDFs are separated: stencil, branching or per light by cost.
     pub technique: TechniqueChoice,
     /// The platform whose stencil and hi-stencil behaviour the passes follow.
     pub caps: PlatformCaps,
+    /// When hi-stencil flushes go in; [`FlushPolicy::Auto`] unless studying what breaks.
     pub flush: FlushPolicy,
 }
 
@@ -358,8 +374,11 @@ pub fn plan_frame(
 /// ([`PlannedFor::difference`]) and refuses one that differs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlannedFor {
+    /// The view's matrices and depth convention.
     pub view: ViewDesc,
+    /// Every light's shape, in the order of [`PlanInputs::lights`].
     pub lights: Vec<LightShape>,
+    /// The stencil layout the passes' masks and references come from.
     pub layout: StencilLayout,
 }
 

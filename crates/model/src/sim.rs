@@ -13,15 +13,21 @@ use crate::tiles::{TileStats, TileSurface};
 /// Depth and stencil of the frame after the G-buffer pass.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SoftTarget {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Surface depth per pixel; the far depth of the plan's convention where there is no
     /// surface.
     pub depth: Vec<f32>,
+    /// Stencil per pixel as the G-buffer pass left it (BRDF ids and the engine's bits); the run
+    /// leaves the final stencil here.
     pub stencil: Vec<u8>,
 }
 
 impl SoftTarget {
+    /// The index of pixel (x, y) in [`SoftTarget::depth`] and [`SoftTarget::stencil`]: rows from
+    /// the top.
     pub fn index(&self, x: u32, y: u32) -> usize {
         (y * self.width + x) as usize
     }
@@ -55,18 +61,22 @@ impl LightShading {
 /// What a run produced besides the final stencil (left in the target).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimResult {
+    /// Per light of the plan, in [`FramePlan::lights`] order: which pixels it shaded, how often.
     pub lights: Vec<LightShading>,
     /// Per light: the culling bit was still set after its last pass. Only the light's footprint
     /// rectangle is checked: passes write nowhere else, so if every earlier light left the
     /// frame clean, the whole frame is clean exactly when this rectangle is.
     pub culling_bit_left: Vec<bool>,
+    /// Hi-stencil tiles tested, culled and passed over the whole run.
     pub stats: TileStats,
 }
 
 /// Runs plans for one stencil layout and tile size.
 #[derive(Clone, Copy, Debug)]
 pub struct Simulator {
+    /// The layout the plans were made for.
     pub layout: StencilLayout,
+    /// Side of a hi-stencil tile in pixels: the granularity the emulated hierarchy culls at.
     pub tile_size: u32,
 }
 

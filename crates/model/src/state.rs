@@ -6,13 +6,21 @@
 /// stencil, `fragment_depth OP stored_depth` for depth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CompareOp {
+    /// Fails every fragment.
     Never,
+    /// `a < b`.
     Less,
+    /// `a == b`: the stencil technique's BRDF and culling tests.
     Equal,
+    /// `a <= b`.
     LessOrEqual,
+    /// `a > b`.
     Greater,
+    /// `a != b`.
     NotEqual,
+    /// `a >= b`.
     GreaterOrEqual,
+    /// Passes every fragment.
     Always,
 }
 
@@ -35,9 +43,13 @@ impl CompareOp {
 /// What a stencil update writes (before the write mask is applied).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum StencilOp {
+    /// Leaves the value.
     Keep,
+    /// Writes 0: the cleanup clears the culling bit with it, 360-like plans the preserved bits.
     Zero,
+    /// Writes the reference: how the setup sets the culling bit.
     Replace,
+    /// Adds one, stopping at 255.
     IncrementAndClamp,
 }
 
@@ -56,9 +68,13 @@ impl StencilOp {
 /// Per-pixel stencil state of one face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FaceStencil {
+    /// How the reference compares with the masked stencil.
     pub compare: CompareOp,
+    /// The bits of the stencil the test reads.
     pub compare_mask: u8,
+    /// The bits a stencil op may change; the others keep their value whatever the op.
     pub write_mask: u8,
+    /// The value compared with and written by [`StencilOp::Replace`].
     pub reference: u8,
     /// Stencil and depth tests pass.
     pub pass: StencilOp,
@@ -130,8 +146,11 @@ impl FaceStencil {
 /// Which rasterised faces are discarded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum CullMode {
+    /// Keeps both faces.
     None,
+    /// Discards front faces, for passes that draw a volume's back faces.
     Front,
+    /// Discards back faces.
     Back,
 }
 
@@ -140,10 +159,12 @@ pub enum CullMode {
 pub struct DepthState {
     /// `None`: no depth test (every fragment passes).
     pub compare: Option<CompareOp>,
+    /// Whether a fragment that passes writes its depth; light passes never do.
     pub write: bool,
 }
 
 impl DepthState {
+    /// No depth test and no depth write.
     pub const OFF: Self = Self {
         compare: None,
         write: false,
@@ -167,7 +188,9 @@ impl DepthState {
 /// reference, evaluated per tile when written and used to reject whole tiles when tested.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct HiStencilState {
+    /// How the masked stencil compares with the reference.
     pub compare: CompareOp,
+    /// The value compared with.
     pub reference: u8,
     /// `None` on hardware without a hi-stencil read mask (360-like): all 8 bits are compared.
     pub read_mask: Option<u8>,
@@ -188,10 +211,14 @@ impl HiStencilState {
 /// Everything a pass sets besides its shader and geometry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PassState {
+    /// Which faces are discarded; the others run with their face's stencil state
+    /// ([`PassState::stencil_for`]).
     pub cull: CullMode,
+    /// Depth test and write.
     pub depth: DepthState,
     /// `None` disables the stencil test and writes.
     pub front: Option<FaceStencil>,
+    /// Stencil state of back faces; `None` disables the stencil test and writes.
     pub back: Option<FaceStencil>,
     /// Colour writes: only light-shading passes have them.
     pub color_write: bool,
@@ -217,10 +244,12 @@ impl PassState {
             .any(FaceStencil::writes)
     }
 
+    /// True when the pass re-evaluates hi-stencil tiles into the pending surface.
     pub fn writes_hi_stencil(&self) -> bool {
         self.hi_stencil.is_some_and(|h| h.write)
     }
 
+    /// True when the pass rejects fragments in tiles the active surface marks as failing.
     pub fn tests_hi_stencil(&self) -> bool {
         self.hi_stencil.is_some_and(|h| h.test)
     }

@@ -9,21 +9,28 @@ use crate::sim::SoftTarget;
 /// Parameters of a synthetic frame.
 #[derive(Clone, Copy, Debug)]
 pub struct SyntheticDesc {
+    /// Side of the square frame, in pixels.
     pub size: u32,
+    /// How many ellipsoid lights.
     pub lights: usize,
+    /// The layout the BRDF slots are drawn from and written with.
     pub layout: StencilLayout,
     /// OR-ed into every pixel's stencil; masked to the layout's preserved bits.
     pub preserved: u8,
     /// Light radii are drawn from `[min, max)` pixels.
     pub radius_px: (f32, f32),
+    /// Same seed, same frame.
     pub seed: u64,
 }
 
 /// A frame and its lights, every light requesting all BRDFs with the stencil technique.
 #[derive(Clone, Debug)]
 pub struct SyntheticFrame {
+    /// Depth and stencil after a random G-buffer pass: a random depth and BRDF slot per pixel.
     pub target: SoftTarget,
+    /// Each light's coverage, in light order.
     pub footprints: Vec<Footprint>,
+    /// Each light's request: its footprint's case, every BRDF, the stencil technique.
     pub requests: Vec<LightRequest>,
 }
 
@@ -40,6 +47,7 @@ impl XorShift {
 }
 
 impl SyntheticFrame {
+    /// Draws the frame `desc` describes, the same on every machine for the same desc.
     pub fn generate(desc: &SyntheticDesc) -> Self {
         let mut rng = XorShift(desc.seed | 1);
         let n = (desc.size * desc.size) as usize;

@@ -20,6 +20,7 @@ pub struct TileStats {
     pub tiles_culled: u64,
     /// Fragments that ran a light shader (passed every test of a colour-writing pass).
     pub fragments_shaded: u64,
+    /// Hi-stencil flushes run (pending state made active).
     pub flushes: u64,
 }
 
@@ -54,10 +55,12 @@ impl TileSurface {
         }
     }
 
+    /// Side of a tile in pixels.
     pub fn tile_size(&self) -> u32 {
         self.tile_size
     }
 
+    /// Tiles over the surface, row by row.
     pub fn tile_count(&self) -> usize {
         self.active.len()
     }
@@ -100,6 +103,7 @@ impl TileSurface {
         self.pending[tile] = may_pass;
     }
 
+    /// Makes the pending surface active: what a hi-stencil flush does on the hardware.
     pub fn flush(&mut self) {
         self.active.copy_from_slice(&self.pending);
         self.unflushed = false;

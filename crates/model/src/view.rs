@@ -55,7 +55,9 @@ impl DepthConvention {
 /// Where the far plane of a [`Perspective`] lies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FarPlane {
+    /// A far plane at this view-space distance.
     Finite(f32),
+    /// No far plane: depth tends to the far value at infinity.
     Infinite,
 }
 
@@ -63,14 +65,21 @@ pub enum FarPlane {
 /// down), for callers without matrices of their own.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Perspective {
+    /// World position of the camera.
     pub eye: [f32; 3],
+    /// World point the camera looks at.
     pub target: [f32; 3],
+    /// World direction that is up on screen.
     pub up: [f32; 3],
+    /// Vertical field of view, radians.
     pub fov_y_radians: f32,
     /// Width over height of the viewport.
     pub aspect: f32,
+    /// Distance to the near plane, above 0.
     pub near: f32,
+    /// Where the far plane lies.
     pub far: FarPlane,
+    /// Which end of depth is near.
     pub depth: DepthConvention,
 }
 
@@ -113,20 +122,26 @@ impl Perspective {
 /// Vulkan clip space (depth in `[0, w]`), and which end of depth is near.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewDesc {
+    /// World to view space: the camera's transform inverted.
     pub world_to_view: [[f32; 4]; 4],
+    /// View to Vulkan clip space: the projection.
     pub view_to_clip: [[f32; 4]; 4],
+    /// Which end of depth is near, as the projection maps it.
     pub depth: DepthConvention,
 }
 
 /// A view that cannot be planned with.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ViewError {
+    /// A matrix holds NaN or an infinity; the name says which.
     #[error("the view's {0} matrix has an element that is not finite")]
     NotFinite(&'static str),
+    /// The two matrices multiply to a matrix without an inverse.
     #[error(
         "the view's world-to-clip matrix is singular: it does not map the world onto the screen"
     )]
     Singular,
+    /// The near plane's corners do not unproject to a finite rectangle of positive area.
     #[error("the view's near plane does not map to a finite rectangle in the world")]
     DegenerateNearPlane,
 }
@@ -145,6 +160,11 @@ pub struct View {
 }
 
 impl View {
+    /// Checks the engine's matrices and derives what the planner classifies lights against:
+    /// the near-plane rectangle in the world, and whether the far plane lies at infinity.
+    ///
+    /// # Errors
+    /// [`ViewError`] when the matrices are not finite, are singular, or map no near plane.
     pub fn new(desc: &ViewDesc) -> Result<Self, ViewError> {
         let matrix = |m: &[[f32; 4]; 4], name| {
             if m.iter().flatten().all(|v| v.is_finite()) {
@@ -200,6 +220,7 @@ impl View {
         &self.desc
     }
 
+    /// Which end of depth is near.
     pub fn depth(&self) -> DepthConvention {
         self.depth
     }
@@ -316,7 +337,9 @@ impl View {
 /// framebuffer's first row) to 1, as Vulkan's viewport maps them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NdcRect {
+    /// The corner with the smallest x and y: left, towards the first row.
     pub min: [f64; 2],
+    /// The corner with the largest x and y: right, towards the last row.
     pub max: [f64; 2],
 }
 
