@@ -223,6 +223,18 @@ pub fn todays_gpus(args: &TodaysGpusArgs, lights: DefaultLights) -> Result<()> {
         println!("wrote {}", path.display());
     }
     print!("{}", report.markdown());
+    // The table is the simulator's; the GPU's emulation must have counted the same.
+    let disagreements = report.disagreements();
+    if !disagreements.is_empty() {
+        let list: Vec<String> = disagreements
+            .iter()
+            .map(|(p, s)| format!("{p} on {s}"))
+            .collect();
+        bail!(
+            "the GPU's counts differ from the simulator's for {}",
+            list.join(", ")
+        );
+    }
     Ok(())
 }
 

@@ -701,5 +701,9 @@ fn todays_gpus_asks_the_talks_questions_of_every_platform() {
     assert!(depth_id["passes"].as_u64().unwrap() >= 1, "{depth_id}");
     let shaded = depth_id["stats"]["fragments_shaded"].as_u64().unwrap();
     assert!(shaded > 0 && shaded <= 96 * 64, "{depth_id}");
+    // Every count was also taken on the GPU, with each hierarchy emulated there: the same.
+    assert_eq!(json["gpu_disagreements"].as_array().unwrap().len(), 0);
+    assert_eq!(depth_id["gpu_ids_stats"], depth_id["stats"]);
+    assert!(stdout.contains("the GPU's counts equal"), "{stdout}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -119,6 +119,10 @@ pub struct SceneCounts {
     /// Fragments the native plan shades with the engine's bits: what every correct platform
     /// shades.
     pub expected_fragments: u64,
+    /// The same frame, with the engine's bits, rendered on the device with the platform's
+    /// hierarchy emulated on the GPU (consoles' hi-stencil, AMD's tiles) and counted there:
+    /// must equal `with_bits`, or the emulation and the model disagree.
+    pub gpu: TileStats,
 }
 
 impl SceneCounts {
@@ -147,14 +151,46 @@ pub struct TodaysGpusReport {
     /// Per platform ([`Platform::ALL`] order), per scene.
     pub counts: Vec<(Platform, Vec<SceneCounts>)>,
     /// Per scene: the depth-id technique's passes (BRDFs in the frame) and what a hierarchical
-    /// depth would cull of them (`histencil_model::depth_id`), with the engine's bits.
-    pub depth_id: Vec<(usize, TileStats)>,
+    /// depth would cull of them (`histencil_model::depth_id`), with the engine's bits, from the
+    /// G-buffer; then the same model on the id image the GPU wrote.
+    pub depth_id: Vec<(usize, TileStats, TileStats)>,
+}
+
+impl TodaysGpusReport {
+    /// Where the GPU's own counts differ from the model's: `(platform or technique, scene)`.
+    pub fn disagreements(&self) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for (platform, per_scene) in &self.counts {
+            for (scene, c) in self.scenes.iter().zip(per_scene) {
+                if c.gpu != c.with_bits {
+                    out.push((platform.name().to_owned(), scene.clone()));
+                }
+            }
+        }
+        for (scene, (_, model, gpu)) in self.scenes.iter().zip(&self.depth_id) {
+            if model != gpu {
+                out.push(("depth-id".to_owned(), scene.clone()));
+            }
+        }
+        out
+    }
 }
 
 /// The simulator's counts of `platform` on `inputs` (captured with some engine bits).
 fn counts_of(inputs: &SimulatorInputs, platform: Platform, plan: &FramePlan) -> TileStats {
     let backend = platform.technique().backend();
     inputs.predict_on(plan, backend).0.stats
+}
+
+/// The statistics of `technique`'s frame with the engine's bits, counted on the device.
+fn gpu_counts(renderer: &mut Renderer, technique: Technique) -> Result<TileStats> {
+    let desc = FrameDesc {
+        preserved_pattern: ENGINE_BITS,
+        tile_stats: true,
+        ..FrameDesc::from(technique)
+    };
+    let stats = renderer.render_frame(&desc)?.tile_stats;
+    Ok(stats.expect("a counting frame of a planned or depth-id technique"))
 }
 
 /// Runs every platform on every scene at `width` x `height`.
@@ -186,7 +222,9 @@ pub fn run_todays_gpus(
         let without_bits = capture(renderer, 0)?;
         tile_size = with_bits.tile_size;
         let passes = with_bits.layout.brdfs_in_use() as usize;
-        depth_id.push((passes, with_bits.predict_depth_id()));
+        let side = histencil_vk::TileSide::for_device(ctx.device_type());
+        let gpu_ids = gpu_counts(renderer, Technique::DepthId { side })?;
+        depth_id.push((passes, with_bits.predict_depth_id(), gpu_ids));
         // The plans follow the lights and the view, not the engine's bits: one per platform.
         let plans = Platform::ALL
             .iter()
@@ -200,6 +238,7 @@ pub fn run_todays_gpus(
                 with_bits: counts_of(&with_bits, *platform, plan),
                 without_bits: counts_of(&without_bits, *platform, plan),
                 expected_fragments: native.fragments_shaded,
+                gpu: gpu_counts(renderer, platform.technique())?,
             });
         }
     }
@@ -278,7 +317,7 @@ impl TodaysGpusReport {
                flush, no stencil bits, the engine's bits untouched; an id range is not a set, so \
                a tile holding ids 1 and 3 is not rejected for 2.\n\n| scene | passes | tiles \
                culled / tested | fragments shaded |\n|---|---|---|---|\n";
-        for (scene, (passes, s)) in self.scenes.iter().zip(&self.depth_id) {
+        for (scene, (passes, s, _)) in self.scenes.iter().zip(&self.depth_id) {
             let _ = writeln!(
                 md,
                 "| `{scene}` | {passes} | {} / {} ({:.0} %) | {} |",
@@ -288,8 +327,27 @@ impl TodaysGpusReport {
                 s.fragments_shaded
             );
         }
+        let disagreements = self.disagreements();
+        if disagreements.is_empty() {
+            md += "\nEvery count above was also taken on the device itself, from the same frames \
+                   rendered with each platform's hierarchy emulated on the GPU (the consoles' \
+                   hi-stencil; AMD's tiles evaluated before each stencil-testing draw; the \
+                   depth-id model run on the id image the GPU wrote): the GPU's counts equal \
+                   the simulator's on every platform and scene.\n";
+        } else {
+            let list: Vec<String> = disagreements
+                .iter()
+                .map(|(p, s)| format!("{p} on `{s}`"))
+                .collect();
+            let _ = writeln!(
+                md,
+                "\n**The GPU's own counts differ from the simulator's** for {}: see the JSON.",
+                list.join(", ")
+            );
+        }
         md += "\nNot yet in this table: the per-extra-BRDF cost of the talk's technique and of \
-               the depth-id technique, which need timings on the hardware itself.\n";
+               the depth-id technique, which need timings on the hardware itself \
+               (`histencil compare` on it).\n";
         md
     }
 
@@ -306,9 +364,11 @@ impl TodaysGpusReport {
             "tile_size": self.tile_size,
             "engine_bits": ENGINE_BITS,
             "scenes": self.scenes,
-            "depth_id": self.depth_id.iter().map(|(passes, s)| json!({
-                "passes": passes, "stats": stats(s),
+            "depth_id": self.depth_id.iter().map(|(passes, s, gpu)| json!({
+                "passes": passes, "stats": stats(s), "gpu_ids_stats": stats(gpu),
             })).collect::<Vec<_>>(),
+            "gpu_disagreements": self.disagreements().iter()
+                .map(|(p, s)| json!({"platform": p, "scene": s})).collect::<Vec<_>>(),
             "platforms": self.counts.iter().map(|(p, per_scene)| json!({
                 "platform": p.name(),
                 "flush_or_reset": p.flush_or_reset(),
@@ -318,6 +378,7 @@ impl TodaysGpusReport {
                     "without_engine_bits": stats(&c.without_bits),
                     "fragments_the_frame_needs": c.expected_fragments,
                     "engine_bits": c.engine_bits_effect(),
+                    "gpu_emulation": stats(&c.gpu),
                 })).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
         })
