@@ -9,9 +9,13 @@ use glam::{Mat4, Vec3};
 /// lies behind it with `opacity`.
 #[derive(Clone, Debug)]
 pub struct AlphaObject {
+    /// Names the object in reports and errors.
     pub name: String,
+    /// The object's shape in object space.
     pub shape: Shape,
+    /// Object to world.
     pub transform: Mat4,
+    /// Its BRDF and tint, lit through its lightmap.
     pub material: Material,
     /// Coverage in `[0, 1]`: 0 invisible, 1 opaque.
     pub opacity: f32,
@@ -49,7 +53,10 @@ pub enum ParticleLayout {
     Billboard,
     /// `count` such quads stacked along the view direction through the system's depth; a
     /// particle interpolates between the two slices around its depth. For thick systems.
-    Slices { count: u32 },
+    Slices {
+        /// How many quads, 2 to [`MAX_SLICES`] (one is a [`ParticleLayout::Billboard`]).
+        count: u32,
+    },
     /// Camera-facing quads as above, as many as the lighting needs: the planner estimates the
     /// error along the view direction from the lights that reach the system and picks the
     /// fewest slices that keep it small (one, a billboard, far from every light).
@@ -65,7 +72,9 @@ pub enum ParticleLayout {
 /// ribbon, a control point and the strip's half-width there).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Particle {
+    /// World position of the sprite's centre.
     pub position: Vec3,
+    /// Half-width of the sprite, world units.
     pub size: f32,
 }
 
@@ -73,9 +82,13 @@ pub struct Particle {
 /// Sprites face the camera, and their shading normal points at the eye.
 #[derive(Clone, Debug)]
 pub struct ParticleSystem {
+    /// Names the system in reports and errors.
     pub name: String,
+    /// How its probes are laid out.
     pub layout: ParticleLayout,
+    /// The sprites (for [`ParticleLayout::Ribbon`], the strip's control points, in order).
     pub particles: Vec<Particle>,
+    /// The sprites' BRDF and tint.
     pub material: Material,
     /// Peak coverage of one sprite (at its centre; it falls to zero at its rim).
     pub opacity: f32,

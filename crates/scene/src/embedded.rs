@@ -106,6 +106,7 @@ pub const EMBEDDED: [(&str, &str); 14] = [
     ),
 ];
 
+/// The names [`embedded`] accepts, in [`EMBEDDED`]'s order.
 pub fn embedded_names() -> impl Iterator<Item = &'static str> {
     EMBEDDED.iter().map(|(n, _)| *n)
 }

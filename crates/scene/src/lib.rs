@@ -5,6 +5,8 @@
 //! its own frames needs the types alone (lights, materials, bounds), so histencil-vk and the
 //! `histencil` front door take this crate without it: no gltf, serde_json, base64 or image.
 
+#![warn(missing_docs)]
+
 mod alpha;
 mod alpha_scenes;
 mod embedded;

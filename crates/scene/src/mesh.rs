@@ -15,11 +15,17 @@ use std::f32::consts::{PI, TAU};
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Vertex {
+    /// Object-space position.
     pub position: [f32; 3],
+    /// Object-space unit normal.
     pub normal: [f32; 3],
+    /// `TEXCOORD_0` (see the type's doc).
     pub uv: [f32; 2],
+    /// `TEXCOORD_1`.
     pub uv1: [f32; 2],
+    /// Object-space tangent along +u, `w` the bitangent's sign; zero without a normal map.
     pub tangent: [f32; 4],
+    /// `COLOR_0`, linear RGBA, multiplying the tint.
     pub color: [f32; 4],
 }
 
@@ -40,7 +46,9 @@ impl Vertex {
 /// An indexed triangle list.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
+    /// The vertices the indices refer to.
     pub vertices: Vec<Vertex>,
+    /// Three indices per triangle, counter-clockwise seen from outside.
     pub indices: Vec<u32>,
 }
 

@@ -13,7 +13,9 @@ use histencil_brdf::Brdf;
 pub struct TextureImage {
     /// Where it came from (the glTF image's name or URI), for error messages and object names.
     pub name: String,
+    /// Width in texels, 1 to [`MAX_TEXTURE_SIDE`].
     pub width: u32,
+    /// Height in texels, 1 to [`MAX_TEXTURE_SIDE`].
     pub height: u32,
     /// `width * height * 4` bytes.
     pub rgba8: Vec<u8>,
@@ -52,16 +54,21 @@ pub(crate) fn side_problem(width: u32, height: u32) -> Option<String> {
 /// How texture coordinates outside `[0, 1]` wrap (glTF's `wrapS` / `wrapT`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Wrap {
+    /// Tiles the image (glTF's default).
     #[default]
     Repeat,
+    /// Tiles the image, mirrored every other tile.
     MirroredRepeat,
+    /// Repeats the edge texels.
     ClampToEdge,
 }
 
 /// Texel filtering (glTF's `magFilter` / `minFilter`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum Filter {
+    /// The nearest texel.
     Nearest,
+    /// Bilinear between the four nearest texels (the default).
     #[default]
     Linear,
 }
@@ -70,9 +77,13 @@ pub enum Filter {
 /// sampler or a filter is absent) is repeat and trilinear.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Sampler {
+    /// Wrapping along u.
     pub wrap_u: Wrap,
+    /// Wrapping along v.
     pub wrap_v: Wrap,
+    /// Filtering when the image is magnified.
     pub mag: Filter,
+    /// Filtering within a mip level when it is minified.
     pub min: Filter,
     /// Between mip levels; `None` reads only the full-resolution level (glTF's `NEAREST` and
     /// `LINEAR` minification filters).
@@ -113,9 +124,11 @@ pub fn uv_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> UvTrans
 pub struct TextureRef {
     /// Index into [`crate::Scene::images`].
     pub image: u32,
+    /// How the texels are wrapped and filtered.
     pub sampler: Sampler,
     /// 0 reads [`crate::Vertex::uv`] (`TEXCOORD_0`), 1 [`crate::Vertex::uv1`].
     pub texcoord: u32,
+    /// Applied to the texture coordinates before sampling (`KHR_texture_transform`).
     pub transform: UvTransform,
 }
 
@@ -145,11 +158,15 @@ impl TextureRef {
 ///   ([`crate::Material::emissive`]), which is added once per pixel, not per light.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct MaterialMaps {
+    /// sRGB; multiplies the tint.
     pub base_color: Option<TextureRef>,
+    /// Linear, tangent space; bends the shading normal.
     pub normal: Option<TextureRef>,
     /// glTF's `normalTexture.scale`.
     pub normal_scale: f32,
+    /// Linear; green scales roughness, blue the metal share ([`textured_brdf`]).
     pub metallic_roughness: Option<TextureRef>,
+    /// sRGB; multiplies the emitted radiance.
     pub emissive: Option<TextureRef>,
     /// glTF's `alphaMode: MASK`: a fragment whose base-colour texel alpha times `COLOR_0`'s
     /// alpha is below this is discarded (in the G-buffer, forward and emissive passes alike).
@@ -178,6 +195,7 @@ impl MaterialMaps {
         i == 0 || i == 3
     }
 
+    /// Whether the material has no maps at all.
     pub fn is_empty(&self) -> bool {
         self.refs().iter().all(Option::is_none)
     }

@@ -10,12 +10,19 @@ use histencil_model::{Aabb, DepthConvention, LightShape, ViewDesc};
 /// it.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The scene's name (an embedded scene's, or the glTF file's stem).
     pub name: String,
+    /// One line on what the scene shows.
     pub description: String,
+    /// The viewpoint the scene is rendered from.
     pub camera: Camera,
+    /// The opaque objects: what the G-buffer holds.
     pub objects: Vec<Object>,
+    /// Every light, in the order plans and reports number them.
     pub lights: Vec<Light>,
+    /// Translucent objects, lit through lightmaps after the deferred pass.
     pub alpha_objects: Vec<AlphaObject>,
+    /// Particle systems, lit through lightmaps after the deferred pass.
     pub particle_systems: Vec<ParticleSystem>,
     /// Imported triangle meshes, referenced by [`Shape::Mesh`]; empty for the embedded scenes.
     pub meshes: Vec<Mesh>,
@@ -26,15 +33,22 @@ pub struct Scene {
 /// A perspective camera. The aspect ratio comes from the render target.
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
+    /// World position of the eye.
     pub eye: Vec3,
+    /// World point looked at.
     pub target: Vec3,
+    /// World direction that is up on screen.
     pub up: Vec3,
+    /// Vertical field of view, radians.
     pub fov_y_radians: f32,
+    /// Distance to the near plane, above 0.
     pub near: f32,
+    /// Distance to the far plane: depth 1 there ([`Camera::projection`]).
     pub far: f32,
 }
 
 impl Camera {
+    /// World to view (right-handed, looking down -Z).
     pub fn view(&self) -> Mat4 {
         glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up)
     }
@@ -70,9 +84,13 @@ pub enum Shape {
 /// An opaque object.
 #[derive(Clone, Debug)]
 pub struct Object {
+    /// Names the object in reports and errors.
     pub name: String,
+    /// The object's shape in object space.
     pub shape: Shape,
+    /// Object to world.
     pub transform: Mat4,
+    /// Its BRDF, tint and maps.
     pub material: Material,
 }
 
@@ -92,6 +110,7 @@ impl Object {
 /// axis projected onto the surface (see `crates/vk/shaders/include/light.glsl`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
+    /// The model and its parameters.
     pub brdf: Brdf,
     /// Linear RGB multiplier in `[0, 1]` per channel: the surface's colour.
     pub tint: Vec3,
@@ -148,25 +167,35 @@ pub enum LightKind {
     /// A cone along `direction`; full intensity inside `inner_angle`, zero outside `outer_angle`
     /// (half-angles, radians, `outer_angle` below 80 degrees so the cone volume stays a cone).
     Spot {
+        /// The cone's axis, from the light outwards.
         direction: Vec3,
+        /// Half-angle of full intensity, radians.
         inner_angle: f32,
+        /// Half-angle past which the light gives nothing, radians, below 80 degrees.
         outer_angle: f32,
     },
     /// Infinitely far, lighting along `direction`; drawn as a full-screen pass.
-    Directional { direction: Vec3 },
+    Directional {
+        /// The direction the light travels in.
+        direction: Vec3,
+    },
 }
 
 /// A light. `color` is linear RGB radiance scale (intensity folded in).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
+    /// Point, spot or directional, with what each needs.
     pub kind: LightKind,
+    /// World position (unused by a directional light).
     pub position: Vec3,
     /// Range: the light's contribution is exactly zero at and beyond this distance.
     pub radius: f32,
+    /// Linear RGB radiance scale, the light's intensity folded in.
     pub color: Vec3,
 }
 
 impl Light {
+    /// A point light at `position`, reaching `radius`.
     pub fn point(position: Vec3, radius: f32, color: Vec3) -> Self {
         Self {
             kind: LightKind::Point,
@@ -217,32 +246,64 @@ impl Light {
 /// A scene that a renderer cannot take, or a name that is not a scene.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SceneError {
+    /// No embedded scene has the name.
     #[error("unknown scene `{name}` (embedded scenes: {known})")]
-    UnknownScene { name: String, known: String },
+    UnknownScene {
+        /// The name asked for.
+        name: String,
+        /// The embedded scenes' names, comma-separated.
+        known: String,
+    },
+    /// A light a renderer cannot draw (not finite, a range or cone out of bounds, ...).
     #[error("light {index}: {problem}")]
-    BadLight { index: usize, problem: String },
+    BadLight {
+        /// Its index in [`Scene::lights`].
+        index: usize,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// An opaque object a renderer cannot draw (its transform, its material, its mesh).
     #[error("object {index} (`{name}`): {problem}")]
     BadObject {
+        /// Its index in [`Scene::objects`].
         index: usize,
+        /// Its name.
         name: String,
+        /// What is wrong with it.
         problem: String,
     },
+    /// A mesh that is not a valid triangle list.
     #[error("mesh {index}: {problem}")]
-    BadMesh { index: usize, problem: &'static str },
+    BadMesh {
+        /// Its index in [`Scene::meshes`].
+        index: usize,
+        /// What is wrong with it.
+        problem: &'static str,
+    },
+    /// An image whose size or data a renderer cannot upload.
     #[error("image {index} (`{name}`) {problem}")]
     BadImage {
+        /// Its index in [`Scene::images`].
         index: usize,
+        /// Its name.
         name: String,
+        /// What is wrong with it.
         problem: String,
     },
+    /// A camera that cannot be projected (not finite, far not beyond near, a field of view out
+    /// of bounds).
     #[error("camera: {0}")]
     BadCamera(String),
+    /// A translucent object or particle system a renderer cannot light.
     #[error("{kind} {index} (`{name}`): {problem}")]
     BadAlphaEntity {
         /// `alpha object` or `particle system`.
         kind: &'static str,
+        /// Its index in [`Scene::alpha_objects`] or [`Scene::particle_systems`].
         index: usize,
+        /// Its name.
         name: String,
+        /// What is wrong with it.
         problem: String,
     },
 }

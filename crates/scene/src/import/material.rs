@@ -9,12 +9,16 @@ use serde_json::{Map, Value};
 /// Why a material's `extras` were refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MaterialError {
+    /// The extras are JSON, but not an object of named values.
     #[error("extras are not a JSON object")]
     NotAnObject,
+    /// `brdf` is there but not a string.
     #[error("`brdf` must be a string naming a model")]
     NameNotAString,
+    /// `tint` is not three numbers in range.
     #[error("`tint` must be an array of 3 numbers in [0, {MAX_TINT}]")]
     BadTint,
+    /// The model or its parameters were refused, as `histencil brdf-eval` would refuse them.
     #[error(transparent)]
     Brdf(#[from] BrdfError),
 }

@@ -45,9 +45,15 @@ use std::path::Path;
 /// Why a glTF file could not become a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum ImportError {
-    /// `problem` names the path.
+    /// The file, or a file it refers to, could not be read; `problem` names the path.
     #[error("{problem}")]
-    Io { path: String, problem: String },
+    Io {
+        /// The file that could not be read.
+        path: String,
+        /// What went wrong, with the path.
+        problem: String,
+    },
+    /// Not JSON glTF or GLB, or not valid against the glTF schema.
     #[error("not a valid glTF file: {0}")]
     Parse(String),
     /// A valid file that needs an extension histencil does not read.
@@ -57,39 +63,68 @@ pub enum ImportError {
         supported = document::SUPPORTED_REQUIRED_EXTENSIONS.join(", ")
     )]
     UnsupportedExtension(String),
+    /// A buffer that is missing, too short, too large to import, or at a URI that cannot be read.
     #[error("buffer {index}: {problem}")]
-    Buffer { index: usize, problem: String },
+    Buffer {
+        /// The buffer's index in the file.
+        index: usize,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A mesh primitive histencil cannot draw (its mode, its accessors, its attributes).
     #[error("mesh {index} (`{name}`): {problem}")]
     Mesh {
+        /// The mesh's index in the file.
         index: usize,
+        /// Its name in the file, empty if it has none.
         name: String,
+        /// What is wrong with it.
         problem: String,
     },
     /// `problem` is in the message, so it is not also the error's source (a chain would print
     /// it twice).
     #[error("material {index} (`{name}`): {problem}")]
     Material {
+        /// The material's index in the file.
         index: usize,
+        /// Its name in the file, `default` if it has none.
         name: String,
+        /// What is wrong with its extras.
         problem: MaterialError,
     },
     /// An image that cannot be read or decoded: `problem` says why.
     #[error("image {index} (`{name}`) {problem}")]
     Image {
+        /// The image's index in the file.
         index: usize,
+        /// Its name in the file, else its URI, else `image<index>`.
         name: String,
+        /// What is wrong with it.
         problem: String,
     },
+    /// A `KHR_lights_punctual` light histencil cannot draw.
     #[error("light {index} (`{name}`): {problem}")]
     Light {
+        /// The light's index in the extension's list.
         index: usize,
+        /// Its name in the file, empty if it has none.
         name: String,
+        /// What is wrong with it.
         problem: String,
     },
+    /// A camera histencil cannot use: an orthographic one.
     #[error("camera {index}: {problem}")]
-    Camera { index: usize, problem: String },
+    Camera {
+        /// The camera's index in the file.
+        index: usize,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// The file's structure: no scene, a node hierarchy too deep (a cycle), a transform that is
+    /// not finite, ...
     #[error("{0}")]
     Structure(String),
+    /// The scene imported, but fails [`Scene::validate`].
     #[error(transparent)]
     Scene(#[from] SceneError),
 }
@@ -129,6 +164,7 @@ pub fn load_scene(spec: &str) -> Result<Scene, ImportError> {
 /// A scene and what its file holds that histencil does not render (for the user: said once).
 #[derive(Clone, Debug)]
 pub struct Imported {
+    /// The scene, validated.
     pub scene: Scene,
     /// One line per glTF feature read past without rendering it (`occlusionTexture`,
     /// animations, extensions not read, ...); empty for embedded scenes.
