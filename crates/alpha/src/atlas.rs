@@ -20,9 +20,13 @@ use std::collections::HashMap;
 /// A rectangle of the atlas, in texels: the entity's own texels, guard band excluded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Region {
+    /// Left edge, in texels from the atlas's left.
     pub x: u32,
+    /// Top edge, in texels from the atlas's first row.
     pub y: u32,
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
 }
 
@@ -45,6 +49,7 @@ impl Region {
         }
     }
 
+    /// How many texels the region holds: what lighting it costs.
     pub fn texels(&self) -> u64 {
         u64::from(self.width) * u64::from(self.height)
     }
@@ -58,37 +63,61 @@ pub struct RegionId(u64);
 /// What an allocation granted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Allocation {
+    /// The handle that frees it ([`Atlas::free`]).
     pub id: RegionId,
+    /// Where it lies: the texels granted, perhaps fewer than asked for.
     pub region: Region,
     /// The size asked for; larger than `region`'s when the atlas was too full for it.
     pub requested: (u32, u32),
 }
 
 impl Allocation {
+    /// Whether the atlas granted less than was asked for: the entity is lit coarser this frame.
     pub fn downgraded(&self) -> bool {
         (self.region.width, self.region.height) != self.requested
     }
 }
 
+/// Why an atlas could not be made, or a region allocated or freed.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum AtlasError {
+    /// An atlas side is 0 or above [`Atlas::MAX_SIDE`].
     #[error("atlas size {width}x{height} is out of range (1..={max} per side)", max = Atlas::MAX_SIDE)]
-    BadSize { width: u32, height: u32 },
+    BadSize {
+        /// The width asked for.
+        width: u32,
+        /// The height asked for.
+        height: u32,
+    },
+    /// A region that no atlas of this size could hold: a side of 0, or larger than the atlas
+    /// less its guard band. A caller bug, unlike [`AtlasError::Full`].
     #[error("a {width}x{height} region cannot be allocated: sides must be at least 1 and fit the {atlas_width}x{atlas_height} atlas with its padding")]
     BadRequest {
+        /// The width asked for.
         width: u32,
+        /// The height asked for.
         height: u32,
+        /// The atlas's width.
         atlas_width: u32,
+        /// The atlas's height.
         atlas_height: u32,
     },
+    /// The live regions leave no room ([`Atlas::allocate_downgrading`]: not even at the minimum
+    /// side).
     #[error("lightmap atlas full: no room for {width}x{height} texels (after downgrading to the minimum); {live} regions hold {used} of {total} texels")]
     Full {
+        /// The width asked for.
         width: u32,
+        /// The height asked for.
         height: u32,
+        /// Regions allocated and not freed.
         live: usize,
+        /// Texels those regions hold.
         used: u64,
+        /// Texels in the atlas.
         total: u64,
     },
+    /// The handle names no live region.
     #[error("region {0:?} is not allocated (freed twice, or from another atlas)")]
     UnknownRegion(RegionId),
 }
@@ -123,10 +152,12 @@ impl Atlas {
         })
     }
 
+    /// `(width, height)` in texels.
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
     }
 
+    /// The guard band, in texels, kept around every region.
     pub fn padding(&self) -> u32 {
         self.padding
     }

@@ -16,15 +16,20 @@ use histencil_scene::Mesh;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Probe {
+    /// Object-space position where the mesh covers the texel; `w` says whether it does.
     pub position: [f32; 4],
+    /// Object-space normal there, unnormalised; `w` 0.
     pub normal: [f32; 4],
 }
 
 /// A `width x height` grid of probes, row by row from the region's top-left texel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakedProbes {
+    /// Texels across: the region's width.
     pub width: u32,
+    /// Texels down: the region's height.
     pub height: u32,
+    /// `width * height` probes, uploaded into the entity's region as they are.
     pub probes: Vec<Probe>,
 }
 

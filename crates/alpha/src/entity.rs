@@ -14,6 +14,7 @@ use histencil_scene::{
 /// One translucent object or particle system, as lit this frame.
 #[derive(Clone, Copy, Debug)]
 pub struct AlphaEntity<'a> {
+    /// A translucent mesh or a particle system, with what its probes are made from.
     pub kind: AlphaEntityKind<'a>,
     /// The BRDF and tint its probes are lit with.
     pub material: Material,
@@ -30,13 +31,18 @@ pub enum AlphaEntityKind<'a> {
     /// `local_bounds` is the object-space box of what is drawn (lights reaching it light the
     /// entity), `transform` object to world.
     Object {
+        /// The mesh in its lightmap UV layout.
         probe_mesh: &'a Mesh,
+        /// Object to world.
         transform: Mat4,
+        /// `(min, max)` of what is drawn, in object space.
         local_bounds: (Vec3, Vec3),
     },
     /// A particle system: `particles` are world-space sprites (position, size).
     Particles {
+        /// How the system's probes are laid out.
         layout: ParticleLayout,
+        /// The sprites, in world space.
         particles: &'a [Particle],
     },
 }
@@ -155,6 +161,7 @@ pub struct ProbeMeshes {
 }
 
 impl ProbeMeshes {
+    /// The built-in shapes' bake meshes, and a copy of the scene's imported meshes.
     pub fn new(scene: &Scene) -> Self {
         Self {
             unit_box: unit_box_bake(),

@@ -11,7 +11,8 @@
 //! the frame by its opacity times as much, and the tonemap's difference grows with that factor,
 //! so the opaque layer bounds it. (Layers with errors of one sign add up, but the weights of
 //! "over" sum to at most one.) Measured against `histencil sweep`, the estimate stays above the
-//! error over the alpha pixels at every slice count and side tried (README).
+//! error over the alpha pixels at every slice count and side tried (the book's measurements,
+//! `docs/src/measurements/alpha.md`, "The estimate against the measurement").
 //!
 //! The choice is the cheapest one whose estimate stays under the target: for a mesh the smallest
 //! side; for a particle system the (slices, side) pair with the fewest texels to light, never
@@ -44,7 +45,9 @@ const MAX_SAMPLES: usize = 2048;
 /// tonemap: the coverage-weighted mean and the largest over the entity's samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Estimate {
+    /// Mean over the samples, weighted by coverage.
     pub mean: f32,
+    /// The largest over the samples.
     pub max: f32,
 }
 
@@ -64,6 +67,7 @@ pub enum ParameterKind {
 /// What an entity's lightmap was given and why.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parameters {
+    /// Which of the parameters there were to choose.
     pub kind: ParameterKind,
     /// Camera-facing slices (1: a billboard). 1 for objects, dust and ribbons.
     pub slices: u32,
@@ -75,6 +79,7 @@ pub struct Parameters {
     pub coverage_side: u32,
     /// Whether the author forced the slices or the side (the estimate then only reports).
     pub forced_slices: bool,
+    /// Whether the author forced the side.
     pub forced_side: bool,
 }
 

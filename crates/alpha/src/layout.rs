@@ -36,12 +36,18 @@ pub enum EntityKind {
     /// A translucent mesh: one square region in its lightmap UV layout.
     Surface,
     /// A particle system of `count` particles laid out as `layout` says.
-    Particles { layout: ParticleLayout, count: u32 },
+    Particles {
+        /// How the system's probes are laid out.
+        layout: ParticleLayout,
+        /// How many particles (dust: motes, one texel each).
+        count: u32,
+    },
 }
 
 /// One alpha entity, as the planner needs it: plain values an engine has.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EntityDesc {
+    /// A surface or a particle system, which decides the region's shape.
     pub kind: EntityKind,
     /// World-space box around everything the entity draws.
     pub bounds: (Vec3, Vec3),
@@ -56,10 +62,13 @@ pub struct EntityDesc {
 /// Where the camera is and how it sees: what sizing and the probe frames need from a view.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Viewer {
+    /// World position of the camera.
     pub eye: Vec3,
     /// Unit camera axes: right, up, and forward (the view direction).
     pub right: Vec3,
+    /// Unit camera axis pointing up on screen.
     pub up: Vec3,
+    /// Unit camera axis along the view direction.
     pub forward: Vec3,
     /// `tan(fov_y / 2)`.
     pub tan_half_fov_y: f32,
@@ -116,9 +125,13 @@ impl Viewer {
 /// of them does not stretch the atlas into a long strip.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RegionShape {
+    /// How many tiles: the slice count of a sliced system, 1 otherwise.
     pub tiles: u32,
+    /// Tiles to a row.
     pub columns: u32,
+    /// Texels across one tile.
     pub tile_width: u32,
+    /// Texels down one tile.
     pub tile_height: u32,
     /// Whether a full atlas may halve the tiles (not for dust: one texel per mote is the layout).
     pub downgradable: bool,
@@ -146,13 +159,16 @@ pub struct EntityRegion {
     pub region: Region,
     /// The tiles as granted (halved when the atlas was full).
     pub shape: RegionShape,
+    /// Whether the tiles are smaller than asked for: the entity is lit coarser this frame.
     pub downgraded: bool,
 }
 
 /// Every entity's region (in the order the entities were given), and the atlas they were packed
 /// into.
 pub struct LightmapLayout {
+    /// The atlas, sized to fit, with every region allocated.
     pub atlas: Atlas,
+    /// One per entity, in the entities' order.
     pub regions: Vec<EntityRegion>,
 }
 
@@ -170,16 +186,29 @@ pub const START_ATLAS_SIDE: u32 = 256;
 /// Texels of guard band around every region.
 pub const ATLAS_PADDING: u32 = 1;
 
+/// Why the entities could not be laid out.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LayoutError {
+    /// A forced side outside `2..=`[`MAX_FORCED_SIDE`].
     #[error("lightmap resolution {0} is out of range (2..={max} texels a side)", max = MAX_FORCED_SIDE)]
     BadResolution(u32),
     /// `reason` is in the message, so it is not also the error's source (a chain would
     /// print it twice).
     #[error("the lightmap atlas is full even at {side}x{side} texels with every region halved down to {min}: {reason}", min = MIN_SIDE)]
-    AtlasFull { side: u32, reason: AtlasError },
+    AtlasFull {
+        /// The largest atlas side tried.
+        side: u32,
+        /// The allocation that failed there.
+        reason: AtlasError,
+    },
+    /// An entity that cannot be laid out (bounds not finite, no particles, ...).
     #[error("alpha entity {index}: {reason}")]
-    BadEntity { index: usize, reason: String },
+    BadEntity {
+        /// Its index in the entities given.
+        index: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
 }
 
 /// Diameter in pixels that a sphere of `radius` at `centre` covers on a `viewport_height`-pixel

@@ -20,6 +20,8 @@
 //! - [`fit_frame`]: the camera-facing probe quad (and slices) around a particle system;
 //! - [`sprite_vertices`] and [`back_to_front`]: the alpha pass's geometry and blending order.
 
+#![warn(missing_docs)]
+
 mod atlas;
 mod bake;
 mod entity;

@@ -13,6 +13,7 @@ use histencil_scene::{Light, ParticleLayout, Scene};
 /// A lightmap plan: the regions, and what each entity was given and why.
 #[derive(Debug)]
 pub struct AlphaPlan {
+    /// The atlas and every entity's region in it.
     pub layout: LightmapLayout,
     /// Per entity, in order: its slices and side and the error estimate behind them.
     pub parameters: Vec<Parameters>,

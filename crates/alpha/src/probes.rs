@@ -13,11 +13,15 @@ use histencil_scene::{Camera, Particle, Scene};
 /// position projected orthogonally onto it: the nearest probe on the quad.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ProbeFrame {
+    /// World centre of the quad (of the middle slice).
     pub centre: Vec3,
     /// Half the quad's side: every sprite lies within it.
     pub radius: f32,
+    /// Half the system's extent along the view: where the first and last slices sit.
     pub half_depth: f32,
+    /// Unit camera axis along the quad's rows (+u).
     pub right: Vec3,
+    /// Unit camera axis up the screen (towards -v).
     pub up: Vec3,
     /// Unit view direction (away from the camera).
     pub forward: Vec3,

@@ -10,6 +10,8 @@ use histencil_scene::{Camera, ParticleLayout, ParticleSystem};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SpriteVertex {
+    /// World position of the vertex: a corner of the sprite (or an edge point of the ribbon's
+    /// strip), already facing the camera.
     pub position: [f32; 3],
     /// `(-1..1, -1..1)` across the sprite (a ribbon's strip: `(0, -1..1)`); coverage falls to
     /// zero at radius 1.
