@@ -42,6 +42,50 @@ impl Default for ChoiceSettings {
 /// regions packed into an atlas of at most `max_side` ([`plan_regions`]). Regions and
 /// parameters come back in entity order.
 ///
+/// A puff of smoke beside a point light, its slices chosen by the estimate:
+/// ```
+/// use glam::Vec3;
+/// use histencil_alpha::*;
+/// use histencil_scene::{Camera, Light, Material, Particle, ParticleLayout};
+///
+/// let camera = Camera {
+///     eye: Vec3::new(0.0, 1.0, 6.0),
+///     target: Vec3::ZERO,
+///     up: Vec3::Y,
+///     fov_y_radians: 1.0,
+///     near: 0.1,
+///     far: 100.0,
+/// };
+/// let particles: Vec<Particle> = (0..16)
+///     .map(|i| {
+///         let a = i as f32 * 0.4;
+///         Particle { position: Vec3::new(a.cos(), 0.4 * a.sin(), a.sin()) * 0.6, size: 0.3 }
+///     })
+///     .collect();
+/// let smoke = AlphaEntity {
+///     kind: AlphaEntityKind::Particles { layout: ParticleLayout::Auto, particles: &particles },
+///     material: Material::lambert(Vec3::splat(0.8)),
+///     opacity: 0.5,
+/// };
+/// let lights = [Light::point(Vec3::new(1.5, 1.0, 0.0), 4.0, Vec3::ONE)];
+/// let settings = ChoiceSettings::default();
+/// let viewer = Viewer::from_camera(&camera);
+/// let plan = plan_entities(&[smoke], &viewer, &lights, 720, MAX_ATLAS_SIDE, &settings)?;
+///
+/// let (chosen, placed) = (plan.parameters[0], plan.layout.regions[0]);
+/// // The cheapest slices and side whose estimated error stays under the target, never more
+/// // texels than the smoke's size on screen can show.
+/// assert_eq!(chosen.kind, ParameterKind::Slices);
+/// assert!(chosen.estimate.mean <= settings.target);
+/// assert!(chosen.side <= chosen.coverage_side);
+/// // One tile per slice in its region, which the atlas granted in full.
+/// assert_eq!(placed.shape.tiles, chosen.slices);
+/// assert_eq!((placed.shape.tile_width, placed.shape.tile_height), (chosen.side, chosen.side));
+/// assert_eq!((placed.region.width, placed.region.height), placed.shape.size());
+/// assert!(!placed.downgraded);
+/// # Ok::<(), LayoutError>(())
+/// ```
+///
 /// # Errors
 /// [`LayoutError::BadEntity`] for an entity [`AlphaEntity::problem`] refuses,
 /// [`LayoutError::BadResolution`] for a forced side outside 2..=[`crate::MAX_FORCED_SIDE`], and
