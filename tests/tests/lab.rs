@@ -301,6 +301,13 @@ fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
         assert!(x.is_finite() && lo <= *x && *x <= hi, "{tiled:?}");
     }
     assert!(tiled.classify_ms > 0.0 && tiled.shade_ms > 0.0, "{tiled:?}");
+    // And the depth-id technique's, which the adaptive technique may take instead of tiled.
+    let ids = tiled.depth_id.expect("calibrated costs carry depth-id's");
+    let ids_intervals = ids.interval.expect("measured");
+    for (x, (lo, hi)) in ids.fields().iter().zip(ids_intervals) {
+        assert!(x.is_finite() && lo <= *x && *x <= hi, "{ids:?}");
+    }
+    assert!(ids.shade_ms > 0.0, "{ids:?}");
     let path = output_dir().join("costs.json");
     calibration.write(&path).unwrap();
     let read = read_costs(&path).unwrap();

@@ -13,8 +13,8 @@
 use histencil_brdf::BrdfId;
 use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
 use histencil_vk::{
-    Backend, CostModel, FlushPolicy, MixedTiles, Readback, Renderer, RendererDesc, Shading,
-    Technique, TileSide, TiledCosts,
+    Backend, CostModel, DepthIdCosts, FlushPolicy, MixedTiles, Readback, Renderer, RendererDesc,
+    Shading, Technique, TileSide, TiledCosts,
 };
 
 const SIZE: u32 = 160;
@@ -280,6 +280,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
                 classify_ms,
                 shade_ms: 0.0,
                 interval: None,
+                depth_id: None,
             })
         };
         let mut renderer = with_costs(CostModel {
@@ -307,5 +308,26 @@ fn adaptive_chooses_what_the_cost_model_says() {
             ..free_branching
         });
         assert_eq!(renderer.resolve(native).unwrap(), native);
+        // Costs whose depth-id figures undercut the tiled kernels light the frame by depth ids:
+        // the tiled image again, bit for bit.
+        let mut renderer = with_costs(CostModel {
+            tiled: Some(TiledCosts {
+                shade_ms: 1.0,
+                depth_id: Some(DepthIdCosts {
+                    per_brdf_ms: 0.0,
+                    shade_ms: 0.0,
+                    interval: None,
+                }),
+                ..tiles(0.0).unwrap()
+            }),
+            ..free_branching
+        });
+        let side = TileSide::for_device(ctx.device_type());
+        assert_eq!(
+            renderer.resolve(native).unwrap(),
+            Technique::DepthId { side }
+        );
+        let frame = renderer.render(native, ldr).unwrap();
+        assert_eq!(frame.images.ldr.unwrap(), expected);
     });
 }

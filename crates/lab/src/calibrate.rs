@@ -22,7 +22,7 @@ use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::stats::{median_interval, sample, Interval, Sampled, Sampling};
 use crate::variants::{light_size_scene, with_brdf_count};
 use crate::{LabError, Result};
-use histencil_model::{TiledCosts, COST_FIELDS, TILED_FIELDS};
+use histencil_model::{DepthIdCosts, TiledCosts, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
 use histencil_vk::{
     Backend, Context, CostModel, FlushPolicy, MixedTiles, Renderer, Technique, TileSide,
 };
@@ -63,8 +63,9 @@ struct Kind {
     classify_ms: Vec<f64>,
 }
 
-/// The costs each round fits: the four of [`COST_FIELDS`], then the two of [`TILED_FIELDS`].
-const FITTED: usize = 6;
+/// The costs each round fits: the four of [`COST_FIELDS`], then the two of [`TILED_FIELDS`],
+/// then the two of [`DEPTH_ID_FIELDS`].
+const FITTED: usize = 8;
 
 /// Measures the six costs at `width` x `height` over interleaved rounds (at least
 /// `sampling.min_rounds`, until each cost's interval is within the target or the budget is
@@ -84,14 +85,16 @@ pub fn calibrate(
     let stencil = Technique::Stencil { backend, flush };
     let branching = Technique::Branching { backend, flush };
     // The side the adaptive technique resolves to on this device.
+    let side = TileSide::for_device(ctx.device_type());
     let tiled = Technique::Tiled {
         mixed: MixedTiles::PerBrdf,
-        side: TileSide::for_device(ctx.device_type()),
+        side,
     };
-    // Full-screen lights: branching, stencil and tiled; small lights: stencil. 1 and 3 BRDFs
-    // each.
+    let depth_id = Technique::DepthId { side };
+    // Full-screen lights: branching, stencil, tiled and depth-id; small lights: stencil. 1 and
+    // 3 BRDFs each.
     let walls = [
-        (1.0, vec![branching, stencil, tiled]),
+        (1.0, vec![branching, stencil, tiled, depth_id]),
         (SMALL_COVERAGE, vec![stencil]),
     ];
     let mut renderers = Vec::new();
@@ -129,16 +132,30 @@ pub fn calibrate(
             renderers.push((renderer, lights));
         }
     }
-    // Kinds in push order: full 1 BRDF (branching, stencil), full 3 (branching, stencil,
-    // tiled), small 1 (stencil), small 3 (stencil).
+    // Kinds in push order: full 1 BRDF (branching, stencil, depth-id), full 3 (branching,
+    // stencil, tiled, depth-id), small 1 (stencil), small 3 (stencil).
+    let full_lights = renderers[0].1;
     let fit = |k: &[Kind], round: usize| -> [f64; FITTED] {
         let t = |i: usize| k[i].per_light_ms[round];
-        let (shade, tax) = (t(0), (t(2) - t(0)) / extra_brdfs[0]);
-        let a = (t(3) - t(1)) / extra_brdfs[0];
-        let b = (t(6) - t(5)) / extra_brdfs[1];
+        let (shade, tax) = (t(0), (t(3) - t(0)) / extra_brdfs[0]);
+        let a = (t(4) - t(1)) / extra_brdfs[0];
+        let b = (t(8) - t(7)) / extra_brdfs[1];
         let per_brdf = (a - b) / (1.0 - SMALL_COVERAGE);
-        let classify = k[4].classify_ms[round];
-        [(a - per_brdf) / 2.0, per_brdf, tax, shade, classify, t(4)]
+        let classify = k[5].classify_ms[round];
+        // Depth-id per light: its BRDFs' full-screen passes shared by the wall's lights, and
+        // each light's shading; two BRDFs more add two passes.
+        let ids_per_brdf = (t(6) - t(2)) * full_lights / 2.0;
+        let ids_shade = t(2) - ids_per_brdf / full_lights;
+        [
+            (a - per_brdf) / 2.0,
+            per_brdf,
+            tax,
+            shade,
+            classify,
+            t(5),
+            ids_per_brdf,
+            ids_shade,
+        ]
     };
     let kinds = std::cell::RefCell::new(kinds);
     let fits = std::cell::RefCell::new(Vec::<[f64; FITTED]>::new());
@@ -186,6 +203,11 @@ pub fn calibrate(
             classify_ms: m(4),
             shade_ms: m(5),
             interval: Some([iv(4), iv(5)]),
+            depth_id: Some(DepthIdCosts {
+                per_brdf_ms: m(6),
+                shade_ms: m(7),
+                interval: Some([iv(6), iv(7)]),
+            }),
         }),
     };
     let measurements = kinds
@@ -245,6 +267,21 @@ impl Calibration {
                     .collect();
                 t.insert("intervals".into(), Value::Object(intervals));
             }
+            if let Some(ids) = tiled.depth_id {
+                let mut d = serde_json::Map::new();
+                for (name, value) in DEPTH_ID_FIELDS.iter().zip(ids.fields()) {
+                    d.insert(name.to_string(), json!(value));
+                }
+                if let Some(iv) = ids.interval {
+                    let intervals: serde_json::Map<String, Value> = DEPTH_ID_FIELDS
+                        .iter()
+                        .zip(iv)
+                        .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
+                        .collect();
+                    d.insert("intervals".into(), Value::Object(intervals));
+                }
+                t.insert("depth_id".into(), Value::Object(d));
+            }
             out["tiled"] = Value::Object(t);
         }
         if let Some(x) = self.costs.crossover_coverage() {
@@ -286,6 +323,11 @@ mod tests {
                 classify_ms: 0.4,
                 shade_ms: 1.0,
                 interval: Some([(0.3, 0.5), (0.9, 1.2)]),
+                depth_id: Some(DepthIdCosts {
+                    per_brdf_ms: 0.3,
+                    shade_ms: 0.8,
+                    interval: Some([(0.2, 0.4), (0.7, 0.9)]),
+                }),
             }),
         };
         let calibration = Calibration {

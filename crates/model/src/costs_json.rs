@@ -1,11 +1,12 @@
 //! The costs file a calibration writes and the adaptive technique reads: a JSON object whose top
 //! level holds the four costs by name, with an optional `intervals` object of `[lo, hi]` pairs,
 //! and optionally the tiled technique's costs as `tiled` (the same shape: `classify_ms`,
-//! `shade_ms` and optional `intervals`).
+//! `shade_ms` and optional `intervals`), which may hold the depth-id technique's as `depth_id`
+//! (`per_brdf_ms`, `shade_ms`, optional `intervals`).
 //! Other keys (the device, the settings, the measurements) are the writer's and are ignored.
 //! Reading needs no device, so it is fuzzed and tested here.
 
-use crate::{CostModel, TiledCosts};
+use crate::{CostModel, DepthIdCosts, TiledCosts};
 use serde_json::Value;
 
 /// The costs' names in the file, in [`CostModel::fields`] order.
@@ -43,10 +44,23 @@ impl CostModel {
             None | Some(Value::Null) => None,
             Some(t) => {
                 let (v, interval) = costs_and_intervals(t, TILED_FIELDS, "tiled.")?;
+                let depth_id = match t.get("depth_id") {
+                    None | Some(Value::Null) => None,
+                    Some(d) => {
+                        let path = "tiled.depth_id.";
+                        let (v, interval) = costs_and_intervals(d, DEPTH_ID_FIELDS, path)?;
+                        Some(DepthIdCosts {
+                            per_brdf_ms: v[0],
+                            shade_ms: v[1],
+                            interval,
+                        })
+                    }
+                };
                 Some(TiledCosts {
                     classify_ms: v[0],
                     shade_ms: v[1],
                     interval,
+                    depth_id,
                 })
             }
         };
@@ -63,6 +77,16 @@ impl CostModel {
 
 /// The tiled costs' names in the file's `tiled` object.
 pub const TILED_FIELDS: [&str; 2] = ["classify_ms", "shade_ms"];
+
+/// The depth-id costs' names in the `tiled` object's `depth_id` object.
+pub const DEPTH_ID_FIELDS: [&str; 2] = ["per_brdf_ms", "shade_ms"];
+
+impl DepthIdCosts {
+    /// The two costs in [`DEPTH_ID_FIELDS`] order.
+    pub fn fields(&self) -> [f64; 2] {
+        [self.per_brdf_ms, self.shade_ms]
+    }
+}
 
 impl TiledCosts {
     /// The two costs in [`TILED_FIELDS`] order.
@@ -155,12 +179,22 @@ mod tests {
         assert_eq!(tiled.fields(), [0.5, 4.0]);
         assert_eq!(tiled.interval, Some([(0.4, 0.6), (3.0, 5.0)]));
         assert_eq!(read("null").unwrap().tiled, None);
+        assert_eq!(tiled.depth_id, None);
+        let with_ids = read(
+            r#"{"classify_ms": 0.5, "shade_ms": 4, "depth_id": {"per_brdf_ms": 0.2, "shade_ms": 3}}"#,
+        );
+        let ids = with_ids.unwrap().tiled.unwrap().depth_id.unwrap();
+        assert_eq!((ids.fields(), ids.interval), ([0.2, 3.0], None));
         for (tiled, needle) in [
             ("{}", "`tiled.classify_ms`"),
             (r#"{"classify_ms": 1, "shade_ms": -2}"#, "`tiled.shade_ms`"),
             (
                 r#"{"classify_ms": 1, "shade_ms": 2, "intervals": {"classify_ms": [2, 3]}}"#,
                 "`tiled.intervals.classify_ms`",
+            ),
+            (
+                r#"{"classify_ms": 1, "shade_ms": 2, "depth_id": {"per_brdf_ms": "x"}}"#,
+                "`tiled.depth_id.per_brdf_ms`",
             ),
         ] {
             let err = read(tiled).unwrap_err().to_string();

@@ -66,7 +66,7 @@ mod view;
 
 pub use backend::{Native, PlatformBackend, PlatformCaps, Ps3Like, X360Like};
 pub use chooser::{CostModel, TalkFigures};
-pub use costs_json::{CostsError, COST_FIELDS, TILED_FIELDS};
+pub use costs_json::{CostsError, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
 pub use footprint::{Footprint, Span};
 pub use frame::{
     insert_flushes, write_test_dependencies, FlushPolicy, FramePlan, PlannedLight, Step,
@@ -85,6 +85,6 @@ pub use state::{
     CompareOp, CullMode, DepthState, FaceStencil, HiStencilState, PassState, StencilOp,
 };
 pub use synthetic::{SyntheticDesc, SyntheticFrame};
-pub use tiled_costs::TiledCosts;
+pub use tiled_costs::{DepthIdCosts, FrameChoice, TiledCosts};
 pub use tiles::{TileStats, TileSurface};
 pub use view::{DepthConvention, FarPlane, NdcRect, Perspective, View, ViewDesc, ViewError};

@@ -183,6 +183,9 @@ impl LightShape {
 }
 
 /// How the BRDFs of the frame's lights are separated.
+// The cost model is plain `Copy` data (a few hundred bytes with its intervals), made once per
+// plan: boxing it would cost the settings their `Copy` for nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TechniqueChoice {
     /// The talk's technique for every light.

@@ -65,7 +65,9 @@ pub use deferred_lighting::{
 pub use driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
 pub use error::{Error, Result};
 pub use gpu_types::ProjectionError;
-pub use histencil_model::{CostModel, FlushPolicy, TileStats, TiledCosts};
+pub use histencil_model::{
+    CostModel, DepthIdCosts, FlushPolicy, FrameChoice, TileStats, TiledCosts,
+};
 pub use hooks::{
     EngineHooks, HookSetLayout, HookSets, LightHooks, LightModules, DECODE_SET, VISIBILITY_SET,
 };

@@ -6,8 +6,8 @@ use crate::error::Result;
 use crate::gpu_types::FrameUniforms;
 use crate::technique::{Backend, FrameDesc, MixedTiles, Technique, TileSide};
 use histencil_model::{
-    plan_frame, DepthConvention, FarPlane, FramePlan, LightShape, Perspective, PlanError,
-    PlanInputs, View, ViewDesc,
+    plan_frame, DepthConvention, FarPlane, FrameChoice, FramePlan, LightShape, Perspective,
+    PlanError, PlanInputs, View, ViewDesc,
 };
 
 impl Renderer<'_> {
@@ -21,10 +21,10 @@ impl Renderer<'_> {
 
     /// What a frame of `technique` records: the adaptive technique on the native backend lights
     /// the whole frame tiled (the device's tiles, [`crate::TileSide::for_device`]; mixed tiles
-    /// per BRDF) where its costs predict that surely cheaper than its plan ([`histencil_model::CostModel::prefers_tiled`]; never with
-    /// the talk's costs, which have no tiled figures); on an emulated console backend it keeps
-    /// the console's plan, whose behaviour it is there to show. Every other technique is
-    /// itself.
+    /// per BRDF), or by depth ids with the same tiles' light lists, where its costs predict
+    /// that surely cheaper than its plan ([`histencil_model::CostModel::frame_choice`]; never
+    /// with the talk's costs, which have no tiled figures); on an emulated backend it keeps the
+    /// platform's plan, whose behaviour it is there to show. Every other technique is itself.
     pub fn resolve(&self, technique: Technique) -> Result<Technique> {
         self.resolve_in(technique, &self.view_desc())
             .map(|(t, _)| t)
@@ -37,14 +37,22 @@ impl Renderer<'_> {
         view: &ViewDesc,
     ) -> Result<(Technique, FramePlan)> {
         let plan = self.plan_in(technique, view)?;
-        if let Technique::Adaptive { backend, .. } = technique {
-            if backend == Backend::Native && self.cost_model(backend).prefers_tiled(&plan) {
-                let tiled = Technique::Tiled {
+        if let Technique::Adaptive {
+            backend: Backend::Native,
+            ..
+        } = technique
+        {
+            let side = TileSide::for_device(self.ctx.device_type());
+            let costs = self.cost_model(Backend::Native);
+            let chosen = match costs.frame_choice(&plan, self.brdfs.len()) {
+                FrameChoice::Planned => technique,
+                FrameChoice::Tiled => Technique::Tiled {
                     mixed: MixedTiles::PerBrdf,
-                    side: TileSide::for_device(self.ctx.device_type()),
-                };
-                return Ok((tiled, plan));
-            }
+                    side,
+                },
+                FrameChoice::DepthId => Technique::DepthId { side },
+            };
+            return Ok((chosen, plan));
         }
         Ok((technique, plan))
     }
