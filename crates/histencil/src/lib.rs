@@ -6,7 +6,8 @@
 //! device. What an engine writes is re-exported here by name; the crates behind it stay
 //! reachable as modules ([`brdf`], [`model`], [`scene`], [`alpha`], [`vk`]) for the rest.
 //!
-//! A frame, in order (README "Use it in your engine"; `examples/engine` is a whole engine):
+//! A frame, in order (the book's "Engine integration: a lit frame", `docs/src/engine/index.md`;
+//! `examples/minimal` lights one frame of its own G-buffer, `examples/engine` is a whole engine):
 //! 1. Lend the device once: [`Context::from_raw`] with a [`BorrowedDevice`] made with
 //!    [`REQUIREMENTS`].
 //! 2. Make the lighting once: [`DeferredLighting::new`] with a [`LightingDesc`] (stencil
@@ -16,8 +17,74 @@
 //!    record ([`DeferredLighting::record`] with a [`LightingFrame`] and [`LightingTargets`]).
 //! 4. Translucent entities: [`plan_entities`] then [`AlphaLightmaps::record`].
 //!
+//! Steps 1 to 3, given what an engine has: its device as `lent`, a recording command buffer
+//! `cmd`, its camera `view` and `lights`, its `brdfs` with the world boxes (`bounds`) of the
+//! objects drawn with each, and its images, the G-buffer already written in the built-in layout
+//! ([`GBUFFER_FORMATS`]):
+//! ```no_run
+//! # use ash::vk;
+//! # use histencil::*;
+//! # unsafe fn light_a_frame(
+//! #     lent: BorrowedDevice,
+//! #     cmd: vk::CommandBuffer,
+//! #     view: &ViewDesc,
+//! #     lights: &[Light],
+//! #     brdfs: Vec<BrdfId>,
+//! #     bounds: &[Vec<Aabb>],
+//! #     gbuffer: Vec<ImageRef>,
+//! #     depth_stencil: ImageRef,
+//! #     hdr: ImageRef,
+//! # ) -> std::result::Result<(), Box<dyn std::error::Error>> {
+//! // Once: lend the device (made with REQUIREMENTS' features), make the lighting.
+//! let ctx = Context::from_raw(lent)?;
+//! let layout = StencilLayout::new(brdfs.len() as u32, 0)?;
+//! let desc = LightingDesc {
+//!     layout,
+//!     brdfs,
+//!     extent: hdr.extent,
+//!     depth_stencil_format: depth_stencil.format,
+//!     hdr_format: hdr.format,
+//!     frames_in_flight: 2,
+//!     max_lights: 64,
+//!     hi_stencil: false,
+//!     hooks: LightHooks::Builtin,
+//! };
+//! let mut lighting = DeferredLighting::new(&ctx, &desc)?;
+//! // The G-buffer pass draws the surfaces of each BRDF with its stencil reference and mask.
+//! let (_reference, _write_mask) = desc.stencil_reference(desc.brdfs[0]).ok_or("unknown BRDF")?;
+//!
+//! // Every frame, after the G-buffer pass: plan on plain data, record into `cmd`.
+//! let shapes: Vec<LightShape> = lights.iter().map(Light::shape).collect();
+//! let inputs = PlanInputs { lights: &shapes, brdf_bounds: bounds, view: &View::new(view)? };
+//! let settings = PlanSettings {
+//!     technique: TechniqueChoice::Stencil,
+//!     caps: Backend::Native.platform().caps(),
+//!     flush: FlushPolicy::Auto,
+//! };
+//! let plan = plan_frame(&layout, &inputs, &settings)?;
+//! let mut targets = LightingTargets { gbuffer, depth_stencil, hdr };
+//! let frame = LightingFrame {
+//!     slot: 0, // frame number % frames_in_flight
+//!     view,
+//!     lights,
+//!     plan: &plan,
+//!     clear_hdr: true,
+//!     timestamps: false,
+//!     brdf_source: BrdfSource::Formula,
+//!     tile_stats: false,
+//!     hook_sets: HookSets::default(),
+//! };
+//! lighting.record(cmd, &frame, &mut targets)?;
+//! // Each `targets` image's `state` is where the commands leave it: the engine's next
+//! // barrier starts there. Submitting and waiting are the engine's.
+//! # Ok(())
+//! # }
+//! ```
+//!
 //! Not here: histencil's own renderer, lab and file helpers (`histencil-vk`'s `tools`
 //! feature, the `histencil` command line).
+
+#![warn(missing_docs)]
 
 pub use histencil_alpha as alpha;
 pub use histencil_brdf as brdf;
