@@ -9,41 +9,20 @@
 //! derived in one place ([`access`]) from declared accesses. Tests run under the Khronos
 //! validation layer with synchronisation validation, and any message fails them.
 
-pub mod access;
+// The layers, each recording through the ones below it: the device layer; the passes (one file
+// per pass or technique) and the hi-stencil emulation; the engine API (`DeferredLighting`, its
+// hooks, `AlphaLightmaps`); histencil's own renderer; and the tools its command line and lab use.
 mod alpha;
-mod brdf_eval;
-mod capture;
-mod compute;
-mod context;
-mod debug;
-mod deferred_lighting;
-pub mod descriptors;
-mod driver;
-mod error;
-pub mod gpu_types;
+pub mod gpu;
 mod hi_stencil;
-mod hooks;
-#[cfg(feature = "tools")]
-mod image_error;
-mod lut;
-mod materials;
-mod meshes;
-#[cfg(feature = "tools")]
-mod output;
+mod lighting;
 pub mod passes;
-mod pipelines;
-mod readback;
 mod renderer;
-mod requirements;
-mod resources;
 mod shader_consts;
-mod spirv_bindings;
-pub mod state;
-mod targets;
-mod teardown;
-mod technique;
-mod timing;
-mod upload;
+mod tools;
+
+// The device layer's public modules, where engines and tests have always found them.
+pub use gpu::{access, descriptors, gpu_types, state};
 
 /// The compiled SPIR-V of every shader module (built by build.rs, never checked in).
 pub mod shaders {
@@ -55,41 +34,43 @@ pub use alpha::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord, AlphaLightmaps,
     AlphaLightmapsDesc, AlphaMode, LightmapFrame,
 };
-pub use brdf_eval::BrdfEvaluator;
-pub use capture::SimulatorInputs;
-pub use context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat};
-pub use debug::{ValidationLog, ValidationMessage};
-pub use deferred_lighting::{
-    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, TiledFrame,
-};
-pub use driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
-pub use error::{Error, Result};
+pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat};
+pub use gpu::debug::{ValidationLog, ValidationMessage};
+pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
+pub use gpu::error::{Error, Result};
+pub use gpu::readback::{FrameImages, Readback};
+pub use gpu::requirements::{DeviceRequirements, REQUIREMENTS};
+pub use gpu::spirv_bindings::{reflect_bindings, ModuleBindings, Resource, ResourceKind};
+pub use gpu::targets::{check_extent, GBUFFER_FORMATS};
+#[cfg(feature = "tools")]
+pub use gpu::timing::median_of_sorted;
+pub use gpu::timing::{FrameTimings, LightingBreakdown, LightmapTimings};
 pub use gpu_types::ProjectionError;
 pub use histencil_model::{
     CostModel, DepthIdCosts, FlushPolicy, FrameChoice, TileStats, TiledCosts,
 };
-pub use hooks::{
+pub use lighting::hooks::{
     EngineHooks, HookSetLayout, HookSets, LightHooks, LightModules, DECODE_SET, VISIBILITY_SET,
 };
-#[cfg(feature = "tools")]
-pub use image_error::{difference_image, masked_error, MaskedError};
-pub use lut::{LutEvaluator, LutTables};
-pub use materials::{
+pub use lighting::lut::{LutEvaluator, LutTables};
+pub use lighting::{
+    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, TiledFrame,
+};
+pub use passes::light_pipelines::BrdfSource;
+pub use renderer::capture::SimulatorInputs;
+pub use renderer::materials::{
     mip_chain, plan_materials, srgb_to_linear, GpuMaterials, MaterialPlan, MaterialRecord, SetPlan,
     TextureKey,
 };
+pub use renderer::technique::{
+    Backend, FrameDesc, MixedTiles, Shading, Technique, TileClassify, TileSide,
+};
+pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
+pub use tools::brdf_eval::BrdfEvaluator;
 #[cfg(feature = "tools")]
-pub use output::{
+pub use tools::image_error::{difference_image, masked_error, MaskedError};
+#[cfg(feature = "tools")]
+pub use tools::output::{
     check_image_output, check_output_dir, check_output_file, image_format, save_image_as, save_png,
     write_atomically, ImageKind,
 };
-pub use passes::light_pipelines::BrdfSource;
-pub use readback::{FrameImages, Readback};
-pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
-pub use requirements::{DeviceRequirements, REQUIREMENTS};
-pub use spirv_bindings::{reflect_bindings, ModuleBindings, Resource, ResourceKind};
-pub use targets::{check_extent, GBUFFER_FORMATS};
-pub use technique::{Backend, FrameDesc, MixedTiles, Shading, Technique, TileClassify, TileSide};
-#[cfg(feature = "tools")]
-pub use timing::median_of_sorted;
-pub use timing::{FrameTimings, LightingBreakdown, LightmapTimings};

@@ -10,21 +10,22 @@
 //! sets, rewritten when a frame is recorded into it; the buffers grow when a frame needs more.
 
 use super::gpu::{frame_records, AlphaDrawPush, FrameRecords};
-use crate::access::ImageRef;
-use crate::context::Context;
-use crate::descriptors::{
+use super::lightmap_checks::{bad, check_direction, check_frame};
+use crate::gpu::access::ImageRef;
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers, ALPHA_SET,
     FRAME_SET, GRAPHICS_STAGES,
 };
-use crate::error::{Error, Result, VkCall};
-use crate::gpu_types::{FrameUniforms, GpuLight};
+use crate::gpu::error::{Error, Result, VkCall};
+use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
+use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::resources::Buffer;
+use crate::gpu::state::{apply, FULLSCREEN};
+use crate::gpu::teardown::InFlight;
+use crate::gpu::timing::{LightmapTimings, SlotTimer};
 use crate::passes::{begin_all_cleared, CLEAR_BLACK};
-use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::resources::Buffer;
 use crate::shaders;
-use crate::state::{apply, FULLSCREEN};
-use crate::teardown::InFlight;
-use crate::timing::{LightmapTimings, SlotTimer};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_alpha::AlphaEntity;
@@ -153,7 +154,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             ("direction map", desc.direction_format),
         ] {
             if let Some(format) = format {
-                if crate::access::aspect_of(format) != vk::ImageAspectFlags::COLOR {
+                if crate::gpu::access::aspect_of(format) != vk::ImageAspectFlags::COLOR {
                     return Err(bad(format!(
                         "{what} format {format:?} is not a colour format"
                     )));
@@ -596,100 +597,6 @@ fn fit(ctx: &Context, buffer: &mut Buffer, name: &str, slot: u32, bytes: usize) 
     Ok(true)
 }
 
-/// A direction map fits when these lightmaps make one, in their format, at the atlas's extent.
-fn check_direction(
-    desc: &AlphaLightmapsDesc,
-    atlas: &ImageRef,
-    direction: &ImageRef,
-) -> Result<()> {
-    let Some(format) = desc.direction_format else {
-        return Err(bad(
-            "these lightmaps were made without a direction format (AlphaLightmapsDesc)".into(),
-        ));
-    };
-    if direction.format != format {
-        return Err(bad(format!(
-            "the direction map is {:?}, these lightmaps make {format:?}",
-            direction.format
-        )));
-    }
-    if direction.extent != atlas.extent {
-        return Err(bad(format!(
-            "the direction map is {}x{}, the atlas {}x{}",
-            direction.extent.width,
-            direction.extent.height,
-            atlas.extent.width,
-            atlas.extent.height
-        )));
-    }
-    Ok(())
-}
-
-/// Checks one frame against the lightmaps and the atlas: the slot, each entity and its region,
-/// the atlas's format and size.
-fn check_frame(desc: &AlphaLightmapsDesc, frame: &LightmapFrame, atlas: &ImageRef) -> Result<()> {
-    if frame.slot >= desc.frames_in_flight {
-        return Err(bad(format!(
-            "slot {} of {} frames in flight",
-            frame.slot, desc.frames_in_flight
-        )));
-    }
-    if atlas.format != desc.atlas_format {
-        return Err(bad(format!(
-            "the lightmap atlas is {:?}, the lightmaps expect {:?}",
-            atlas.format, desc.atlas_format
-        )));
-    }
-    let (w, h) = frame.layout.atlas.size();
-    let e = atlas.extent;
-    if e.width < w || e.height < h {
-        return Err(bad(format!(
-            "the lightmap atlas is {}x{}, the layout needs {w}x{h}",
-            e.width, e.height
-        )));
-    }
-    let regions = &frame.layout.regions;
-    if regions.len() != frame.entities.len() {
-        return Err(bad(format!(
-            "{} entities and {} lightmap regions",
-            frame.entities.len(),
-            regions.len()
-        )));
-    }
-    for (i, (entity, r)) in frame.entities.iter().zip(regions).enumerate() {
-        if let Some(problem) = entity.problem() {
-            return Err(bad(format!("alpha entity {i}: {problem}")));
-        }
-        let s = r.shape;
-        let width = u64::from(s.columns) * u64::from(s.tile_width);
-        let height = u64::from(s.tiles.div_ceil(s.columns.max(1))) * u64::from(s.tile_height);
-        let fits = s.tiles >= 1
-            && (1..=s.tiles).contains(&s.columns)
-            && s.tile_width >= 1
-            && s.tile_height >= 1
-            && width <= u64::from(r.region.width)
-            && height <= u64::from(r.region.height)
-            && u64::from(r.region.x) + width <= u64::from(e.width)
-            && u64::from(r.region.y) + height <= u64::from(e.height);
-        let texels = u64::from(s.tile_width) * u64::from(s.tile_height);
-        let holds_motes = match entity.desc().kind {
-            histencil_alpha::EntityKind::Particles {
-                layout: histencil_scene::ParticleLayout::Dust,
-                count,
-            } => texels >= u64::from(count),
-            _ => true,
-        };
-        if !(fits && holds_motes) {
-            return Err(bad(format!(
-                "alpha entity {i}: its region {:?} ({} tiles of {}x{}, {} to a row) does not fit \
-                 the atlas or its particles",
-                r.region, s.tiles, s.tile_width, s.tile_height, s.columns
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// Viewport and scissor over one atlas region.
 pub(crate) fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: Region) {
     let viewport = vk::Viewport {
@@ -714,8 +621,4 @@ pub(crate) fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: Region) {
         ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
         ctx.device.cmd_set_scissor(cmd, 0, &[scissor]);
     }
-}
-
-fn bad(message: String) -> Error {
-    Error::BadFrame(message)
 }

@@ -11,28 +11,29 @@
 //! `lightmap.frag` computes them per texel.
 
 mod gpu;
+mod lightmap_checks;
 mod lightmaps;
 
 pub use gpu::AlphaEntityRecord;
 pub use histencil_alpha::{mesh_bounds, AlphaEntity, AlphaEntityKind};
 pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 
-use crate::access::{transition, Contents, ImageAccess};
-use crate::context::Context;
-use crate::descriptors::{
+use crate::gpu::access::{transition, Contents, ImageAccess};
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, write_sampled_images, ALPHA_LIGHTMAP_SET,
     GRAPHICS_STAGES,
 };
-use crate::error::{Result, VkCall};
-use crate::meshes::Meshes;
+use crate::gpu::error::{Result, VkCall};
+use crate::gpu::meshes::Meshes;
+use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::resources::{Buffer, Image};
+use crate::gpu::state::{apply, oriented, FULLSCREEN};
+use crate::gpu::targets::{Targets, HDR_FORMAT};
+use crate::gpu::timing::LightmapTimings;
 use crate::passes::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
-use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::resources::{Buffer, Image};
 use crate::shader_consts::ALPHA_MODES;
 use crate::shaders;
-use crate::state::{apply, oriented, FULLSCREEN};
-use crate::targets::{Targets, HDR_FORMAT};
-use crate::timing::LightmapTimings;
 use ash::vk;
 use gpu::AlphaDrawPush;
 use histencil_alpha::{

@@ -23,18 +23,20 @@
 //! testing draw is preceded by `hi_stencil_count.frag` over the same geometry, and light shaders
 //! count the fragments they shade.
 
-use crate::access::{access_info, memory_barrier, transition, Contents, ImageAccess, ImageRef};
-use crate::compute::ComputePipeline;
-use crate::context::Context;
-use crate::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
-use crate::error::{Result, VkCall};
+use crate::gpu::access::{
+    access_info, memory_barrier, transition, Contents, ImageAccess, ImageRef,
+};
+use crate::gpu::compute::ComputePipeline;
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
+use crate::gpu::error::{Result, VkCall};
+use crate::gpu::readback::{copy_image_to_buffer, host_readable};
+use crate::gpu::resources::{Buffer, Image};
+use crate::gpu::state::compare_op;
+use crate::gpu::teardown::{build, Destroy};
 use crate::passes::{depth_stencil_attachment, Load};
-use crate::readback::{copy_image_to_buffer, host_readable};
-use crate::resources::{Buffer, Image};
 use crate::shader_consts::HI_STENCIL_UPDATE_GROUP;
 use crate::shaders;
-use crate::state::compare_op;
-use crate::teardown::{build, Destroy};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_model::{HiStencilState, TileStats};

@@ -17,18 +17,18 @@
 //! what the EQUAL test saves on a GPU is modelled in the simulator
 //! (`histencil_model::depth_id_stats`), not timed here.
 
-use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
-use crate::context::Context;
-use crate::descriptors::create_pipeline_layout;
-use crate::error::Result;
-use crate::hooks::LightModules;
+use crate::gpu::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::create_pipeline_layout;
+use crate::gpu::error::Result;
+use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::readback::copy_image_to_buffer;
+use crate::gpu::resources::{Buffer, Image};
+use crate::gpu::state::apply;
+use crate::gpu::teardown::{build, Destroy};
+use crate::passes::light_modules::LightModules;
 use crate::passes::{depth_stencil_attachment, Load};
-use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::readback::copy_image_to_buffer;
-use crate::resources::{Buffer, Image};
 use crate::shaders;
-use crate::state::apply;
-use crate::teardown::{build, Destroy};
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{CompareOp, CullMode, DepthState, PassState};

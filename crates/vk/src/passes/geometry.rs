@@ -6,16 +6,16 @@ use super::{
     begin_hdr_rendering, begin_rendering, clear_depth_stencil, color_attachment,
     depth_stencil_attachment, Load, CLEAR_BLACK,
 };
-use crate::access::{transition, Contents, ImageAccess, LightingTargets};
-use crate::context::Context;
-use crate::descriptors::{pass_layouts, MATERIAL_SET};
-use crate::error::Result;
-use crate::gpu_types::DrawPush;
-use crate::meshes::Meshes;
-use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::access::{transition, Contents, ImageAccess, LightingTargets};
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{pass_layouts, MATERIAL_SET};
+use crate::gpu::error::Result;
+use crate::gpu::gpu_types::DrawPush;
+use crate::gpu::meshes::Meshes;
+use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::state::{apply, oriented, with_stencil, OPAQUE};
+use crate::gpu::teardown::build;
 use crate::shaders;
-use crate::state::{apply, oriented, with_stencil, OPAQUE};
-use crate::teardown::build;
 use ash::vk;
 use histencil_model::{
     CompareOp, CullMode, DepthConvention, DepthState, FaceStencil, PassState, StencilLayout,
@@ -258,7 +258,7 @@ impl MeshPasses {
     }
 }
 
-crate::teardown::destroy_by_method!(MeshPasses);
+crate::gpu::teardown::destroy_by_method!(MeshPasses);
 
 /// One mesh pass being recorded: a pipeline and the frame's inputs.
 struct Draw<'a> {

@@ -13,17 +13,17 @@ use super::light_pipelines::{
     pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
 };
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
-use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
-use crate::context::Context;
-use crate::error::{Error, Result};
-use crate::gpu_types::LightDrawPush;
+use crate::gpu::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
+use crate::gpu::context::Context;
+use crate::gpu::error::{Error, Result};
+use crate::gpu::gpu_types::LightDrawPush;
+use crate::gpu::meshes::LightVolumes;
+use crate::gpu::state::{apply, FULLSCREEN};
+use crate::gpu::timing::StepTimer;
 use crate::hi_stencil::{
     plan_touches, tile_rect, GpuHierarchy, HiStencilSurface, TouchedTiles, WriteTiles,
 };
-use crate::meshes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
-use crate::state::{apply, FULLSCREEN};
-use crate::timing::StepTimer;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{

@@ -9,13 +9,14 @@
 
 pub(crate) mod depth_id;
 pub mod geometry;
+pub mod light_modules;
 pub mod light_pipelines;
 pub mod lighting;
 pub(crate) mod tiled;
 pub mod tonemap;
 
-use crate::access::{transition, Contents, ImageAccess, ImageRef};
-use crate::context::Context;
+use crate::gpu::access::{transition, Contents, ImageAccess, ImageRef};
+use crate::gpu::context::Context;
 use ash::vk;
 use histencil_model::DepthConvention;
 

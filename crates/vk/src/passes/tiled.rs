@@ -10,18 +10,18 @@
 //! into the tiles of its screen rectangle whose depth range its range sphere reaches.
 //! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
-use crate::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
-use crate::context::Context;
-use crate::descriptors::{
+use crate::gpu::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers, TILED_SET,
 };
-use crate::error::{Error, Result};
-use crate::hooks::LightModules;
-use crate::pipelines::create_compute_pipeline;
-use crate::resources::Buffer;
+use crate::gpu::error::{Error, Result};
+use crate::gpu::pipelines::create_compute_pipeline;
+use crate::gpu::resources::Buffer;
+use crate::gpu::teardown::{build, Destroy};
+use crate::passes::light_modules::LightModules;
 use crate::shader_consts::TILED_MODELS;
 use crate::shaders;
-use crate::teardown::{build, Destroy};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_brdf::BrdfId;

@@ -2,15 +2,15 @@
 //! renderer's HDR target; each frame it reads [`TonemapInputs`].
 
 use super::{begin_rendering, color_attachment, Load, CLEAR_BLACK};
-use crate::access::{transition, Contents, ImageAccess};
-use crate::context::Context;
-use crate::descriptors::{one_set, pass_layouts, write_sampled_images, TONEMAP_SET};
-use crate::error::Result;
-use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::access::{transition, Contents, ImageAccess};
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{one_set, pass_layouts, write_sampled_images, TONEMAP_SET};
+use crate::gpu::error::Result;
+use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::state::{apply, FULLSCREEN};
+use crate::gpu::targets::Targets;
+use crate::gpu::teardown::build;
 use crate::shaders;
-use crate::state::{apply, FULLSCREEN};
-use crate::targets::Targets;
-use crate::teardown::build;
 use ash::vk;
 
 /// The tonemap pass, made once for one HDR target.
@@ -128,4 +128,4 @@ impl Tonemap {
     }
 }
 
-crate::teardown::destroy_by_method!(Tonemap);
+crate::gpu::teardown::destroy_by_method!(Tonemap);

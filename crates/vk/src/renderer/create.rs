@@ -3,21 +3,21 @@
 //! order at drop.
 
 use super::{Renderer, RendererDesc};
-use crate::context::Context;
-use crate::deferred_lighting::{DeferredLighting, LightingDesc};
-use crate::descriptors::Descriptors;
-use crate::error::{Result, VkCall};
-use crate::gpu_types::{FrameUniforms, GpuLight};
-use crate::hooks::LightHooks;
-use crate::materials::GpuMaterials;
-use crate::meshes::Meshes;
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::Descriptors;
+use crate::gpu::error::{Result, VkCall};
+use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
+use crate::gpu::meshes::Meshes;
+use crate::gpu::readback::ReadbackBuffers;
+use crate::gpu::resources::Buffer;
+use crate::gpu::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
+use crate::gpu::teardown::{build, Destroy, Owned};
+use crate::gpu::timing::Timestamps;
+use crate::lighting::hooks::LightHooks;
+use crate::lighting::{DeferredLighting, LightingDesc};
 use crate::passes::geometry::{MeshFormats, MeshPasses};
 use crate::passes::tonemap::Tonemap;
-use crate::readback::ReadbackBuffers;
-use crate::resources::Buffer;
-use crate::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
-use crate::teardown::{build, Destroy, Owned};
-use crate::timing::Timestamps;
+use crate::renderer::materials::GpuMaterials;
 use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, BrdfId};
@@ -81,7 +81,7 @@ impl<'c> Renderer<'c> {
             histencil_alpha::check_forced_side(side)?;
         }
         scene.validate()?;
-        crate::materials::check_images(ctx, &scene)?;
+        crate::renderer::materials::check_images(ctx, &scene)?;
         scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
         let brdf_count = brdfs.len().max(1) as u32;

@@ -3,20 +3,20 @@
 //! readback), submitted and waited for.
 
 use super::{Frame, Renderer};
-use crate::access::LightingTargets;
 use crate::alpha::AlphaInputs;
-use crate::deferred_lighting::{LightingFrame, TiledFrame};
-use crate::error::{Result, VkCall};
+use crate::gpu::access::LightingTargets;
+use crate::gpu::error::{Result, VkCall};
+use crate::gpu::readback::Readback;
+use crate::gpu::targets::GBUFFER_FORMATS;
+use crate::gpu::timing::FrameTimings;
 use crate::hi_stencil::GpuHierarchy;
-use crate::hooks::HookSets;
+use crate::lighting::hooks::HookSets;
+use crate::lighting::{LightingFrame, TiledFrame};
 use crate::passes::geometry::{GbufferStencil, MeshInputs};
 use crate::passes::light_pipelines::BrdfSource;
 use crate::passes::tiled::TiledShade;
 use crate::passes::tonemap::TonemapInputs;
-use crate::readback::Readback;
-use crate::targets::GBUFFER_FORMATS;
-use crate::technique::{FrameDesc, MixedTiles, Shading, Technique, TileClassify};
-use crate::timing::FrameTimings;
+use crate::renderer::technique::{FrameDesc, MixedTiles, Shading, Technique, TileClassify};
 use ash::vk;
 use histencil_model::{DepthConvention, FramePlan, ViewDesc};
 
@@ -225,7 +225,7 @@ impl Renderer<'_> {
                 .queue_submit2(ctx.queue, &[submit], self.fence)
                 .call("vkQueueSubmit2")?;
             ctx.device
-                .wait_for_fences(&[self.fence], true, crate::context::FENCE_TIMEOUT_NS)
+                .wait_for_fences(&[self.fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")?;
             ctx.device
                 .reset_fences(&[self.fence])

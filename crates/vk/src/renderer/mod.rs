@@ -3,26 +3,29 @@
 //! and freed, `plan.rs` how a frame is planned, `frame.rs` the order of a frame's passes,
 //! `simulator.rs` what the CPU simulator is given.
 
+pub(crate) mod capture;
 mod create;
 mod frame;
+pub(crate) mod materials;
 mod plan;
 mod simulator;
+pub(crate) mod technique;
 
 use crate::alpha::AlphaLighting;
-use crate::context::Context;
-use crate::deferred_lighting::DeferredLighting;
-use crate::descriptors::Descriptors;
-use crate::error::Result;
-use crate::lut::LutTables;
-use crate::materials::GpuMaterials;
-use crate::meshes::Meshes;
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::Descriptors;
+use crate::gpu::error::Result;
+use crate::gpu::meshes::Meshes;
+use crate::gpu::readback::{FrameImages, ReadbackBuffers};
+use crate::gpu::resources::Buffer;
+use crate::gpu::targets::Targets;
+use crate::gpu::timing::{FrameTimings, Timestamps};
+use crate::lighting::lut::LutTables;
+use crate::lighting::DeferredLighting;
 use crate::passes::geometry::MeshPasses;
 use crate::passes::tonemap::Tonemap;
-use crate::readback::{FrameImages, ReadbackBuffers};
-use crate::resources::Buffer;
-use crate::targets::Targets;
-use crate::technique::Backend;
-use crate::timing::{FrameTimings, Timestamps};
+use crate::renderer::materials::GpuMaterials;
+use crate::renderer::technique::Backend;
 use ash::vk;
 use histencil_brdf::{Brdf, BrdfId};
 use histencil_model::{CostModel, StencilBits, StencilLayout, TalkFigures, TileStats};

@@ -1,13 +1,13 @@
 //! The CPU simulator's inputs, captured from the GPU's own frame.
 
 use super::Renderer;
-use crate::capture::{FootprintCapture, SimulatorInputs};
-use crate::error::Result;
+use crate::gpu::error::Result;
+use crate::gpu::readback::{copy_image_to_buffer, host_readable};
+use crate::gpu::resources::Buffer;
 use crate::hi_stencil::GpuHierarchy;
-use crate::readback::{copy_image_to_buffer, host_readable};
-use crate::resources::Buffer;
+use crate::renderer::capture::{FootprintCapture, SimulatorInputs};
+use crate::renderer::technique::{Backend, FrameDesc, Technique, TileSide};
 use crate::shader_consts::HI_STENCIL_TILE;
-use crate::technique::{Backend, FrameDesc, Technique, TileSide};
 use ash::vk;
 use histencil_model::amd::{choose_pretests, slot_tile_counts, Pretest, PRETEST_SLOTS};
 use histencil_model::depth_id::{depth_id_stats, slot_id};

@@ -3,7 +3,7 @@
 //! barrier, whoever owns the image: histencil's own targets and an engine's images handed in as
 //! [`ImageRef`]s go through the same code.
 
-use crate::context::Context;
+use crate::gpu::context::Context;
 use ash::vk;
 
 /// Where an image stands: its layout and the last stages and accesses that touched it (the

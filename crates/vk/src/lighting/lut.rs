@@ -3,13 +3,13 @@
 //! evaluator that runs the GLSL lookup on chosen directions so it can be held to
 //! [`Lut::lookup`].
 
-use crate::compute::{pad, CaseKernel};
-use crate::context::Context;
-use crate::descriptors::LUT_EVAL_SET;
-use crate::error::{Error, Result};
-use crate::resources::Buffer;
+use crate::gpu::compute::{pad, CaseKernel};
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::LUT_EVAL_SET;
+use crate::gpu::error::{Error, Result};
+use crate::gpu::resources::Buffer;
+use crate::gpu::teardown::InFlight;
 use crate::shaders;
-use crate::teardown::InFlight;
 use ash::vk;
 use histencil_brdf::lut::Lut;
 use histencil_brdf::{Brdf, V3};

@@ -1,12 +1,12 @@
 //! Copying the frame's images back to the host: tonemapped colour, HDR colour and the raw stencil.
 
-use crate::access::ImageRef;
-use crate::access::{transition, Contents, ImageAccess};
-use crate::context::Context;
-use crate::error::Result;
-use crate::resources::Buffer;
-use crate::targets::Targets;
-use crate::teardown::build;
+use crate::gpu::access::ImageRef;
+use crate::gpu::access::{transition, Contents, ImageAccess};
+use crate::gpu::context::Context;
+use crate::gpu::error::Result;
+use crate::gpu::resources::Buffer;
+use crate::gpu::targets::Targets;
+use crate::gpu::teardown::build;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use image::{GrayImage, Rgba32FImage, RgbaImage};
@@ -200,4 +200,4 @@ impl ReadbackBuffers {
     }
 }
 
-crate::teardown::destroy_by_method!(ReadbackBuffers);
+crate::gpu::teardown::destroy_by_method!(ReadbackBuffers);

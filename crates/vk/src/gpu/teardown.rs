@@ -10,8 +10,8 @@
 //! - [`Owned`] holds one finished part of a larger whole (a renderer's targets, its meshes) until
 //!   the whole is made; dropped before [`Owned::keep`], it destroys its part.
 
-use crate::context::Context;
-use crate::error::Result;
+use crate::gpu::context::Context;
+use crate::gpu::error::Result;
 
 /// A value made of Vulkan objects and allocations that frees them all. It must accept being
 /// destroyed twice, and when only some of its parts exist.
@@ -83,8 +83,8 @@ impl<T: Destroy> Drop for Owned<'_, T> {
 /// Implements [`Destroy`] by the types' own `destroy(&mut self, &Context)`.
 macro_rules! destroy_by_method {
     ($($t:ty),* $(,)?) => {
-        $(impl $crate::teardown::Destroy for $t {
-            fn destroy(&mut self, ctx: &$crate::context::Context) {
+        $(impl $crate::gpu::teardown::Destroy for $t {
+            fn destroy(&mut self, ctx: &$crate::gpu::context::Context) {
                 <$t>::destroy(self, ctx)
             }
         })*

@@ -1,11 +1,11 @@
 //! The frame's render targets, named after their role (the names show up in validation messages
 //! and captures).
 
-use crate::access::LightingTargets;
-use crate::context::Context;
-use crate::error::{Error, Result};
-use crate::resources::Image;
-use crate::teardown::build;
+use crate::gpu::access::LightingTargets;
+use crate::gpu::context::Context;
+use crate::gpu::error::{Error, Result};
+use crate::gpu::resources::Image;
+use crate::gpu::teardown::build;
 use ash::vk;
 
 /// The G-buffer's formats, in binding order: albedo, normal-depth, material
@@ -110,4 +110,4 @@ impl Targets {
     }
 }
 
-crate::teardown::destroy_by_method!(Targets);
+crate::gpu::teardown::destroy_by_method!(Targets);

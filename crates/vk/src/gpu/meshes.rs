@@ -1,11 +1,11 @@
 //! Meshes on the GPU: the scene's object shapes, and the two light-volume meshes the lighting
 //! draws.
 
-use crate::context::Context;
-use crate::error::Result;
-use crate::resources::Buffer;
-use crate::teardown::{build, Owned};
-use crate::upload::{upload, BufferUpload};
+use crate::gpu::context::Context;
+use crate::gpu::error::Result;
+use crate::gpu::resources::Buffer;
+use crate::gpu::teardown::{build, Owned};
+use crate::gpu::upload::{upload, BufferUpload};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_scene::{
@@ -220,9 +220,9 @@ impl Meshes {
     }
 }
 
-crate::teardown::destroy_by_method!(Meshes);
+crate::gpu::teardown::destroy_by_method!(Meshes);
 
-crate::teardown::destroy_by_method!(GpuMesh);
+crate::gpu::teardown::destroy_by_method!(GpuMesh);
 
 #[cfg(test)]
 mod tests {

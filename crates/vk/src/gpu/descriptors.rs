@@ -1,10 +1,10 @@
 //! Descriptor set layouts as data, the pipeline layouts built from them, and the sets of a frame.
 //! The tables here are what the reflection test holds every shader module against.
 
-use crate::context::Context;
-use crate::error::{Result, VkCall};
-use crate::gpu_types::PUSH_CONSTANT_BYTES;
-use crate::teardown::build;
+use crate::gpu::context::Context;
+use crate::gpu::error::{Result, VkCall};
+use crate::gpu::gpu_types::PUSH_CONSTANT_BYTES;
+use crate::gpu::teardown::build;
 use ash::vk;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -482,4 +482,4 @@ impl Descriptors {
     }
 }
 
-crate::teardown::destroy_by_method!(Descriptors);
+crate::gpu::teardown::destroy_by_method!(Descriptors);

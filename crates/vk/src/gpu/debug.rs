@@ -121,7 +121,7 @@ pub(crate) unsafe extern "system" fn messenger_callback(
         // The canary's deliberate call is the one call the layer is asked to stop (a callback's
         // TRUE makes it return VK_ERROR_VALIDATION_FAILED_EXT instead of passing the call on):
         // no driver ever sees a buffer of size zero from a layer that reports it.
-        let abort = id == crate::driver::CANARY_ID;
+        let abort = id == crate::gpu::driver::CANARY_ID;
         log.lock().push(ValidationMessage {
             severity,
             id,

@@ -3,15 +3,15 @@
 //! evaluators of GLSL BRDFs and table lookups that hold the shader code to its Rust reference,
 //! case by case).
 
-use crate::context::Context;
-use crate::descriptors::{
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, create_storage_buffer_set, BindingDesc,
 };
-use crate::error::Result;
-use crate::pipelines::create_compute_pipeline;
-use crate::readback::host_readable;
-use crate::resources::Buffer;
-use crate::upload::submit_once;
+use crate::gpu::error::Result;
+use crate::gpu::pipelines::create_compute_pipeline;
+use crate::gpu::readback::host_readable;
+use crate::gpu::resources::Buffer;
+use crate::gpu::upload::submit_once;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 

@@ -1,7 +1,7 @@
 //! GPU timestamps around the passes of a frame.
 
-use crate::context::Context;
-use crate::error::{Result, VkCall};
+use crate::gpu::context::Context;
+use crate::gpu::error::{Result, VkCall};
 use ash::vk;
 
 const MAX_MARKS: u32 = 16;
@@ -397,7 +397,7 @@ impl SlotTimer {
     }
 }
 
-crate::teardown::destroy_by_method!(Timestamps);
+crate::gpu::teardown::destroy_by_method!(Timestamps);
 
 #[cfg(test)]
 mod tests {

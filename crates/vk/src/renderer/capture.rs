@@ -4,16 +4,16 @@
 //! clamp). Running `histencil_model::Simulator` on them predicts the GPU frame exactly: its
 //! final stencil and its hi-stencil statistics (`tests/tests/hi_stencil.rs` holds it to that).
 
-use crate::context::Context;
-use crate::error::{Error, Result};
-use crate::gpu_types::LightDrawPush;
-use crate::meshes::LightVolumes;
+use crate::gpu::context::Context;
+use crate::gpu::error::{Error, Result};
+use crate::gpu::gpu_types::LightDrawPush;
+use crate::gpu::meshes::LightVolumes;
+use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::readback::{copy_image_to_buffer, host_readable};
+use crate::gpu::resources::{Buffer, Image};
+use crate::gpu::state::apply;
 use crate::passes::begin_cleared;
-use crate::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::readback::{copy_image_to_buffer, host_readable};
-use crate::resources::{Buffer, Image};
 use crate::shaders;
-use crate::state::apply;
 use ash::vk;
 use histencil_model::{
     CullMode, DepthConvention, DepthState, Footprint, FramePlan, PassState, SimResult, Simulator,

@@ -3,9 +3,9 @@
 //! frame description that carries them.
 
 use crate::alpha::AlphaMode;
+use crate::gpu::readback::Readback;
 use crate::passes::light_pipelines::BrdfSource;
 pub use crate::passes::tiled::{MixedTiles, TileClassify, TileSide};
-use crate::readback::Readback;
 use histencil_model::{
     CostModel, DepthConvention, FlushPolicy, Native, PlanSettings, PlatformBackend, Ps3Like,
     TechniqueChoice, X360Like,

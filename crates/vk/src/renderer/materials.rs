@@ -4,11 +4,11 @@
 //! of the mesh pipelines (`crates/vk/shaders/include/material.glsl`). Objects without maps share a set
 //! whose maps are a white texel, which changes nothing.
 
-use crate::context::Context;
-use crate::error::{Error, Result, VkCall};
-use crate::resources::{Buffer, Image};
-use crate::teardown::build;
-use crate::upload::{upload, BufferUpload, ImageUpload};
+use crate::gpu::context::Context;
+use crate::gpu::error::{Error, Result, VkCall};
+use crate::gpu::resources::{Buffer, Image};
+use crate::gpu::teardown::build;
+use crate::gpu::upload::{upload, BufferUpload, ImageUpload};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -381,7 +381,9 @@ impl GpuMaterials {
         }];
         upload(ctx, "material-upload", &buffer_uploads, &image_uploads)?;
         for t in &mut self.textures {
-            t.state = crate::access::ImageState::after(crate::access::ImageAccess::FragmentSampled);
+            t.state = crate::gpu::access::ImageState::after(
+                crate::gpu::access::ImageAccess::FragmentSampled,
+            );
         }
         self.create_sets(ctx, plan, layout)
     }
@@ -473,7 +475,7 @@ impl GpuMaterials {
     }
 }
 
-crate::teardown::destroy_by_method!(GpuMaterials);
+crate::gpu::teardown::destroy_by_method!(GpuMaterials);
 
 #[cfg(test)]
 mod tests {

@@ -12,7 +12,7 @@
 //! known invalid call on purpose, [`CANARY_CALLS`] times, and counts what came back: anything
 //! short of every call reported means the verdict cannot be trusted.
 
-use crate::context::Context;
+use crate::gpu::context::Context;
 use ash::vk;
 use std::ffi::CStr;
 use std::fmt;

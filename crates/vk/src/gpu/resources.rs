@@ -2,9 +2,9 @@
 //! destroyed explicitly with the context (`destroy`), never by `Drop` (see `teardown`); their
 //! empty values (`Default`) hold null handles, which `destroy` accepts.
 
-use crate::access::{subresource_range, ImageRef, ImageState};
-use crate::context::Context;
-use crate::error::{Error, Result, VkCall};
+use crate::gpu::access::{subresource_range, ImageRef, ImageState};
+use crate::gpu::context::Context;
+use crate::gpu::error::{Error, Result, VkCall};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
@@ -210,7 +210,7 @@ impl Image {
         usage: vk::ImageUsageFlags,
         mip_levels: u32,
     ) -> Result<Self> {
-        let aspect = crate::access::aspect_of(format);
+        let aspect = crate::gpu::access::aspect_of(format);
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
@@ -303,12 +303,12 @@ impl Default for Image {
     }
 }
 
-crate::teardown::destroy_by_method!(Buffer, Image);
+crate::gpu::teardown::destroy_by_method!(Buffer, Image);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::context::ContextDesc;
+    use crate::gpu::context::ContextDesc;
 
     /// The leak check the end-to-end tests rely on can fail: a buffer left alive at teardown is
     /// reported by the validation layer's object tracker.

@@ -3,9 +3,9 @@
 //! one staging buffer into device-local memory ([`upload`]); the staging memory is freed
 //! before the function returns.
 
-use crate::context::Context;
-use crate::error::{Result, VkCall};
-use crate::resources::Buffer;
+use crate::gpu::context::Context;
+use crate::gpu::error::{Result, VkCall};
+use crate::gpu::resources::Buffer;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
@@ -45,7 +45,7 @@ pub(crate) fn submit_once(
                 .call("vkQueueSubmit2")?;
             // Creation waits for its own one-off work, as buffer creation does; frames never
             // come through here.
-            d.wait_for_fences(&[fence], true, crate::context::FENCE_TIMEOUT_NS)
+            d.wait_for_fences(&[fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")
         }
     })();

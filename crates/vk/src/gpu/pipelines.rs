@@ -1,10 +1,10 @@
 //! Graphics pipelines. Everything that changes between the talk's light passes (cull mode, depth
 //! and stencil state) is dynamic state set per draw from the model's pass state
-//! ([`crate::state::apply`]); pipelines differ only in shaders, attachments, blending and
+//! ([`crate::gpu::state::apply`]); pipelines differ only in shaders, attachments, blending and
 //! colour writes.
 
-use crate::context::Context;
-use crate::error::{Result, VkCall};
+use crate::gpu::context::Context;
+use crate::gpu::error::{Result, VkCall};
 use ash::vk;
 use std::io::Cursor;
 
@@ -269,8 +269,8 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&DYNAMIC_STATES);
     let has_depth = desc.depth_stencil_format != vk::Format::UNDEFINED;
     // A depth-only format (the hi-stencil touch image) has no stencil attachment.
-    let has_stencil =
-        crate::access::aspect_of(desc.depth_stencil_format).contains(vk::ImageAspectFlags::STENCIL);
+    let has_stencil = crate::gpu::access::aspect_of(desc.depth_stencil_format)
+        .contains(vk::ImageAspectFlags::STENCIL);
     let stencil_format = if has_stencil {
         desc.depth_stencil_format
     } else {

@@ -1,0 +1,108 @@
+//! What a lightmap frame must fit to be recorded: its entities' regions, lights and atlas, held
+//! before anything is written or recorded.
+
+use super::lightmaps::{AlphaLightmapsDesc, LightmapFrame};
+use crate::gpu::access::ImageRef;
+use crate::gpu::error::{Error, Result};
+
+/// A direction map fits when these lightmaps make one, in their format, at the atlas's extent.
+pub(super) fn check_direction(
+    desc: &AlphaLightmapsDesc,
+    atlas: &ImageRef,
+    direction: &ImageRef,
+) -> Result<()> {
+    let Some(format) = desc.direction_format else {
+        return Err(bad(
+            "these lightmaps were made without a direction format (AlphaLightmapsDesc)".into(),
+        ));
+    };
+    if direction.format != format {
+        return Err(bad(format!(
+            "the direction map is {:?}, these lightmaps make {format:?}",
+            direction.format
+        )));
+    }
+    if direction.extent != atlas.extent {
+        return Err(bad(format!(
+            "the direction map is {}x{}, the atlas {}x{}",
+            direction.extent.width,
+            direction.extent.height,
+            atlas.extent.width,
+            atlas.extent.height
+        )));
+    }
+    Ok(())
+}
+
+/// Checks one frame against the lightmaps and the atlas: the slot, each entity and its region,
+/// the atlas's format and size.
+pub(super) fn check_frame(
+    desc: &AlphaLightmapsDesc,
+    frame: &LightmapFrame,
+    atlas: &ImageRef,
+) -> Result<()> {
+    if frame.slot >= desc.frames_in_flight {
+        return Err(bad(format!(
+            "slot {} of {} frames in flight",
+            frame.slot, desc.frames_in_flight
+        )));
+    }
+    if atlas.format != desc.atlas_format {
+        return Err(bad(format!(
+            "the lightmap atlas is {:?}, the lightmaps expect {:?}",
+            atlas.format, desc.atlas_format
+        )));
+    }
+    let (w, h) = frame.layout.atlas.size();
+    let e = atlas.extent;
+    if e.width < w || e.height < h {
+        return Err(bad(format!(
+            "the lightmap atlas is {}x{}, the layout needs {w}x{h}",
+            e.width, e.height
+        )));
+    }
+    let regions = &frame.layout.regions;
+    if regions.len() != frame.entities.len() {
+        return Err(bad(format!(
+            "{} entities and {} lightmap regions",
+            frame.entities.len(),
+            regions.len()
+        )));
+    }
+    for (i, (entity, r)) in frame.entities.iter().zip(regions).enumerate() {
+        if let Some(problem) = entity.problem() {
+            return Err(bad(format!("alpha entity {i}: {problem}")));
+        }
+        let s = r.shape;
+        let width = u64::from(s.columns) * u64::from(s.tile_width);
+        let height = u64::from(s.tiles.div_ceil(s.columns.max(1))) * u64::from(s.tile_height);
+        let fits = s.tiles >= 1
+            && (1..=s.tiles).contains(&s.columns)
+            && s.tile_width >= 1
+            && s.tile_height >= 1
+            && width <= u64::from(r.region.width)
+            && height <= u64::from(r.region.height)
+            && u64::from(r.region.x) + width <= u64::from(e.width)
+            && u64::from(r.region.y) + height <= u64::from(e.height);
+        let texels = u64::from(s.tile_width) * u64::from(s.tile_height);
+        let holds_motes = match entity.desc().kind {
+            histencil_alpha::EntityKind::Particles {
+                layout: histencil_scene::ParticleLayout::Dust,
+                count,
+            } => texels >= u64::from(count),
+            _ => true,
+        };
+        if !(fits && holds_motes) {
+            return Err(bad(format!(
+                "alpha entity {i}: its region {:?} ({} tiles of {}x{}, {} to a row) does not fit \
+                 the atlas or its particles",
+                r.region, s.tiles, s.tile_width, s.tile_height, s.columns
+            )));
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn bad(message: String) -> Error {
+    Error::BadFrame(message)
+}

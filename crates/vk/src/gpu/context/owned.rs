@@ -1,0 +1,336 @@
+//! An owned context, as histencil's own tools make it ([`Context::new`]): the loader, the
+//! instance with the validation layer when asked for, the device picked by `HISTENCIL_DEVICE`,
+//! its depth-stencil format and the allocator; each step undone if a later one fails.
+
+use super::{Context, ContextDesc, DepthStencilFormat, MemoryAccount, VALIDATION_LAYER};
+use crate::gpu::debug::ValidationLog;
+use crate::gpu::error::{Error, Result, VkCall};
+use crate::gpu::requirements::REQUIREMENTS;
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::ffi::CStr;
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex};
+
+/// The format `wanted` names, or the first the device has; [`Error::MissingFormat`] when the
+/// device cannot attach it (or either).
+pub(super) fn pick_depth_stencil_format(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    wanted: Option<DepthStencilFormat>,
+) -> Result<DepthStencilFormat> {
+    // Sampled: the hi-stencil emulation reads the stencil through a stencil-aspect view.
+    let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT
+        | vk::FormatFeatureFlags::TRANSFER_SRC
+        | vk::FormatFeatureFlags::SAMPLED_IMAGE;
+    let candidates = match wanted {
+        Some(f) => vec![f],
+        None => DepthStencilFormat::ALL.to_vec(),
+    };
+    candidates
+        .iter()
+        .copied()
+        .find(|f| {
+            // SAFETY: `pd` was enumerated from `instance`, which is alive.
+            let props = unsafe { instance.get_physical_device_format_properties(pd, f.vk()) };
+            props.optimal_tiling_features.contains(needed)
+        })
+        .ok_or_else(|| {
+            let names: Vec<_> = candidates.iter().map(|f| f.vk_name()).collect();
+            Error::MissingFormat(format!(
+                "the device cannot use {} as a depth-stencil attachment copied out and sampled",
+                names.join(" or ")
+            ))
+        })
+}
+
+/// What `Context::new` has created so far, destroyed in reverse order if a later step fails:
+/// a failed `Context::new` leaks nothing (the device, the messenger and the instance included).
+struct Partial {
+    instance: Option<ash::Instance>,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    device: Option<ash::Device>,
+}
+
+impl Drop for Partial {
+    fn drop(&mut self) {
+        // SAFETY: every handle here was created by `Context::new` and nothing else holds it: a
+        // successful `new` takes them out (leaving `None` / null) before this runs.
+        unsafe {
+            if let Some(device) = self.device.take() {
+                device.destroy_device(None);
+            }
+            if let Some(di) = &self.debug_instance {
+                if self.messenger != vk::DebugUtilsMessengerEXT::null() {
+                    di.destroy_debug_utils_messenger(self.messenger, None);
+                }
+            }
+            if let Some(instance) = self.instance.take() {
+                instance.destroy_instance(None);
+            }
+        }
+    }
+}
+
+impl Context {
+    pub fn new(desc: ContextDesc) -> Result<Self> {
+        // SAFETY: loading the system Vulkan loader; nothing else runs inside it yet.
+        let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loading(e.to_string()))?;
+        let available_exts = unsafe { entry.enumerate_instance_extension_properties(None) }
+            .call("vkEnumerateInstanceExtensionProperties")?;
+        let has_ext = |name: &CStr| {
+            available_exts
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(name))
+        };
+        let debug_utils = has_ext(ash::ext::debug_utils::NAME) || desc.validation;
+        let mut layer_text = None;
+        let mut layer_settings_ext = false;
+        if desc.validation {
+            let layers = unsafe { entry.enumerate_instance_layer_properties() }
+                .call("vkEnumerateInstanceLayerProperties")?;
+            let Some(layer) = layers
+                .iter()
+                .find(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
+            else {
+                return Err(Error::Loading(
+                    "validation requested but VK_LAYER_KHRONOS_validation is not installed \
+                     (tools/setup installs vulkan-validationlayers)"
+                        .into(),
+                ));
+            };
+            layer_text = Some(crate::gpu::driver::layer_version(layer));
+            let layer_exts =
+                unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+                    .call("vkEnumerateInstanceExtensionProperties")?;
+            layer_settings_ext = layer_exts
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(ash::ext::layer_settings::NAME));
+        }
+
+        let app_name = c"histencil";
+        let app_info = vk::ApplicationInfo::default()
+            .application_name(app_name)
+            .engine_name(app_name)
+            .api_version(vk::API_VERSION_1_3);
+        let mut extensions = Vec::new();
+        if debug_utils {
+            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+        let mut layers = Vec::new();
+        let mut enabled_features = vec![vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        if desc.best_practices {
+            enabled_features.push(vk::ValidationFeatureEnableEXT::BEST_PRACTICES);
+        }
+        let mut validation_features =
+            vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
+        if desc.validation {
+            layers.push(VALIDATION_LAYER.as_ptr());
+            extensions.push(ash::ext::validation_features::NAME.as_ptr());
+        }
+        // The settings a validation verdict rests on, pinned where the layer takes settings
+        // through the API (VK_EXT_layer_settings, layers from 1.3.268 on): no duplicate-message
+        // limit, synchronisation validation on. The layer lets its environment variables
+        // override these; `histencil check` clears them for its workers, and its canary
+        // ([`Context::validation_canary`]) proves what is in force.
+        let (off, on): (vk::Bool32, vk::Bool32) = (vk::FALSE, vk::TRUE);
+        // ash's `values` counts bytes; a BOOL32 setting holds one value.
+        let bool_setting = |name: &'static CStr, value: &vk::Bool32| {
+            let mut setting = vk::LayerSettingEXT::default()
+                .layer_name(VALIDATION_LAYER)
+                .setting_name(name)
+                .ty(vk::LayerSettingTypeEXT::BOOL32);
+            setting.value_count = 1;
+            setting.p_values = (value as *const vk::Bool32).cast();
+            setting
+        };
+        let pinned = [
+            bool_setting(c"enable_message_limit", &off),
+            bool_setting(c"validate_sync", &on),
+        ];
+        let mut layer_settings = vk::LayerSettingsCreateInfoEXT::default().settings(&pinned);
+        let pin_settings = desc.validation && layer_settings_ext;
+        if pin_settings {
+            extensions.push(ash::ext::layer_settings::NAME.as_ptr());
+        }
+        let validation = Arc::new(ValidationLog::default());
+        // SAFETY: the context keeps `validation` until after it destroys the messenger.
+        let messenger_info = unsafe { ValidationLog::messenger_create_info(&validation) };
+        // Chained into instance creation too, so messages from vkCreateInstance are caught.
+        let mut messenger_for_create = messenger_info;
+        let mut instance_info = vk::InstanceCreateInfo::default()
+            .application_info(&app_info)
+            .enabled_extension_names(&extensions)
+            .enabled_layer_names(&layers);
+        if desc.validation {
+            instance_info = instance_info
+                .push_next(&mut validation_features)
+                .push_next(&mut messenger_for_create);
+        }
+        if pin_settings {
+            instance_info = instance_info.push_next(&mut layer_settings);
+        }
+        let instance =
+            unsafe { entry.create_instance(&instance_info, None) }.call("vkCreateInstance")?;
+        let mut partial = Partial {
+            instance: Some(instance.clone()),
+            debug_instance: None,
+            messenger: vk::DebugUtilsMessengerEXT::null(),
+            device: None,
+        };
+        if debug_utils {
+            let di = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            // A fresh copy: messenger_for_create's pNext was rewritten by push_next.
+            if desc.validation {
+                partial.messenger =
+                    unsafe { di.create_debug_utils_messenger(&messenger_info, None) }
+                        .call("vkCreateDebugUtilsMessengerEXT")?;
+            }
+            partial.debug_instance = Some(di);
+        }
+
+        let filter = desc.device_filter.clone().or_else(|| {
+            std::env::var("HISTENCIL_DEVICE")
+                .ok()
+                .filter(|s| !s.is_empty())
+        });
+        let (physical_device, queue_family, device_name) =
+            Self::pick_physical_device(&instance, filter.as_deref())?;
+        let depth_stencil =
+            pick_depth_stencil_format(&instance, physical_device, desc.depth_stencil)?;
+
+        let priorities = [1.0];
+        let queue_infos = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(queue_family)
+            .queue_priorities(&priorities)];
+        let features = REQUIREMENTS.features();
+        let mut features13 = REQUIREMENTS.features13();
+        let device_info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_infos)
+            .enabled_features(&features)
+            .push_next(&mut features13);
+        let device = unsafe { instance.create_device(physical_device, &device_info, None) }
+            .call("vkCreateDevice")?;
+        partial.device = Some(device.clone());
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let debug_device =
+            debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
+
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| Error::Allocation {
+            name: "allocator".into(),
+            message: e.to_string(),
+        })?;
+
+        // From here the context owns every handle and its Drop destroys them.
+        partial.device = None;
+        partial.instance = None;
+        let debug_instance = partial.debug_instance.take();
+        let messenger =
+            std::mem::replace(&mut partial.messenger, vk::DebugUtilsMessengerEXT::null());
+        // SAFETY: `physical_device` was enumerated from `instance`.
+        let props = unsafe { instance.get_physical_device_properties(physical_device) };
+        let limits = props.limits;
+        // SAFETY: as above; the instance asks for Vulkan 1.3.
+        let driver =
+            unsafe { crate::gpu::driver::driver_info(&instance, physical_device, layer_text) };
+        // A cache of histencil's own, destroyed with the device; without one (a driver that
+        // refuses) pipelines are made uncached.
+        let pipeline_cache =
+            unsafe { device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default(), None) }
+                .unwrap_or_default();
+        let ctx = Self {
+            _entry: Some(entry),
+            owned: true,
+            instance,
+            device,
+            queue,
+            queue_family,
+            allocator: ManuallyDrop::new(Arc::new(Mutex::new(allocator))),
+            debug_instance,
+            debug_device,
+            messenger,
+            validation,
+            device_name,
+            device_type: props.device_type,
+            driver,
+            pipeline_cache,
+            depth_stencil_format: depth_stencil.vk(),
+            depth_stencil,
+            depth_stencil_named: desc.depth_stencil.is_some(),
+            timestamp_period_ns: f64::from(limits.timestamp_period),
+            max_image_dimension: limits.max_image_dimension2_d,
+            max_storage_buffer_range: limits.max_storage_buffer_range,
+            max_bound_descriptor_sets: limits.max_bound_descriptor_sets,
+            memory: MemoryAccount::new(desc.memory_budget),
+        };
+        ctx.name(ctx.device.handle(), "histencil-device");
+        if ctx.pipeline_cache != vk::PipelineCache::null() {
+            ctx.name(ctx.pipeline_cache, "histencil-pipeline-cache");
+        }
+        ctx.name(ctx.queue, "graphics-queue");
+        Ok(ctx)
+    }
+
+    fn pick_physical_device(
+        instance: &ash::Instance,
+        filter: Option<&str>,
+    ) -> Result<(vk::PhysicalDevice, u32, String)> {
+        let devices =
+            unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
+        let mut candidates = Vec::new();
+        let mut seen = Vec::new();
+        for pd in devices {
+            let props = unsafe { instance.get_physical_device_properties(pd) };
+            let name = props
+                .device_name_as_c_str()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            seen.push(name.clone());
+            // SAFETY: `pd` was just enumerated from the live `instance`.
+            if !unsafe { REQUIREMENTS.missing(instance, pd) }.is_empty() {
+                continue;
+            }
+            let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+            let Some(family) = (0..families.len() as u32)
+                .find(|&f| unsafe { REQUIREMENTS.queue_family_fits(instance, pd, f) })
+            else {
+                continue;
+            };
+            if let Some(f) = filter {
+                if !name.to_lowercase().contains(&f.to_lowercase()) {
+                    continue;
+                }
+            }
+            let rank = match props.device_type {
+                vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+                vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+                vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+                _ => 3,
+            };
+            candidates.push((rank, pd, family, name));
+        }
+        candidates.sort_by_key(|c| c.0);
+        candidates
+            .into_iter()
+            .next()
+            .map(|(_, pd, family, name)| (pd, family, name))
+            .ok_or_else(|| {
+                Error::NoDevice(format!(
+                    "{}devices seen: [{}]",
+                    filter
+                        .map(|f| format!("none matches HISTENCIL_DEVICE=`{f}`; "))
+                        .unwrap_or_default(),
+                    seen.join(", ")
+                ))
+            })
+    }
+}

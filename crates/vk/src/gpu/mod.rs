@@ -1,0 +1,25 @@
+//! The device layer: the device histencil borrows or owns, memory and images, barriers derived
+//! from declared accesses, descriptors, pipelines, readback and upload, timing, names and
+//! validation messages, and teardown that survives a creation failing half way. Everything
+//! above it (the passes, the emulation, the engine API, the renderer) records through it; it
+//! knows nothing of lighting.
+
+pub mod access;
+pub(crate) mod compute;
+pub(crate) mod context;
+pub(crate) mod debug;
+pub mod descriptors;
+pub(crate) mod driver;
+pub(crate) mod error;
+pub mod gpu_types;
+pub(crate) mod meshes;
+pub(crate) mod pipelines;
+pub(crate) mod readback;
+pub(crate) mod requirements;
+pub(crate) mod resources;
+pub(crate) mod spirv_bindings;
+pub mod state;
+pub(crate) mod targets;
+pub(crate) mod teardown;
+pub(crate) mod timing;
+pub(crate) mod upload;

@@ -1,0 +1,192 @@
+//! What a lighting refuses, and why: descriptions, frames and targets that do not fit, held
+//! before anything is made or recorded.
+
+use super::{LightingDesc, LightingFrame};
+use crate::gpu::access::{ImageRef, LightingTargets};
+use crate::gpu::error::{Error, Result};
+use crate::gpu::targets::GBUFFER_FORMATS;
+use crate::lighting::hooks::{HookSets, LightHooks};
+use ash::vk;
+use histencil_model::{FramePlan, Step};
+
+pub(super) fn bad(message: String) -> Error {
+    Error::BadFrame(message)
+}
+
+pub(super) fn bad_setup(message: String) -> Error {
+    Error::BadSetup(message)
+}
+
+pub(super) fn check_desc(desc: &LightingDesc) -> Result<()> {
+    let e = desc.extent;
+    if e.width == 0 || e.height == 0 {
+        return Err(bad_setup(format!(
+            "a {}x{} lighting extent",
+            e.width, e.height
+        )));
+    }
+    if !crate::gpu::access::aspect_of(desc.depth_stencil_format)
+        .contains(vk::ImageAspectFlags::STENCIL)
+    {
+        return Err(bad_setup(format!(
+            "depth format {:?} has no stencil for the BRDF ids",
+            desc.depth_stencil_format
+        )));
+    }
+    if desc.frames_in_flight == 0 {
+        return Err(bad_setup("frames_in_flight must be at least 1".into()));
+    }
+    for (slot, brdf) in desc.brdfs.iter().enumerate() {
+        if let Some(first) = desc.brdfs[..slot].iter().position(|b| b == brdf) {
+            return Err(bad_setup(format!(
+                "{brdf:?} is in BRDF slots {first} and {slot}: one slot per BRDF, so that a BRDF id \
+                 names one slot"
+            )));
+        }
+    }
+    let slots = desc.layout.brdfs_in_use() as usize;
+    if desc.brdfs.len() > slots {
+        return Err(bad_setup(format!(
+            "{} BRDFs for a stencil layout with {slots} BRDF slots",
+            desc.brdfs.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Whether recording `plan` needs the hi-stencil emulation: a hi-stencil test, write or flush,
+/// or the stencil copy of a 360-like save/restore.
+pub(super) fn needs_hi_stencil(plan: &FramePlan) -> bool {
+    plan.steps.iter().any(|step| match step {
+        Step::Pass { pass, .. } => pass.state.tests_hi_stencil() || pass.state.writes_hi_stencil(),
+        Step::FlushHiStencil | Step::SavePreserved { .. } | Step::RestorePreserved { .. } => true,
+    })
+}
+
+/// Whether `plan` writes hi-stencil: its tile updates read the frame's stencil.
+pub(super) fn writes_hi_stencil(plan: &FramePlan) -> bool {
+    plan.passes().any(|pass| pass.state.writes_hi_stencil())
+}
+
+/// Checks one frame against the lighting's description: the slot, the light count, the plan's
+/// light indices and depth convention, and every target's extent and format.
+pub(super) fn check_frame(
+    desc: &LightingDesc,
+    frame: &LightingFrame,
+    targets: &LightingTargets,
+) -> Result<()> {
+    check_slot_and_lights(desc, frame.slot, frame.lights.len())?;
+    if let Some(l) = frame
+        .plan
+        .lights
+        .iter()
+        .find(|l| l.input >= frame.lights.len())
+    {
+        return Err(bad(format!(
+            "the plan lights input {} of {} lights",
+            l.input,
+            frame.lights.len()
+        )));
+    }
+    if !desc.hi_stencil && needs_hi_stencil(frame.plan) {
+        return Err(bad(
+            "the plan uses hi-stencil (a PS3-like or 360-like backend), and this lighting was \
+             made without it (LightingDesc::hi_stencil)"
+                .into(),
+        ));
+    }
+    if frame.plan.depth != frame.view.depth {
+        return Err(bad(format!(
+            "the plan is for {:?} depth, the view is {:?}",
+            frame.plan.depth, frame.view.depth
+        )));
+    }
+    // A plan made for another view or other lights records without complaint and lights the
+    // frame wrong: hold it to what it was made for.
+    if let Some(made_for) = &frame.plan.made_for {
+        let shapes = frame.lights.iter().map(|l| l.shape());
+        if let Some(difference) = made_for.difference(frame.view, shapes, &desc.layout) {
+            return Err(bad(difference));
+        }
+    }
+    check_targets(desc, &frame.hook_sets, targets)
+}
+
+/// Checks a frame's slot and light count against the lighting's description.
+pub(super) fn check_slot_and_lights(desc: &LightingDesc, slot: u32, lights: usize) -> Result<()> {
+    if slot >= desc.frames_in_flight {
+        return Err(bad(format!(
+            "slot {slot} of {} frames in flight",
+            desc.frames_in_flight
+        )));
+    }
+    if lights > desc.max_lights as usize {
+        return Err(bad(format!(
+            "{lights} lights, more than the {} this lighting was made for",
+            desc.max_lights
+        )));
+    }
+    Ok(())
+}
+
+/// Checks the hook sets and every target's extent and format against the description.
+pub(super) fn check_targets(
+    desc: &LightingDesc,
+    hook_sets: &HookSets,
+    targets: &LightingTargets,
+) -> Result<()> {
+    let expect = |what: &str, image: &ImageRef, format: vk::Format| {
+        if image.extent != desc.extent {
+            return Err(bad(format!(
+                "{what} is {}x{}, the lighting {}x{}",
+                image.extent.width, image.extent.height, desc.extent.width, desc.extent.height
+            )));
+        }
+        if image.format != format {
+            return Err(bad(format!(
+                "{what} is {:?}, the lighting expects {format:?}",
+                image.format
+            )));
+        }
+        Ok(())
+    };
+    desc.hooks.check_sets(hook_sets)?;
+    if let LightHooks::Builtin = desc.hooks {
+        let names = [
+            "G-buffer albedo",
+            "G-buffer normal-depth",
+            "G-buffer material",
+        ];
+        if targets.gbuffer.len() != names.len() {
+            return Err(bad(format!(
+                "{} G-buffer images, and histencil's G-buffer has {}",
+                targets.gbuffer.len(),
+                names.len()
+            )));
+        }
+        for ((image, name), format) in targets.gbuffer.iter().zip(names).zip(GBUFFER_FORMATS) {
+            expect(name, image, format)?;
+        }
+    } else if let LightHooks::Engine(engine) = &desc.hooks {
+        // The decode reads these through the engine's set; the lighting barriers each one for
+        // the light shaders' reads, so one left out would be read in whatever layout it was.
+        let formats = &engine.surface_formats;
+        if targets.gbuffer.len() != formats.len() {
+            return Err(bad(format!(
+                "{} surface images in LightingTargets::gbuffer, and the engine's decode hook \
+                 reads {} (EngineHooks::new's surface formats)",
+                targets.gbuffer.len(),
+                formats.len()
+            )));
+        }
+        for (i, (image, format)) in targets.gbuffer.iter().zip(formats).enumerate() {
+            expect(&format!("surface image {i}"), image, *format)?;
+        }
+    }
+    expect(
+        "the depth-stencil target",
+        &targets.depth_stencil,
+        desc.depth_stencil_format,
+    )?;
+    expect("the HDR target", &targets.hdr, desc.hdr_format)
+}

@@ -1,0 +1,524 @@
+//! The talk's lighting as a part an engine records into its own frame: [`DeferredLighting`]
+//! records a [`FramePlan`] into the caller's command buffer, against the caller's G-buffer,
+//! depth-stencil and HDR images ([`LightingTargets`]), with the camera and lights of that frame.
+//! It submits nothing and waits for nothing; [`crate::Renderer`] lights its frames through it
+//! too.
+//!
+//! Frames in flight: each of the `frames_in_flight` slots has its own uniform and light buffers
+//! and descriptor sets, written when a frame is recorded into that slot. The caller cycles the
+//! slots and records into one again only after the GPU finished the frame that last used it
+//! (the engine's own fence per frame in flight does this).
+//!
+//! The G-buffer contract (`crates/vk/shaders/include/gbuffer_write.glsl` writes it, `gbuffer.glsl` reads
+//! it): [`crate::GBUFFER_FORMATS`] in that order, each pixel's BRDF slot in the stencil's BRDF
+//! field with the culling bit clear ([`gbuffer_stencil_reference`]), standard or reversed depth as
+//! the [`ViewDesc`] says.
+
+mod checks;
+mod create;
+mod frames;
+pub mod hooks;
+pub(crate) mod lut;
+mod tiled;
+
+use checks::{bad, bad_setup, check_desc, check_frame, needs_hi_stencil, writes_hi_stencil};
+pub use frames::{gbuffer_stencil_reference, LightingDesc, LightingFrame, TiledFrame};
+
+use crate::gpu::access::LightingTargets;
+use crate::gpu::context::Context;
+use crate::gpu::descriptors::{write_sampled_images, write_storage_buffers};
+use crate::gpu::error::{Error, Result};
+use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
+use crate::gpu::meshes::LightVolumes;
+use crate::gpu::resources::Buffer;
+use crate::gpu::teardown::{Destroy, InFlight};
+use crate::gpu::timing::{LightingBreakdown, SlotTimer};
+use crate::hi_stencil::{GpuHierarchy, HiStencilSurface};
+use crate::lighting::hooks::HookSets;
+use crate::passes::depth_id::DepthIdPass;
+use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
+use crate::passes::lighting::{Emulation, LightingPass};
+use crate::passes::tiled::TiledLighting;
+use crate::renderer::technique::TileSide;
+use ash::vk;
+use histencil_model::{FramePlan, Step, TileStats, ViewDesc};
+use histencil_scene::Light;
+use std::ops::Deref;
+
+/// The per-frame-in-flight part: buffers the host writes at record time and the sets that point
+/// at them and at the frame's G-buffer.
+struct Slot {
+    uniforms: Buffer,
+    lights: Buffer,
+    frame_set: vk::DescriptorSet,
+    /// histencil's G-buffer set; null with an engine's decode hook.
+    gbuffer_set: vk::DescriptorSet,
+    timer: SlotTimer,
+    /// The hi-stencil emulation's bookkeeping against the technique (`Emulation`).
+    emulation: SlotTimer,
+}
+
+/// The lighting passes of the talk, recorded into an engine's frames.
+///
+/// `C` is how it holds its context: `&Context`, or `Arc<Context>` so that an engine's struct
+/// owns it beside the context (as [`crate::AlphaLightmaps`] and [`crate::LutTables`] do).
+///
+/// What an engine writes per frame, after its own G-buffer pass and before its own post
+/// passes (the whole engine: `examples/engine`):
+///
+/// ```no_run
+/// use ash::vk;
+/// use histencil_model::{
+///     plan_frame, FlushPolicy, PlanInputs, PlanSettings, StencilLayout, TechniqueChoice, View,
+///     ViewDesc,
+/// };
+/// use histencil_scene::Light;
+/// use histencil_vk::{
+///     Backend, BrdfSource, Context, DeferredLighting, HookSets, ImageRef, LightingFrame, LightingTargets,
+/// };
+///
+/// /// `gbuffer`, `depth_stencil` and `hdr` carry the states the engine's barriers left.
+/// fn light(
+///     lighting: &mut DeferredLighting<&Context>,
+///     cmd: vk::CommandBuffer,
+///     frame_index: u64,
+///     view: &ViewDesc,
+///     lights: &[Light],
+///     brdf_bounds: &[Vec<histencil_model::Aabb>],
+///     images: (Vec<ImageRef>, ImageRef, ImageRef),
+/// ) -> Result<LightingTargets, Box<dyn std::error::Error>> {
+///     let layout: StencilLayout = lighting.desc().layout;
+///     let shapes: Vec<_> = lights.iter().map(Light::shape).collect();
+///     let inputs = PlanInputs {
+///         lights: &shapes,
+///         brdf_bounds,
+///         view: &View::new(view)?,
+///     };
+///     let settings = PlanSettings {
+///         technique: TechniqueChoice::Stencil,
+///         caps: Backend::Native.platform().caps(),
+///         flush: FlushPolicy::Auto,
+///     };
+///     let plan = plan_frame(&layout, &inputs, &settings)?;
+///     let (gbuffer, depth_stencil, hdr) = images;
+///     let mut targets = LightingTargets { gbuffer, depth_stencil, hdr };
+///     let frame = LightingFrame {
+///         slot: (frame_index % 2) as u32,
+///         view,
+///         lights,
+///         plan: &plan,
+///         clear_hdr: true,
+///         timestamps: false,
+///         brdf_source: BrdfSource::Formula,
+///         tile_stats: false,
+///         hook_sets: HookSets::default(),
+///     };
+///     // SAFETY: `cmd` is recording on the lighting's device, the images' states are true, and
+///     // the frame two frames ago (the last one in this slot) has finished on the GPU.
+///     unsafe { lighting.record(cmd, &frame, &mut targets)? };
+///     Ok(targets) // each image's state now, for the engine's next barrier
+/// }
+/// ```
+pub struct DeferredLighting<C: Deref<Target = Context>> {
+    ctx: C,
+    desc: LightingDesc,
+    /// Frame, G-buffer, hi-stencil and LUT set layouts: sets 0 to 3 of every light pipeline
+    /// (with an engine's decode hook, set 1 is the engine's layout and this one stays null).
+    set_layouts: [vk::DescriptorSetLayout; 4],
+    pipeline_layout: vk::PipelineLayout,
+    pool: vk::DescriptorPool,
+    hi_stencil_set: vk::DescriptorSet,
+    lut_set: vk::DescriptorSet,
+    /// The LUT set is written once tables exist (`set_lut_tables`); binding an unwritten set
+    /// is invalid.
+    lut_written: bool,
+    slots: Vec<Slot>,
+    hi_stencil: Option<HiStencilSurface>,
+    volumes: Option<LightVolumes>,
+    pipelines: LightPipelines,
+    /// The tiled technique per tile side, made at its first frame with that side.
+    tiled: Vec<(TileSide, TiledLighting)>,
+    /// The depth-id technique per tile side, made at its first frame with that side.
+    depth_id: Vec<(TileSide, DepthIdPass)>,
+    in_flight: InFlight,
+}
+
+impl<C: Deref<Target = Context>> DeferredLighting<C> {
+    /// Creates the pipeline layout, the light volumes, the hi-stencil emulation and every slot's
+    /// buffers and sets. Light pipelines are made when a plan first needs them
+    /// ([`DeferredLighting::prepare`]). A failure half way frees what was made.
+    ///
+    /// # Errors
+    /// [`Error::BadSetup`] for a zero extent, a depth format without stencil, no frames in
+    /// flight, too many BRDFs for the layout, or a depth-stencil format other than the one the
+    /// context was lent with; Vulkan and allocation errors.
+    pub fn new(ctx: C, desc: &LightingDesc) -> Result<Self> {
+        check_desc(desc)?;
+        desc.hooks.check(&ctx)?;
+        if ctx.depth_stencil_named && desc.depth_stencil_format != ctx.depth_stencil_format {
+            return Err(bad_setup(format!(
+                "depth-stencil format {:?}, but the context was lent {:?} \
+                 (BorrowedDevice::depth_stencil): name one format, or leave the context's None",
+                desc.depth_stencil_format, ctx.depth_stencil_format
+            )));
+        }
+        let mut this = Self {
+            ctx,
+            desc: desc.clone(),
+            set_layouts: [vk::DescriptorSetLayout::null(); 4],
+            pipeline_layout: vk::PipelineLayout::null(),
+            pool: vk::DescriptorPool::null(),
+            hi_stencil_set: vk::DescriptorSet::null(),
+            lut_set: vk::DescriptorSet::null(),
+            lut_written: false,
+            slots: Vec::new(),
+            hi_stencil: None,
+            volumes: None,
+            tiled: Vec::new(),
+            depth_id: Vec::new(),
+            in_flight: InFlight::default(),
+            pipelines: LightPipelines::new(
+                vk::PipelineLayout::null(),
+                desc.hooks.modules(),
+                desc.hdr_format,
+                desc.depth_stencil_format,
+            ),
+        };
+        // On an error `this` drops, destroying what exists so far.
+        this.create()?;
+        Ok(this)
+    }
+}
+
+impl<C: Deref<Target = Context>> DeferredLighting<C> {
+    /// Makes the lighting fit targets of a new `extent`, keeping every pipeline (viewport and
+    /// scissor are dynamic state; the tile side, not the extent, shapes the tiled kernels): the
+    /// hi-stencil tile surface and the tiled technique's tile buffers are made anew, nothing
+    /// else. A resize to the same extent does nothing; a failure leaves the lighting as it was.
+    ///
+    /// # Errors
+    /// [`Error::BadSetup`] for a zero extent; allocation errors.
+    ///
+    /// # Safety
+    /// The GPU has finished every command buffer this lighting recorded into (wait for your
+    /// frames in flight first, as for any resize of your own targets).
+    pub unsafe fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
+        if extent.width == 0 || extent.height == 0 {
+            return Err(bad_setup(format!(
+                "a {}x{} lighting extent",
+                extent.width, extent.height
+            )));
+        }
+        if extent == self.desc.extent {
+            return Ok(());
+        }
+        let ctx: &Context = &self.ctx;
+        if self.desc.hi_stencil {
+            let surface = self.hi_stencil.as_mut().expect("made with the lighting");
+            surface.resize(ctx, extent)?;
+            let buffers = surface.light_set_buffers();
+            write_storage_buffers(ctx, self.hi_stencil_set, &buffers);
+        }
+        for (_, tiled) in &mut self.tiled {
+            tiled.resize(ctx, extent)?;
+        }
+        for (_, depth_id) in &mut self.depth_id {
+            depth_id.resize(ctx, extent)?;
+        }
+        self.desc.extent = extent;
+        Ok(())
+    }
+}
+
+impl<C: Deref<Target = Context>> DeferredLighting<C> {
+    /// What this lighting was made for.
+    pub fn desc(&self) -> &LightingDesc {
+        &self.desc
+    }
+
+    /// Creates every light pipeline `plan` uses, so the first frame that needs them does not
+    /// compile them while recording.
+    pub fn prepare(&mut self, plan: &FramePlan) -> Result<()> {
+        self.prepare_for(plan, false, BrdfSource::Formula, false)
+    }
+
+    fn prepare_for(
+        &mut self,
+        plan: &FramePlan,
+        count_stats: bool,
+        source: BrdfSource,
+        hierarchy: bool,
+    ) -> Result<()> {
+        let (ctx, brdfs) = (&*self.ctx, &self.desc.brdfs);
+        let pipelines = &mut self.pipelines;
+        prepare_pipelines(ctx, pipelines, plan, brdfs, count_stats, source, hierarchy)
+    }
+
+    /// Light pipelines created so far (kept across [`DeferredLighting::resize`]).
+    pub fn pipeline_count(&self) -> usize {
+        self.pipelines.count()
+    }
+
+    /// The tiled and depth-id techniques' pipelines created so far, over every tile side used
+    /// (kept across [`DeferredLighting::resize`]).
+    pub fn tiled_pipeline_count(&self) -> usize {
+        let tiled = self.tiled.iter().map(|(_, t)| t.pipeline_count());
+        let depth_id = self.depth_id.iter().map(|(_, p)| p.pipeline_count());
+        tiled.chain(depth_id).sum()
+    }
+
+    /// Records `frame`'s lighting into `cmd` against `targets`, and leaves each target's state
+    /// as the commands leave the image. Outside any render pass; binds its own pipelines and
+    /// sets, sets the dynamic state it uses, and leaves the HDR and depth-stencil images
+    /// attached-ready.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] when the frame does not fit this lighting (see [`LightingFrame`]), or
+    /// the view's projection cannot be inverted per pixel; pipeline creation errors. Nothing is
+    /// recorded on an error.
+    ///
+    /// # Safety
+    /// - `cmd` is in the recording state, on a queue family with graphics, from the device of
+    ///   the context this lighting was made with.
+    /// - The images of `targets` are live, from that device, with the usages
+    ///   [`LightingTargets`] lists, and their `state`s are true when `cmd` executes: the layout
+    ///   each subresource is in, and the stages and accesses of the last commands before it that
+    ///   touched it (`ImageState::UNDEFINED` discards contents, so not for the G-buffer or
+    ///   depth-stencil).
+    /// - The GPU has finished every command buffer that recorded into `frame.slot` before;
+    ///   this call rewrites that slot's buffers and descriptor sets.
+    pub unsafe fn record(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightingFrame,
+        targets: &mut LightingTargets,
+    ) -> Result<()> {
+        self.record_emulating(cmd, frame, targets, None)
+    }
+
+    /// [`DeferredLighting::record`], emulating `hierarchy`, the hierarchical stencil of an AMD
+    /// GPU (`crate::hi_stencil::amd`), which needs [`LightingDesc::hi_stencil`].
+    ///
+    /// # Safety
+    /// As [`DeferredLighting::record`].
+    pub(crate) unsafe fn record_emulating(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightingFrame,
+        targets: &mut LightingTargets,
+        hierarchy: Option<GpuHierarchy>,
+    ) -> Result<()> {
+        let (count_stats, source) = (frame.tile_stats, frame.brdf_source);
+        check_frame(&self.desc, frame, targets)?;
+        if hierarchy.is_some() && !self.desc.hi_stencil {
+            return Err(Error::Unsupported(
+                "an AMD hierarchy's emulation from a lighting made without hi-stencil",
+            ));
+        }
+        if count_stats && !self.desc.hi_stencil {
+            return Err(Error::Unsupported(
+                "hi-stencil statistics from a lighting made without hi-stencil",
+            ));
+        }
+        if source == BrdfSource::Table && !self.lut_written {
+            return Err(Error::Unsupported(
+                "the LUT technique before its tables exist",
+            ));
+        }
+        self.prepare_for(frame.plan, count_stats, source, hierarchy.is_some())?;
+        let inputs = (frame.view, frame.lights, &frame.hook_sets);
+        let (frame_set, decode_set) = self.write_slot(frame.slot, inputs, targets)?;
+        let ctx: &Context = &self.ctx;
+        let slot = &mut self.slots[frame.slot as usize];
+        let steps = frame.plan.steps.len() as u32;
+        let name = "lighting-step-timestamps";
+        slot.timer.prepare(ctx, name, frame.timestamps, steps)?;
+        let name = "lighting-emulation-timestamps";
+        let emulated = needs_hi_stencil(frame.plan) || hierarchy.is_some();
+        let marks = Emulation::marks(frame.plan, hierarchy.as_ref());
+        slot.emulation.prepare(ctx, name, emulated, marks)?;
+        let mut sets = vec![frame_set, decode_set, self.hi_stencil_set];
+        if source == BrdfSource::Table {
+            sets.push(self.lut_set);
+        }
+        let pass = LightingPass {
+            ctx,
+            cmd,
+            plan: frame.plan,
+            lights: frame.lights,
+            brdfs: &self.desc.brdfs,
+            volumes: self.volumes.as_ref().expect("made with the lighting"),
+            pipelines: &self.pipelines,
+            pipeline_layout: self.pipeline_layout,
+            sets: &sets,
+            visibility_set: frame.hook_sets.visibility,
+            brdf_source: source,
+            extent: self.desc.extent,
+            count_stats,
+            clear_hdr: frame.clear_hdr,
+            depth_sampled: self.desc.hooks.samples_depth(),
+            slot: frame.slot,
+            hierarchy,
+        };
+        let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
+        if writes_hi_stencil(frame.plan) || hierarchy.is_some() {
+            hi_stencil.prepare_slot(ctx, frame.slot, &targets.depth_stencil)?;
+        }
+        let timer = slot.timer.active();
+        let emulation = slot.emulation.active();
+        self.in_flight.mark();
+        pass.record(targets, hi_stencil, timer, emulation)
+    }
+
+    /// Of the last frame recorded into `slot`, once the GPU has finished it: the time the
+    /// hi-stencil emulator spent on bookkeeping a console does not do (resetting its tile
+    /// surface; after each hi-stencil write the split, the touch draw and the tile update; the
+    /// copy at each flush), in milliseconds; the rest of the lighting is the platform's technique.
+    /// `None` when that frame's plan used no hi-stencil (a native plan). Every frame with
+    /// hi-stencil writes these timestamps, two per piece of bookkeeping, where rendering is
+    /// split anyway. Waits for the query results.
+    pub fn emulation_ms(&self, slot: u32) -> Result<Option<f64>> {
+        match self
+            .slots
+            .get(slot as usize)
+            .and_then(|s| s.emulation.last())
+        {
+            Some(t) => Ok(t.read(&self.ctx)?.group_ms(Emulation::BOOKKEEPING)),
+            None => Ok(None),
+        }
+    }
+
+    /// Writes `slot`'s uniforms from `view` and `lights`, and its G-buffer set from `targets`
+    /// with histencil's decode; returns the frame set and the decode set (the engine's, with
+    /// its hook).
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] when the view's projection cannot be inverted per pixel; nothing
+    /// is written then.
+    fn write_slot(
+        &mut self,
+        slot: u32,
+        (view, lights, hook_sets): (&ViewDesc, &[Light], &HookSets),
+        targets: &LightingTargets,
+    ) -> Result<(vk::DescriptorSet, vk::DescriptorSet)> {
+        let e = self.desc.extent;
+        let uniforms = FrameUniforms::from_view(view, e.width, e.height, lights.len() as u32)
+            .map_err(|p| bad(p.to_string()))?;
+        let ctx: &Context = &self.ctx;
+        let slot = &mut self.slots[slot as usize];
+        slot.uniforms.write(bytemuck::bytes_of(&uniforms));
+        let gpu_lights: Vec<GpuLight> = lights.iter().map(GpuLight::new).collect();
+        slot.lights.write(bytemuck::cast_slice(&gpu_lights));
+        let decode_set = match hook_sets.decode {
+            Some(set) => set,
+            None => {
+                let views: Vec<vk::ImageView> = targets.gbuffer.iter().map(|g| g.view).collect();
+                write_sampled_images(ctx, slot.gbuffer_set, &views);
+                slot.gbuffer_set
+            }
+        };
+        Ok((slot.frame_set, decode_set))
+    }
+
+    /// The per-step GPU times of the last frame recorded into `slot` with timestamps, once the
+    /// GPU has finished it (`None` when that frame had none). Waits for the query results.
+    pub fn step_timings(&self, slot: u32) -> Result<Option<LightingBreakdown>> {
+        match self.slots.get(slot as usize).and_then(|s| s.timer.last()) {
+            Some(t) => Ok(Some(t.read(&self.ctx)?)),
+            None => Ok(None),
+        }
+    }
+
+    /// The hi-stencil statistics of the last frame recorded with
+    /// [`LightingFrame::tile_stats`], read once the GPU has finished it; `flushes` from that
+    /// frame's `plan`. One set of counters for all slots: a caller counts a frame, waits for it,
+    /// then reads, before the next counting frame. `None` for a lighting made without
+    /// [`LightingDesc::hi_stencil`], which has no counters (and refuses counting frames).
+    pub fn tile_stats(&self, plan: &FramePlan) -> Option<TileStats> {
+        if !self.desc.hi_stencil {
+            return None;
+        }
+        let hi = self.hi_stencil.as_ref()?;
+        Some(TileStats {
+            flushes: plan
+                .steps
+                .iter()
+                .filter(|s| matches!(s, Step::FlushHiStencil))
+                .count() as u64,
+            ..hi.read_stats()
+        })
+    }
+
+    /// Frees everything now, without the device-wide wait that dropping does once this has
+    /// recorded (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
+    /// device): an engine that submits from other threads frees through this, once its own
+    /// fences say the GPU is done.
+    ///
+    /// # Safety
+    /// The GPU has finished every command buffer recorded with this lighting.
+    pub unsafe fn destroy(mut self) {
+        self.in_flight.clear();
+    }
+
+    /// Points the LUT technique at `tables` (one per material, in the order of the G-buffer's
+    /// material indices; [`crate::LutTables::new`]) for the frames recorded with
+    /// [`BrdfSource::Table`] after this.
+    ///
+    /// # Safety
+    /// `tables` outlive every command buffer recorded with [`BrdfSource::Table`] after this
+    /// call, until the GPU has finished them; no command buffer that reads earlier tables is
+    /// still pending (the set is rewritten in place).
+    pub unsafe fn set_lut_tables(
+        &mut self,
+        tables: &crate::LutTables<impl Deref<Target = Context>>,
+    ) {
+        write_storage_buffers(&self.ctx, self.lut_set, &tables.buffers());
+        self.lut_written = true;
+    }
+
+    pub(crate) fn pipeline_layout(&self) -> vk::PipelineLayout {
+        self.pipeline_layout
+    }
+
+    pub(crate) fn volumes(&self) -> &LightVolumes {
+        self.volumes.as_ref().expect("made with the lighting")
+    }
+}
+
+impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
+    /// Once this has recorded, waits for the device to go idle (so nothing else may use any
+    /// of its queues meanwhile; [`DeferredLighting::destroy`] does not wait), then frees
+    /// everything, also after a creation that failed half way.
+    fn drop(&mut self) {
+        let ctx: &Context = &self.ctx;
+        let d = &ctx.device;
+        self.in_flight.wait(ctx);
+        self.pipelines.destroy(ctx);
+        for (_, t) in &mut self.tiled {
+            t.destroy(ctx);
+        }
+        for (_, p) in &mut self.depth_id {
+            p.destroy(ctx);
+        }
+        for slot in &mut self.slots {
+            slot.uniforms.destroy(ctx);
+            slot.lights.destroy(ctx);
+            slot.timer.destroy(ctx);
+            slot.emulation.destroy(ctx);
+        }
+        if let Some(h) = self.hi_stencil.as_mut() {
+            h.destroy(ctx);
+        }
+        if let Some(v) = self.volumes.as_mut() {
+            v.destroy(ctx);
+        }
+        unsafe {
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_pipeline_layout(self.pipeline_layout, None);
+            // The null ones (set 1 with an engine's decode hook) are no-ops.
+            for l in self.set_layouts {
+                d.destroy_descriptor_set_layout(l, None);
+            }
+        }
+    }
+}

@@ -1,0 +1,50 @@
+//! The SPIR-V modules of the light shaders that call the hooks, which the passes make their
+//! pipelines from: histencil's own, or an engine's compiled with its hooks
+//! (`crate::lighting::hooks`, which checks them against the engine's layouts).
+
+use crate::shaders;
+
+/// The SPIR-V of the light shaders that call the hooks: `deferred_light.frag` (the talk's
+/// per-BRDF and branching shaders, by specialisation), `lut_light.frag` (the LUT technique) and
+/// the tiled technique's classification and shade kernels for 16x16 and 8x8 tiles, and the
+/// depth-id technique's id copy and shade pass (`depth_id_copy.frag`, `depth_id_shade.frag`).
+/// `histencil_build::compile_light_shaders` writes this as an expression for `include!`.
+#[derive(Clone, Copy, Debug)]
+pub struct LightModules {
+    pub deferred_light: &'static [u8],
+    pub lut_light: &'static [u8],
+    pub tile_classify: &'static [u8],
+    pub tile_shade: &'static [u8],
+    pub tile_classify_8: &'static [u8],
+    pub tile_shade_8: &'static [u8],
+    pub depth_id_copy: &'static [u8],
+    pub depth_id_shade: &'static [u8],
+}
+
+impl LightModules {
+    /// histencil's own: its G-buffer, no shadows.
+    pub const BUILTIN: LightModules = LightModules {
+        deferred_light: shaders::DEFERRED_LIGHT_FRAG,
+        lut_light: shaders::LUT_LIGHT_FRAG,
+        tile_classify: shaders::TILE_CLASSIFY_COMP,
+        tile_shade: shaders::TILE_SHADE_COMP,
+        tile_classify_8: shaders::TILE_CLASSIFY_8_COMP,
+        tile_shade_8: shaders::TILE_SHADE_8_COMP,
+        depth_id_copy: shaders::DEPTH_ID_COPY_FRAG,
+        depth_id_shade: shaders::DEPTH_ID_SHADE_FRAG,
+    };
+
+    /// Each module with its name, for checks and messages.
+    pub(crate) fn named(&self) -> [(&'static str, &'static [u8]); 8] {
+        [
+            ("deferred_light", self.deferred_light),
+            ("lut_light", self.lut_light),
+            ("tile_classify", self.tile_classify),
+            ("tile_shade", self.tile_shade),
+            ("tile_classify_8", self.tile_classify_8),
+            ("tile_shade_8", self.tile_shade_8),
+            ("depth_id_copy", self.depth_id_copy),
+            ("depth_id_shade", self.depth_id_shade),
+        ]
+    }
+}
