@@ -2,7 +2,7 @@
 // Evaluates BRDF cases with the GLSL spelling, in parts (tinted RGB, white), for the comparison
 // against the f64 reference
 // (histencil brdf-eval --device gpu, and crates/vk/tests/brdf_gpu.rs).
-// Rust mirror of the structs: crates/vk/src/brdf_eval.rs (GpuBrdfCase).
+// Rust mirror of the structs: crates/vk/src/tools/brdf_eval.rs (GpuBrdfCase).
 
 #include "brdf/eval.glsl"
 

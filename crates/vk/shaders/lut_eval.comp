@@ -1,6 +1,6 @@
 #version 460
 // Looks BRDF tables up with the GLSL spelling, for the comparison against Rust's Lut::lookup
-// (crates/vk/src/lut.rs, LutEvaluator). The cases are brdf_eval.comp's, with `model.x` naming
+// (crates/vk/src/lighting/lut.rs, LutEvaluator). The cases are brdf_eval.comp's, with `model.x` naming
 // the table.
 
 #define LUT_SET 0

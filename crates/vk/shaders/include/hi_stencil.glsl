@@ -1,5 +1,5 @@
 // The hi-stencil emulation's tile surface (set 2 of the light pipelines): one word per tile of
-// HI_STENCIL_TILE x HI_STENCIL_TILE pixels, row-major. Rust side: crates/vk/src/hi_stencil.rs;
+// HI_STENCIL_TILE x HI_STENCIL_TILE pixels, row-major. Rust side: crates/vk/src/hi_stencil/mod.rs;
 // semantics: histencil_model::TileSurface.
 #ifndef HI_STENCIL_GLSL
 #define HI_STENCIL_GLSL

@@ -1,6 +1,6 @@
 // BRDF look-up tables on the GPU: the GLSL spelling of histencil_brdf::lut (axes, coordinates and
 // the multilinear lookup of `Lut::lookup`, operation for operation in f32). Rust side of the
-// buffers: crates/vk/src/lut.rs (GpuLutTable).
+// buffers: crates/vk/src/lighting/lut.rs (GpuLutTable).
 //
 // Tables live in storage buffers and are interpolated here rather than by texture filtering:
 // the lookup is then the one the accuracy report measured, on every device (hardware filtering

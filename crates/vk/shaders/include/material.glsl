@@ -1,6 +1,6 @@
 // A mesh draw's surface with its material's texture maps applied: the one function the G-buffer
 // pass and the forward reference both call, so textures change what is lit, never how exactly a
-// technique lights it. Rust side: crates/vk/src/materials.rs (MaterialRecord), the rules in
+// technique lights it. Rust side: crates/vk/src/renderer/materials.rs (MaterialRecord), the rules in
 // histencil_scene::MaterialMaps and histencil_scene::textured_brdf.
 #ifndef MATERIAL_GLSL
 #define MATERIAL_GLSL

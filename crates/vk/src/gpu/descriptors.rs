@@ -342,7 +342,7 @@ fn write_in_order<'a, T>(
 
 /// The renderer's frame set (set 0 of its mesh, alpha and tonemap passes): its layout, pool
 /// and the one set, pointing at the frame's uniforms and lights. Each pass owns the rest of
-/// its layout (`passes/`); the lighting has its own (`deferred_lighting.rs`).
+/// its layout (`passes/`); the lighting has its own (`lighting/`).
 #[derive(Default)]
 pub struct Descriptors {
     pub frame_layout: vk::DescriptorSetLayout,
