@@ -243,43 +243,15 @@ impl Calibration {
             "sampling": {"rounds": self.sampled.rounds, "stopped": self.sampled.stop.word(),
                          "seconds": self.sampled.seconds},
         });
-        for (name, value) in COST_FIELDS.iter().zip(self.costs.fields()) {
-            out[*name] = json!(value);
-        }
-        if let Some(iv) = self.costs.interval {
-            let intervals: serde_json::Map<String, Value> = COST_FIELDS
-                .iter()
-                .zip(iv)
-                .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
-                .collect();
-            out["intervals"] = Value::Object(intervals);
+        // The costs as `CostModel::from_json` reads them back: each group's costs by name, with
+        // their intervals beside them.
+        for (name, value) in costs_object(&COST_FIELDS, &self.costs.fields(), self.costs.interval) {
+            out[name] = value;
         }
         if let Some(tiled) = self.costs.tiled {
-            let mut t = serde_json::Map::new();
-            for (name, value) in TILED_FIELDS.iter().zip(tiled.fields()) {
-                t.insert(name.to_string(), json!(value));
-            }
-            if let Some(iv) = tiled.interval {
-                let intervals: serde_json::Map<String, Value> = TILED_FIELDS
-                    .iter()
-                    .zip(iv)
-                    .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
-                    .collect();
-                t.insert("intervals".into(), Value::Object(intervals));
-            }
+            let mut t = costs_object(&TILED_FIELDS, &tiled.fields(), tiled.interval);
             if let Some(ids) = tiled.depth_id {
-                let mut d = serde_json::Map::new();
-                for (name, value) in DEPTH_ID_FIELDS.iter().zip(ids.fields()) {
-                    d.insert(name.to_string(), json!(value));
-                }
-                if let Some(iv) = ids.interval {
-                    let intervals: serde_json::Map<String, Value> = DEPTH_ID_FIELDS
-                        .iter()
-                        .zip(iv)
-                        .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
-                        .collect();
-                    d.insert("intervals".into(), Value::Object(intervals));
-                }
+                let d = costs_object(&DEPTH_ID_FIELDS, &ids.fields(), ids.interval);
                 t.insert("depth_id".into(), Value::Object(d));
             }
             out["tiled"] = Value::Object(t);
@@ -293,6 +265,28 @@ impl Calibration {
     pub fn write(&self, path: &Path) -> Result<()> {
         crate::write_json(path, &self.json())
     }
+}
+
+/// `names` with their `values`, and an `intervals` object of `[lo, hi]` pairs when measured.
+fn costs_object<const N: usize>(
+    names: &[&str; N],
+    values: &[f64; N],
+    interval: Option<[(f64, f64); N]>,
+) -> serde_json::Map<String, Value> {
+    let mut object: serde_json::Map<String, Value> = names
+        .iter()
+        .zip(values)
+        .map(|(name, value)| (name.to_string(), json!(value)))
+        .collect();
+    if let Some(iv) = interval {
+        let intervals = names
+            .iter()
+            .zip(iv)
+            .map(|(name, (lo, hi))| (name.to_string(), json!([lo, hi])))
+            .collect();
+        object.insert("intervals".into(), Value::Object(intervals));
+    }
+    object
 }
 
 /// Reads the costs a calibration wrote ([`CostModel::from_json`]), naming the file in errors.
