@@ -10,8 +10,11 @@ use ash::vk;
 /// source half of the next barrier).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ImageState {
+    /// The layout the image is in now.
     pub layout: vk::ImageLayout,
+    /// The stages of its last use, which the next barrier waits for.
     pub stage: vk::PipelineStageFlags2,
+    /// The accesses of its last use, which the next barrier makes available.
     pub access: vk::AccessFlags2,
 }
 
@@ -42,10 +45,15 @@ impl ImageState {
 /// depth-stencil format); `view` is a 2D view over the aspects histencil samples or attaches.
 #[derive(Clone, Copy, Debug)]
 pub struct ImageRef {
+    /// The image barriers and copies name.
     pub image: vk::Image,
+    /// The 2D view passes attach or sample.
     pub view: vk::ImageView,
+    /// Its format, which decides the aspects ([`aspect_of`]).
     pub format: vk::Format,
+    /// Its size in pixels.
     pub extent: vk::Extent2D,
+    /// Where it stands now; updated by every recording that uses it.
     pub state: ImageState,
 }
 

@@ -15,6 +15,7 @@ pub struct ValidationMessage {
     /// The layer's message id name, e.g. `SYNC-HAZARD-WRITE-AFTER-READ`
     /// (`VUID-...` for a valid-usage rule); empty when the layer gives none.
     pub id: String,
+    /// The layer's full message.
     pub text: String,
 }
 
@@ -41,6 +42,7 @@ impl ValidationLog {
         self.lock().len()
     }
 
+    /// Whether the layer has said nothing worth failing on.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }

@@ -7,12 +7,19 @@ use crate::gpu::gpu_types::PUSH_CONSTANT_BYTES;
 use crate::gpu::teardown::build;
 use ash::vk;
 
+/// What a binding holds: the subset of Vulkan's descriptor types histencil's shaders use
+/// (separate images and samplers, no combined image samplers).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
+    /// A `uniform` block (`UNIFORM_BUFFER`).
     UniformBuffer,
+    /// A `buffer` block (`STORAGE_BUFFER`).
     StorageBuffer,
+    /// A `texture2D` (`SAMPLED_IMAGE`).
     SampledImage,
+    /// A `sampler` (`SAMPLER`).
     Sampler,
+    /// An `image2D` written by a compute pass (`STORAGE_IMAGE`).
     StorageImage,
 }
 
@@ -31,8 +38,12 @@ impl BindingKind {
 /// One binding of a set: its number, what it holds, and the GLSL name that declares it.
 #[derive(Clone, Copy, Debug)]
 pub struct BindingDesc {
+    /// The `binding =` number in the set.
     pub binding: u32,
+    /// What it holds.
     pub kind: BindingKind,
+    /// The variable the GLSL declares there, which the reflection test checks; empty for an
+    /// anonymous block, which SPIR-V leaves unnamed.
     pub glsl_name: &'static str,
 }
 
@@ -130,16 +141,26 @@ pub const TILED_SET: &[BindingDesc] = &[
     binding(4, BindingKind::StorageImage, "tiled_hdr"),
 ];
 
-/// The pipeline layouts: which sets, in order.
+// The pipeline layouts: which sets, in order (set N is element N), as `SHADER_LAYOUTS` holds
+// each module to them.
+
+/// The mesh pipelines: G-buffer, forward reference and emissive.
 pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, MATERIAL_SET];
+/// The light pipelines: deferred and LUT lights, hi-stencil count, stencil restore, footprint.
 pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET, LUT_SET];
+/// The tonemap pass.
 pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
+/// The BRDF evaluator's compute pipeline.
 pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
+/// The hi-stencil tile update's compute pipeline.
 pub const HI_STENCIL_UPDATE_LAYOUT: &[&[BindingDesc]] = &[HI_STENCIL_UPDATE_SET];
+/// The table lookup evaluator's compute pipeline.
 pub const LUT_EVAL_LAYOUT: &[&[BindingDesc]] = &[LUT_EVAL_SET];
+/// The alpha pass: translucent objects and particles.
 pub const ALPHA_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET, ALPHA_LIGHTMAP_SET];
 /// The lightmap pass renders into the atlas, so it does not bind it.
 pub const LIGHTMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET];
+/// The tiled technique's compute passes and the depth-id technique's copy and shade.
 pub const TILED_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, TILED_SET];
 
 /// Every shader module and the pipeline layout it is used with.
@@ -345,8 +366,10 @@ fn write_in_order<'a, T>(
 /// its layout (`passes/`); the lighting has its own (`lighting/`).
 #[derive(Default)]
 pub struct Descriptors {
+    /// The layout of [`FRAME_SET`], set 0 of the passes' pipeline layouts.
     pub frame_layout: vk::DescriptorSetLayout,
     pool: vk::DescriptorPool,
+    /// The one set, bound at set 0 by each pass.
     pub frame_set: vk::DescriptorSet,
 }
 
@@ -472,6 +495,7 @@ impl Descriptors {
         Ok(d)
     }
 
+    /// Frees the pool (and with it the set) and the layout; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);

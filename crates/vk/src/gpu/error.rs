@@ -3,56 +3,100 @@ use ash::vk;
 /// What can go wrong in the renderer that a caller cannot prevent by calling it correctly.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
+    /// The Vulkan loader, or the validation layer that was asked for, is not installed.
     #[error("cannot load the Vulkan library: {0}")]
     Loading(String),
+    /// No device (or, for a lent device, not that one or its queue family) meets
+    /// [`crate::REQUIREMENTS`]; the message lists what was seen or what is missing.
     #[error("no suitable Vulkan 1.3 device: {0}")]
     NoDevice(String),
     /// The device lacks a format that was asked for (a caller can skip that configuration).
     #[error("missing format: {0}")]
     MissingFormat(String),
+    /// A Vulkan call returned an error code (out of memory, device lost, ...).
     #[error("Vulkan call `{call}` failed: {result}")]
     Vulkan {
+        /// The Vulkan entry point, as `vkCreateImage`.
         call: &'static str,
+        /// What it returned.
         result: vk::Result,
     },
+    /// The memory budget or gpu-allocator refused an allocation.
     #[error("GPU memory allocation `{name}` failed: {message}")]
-    Allocation { name: String, message: String },
+    Allocation {
+        /// The allocation's name, as it would have appeared in a leak report.
+        name: String,
+        /// Why: over the budget, or the allocator's own error.
+        message: String,
+    },
+    /// A frame size of zero, or larger than the device's largest image.
     #[error("bad resolution {width}x{height}: {reason}")]
     BadResolution {
+        /// The requested width in pixels.
         width: u32,
+        /// The requested height in pixels.
         height: u32,
+        /// Which limit it broke.
         reason: String,
     },
+    /// A scene the renderer cannot take.
     #[error(transparent)]
     Scene(#[from] histencil_scene::SceneError),
+    /// The stencil bit layout cannot hold the scene's BRDFs and the engine's reserved bits.
     #[error(transparent)]
     Layout(#[from] histencil_model::LayoutError),
+    /// The model refused to plan the frame: a request that does not fit the stencil layout.
     #[error(transparent)]
     Plan(#[from] histencil_model::PlanError),
+    /// histencil-brdf refused to build a BRDF table (its resolution, or a BRDF it cannot hold).
     #[error(transparent)]
     Lut(#[from] histencil_brdf::lut::LutError),
+    /// The LUT technique's tables would not fit in one storage buffer on this device.
     #[error(
         "the BRDF tables need {bytes} bytes, more than this device's storage-buffer range of \
          {limit} bytes: lower the LUT resolution"
     )]
-    LutTooLarge { bytes: u64, limit: u64 },
+    LutTooLarge {
+        /// The size of all the tables together.
+        bytes: u64,
+        /// The device's `maxStorageBufferRange`.
+        limit: u64,
+    },
     /// The LUT technique on a scene whose BRDF parameters vary per texel.
     #[error(
         "the LUT technique tabulates each material's own BRDF parameters, and object `{object}`'s \
          metallic-roughness map changes its {brdf} parameters per texel, which no table per \
          material follows: light this scene with stencil, branching or adaptive"
     )]
-    LutTexturedParameters { object: String, brdf: &'static str },
+    LutTexturedParameters {
+        /// The scene object's name.
+        object: String,
+        /// The name of its BRDF.
+        brdf: &'static str,
+    },
+    /// The LUT technique on a BRDF that a table divided by the tint cannot hold.
     #[error(
         "the LUT technique tabulates each material's BRDF divided by its tint, and object \
          `{object}`'s {brdf} is not its tint times a function of the angles (its dielectric \
          specular is white): light this scene with stencil, branching or adaptive"
     )]
-    LutUntabulable { object: String, brdf: &'static str },
+    LutUntabulable {
+        /// The scene object's name.
+        object: String,
+        /// The name of its BRDF.
+        brdf: &'static str,
+    },
+    /// The alpha entities could not be laid out in the lightmap atlas.
     #[error(transparent)]
     Lightmap(#[from] histencil_alpha::LayoutError),
+    /// More materials than the G-buffer's material index can name.
     #[error("{count} distinct materials; the G-buffer indexes at most {max}")]
-    TooManyMaterials { count: usize, max: usize },
+    TooManyMaterials {
+        /// Distinct materials in the scene.
+        count: usize,
+        /// What the G-buffer indexes.
+        max: usize,
+    },
     /// A frame that does not fit its lighting or lightmaps (an engine's input at record time).
     #[error("bad lighting frame: {0}")]
     BadFrame(String),
@@ -61,12 +105,21 @@ pub enum Error {
     /// as such, not as a frame's fault.
     #[error("bad lighting setup: {0}")]
     BadSetup(String),
+    /// A combination histencil does not implement (statistics without hi-stencil, the LUT
+    /// technique before its tables, ...): the message names it.
     #[error("not supported yet: {0}")]
     Unsupported(&'static str),
+    /// A tool's output file could not be written (nothing half-written is left behind).
     #[error("cannot write `{path}`: {message}")]
-    Output { path: String, message: String },
+    Output {
+        /// The file that was to be written.
+        path: String,
+        /// The I/O or encoder error.
+        message: String,
+    },
 }
 
+/// The crate's result, with [`Error`] unless said otherwise.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Attaches the call name to a raw `vk::Result`.

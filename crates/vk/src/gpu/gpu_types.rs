@@ -11,11 +11,17 @@ use histencil_scene::{Camera, Light, LightKind, Material};
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct FrameUniforms {
+    /// World to view (column-major, as every matrix here).
     pub view: [[f32; 4]; 4],
+    /// View to clip.
     pub proj: [[f32; 4]; 4],
+    /// World to clip: `proj * view`.
     pub view_proj: [[f32; 4]; 4],
+    /// View to world, for rebuilding a pixel's world position from its depth.
     pub inv_view: [[f32; 4]; 4],
+    /// The camera's world position; w is 1.
     pub eye: [f32; 4],
+    /// `(width, height, 1 / width, 1 / height)` in pixels.
     pub viewport: [f32; 4],
     /// How a pixel's view ray is rebuilt from its NDC: `(1 / P00, 1 / P11, P20, P21)` of the
     /// projection `P` (`m[column][row]`), so `view.xy / -view.z = (ndc.xy + zw) * xy`; off-centre
@@ -24,6 +30,7 @@ pub struct FrameUniforms {
     /// x: exposure; y: the far plane's depth (1, or 0 with reversed Z), where full-screen light
     /// passes are drawn.
     pub settings: [f32; 4],
+    /// x: the number of lights in the light buffer (the forward pass and tile lists loop to it).
     pub counts: [u32; 4],
 }
 
@@ -39,6 +46,8 @@ pub struct ProjectionError(pub &'static str);
 pub const EXPOSURE: f32 = 1.0;
 
 impl FrameUniforms {
+    /// The uniforms of a scene's camera at `width` x `height` (histencil's own renderer; an
+    /// engine's view goes through [`Self::from_view`]).
     pub fn new(camera: &Camera, width: u32, height: u32, light_count: u32) -> Self {
         let aspect = width as f32 / height as f32;
         let view = camera.view();
@@ -112,9 +121,13 @@ impl FrameUniforms {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct GpuLight {
+    /// xyz: position; w: range, at and beyond which the light contributes nothing.
     pub position_radius: [f32; 4],
+    /// rgb: radiance scale; w: the `LIGHT_*` kind code, as a float.
     pub color_kind: [f32; 4],
+    /// xyz: the normalised direction the light travels (spot and directional); w is 0.
     pub direction: [f32; 4],
+    /// Spot cone: `(cos outer, cos inner, tan outer, 0)`; zero for other kinds.
     pub spot: [f32; 4],
 }
 
@@ -127,6 +140,7 @@ fn kind_code(name: &str) -> f32 {
 }
 
 impl GpuLight {
+    /// The shader's record of a scene light.
     pub fn new(light: &Light) -> Self {
         let (kind, direction, spot) = match light.kind {
             LightKind::Point => ("LIGHT_POINT", Vec3::Z, [0.0; 4]),
@@ -156,8 +170,11 @@ impl GpuLight {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct DrawPush {
+    /// Object to world.
     pub model: [[f32; 4]; 4],
+    /// rgb: the material's tint; w: its material index (the LUT technique's table).
     pub tint: [f32; 4],
+    /// xyz: the BRDF's packed parameters; w: its model index.
     pub params: [f32; 4],
 }
 
@@ -183,6 +200,7 @@ impl DrawPush {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LightDrawPush {
+    /// The light's index in the frame's light buffer.
     pub light_index: u32,
     /// Unique per draw of a frame: the hi-stencil emulation marks covered tiles with it.
     pub stamp: u32,

@@ -14,20 +14,25 @@ use image::{GrayImage, Rgba32FImage, RgbaImage};
 /// Which images a frame copies back.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Readback {
+    /// The tonemapped colour ([`FrameImages::ldr`]).
     pub ldr: bool,
+    /// The linear HDR colour ([`FrameImages::hdr`]).
     pub hdr: bool,
+    /// The stencil after lighting ([`FrameImages::stencil`]).
     pub stencil: bool,
     /// The BRDF id the G-buffer stored per pixel (deferred only).
     pub brdf_ids: bool,
 }
 
 impl Readback {
+    /// Nothing: a frame only timed, or whose images stay on the GPU.
     pub const NONE: Self = Self {
         ldr: false,
         hdr: false,
         stencil: false,
         brdf_ids: false,
     };
+    /// Every image, for checks that compare them all.
     pub const ALL: Self = Self {
         ldr: true,
         hdr: true,

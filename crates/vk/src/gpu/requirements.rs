@@ -25,6 +25,7 @@ pub struct DeviceRequirements {
     /// The queue family's capabilities: graphics (compute is implied), and timestamps for the
     /// per-pass timings.
     pub queue_flags: vk::QueueFlags,
+    /// The queue family writes timestamps (`timestampValidBits` above 0), for the timings.
     pub timestamps: bool,
 }
 

@@ -11,15 +11,25 @@ use ash::vk;
 /// What a binding holds, as the shader declares it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ResourceKind {
+    /// A `uniform` block.
     UniformBuffer,
+    /// A `buffer` block.
     StorageBuffer,
+    /// A `texture2D` (or other dimension), without a sampler.
     SampledImage,
+    /// An `image2D` (or other dimension), read and written with image load/store.
     StorageImage,
+    /// A `sampler`.
     Sampler,
+    /// A `sampler2D`: image and sampler in one binding.
     CombinedImageSampler,
+    /// A `textureBuffer`.
     UniformTexelBuffer,
+    /// An `imageBuffer`.
     StorageTexelBuffer,
+    /// A `subpassInput`.
     InputAttachment,
+    /// An `accelerationStructureEXT`.
     AccelerationStructure,
 }
 
@@ -68,8 +78,11 @@ impl ResourceKind {
 /// One descriptor binding a module declares.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Resource {
+    /// Its `set =` decoration.
     pub set: u32,
+    /// Its `binding =` decoration.
     pub binding: u32,
+    /// What it holds.
     pub kind: ResourceKind,
     /// Array length; 0 for a runtime-sized array, 1 for a single resource.
     pub count: u32,
@@ -81,7 +94,9 @@ pub struct Resource {
 /// binding.
 #[derive(Clone, Debug, Default)]
 pub struct ModuleBindings {
+    /// Every stage with an entry point in the module.
     pub stages: vk::ShaderStageFlags,
+    /// Its bindings, ordered by set and binding.
     pub resources: Vec<Resource>,
 }
 

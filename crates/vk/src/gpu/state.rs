@@ -11,6 +11,7 @@ use histencil_model::{
     CompareOp, CullMode, DepthConvention, DepthState, FaceStencil, PassState, StencilOp,
 };
 
+/// The Vulkan compare op (also the value the hi-stencil emulation's shaders compare by).
 pub fn compare_op(op: CompareOp) -> vk::CompareOp {
     match op {
         CompareOp::Never => vk::CompareOp::NEVER,
@@ -24,6 +25,7 @@ pub fn compare_op(op: CompareOp) -> vk::CompareOp {
     }
 }
 
+/// The Vulkan stencil op.
 pub fn stencil_op(op: StencilOp) -> vk::StencilOp {
     match op {
         StencilOp::Keep => vk::StencilOp::KEEP,
@@ -33,6 +35,7 @@ pub fn stencil_op(op: StencilOp) -> vk::StencilOp {
     }
 }
 
+/// The Vulkan cull mode.
 pub fn cull_mode(cull: CullMode) -> vk::CullModeFlags {
     match cull {
         CullMode::None => vk::CullModeFlags::NONE,

@@ -9,6 +9,7 @@ const MAX_MARKS: u32 = 16;
 /// Milliseconds spent in each pass of one frame (or the median over several), in pass order.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameTimings {
+    /// `(pass name, ms)` between consecutive timestamps, as `gbuffer`, `lighting`, `tonemap`.
     pub passes: Vec<(&'static str, f64)>,
     /// The lighting pass broken down by the talk's pass groups, when asked for
     /// (`FrameDesc::pass_timing`).
@@ -46,6 +47,7 @@ impl LightmapTimings {
         out
     }
 
+    /// The whole lightmap pass: the clear and every entity.
     pub fn total_ms(&self) -> f64 {
         self.clear_ms + self.per_entity.iter().map(|e| e.1).sum::<f64>()
     }
@@ -55,6 +57,7 @@ impl LightmapTimings {
 /// `zero-preserved`, `flush`), totalled over lights in first-seen order, and per light.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LightingBreakdown {
+    /// `(group, ms)`, summed over every light.
     pub groups: Vec<(String, f64)>,
     /// `(scene light index, ms)`.
     pub per_light: Vec<(u32, f64)>,
@@ -73,16 +76,19 @@ impl LightingBreakdown {
         out
     }
 
+    /// One group's total; `None` when the frame had no such pass.
     pub fn group_ms(&self, group: &str) -> Option<f64> {
         self.groups.iter().find(|g| g.0 == group).map(|g| g.1)
     }
 }
 
 impl FrameTimings {
+    /// The whole frame: every pass, bookkeeping included.
     pub fn total_ms(&self) -> f64 {
         self.passes.iter().map(|p| p.1).sum()
     }
 
+    /// One pass's time; `None` when the frame did not run it.
     pub fn pass_ms(&self, name: &str) -> Option<f64> {
         self.passes.iter().find(|p| p.0 == name).map(|p| p.1)
     }

@@ -38,20 +38,27 @@ pub struct MeshPasses {
 
 /// The formats the mesh passes render to.
 pub struct MeshFormats {
+    /// The G-buffer's colour attachments, in binding order ([`crate::GBUFFER_FORMATS`]).
     pub gbuffer: [vk::Format; 3],
+    /// The HDR target the forward and emission passes write.
     pub hdr: vk::Format,
+    /// The depth-stencil the device was given or chose.
     pub depth_stencil: vk::Format,
 }
 
 /// What the mesh passes draw in one frame.
 pub struct MeshInputs<'a> {
+    /// The objects drawn, with their transforms and materials.
     pub scene: &'a Scene,
+    /// The built-in shapes and the scene's imported meshes the objects are drawn with.
     pub meshes: &'a Meshes,
+    /// Set 0: the frame's uniforms and lights.
     pub frame_set: vk::DescriptorSet,
     /// Each object's material set (set 1: its texture maps), in `Scene::objects` order.
     pub material_sets: &'a [vk::DescriptorSet],
     /// Each object's material index (its LUT table), stored in the G-buffer.
     pub material_indices: &'a [u32],
+    /// The size of the targets: the render area and viewport.
     pub extent: vk::Extent2D,
     /// Which end of depth is near: the depth test and the clear follow it.
     pub depth: DepthConvention,
@@ -60,9 +67,12 @@ pub struct MeshInputs<'a> {
 /// What the G-buffer pass writes into the stencil: each object's BRDF slot into the layout's
 /// BRDF bits, the engine's pattern into its preserved bits.
 pub struct GbufferStencil<'a> {
+    /// Where the BRDF and preserved bits sit.
     pub layout: &'a StencilLayout,
     /// Each object's BRDF slot, in `Scene::objects` order.
     pub slots: &'a [u32],
+    /// The engine's bits for the preserved stencil bits; bits outside
+    /// `StencilLayout::preserved_mask` are dropped.
     pub preserved_pattern: u8,
 }
 
@@ -244,6 +254,7 @@ impl MeshPasses {
             });
     }
 
+    /// Frees the pipelines and layouts; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             for p in [self.gbuffer, self.forward, self.emissive] {

@@ -11,13 +11,21 @@ use crate::shaders;
 /// `histencil_build::compile_light_shaders` writes this as an expression for `include!`.
 #[derive(Clone, Copy, Debug)]
 pub struct LightModules {
+    /// `deferred_light.frag`: the per-BRDF and branching light shaders.
     pub deferred_light: &'static [u8],
+    /// `lut_light.frag`: the LUT technique's light shader.
     pub lut_light: &'static [u8],
+    /// `tile_classify.comp`: the tiled technique's classification, 16x16 tiles.
     pub tile_classify: &'static [u8],
+    /// `tile_shade.comp`: the tiled technique's shade kernel, 16x16 tiles.
     pub tile_shade: &'static [u8],
+    /// `tile_classify_8.comp`: the classification for 8x8 tiles.
     pub tile_classify_8: &'static [u8],
+    /// `tile_shade_8.comp`: the shade kernel for 8x8 tiles.
     pub tile_shade_8: &'static [u8],
+    /// `depth_id_copy.frag`: the depth-id technique's id copy.
     pub depth_id_copy: &'static [u8],
+    /// `depth_id_shade.frag`: the depth-id technique's shade pass.
     pub depth_id_shade: &'static [u8],
 }
 

@@ -25,11 +25,22 @@ pub enum LightShader {
     /// Writes one saved preserved stencil bit back (`restore_preserved.frag`).
     RestoreBit,
     /// The light shader of one BRDF.
-    Brdf { id: BrdfId, tiles: TileWork },
+    Brdf {
+        /// The BRDF it is specialised for.
+        id: BrdfId,
+        /// The hi-stencil work it carries.
+        tiles: TileWork,
+    },
     /// The uber light shader branching on the G-buffer's BRDF id.
-    Branching { tiles: TileWork },
+    Branching {
+        /// The hi-stencil work it carries.
+        tiles: TileWork,
+    },
     /// The LUT technique's light shader: every BRDF from its material's table.
-    Lut { tiles: TileWork },
+    Lut {
+        /// The hi-stencil work it carries.
+        tiles: TileWork,
+    },
 }
 
 /// Where shade passes get a BRDF's value from.
@@ -48,6 +59,7 @@ pub enum BrdfSource {
 /// where it never runs (about 5 of the 14 % a testing pass cost over native's; README).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TileWork {
+    /// Neither: a pass without an emulated hi-stencil test.
     None,
     /// The emulated hi-stencil test, read-only.
     Test,
@@ -61,6 +73,8 @@ pub type LightPipelineKey = (Geometry, LightShader);
 /// `SHADED_BRDF` of `deferred_light.frag` for the branching shader.
 const BRANCH_ON_GBUFFER: u32 = u32::MAX;
 
+/// The lighting's pipelines, one per [`LightPipelineKey`] a plan has needed so far, made from
+/// one set of [`LightModules`] and kept until the lighting is destroyed.
 pub struct LightPipelines {
     layout: vk::PipelineLayout,
     /// The light shaders: histencil's, or compiled with an engine's hooks.
@@ -71,6 +85,8 @@ pub struct LightPipelines {
 }
 
 impl LightPipelines {
+    /// None made yet: pipelines for `layout` (the lighting's, which it keeps owning), rendering
+    /// to `hdr_format` and `depth_stencil_format`, from `modules`.
     pub fn new(
         layout: vk::PipelineLayout,
         modules: LightModules,
@@ -176,6 +192,7 @@ impl LightPipelines {
         self.pipelines.len()
     }
 
+    /// Frees the pipelines made so far (not the layout); a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         for (_, p) in self.pipelines.drain() {
             unsafe { ctx.device.destroy_pipeline(p, None) };

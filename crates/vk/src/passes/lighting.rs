@@ -49,20 +49,32 @@ pub fn pass_group(kind: PassKind, brdfs: &[BrdfId], source: BrdfSource) -> Strin
     }
 }
 
+/// One frame's lighting as `DeferredLighting::record` hands it to the recorder: the plan and
+/// everything its steps bind, borrowed for the recording only.
 pub struct LightingPass<'a> {
+    /// The device the commands are recorded for.
     pub ctx: &'a Context,
+    /// The command buffer being recorded, outside any rendering.
     pub cmd: vk::CommandBuffer,
+    /// The model's steps for this frame, in order.
     pub plan: &'a FramePlan,
+    /// The frame's lights; a planned light's index points here and into the light buffer.
     pub lights: &'a [Light],
+    /// The BRDF of each stencil slot, for the per-BRDF shaders and the timing groups.
     pub brdfs: &'a [BrdfId],
+    /// The unit sphere and cone meshes a light's volume is drawn with.
     pub volumes: &'a LightVolumes,
+    /// The pipelines made for this plan's pass states.
     pub pipelines: &'a LightPipelines,
+    /// The layout of those pipelines, for binding sets and pushing [`LightDrawPush`].
     pub pipeline_layout: vk::PipelineLayout,
     /// Frame, G-buffer and hi-stencil sets, and the LUT set when shading from tables.
     pub sets: &'a [vk::DescriptorSet],
     /// The engine's visibility hook set, bound at set 4.
     pub visibility_set: Option<vk::DescriptorSet>,
+    /// Whether shade passes evaluate each BRDF's formula or its material's table.
     pub brdf_source: BrdfSource,
+    /// The size of the targets, for the render area and hi-stencil tile rectangles.
     pub extent: vk::Extent2D,
     /// Count tile and fragment statistics (extra draws and atomics).
     pub count_stats: bool,

@@ -73,6 +73,7 @@ impl TileSide {
         }
     }
 
+    /// The side in pixels (`TILED_TILE` of the kernels built for it).
     pub fn pixels(self) -> u32 {
         match self {
             TileSide::Eight => 8,

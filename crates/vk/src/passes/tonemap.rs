@@ -28,6 +28,7 @@ pub struct Tonemap {
 pub struct TonemapInputs {
     /// Set 0: the frame's uniforms (exposure).
     pub frame_set: vk::DescriptorSet,
+    /// The size of the LDR target: the render area.
     pub extent: vk::Extent2D,
 }
 
@@ -115,6 +116,7 @@ impl Tonemap {
         ctx.end_label(cmd);
     }
 
+    /// Frees the pipeline, the set's pool and the layouts; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_pipeline(self.pipeline, None);

@@ -38,6 +38,7 @@ impl DepthStencilFormat {
     /// Both, in the order a device's format is probed when none is asked for.
     pub const ALL: [DepthStencilFormat; 2] = [DepthStencilFormat::D32S8, DepthStencilFormat::D24S8];
 
+    /// The Vulkan format.
     pub fn vk(self) -> vk::Format {
         match self {
             DepthStencilFormat::D32S8 => vk::Format::D32_SFLOAT_S8_UINT,
@@ -88,11 +89,16 @@ impl ContextDesc {
 /// An engine's device, lent to histencil: the handles the engine created, which it keeps and
 /// destroys itself after every histencil object made with them.
 pub struct BorrowedDevice {
+    /// The engine's instance, which `device` was created from.
     pub instance: ash::Instance,
+    /// The engine's device, with the features of [`REQUIREMENTS`] enabled.
     pub device: ash::Device,
+    /// The physical device behind `device`, whose limits and formats histencil reads.
     pub physical_device: vk::PhysicalDevice,
     /// The family of `queue`; it must fit [`REQUIREMENTS`].
     pub queue_family: u32,
+    /// The queue of `queue_family` that histencil's own tools (the renderer, the evaluators)
+    /// submit to; the engine-facing parts submit nothing.
     pub queue: vk::Queue,
     /// The engine's allocator for `device`; histencil's allocations are named `histencil`-side
     /// and freed before its objects are dropped.

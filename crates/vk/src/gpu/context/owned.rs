@@ -74,6 +74,12 @@ impl Drop for Partial {
 }
 
 impl Context {
+    /// histencil's own instance and device, as `desc` asks: what its tools and tests light with.
+    ///
+    /// # Errors
+    /// [`Error::Loading`] without a Vulkan loader (or, asked for, the validation layer);
+    /// [`Error::NoDevice`] when no device meets [`REQUIREMENTS`] (or matches the filter);
+    /// [`Error::MissingFormat`] when it cannot attach the depth-stencil format asked for.
     pub fn new(desc: ContextDesc) -> Result<Self> {
         // SAFETY: loading the system Vulkan loader; nothing else runs inside it yet.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loading(e.to_string()))?;
