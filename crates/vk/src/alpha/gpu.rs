@@ -13,17 +13,24 @@ use histencil_scene::{Light, Material, ParticleLayout};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct AlphaEntityRecord {
+    /// Object to world; identity for a particle system, whose points are in world space.
     pub model: [[f32; 4]; 4],
+    /// rgb: the material's tint; w: the entity's opacity.
     pub tint_opacity: [f32; 4],
+    /// xyz: the BRDF's packed parameters; w: its model index.
     pub params: [f32; 4],
     /// xy: the region's first texel in the atlas; zw: one tile's size.
     pub region: [u32; 4],
     /// x: kind, y: tiles, z: first point or probe (a sliced system: tiles to a row), w: point
     /// count.
     pub shape: [u32; 4],
+    /// The probe frame's centre (the single probe's point) and radius.
     pub centre_radius: [f32; 4],
+    /// xyz: the probe frame's unit right axis; w: half the depth of a slice stack.
     pub right_depth: [f32; 4],
+    /// xyz: the probe frame's unit up axis.
     pub up: [f32; 4],
+    /// xyz: the probe frame's unit view direction.
     pub forward: [f32; 4],
     /// First index into the entity light list, and count.
     pub light_range: [u32; 4],

@@ -55,7 +55,10 @@ pub struct LightmapFrame<'a> {
     pub slot: u32,
     /// The camera: particle probe frames face it, and probes are lit towards it.
     pub view: &'a ViewDesc,
+    /// The frame's lights; each entity is lit by those whose range reaches its bounds.
     pub lights: &'a [Light],
+    /// The entities to light, in the order their records are written
+    /// ([`AlphaLightmaps::entity_buffer`]).
     pub entities: &'a [AlphaEntity<'a>],
     /// The entities' regions, from [`histencil_alpha::plan_entities`] (or
     /// [`histencil_alpha::plan_regions`] on their descriptions), in the same order.

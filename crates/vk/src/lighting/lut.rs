@@ -96,6 +96,7 @@ impl<C: Deref<Target = Context>> LutTables<C> {
         &self.luts
     }
 
+    /// Grid points per axis of every table, as baked.
     pub fn resolution(&self) -> u32 {
         self.resolution
     }
@@ -151,6 +152,7 @@ pub struct LutEvaluator {
 }
 
 impl LutEvaluator {
+    /// Makes the compute pipeline; the tables are given per call.
     pub fn new(ctx: &Context) -> Result<Self> {
         let kernel = CaseKernel::new(
             ctx,
@@ -194,6 +196,7 @@ impl LutEvaluator {
         Ok(values.into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
     }
 
+    /// Frees the pipeline and its layouts; call it once, before the context goes.
     pub fn destroy(&mut self, ctx: &Context) {
         self.kernel.destroy(ctx);
     }

@@ -24,10 +24,13 @@ use histencil_scene::Light;
 /// Everything `histencil_model::Simulator` needs to predict a frame.
 #[derive(Clone, Debug)]
 pub struct SimulatorInputs {
+    /// The renderer's stencil layout, which the plan's stencil states use.
     pub layout: StencilLayout,
+    /// The hi-stencil tile side in pixels, as the GPU emulation uses.
     pub tile_size: u32,
     /// Depth and stencil after the G-buffer pass.
     pub target: SoftTarget,
+    /// The lighting plan the GPU frame records.
     pub plan: FramePlan,
     /// Per planned light (the plan's light indices).
     pub footprints: Vec<Footprint>,

@@ -31,6 +31,8 @@ pub struct MaterialRecord {
 }
 
 impl MaterialRecord {
+    /// The record of one map set: an absent map reads texture set 0 through the identity
+    /// transform (its slot binds the white texel).
     pub fn new(maps: &MaterialMaps, emissive: Vec3) -> Self {
         let mut transform = [[0.0; 4]; 2 * MAP_COUNT];
         for (i, map) in maps.refs().iter().enumerate() {
@@ -64,7 +66,10 @@ const RECORD_STRIDE: u64 = 256;
 /// A texture to make: a scene image, and whether it holds sRGB colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TextureKey {
+    /// Index into the scene's images.
     pub image: u32,
+    /// Decoded as sRGB (a base colour or emissive map): the same image read as another map
+    /// is a second, linear texture.
     pub srgb: bool,
 }
 
@@ -72,9 +77,13 @@ pub struct TextureKey {
 /// sampler slots it binds (slot 0 is the white texel and the default sampler).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SetPlan {
+    /// The maps its objects share.
     pub maps: MaterialMaps,
+    /// The radiance its objects emit (times the emissive map).
     pub emissive: Vec3,
+    /// Per map, its texture slot in [`MaterialPlan::textures`] (0: the white texel).
     pub textures: [usize; MAP_COUNT],
+    /// Per map, its sampler slot in [`MaterialPlan::samplers`] (0: the default sampler).
     pub samplers: [usize; MAP_COUNT],
 }
 
@@ -457,6 +466,7 @@ impl GpuMaterials {
         Ok(())
     }
 
+    /// Frees the textures, samplers, records and sets; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);

@@ -45,8 +45,11 @@ const MAX_MATERIALS: usize = 2048;
 /// A rendered frame: its GPU timings, the images asked for, and the hi-stencil statistics when
 /// [`crate::FrameDesc::tile_stats`] asks for them (deferred techniques only).
 pub struct Frame {
+    /// GPU time per pass, read from the frame's timestamps.
     pub timings: FrameTimings,
+    /// The images [`crate::FrameDesc::readback`] asked for; the others are `None`.
     pub images: FrameImages,
+    /// Tiles tested and culled, fragments shaded, flushes; `None` unless asked for.
     pub tile_stats: Option<TileStats>,
 }
 
@@ -59,7 +62,9 @@ pub struct Frame {
 /// in [`crate::FrameDesc`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RendererDesc {
+    /// The targets' width in pixels.
     pub width: u32,
+    /// The targets' height in pixels.
     pub height: u32,
     /// The culling bit and the BRDF field where an engine wants them; `None`: the talk's
     /// layout (culling bit 0, BRDF bits above it).
@@ -136,6 +141,7 @@ impl<'c> Renderer<'c> {
         &self.scene
     }
 
+    /// Where the culling bit, the BRDF field and the preserved bits sit in its stencil.
     pub fn stencil_layout(&self) -> &StencilLayout {
         &self.stencil_layout
     }

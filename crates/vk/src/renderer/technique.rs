@@ -18,7 +18,9 @@ pub enum Backend {
     /// bits as lights draw (the talk's fix); without it, hi-stencil fails on preserved bits.
     /// `save_restore` (with zeroing) copies them aside before lighting and writes them back after.
     X360 {
+        /// Zero the preserved bits as lights draw (the talk's fix).
         zero_preserved: bool,
+        /// Save the preserved bits before lighting and restore them after (with zeroing).
         save_restore: bool,
     },
     /// PS3-like: hi-stencil with a read mask; preserved bits survive.
@@ -39,6 +41,7 @@ pub enum Backend {
 }
 
 impl Backend {
+    /// The model's platform: its name for reports and the caps the planner reads.
     pub fn platform(self) -> Box<dyn PlatformBackend> {
         match self {
             Backend::X360 {
@@ -123,12 +126,16 @@ pub enum Technique {
     /// The talk's technique: each light volume drawn once per BRDF it touches, masked by the
     /// BRDF id in the stencil, with one shader per BRDF.
     Stencil {
+        /// The platform whose stencil and hi-stencil behaviour the plan follows.
         backend: Backend,
+        /// When hi-stencil writes are flushed for later tests.
         flush: FlushPolicy,
     },
     /// One uber light shader branching on the G-buffer's BRDF id; one draw per light.
     Branching {
+        /// The platform whose stencil and hi-stencil behaviour the plan follows.
         backend: Backend,
+        /// When hi-stencil writes are flushed for later tests.
         flush: FlushPolicy,
     },
     /// Stencil or branching per light, whichever the renderer's [`CostModel`] predicts cheaper
@@ -136,14 +143,18 @@ pub enum Technique {
     /// or the whole frame tiled where costs measured on the device predict that surely cheaper
     /// than the plan ([`crate::Renderer::resolve`]).
     Adaptive {
+        /// The platform whose stencil and hi-stencil behaviour the plan follows.
         backend: Backend,
+        /// When hi-stencil writes are flushed for later tests.
         flush: FlushPolicy,
     },
     /// The talk's third option: one draw per light, as branching, with every BRDF read from its
     /// material's look-up table ([`crate::RendererDesc::lut_resolution`]) instead of its formula.
     /// Approximate: its error against forward falls with the table resolution.
     Lut {
+        /// The platform whose stencil and hi-stencil behaviour the plan follows.
         backend: Backend,
+        /// When hi-stencil writes are flushed for later tests.
         flush: FlushPolicy,
     },
     /// Today's engines' way (Unity HDRP's material tiles, UE5 Substrate's classification,
@@ -153,13 +164,21 @@ pub enum Technique {
     /// own BRDF with its tile's lights (`passes/tiled.rs`). No stencil, no hi-stencil: the same
     /// on every platform. `mixed` says how tiles of several BRDFs are shaded, `side` how big a
     /// tile is.
-    Tiled { mixed: MixedTiles, side: TileSide },
+    Tiled {
+        /// How tiles that hold several BRDFs are shaded.
+        mixed: MixedTiles,
+        /// The tile's side.
+        side: TileSide,
+    },
     /// What Bevy's deferred renderer ships instead of stencil ids: each pixel's BRDF slot copied
     /// into a 16-bit depth image, then one full-screen pass per BRDF drawn at its slot's depth
     /// with compare EQUAL, so hierarchical depth rejects other BRDFs' tiles; each pixel adds
     /// its tile's lights from the tiled technique's light lists (`passes/depth_id.rs`). The
     /// same image as [`Technique::Tiled`], bit for bit. `side` is the light lists' tile.
-    DepthId { side: TileSide },
+    DepthId {
+        /// The light lists' tile side.
+        side: TileSide,
+    },
 }
 
 impl Technique {
@@ -226,6 +245,7 @@ impl Technique {
 /// resolution, lightmap sides) or is calibration (the cost model).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameDesc {
+    /// Forward, or deferred with a lighting technique.
     pub shading: Shading,
     /// Which images to copy back.
     pub readback: Readback,

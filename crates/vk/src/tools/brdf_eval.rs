@@ -26,6 +26,7 @@ pub struct BrdfEvaluator {
 }
 
 impl BrdfEvaluator {
+    /// Makes the compute pipeline that runs `brdf_eval.comp`.
     pub fn new(ctx: &Context) -> Result<Self> {
         let kernel = CaseKernel::new(
             ctx,
@@ -66,6 +67,7 @@ impl BrdfEvaluator {
             .collect())
     }
 
+    /// Frees the pipeline and its layouts; call it once, before the context goes.
     pub fn destroy(&mut self, ctx: &Context) {
         self.kernel.destroy(ctx);
     }
