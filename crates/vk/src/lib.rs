@@ -9,6 +9,8 @@
 //! derived in one place ([`access`]) from declared accesses. Tests run under the Khronos
 //! validation layer with synchronisation validation, and any message fails them.
 
+#![warn(missing_docs)]
+
 // The layers, each recording through the ones below it: the device layer; the passes (one file
 // per pass or technique) and the hi-stencil emulation; the engine API (`DeferredLighting`, its
 // hooks, `AlphaLightmaps`); histencil's own renderer; and the tools its command line and lab use.
