@@ -53,10 +53,10 @@ fn a_clean_slice_passes_and_its_known_wrong_cases_fail_as_expected() {
     assert_eq!(code, Some(0), "{stdout}\n{stderr}");
     // Not a terminal: no progress bar in the log.
     assert!(!stderr.contains('\u{1b}'), "{stderr}");
-    assert!(stdout.contains(": 64 Pass\n"), "{stdout}");
+    assert!(stdout.contains(": 71 Pass\n"), "{stdout}");
     assert!(stdout.contains("driver: llvmpipe (Mesa "), "{stdout}");
     assert!(
-        stdout.contains("known-wrong cases: 3 failed as expected"),
+        stdout.contains("known-wrong cases: 4 failed as expected"),
         "{stdout}"
     );
     let xml = text(&junit);
@@ -66,12 +66,13 @@ fn a_clean_slice_passes_and_its_known_wrong_cases_fail_as_expected() {
         xml.contains("<property name=\"driver\" value=\"llvmpipe (Mesa "),
         "{xml}"
     );
-    assert_eq!(xml.matches("failed as expected").count(), 3, "{xml}");
+    assert_eq!(xml.matches("failed as expected").count(), 4, "{xml}");
     let report: serde_json::Value = serde_json::from_str(&text(&json)).unwrap();
     let cases = report["cases"].as_array().unwrap();
-    // The reference, 2 patterns x 29 lighting configurations, 3 known-wrong, and the D32S8
-    // context's canary and teardown (one row each, whichever workers made them).
-    assert_eq!(cases.len(), 1 + 2 * 29 + 3 + 2);
+    // The reference, 2 patterns x 32 lighting configurations (tiled, depth-id and stencil on
+    // the two AMD platforms among them), 4 known-wrong, and the D32S8 context's canary and
+    // teardown (one row each, whichever workers made them).
+    assert_eq!(cases.len(), 1 + 2 * 32 + 4 + 2);
     assert!(cases.iter().all(|c| c["status"] == "Pass"));
     let stencil_ps3 = cases
         .iter()
@@ -85,7 +86,7 @@ fn a_clean_slice_passes_and_its_known_wrong_cases_fail_as_expected() {
     let results = text(&dir.join("cases").join("results.csv"));
     assert_eq!(
         results.lines().filter(|l| l.contains(",Pass,")).count(),
-        64,
+        71,
         "{results}"
     );
 }
@@ -167,10 +168,11 @@ fn list_prints_the_matrix_without_a_device() {
             .filter(|l| l.starts_with("default\t"))
             .count()
     };
-    // Per format and resolution: the reference and 58 lighting cases (29 per pattern, tiled
-    // among them), plus 3 known-wrong cases on D32S8 at 64x64 and up.
-    assert_eq!(count(&quick), 2 * 3 * 59 + 3);
-    assert_eq!(count(&full), 2 * 4 * 59 + 2 * 3);
+    // Per format and resolution: the reference and 64 lighting cases (32 per pattern, tiled,
+    // depth-id and the AMD platforms among them), plus 4 known-wrong cases on D32S8 at 64x64
+    // and up.
+    assert_eq!(count(&quick), 2 * 3 * 65 + 4);
+    assert_eq!(count(&full), 2 * 4 * 65 + 2 * 4);
     assert!(quick.contains("default\tstencil-x360-no-zeroing-auto-pA0-lightmap-d32s8-257x129\tWrong(PreservedBitsNotZeroed)"), "{quick}");
     assert!(full.contains("d24s8-1280x720"));
 }

@@ -600,16 +600,20 @@ fn demo_prints_the_tour_and_writes_the_contact_sheet_under_validation() {
         "stencil, PS3-like",
         "stencil, 360-like (zeroing)",
         "stencil, 360-like (save/restore)",
+        "stencil, AMD GFX9-11 pretests (modelled)",
+        "stencil, AMD GFX12 AND/OR (modelled)",
         "tiled, native",
+        "depth-id (Bevy's), native",
     ] {
         assert!(stdout.contains(row), "{row}: {stdout}");
     }
     assert!(stdout.contains("flushes"), "{stdout}");
     assert!(stdout.contains("histencil check"), "{stdout}");
-    // Four half-size tiles per row, two rows, each under a caption band.
+    // Four half-size tiles per row, three rows (the frames, then the three failures beside
+    // their fixes), each under a caption band.
     let image = image::open(&sheet).expect("the contact sheet");
     assert_eq!(image.width(), 4 * (48 + 6) + 6);
-    assert_eq!(image.height(), 2 * (32 + 30 + 6) + 6);
+    assert_eq!(image.height(), 3 * (32 + 30 + 6) + 6);
 }
 
 #[test]

@@ -54,7 +54,7 @@ fn statuses(out: &Path) -> Vec<(String, String)> {
         .collect()
 }
 
-/// A small slice: `brdfs-3` at 7x5 in D32S8 (the reference and 58 lighting cases).
+/// A small slice: `brdfs-3` at 7x5 in D32S8 (the reference and 64 lighting cases).
 const SLICE: [&str; 5] = ["--quick", "--scene", "brdfs-3", "--filter", "d32s8-7x5"];
 
 #[test]
@@ -194,9 +194,9 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
             .map(|(_, s)| s.clone())
     };
     assert_eq!(status(hung).as_deref(), Some("Timeout"), "{results:?}");
-    // Every other case ran and passed: 59 cases, one timed out.
+    // Every other case ran and passed: 65 cases, one timed out.
     let passed = results.iter().filter(|(_, s)| s == "Pass").count();
-    assert_eq!(passed, 58 + 2, "{results:?}");
+    assert_eq!(passed, 64 + 2, "{results:?}");
     let report: serde_json::Value = serde_json::from_str(&read(&json)).unwrap();
     assert!(report["workers"]
         .as_array()
@@ -246,7 +246,7 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
     let passed = teardown
         .iter()
         .filter(|(n, s)| n.starts_with("brdfs-3/") && s == "Pass");
-    assert_eq!(passed.count(), 59, "{teardown:?}");
+    assert_eq!(passed.count(), 65, "{teardown:?}");
 
     // --max-fails stops the run at the first failing case, and says so.
     let json = dir.join("max-fails.json");
@@ -368,9 +368,9 @@ fn shards_merge_into_one_report() {
         .filter(|c| c["scene"] == "brdfs-3")
         .map(|c| c["name"].as_str().unwrap().to_owned())
         .collect();
-    assert_eq!(names.len(), 1 + 58, "{names:?}");
+    assert_eq!(names.len(), 1 + 64, "{names:?}");
     assert_eq!(merged["shards"], serde_json::json!(["1/2", "2/2"]));
-    assert!(read(&junit).contains("<testsuite name=\"brdfs-3\" tests=\"59\""));
+    assert!(read(&junit).contains("<testsuite name=\"brdfs-3\" tests=\"65\""));
     // A shard given twice, or one missing (its job died before writing its report), is refused.
     for (shards, why) in [
         (vec![&jsons[0], &jsons[0]], "twice"),
