@@ -393,11 +393,59 @@ impl HiStencilSurface {
         }
         self.unflushed = true;
         let WriteTiles { touched, rect } = tiles;
-        let rect_tiles = rect.width * rect.height;
         if rect.is_empty() {
             // The volume lies off screen: it rasterised nothing.
             return;
         }
+        let marker = match touched {
+            TouchedTiles::All => 0,
+            TouchedTiles::Drawn | TouchedTiles::Kept => {
+                assert_ne!(self.marker, 0, "a kept write follows a touch draw");
+                self.marker
+            }
+        };
+        let push = UpdatePush {
+            compare: compare_op(hi.compare).as_raw() as u32,
+            reference: u32::from(hi.reference),
+            read_mask: u32::from(hi.read_mask.unwrap_or(0xFF)),
+            marker,
+            ..self.update_push(rect)
+        };
+        self.dispatch_update(ctx, cmd, slot, depth_stencil, &push);
+    }
+
+    /// The update's settings over the tiles of `rect`, evaluating nothing yet (mode 0, no
+    /// compare, every tile of the rectangle touched).
+    fn update_push(&self, rect: TileRect) -> UpdatePush {
+        UpdatePush {
+            compare: 0,
+            reference: 0,
+            read_mask: 0,
+            width: self.extent.width,
+            height: self.extent.height,
+            tiles_x: self.tiles_x,
+            rect_x: rect.x,
+            rect_y: rect.y,
+            rect_width: rect.width,
+            rect_tiles: rect.width * rect.height,
+            marker: 0,
+            mode: 0,
+            tests: 0,
+            mask2: 0,
+            value2: 0,
+        }
+    }
+
+    /// Runs the tile update with `push` over its rectangle, reading the stencil in place, into
+    /// the pending surface; leaves the depth-stencil image attached-ready.
+    fn dispatch_update(
+        &mut self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        slot: u32,
+        depth_stencil: &mut ImageRef,
+        push: &UpdatePush,
+    ) {
         let stencil_read = ImageAccess::ComputeDepthStencilSampled;
         transition(ctx, cmd, depth_stencil, stencil_read, Contents::Keep);
         // The update's set holds the touch image whether or not this update looks at it, so it
@@ -412,34 +460,10 @@ impl HiStencilSurface {
             };
             transition(ctx, cmd, &mut self.touch, stencil_read, contents);
         }
-        let marker = match touched {
-            TouchedTiles::All => 0,
-            TouchedTiles::Drawn | TouchedTiles::Kept => {
-                assert_ne!(self.marker, 0, "a kept write follows a touch draw");
-                self.marker
-            }
-        };
-        let push = UpdatePush {
-            compare: compare_op(hi.compare).as_raw() as u32,
-            reference: u32::from(hi.reference),
-            read_mask: u32::from(hi.read_mask.unwrap_or(0xFF)),
-            width: self.extent.width,
-            height: self.extent.height,
-            tiles_x: self.tiles_x,
-            rect_x: rect.x,
-            rect_y: rect.y,
-            rect_width: rect.width,
-            rect_tiles,
-            marker,
-            mode: 0,
-            tests: 0,
-            mask2: 0,
-            value2: 0,
-        };
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
-        update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
-        let groups = rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
+        update.bind(ctx, cmd, set, bytemuck::bytes_of(push));
+        let groups = push.rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
         unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
         let attached = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
@@ -464,20 +488,6 @@ impl HiStencilSurface {
         if rect.is_empty() {
             return;
         }
-        let stencil_read = ImageAccess::ComputeDepthStencilSampled;
-        transition(ctx, cmd, depth_stencil, stencil_read, Contents::Keep);
-        let (read_layout, ..) = access_info(stencil_read);
-        if self.touch.state.layout != read_layout {
-            // Bound by the set, never read here (marker 0).
-            let drawn = self.touch.state.layout != vk::ImageLayout::UNDEFINED;
-            let contents = if drawn {
-                Contents::Keep
-            } else {
-                Contents::Discard
-            };
-            transition(ctx, cmd, &mut self.touch, stencil_read, contents);
-        }
-        let rect_tiles = rect.width * rect.height;
         let (mode, tests, first, second, compare) = match test {
             TileTest::Pretests(p) => {
                 let held: Vec<(u8, u8)> = p.into_iter().flatten().collect();
@@ -500,28 +510,15 @@ impl HiStencilSurface {
             compare,
             reference: u32::from(first.1),
             read_mask: u32::from(first.0),
-            width: self.extent.width,
-            height: self.extent.height,
-            tiles_x: self.tiles_x,
-            rect_x: rect.x,
-            rect_y: rect.y,
-            rect_width: rect.width,
-            rect_tiles,
-            marker: 0,
             mode,
             tests,
             mask2: u32::from(second.0),
             value2: u32::from(second.1),
+            ..self.update_push(rect)
         };
-        let set = self.sets[slot as usize];
-        let update = self.update.as_ref().expect("made with the surface");
-        update.bind(ctx, cmd, set, bytemuck::bytes_of(&push));
-        let groups = rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
-        unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
+        self.dispatch_update(ctx, cmd, slot, depth_stencil, &push);
         // The tiles outside `rect` are not the draw's: active there is whatever it was.
         self.record_flush(ctx, cmd);
-        let attached = ImageAccess::DepthStencilAttachment;
-        transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
     }
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
