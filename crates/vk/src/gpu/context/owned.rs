@@ -160,6 +160,11 @@ impl Context {
         if pin_settings {
             extensions.push(ash::ext::layer_settings::NAME.as_ptr());
         }
+        let extensions_without: Vec<_> = extensions
+            .iter()
+            .copied()
+            .filter(|&e| e != ash::ext::layer_settings::NAME.as_ptr())
+            .collect();
         let validation = Arc::new(ValidationLog::default());
         // SAFETY: the context keeps `validation` until after it destroys the messenger.
         let messenger_info = unsafe { ValidationLog::messenger_create_info(&validation) };
@@ -174,11 +179,32 @@ impl Context {
                 .push_next(&mut validation_features)
                 .push_next(&mut messenger_for_create);
         }
+        let without_settings = instance_info;
         if pin_settings {
             instance_info = instance_info.push_next(&mut layer_settings);
         }
-        let instance =
-            unsafe { entry.create_instance(&instance_info, None) }.call("vkCreateInstance")?;
+        // A layer newer than the loader (an SDK's layer over a distribution's loader, say) offers
+        // VK_EXT_layer_settings, and a loader that predates the extension refuses it at
+        // vkCreateInstance. Then the settings stay pinned as they are for layers without the
+        // extension (the check's settings file, its cleared environment, its canary), and the
+        // report says so.
+        let mut settings_way = "through VK_EXT_layer_settings";
+        let created = unsafe { entry.create_instance(&instance_info, None) };
+        let instance = match created {
+            Err(vk::Result::ERROR_EXTENSION_NOT_PRESENT) if pin_settings => {
+                settings_way = "from the environment (the loader refused VK_EXT_layer_settings)";
+                let retry = without_settings.enabled_extension_names(&extensions_without);
+                unsafe { entry.create_instance(&retry, None) }
+            }
+            other => {
+                if !pin_settings {
+                    settings_way = "from the environment (the layer lacks VK_EXT_layer_settings)";
+                }
+                other
+            }
+        }
+        .call("vkCreateInstance")?;
+        let layer_text = layer_text.map(|t| format!("{t}, settings {settings_way}"));
         let mut partial = Partial {
             instance: Some(instance.clone()),
             debug_instance: None,
