@@ -18,8 +18,10 @@ void main() {
     if (material_masked(in_uv, in_color)) {
         discard;
     }
-    Surface s = surface_from_material(in_world_position, in_world_normal, in_uv,
-                                      in_world_tangent, in_color, gl_FrontFacing);
+    // Lit at the point the deferred passes rebuild from the G-buffer's depth (frame.glsl).
+    vec3 position = world_position_on_ray(gl_FragCoord.xy, in_linear_depth);
+    Surface s = surface_from_material(position, in_world_normal, in_uv, in_world_tangent,
+                                      in_color, gl_FrontFacing);
     vec3 sum = material_emissive(in_uv);
     for (uint i = 0; i < frame.counts.x; ++i) {
         sum += shade_light(lights[i], s);

@@ -29,4 +29,19 @@ layout(set = 0, binding = 1, std430) readonly buffer Lights {
     Light lights[];
 };
 
+// The world-space point at `linear_depth` (-z in view space) on the view ray through
+// `frag_coord` (gl_FragCoord.xy). The deferred passes rebuild every surface position this way
+// from the G-buffer's depth, and the forward reference rebuilds its own the same way from the
+// same interpolated depth instead of interpolating the world position: a rasteriser snaps
+// vertices to its sub-pixel grid (the spec's minimum is 4 bits), so an interpolated position is
+// a point on the snapped triangle, off the pixel's true view ray by up to 1/16 of a pixel's
+// footprint, while the rebuilt one lies on the ray. Lit from two different points, forward and
+// deferred differed by up to 21/255 on SwiftShader (4 bits); sharing the computation leaves
+// them the same point on every rasteriser.
+vec3 world_position_on_ray(vec2 frag_coord, float linear_depth) {
+    vec2 ndc = frag_coord * frame.viewport.zw * 2.0 - 1.0;
+    vec3 view_position = vec3((ndc + frame.projection.zw) * frame.projection.xy, -1.0) * linear_depth;
+    return (frame.inv_view * vec4(view_position, 1.0)).xyz;
+}
+
 #endif

@@ -24,9 +24,7 @@ bool gbuffer_load(vec2 frag_coord, out Surface s) {
     float linear_depth = normal_depth.w;
     vec4 albedo = texelFetch(gbuffer_albedo, px, 0);
     vec4 material = texelFetch(gbuffer_material, px, 0);
-    vec2 ndc = frag_coord * frame.viewport.zw * 2.0 - 1.0;
-    vec3 view_position = vec3((ndc + frame.projection.zw) * frame.projection.xy, -1.0) * linear_depth;
-    s.position = (frame.inv_view * vec4(view_position, 1.0)).xyz;
+    s.position = world_position_on_ray(frag_coord, linear_depth);
     s.normal = normal_depth.xyz;
     s.tint = albedo.rgb;
     s.params = vec4(material.xyz, 0.0);
