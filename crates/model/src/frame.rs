@@ -65,6 +65,9 @@ pub struct PlannedLight {
     /// (plans from bare requests, full-screen lights, a bound reaching the eye plane). The GPU
     /// hi-stencil emulation looks for the tiles a write touched only inside it.
     pub screen_rect: Option<NdcRect>,
+    /// The depth-buffer values its volume can reach, where its shade passes are confined to
+    /// them by the depth bounds test ([`FramePlan::with_depth_bounds`]); `None` otherwise.
+    pub depth_range: Option<crate::depth_bounds::DepthRange>,
     /// Its case, the BRDF slots it touches and the technique chosen for it.
     pub request: LightRequest,
 }
@@ -79,6 +82,7 @@ impl PlannedLight {
                 input,
                 coverage: None,
                 screen_rect: None,
+                depth_range: None,
                 request,
             })
             .collect()

@@ -51,6 +51,7 @@ pub mod amd;
 mod backend;
 mod chooser;
 mod costs_json;
+pub mod depth_bounds;
 pub mod depth_id;
 mod footprint;
 mod frame;
@@ -67,6 +68,7 @@ mod view;
 pub use backend::{Native, PlatformBackend, PlatformCaps, Ps3Like, X360Like};
 pub use chooser::{CostModel, TalkFigures};
 pub use costs_json::{CostsError, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
+pub use depth_bounds::DepthRange;
 pub use footprint::{Footprint, Span};
 pub use frame::{
     insert_flushes, write_test_dependencies, FlushPolicy, FramePlan, PlannedLight, Step,

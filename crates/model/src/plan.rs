@@ -236,6 +236,7 @@ fn stencil_pass(
         back: None,
         color_write: false,
         hi_stencil: None,
+        depth_bounds: false,
     };
     Pass {
         kind,
@@ -358,6 +359,7 @@ pub fn plan_light(
             back: None,
             color_write: false,
             hi_stencil: Some(hi(reference, true)),
+            depth_bounds: false,
         },
     };
     let single_shader = match technique {
@@ -378,6 +380,7 @@ pub fn plan_light(
             back: None,
             color_write: true,
             hi_stencil: hi_test.then(|| hi(reference, false)),
+            depth_bounds: false,
         };
         Pass {
             kind: PassKind::Shade(shader),

@@ -151,7 +151,7 @@ impl LightShape {
     }
 
     /// A sphere containing the volume mesh histencil draws for the light.
-    fn volume_bound(&self) -> Option<(DVec3, f64)> {
+    pub(crate) fn volume_bound(&self) -> Option<(DVec3, f64)> {
         match *self {
             LightShape::Point { position, range } => Some((
                 DVec3::from(position.map(f64::from)),
@@ -354,6 +354,7 @@ pub fn plan_frame(
             input: index,
             coverage: Some(coverage),
             screen_rect,
+            depth_range: None,
             request: LightRequest {
                 case,
                 affected,

@@ -3,6 +3,7 @@
 //! It is the oracle for the GPU implementation: the same plan, the same state values.
 
 use crate::amd::{tile_values, TileHierarchy};
+use crate::depth_bounds::DepthRange;
 use crate::footprint::Footprint;
 use crate::frame::{FramePlan, Step};
 use crate::layout::StencilLayout;
@@ -69,6 +70,11 @@ pub struct SimResult {
     pub culling_bit_left: Vec<bool>,
     /// Hi-stencil tiles tested, culled and passed over the whole run.
     pub stats: TileStats,
+    /// Fragments of shade passes the depth bounds test rejected
+    /// ([`crate::FramePlan::with_depth_bounds`]): pixels in a light's footprint whose surface
+    /// lies outside its depth range, which the pass would otherwise have tested and, where its
+    /// stencil and depth tests passed, shaded.
+    pub depth_bounds_rejected: u64,
 }
 
 /// Runs plans for one stencil layout and tile size.
@@ -142,6 +148,7 @@ impl Simulator {
             rejected: vec![false; tiles.tile_count()],
             tiles,
             stats: TileStats::default(),
+            depth_bounds_rejected: 0,
             touched: Vec::new(),
             target,
             hierarchy,
@@ -160,9 +167,12 @@ impl Simulator {
             match step {
                 Step::Pass { light, pass } => {
                     let far = plan.depth.far();
+                    let bounds = plan.lights[*light]
+                        .depth_range
+                        .filter(|_| pass.state.depth_bounds);
                     run.pass(
                         index as u32,
-                        pass,
+                        (pass, bounds),
                         far,
                         &footprints[*light],
                         &mut lights[*light],
@@ -189,6 +199,7 @@ impl Simulator {
             lights,
             culling_bit_left,
             stats: run.stats,
+            depth_bounds_rejected: run.depth_bounds_rejected,
         }
     }
 }
@@ -198,6 +209,7 @@ struct Run<'a> {
     target: &'a mut SoftTarget,
     tiles: TileSurface,
     stats: TileStats,
+    depth_bounds_rejected: u64,
     /// The step that last touched each tile, so each draw counts a tile once.
     tile_stamp: Vec<u32>,
     touched: Vec<usize>,
@@ -219,7 +231,7 @@ impl Run<'_> {
     fn pass(
         &mut self,
         step: u32,
-        pass: &Pass,
+        (pass, bounds): (&Pass, Option<DepthRange>),
         far: f32,
         footprint: &Footprint,
         shading: &mut LightShading,
@@ -275,6 +287,12 @@ impl Run<'_> {
                     continue;
                 }
                 let i = self.target.index(x, y);
+                // Vulkan's depth bounds test comes before the stencil test: a fragment it
+                // rejects runs no stencil op either.
+                if bounds.is_some_and(|b| !b.contains(self.target.depth[i])) {
+                    self.depth_bounds_rejected += 1;
+                    continue;
+                }
                 let stencil = self.target.stencil[i];
                 let stencil_passed = face.is_none_or(|f| f.test(stencil));
                 let depth_passed =

@@ -224,6 +224,9 @@ pub struct PassState {
     pub color_write: bool,
     /// `None` on platforms without hi-stencil, or when the pass neither tests nor writes it.
     pub hi_stencil: Option<HiStencilState>,
+    /// The device's depth bounds test confines the pass to its light's depth range
+    /// ([`crate::PlannedLight::depth_range`]; [`crate::FramePlan::with_depth_bounds`]).
+    pub depth_bounds: bool,
 }
 
 impl PassState {

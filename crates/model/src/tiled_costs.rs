@@ -166,6 +166,7 @@ mod tests {
                 input,
                 coverage: Some(c),
                 screen_rect: None,
+                depth_range: None,
                 request: LightRequest {
                     case: LightCase::Outside,
                     affected: (0..n).collect(),

@@ -220,6 +220,11 @@ impl View {
         &self.desc
     }
 
+    /// World space to Vulkan clip space: the projection times the view.
+    pub(crate) fn world_to_clip(&self) -> DMat4 {
+        self.world_to_clip
+    }
+
     /// Which end of depth is near.
     pub fn depth(&self) -> DepthConvention {
         self.depth
@@ -344,11 +349,11 @@ pub struct NdcRect {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// Looking down -Z from z = 5, 1 radian high, 1.5 wide over high, near plane at 0.1.
-    fn perspective(depth: DepthConvention, far: FarPlane) -> Perspective {
+    pub(crate) fn perspective(depth: DepthConvention, far: FarPlane) -> Perspective {
         Perspective {
             eye: [0.0, 0.0, 5.0],
             target: [0.0; 3],
@@ -361,11 +366,11 @@ mod tests {
         }
     }
 
-    fn camera(depth: DepthConvention, far: FarPlane) -> View {
+    pub(crate) fn camera(depth: DepthConvention, far: FarPlane) -> View {
         View::new(&perspective(depth, far).desc()).unwrap()
     }
 
-    const CONVENTIONS: [(DepthConvention, FarPlane); 4] = [
+    pub(crate) const CONVENTIONS: [(DepthConvention, FarPlane); 4] = [
         (DepthConvention::Standard, FarPlane::Finite(100.0)),
         (DepthConvention::Standard, FarPlane::Infinite),
         (DepthConvention::Reversed, FarPlane::Finite(100.0)),
