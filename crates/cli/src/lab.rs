@@ -21,6 +21,19 @@ pub struct RunArgs {
     /// Run under the validation layer; any message fails the run.
     #[arg(long)]
     validate: bool,
+    /// Leave the device's depth bounds test unused where it has one (`depthBounds`): the path
+    /// of a device without it, for comparing the two.
+    #[arg(long)]
+    no_depth_bounds: bool,
+}
+
+impl RunArgs {
+    fn device(&self) -> crate::DeviceArgs {
+        crate::DeviceArgs {
+            validate: self.validate,
+            no_depth_bounds: self.no_depth_bounds,
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -320,7 +333,7 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;
     settings.beside_load = usize::from(args.beside_load);
-    let report = on_device(args.run.validate, |ctx| {
+    let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {
             histencil_lab::run_compare(ctx, &settings, step)
         })?)
@@ -350,7 +363,7 @@ pub fn sweep(args: &SweepArgs, lights: DefaultLights) -> Result<()> {
         args.scene.as_deref().unwrap_or(param.default_scene()),
         lights,
     )?;
-    let report = on_device(args.run.validate, |ctx| {
+    let report = on_device(args.run.device(), |ctx| {
         let bar = progress_bar(Some(values.len() as u64));
         bar.set_message(format!("{} on {}", param.name(), scene.name));
         let report = histencil_lab::run_sweep(
@@ -376,7 +389,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     steady_llvmpipe();
     histencil_vk::check_output_file(&args.out)?;
     let sampling = args.sampling.sampling(args.run.frames)?;
-    let calibration = on_device(args.run.validate, |ctx| {
+    let calibration = on_device(args.run.device(), |ctx| {
         let c = with_spinner(|step| {
             histencil_lab::calibrate(ctx, args.run.width, args.run.height, &sampling, step)
         });
@@ -427,7 +440,7 @@ pub fn scale(args: &ScaleArgs, lights: DefaultLights) -> Result<()> {
         height: args.run.height,
         rounds: args.run.frames as usize,
     };
-    let report = on_device(args.run.validate, |ctx| {
+    let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {
             histencil_lab::run_scale(ctx, settings, step)
         })?)
@@ -447,7 +460,7 @@ pub fn demo(args: &DemoArgs, lights: DefaultLights) -> Result<()> {
         height: args.run.height,
         frames: args.run.frames as usize,
     };
-    let report = on_device(args.run.validate, |ctx| {
+    let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {
             histencil_lab::run_demo(ctx, settings, step)
         })?)

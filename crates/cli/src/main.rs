@@ -192,6 +192,10 @@ struct RenderArgs {
     /// the run fail.
     #[arg(long)]
     validate: bool,
+    /// Leave the device's depth bounds test unused where it has one (`depthBounds`): the path
+    /// of a device without it, for comparing the two.
+    #[arg(long)]
+    no_depth_bounds: bool,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -380,7 +384,11 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             histencil_vk::check_image_output(path, kind)?;
         }
     }
-    on_device(args.validate, |ctx| {
+    let device = DeviceArgs {
+        validate: args.validate,
+        no_depth_bounds: args.no_depth_bounds,
+    };
+    on_device(device, |ctx| {
         let shading = args.shading(ctx);
         let desc = RendererDesc {
             lut_resolution: args.lut_resolution,
@@ -546,10 +554,16 @@ fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
     }
     let inputs = renderer.simulator_inputs(*desc)?;
     let depth_id = matches!(desc.shading, Shading::Deferred(Technique::DepthId { .. }));
-    let predicted = match desc.shading.technique() {
-        _ if depth_id => inputs.predict_depth_id(),
-        Some(technique) => inputs.predict_on(&inputs.plan, technique.backend()).0.stats,
-        None => inputs.predict().0.stats,
+    let (predicted, depth_bounds_rejected) = match desc.shading.technique() {
+        _ if depth_id => (inputs.predict_depth_id(), 0),
+        Some(technique) => {
+            let sim = inputs.predict_on(&inputs.plan, technique.backend()).0;
+            (sim.stats, sim.depth_bounds_rejected)
+        }
+        None => {
+            let sim = inputs.predict().0;
+            (sim.stats, sim.depth_bounds_rejected)
+        }
     };
     let counted = FrameDesc {
         tile_stats: true,
@@ -591,14 +605,54 @@ fn print_stats(renderer: &mut Renderer, desc: &FrameDesc) -> Result<()> {
         gpu.flushes,
         agrees(gpu)
     );
+    // The test rejects fragments before any shader runs, so the GPU cannot count them: the
+    // simulator does, on the frame's own depth and the plan's ranges.
+    if inputs.plan.uses_depth_bounds() {
+        println!(
+            "depth bounds test: {depth_bounds_rejected} fragments of shade passes outside their \
+             light's depth range rejected before stencil and shading (simulator, on the frame's \
+             own depth)"
+        );
+    } else {
+        let why = if renderer.context().depth_bounds() {
+            "no light of this plan has a range that cuts"
+        } else {
+            "not used: the device has no depthBounds, or --no-depth-bounds"
+        };
+        println!("depth bounds test: {why}");
+    }
     Ok(())
+}
+
+/// How a command opens its device.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct DeviceArgs {
+    /// Run under the validation layer; any message fails the run.
+    pub validate: bool,
+    /// Leave the device's depth bounds test unused where it has one.
+    pub no_depth_bounds: bool,
+}
+
+impl From<bool> for DeviceArgs {
+    /// Validation as asked, the depth bounds test where the device has it.
+    fn from(validate: bool) -> Self {
+        Self {
+            validate,
+            no_depth_bounds: false,
+        }
+    }
 }
 
 /// Runs `body` on a device, then drops the context and fails on any validation message (with
 /// `validate`): leaked objects are only reported when the device goes away.
-fn on_device<T>(validate: bool, body: impl FnOnce(&Context) -> Result<T>) -> Result<T> {
+fn on_device<T>(
+    device: impl Into<DeviceArgs>,
+    body: impl FnOnce(&Context) -> Result<T>,
+) -> Result<T> {
+    let device = device.into();
     let ctx = Context::new(ContextDesc {
-        validation: validate,
+        validation: device.validate,
+        without_depth_bounds: device.no_depth_bounds,
         ..ContextDesc::default()
     })?;
     let log = ctx.validation_log();

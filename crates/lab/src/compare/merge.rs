@@ -48,6 +48,8 @@ pub struct DeviceReport {
     pub rounds: u64,
     /// Busy threads beside the run (0: quiet; absent in reports from before the option).
     pub beside_load: u64,
+    /// The depth bounds test was on (absent, so off, in reports from before it existed).
+    pub depth_bounds: bool,
     /// `(technique, cells by BRDF count)`.
     pub rows: Vec<(String, Vec<MergedCell>)>,
     pub sizes: Vec<MergedSize>,
@@ -148,6 +150,8 @@ impl DeviceReport {
             height: number(&file, &v, "settings.height")? as u64,
             rounds: number(&file, &v, "table_sampling.rounds")? as u64,
             beside_load: v["settings"]["beside_load_threads"].as_u64().unwrap_or(0),
+            // Reports from before the depth bounds test ran without it.
+            depth_bounds: v["settings"]["depth_bounds"].as_bool().unwrap_or(false),
             rows,
             sizes,
         })
@@ -155,9 +159,14 @@ impl DeviceReport {
 
     /// The conditions of the run: "quiet", or the load beside it.
     fn conditions(&self) -> String {
-        match self.beside_load {
+        let load = match self.beside_load {
             0 => "quiet".into(),
             n => format!("beside {n} busy threads"),
+        };
+        if self.depth_bounds {
+            format!("{load}, depth bounds test")
+        } else {
+            load
         }
     }
 
@@ -250,7 +259,8 @@ impl Merged {
                 )));
             }
             if let Some(j) = reports[..i].iter().position(|o| {
-                (&o.device, &o.driver, o.beside_load) == (&r.device, &r.driver, r.beside_load)
+                (&o.device, &o.driver, o.beside_load, o.depth_bounds)
+                    == (&r.device, &r.driver, r.beside_load, r.depth_bounds)
             }) {
                 return Err(LabError::Settings(format!(
                     "{} and {} are the same device, driver and load ({}, {}, {}): one report per \
@@ -545,6 +555,7 @@ mod tests {
             height: 180,
             rounds: 10,
             beside_load: 0,
+            depth_bounds: false,
             rows: vec![(
                 "stencil".into(),
                 vec![
@@ -582,6 +593,11 @@ mod tests {
             report("b", "fast", "Mesa 22.3", "huge-lights")
         ])
         .contains("the same device, driver and load"));
+        // The depth bounds test on and off: one device under two conditions.
+        let mut bounded = report("b", "fast", "Mesa 22.3", "huge-lights");
+        bounded.depth_bounds = true;
+        assert!(Merged::new(vec![a.clone(), bounded.clone()]).is_ok());
+        assert!(bounded.conditions().contains("depth bounds test"));
         let mut other_sizes = report("b", "slow", "Mesa 25.0", "huge-lights");
         other_sizes.sizes[0].coverage = 0.1;
         assert!(err(vec![a.clone(), other_sizes]).contains("swept light sizes"));

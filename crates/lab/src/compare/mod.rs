@@ -388,6 +388,9 @@ pub struct CompareReport {
     pub lp_num_threads: Option<String>,
     /// Busy threads that ran beside the measurement ([`CompareSettings::beside_load`]).
     pub beside_load: usize,
+    /// The device's depth bounds test confined the lights' shade passes
+    /// (`Context::depth_bounds`): a condition of the run, as the load is.
+    pub depth_bounds: bool,
     /// The costs the adaptive rows used.
     pub costs: CostModel,
     pub costs_calibrated: bool,
@@ -678,6 +681,7 @@ pub fn run_compare(
         target_ci: settings.target_ci,
         lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
         beside_load: settings.beside_load,
+        depth_bounds: ctx.depth_bounds(),
         costs: costs.expect("at least one BRDF count"),
         costs_calibrated: settings.costs.is_some(),
         depth_id,

@@ -82,6 +82,7 @@ impl CompareReport {
             out["settings"]["environment"] = json!({ "LP_NUM_THREADS": n });
         }
         out["settings"]["beside_load_threads"] = json!(self.beside_load);
+        out["settings"]["depth_bounds"] = json!(self.depth_bounds);
         out
     }
 
@@ -113,6 +114,15 @@ impl CompareReport {
                 self.beside_load
             );
         }
+        let _ = writeln!(
+            md,
+            "Depth bounds test: {}.\n",
+            if self.depth_bounds {
+                "on (each light's shade passes confined to its depth range)"
+            } else {
+                "off (the device has none, or `--no-depth-bounds`)"
+            }
+        );
         let _ = writeln!(
             md,
             "Sampling: the table took {} rounds in {:.1} s ({}; at least {} rounds{}); its widest \

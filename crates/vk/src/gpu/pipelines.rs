@@ -266,7 +266,16 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
         .color_write_mask(write_mask);
     let blend_attachments = vec![blend_attachment; desc.color_formats.len()];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&DYNAMIC_STATES);
+    // With the depth bounds test enabled, every pipeline takes it as dynamic state, so one
+    // pipeline serves a light's passes with and without it (`state::apply` sets it per draw).
+    let mut dynamic_states = DYNAMIC_STATES.to_vec();
+    if ctx.depth_bounds {
+        dynamic_states.extend([
+            vk::DynamicState::DEPTH_BOUNDS_TEST_ENABLE,
+            vk::DynamicState::DEPTH_BOUNDS,
+        ]);
+    }
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
     let has_depth = desc.depth_stencil_format != vk::Format::UNDEFINED;
     // A depth-only format (the hi-stencil touch image) has no stencil attachment.
     let has_stencil = crate::gpu::access::aspect_of(desc.depth_stencil_format)

@@ -8,7 +8,7 @@
 use crate::gpu::context::Context;
 use ash::vk;
 use histencil_model::{
-    CompareOp, CullMode, DepthConvention, DepthState, FaceStencil, PassState, StencilOp,
+    CompareOp, CullMode, DepthConvention, DepthRange, DepthState, FaceStencil, PassState, StencilOp,
 };
 
 /// The Vulkan compare op (also the value the hi-stencil emulation's shaders compare by).
@@ -55,6 +55,7 @@ pub const OPAQUE: PassState = PassState {
     back: None,
     color_write: true,
     hi_stencil: None,
+    depth_bounds: false,
 };
 
 /// A full-screen pass with no depth or stencil (tonemap).
@@ -65,6 +66,7 @@ pub const FULLSCREEN: PassState = PassState {
     back: None,
     color_write: true,
     hi_stencil: None,
+    depth_bounds: false,
 };
 
 /// `state`, written for standard depth, with its depth compare as `depth` spells it.
@@ -90,9 +92,31 @@ pub fn with_stencil(state: PassState, face: FaceStencil) -> PassState {
 /// Records `state` into `cmd` as dynamic state. A face without stencil state passes and keeps
 /// (the stencil test is one switch for both faces in Vulkan). Colour writes are pipeline state:
 /// the caller binds a pipeline that matches `state.color_write`.
+/// Without the depth bounds test ([`apply_bounded`] for a light's passes).
 pub(crate) fn apply(ctx: &Context, cmd: vk::CommandBuffer, state: &PassState) {
+    apply_bounded(ctx, cmd, state, None);
+}
+
+/// [`apply`], where `bounds` is the depth range a pass with `state.depth_bounds` is confined to
+/// (its light's, from the plan) when the device has the depth bounds test enabled; every other
+/// draw runs without the test.
+pub(crate) fn apply_bounded(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    state: &PassState,
+    bounds: Option<DepthRange>,
+) {
     let d = &ctx.device;
     let enabled = state.front.is_some() || state.back.is_some();
+    if ctx.depth_bounds {
+        let bounds = bounds.filter(|_| state.depth_bounds);
+        unsafe {
+            d.cmd_set_depth_bounds_test_enable(cmd, bounds.is_some());
+            if let Some(b) = bounds {
+                d.cmd_set_depth_bounds(cmd, b.min, b.max);
+            }
+        }
+    }
     unsafe {
         d.cmd_set_cull_mode(cmd, cull_mode(state.cull));
         d.cmd_set_depth_test_enable(cmd, state.depth.compare.is_some());

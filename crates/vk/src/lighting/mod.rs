@@ -310,6 +310,13 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ) -> Result<()> {
         let (count_stats, source) = (frame.tile_stats, frame.brdf_source);
         check_frame(&self.desc, frame, targets)?;
+        if frame.plan.uses_depth_bounds() && !self.ctx.depth_bounds() {
+            return Err(Error::BadFrame(
+                "the plan confines lights to their depth ranges (FramePlan::with_depth_bounds), \
+                 and this device has no depth bounds test enabled for histencil"
+                    .into(),
+            ));
+        }
         if hierarchy.is_some() && !self.desc.hi_stencil {
             return Err(Error::Unsupported(
                 "an AMD hierarchy's emulation from a lighting made without hi-stencil",

@@ -261,6 +261,7 @@ impl DepthIdPass {
             back: None,
             color_write: false,
             hi_stencil: None,
+            depth_bounds: false,
         };
         // The copy: every surface pixel's slot as its depth (the shader writes the depth).
         ctx.begin_label(cmd, "depth-id-copy");

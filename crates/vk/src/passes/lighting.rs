@@ -18,7 +18,7 @@ use crate::gpu::context::Context;
 use crate::gpu::error::{Error, Result};
 use crate::gpu::gpu_types::LightDrawPush;
 use crate::gpu::meshes::LightVolumes;
-use crate::gpu::state::{apply, FULLSCREEN};
+use crate::gpu::state::{apply_bounded, FULLSCREEN};
 use crate::gpu::timing::StepTimer;
 use crate::hi_stencil::{
     plan_touches, tile_rect, GpuHierarchy, HiStencilSurface, TouchedTiles, WriteTiles,
@@ -27,8 +27,8 @@ use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{
-    CompareOp, DepthState, FaceStencil, FramePlan, Geometry, HiStencilState, Pass, PassKind,
-    PassState, Shader, StencilOp, Step,
+    CompareOp, DepthRange, DepthState, FaceStencil, FramePlan, Geometry, HiStencilState, Pass,
+    PassKind, PassState, Shader, StencilOp, Step,
 };
 use histencil_scene::Light;
 
@@ -276,7 +276,8 @@ impl LightingPass<'_> {
                         Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
                     }
                     let tested = test.is_some();
-                    self.record_pass(targets, &mut rendering, index, pass, scene_light, tested)?;
+                    let bounded = (pass, self.plan.lights[*light].depth_range);
+                    self.record_pass(targets, &mut rendering, index, bounded, scene_light, tested)?;
                     if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
                         Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
                         rendering.split(self);
@@ -354,7 +355,7 @@ impl LightingPass<'_> {
         targets: &mut LightingTargets,
         rendering: &mut Rendering,
         step: usize,
-        pass: &Pass,
+        (pass, bounds): (&Pass, Option<DepthRange>),
         scene_light: u32,
         hierarchy_tested: bool,
     ) -> Result<()> {
@@ -382,6 +383,8 @@ impl LightingPass<'_> {
                     back: None,
                     color_write: false,
                     hi_stencil: None,
+                    // The statistics count every tile the draw covers, as the simulator does.
+                    depth_bounds: false,
                     ..*state
                 };
                 let key = (pass.geometry, LightShader::CountTiles);
@@ -390,7 +393,7 @@ impl LightingPass<'_> {
                     stamp: stamp(step, true),
                     ..Default::default()
                 };
-                self.draw(key, &count, pass.geometry, push);
+                self.draw(key, &count, (pass.geometry, None), push);
             }
         }
         if shades && self.count_stats {
@@ -406,7 +409,7 @@ impl LightingPass<'_> {
         };
         let tests = self.hierarchy.is_some();
         let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source, tests);
-        self.draw(key, state, pass.geometry, push);
+        self.draw(key, state, (pass.geometry, bounds), push);
         Ok(())
     }
 
@@ -439,7 +442,7 @@ impl LightingPass<'_> {
                 ..Default::default()
             };
             let key = (Geometry::Volume, LightShader::TouchTiles);
-            self.draw(key, &state, Geometry::Volume, push);
+            self.draw(key, &state, (Geometry::Volume, None), push);
             hi_stencil.end_touch(self.ctx, self.cmd);
         }
         let (ctx, ds) = (self.ctx, &mut targets.depth_stencil);
@@ -463,7 +466,7 @@ impl LightingPass<'_> {
         self.draw(
             zero,
             &state(write(mask, 0)),
-            Geometry::FullScreen,
+            (Geometry::FullScreen, None),
             LightDrawPush::default(),
         );
         for bit in (0..8).map(|b| 1u8 << b).filter(|b| mask & b != 0) {
@@ -472,15 +475,21 @@ impl LightingPass<'_> {
                 ..Default::default()
             };
             let key = (Geometry::FullScreen, LightShader::RestoreBit);
-            self.draw(key, &state(write(bit, bit)), Geometry::FullScreen, push);
+            self.draw(
+                key,
+                &state(write(bit, bit)),
+                (Geometry::FullScreen, None),
+                push,
+            );
         }
     }
 
+    /// Records one draw; `bounds` is the light's depth range for a pass confined to it.
     fn draw(
         &self,
         key: LightPipelineKey,
         state: &PassState,
-        geometry: Geometry,
+        (geometry, bounds): (Geometry, Option<DepthRange>),
         push: LightDrawPush,
     ) {
         let (ctx, cmd) = (self.ctx, self.cmd);
@@ -499,7 +508,7 @@ impl LightingPass<'_> {
                 bytemuck::bytes_of(&push),
             );
         }
-        apply(ctx, cmd, state);
+        apply_bounded(ctx, cmd, state, bounds);
         match geometry {
             Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
             Geometry::Volume => {

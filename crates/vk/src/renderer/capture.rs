@@ -213,6 +213,7 @@ impl FootprintCapture {
                     back: None,
                     color_write: true,
                     hi_stencil: None,
+                    depth_bounds: false,
                 },
             );
             volumes.draw(ctx, cmd, &light.1.kind);

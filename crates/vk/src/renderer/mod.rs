@@ -136,6 +136,11 @@ pub struct Renderer<'c> {
 }
 
 impl<'c> Renderer<'c> {
+    /// The device it renders on.
+    pub fn context(&self) -> &'c Context {
+        self.ctx
+    }
+
     /// The scene being rendered.
     pub fn scene(&self) -> &Scene {
         &self.scene

@@ -70,7 +70,14 @@ impl Renderer<'_> {
             brdf_bounds: &brdf_bounds,
             view: &view,
         };
-        Ok(plan_frame(&self.stencil_layout, &inputs, &settings)?)
+        let plan = plan_frame(&self.stencil_layout, &inputs, &settings)?;
+        // Where the device has the depth bounds test, every light's shade passes are confined
+        // to its depth range: the same image, fewer pixels shaded for nothing.
+        Ok(if self.ctx.depth_bounds() {
+            plan.with_depth_bounds()
+        } else {
+            plan
+        })
     }
 
     /// The camera as the planner and the lighting take it, with standard depth and its own far

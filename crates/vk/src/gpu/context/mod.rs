@@ -74,6 +74,9 @@ pub struct ContextDesc {
     /// limit but the device's. An allocation past it fails with [`Error::Allocation`], as one
     /// past the device's memory would.
     pub memory_budget: Option<u64>,
+    /// Leave the device's depth bounds test unused even where it has one (`depthBounds`): the
+    /// lighting then takes the path of a device without it, as a comparison of the two needs.
+    pub without_depth_bounds: bool,
 }
 
 impl ContextDesc {
@@ -152,6 +155,11 @@ pub struct Context {
     pub(crate) max_storage_buffer_range: u32,
     /// How many descriptor sets a pipeline layout may hold (an engine's visibility hook needs 5).
     pub(crate) max_bound_descriptor_sets: u32,
+    /// `depthBounds` is enabled on the device and histencil's pipelines take the depth bounds
+    /// test as dynamic state: the renderer confines lights to their depth ranges
+    /// ([`histencil_model::FramePlan::with_depth_bounds`]). Off on an engine's device, whose
+    /// enabled features histencil is not told.
+    pub(crate) depth_bounds: bool,
     pub(crate) memory: MemoryAccount,
 }
 
@@ -292,6 +300,7 @@ impl Context {
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             max_bound_descriptor_sets: props.limits.max_bound_descriptor_sets,
+            depth_bounds: false,
             memory: MemoryAccount::new(memory_budget),
         })
     }
@@ -316,6 +325,14 @@ impl Context {
     /// version: what tells two builds of one driver apart where [`Context::device_name`] cannot.
     pub fn driver(&self) -> &crate::gpu::driver::DriverInfo {
         &self.driver
+    }
+
+    /// Whether the depth bounds test is enabled and in use: light shade passes are confined to
+    /// their light's depth range ([`histencil_model::FramePlan::with_depth_bounds`]). False on a
+    /// device without `depthBounds`, with [`ContextDesc::without_depth_bounds`], and on an
+    /// engine's device.
+    pub fn depth_bounds(&self) -> bool {
+        self.depth_bounds
     }
 
     /// The kind of device in use (llvmpipe is `CPU`): what some passes shape their work by

@@ -236,7 +236,13 @@ impl Context {
         let queue_infos = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let features = REQUIREMENTS.features();
+        // The depth bounds test, where the device has it and the caller does not decline it:
+        // light passes confined to their light's depth range (histencil_model::depth_bounds).
+        // SAFETY: `physical_device` was enumerated from `instance`.
+        let depth_bounds = !desc.without_depth_bounds
+            && unsafe { instance.get_physical_device_features(physical_device) }.depth_bounds
+                == vk::TRUE;
+        let features = REQUIREMENTS.features().depth_bounds(depth_bounds);
         let mut features13 = REQUIREMENTS.features13();
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
@@ -302,6 +308,7 @@ impl Context {
             max_image_dimension: limits.max_image_dimension2_d,
             max_storage_buffer_range: limits.max_storage_buffer_range,
             max_bound_descriptor_sets: limits.max_bound_descriptor_sets,
+            depth_bounds,
             memory: MemoryAccount::new(desc.memory_budget),
         };
         ctx.name(ctx.device.handle(), "histencil-device");
