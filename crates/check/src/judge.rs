@@ -7,16 +7,14 @@ use histencil_model::StencilLayout;
 use image::RgbaImage;
 
 /// A bound on the 8-bit error per channel: the largest difference and the mean over every
-/// channel of the pixels judged.
+/// channel of the pixels judged. Exact techniques' bounds are derived per scene and technique
+/// ([`crate::bound`], [`crate::matrix::SceneNeeds::exact_tolerance`]); the approximate ones'
+/// are the constants below.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
     pub max: u8,
     pub mean: f64,
 }
-
-/// Exact techniques: every channel within one 8-bit step of forward (f16 HDR and float summation
-/// order differ between a light-volume pass and forward's loop).
-pub const EXACT: Tolerance = Tolerance { max: 1, mean: 1.0 };
 
 /// The LUT technique at its default resolution (32): the bound `tests/tests/techniques.rs`
 /// holds it to and the README documents (23/255 at most where Blinn-Phong 256 highlights fall
@@ -115,7 +113,8 @@ impl ImageVerdict {
         self.error.within(self.tolerance)
     }
 
-    /// `max 12/255 (bound 1), mean 0.310/255 (bound 1) over 33153 pixels, 210 beyond the max`.
+    /// `max 12/255 (bound 2), mean 0.310/255 (bound 1) over 33153 pixels, 210 beyond the max`;
+    /// a mean bound that is not whole is given to three decimals (`bound 1.873`).
     pub fn describe(&self) -> String {
         let (e, t) = (&self.error, &self.tolerance);
         format!(
@@ -128,30 +127,34 @@ impl ImageVerdict {
             e.max,
             t.max,
             e.mean,
-            t.mean,
+            (t.mean * 1000.0).round() / 1000.0,
             e.pixels,
             e.over
         )
     }
 }
 
-/// Judges `actual` against the forward reference `expected`.
+/// Judges `actual` against the forward reference `expected`: the LUT technique ([`Expect::Lut`])
+/// within [`LUT`], every other case within `exact`, the bound derived for its scene and
+/// technique ([`crate::matrix::SceneNeeds::exact_tolerance`]).
 ///
 /// An approximate alpha mode ([`Expect::Alpha`], with `alpha`: the forward frame without alpha
-/// entities and the mode's bound) is judged over the pixels alpha entities cover: where either
-/// the reference or the case differs from that background. (Where neither does, the case is
-/// within 1/255 of the reference by construction; the opaque frame under alpha entities is held
-/// exactly by the cases that light them forward.) Coverage cannot be read from the reference
-/// alone: an entity whose forward-lit colour equals the background there would be missed.
+/// entities and the mode's bound) is judged over the pixels alpha entities cover: where the
+/// reference differs from that background, or the case differs from it by more than `exact`
+/// allows. (Where neither does, the case is within `exact` of the reference by construction;
+/// the opaque frame under alpha entities is held exactly by the cases that light them forward.)
+/// Coverage cannot be read from the reference alone: an entity whose forward-lit colour equals
+/// the background there would be missed.
 pub fn judge_image(
     expect: Expect,
     actual: &RgbaImage,
     expected: &RgbaImage,
+    exact: Tolerance,
     alpha: Option<(&RgbaImage, Tolerance)>,
 ) -> ImageVerdict {
     match alpha {
         None => {
-            let tolerance = if expect == Expect::Lut { LUT } else { EXACT };
+            let tolerance = if expect == Expect::Lut { LUT } else { exact };
             ImageVerdict {
                 error: image_error(actual, expected, tolerance.max, |_| true),
                 tolerance,
@@ -160,7 +163,7 @@ pub fn judge_image(
         }
         Some((background, tolerance)) => {
             let differs = |a: &image::Rgba<u8>, b: &image::Rgba<u8>| {
-                a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > EXACT.max)
+                a.0.iter().zip(b.0).any(|(x, y)| x.abs_diff(y) > exact.max)
             };
             let covered: Vec<bool> = (expected.pixels().zip(actual.pixels()))
                 .zip(background.pixels())
@@ -246,6 +249,7 @@ pub fn judge_stencil(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bound::exact_bound;
 
     fn image(pixels: &[[u8; 4]], width: u32) -> RgbaImage {
         RgbaImage::from_raw(width, pixels.len() as u32 / width, pixels.concat()).unwrap()
@@ -279,8 +283,37 @@ mod tests {
         assert!((all.mean - 41.0 / 8.0).abs() < 1e-12);
         let first = image_error(&a, &b, 1, |i| i == 0);
         assert_eq!((first.max, first.over), (1, 0));
-        assert!(first.within(EXACT));
-        assert!(!all.within(EXACT));
+        assert!(first.within(exact_bound(1)));
+        assert!(!all.within(exact_bound(1)));
+    }
+
+    /// Exact cases are held to the bound they are given, and say which.
+    #[test]
+    fn exact_cases_are_judged_by_their_derived_bound() {
+        let expected = image(&[[10, 10, 10, 255], [200, 100, 0, 255]], 2);
+        let actual = image(&[[12, 10, 10, 255], [201, 100, 0, 255]], 2);
+        let one = Tolerance { max: 1, mean: 1.0 };
+        let v = judge_image(Expect::Exact, &actual, &expected, one, None);
+        assert!(!v.passed(), "{}", v.describe());
+        let derived = exact_bound(1);
+        assert_eq!(derived.max, 2);
+        let v = judge_image(Expect::Exact, &actual, &expected, derived, None);
+        assert!(v.passed(), "{}", v.describe());
+        assert!(v
+            .describe()
+            .starts_with("max 2/255 (bound 2), mean 0.375/255 (bound 1) "));
+        // Many roundings: a larger bound, its mean given to three decimals.
+        let many = exact_bound(64);
+        let v = judge_image(Expect::Exact, &actual, &expected, many, None);
+        let text = v.describe();
+        assert!(text.contains(&format!("(bound {})", many.max)), "{text}");
+        assert!(
+            text.contains(&format!("(bound {:.3})", many.mean)),
+            "{text}"
+        );
+        // The LUT technique keeps its own bound whatever it is given.
+        let v = judge_image(Expect::Lut, &actual, &expected, one, None);
+        assert_eq!(v.tolerance, LUT);
     }
 
     #[test]
@@ -294,6 +327,7 @@ mod tests {
             Expect::Alpha,
             &actual,
             &expected,
+            exact_bound(1),
             Some((&background, ALPHA_LIGHTMAP)),
         );
         assert_eq!((v.error.pixels, v.error.max), (2, 90));
@@ -307,6 +341,7 @@ mod tests {
             Expect::Alpha,
             &actual,
             &expected,
+            exact_bound(1),
             Some((&background, tight)),
         );
         assert!(!v.passed(), "{}", v.describe());

@@ -10,6 +10,8 @@
 //! the known-wrong configurations run on the one depth format whose depths the CPU simulator
 //! reads (it decides whether their failure must show).
 
+use crate::bound::{alpha_layers, exact_bound, lights_at_a_point, Accumulation, PixelPath};
+use crate::judge::Tolerance;
 use histencil_model::FlushPolicy;
 use histencil_vk::{AlphaMode, Backend, DepthStencilFormat, MixedTiles, Technique, TileSide};
 use std::fmt;
@@ -189,7 +191,8 @@ pub enum Expect {
     /// The forward reference itself: it must render cleanly under validation (and light the
     /// frame somewhere, unless the scene has no lights).
     Reference,
-    /// Within 1/255 of forward, stencil as the backend promises.
+    /// Within the bound derived for its scene and technique ([`SceneNeeds::exact_tolerance`]) of
+    /// forward, stencil as the backend promises.
     Exact,
     /// The LUT technique's documented bound against forward.
     Lut,
@@ -290,6 +293,13 @@ pub struct SceneNeeds {
     /// (`Material::parameters_vary`), which a table per material cannot follow, and every BRDF
     /// is its tint times a table (`Brdf::is_tabulable`; not glTF's metallic-roughness).
     pub lut: bool,
+    /// The most lights whose range can hold one point ([`lights_at_a_point`]): the f16 blends
+    /// a light-volume technique can make at one pixel.
+    pub lights_at_a_point: u32,
+    /// Some opaque surface emits: its pixels' emission is stored before the lights add on.
+    pub emissive: bool,
+    /// The most alpha-entity layers that can be blended over one pixel ([`alpha_layers`]).
+    pub alpha_layers: u32,
 }
 
 impl SceneNeeds {
@@ -305,7 +315,27 @@ impl SceneNeeds {
                 .objects
                 .iter()
                 .any(|o| o.material.parameters_vary() || !o.material.brdf.is_tabulable()),
+            lights_at_a_point: lights_at_a_point(&scene.lights),
+            emissive: scene.objects.iter().any(|o| o.material.emits()),
+            alpha_layers: alpha_layers(scene),
         })
+    }
+
+    /// The image bound of an exact case of `lighting` on the scene, derived from the f16
+    /// roundings its pixels can go through ([`crate::bound`]). Adaptive may light a frame
+    /// tiled, which rounds less than its light volumes do.
+    pub fn exact_tolerance(&self, lighting: Lighting) -> Tolerance {
+        let accumulation = match lighting {
+            Lighting::Tiled | Lighting::DepthId => Accumulation::Summed,
+            _ => Accumulation::Blended,
+        };
+        let path = PixelPath {
+            lights: self.lights_at_a_point,
+            emissive: self.emissive,
+            alpha_layers: self.alpha_layers,
+            accumulation,
+        };
+        exact_bound(path.roundings())
     }
 }
 
@@ -486,6 +516,9 @@ mod tests {
         preserved_mask: 0xFC,
         has_alpha: false,
         lut: true,
+        lights_at_a_point: 8,
+        emissive: false,
+        alpha_layers: 0,
     };
 
     #[test]
@@ -495,7 +528,8 @@ mod tests {
             SceneNeeds {
                 preserved_mask: 0xF0,
                 has_alpha: true,
-                lut: true,
+                alpha_layers: 2,
+                ..ROOM
             },
         ] {
             let mut seen = HashSet::new();
@@ -593,6 +627,33 @@ mod tests {
                     "{case}: its correction is not a case"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn every_embedded_scene_has_an_exact_bound_from_its_content() {
+        for name in histencil_scene::embedded_names() {
+            let scene = histencil_scene::embedded(name).unwrap();
+            let needs = SceneNeeds::of(&scene).unwrap();
+            assert!(
+                needs.lights_at_a_point as usize <= scene.lights.len(),
+                "{name}"
+            );
+            assert!(needs.lights_at_a_point >= 1, "{name}");
+            assert_eq!(needs.alpha_layers > 0, needs.has_alpha, "{name}");
+            for lighting in Lighting::ALL {
+                let t = needs.exact_tolerance(lighting);
+                assert!(t.max >= 2 && t.mean >= 1.0, "{name} {lighting:?}");
+            }
+            // Summing in one kernel rounds less than blending each light.
+            let (tiled, stencil) = (
+                needs.exact_tolerance(Lighting::Tiled),
+                needs.exact_tolerance(Lighting::Stencil),
+            );
+            assert!(
+                tiled.max <= stencil.max && tiled.mean <= stencil.mean,
+                "{name}"
+            );
         }
     }
 }

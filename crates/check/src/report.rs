@@ -723,6 +723,9 @@ mod tests {
             preserved_mask: 0xFC,
             has_alpha: false,
             lut: true,
+            lights_at_a_point: 8,
+            emissive: false,
+            alpha_layers: 0,
         };
         let all = cases(needs, DepthStencilFormat::D32S8, (7, 5));
         let result = |case: crate::matrix::Case, outcome| CaseResult {

@@ -315,10 +315,16 @@ pub fn run_check(
             }
         }
         for ((scene, width, height), cases) in groups {
+            let scene = &scenes[scene];
+            let needs = SceneNeeds::of(&scene.scene).map_err(|source| CheckError::Layout {
+                scene: scene.name.clone(),
+                source,
+            })?;
             let group = Group {
                 ctx: &ctx,
                 log: &log,
-                scene: &scenes[scene],
+                scene,
+                needs,
                 size: (width, height),
                 options,
             };
@@ -361,6 +367,8 @@ struct Group<'a> {
     ctx: &'a Context,
     log: &'a ValidationLog,
     scene: &'a CheckScene,
+    /// What the scene holds that its cases' bounds depend on.
+    needs: SceneNeeds,
     size: (u32, u32),
     options: &'a CheckOptions,
 }
@@ -551,7 +559,16 @@ impl Group<'_> {
         let alpha = (case.expect == Expect::Alpha)
             .then(|| references.background.as_ref().map(|b| (b, alpha_bound)))
             .flatten();
-        let verdict = judge::judge_image(case.expect, &ldr, &references.forward, alpha);
+        let exact = match case.expect {
+            // Read only by the coverage test: where no alpha entity is, no layer is blended.
+            Expect::Alpha => SceneNeeds {
+                alpha_layers: 0,
+                ..self.needs
+            }
+            .exact_tolerance(config.lighting),
+            _ => self.needs.exact_tolerance(config.lighting),
+        };
+        let verdict = judge::judge_image(case.expect, &ldr, &references.forward, exact, alpha);
 
         // The simulator's stencil pins down where 360-like zeroing may happen; it needs the
         // GPU's own f32 depths, and preserved bits to zero.
