@@ -331,6 +331,9 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
             },
         )
         .unwrap();
+        // Confined by the depth bounds test, which an engine's device is not known to have.
+        let bounded_plan = plan.clone().with_depth_bounds();
+        assert!(bounded_plan.uses_depth_bounds());
         let few_lights = &scene.lights[..2];
         // A plan made before the camera moved, the projection changed or a light moved: each
         // recorded without an error and lit the frame wrong (the case: the camera moved
@@ -343,6 +346,14 @@ fn frames_that_do_not_fit_are_refused_before_recording() {
         moved_lights[1].position.y += 0.5;
         let cases: Vec<(&str, LightingFrame, LightingTargets)> = vec![
             ("slot", LightingFrame { slot: 2, ..frame }, targets.clone()),
+            (
+                "no depth bounds test",
+                LightingFrame {
+                    plan: &bounded_plan,
+                    ..frame
+                },
+                targets.clone(),
+            ),
             (
                 "plan lights input",
                 LightingFrame {
