@@ -290,7 +290,7 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
             clear_hdr: true,
             side: TileSide::Sixteen,
             mixed: MixedTiles::PerBrdf,
-            classify: TileClassify::for_device(ctx.device_type()),
+            classify: TileClassify::for_context(&ctx),
             hook_sets,
         };
         // SAFETY: refused before any command is recorded.

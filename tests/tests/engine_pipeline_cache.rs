@@ -57,7 +57,7 @@ fn an_engines_pipeline_cache_serves_every_lighting_on_its_device() {
                     clear_hdr: true,
                     side: TileSide::Sixteen,
                     mixed: MixedTiles::PerBrdf,
-                    classify: TileClassify::for_device(ctx.device_type()),
+                    classify: TileClassify::for_context(&ctx),
                     hook_sets: HookSets::default(),
                 };
                 lighting.record_tiled(cmd, &frame, &mut targets).unwrap();

@@ -68,7 +68,7 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
                         clear_hdr: true,
                         side,
                         mixed,
-                        classify: TileClassify::for_device(ctx.device_type()),
+                        classify: TileClassify::for_context(&ctx),
                         hook_sets: HookSets::default(),
                     };
                     lighting.record_tiled(cmd, &frame, &mut targets).unwrap();

@@ -160,7 +160,7 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                 clear_hdr: true,
                 side: TileSide::Sixteen,
                 mixed: MixedTiles::PerBrdf,
-                classify: TileClassify::for_device(ctx.device_type()),
+                classify: TileClassify::for_context(&ctx),
                 hook_sets: HookSets::default(),
             };
             let mut refs = images.refs();

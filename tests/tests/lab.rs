@@ -89,7 +89,7 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
     settings.target_ci = Some(1e-9);
     settings.budget = std::time::Duration::ZERO;
     let (report, side) = with_validated_context(|ctx| {
-        let side = TileSide::for_device(ctx.device_type()).pixels();
+        let side = TileSide::for_context(ctx).pixels();
         (run_compare(ctx, &settings, &mut |_| {}).unwrap(), side)
     });
     use histencil_lab::stats::Stop;

@@ -273,7 +273,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
         // dear tiles keep the plan.
         let tiled = Technique::Tiled {
             mixed: MixedTiles::PerBrdf,
-            side: TileSide::for_device(ctx.device_type()),
+            side: TileSide::for_context(ctx),
         };
         let tiles = |classify_ms| {
             Some(TiledCosts {
@@ -322,7 +322,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             }),
             ..free_branching
         });
-        let side = TileSide::for_device(ctx.device_type());
+        let side = TileSide::for_context(ctx);
         assert_eq!(
             renderer.resolve(native).unwrap(),
             Technique::DepthId { side }

@@ -83,6 +83,9 @@ pub struct CheckOptions {
     pub quick: bool,
     /// The validation layer's best-practices checks as well.
     pub best_practices: bool,
+    /// No driver quirk and no depth bounds test: the general path, on any device
+    /// (`ContextDesc::general_path`, `ContextDesc::without_depth_bounds`).
+    pub general_path: bool,
     /// Where a failing case writes its images, stencil dump and validation messages.
     pub out: Option<PathBuf>,
     /// Only cases whose `scene/case` name contains this.
@@ -268,6 +271,8 @@ pub fn run_check(
             validation: true,
             best_practices: options.best_practices,
             depth_stencil: Some(format),
+            general_path: options.general_path,
+            without_depth_bounds: options.general_path,
             ..ContextDesc::default()
         }) {
             Ok(ctx) => ctx,

@@ -66,6 +66,10 @@ pub struct CheckArgs {
     /// Enable the validation layer's best-practices checks too.
     #[arg(long)]
     best_practices: bool,
+    /// Apply no driver quirk and leave the depth bounds test unused: the general path every
+    /// device without them takes, on this one (the driver line says `quirks: none`).
+    #[arg(long)]
+    general_path: bool,
     /// Run only the cases whose `scene/case` name contains this.
     #[arg(long)]
     filter: Option<String>,
@@ -211,6 +215,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     let options = CheckOptions {
         quick: args.quick,
         best_practices: args.best_practices,
+        general_path: args.general_path,
         out: Some(args.out.clone()),
         filter: args.filter.clone(),
         only,
@@ -385,6 +390,9 @@ fn run(
     }
     if args.best_practices {
         worker_args.push("--best-practices".into());
+    }
+    if args.general_path {
+        worker_args.push("--general-path".into());
     }
     worker_args.extend(["--out".into(), args.out.clone().into_os_string()]);
     if let Some(path) = &args.accept_messages {

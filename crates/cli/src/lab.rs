@@ -25,6 +25,10 @@ pub struct RunArgs {
     /// of a device without it, for comparing the two.
     #[arg(long)]
     no_depth_bounds: bool,
+    /// Apply no driver quirk (tile side and classification shape): the general path every
+    /// other driver takes, on this one.
+    #[arg(long)]
+    general_path: bool,
 }
 
 impl RunArgs {
@@ -32,6 +36,7 @@ impl RunArgs {
         crate::DeviceArgs {
             validate: self.validate,
             no_depth_bounds: self.no_depth_bounds,
+            general_path: self.general_path,
         }
     }
 }

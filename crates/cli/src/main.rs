@@ -196,6 +196,10 @@ struct RenderArgs {
     /// of a device without it, for comparing the two.
     #[arg(long)]
     no_depth_bounds: bool,
+    /// Apply no driver quirk (tile side and classification shape): the general path every
+    /// other driver takes, on this one.
+    #[arg(long)]
+    general_path: bool,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -272,7 +276,7 @@ impl RenderArgs {
         match self.tile_size {
             Some(TileSizeArg::Eight) => TileSide::Eight,
             Some(TileSizeArg::Sixteen) => TileSide::Sixteen,
-            None => TileSide::for_device(ctx.device_type()),
+            None => TileSide::for_context(ctx),
         }
     }
 
@@ -387,6 +391,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
     let device = DeviceArgs {
         validate: args.validate,
         no_depth_bounds: args.no_depth_bounds,
+        general_path: args.general_path,
     };
     on_device(device, |ctx| {
         let shading = args.shading(ctx);
@@ -631,6 +636,8 @@ pub struct DeviceArgs {
     pub validate: bool,
     /// Leave the device's depth bounds test unused where it has one.
     pub no_depth_bounds: bool,
+    /// Apply no driver quirk.
+    pub general_path: bool,
 }
 
 impl From<bool> for DeviceArgs {
@@ -639,6 +646,7 @@ impl From<bool> for DeviceArgs {
         Self {
             validate,
             no_depth_bounds: false,
+            general_path: false,
         }
     }
 }
@@ -653,6 +661,7 @@ fn on_device<T>(
     let ctx = Context::new(ContextDesc {
         validation: device.validate,
         without_depth_bounds: device.no_depth_bounds,
+        general_path: device.general_path,
         ..ContextDesc::default()
     })?;
     let log = ctx.validation_log();

@@ -85,7 +85,7 @@ pub fn calibrate(
     let stencil = Technique::Stencil { backend, flush };
     let branching = Technique::Branching { backend, flush };
     // The side the adaptive technique resolves to on this device.
-    let side = TileSide::for_device(ctx.device_type());
+    let side = TileSide::for_context(ctx);
     let tiled = Technique::Tiled {
         mixed: MixedTiles::PerBrdf,
         side,

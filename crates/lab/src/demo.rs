@@ -145,7 +145,7 @@ pub fn run_demo(
     };
     let mut frames: Vec<(RgbaImage, Option<StencilView>)> = Vec::new();
     let mut rows = Vec::new();
-    for (label, shading) in configurations(TileSide::for_device(ctx.device_type())) {
+    for (label, shading) in configurations(TileSide::for_context(ctx)) {
         step(label);
         let passes = shading.lighting_passes();
         let desc = FrameDesc {

@@ -222,7 +222,7 @@ pub fn run_todays_gpus(
         let without_bits = capture(renderer, 0)?;
         tile_size = with_bits.tile_size;
         let passes = with_bits.layout.brdfs_in_use() as usize;
-        let side = histencil_vk::TileSide::for_device(ctx.device_type());
+        let side = histencil_vk::TileSide::for_context(ctx);
         let gpu_ids = gpu_counts(renderer, Technique::DepthId { side })?;
         depth_id.push((passes, with_bits.predict_depth_id(), gpu_ids));
         // The plans follow the lights and the view, not the engine's bits: one per platform.

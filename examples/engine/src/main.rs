@@ -443,7 +443,7 @@ fn main() {
                 clear_hdr: true,
                 side,
                 mixed,
-                classify: TileClassify::for_device(ctx.device_type()),
+                classify: TileClassify::for_context(&ctx),
                 hook_sets: frame.hook_sets,
             };
             match technique(f) {

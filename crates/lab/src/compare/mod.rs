@@ -286,7 +286,7 @@ pub struct SizePoint {
     pub tiled: Timing,
     /// The depth-id technique, with the tiled technique's light lists of the same tile side.
     pub depth_id: Timing,
-    /// Their tile side in pixels ([`TileSide::for_device`]).
+    /// Their tile side in pixels ([`TileSide::for_context`]).
     pub tile_side: u32,
     /// The worst of the five techniques' errors against forward.
     pub error: ImageError,
@@ -619,7 +619,7 @@ pub fn run_compare(
         }
     }
     let aspect = w as f32 / h as f32;
-    let side = TileSide::for_device(ctx.device_type());
+    let side = TileSide::for_context(ctx);
     let mut sizes = Vec::new();
     for &coverage in &settings.light_sizes {
         progress(&format!("light size {:.1} %", coverage * 100.0));

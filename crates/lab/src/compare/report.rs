@@ -224,7 +224,7 @@ impl CompareReport {
              A striped wall in three BRDFs under lights covering the given fraction of the \
              screen each, `2 / coverage` of them (at most 400), so the lit area stays about two \
              screens. Native backend; tiled and depth-id with {side}x{side} tiles (the device's \
-             side, `TileSide::for_device`), tiled's mixed tiles per BRDF; the error is the worst \
+             side, `TileSide::for_context`), tiled's mixed tiles per BRDF; the error is the worst \
              of the five techniques.\n\n"
         );
         md += "\
@@ -333,9 +333,9 @@ impl CompareReport {
         }
         let mut md = String::from(
             "\nThe depth-id row draws one full-screen pass per BRDF at its id's depth with compare \
-             EQUAL. Its time above is the device's own (llvmpipe has no hierarchical depth: it \
-             tests depth per pixel); what a GPU's hierarchical depth would reject of the same \
-             frame is modelled on the id image the GPU wrote (`histencil_model::depth_id`, 8x8 tiles: \
+             EQUAL. Its time above is the device's own, with whatever hierarchical depth the device \
+             has (a CPU rasteriser such as llvmpipe has none, and tests depth per pixel); what a \
+             GPU's hierarchical depth would reject of the same frame is modelled on the id image the GPU wrote (`histencil_model::depth_id`, 8x8 tiles: \
              a tile whose id range excludes the pass's id is rejected whole), not measured.\n\n\
              | BRDFs | tile tests | rejected (modelled) | fragments shaded |\n\
              |---|---|---|---|\n",

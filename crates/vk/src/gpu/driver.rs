@@ -33,14 +33,20 @@ pub struct DriverInfo {
     /// `VK_LAYER_KHRONOS_validation`'s version (`spec version, implementation version`) where
     /// the layer is enabled; `None` without validation or on a lent device.
     pub validation_layer: Option<String>,
+    /// `driverID`: what the quirk table is keyed by ([`crate::QUIRKS`]).
+    pub id: vk::DriverId,
+    /// `VkPhysicalDeviceProperties::driverVersion`, in the driver's own encoding.
+    pub version: u32,
+    /// The quirks in force on the device, as [`crate::Quirks::describe`] names them.
+    pub quirks: String,
 }
 
 impl fmt::Display for DriverInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} ({}), Vulkan {}, conformance {}",
-            self.name, self.info, self.api_version, self.conformance
+            "{} ({}), Vulkan {}, conformance {}, quirks: {}",
+            self.name, self.info, self.api_version, self.conformance, self.quirks
         )?;
         if let Some(layer) = &self.validation_layer {
             write!(f, ", validation layer {layer}")?;
@@ -80,6 +86,7 @@ pub(crate) unsafe fn driver_info(
     // SAFETY: the caller's promise.
     unsafe { instance.get_physical_device_properties2(physical_device, &mut props) };
     let api_version = version_text(props.properties.api_version);
+    let driver_version = props.properties.driver_version;
     let c = driver.conformance_version;
     DriverInfo {
         name: c_text(&driver.driver_name),
@@ -87,6 +94,9 @@ pub(crate) unsafe fn driver_info(
         conformance: format!("{}.{}.{}.{}", c.major, c.minor, c.subminor, c.patch),
         api_version,
         validation_layer,
+        id: driver.driver_id,
+        version: driver_version,
+        quirks: String::new(),
     }
 }
 

@@ -14,6 +14,7 @@ pub(crate) mod error;
 pub mod gpu_types;
 pub(crate) mod meshes;
 pub(crate) mod pipelines;
+pub(crate) mod quirks;
 pub(crate) mod readback;
 pub(crate) mod requirements;
 pub(crate) mod resources;

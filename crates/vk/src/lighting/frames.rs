@@ -88,13 +88,13 @@ pub struct TiledFrame<'a> {
     pub lights: &'a [Light],
     /// Clear the HDR target to black first; otherwise light adds onto its contents.
     pub clear_hdr: bool,
-    /// The tiles' side: [`TileSide::for_device`] picks 8x8 on a CPU rasteriser, faster there,
+    /// The tiles' side: [`TileSide::for_context`] picks 8x8 where the quirk table says it is faster,
     /// and 16x16 on a GPU.
     pub side: TileSide,
     /// What a tile of several BRDFs does.
     pub mixed: MixedTiles,
     /// How the classification's work is shaped (the same results either way):
-    /// [`TileClassify::for_device`] picks the faster for the device.
+    /// [`TileClassify::for_context`] picks the faster for the driver (the quirk table).
     pub classify: TileClassify,
     /// The engine's sets for its hooks (none with histencil's built-in hooks).
     pub hook_sets: HookSets,

@@ -17,6 +17,7 @@ use crate::gpu::descriptors::{
 };
 use crate::gpu::error::{Error, Result};
 use crate::gpu::pipelines::create_compute_pipeline;
+use crate::gpu::quirks::Quirk;
 use crate::gpu::resources::Buffer;
 use crate::gpu::teardown::{build, Destroy};
 use crate::passes::light_modules::LightModules;
@@ -61,12 +62,12 @@ pub enum TileSide {
 }
 
 impl TileSide {
-    /// The side for a device of `device_type`: 8x8 on a CPU, else HDRP's 16x16. On llvmpipe
-    /// 8x8 tiles were as fast or faster within the noise wherever measured, and clearly faster
-    /// with full-screen lights on a striped wall and on `town` (README); on GPUs 16x16 is the
-    /// common choice, and the two measured within a few per cent on an H200.
-    pub fn for_device(device_type: vk::PhysicalDeviceType) -> Self {
-        if device_type == vk::PhysicalDeviceType::CPU {
+    /// The side for `ctx`'s driver: 8x8 where the quirk table says so
+    /// ([`crate::Quirk::SmallTiles`]: lavapipe, where 8x8 tiles were as fast or faster within
+    /// the noise wherever measured), else HDRP's 16x16, the common choice on GPUs (the two
+    /// measured within a few per cent on an H200).
+    pub fn for_context(ctx: &Context) -> Self {
+        if ctx.quirks().has(Quirk::SmallTiles) {
             TileSide::Eight
         } else {
             TileSide::Sixteen
@@ -110,9 +111,10 @@ pub enum TileClassify {
 }
 
 impl TileClassify {
-    /// The shape for a device of `device_type`: per invocation on a CPU, else a workgroup.
-    pub fn for_device(device_type: vk::PhysicalDeviceType) -> Self {
-        if device_type == vk::PhysicalDeviceType::CPU {
+    /// The shape for `ctx`'s driver: per invocation where the quirk table says so
+    /// ([`crate::Quirk::ClassifyPerInvocation`]), else a workgroup.
+    pub fn for_context(ctx: &Context) -> Self {
+        if ctx.quirks().has(Quirk::ClassifyPerInvocation) {
             TileClassify::PerInvocation
         } else {
             TileClassify::Workgroup
@@ -606,24 +608,4 @@ fn buffer_barrier(
         .dst_access_mask(dst.1)];
     let info = vk::DependencyInfo::default().memory_barriers(&barrier);
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &info) };
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn cpus_take_small_tiles_one_invocation_per_tile_and_gpus_hdrps() {
-        let cpu = vk::PhysicalDeviceType::CPU;
-        assert_eq!(TileSide::for_device(cpu), TileSide::Eight);
-        assert_eq!(TileClassify::for_device(cpu), TileClassify::PerInvocation);
-        for gpu in [
-            vk::PhysicalDeviceType::DISCRETE_GPU,
-            vk::PhysicalDeviceType::INTEGRATED_GPU,
-            vk::PhysicalDeviceType::VIRTUAL_GPU,
-        ] {
-            assert_eq!(TileSide::for_device(gpu), TileSide::Sixteen);
-            assert_eq!(TileClassify::for_device(gpu), TileClassify::Workgroup);
-        }
-    }
 }

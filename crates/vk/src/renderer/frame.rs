@@ -159,7 +159,7 @@ impl Renderer<'_> {
                 clear_hdr: !emits,
                 side,
                 mixed,
-                classify: TileClassify::for_device(ctx.device_type()),
+                classify: TileClassify::for_context(ctx),
                 hook_sets: HookSets::default(),
             };
             let mut targets = self.targets.lighting();

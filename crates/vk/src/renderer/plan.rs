@@ -20,7 +20,7 @@ impl Renderer<'_> {
     }
 
     /// What a frame of `technique` records: the adaptive technique on the native backend lights
-    /// the whole frame tiled (the device's tiles, [`crate::TileSide::for_device`]; mixed tiles
+    /// the whole frame tiled (the device's tiles, [`crate::TileSide::for_context`]; mixed tiles
     /// per BRDF), or by depth ids with the same tiles' light lists, where its costs predict
     /// that surely cheaper than its plan ([`histencil_model::CostModel::frame_choice`]; never
     /// with the talk's costs, which have no tiled figures); on an emulated backend it keeps the
@@ -42,7 +42,7 @@ impl Renderer<'_> {
             ..
         } = technique
         {
-            let side = TileSide::for_device(self.ctx.device_type());
+            let side = TileSide::for_context(self.ctx);
             let costs = self.cost_model(Backend::Native);
             let chosen = match costs.frame_choice(&plan, self.brdfs.len()) {
                 FrameChoice::Planned => technique,

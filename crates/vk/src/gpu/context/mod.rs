@@ -4,6 +4,7 @@
 
 mod owned;
 
+use crate::gpu::quirks::{Quirks, QUIRKS};
 use owned::pick_depth_stencil_format;
 
 use crate::gpu::debug::ValidationLog;
@@ -77,6 +78,9 @@ pub struct ContextDesc {
     /// Leave the device's depth bounds test unused even where it has one (`depthBounds`): the
     /// lighting then takes the path of a device without it, as a comparison of the two needs.
     pub without_depth_bounds: bool,
+    /// Apply no driver quirk ([`crate::QUIRKS`]): the general path every other device takes,
+    /// on this one too.
+    pub general_path: bool,
 }
 
 impl ContextDesc {
@@ -160,6 +164,8 @@ pub struct Context {
     /// ([`histencil_model::FramePlan::with_depth_bounds`]). Off on an engine's device, whose
     /// enabled features histencil is not told.
     pub(crate) depth_bounds: bool,
+    /// How histencil shapes its work on this driver ([`crate::QUIRKS`]).
+    pub(crate) quirks: crate::gpu::quirks::Quirks,
     pub(crate) memory: MemoryAccount,
 }
 
@@ -276,7 +282,10 @@ impl Context {
         let debug_device =
             debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
         // SAFETY: the caller's promise; histencil requires Vulkan 1.3.
-        let driver = unsafe { crate::gpu::driver::driver_info(&instance, physical_device, None) };
+        let mut driver =
+            unsafe { crate::gpu::driver::driver_info(&instance, physical_device, None) };
+        let quirks = Quirks::of(QUIRKS, driver.id, driver.version);
+        driver.quirks = quirks.describe();
         Ok(Self {
             _entry: None,
             owned: false,
@@ -301,6 +310,7 @@ impl Context {
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             max_bound_descriptor_sets: props.limits.max_bound_descriptor_sets,
             depth_bounds: false,
+            quirks,
             memory: MemoryAccount::new(memory_budget),
         })
     }
@@ -335,8 +345,13 @@ impl Context {
         self.depth_bounds
     }
 
-    /// The kind of device in use (llvmpipe is `CPU`): what some passes shape their work by
-    /// ([`crate::TileClassify::for_device`]).
+    /// The quirks in force on this device: the table's rows for its driver, or none with
+    /// [`ContextDesc::general_path`].
+    pub fn quirks(&self) -> &crate::gpu::quirks::Quirks {
+        &self.quirks
+    }
+
+    /// The kind of device in use (llvmpipe is `CPU`), as Vulkan reports it.
     pub fn device_type(&self) -> vk::PhysicalDeviceType {
         self.device_type
     }

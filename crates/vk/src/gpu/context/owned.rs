@@ -278,8 +278,18 @@ impl Context {
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
         let limits = props.limits;
         // SAFETY: as above; the instance asks for Vulkan 1.3.
-        let driver =
+        let mut driver =
             unsafe { crate::gpu::driver::driver_info(&instance, physical_device, layer_text) };
+        let quirks = if desc.general_path {
+            crate::gpu::quirks::Quirks::none()
+        } else {
+            crate::gpu::quirks::Quirks::of(crate::gpu::quirks::QUIRKS, driver.id, driver.version)
+        };
+        driver.quirks = if desc.general_path {
+            "none (the general path, asked for)".into()
+        } else {
+            quirks.describe()
+        };
         // A cache of histencil's own, destroyed with the device; without one (a driver that
         // refuses) pipelines are made uncached.
         let pipeline_cache =
@@ -309,6 +319,7 @@ impl Context {
             max_storage_buffer_range: limits.max_storage_buffer_range,
             max_bound_descriptor_sets: limits.max_bound_descriptor_sets,
             depth_bounds,
+            quirks,
             memory: MemoryAccount::new(desc.memory_budget),
         };
         ctx.name(ctx.device.handle(), "histencil-device");
