@@ -313,7 +313,10 @@ impl LightHooks {
         };
         if sets > ctx.max_bound_descriptor_sets {
             return Err(Error::BadSetup(format!(
-                "a visibility hook binds set 4, and this device binds at most {} sets",
+                "a visibility hook binds set 4, and this device binds at most {} sets (the \
+                 spec's minimum is 4): declare the visibility hook's resources in the decode \
+                 hook's set 1 instead (its layout, its sets), and give the hooks no visibility \
+                 layout",
                 ctx.max_bound_descriptor_sets
             )));
         }
