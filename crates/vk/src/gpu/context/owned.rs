@@ -160,10 +160,12 @@ impl Context {
         if pin_settings {
             extensions.push(ash::ext::layer_settings::NAME.as_ptr());
         }
+        // By name: two uses of a const need not share an address.
         let extensions_without: Vec<_> = extensions
             .iter()
             .copied()
-            .filter(|&e| e != ash::ext::layer_settings::NAME.as_ptr())
+            // SAFETY: every pointer in `extensions` is a NUL-terminated extension name.
+            .filter(|&e| unsafe { CStr::from_ptr(e) } != ash::ext::layer_settings::NAME)
             .collect();
         let validation = Arc::new(ValidationLog::default());
         // SAFETY: the context keeps `validation` until after it destroys the messenger.
