@@ -21,7 +21,7 @@ fn main() {
         println!("cargo:rerun-if-changed=shaders/{shared}");
     }
     // (output, source, defines): the compact G-buffer's vertex stage is gbuffer.vert without
-    // the linear depth output, the forward reference's with the world position instead.
+    // the linear depth output, and so is the forward reference's (it rebuilds position from depth).
     let stages = [
         ("gbuffer.vert", "gbuffer.vert", None),
         ("gbuffer_compact.vert", "gbuffer.vert", Some("-DCOMPACT")),

@@ -2,7 +2,9 @@
 // The engine's forward reference for its lighting: every light at every pixel of every draw,
 // through histencil's own shading (light.glsl, which reads set 0 as histencil's frame.glsl lays
 // it out), with the same round trip through the compact G-buffer's formats as the deferred path
-// (compact_round_trip) and the same shadows (the visibility hook, set 4).
+// (compact_round_trip), the same surface point (rebuilt from this fragment's depth as the decode
+// hook rebuilds it from the depth buffer, not interpolated: a rasteriser with 4 sub-pixel bits
+// interpolates off the pixel's view ray) and the same shadows (the visibility hook).
 #extension GL_GOOGLE_include_directive : require
 #include "light.glsl"
 #include "histencil_hooks/compact_gbuffer.glsl"
@@ -15,12 +17,13 @@ layout(push_constant) uniform Draw {
 } draw;
 
 layout(location = 0) in vec3 in_normal;
-layout(location = 1) in vec3 in_world;
 
 layout(location = 0) out vec4 out_color;
 
 void main() {
-    Surface s = compact_round_trip(in_world, normalize(in_normal), draw.tint_material.rgb,
+    float linear_depth = frame.proj[3][2] / (gl_FragCoord.z + frame.proj[2][2]);
+    vec3 position = world_position_on_ray(gl_FragCoord.xy, linear_depth);
+    Surface s = compact_round_trip(position, normalize(in_normal), draw.tint_material.rgb,
                                    draw.brdf.xy, uint(draw.brdf.w));
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < frame.counts.x; ++i) {

@@ -1,7 +1,7 @@
 #version 460
 // The engine's G-buffer vertex stage: its own camera block and per-draw push constants. Built
 // three ways (build.rs): for histencil's G-buffer, for the compact one (-DCOMPACT), and for the
-// forward reference (-DFORWARD).
+// forward reference (-DFORWARD), which rebuilds its position from depth as the decode hook does.
 
 #ifdef FORWARD
 // The forward reference binds histencil's frame layout at set 0 (its fragment stage shades
@@ -26,10 +26,7 @@ layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 
 layout(location = 0) out vec3 out_normal;
-#if defined(FORWARD)
-// The forward reference shades the world position.
-layout(location = 1) out vec3 out_world;
-#elif !defined(COMPACT)
+#if !defined(FORWARD) && !defined(COMPACT)
 // histencil's layout stores linear depth; the compact one reads the depth attachment instead.
 layout(location = 1) out float out_linear_depth;
 #endif
@@ -38,9 +35,7 @@ void main() {
     vec4 world = draw.model * vec4(in_position, 1.0);
     vec4 view = camera.view * world;
     out_normal = transpose(inverse(mat3(draw.model))) * in_normal;
-#if defined(FORWARD)
-    out_world = world.xyz;
-#elif !defined(COMPACT)
+#if !defined(FORWARD) && !defined(COMPACT)
     out_linear_depth = -view.z;
 #endif
     gl_Position = camera.proj * view;

@@ -289,12 +289,15 @@ pub struct CompactDecode {
 }
 
 impl CompactDecode {
-    /// `depth_view` is a depth-aspect view of the depth-stencil image.
+    /// `depth_view` is a depth-aspect view of the depth-stencil image. The visibility hook's
+    /// shadow bindings join the decode's in one layout (set 1), and `shadow` writes them into
+    /// each slot's set: the light pipelines then need four sets.
     pub fn new(
         gpu: &Gpu,
         in_flight: usize,
         targets: &[ImageRef],
         depth_view: vk::ImageView,
+        shadow: &crate::shadow::ShadowMap,
     ) -> Self {
         let d = &gpu.device;
         // Fragment shaders, and the tiled technique's compute kernels.
@@ -302,9 +305,11 @@ impl CompactDecode {
             vk::DescriptorType::SAMPLED_IMAGE,
             vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE,
         );
-        let bindings = layout_bindings(&[sampled; 3]);
+        let mut bindings = layout_bindings(&[sampled; 3]);
+        bindings.extend(shadow.bindings.iter().copied());
         let set_layout = set_layout(d, &bindings);
-        let (pool, sets) = allocate_sets(d, set_layout, in_flight, &[sampled.0; 3]);
+        let types: Vec<_> = bindings.iter().map(|b| b.descriptor_type).collect();
+        let (pool, sets) = allocate_sets(d, set_layout, in_flight, &types);
         // The layouts the images are in while histencil's light passes read them.
         let color = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         let depth = vk::ImageLayout::DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL;
@@ -331,6 +336,9 @@ impl CompactDecode {
                 })
                 .collect();
             unsafe { d.update_descriptor_sets(&writes, &[]) };
+        }
+        for (slot, set) in sets.iter().enumerate() {
+            shadow.write_descriptors(d, *set, slot);
         }
         Self {
             set_layout,

@@ -193,31 +193,22 @@ fn main() {
     );
     let depth_view = gpu.depth_view(&depth);
     let gbuffer_refs: Vec<_> = gbuffer.iter().map(|g| g.target).collect();
-    let decode = CompactDecode::new(&gpu, IN_FLIGHT, &gbuffer_refs, depth_view);
     let mut shadow = shadow::ShadowMap::new(&gpu, IN_FLIGHT);
+    // One hook layout for both hooks: the decode's images and the visibility's shadow map in
+    // set 1, so the light pipelines bind the 4 sets every device binds (no visibility set).
+    let decode = CompactDecode::new(&gpu, IN_FLIGHT, &gbuffer_refs, depth_view, &shadow);
     // The hooks are held to the layouts they bind (set, binding, type, stage) and the decode to
     // the G-buffer images it reads.
     let decode_layout = HookSetLayout {
         layout: decode.set_layout,
         bindings: &decode.bindings,
     };
-    let shadow_layout = HookSetLayout {
-        layout: shadow.set_layout,
-        bindings: &shadow.bindings,
-    };
     let surface_formats = gbuffer_pass.kind.formats();
-    // SAFETY: the decode and shadow set layouts are the engine's, made from those bindings on
-    // the lent device, and are destroyed after the lighting; LIGHT_MODULES come from
-    // histencil_build of this histencil-vk.
-    let hooks = unsafe {
-        EngineHooks::new(
-            LIGHT_MODULES,
-            decode_layout,
-            Some(shadow_layout),
-            surface_formats,
-        )
-    }
-    .expect("the engine's light shaders");
+    // SAFETY: the decode set layout is the engine's, made from those bindings on the lent
+    // device, and is destroyed after the lighting; LIGHT_MODULES come from histencil_build of
+    // this histencil-vk.
+    let hooks = unsafe { EngineHooks::new(LIGHT_MODULES, decode_layout, None, surface_formats) }
+        .expect("the engine's light shaders");
     let mut lighting = DeferredLighting::new(
         &ctx,
         &LightingDesc {
@@ -428,7 +419,7 @@ fn main() {
                 tile_stats: false,
                 hook_sets: HookSets {
                     decode: Some(decode.sets[f % IN_FLIGHT]),
-                    visibility: Some(shadow.sets[f % IN_FLIGHT]),
+                    visibility: None,
                 },
             };
             // SAFETY: the command buffer is recording on the engine's device; the images' states
@@ -599,7 +590,7 @@ fn main() {
                 lighting: &mut lighting,
                 hook_sets: HookSets {
                     decode: Some(decode.sets[0]),
-                    visibility: Some(shadow.sets[0]),
+                    visibility: None,
                 },
             },
             layouts::Layout {

@@ -18,8 +18,6 @@ use histencil::vk::{ImageRef, ImageState};
 
 pub struct ForwardReference {
     frame_layout: vk::DescriptorSetLayout,
-    /// Sets 1 to 3 are unused: an empty layout holds their places.
-    empty_layout: vk::DescriptorSetLayout,
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
@@ -32,7 +30,8 @@ pub struct ForwardReference {
 }
 
 impl ForwardReference {
-    /// `shadow_layout`: the visibility hook's set layout (set 4); `max_lights` lights a frame.
+    /// `shadow_layout`: the visibility hook's bindings alone, as set 1; `max_lights` lights a
+    /// frame.
     pub fn new(
         gpu: &Gpu,
         extent: vk::Extent2D,
@@ -52,17 +51,10 @@ impl ForwardReference {
                 ),
             ]),
         );
-        let empty_layout = set_layout(d, &[]);
         let push = [vk::PushConstantRange::default()
             .stage_flags(both)
             .size(std::mem::size_of::<DrawPush>() as u32)];
-        let sets = [
-            frame_layout,
-            empty_layout,
-            empty_layout,
-            empty_layout,
-            shadow_layout,
-        ];
+        let sets = [frame_layout, shadow_layout];
         let layout = unsafe {
             d.create_pipeline_layout(
                 &vk::PipelineLayoutCreateInfo::default()
@@ -148,7 +140,6 @@ impl ForwardReference {
         );
         Self {
             frame_layout,
-            empty_layout,
             layout,
             pipeline,
             pool,
@@ -162,7 +153,8 @@ impl ForwardReference {
     }
 
     /// Draws `world` lit by `lights` seen through `frame` into [`ForwardReference::hdr`], with
-    /// `shadow_set` (a visibility hook set whose map is ready to sample) at set 4. Used once per
+    /// `shadow_set` (a set of the shadow map's own layout whose map is ready to sample) at set 1.
+    /// Used once per
     /// captured frame: its buffers are written now, so the GPU must have finished its last use.
     pub fn record(
         &mut self,
@@ -216,7 +208,7 @@ impl ForwardReference {
                 )
             };
             bind(0, self.set);
-            bind(4, shadow_set);
+            bind(1, shadow_set);
             for (i, object) in world.objects.iter().enumerate() {
                 let push = DrawPush::new(object, i);
                 d.cmd_push_constants(cmd, self.layout, both, 0, bytemuck::bytes_of(&push));
@@ -233,7 +225,6 @@ impl ForwardReference {
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_pool(self.pool, None);
             d.destroy_descriptor_set_layout(self.frame_layout, None);
-            d.destroy_descriptor_set_layout(self.empty_layout, None);
         }
         gpu.free_buffer(self.uniforms);
         gpu.free_buffer(self.lights);

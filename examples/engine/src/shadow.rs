@@ -1,6 +1,8 @@
-//! The engine's shadow map for its spot light, and the descriptor sets through which histencil's
-//! visibility hook (`shaders/histencil_hooks/light_visibility.glsl`, set 4) reads it: a
-//! depth-compare sampler over the map and a block with the light's matrix, index and bias.
+//! The engine's shadow map for its spot light, and what histencil's visibility hook
+//! (`shaders/histencil_hooks/light_visibility.glsl`) reads it through: a depth-compare sampler
+//! over the map and a block with the light's matrix, index and bias, at bindings 3 and 4 of
+//! set 1. The light pipelines find them in the decode hook's sets ([`ShadowMap::descriptors`]),
+//! the forward reference in sets of this layout's own.
 
 use crate::device::{
     allocate_sets, barrier, begin_rendering, depth_attachment, graphics_pipeline, layout_bindings,
@@ -11,6 +13,9 @@ use ash::vk;
 use glam::Mat4;
 use gpu_allocator::MemoryLocation;
 use histencil::vk::ImageState;
+
+/// The hook's first binding in set 1: the decode hook's three images come first.
+pub const FIRST_BINDING: u32 = 3;
 
 /// The shadow map's side in texels and format.
 pub const SIDE: u32 = 1024;
@@ -54,9 +59,9 @@ pub struct ShadowMap {
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
     unit_box: GpuMesh,
-    /// Set 4 of histencil's light pipelines (and the forward reference's).
+    /// Set 1 of the forward reference: bindings 3 and 4 alone.
     pub set_layout: vk::DescriptorSetLayout,
-    /// What `set_layout` was made from, for histencil's check of the visibility hook.
+    /// Bindings 3 and 4 as the hook declares them, for the decode hook's layout too.
     pub bindings: Vec<vk::DescriptorSetLayoutBinding<'static>>,
     pool: vk::DescriptorPool,
     /// Per frame in flight: the block and the set.
@@ -143,7 +148,11 @@ impl ShadowMap {
             vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
             vk::DescriptorType::UNIFORM_BUFFER,
         ];
-        let bindings = layout_bindings(&[(types[0], stage), (types[1], stage)]);
+        let bindings: Vec<_> = layout_bindings(&[(types[0], stage), (types[1], stage)])
+            .into_iter()
+            .zip(FIRST_BINDING..)
+            .map(|(b, n)| b.binding(n))
+            .collect();
         let set_layout = set_layout(d, &bindings);
         let (pool, sets) = allocate_sets(d, set_layout, in_flight, &types);
         let blocks: Vec<Buffer> = (0..in_flight)
@@ -156,29 +165,7 @@ impl ShadowMap {
                 )
             })
             .collect();
-        for (set, block) in sets.iter().zip(&blocks) {
-            let image = [vk::DescriptorImageInfo::default()
-                .sampler(sampler)
-                .image_view(map.target.view)
-                .image_layout(SAMPLED.layout)];
-            let buffer = [vk::DescriptorBufferInfo::default()
-                .buffer(block.buffer)
-                .range(vk::WHOLE_SIZE)];
-            let writes = [
-                vk::WriteDescriptorSet::default()
-                    .dst_set(*set)
-                    .dst_binding(0)
-                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                    .image_info(&image),
-                vk::WriteDescriptorSet::default()
-                    .dst_set(*set)
-                    .dst_binding(1)
-                    .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
-                    .buffer_info(&buffer),
-            ];
-            unsafe { d.update_descriptor_sets(&writes, &[]) };
-        }
-        Self {
+        let shadow = Self {
             map,
             sampler,
             layout,
@@ -189,7 +176,36 @@ impl ShadowMap {
             pool,
             blocks,
             sets,
+        };
+        for (slot, set) in shadow.sets.clone().into_iter().enumerate() {
+            shadow.write_descriptors(d, set, slot);
         }
+        shadow
+    }
+
+    /// Writes the map and slot `slot`'s block into bindings 3 and 4 of `set`: one of this
+    /// layout's sets, or a decode hook set that holds the same bindings.
+    pub fn write_descriptors(&self, d: &ash::Device, set: vk::DescriptorSet, slot: usize) {
+        let image = [vk::DescriptorImageInfo::default()
+            .sampler(self.sampler)
+            .image_view(self.map.target.view)
+            .image_layout(SAMPLED.layout)];
+        let buffer = [vk::DescriptorBufferInfo::default()
+            .buffer(self.blocks[slot].buffer)
+            .range(vk::WHOLE_SIZE)];
+        let writes = [
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(FIRST_BINDING)
+                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .image_info(&image),
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(FIRST_BINDING + 1)
+                .descriptor_type(vk::DescriptorType::UNIFORM_BUFFER)
+                .buffer_info(&buffer),
+        ];
+        unsafe { d.update_descriptor_sets(&writes, &[]) };
     }
 
     /// Renders the world's depth from `view_proj` and leaves the map ready for fragment

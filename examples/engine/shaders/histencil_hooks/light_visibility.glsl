@@ -1,5 +1,7 @@
-// The engine's visibility hook: its shadowed spot light is looked up in the engine's shadow map
-// (set 4, the engine's own layout); every other light is unshadowed. histencil_build compiles
+// The engine's visibility hook: its shadowed spot light is looked up in the engine's shadow map;
+// every other light is unshadowed. Its resources sit in set 1 beside the decode hook's (bindings
+// 3 and 4 of the engine's one hook layout), not in a set of their own: the light pipelines then
+// bind four sets, which every Vulkan device can (SwiftShader binds no more). histencil_build compiles
 // histencil's light shaders with this file; the engine's forward reference (forward.frag)
 // includes it too, so both apply the same shadows.
 #ifndef LIGHT_VISIBILITY_GLSL
@@ -9,8 +11,8 @@
 #include "surface.glsl"
 
 // A depth-compare sampler: linear filtering averages the four nearest comparisons (2x2 PCF).
-layout(set = 4, binding = 0) uniform sampler2DShadow shadow_map;
-layout(set = 4, binding = 1, std140) uniform Shadow {
+layout(set = 1, binding = 3) uniform sampler2DShadow shadow_map;
+layout(set = 1, binding = 4, std140) uniform Shadow {
     mat4 light_view_proj; // world to the shadow map's clip space (depth 0..1, nearer is smaller)
     uvec4 light;          // x: the index of the shadowed light in the frame's lights, or ~0u
     vec4 bias;            // x: depth bias, y: normal offset (world units)

@@ -25,9 +25,7 @@ bool decode_surface(vec2 frag_coord, out Surface s) {
     // Device depth to -z in view space, for any perspective projection: depth = P22 + P32 / -z
     // with -z = linear depth (reversed or not, finite or infinite far plane).
     float linear_depth = frame.proj[3][2] / (depth + frame.proj[2][2]);
-    vec2 ndc = frag_coord * frame.viewport.zw * 2.0 - 1.0;
-    vec3 view_position = vec3((ndc + frame.projection.zw) * frame.projection.xy, -1.0) * linear_depth;
-    s.position = (frame.inv_view * vec4(view_position, 1.0)).xyz;
+    s.position = world_position_on_ray(frag_coord, linear_depth);
     s.normal = octahedral_decode(normal_params.xy);
     s.tint = albedo.rgb;
     s.brdf = uint(round(albedo.a * 255.0));
