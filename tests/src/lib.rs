@@ -112,3 +112,31 @@ pub fn lit_fraction(image: &RgbaImage) -> f64 {
         .count();
     lit as f64 / (image.width() * image.height()) as f64
 }
+
+/// Every device limit the work done on `ctx` needed lies within [`histencil_vk::NEEDS`] (or
+/// the spec's minimum for a limit the table leaves out), so the table every driver line reports
+/// cannot fall behind the code; where `reached`, each need the table puts above the spec's
+/// minimum was met exactly by this work (the table is no larger than the code needs).
+pub fn assert_needs_hold(ctx: &Context, reached: &[histencil_vk::Limit]) {
+    for limit in histencil_vk::Limit::ALL {
+        let most = histencil_vk::NEEDS
+            .iter()
+            .find(|n| n.limit == limit)
+            .map_or(limit.spec_minimum(), |n| n.most);
+        let used = ctx.limit_used(limit);
+        println!("{}: used {used}, need at most {most}", limit.vk_name());
+        assert!(
+            used <= most,
+            "{} used {used}, more than histencil::NEEDS says ({most})",
+            limit.vk_name()
+        );
+        if reached.contains(&limit) {
+            assert_eq!(
+                used,
+                most,
+                "{}: the table's need not reached",
+                limit.vk_name()
+            );
+        }
+    }
+}

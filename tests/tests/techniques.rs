@@ -11,10 +11,12 @@
 //! order. So the sums round identically. The test asserts it.
 
 use histencil_brdf::BrdfId;
-use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
+use histencil_tests::{
+    assert_close, assert_needs_hold, diff, lit_fraction, with_validated_context,
+};
 use histencil_vk::{
-    Backend, CostModel, DepthIdCosts, FlushPolicy, MixedTiles, Readback, Renderer, RendererDesc,
-    Shading, Technique, TileSide, TiledCosts,
+    Backend, CostModel, DepthIdCosts, FlushPolicy, Limit, MixedTiles, Readback, Renderer,
+    RendererDesc, Shading, Technique, TileSide, TiledCosts,
 };
 
 const SIZE: u32 = 160;
@@ -185,6 +187,18 @@ fn check(scene_name: &str) {
             "{scene_name}: {} light pipelines for {brdfs} BRDFs",
             renderer.light_pipeline_count()
         );
+        drop(renderer);
+        // Every technique on one context: the device limits they needed are the table's.
+        let reached: &[Limit] = if tabulable {
+            &[
+                Limit::PerStageStorageBuffers,
+                Limit::ComputeWorkGroupInvocations,
+                Limit::ComputeWorkGroupSize,
+            ]
+        } else {
+            &[]
+        };
+        assert_needs_hold(ctx, reached);
     });
 }
 
@@ -330,4 +344,38 @@ fn adaptive_chooses_what_the_cost_model_says() {
         let frame = renderer.render(native, ldr).unwrap();
         assert_eq!(frame.images.ldr.unwrap(), expected);
     });
+}
+
+/// A device that offers only the spec's minimum of every limit (capped here, on any device):
+/// the driver line lists what histencil needs above it and what is unmet, the tiles shrink to
+/// 8x8, and the lighting, whose layouts bind 7 storage buffers per stage against the minimum's
+/// 4, is refused with an error that names the limit before Vulkan sees the layout (so no
+/// validation message).
+#[test]
+fn a_device_at_the_spec_minimum_is_refused_by_name() {
+    let _turn = histencil_tests::instance_turn();
+    let ctx = histencil_vk::Context::new(histencil_vk::ContextDesc {
+        spec_minimum_limits: true,
+        ..histencil_vk::ContextDesc::validated()
+    })
+    .expect("a device");
+    let log = ctx.validation_log();
+    let line = ctx.driver().to_string();
+    assert!(
+        line.contains("unmet: maxPerStageDescriptorStorageBuffers 4 < 7")
+            && line.contains("maxComputeWorkGroupInvocations 128 < 256"),
+        "{line}"
+    );
+    assert_eq!(TileSide::for_context(&ctx), TileSide::Eight);
+    let scene = histencil_scene::embedded("default").unwrap();
+    // The renderer makes its lighting's layouts as it is made.
+    let refused = Renderer::new(&ctx, scene, 16, 16).err();
+    match refused {
+        Some(histencil_vk::Error::DeviceLimit(why)) => {
+            assert!(why.contains("maxPerStageDescriptorStorageBuffers"), "{why}")
+        }
+        other => panic!("expected a device-limit error, got {other:?}"),
+    }
+    drop(ctx);
+    log.assert_clean();
 }

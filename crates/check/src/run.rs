@@ -86,6 +86,8 @@ pub struct CheckOptions {
     /// No driver quirk and no depth bounds test: the general path, on any device
     /// (`ContextDesc::general_path`, `ContextDesc::without_depth_bounds`).
     pub general_path: bool,
+    /// The device's limits capped at the spec's minimums (`ContextDesc::spec_minimum_limits`).
+    pub spec_minimum_limits: bool,
     /// Where a failing case writes its images, stencil dump and validation messages.
     pub out: Option<PathBuf>,
     /// Only cases whose `scene/case` name contains this.
@@ -273,6 +275,7 @@ pub fn run_check(
             depth_stencil: Some(format),
             general_path: options.general_path,
             without_depth_bounds: options.general_path,
+            spec_minimum_limits: options.spec_minimum_limits,
             ..ContextDesc::default()
         }) {
             Ok(ctx) => ctx,
@@ -405,6 +408,12 @@ impl Group<'_> {
         let (mut renderer, references) = match setup {
             Ok(built) if setup_messages.is_empty() => built,
             outcome => {
+                // A device below a limit the lighting needs runs none of the group: skips that
+                // name the limit, as a missing depth format's do.
+                let skip = match &outcome {
+                    Err(histencil_vk::Error::DeviceLimit(why)) => Some(why.clone()),
+                    _ => None,
+                };
                 let reason = match outcome {
                     Err(e) => format!("setting up the scene failed: {e}"),
                     Ok(_) => format!(
@@ -418,7 +427,10 @@ impl Group<'_> {
                     let mut r = self.result(case);
                     r.validation.clone_from(&setup_messages);
                     r.accepted = setup_accepted;
-                    r.outcome = Outcome::Failed(reason.clone());
+                    r.outcome = match &skip {
+                        Some(why) => Outcome::Skipped(why.clone()),
+                        None => Outcome::Failed(reason.clone()),
+                    };
                     emit(r);
                 }
                 return;
@@ -546,6 +558,13 @@ impl Group<'_> {
         (r.validation, r.accepted) = messages_since(self.log, mark, &self.options.accepted);
         let frame = match frame {
             Ok(frame) => frame,
+            // A device below a limit the configuration needs (a spec-minimum device and the
+            // tiled kernels' 7 storage buffers, say) cannot run it: a skip that says why, as a
+            // missing depth format is.
+            Err(histencil_vk::Error::DeviceLimit(why)) => {
+                r.outcome = Outcome::Skipped(why);
+                return r;
+            }
             Err(e) => {
                 r.outcome = Outcome::Failed(format!("rendering failed: {e}"));
                 return r;

@@ -70,6 +70,10 @@ pub struct CheckArgs {
     /// device without them takes, on this one (the driver line says `quirks: none`).
     #[arg(long)]
     general_path: bool,
+    /// Act as a device that offers only the Vulkan spec's minimum of every limit histencil
+    /// checks: a case that needs more is a skip that names the limit.
+    #[arg(long)]
+    spec_minimum_limits: bool,
     /// Run only the cases whose `scene/case` name contains this.
     #[arg(long)]
     filter: Option<String>,
@@ -216,6 +220,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         quick: args.quick,
         best_practices: args.best_practices,
         general_path: args.general_path,
+        spec_minimum_limits: args.spec_minimum_limits,
         out: Some(args.out.clone()),
         filter: args.filter.clone(),
         only,
@@ -393,6 +398,9 @@ fn run(
     }
     if args.general_path {
         worker_args.push("--general-path".into());
+    }
+    if args.spec_minimum_limits {
+        worker_args.push("--spec-minimum-limits".into());
     }
     worker_args.extend(["--out".into(), args.out.clone().into_os_string()]);
     if let Some(path) = &args.accept_messages {

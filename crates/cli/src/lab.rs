@@ -37,6 +37,7 @@ impl RunArgs {
             validate: self.validate,
             no_depth_bounds: self.no_depth_bounds,
             general_path: self.general_path,
+            spec_minimum_limits: false,
         }
     }
 }

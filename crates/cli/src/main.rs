@@ -200,6 +200,10 @@ struct RenderArgs {
     /// other driver takes, on this one.
     #[arg(long)]
     general_path: bool,
+    /// Act as a device that offers only the Vulkan spec's minimum of every limit histencil
+    /// checks: what needs more is refused naming the limit (the driver line lists them).
+    #[arg(long)]
+    spec_minimum_limits: bool,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -392,6 +396,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
         validate: args.validate,
         no_depth_bounds: args.no_depth_bounds,
         general_path: args.general_path,
+        spec_minimum_limits: args.spec_minimum_limits,
     };
     on_device(device, |ctx| {
         let shading = args.shading(ctx);
@@ -638,6 +643,8 @@ pub struct DeviceArgs {
     pub no_depth_bounds: bool,
     /// Apply no driver quirk.
     pub general_path: bool,
+    /// Cap the device's limits at the spec's minimums.
+    pub spec_minimum_limits: bool,
 }
 
 impl From<bool> for DeviceArgs {
@@ -647,6 +654,7 @@ impl From<bool> for DeviceArgs {
             validate,
             no_depth_bounds: false,
             general_path: false,
+            spec_minimum_limits: false,
         }
     }
 }
@@ -662,6 +670,7 @@ fn on_device<T>(
         validation: device.validate,
         without_depth_bounds: device.no_depth_bounds,
         general_path: device.general_path,
+        spec_minimum_limits: device.spec_minimum_limits,
         ..ContextDesc::default()
     })?;
     let log = ctx.validation_log();

@@ -4,11 +4,13 @@
 use crate::gpu::context::Context;
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::gpu_types::PUSH_CONSTANT_BYTES;
+use crate::gpu::limits::{layout_needs, SetCounts};
 use crate::gpu::teardown::build;
 use ash::vk;
 
 /// What a binding holds: the subset of Vulkan's descriptor types histencil's shaders use
-/// (separate images and samplers, no combined image samplers).
+/// (separate images and samplers, no combined image samplers). The order is
+/// [`crate::gpu::limits::SetCounts`]'s.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
     /// A `uniform` block (`UNIFORM_BUFFER`).
@@ -228,6 +230,17 @@ pub(crate) fn create_set_layout(
     let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
         .call("vkCreateDescriptorSetLayout")?;
     ctx.name(layout, name);
+    let mut counts = SetCounts {
+        stages,
+        kinds: [0; 5],
+    };
+    for b in set {
+        counts.kinds[b.kind as usize] += 1;
+    }
+    ctx.set_counts
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(layout, counts);
     Ok(layout)
 }
 
@@ -463,6 +476,17 @@ pub(crate) fn create_pipeline_layout(
     stages: vk::ShaderStageFlags,
     push_constant_bytes: u32,
 ) -> Result<vk::PipelineLayout> {
+    // Each need checked before Vulkan sees the layout: a device below one gets an error that
+    // names the limit, not a driver's undefined behaviour.
+    let counts: Vec<SetCounts> = {
+        let known = ctx.set_counts.lock().unwrap_or_else(|e| e.into_inner());
+        sets.iter()
+            .map(|s| known.get(s).copied().unwrap_or_default())
+            .collect()
+    };
+    for (limit, need) in layout_needs(&counts, push_constant_bytes) {
+        ctx.need(limit, need, &format!("pipeline layout `{name}`"))?;
+    }
     let ranges = [vk::PushConstantRange::default()
         .stage_flags(stages)
         .size(push_constant_bytes)];

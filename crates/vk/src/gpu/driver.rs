@@ -39,14 +39,17 @@ pub struct DriverInfo {
     pub version: u32,
     /// The quirks in force on the device, as [`crate::Quirks::describe`] names them.
     pub quirks: String,
+    /// The device limits histencil needs above the spec's minimum, with the device's values, as
+    /// [`crate::describe_limits`] writes them.
+    pub limits: String,
 }
 
 impl fmt::Display for DriverInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} ({}), Vulkan {}, conformance {}, quirks: {}",
-            self.name, self.info, self.api_version, self.conformance, self.quirks
+            "{} ({}), Vulkan {}, conformance {}, quirks: {}, limits: {}",
+            self.name, self.info, self.api_version, self.conformance, self.quirks, self.limits
         )?;
         if let Some(layer) = &self.validation_layer {
             write!(f, ", validation layer {layer}")?;
@@ -87,6 +90,10 @@ pub(crate) unsafe fn driver_info(
     unsafe { instance.get_physical_device_properties2(physical_device, &mut props) };
     let api_version = version_text(props.properties.api_version);
     let driver_version = props.properties.driver_version;
+    let limits = crate::gpu::limits::describe(
+        crate::gpu::limits::NEEDS,
+        &crate::gpu::limits::DeviceLimits::new(&props.properties.limits),
+    );
     let c = driver.conformance_version;
     DriverInfo {
         name: c_text(&driver.driver_name),
@@ -97,6 +104,7 @@ pub(crate) unsafe fn driver_info(
         id: driver.driver_id,
         version: driver_version,
         quirks: String::new(),
+        limits,
     }
 }
 

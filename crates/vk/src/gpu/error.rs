@@ -13,6 +13,11 @@ pub enum Error {
     /// The device lacks a format that was asked for (a caller can skip that configuration).
     #[error("missing format: {0}")]
     MissingFormat(String),
+    /// The device offers less of a limit than the work asked of it needs (a device below
+    /// [`crate::NEEDS`], or an engine's hooks adding descriptors): the message names the limit,
+    /// the need and the device's value.
+    #[error("device limit: {0}")]
+    DeviceLimit(String),
     /// A Vulkan call returned an error code (out of memory, device lost, ...).
     #[error("Vulkan call `{call}` failed: {result}")]
     Vulkan {

@@ -12,6 +12,7 @@ pub mod descriptors;
 pub(crate) mod driver;
 pub(crate) mod error;
 pub mod gpu_types;
+pub(crate) mod limits;
 pub(crate) mod meshes;
 pub(crate) mod pipelines;
 pub(crate) mod quirks;

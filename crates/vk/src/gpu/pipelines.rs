@@ -189,6 +189,11 @@ fn vertex_attributes(input: VertexInput) -> (u32, Vec<vk::VertexInputAttributeDe
 }
 
 pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipeline> {
+    ctx.need(
+        crate::gpu::limits::Limit::ColorAttachments,
+        desc.color_formats.len() as u32,
+        &format!("pipeline `{}`", desc.name),
+    )?;
     let vertex_module = create_module(ctx, desc.vertex.0, desc.vertex.1)?;
     let fragment_module = match desc.fragment {
         Some((name, spirv)) => match create_module(ctx, name, spirv) {

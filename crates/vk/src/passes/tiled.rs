@@ -16,6 +16,7 @@ use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers, TILED_SET,
 };
 use crate::gpu::error::{Error, Result};
+use crate::gpu::limits::Limit;
 use crate::gpu::pipelines::create_compute_pipeline;
 use crate::gpu::quirks::Quirk;
 use crate::gpu::resources::Buffer;
@@ -65,9 +66,14 @@ impl TileSide {
     /// The side for `ctx`'s driver: 8x8 where the quirk table says so
     /// ([`crate::Quirk::SmallTiles`]: lavapipe, where 8x8 tiles were as fast or faster within
     /// the noise wherever measured), else HDRP's 16x16, the common choice on GPUs (the two
-    /// measured within a few per cent on an H200).
+    /// measured within a few per cent on an H200). 8x8 too where the device cannot run a 16x16
+    /// workgroup (`maxComputeWorkGroupInvocations` 256 and `maxComputeWorkGroupSize` 16 are
+    /// above the spec's minimums of 128; 8x8 is within them).
     pub fn for_context(ctx: &Context) -> Self {
-        if ctx.quirks().has(Quirk::SmallTiles) {
+        let limits = ctx.device_limits();
+        let fits_16 = limits.get(Limit::ComputeWorkGroupInvocations) >= 256
+            && limits.get(Limit::ComputeWorkGroupSize) >= 16;
+        if ctx.quirks().has(Quirk::SmallTiles) || !fits_16 {
             TileSide::Eight
         } else {
             TileSide::Sixteen
@@ -240,6 +246,10 @@ impl TiledLighting {
         let compute = vk::ShaderStageFlags::COMPUTE;
         let e = desc.extent;
         let tile = desc.side.pixels();
+        // The classification and shade kernels run one invocation per pixel of a tile.
+        let what = format!("the tiled technique's {tile}x{tile} tiles");
+        ctx.need(Limit::ComputeWorkGroupInvocations, tile * tile, &what)?;
+        ctx.need(Limit::ComputeWorkGroupSize, tile, &what)?;
         let tiles_xy = (e.width.div_ceil(tile), e.height.div_ceil(tile));
         let [classify, shade] = desc.side.modules(desc.modules);
         let tiles = tiles_xy.0 * tiles_xy.1;

@@ -81,6 +81,11 @@ pub struct ContextDesc {
     /// Apply no driver quirk ([`crate::QUIRKS`]): the general path every other device takes,
     /// on this one too.
     pub general_path: bool,
+    /// Act as a device that offers only the spec's minimum of every limit histencil checks
+    /// ([`crate::Limit`]): work that needs more is refused with [`Error::DeviceLimit`] or takes
+    /// its smaller shape (8x8 tiles), as on such a device; the driver line reports the capped
+    /// values. What a device at the minimums can run, tried on any device.
+    pub spec_minimum_limits: bool,
 }
 
 impl ContextDesc {
@@ -159,6 +164,15 @@ pub struct Context {
     pub(crate) max_storage_buffer_range: u32,
     /// How many descriptor sets a pipeline layout may hold (an engine's visibility hook needs 5).
     pub(crate) max_bound_descriptor_sets: u32,
+    /// The device's values of the limits histencil checks ([`crate::Limit`]).
+    pub(crate) limits: crate::gpu::limits::DeviceLimits,
+    /// The largest need of each limit met on this context, for the reports and the test that
+    /// holds [`crate::NEEDS`] to the code.
+    pub(crate) limits_used: crate::gpu::limits::LimitsUsed,
+    /// What each set layout made on this context holds, by stage and kind: what a pipeline
+    /// layout built from them is checked against.
+    pub(crate) set_counts:
+        Mutex<std::collections::HashMap<vk::DescriptorSetLayout, crate::gpu::limits::SetCounts>>,
     /// `depthBounds` is enabled on the device and histencil's pipelines take the depth bounds
     /// test as dynamic state: the renderer confines lights to their depth ranges
     /// ([`histencil_model::FramePlan::with_depth_bounds`]). Off on an engine's device, whose
@@ -309,6 +323,9 @@ impl Context {
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             max_bound_descriptor_sets: props.limits.max_bound_descriptor_sets,
+            limits: crate::gpu::limits::DeviceLimits::new(&props.limits),
+            limits_used: Default::default(),
+            set_counts: Default::default(),
             depth_bounds: false,
             quirks,
             memory: MemoryAccount::new(memory_budget),
@@ -349,6 +366,31 @@ impl Context {
     /// [`ContextDesc::general_path`].
     pub fn quirks(&self) -> &crate::gpu::quirks::Quirks {
         &self.quirks
+    }
+
+    /// The device's values of the limits histencil checks.
+    pub fn device_limits(&self) -> &crate::gpu::limits::DeviceLimits {
+        &self.limits
+    }
+
+    /// The largest need of `limit` that work made on this context has had (0 before any).
+    pub fn limit_used(&self, limit: crate::gpu::limits::Limit) -> u32 {
+        self.limits_used.get(limit)
+    }
+
+    /// Checks `need` of `limit` against the device and notes it: an error naming the limit
+    /// and `what` needs it where the device offers less.
+    pub(crate) fn need(
+        &self,
+        limit: crate::gpu::limits::Limit,
+        need: u32,
+        what: &str,
+    ) -> Result<()> {
+        self.limits
+            .check(limit, need, what)
+            .map_err(Error::DeviceLimit)?;
+        self.limits_used.note(limit, need);
+        Ok(())
     }
 
     /// The kind of device in use (llvmpipe is `CPU`), as Vulkan reports it.

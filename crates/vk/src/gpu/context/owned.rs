@@ -287,6 +287,18 @@ impl Context {
         } else {
             crate::gpu::quirks::Quirks::of(crate::gpu::quirks::QUIRKS, driver.id, driver.version)
         };
+        let device_limits = crate::gpu::limits::DeviceLimits::new(&limits);
+        let device_limits = if desc.spec_minimum_limits {
+            device_limits.at_spec_minimum()
+        } else {
+            device_limits
+        };
+        driver.limits = crate::gpu::limits::describe(crate::gpu::limits::NEEDS, &device_limits);
+        if desc.spec_minimum_limits {
+            driver
+                .limits
+                .push_str(" (capped at the spec's minimums, asked for)");
+        }
         driver.quirks = if desc.general_path {
             "none (the general path, asked for)".into()
         } else {
@@ -319,7 +331,11 @@ impl Context {
             timestamp_period_ns: f64::from(limits.timestamp_period),
             max_image_dimension: limits.max_image_dimension2_d,
             max_storage_buffer_range: limits.max_storage_buffer_range,
-            max_bound_descriptor_sets: limits.max_bound_descriptor_sets,
+            max_bound_descriptor_sets: device_limits
+                .get(crate::gpu::limits::Limit::BoundDescriptorSets),
+            limits: device_limits,
+            limits_used: Default::default(),
+            set_counts: Default::default(),
             depth_bounds,
             quirks,
             memory: MemoryAccount::new(desc.memory_budget),
