@@ -11,6 +11,7 @@
 //! and a summary. `histencil check` is a thin wrapper over [`run_check`].
 
 pub mod bound;
+pub mod gtest;
 pub mod judge;
 pub mod lists;
 pub mod matrix;

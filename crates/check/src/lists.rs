@@ -214,8 +214,46 @@ pub fn parse_caselist(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// The case names of the case list at `path`. A line naming a `.txt` file includes that file's
+/// names (relative to the including file's folder), as deqp-runner reads dEQP's newer case lists
+/// (`vk-default.txt` lists other `.txt` files); an include that loops back is refused.
 pub fn load_caselist(path: &Path) -> Result<Vec<String>, ListError> {
-    Ok(parse_caselist(&read(path)?))
+    let mut names = Vec::new();
+    load_included(path, &mut Vec::new(), &mut names)?;
+    Ok(names)
+}
+
+fn load_included(
+    path: &Path,
+    reading: &mut Vec<std::path::PathBuf>,
+    names: &mut Vec<String>,
+) -> Result<(), ListError> {
+    let text = read(path)?;
+    let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    reading.push(key);
+    for (line, content) in lines(&text) {
+        let name = content.split(',').next().unwrap_or(content).trim();
+        if !name.ends_with(".txt") {
+            names.push(name.to_owned());
+            continue;
+        }
+        let included = path.parent().unwrap_or(Path::new(".")).join(name);
+        let canonical = std::fs::canonicalize(&included).unwrap_or_else(|_| included.clone());
+        if reading.contains(&canonical) {
+            return Err(ListError {
+                path: path.display().to_string(),
+                line,
+                message: format!("`{name}` includes a list that includes this one"),
+            });
+        }
+        load_included(&included, reading, names).map_err(|e| ListError {
+            path: path.display().to_string(),
+            line,
+            message: format!("including `{name}`: {e}"),
+        })?;
+    }
+    reading.pop();
+    Ok(())
 }
 
 /// Validation messages a team accepts on its device, each with the reason it gives: counted in
@@ -271,26 +309,59 @@ impl AcceptedMessages {
 pub struct Shard {
     pub index: u32,
     pub count: u32,
+    /// Mesa's split (`--fraction N --fraction-start K`, as deqp-runner's): every Nth case of
+    /// the run's order from the Kth. Otherwise histencil's `--shard K/N`: a hash of each
+    /// case's name.
+    pub interleaved: bool,
 }
 
 impl Shard {
+    /// `K/N` (`--shard`), or `fraction K/N` as a report writes an interleaved split.
     pub fn parse(text: &str) -> Result<Shard, String> {
+        let (interleaved, split) = match text.strip_prefix("fraction ") {
+            Some(rest) => (true, rest),
+            None => (false, text),
+        };
         let bad = || format!("`{text}` is not a shard: write K/N with 1 <= K <= N");
-        let (k, n) = text.split_once('/').ok_or_else(bad)?;
+        let (k, n) = split.split_once('/').ok_or_else(bad)?;
         let (index, count) = (
             k.trim().parse::<u32>().map_err(|_| bad())?,
             n.trim().parse::<u32>().map_err(|_| bad())?,
         );
-        if index == 0 || index > count {
-            return Err(bad());
-        }
-        Ok(Shard { index, count })
+        Shard::new(index, count, interleaved).map_err(|_| bad())
     }
 
-    /// Whether the case named `full` (`scene/case`) is this shard's. The hash is of the name
-    /// alone, so adding, removing or filtering other cases moves no case between shards.
-    pub fn holds(&self, full: &str) -> bool {
-        (fnv1a(full) % u64::from(self.count)) as u32 == self.index - 1
+    /// Split `index` of `count` (from 1), refused unless `1 <= index <= count`.
+    pub fn new(index: u32, count: u32, interleaved: bool) -> Result<Shard, String> {
+        if index == 0 || index > count {
+            return Err(format!(
+                "{index} of {count} is not a part: the start must be 1 to the count"
+            ));
+        }
+        Ok(Shard {
+            index,
+            count,
+            interleaved,
+        })
+    }
+
+    /// Whether the case named `full` (`scene/case`), at `position` (from 0) of the run's
+    /// order, is this part's. A hash shard reads the name alone, so adding, removing or
+    /// filtering other cases moves no case between shards; an interleaved part reads the
+    /// position, as deqp-runner's `--fraction` does.
+    pub fn holds(&self, position: usize, full: &str) -> bool {
+        if self.interleaved {
+            position % self.count as usize == (self.index - 1) as usize
+        } else {
+            (fnv1a(full) % u64::from(self.count)) as u32 == self.index - 1
+        }
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let kind = if self.interleaved { "fraction " } else { "" };
+        write!(f, "{kind}{}/{}", self.index, self.count)
     }
 }
 
@@ -356,14 +427,53 @@ mod tests {
     }
 
     #[test]
+    fn caselists_include_other_lists_and_refuse_loops() {
+        let dir = std::env::temp_dir().join(format!("histencil-caselist-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("sub")).unwrap();
+        std::fs::write(dir.join("top.txt"), "a/1\nsub/more.txt\n# note\nb/2,Fail\n").unwrap();
+        std::fs::write(dir.join("sub/more.txt"), "c/3\n").unwrap();
+        assert_eq!(
+            load_caselist(&dir.join("top.txt")).unwrap(),
+            ["a/1", "c/3", "b/2"]
+        );
+        std::fs::write(dir.join("sub/more.txt"), "../top.txt\n").unwrap();
+        let err = load_caselist(&dir.join("top.txt")).unwrap_err().to_string();
+        assert!(
+            err.contains("includes a list that includes this one"),
+            "{err}"
+        );
+        std::fs::write(dir.join("top.txt"), "missing.txt\n").unwrap();
+        let err = load_caselist(&dir.join("top.txt")).unwrap_err().to_string();
+        assert!(err.contains("top.txt:1: including `missing.txt`"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn shards_partition_and_are_stable() {
         let names: Vec<String> = (0..500).map(|i| format!("scene/case-{i}")).collect();
-        let shards: Vec<Shard> = (1..=4).map(|k| Shard { index: k, count: 4 }).collect();
-        for n in &names {
-            assert_eq!(shards.iter().filter(|s| s.holds(n)).count(), 1, "{n}");
+        for interleaved in [false, true] {
+            let shards: Vec<Shard> = (1..=4)
+                .map(|k| Shard::new(k, 4, interleaved).unwrap())
+                .collect();
+            for (i, n) in names.iter().enumerate() {
+                assert_eq!(shards.iter().filter(|s| s.holds(i, n)).count(), 1, "{n}");
+            }
+            // Round-trips through the report's spelling.
+            for s in &shards {
+                assert_eq!(Shard::parse(&s.to_string()), Ok(*s));
+            }
         }
+        // deqp-runner's --fraction 3 --fraction-start 2: the 2nd, 5th, 8th... case.
+        let part = Shard::new(2, 3, true).unwrap();
+        let held: Vec<usize> = (0..9).filter(|&i| part.holds(i, "")).collect();
+        assert_eq!(held, [1, 4, 7]);
+        let shards: Vec<Shard> = (1..=4).map(|k| Shard::new(k, 4, false).unwrap()).collect();
         for s in &shards {
-            let held = names.iter().filter(|n| s.holds(n)).count();
+            let held = names
+                .iter()
+                .enumerate()
+                .filter(|(i, n)| s.holds(*i, n))
+                .count();
             assert!((80..=170).contains(&held), "{s:?} holds {held}");
         }
         // The FNV-1a test vector: the hash cannot drift between releases.
@@ -371,6 +481,7 @@ mod tests {
         for bad in ["0/4", "5/4", "1", "a/b", "1/0"] {
             assert!(Shard::parse(bad).is_err(), "{bad}");
         }
-        assert_eq!(Shard::parse("2/3"), Ok(Shard { index: 2, count: 3 }));
+        assert_eq!(Shard::parse("2/3"), Shard::new(2, 3, false));
+        assert_eq!(Shard::parse("fraction 2/3"), Shard::new(2, 3, true));
     }
 }

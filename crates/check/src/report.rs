@@ -489,30 +489,35 @@ pub fn from_json(v: &Value) -> Result<RunReport, String> {
 /// so is a set of shards with one missing (a shard whose job died before writing its report
 /// would otherwise leave a green merge) or one twice.
 pub fn merge(runs: Vec<RunReport>) -> Result<RunReport, String> {
-    let shards: Vec<(u32, u32)> = runs
+    let shards: Vec<crate::lists::Shard> = runs
         .iter()
         .flat_map(|r| &r.shards)
-        .map(|s| {
-            crate::lists::Shard::parse(s)
-                .map(|s| (s.index, s.count))
-                .map_err(|e| format!("a report names {e}"))
-        })
+        .map(|s| crate::lists::Shard::parse(s).map_err(|e| format!("a report names {e}")))
         .collect::<Result<_, _>>()?;
-    if let Some(&(_, count)) = shards.first() {
-        if shards.iter().any(|&(_, n)| n != count) || runs.iter().any(|r| r.shards.is_empty()) {
+    if let Some(first) = shards.first() {
+        let (count, interleaved) = (first.count, first.interleaved);
+        if shards
+            .iter()
+            .any(|s| s.count != count || s.interleaved != interleaved)
+            || runs.iter().any(|r| r.shards.is_empty())
+        {
             return Err("the reports are shards of different splits (or some not a shard)".into());
         }
-        if let Some(&(k, _)) = shards
+        if let Some(twice) = shards
             .iter()
             .enumerate()
             .find(|(i, s)| shards[..*i].contains(s))
             .map(|(_, s)| s)
         {
-            return Err(format!("shard {k}/{count} is given twice"));
+            return Err(format!("shard {twice} is given twice"));
         }
         let missing: Vec<String> = (1..=count)
-            .filter(|k| !shards.iter().any(|&(i, _)| i == *k))
-            .map(|k| format!("{k}/{count}"))
+            .filter(|k| !shards.iter().any(|s| s.index == *k))
+            .map(|k| {
+                crate::lists::Shard::new(k, count, interleaved)
+                    .map(|s| s.to_string())
+                    .unwrap_or_default()
+            })
             .collect();
         if !missing.is_empty() {
             return Err(format!(
@@ -819,6 +824,16 @@ mod tests {
         let err = merge(vec![a.clone(), b.clone()]).unwrap_err();
         assert!(err.contains("shard 2/3 missing"), "{err}");
         b.shards = vec!["1/3".into()];
-        assert!(merge(vec![a, b]).is_err());
+        assert!(merge(vec![a.clone(), b.clone()]).is_err());
+        // Mesa's interleaved parts join the same way, never with hash shards.
+        a.shards = vec!["fraction 1/2".into()];
+        b.shards = vec!["2/2".into()];
+        let err = merge(vec![a.clone(), b.clone()]).unwrap_err();
+        assert!(err.contains("different splits"), "{err}");
+        b.shards = vec!["fraction 2/2".into()];
+        assert_eq!(
+            merge(vec![a, b]).unwrap().shards,
+            ["fraction 1/2", "fraction 2/2"]
+        );
     }
 }

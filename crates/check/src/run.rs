@@ -74,6 +74,10 @@ pub enum InjectedFault {
     /// Cases whose `scene/case` name contains this abort the process (a driver crash, as a
     /// runner sees one); `device/teardown-<format>` names a context's destruction.
     Crash(String),
+    /// Cases whose `scene/case` name contains this fail the first time they run with a given
+    /// `--out` folder and pass after (a marker file there remembers): a flaky driver, as a
+    /// runner that reruns failures sees one.
+    Flaky(String),
 }
 
 /// How to run the matrix.
@@ -96,7 +100,7 @@ pub struct CheckOptions {
     pub only: Option<HashSet<String>>,
     /// Validation messages the user accepts: counted per case, never failing it.
     pub accepted: AcceptedMessages,
-    pub inject: Option<InjectedFault>,
+    pub inject: Vec<InjectedFault>,
 }
 
 /// What [`run_check`] tells its caller as it goes.
@@ -341,10 +345,12 @@ pub fn run_check(
         let mark = log.len();
         let teardown_start = Instant::now();
         let teardown = format!("teardown-{}", format.vk_name().to_lowercase());
-        if let Some(InjectedFault::Crash(part)) = &options.inject {
+        for fault in &options.inject {
             // A driver that crashes destroying its device, after every case reported.
-            if format!("device/{teardown}").contains(part.as_str()) {
-                std::process::abort();
+            if let InjectedFault::Crash(part) = fault {
+                if format!("device/{teardown}").contains(part.as_str()) {
+                    std::process::abort();
+                }
             }
         }
         drop(ctx);
@@ -446,6 +452,12 @@ impl Group<'_> {
                 started(&self.full_name(case));
             }
             self.inject_runner_fault(case);
+            if let Some(why) = self.injected_flake(case) {
+                let mut r = self.result(case);
+                r.outcome = Outcome::Failed(why);
+                emit(r);
+                continue;
+            }
             let mut r = match case.config {
                 None => self.reference(case, &references, setup_seconds),
                 Some(config) => self.case(case, config, &mut renderer, &references, &mut simulated),
@@ -462,18 +474,37 @@ impl Group<'_> {
         format!("{}/{}", self.scene.name, case.name())
     }
 
+    /// `--inject-fault flaky=`: the first run of a matching case in this `--out` folder fails
+    /// (and leaves the marker), every later one runs as usual.
+    fn injected_flake(&self, case: &Case) -> Option<String> {
+        let name = self.full_name(case);
+        let flaky = self
+            .options
+            .inject
+            .iter()
+            .any(|f| matches!(f, InjectedFault::Flaky(part) if name.contains(part.as_str())));
+        let out = self.options.out.as_ref().filter(|_| flaky)?;
+        let marker = out.join(format!("flaky-{}-{}", self.scene.file_name(), case.name()));
+        let first = std::fs::create_dir_all(out).is_ok()
+            && std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&marker)
+                .is_ok();
+        first.then(|| format!("injected flake: first run ({} written)", marker.display()))
+    }
+
     /// `--inject-fault hang=` and `crash=`: what a hung or crashing driver does to a runner.
     fn inject_runner_fault(&self, case: &Case) {
-        match &self.options.inject {
-            Some(InjectedFault::Hang(part)) if self.full_name(case).contains(part.as_str()) => {
-                loop {
+        let name = self.full_name(case);
+        for fault in &self.options.inject {
+            match fault {
+                InjectedFault::Hang(part) if name.contains(part.as_str()) => loop {
                     std::thread::sleep(std::time::Duration::from_secs(3600));
-                }
+                },
+                InjectedFault::Crash(part) if name.contains(part.as_str()) => std::process::abort(),
+                _ => {}
             }
-            Some(InjectedFault::Crash(part)) if self.full_name(case).contains(part.as_str()) => {
-                std::process::abort()
-            }
-            _ => {}
         }
     }
 
@@ -539,7 +570,7 @@ impl Group<'_> {
         let mut r = self.result(case);
         let mut technique = config.technique();
         // Deferred runs on the native backend: no hi-stencil, nothing to drop.
-        if self.options.inject == Some(InjectedFault::DropFlushes)
+        if self.options.inject.contains(&InjectedFault::DropFlushes)
             && config.platform.has_hi_stencil()
         {
             technique = matrix::Config {

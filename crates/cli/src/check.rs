@@ -26,12 +26,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Exit codes apart, as a CI script reads them.
-const EXIT_FAILING: u8 = 1;
+pub(crate) const EXIT_FAILING: u8 = 1;
 const EXIT_USAGE: u8 = 2;
-const EXIT_NO_DEVICE: u8 = runner::NO_DEVICE_EXIT as u8;
+pub(crate) const EXIT_NO_DEVICE: u8 = runner::NO_DEVICE_EXIT as u8;
 const EXIT_NO_CASES: u8 = 4;
 const EXIT_INCOMPLETE: u8 = 5;
-const EXIT_RUNNER: u8 = 6;
+pub(crate) const EXIT_RUNNER: u8 = 6;
 
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true)]
@@ -45,9 +45,23 @@ pub struct CheckArgs {
     /// Resolutions 1x1, 7x5 and 257x129 only; the full run adds 1280x720.
     #[arg(long)]
     quick: bool,
-    /// Print the cases selected (scene, case, expectation) without running them.
+    /// Print the cases selected, `scene/case` a line, without running them (the count goes
+    /// to stderr): a valid `--caselist`, and the first column of a baseline.
     #[arg(long)]
     list: bool,
+    /// What `--list` prints: `names` (`scene/case`), or `table` (scene, case and what the case
+    /// expects, tab-separated).
+    #[arg(long, value_enum, default_value_t = ListFormat::Names)]
+    list_format: ListFormat,
+    /// Print the selected cases as googletest lists tests (`Group.` lines, then indented
+    /// names), for Mesa's deqp-runner (`gtest-runner`); see the book's Validation CI.
+    #[arg(long = "gtest_list_tests")]
+    gtest_list_tests: bool,
+    /// Run the selected cases whose googletest name matches, in this process, printing
+    /// googletest's RUN/OK/FAILED/SKIPPED lines (`POSITIVE[-NEGATIVE]`, `:`-separated, `*`
+    /// and `?` wildcards), as deqp-runner's `gtest-runner` runs a group.
+    #[arg(long = "gtest_filter")]
+    gtest_filter: Option<String>,
     /// Write JUnit XML here (a testsuite per scene, a testcase per configuration).
     #[arg(long)]
     junit: Option<PathBuf>,
@@ -77,13 +91,20 @@ pub struct CheckArgs {
     /// Run only the cases whose `scene/case` name contains this.
     #[arg(long)]
     filter: Option<String>,
-    /// Run exactly the cases named in this file (a `scene/case` per line, or a results.csv or
-    /// failures.csv).
+    /// Run exactly the cases named in this file (a `scene/case` or googletest name per line,
+    /// or a results.csv or failures.csv; a line naming a `.txt` file includes that file).
     #[arg(long)]
     caselist: Option<PathBuf>,
     /// Run one shard of the cases, K of N (from 1), by a stable hash of each case's name.
-    #[arg(long, value_parser = Shard::parse)]
+    #[arg(long, value_parser = Shard::parse, conflicts_with = "fraction")]
     shard: Option<Shard>,
+    /// Run every Nth case of the run's order (Mesa's split, as deqp-runner's `--fraction`:
+    /// `--fraction $CI_NODE_TOTAL --fraction-start $CI_NODE_INDEX`).
+    #[arg(long)]
+    fraction: Option<u32>,
+    /// With `--fraction`: start at the Kth case (from 1).
+    #[arg(long, requires = "fraction", default_value_t = 1)]
+    fraction_start: u32,
     /// Worker processes at once (default: the machine's cores).
     #[arg(long)]
     jobs: Option<usize>,
@@ -97,8 +118,9 @@ pub struct CheckArgs {
     /// At most this many cases per worker process: a fresh process bounds a driver's growth.
     #[arg(long, default_value_t = 100)]
     cases_per_worker: usize,
-    /// Expected results, `scene/case,Status` per line (Fail, Crash or Timeout; `#` comments):
-    /// a failure listed is ExpectedFail, a listed case that passes is UnexpectedPass.
+    /// Expected results, `scene/case,Status` per line (Fail, Crash or Timeout; `#` comments;
+    /// a case may be named as googletest names it, so deqp-runner's baseline serves too): a
+    /// failure listed is ExpectedFail, a listed case that passes is UnexpectedPass.
     #[arg(long)]
     baseline: Option<PathBuf>,
     /// Regular expressions (one per line) of cases not to run; repeat for several files.
@@ -119,14 +141,23 @@ pub struct CheckArgs {
     /// counted per case in the reports, never dropped silently.
     #[arg(long)]
     accept_messages: Option<PathBuf>,
-    /// Break the renderer on purpose, to see the check fail (tests of the check itself):
-    /// `drop-flushes`, `hang=PART` or `crash=PART` (cases whose name contains PART).
-    #[arg(long, hide = true, value_parser = parse_fault)]
-    inject_fault: Option<InjectedFault>,
+    /// Break the renderer on purpose, to see the check fail (a baseline's or a CI job's own
+    /// test): `drop-flushes` (the hi-stencil emulation skips its flushes: the 360-like and
+    /// PS3-like cases that need one fail), `hang=PART` or `crash=PART` (cases whose name
+    /// contains PART hang or abort), `flaky=PART` (they fail the first time they run with this
+    /// `--out` folder, then pass); repeat for several.
+    #[arg(long, value_parser = parse_fault)]
+    inject_fault: Vec<InjectedFault>,
     /// Run the cases in this process and report them on stdout, a line each (what the runner
     /// starts; the environment is not cleaned here).
     #[arg(long, hide = true)]
     worker: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ListFormat {
+    Names,
+    Table,
 }
 
 #[derive(clap::Subcommand)]
@@ -152,8 +183,9 @@ fn parse_fault(text: &str) -> Result<InjectedFault, String> {
         None if text == "drop-flushes" => Ok(InjectedFault::DropFlushes),
         Some(("hang", part)) if !part.is_empty() => Ok(InjectedFault::Hang(part.to_owned())),
         Some(("crash", part)) if !part.is_empty() => Ok(InjectedFault::Crash(part.to_owned())),
+        Some(("flaky", part)) if !part.is_empty() => Ok(InjectedFault::Flaky(part.to_owned())),
         _ => Err(format!(
-            "`{text}`: expected drop-flushes, hang=PART or crash=PART"
+            "`{text}`: expected drop-flushes, hang=PART, crash=PART or flaky=PART"
         )),
     }
 }
@@ -168,7 +200,7 @@ fn usage(e: impl std::fmt::Display) -> ExitCode {
 /// `VK_LAYER_*` setting variable (message-id filter, duplicate limit, disables, report flags,
 /// debug action, a settings file's path...), the newer `VK_KHRONOS_VALIDATION_*` spellings, and
 /// the loader's switch that disables layers. `VK_LAYER_PATH` (where layers are found) stays.
-fn muting_variable(name: &str) -> bool {
+pub(crate) fn muting_variable(name: &str) -> bool {
     (name.starts_with("VK_LAYER_") && name != "VK_LAYER_PATH")
         || name.starts_with("VK_KHRONOS_VALIDATION_")
         || name == "VK_LOADER_LAYERS_DISABLE"
@@ -182,6 +214,18 @@ const PINNED_SETTINGS: &str = "\
 khronos_validation.enable_message_limit = false
 khronos_validation.validate_sync = true
 ";
+
+/// Writes [`PINNED_SETTINGS`] as `vk_layer_settings.txt` in `out` (made if missing), whole or
+/// not at all (processes running side by side write the same file), and returns its absolute
+/// path.
+pub(crate) fn write_pinned_settings(out: &std::path::Path) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(out)?;
+    let path = out.join("vk_layer_settings.txt");
+    let partial = out.join(format!(".vk_layer_settings.{}.txt", std::process::id()));
+    std::fs::write(&partial, PINNED_SETTINGS)?;
+    std::fs::rename(&partial, &path)?;
+    std::fs::canonicalize(&path)
+}
 
 pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     if let Some(CheckCommand::Merge(merge_args)) = &args.command {
@@ -216,7 +260,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         },
         None => None,
     };
-    let options = CheckOptions {
+    let mut options = CheckOptions {
         quick: args.quick,
         best_practices: args.best_practices,
         general_path: args.general_path,
@@ -230,6 +274,23 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     if args.worker {
         return worker(&scenes, &options, args.expect_driver.as_deref());
     }
+    // Every case's googletest name, over the whole matrix of these scenes, so that a case list
+    // or baseline in either spelling selects the same cases.
+    let names = match gtest_names(&scenes, &options) {
+        Ok(n) => n,
+        Err(e) => return usage(e),
+    };
+    if let Some(only) = options.only.take() {
+        let full = |name: String| names.full_name(&name).map(str::to_owned).unwrap_or(name);
+        options.only = Some(only.into_iter().map(full).collect());
+    }
+    let split = match args.fraction {
+        Some(count) => match Shard::new(args.fraction_start, count, true) {
+            Ok(s) => Some(s),
+            Err(e) => return usage(format!("--fraction-start/--fraction: {e}")),
+        },
+        None => args.shard,
+    };
     let mut skips = Patterns::default();
     for path in &args.skips {
         match Patterns::load(path) {
@@ -242,7 +303,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         Err(e) => return usage(e),
     };
     let (mut cases, mut skipped) = (Vec::new(), Vec::new());
-    for (scene, case) in &planned {
+    for (position, (scene, case)) in planned.iter().enumerate() {
         let planned = PlannedCase {
             scene: scenes[*scene].name.clone(),
             case: case.name(),
@@ -256,10 +317,11 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
             pixels: u64::from(case.width) * u64::from(case.height),
         };
         let full = planned.full_name();
-        if args.shard.is_some_and(|s| !s.holds(&full)) {
+        if split.is_some_and(|s| !s.holds(position, &full)) {
             continue;
         }
-        if skips.matches(&full) {
+        let gtest = names.gtest_name(&full).unwrap_or_default();
+        if skips.matches(&full) || skips.matches(gtest) {
             skipped.push(Record {
                 scene: planned.scene.clone(),
                 name: planned.case.clone(),
@@ -276,17 +338,34 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     }
     if args.list {
         for (c, expect) in &cases {
-            println!("{}\t{}\t{expect}", c.scene, c.case);
+            match args.list_format {
+                ListFormat::Names => println!("{}", c.full_name()),
+                ListFormat::Table => println!("{}\t{}\t{expect}", c.scene, c.case),
+            }
         }
-        println!(
+        eprintln!(
             "{} cases ({} scenes{}; a format the device lacks is skipped when run)",
             cases.len(),
             scenes.len(),
-            args.shard
-                .map(|s| format!(", shard {}/{}", s.index, s.count))
-                .unwrap_or_default()
+            split.map(|s| format!(", shard {s}")).unwrap_or_default()
         );
         return ExitCode::SUCCESS;
+    }
+    let selected: HashSet<String> = cases.iter().map(|(c, _)| c.full_name()).collect();
+    if args.gtest_list_tests {
+        return crate::gtest::list(&names, &|full| selected.contains(full));
+    }
+    if let Some(filter) = &args.gtest_filter {
+        let filter = histencil_check::gtest::GtestFilter::parse(filter);
+        let chosen = names.select(&filter);
+        options.only = Some(
+            chosen
+                .into_iter()
+                .filter(|full| selected.contains(*full))
+                .map(str::to_owned)
+                .collect(),
+        );
+        return crate::gtest::run(&scenes, &options, &names, args.expect_driver.as_deref());
     }
     if cases.is_empty() {
         eprintln!(
@@ -308,13 +387,20 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     if let Err(e) = histencil_vk::check_output_dir(&args.out) {
         return usage(e);
     }
-    let baseline = match &args.baseline {
+    let mut baseline = match &args.baseline {
         Some(path) => match Baseline::load(path) {
             Ok(b) => b,
             Err(e) => return usage(e),
         },
         None => Baseline::default(),
     };
+    baseline.expected = std::mem::take(&mut baseline.expected)
+        .into_iter()
+        .map(|(name, status)| match names.full_name(&name) {
+            Some(full) => (full.to_owned(), status),
+            None => (name, status),
+        })
+        .collect();
     let mut flakes = Patterns::default();
     for path in &args.flakes {
         match Patterns::load(path) {
@@ -323,7 +409,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         }
     }
     let cases: Vec<PlannedCase> = cases.into_iter().map(|(c, _)| c).collect();
-    match run(args, &options, cases, skipped, baseline, flakes) {
+    match run(args, &options, cases, skipped, baseline, flakes, split) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("histencil: {e:#}");
@@ -340,6 +426,35 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     }
 }
 
+/// Every case of `scenes`' matrix (whatever `options.only` selects), named for googletest.
+fn gtest_names(
+    scenes: &[CheckScene],
+    options: &CheckOptions,
+) -> Result<histencil_check::gtest::GtestNames, String> {
+    let all = CheckOptions {
+        only: None,
+        filter: None,
+        ..options.clone()
+    };
+    let planned = histencil_check::planned_cases(scenes, &all).map_err(|e| e.to_string())?;
+    let named: Vec<(String, String, String)> = planned
+        .iter()
+        .map(|(scene, case)| {
+            let s = &scenes[*scene];
+            (
+                s.file_name(),
+                format!("{}/{}", s.name, case.name()),
+                case.name(),
+            )
+        })
+        .collect();
+    histencil_check::gtest::GtestNames::new(
+        named
+            .iter()
+            .map(|(f, full, case)| (f.as_str(), full.as_str(), case.as_str())),
+    )
+}
+
 /// Set by SIGINT and SIGTERM; the runner stops, keeps what finished and writes its reports.
 static STOP: AtomicBool = AtomicBool::new(false);
 
@@ -354,6 +469,7 @@ fn run(
     skipped: Vec<Record>,
     baseline: Baseline,
     flakes: Patterns,
+    split: Option<Shard>,
 ) -> Result<ExitCode> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
@@ -409,11 +525,12 @@ fn run(
     if let Some(driver) = &args.expect_driver {
         worker_args.extend(["--expect-driver".into(), driver.into()]);
     }
-    if let Some(fault) = &args.inject_fault {
+    for fault in &args.inject_fault {
         let text = match fault {
             InjectedFault::DropFlushes => "drop-flushes".to_owned(),
             InjectedFault::Hang(p) => format!("hang={p}"),
             InjectedFault::Crash(p) => format!("crash={p}"),
+            InjectedFault::Flaky(p) => format!("flaky={p}"),
         };
         worker_args.extend(["--inject-fault".into(), text.into()]);
     }
@@ -455,10 +572,7 @@ fn run(
         accepted: options.accepted.accepted.clone(),
         best_practices: args.best_practices,
         quick: args.quick,
-        shards: args
-            .shard
-            .map(|s| vec![format!("{}/{}", s.index, s.count)])
-            .unwrap_or_default(),
+        shards: split.map(|s| vec![s.to_string()]).unwrap_or_default(),
         allow_unexpected_pass: args.allow_unexpected_pass,
         ..RunReport::default()
     };

@@ -16,6 +16,7 @@ use std::process::ExitCode;
 mod brdf_eval;
 mod brdf_report;
 mod check;
+mod gtest;
 mod lab;
 
 #[derive(Parser)]

@@ -148,24 +148,28 @@ fn four_shards_hold_every_case_once() {
         assert_eq!(o.status.code(), Some(0), "{}", text(&o));
         String::from_utf8_lossy(&o.stdout)
             .lines()
-            .filter(|l| l.contains('\t'))
             .map(str::to_owned)
             .collect()
     };
     let all = list(&[]);
-    let mut union = BTreeSet::new();
-    for k in 1..=4 {
-        let shard = list(&["--shard", &format!("{k}/4")]);
-        assert!(
-            shard.len() > all.len() / 8,
-            "shard {k} holds {}",
-            shard.len()
-        );
-        for case in shard {
-            assert!(union.insert(case.clone()), "{case} is in two shards");
+    // histencil's hash shards and Mesa's interleaved fractions alike.
+    for split in ["--shard K/4", "--fraction 4 --fraction-start K"] {
+        let mut union = BTreeSet::new();
+        for k in 1..=4 {
+            let args = split.replace('K', &k.to_string());
+            let args: Vec<&str> = args.split(' ').collect();
+            let shard = list(&args);
+            assert!(
+                shard.len() > all.len() / 8,
+                "{split}: {k} holds {}",
+                shard.len()
+            );
+            for case in shard {
+                assert!(union.insert(case.clone()), "{case} is in two shards");
+            }
         }
+        assert_eq!(union, all, "{split}");
     }
-    assert_eq!(union, all);
 }
 
 #[test]
@@ -465,4 +469,110 @@ fn exit_codes_tell_usage_no_cases_and_bad_lists_apart() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o));
         assert!(!text(&o).contains("panicked"), "{}", text(&o));
     }
+}
+
+/// The gtest face: `--gtest_list_tests` prints only what deqp-runner's list parser takes (a
+/// `Group.` line, then indented names that hold no dot), one test per case `--list` prints;
+/// `--gtest_filter` runs exactly the named tests here, with googletest's lines on stdout and an
+/// empty stderr; a case list or baseline in gtest spelling selects what the `scene/case`
+/// spelling does.
+#[test]
+fn the_gtest_face_lists_runs_and_maps_names_one_to_one() {
+    let args = ["--quick", "--scene", "default", "--filter", "d32s8-7x5"];
+    let o = command(&[&args[..], &["--gtest_list_tests"]].concat())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let listing = String::from_utf8_lossy(&o.stdout).into_owned();
+    let mut tests = Vec::new();
+    let mut group = None;
+    for line in listing.lines() {
+        if let Some(name) = line.strip_prefix("  ") {
+            assert!(!name.contains('.') && !name.contains('-'), "{line}");
+            tests.push(format!("{}{name}", group.as_deref().unwrap()));
+        } else {
+            assert!(line.ends_with('.') && !line.contains(' '), "{line}");
+            group = Some(line.to_owned());
+        }
+    }
+    let o = command(&[&args[..], &["--list"]].concat())
+        .output()
+        .unwrap();
+    let full: Vec<String> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    assert_eq!(tests.len(), full.len());
+    assert!(tests.len() > 30, "{listing}");
+
+    let dir = fresh_dir("gtest");
+    let out = dir.join("out");
+    let chosen = [tests[0].as_str(), tests[5].as_str()].join(":");
+    let o = command(
+        &[
+            &args[..],
+            &[
+                &format!("--gtest_filter={chosen}"),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    )
+    .output()
+    .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(o.stderr.is_empty(), "{}", text(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    for test in [&tests[0], &tests[5]] {
+        assert!(
+            stdout.contains(&format!("[ RUN      ] {test}\n")),
+            "{stdout}"
+        );
+        assert!(
+            stdout.contains(&format!("[       OK ] {test} (")),
+            "{stdout}"
+        );
+    }
+    assert_eq!(stdout.matches("[ RUN      ]").count(), 2, "{stdout}");
+
+    // A failing test: FAILED, exit 1, its reason indented after the line, no bracket in it.
+    let o = command(
+        &[
+            &args[..],
+            &[
+                "--gtest_filter=default.stencil_ps3_auto_p00_lightmap_d32s8_7x5",
+                "--out",
+                out.to_str().unwrap(),
+                "--inject-fault",
+                "flaky=stencil-ps3-auto-p00-lightmap-d32s8-7x5",
+            ],
+        ]
+        .concat(),
+    )
+    .output()
+    .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let after: Vec<&str> = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("[  FAILED  ]"))
+        .skip(1)
+        .collect();
+    assert!(after[0].starts_with("    default/stencil-ps3"), "{stdout}");
+    assert!(after.iter().all(|l| !l.contains('[')), "{stdout}");
+
+    // Case lists and baselines in gtest spelling.
+    let gtest_list = dir.join("gtest.txt");
+    std::fs::write(&gtest_list, format!("{}\n{}\n", tests[0], tests[5])).unwrap();
+    let full_list = dir.join("full.txt");
+    std::fs::write(&full_list, format!("{}\n{}\n", full[0], full[5])).unwrap();
+    let listed = |list: &Path| {
+        let o = command(&[&args[..], &["--list", "--caselist", list.to_str().unwrap()]].concat())
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    assert_eq!(listed(&gtest_list), listed(&full_list));
+    assert_eq!(listed(&gtest_list).lines().count(), 2);
 }
