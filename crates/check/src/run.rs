@@ -13,7 +13,9 @@ use histencil_vk::{
 };
 use image::{GrayImage, RgbaImage};
 use std::collections::{HashMap, HashSet};
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// A scene to check, with the name it was asked for by (an embedded name or a glTF path).
@@ -80,6 +82,17 @@ pub enum InjectedFault {
     Flaky(String),
 }
 
+/// What an injected hang or crash does: never return, or abort the process.
+fn strike(fault: &InjectedFault) {
+    match fault {
+        InjectedFault::Hang(_) => loop {
+            std::thread::sleep(std::time::Duration::from_secs(3600));
+        },
+        InjectedFault::Crash(_) => std::process::abort(),
+        _ => {}
+    }
+}
+
 /// How to run the matrix.
 #[derive(Clone, Debug, Default)]
 pub struct CheckOptions {
@@ -92,6 +105,10 @@ pub struct CheckOptions {
     pub general_path: bool,
     /// The device's limits capped at the spec's minimums (`ContextDesc::spec_minimum_limits`).
     pub spec_minimum_limits: bool,
+    /// Print each step of the work on stdout as it begins, `step <what>` a line
+    /// (`Context::observe_steps`): a runner reading them knows what a crashed or hung process
+    /// was recording or waiting on.
+    pub trace_steps: bool,
     /// Where a failing case writes its images, stencil dump and validation messages.
     pub out: Option<PathBuf>,
     /// Only cases whose `scene/case` name contains this.
@@ -267,6 +284,7 @@ pub fn run_check(
         (progress.borrow_mut())(Event::Finished(&result, total));
         results.push(result);
     };
+    let armed: Arc<Mutex<Option<InjectedFault>>> = Arc::default();
     for format in DepthStencilFormat::ALL {
         let mine: Vec<&(usize, Case)> =
             planned.iter().filter(|(_, c)| c.format == format).collect();
@@ -293,6 +311,25 @@ pub fn run_check(
             }
             Err(e) => return Err(e.into()),
         };
+        if options.trace_steps {
+            let armed = Arc::clone(&armed);
+            ctx.observe_steps(Some(Box::new(move |step: &str| {
+                {
+                    let mut out = std::io::stdout().lock();
+                    // No square brackets: a googletest runner reads a bracketed line as a status.
+                    let step = step.replace('[', "(").replace(']', ")");
+                    let _ = writeln!(out, "step {step}");
+                    let _ = out.flush();
+                }
+                // An injected hang or crash strikes where a GPU's would: while the frame runs.
+                if step.starts_with("waiting on the GPU for") {
+                    let fault = armed.lock().unwrap_or_else(|e| e.into_inner()).take();
+                    if let Some(fault) = fault {
+                        strike(&fault);
+                    }
+                }
+            })));
+        }
         device = ctx.device_name().to_owned();
         driver = ctx.driver().clone();
         (progress.borrow_mut())(Event::Context {
@@ -333,6 +370,7 @@ pub fn run_check(
                 source,
             })?;
             let group = Group {
+                armed: &armed,
                 ctx: &ctx,
                 log: &log,
                 scene,
@@ -385,6 +423,9 @@ struct Group<'a> {
     needs: SceneNeeds,
     size: (u32, u32),
     options: &'a CheckOptions,
+    /// A hang or crash `--inject-fault` set for the case running, which the step observer
+    /// strikes at the case's first wait on the GPU (with `trace_steps`).
+    armed: &'a Arc<Mutex<Option<InjectedFault>>>,
 }
 
 /// What every case of a group is judged against.
@@ -498,12 +539,16 @@ impl Group<'_> {
     fn inject_runner_fault(&self, case: &Case) {
         let name = self.full_name(case);
         for fault in &self.options.inject {
-            match fault {
-                InjectedFault::Hang(part) if name.contains(part.as_str()) => loop {
-                    std::thread::sleep(std::time::Duration::from_secs(3600));
-                },
-                InjectedFault::Crash(part) if name.contains(part.as_str()) => std::process::abort(),
-                _ => {}
+            let hits = match fault {
+                InjectedFault::Hang(part) | InjectedFault::Crash(part) => {
+                    name.contains(part.as_str())
+                }
+                _ => false,
+            };
+            if hits && self.options.trace_steps {
+                *self.armed.lock().unwrap_or_else(|e| e.into_inner()) = Some(fault.clone());
+            } else if hits {
+                strike(fault);
             }
         }
     }

@@ -495,6 +495,7 @@ fn run_worker(
         child,
         pending: batch.to_vec(),
         in_flight: None,
+        step: None,
         last_event: Instant::now(),
         info: WorkerInfo {
             cases: 0,
@@ -586,6 +587,8 @@ struct Worker<'a> {
     /// The batch's cases not yet begun.
     pending: Vec<PlannedCase>,
     in_flight: Option<(PlannedCase, Instant)>,
+    /// The last step the worker said it began (`step ...`): what it was recording or waiting on.
+    step: Option<String>,
     last_event: Instant,
     info: WorkerInfo,
     tx: &'a mpsc::Sender<Message>,
@@ -608,7 +611,9 @@ impl Worker<'_> {
         self.last_event = Instant::now();
         let (verb, rest) = line.split_once(' ').unwrap_or((line, ""));
         match verb {
+            "step" => self.step = Some(rest.to_owned()),
             "start" => {
+                self.step = None;
                 if let Some((case, t)) = self.in_flight.take() {
                     let why = "its worker began another case without reporting this one";
                     self.lose(&case, Status::Crash, why.into(), t);
@@ -658,6 +663,10 @@ impl Worker<'_> {
     /// on; else, with its batch done (tearing its device down), to the worker's own device row,
     /// so that a crash or hang at teardown fails the run too.
     fn charge(&mut self, status: Status, reason: String, since: Instant) {
+        let reason = match self.step.take() {
+            Some(step) => format!("{reason}; it was {step}"),
+            None => reason,
+        };
         if let Some((case, t)) = self.in_flight.take() {
             self.lose(&case, status, reason, t);
         } else if !self.pending.is_empty() {

@@ -265,6 +265,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         best_practices: args.best_practices,
         general_path: args.general_path,
         spec_minimum_limits: args.spec_minimum_limits,
+        trace_steps: false,
         out: Some(args.out.clone()),
         filter: args.filter.clone(),
         only,
@@ -272,7 +273,11 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         inject: args.inject_fault.clone(),
     };
     if args.worker {
-        return worker(&scenes, &options, args.expect_driver.as_deref());
+        let traced = CheckOptions {
+            trace_steps: true,
+            ..options
+        };
+        return worker(&scenes, &traced, args.expect_driver.as_deref());
     }
     // Every case's googletest name, over the whole matrix of these scenes, so that a case list
     // or baseline in either spelling selects the same cases.
@@ -365,6 +370,7 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
                 .map(str::to_owned)
                 .collect(),
         );
+        options.trace_steps = true;
         return crate::gtest::run(&scenes, &options, &names, args.expect_driver.as_deref());
     }
     if cases.is_empty() {

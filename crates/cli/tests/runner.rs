@@ -198,6 +198,15 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
             .map(|(_, s)| s.clone())
     };
     assert_eq!(status(hung).as_deref(), Some("Timeout"), "{results:?}");
+    // The reason names what the worker was waiting on: the frame's passes, as recorded.
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains(&format!(
+            "Timeout brdfs-3/{hung}: ran past the 10 s timeout; its worker was killed; it was \
+             waiting on the GPU for gbuffer, lighting, tonemap"
+        )),
+        "{stderr}"
+    );
     // Every other case ran and passed: 65 cases, one timed out.
     let passed = results.iter().filter(|(_, s)| s == "Pass").count();
     assert_eq!(passed, 64 + 2, "{results:?}");
@@ -229,6 +238,11 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
         crashes,
         [&(format!("brdfs-3/{crashed}"), "Crash".to_owned())],
         "{results:?}"
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("it was waiting on the GPU for gbuffer, lighting, tonemap"),
+        "{stderr}"
     );
 
     // A crash tearing the device down, after every case reported, fails the run as the worker's

@@ -36,7 +36,7 @@ pub use alpha::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord, AlphaLightmaps,
     AlphaLightmapsDesc, AlphaMode, LightmapFrame,
 };
-pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat};
+pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};
 pub use gpu::debug::{ValidationLog, ValidationMessage};
 pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
 pub use gpu::error::{Error, Result};

@@ -45,6 +45,7 @@ pub(crate) fn submit_once(
                 .call("vkQueueSubmit2")?;
             // Creation waits for its own one-off work, as buffer creation does; frames never
             // come through here.
+            ctx.step("waiting on the GPU");
             d.wait_for_fences(&[fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")
         }

@@ -224,6 +224,7 @@ impl Renderer<'_> {
             ctx.device
                 .queue_submit2(ctx.queue, &[submit], self.fence)
                 .call("vkQueueSubmit2")?;
+            ctx.step("waiting on the GPU");
             ctx.device
                 .wait_for_fences(&[self.fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")?;

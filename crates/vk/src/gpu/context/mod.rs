@@ -181,6 +181,29 @@ pub struct Context {
     /// How histencil shapes its work on this driver ([`crate::QUIRKS`]).
     pub(crate) quirks: crate::gpu::quirks::Quirks,
     pub(crate) memory: MemoryAccount,
+    /// The step observer and the labelled regions open ([`Context::observe_steps`]).
+    steps: Mutex<Steps>,
+}
+
+/// What [`Context::observe_steps`] calls with each step.
+pub type StepObserver = Box<dyn Fn(&str) + Send + Sync>;
+
+/// The labelled regions open on the context's command buffers, for the step observer.
+#[derive(Default)]
+struct Steps {
+    observer: Option<StepObserver>,
+    open: Vec<String>,
+    /// The outermost regions recorded since the last wait: what a fence wait waits for.
+    since_wait: Vec<String>,
+}
+
+impl std::fmt::Debug for Steps {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Steps")
+            .field("observed", &self.observer.is_some())
+            .field("open", &self.open)
+            .finish()
+    }
 }
 
 /// The device memory histencil's allocations hold, against the budget the context was given.
@@ -326,6 +349,7 @@ impl Context {
             limits: crate::gpu::limits::DeviceLimits::new(&props.limits),
             limits_used: Default::default(),
             set_counts: Default::default(),
+            steps: Default::default(),
             depth_bounds: false,
             quirks,
             memory: MemoryAccount::new(memory_budget),
@@ -438,8 +462,47 @@ impl Context {
         }
     }
 
+    /// Calls `observer` with each step of histencil's work as it begins: the labelled region
+    /// being recorded, nested regions joined by ` / ` (`recording lighting / light-3 /
+    /// shade-ggx`), and before each fence wait what the GPU is given (`waiting on the GPU for
+    /// gbuffer, lighting, tonemap, readback`). A runner that prints them learns,
+    /// when the process crashes or hangs, what was being recorded or waited on (`histencil
+    /// check`'s workers do). `None` stops it. Without an observer a step costs one lock.
+    pub fn observe_steps(&self, observer: Option<StepObserver>) {
+        let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
+        steps.observer = observer;
+        steps.open.clear();
+    }
+
+    /// Tells the observer that `what` begins (a fence wait, a submission), after the regions
+    /// recorded last.
+    pub(crate) fn step(&self, what: &str) {
+        let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
+        let work = std::mem::take(&mut steps.since_wait);
+        if let Some(observer) = &steps.observer {
+            let work = if work.is_empty() {
+                "work recorded without a label".to_owned()
+            } else {
+                work.join(", ")
+            };
+            observer(&format!("{what} for {work}"));
+        }
+    }
+
     /// Opens a debug label region on a command buffer; pair with [`Context::end_label`].
     pub(crate) fn begin_label(&self, cmd: vk::CommandBuffer, label: &str) {
+        {
+            let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
+            if steps.observer.is_some() {
+                if steps.open.is_empty() {
+                    steps.since_wait.push(label.to_owned());
+                }
+                steps.open.push(label.to_owned());
+                if let Some(observer) = &steps.observer {
+                    observer(&format!("recording {}", steps.open.join(" / ")));
+                }
+            }
+        }
         if let Some(dd) = &self.debug_device {
             let name = CString::new(label).expect("labels contain no NUL");
             let info = vk::DebugUtilsLabelEXT::default().label_name(&name);
@@ -448,6 +511,12 @@ impl Context {
     }
 
     pub(crate) fn end_label(&self, cmd: vk::CommandBuffer) {
+        {
+            let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
+            if steps.observer.is_some() {
+                steps.open.pop();
+            }
+        }
         if let Some(dd) = &self.debug_device {
             unsafe { dd.cmd_end_debug_utils_label(cmd) };
         }

@@ -336,6 +336,7 @@ impl Context {
             limits: device_limits,
             limits_used: Default::default(),
             set_counts: Default::default(),
+            steps: Default::default(),
             depth_bounds,
             quirks,
             memory: MemoryAccount::new(desc.memory_budget),
