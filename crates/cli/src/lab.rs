@@ -62,12 +62,25 @@ pub struct CompareArgs {
     out: PathBuf,
     #[command(flatten)]
     sampling: SamplingArgs,
+    /// When the table and each light size stop sampling: `decided`, once the talk's cells
+    /// (branching and stencil x360/ps3/native at 2 and 3 BRDFs; each size's stencil against
+    /// branching) are decided, at least --frames rounds, within a budget a 10-round pilot
+    /// predicts unless --budget-s sets it; `rounds`, after --frames rounds exactly (or at
+    /// --target-ci's width).
+    #[arg(long, value_enum, default_value_t = Until::Decided, conflicts_with = "target_ci")]
+    until: Until,
     /// Run this many busy threads beside the measurement: the same run under contention, to
     /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
     beside_load: u16,
     #[command(subcommand)]
     command: Option<CompareCommand>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Until {
+    Decided,
+    Rounds,
 }
 
 #[derive(clap::Subcommand)]
@@ -122,10 +135,15 @@ pub struct SamplingArgs {
     /// many percent, or --budget-s runs out. Without it, --frames rounds exactly.
     #[arg(long)]
     target_ci: Option<f64>,
-    /// Seconds each measurement set (compare: the table, each light size) may sample for.
-    #[arg(long, default_value_t = 60.0)]
-    budget_s: f64,
+    /// Seconds each measurement set (compare: the table, each light size) may sample for
+    /// (default: compare until its cells are decided lets a pilot predict it, at most 1800 s;
+    /// otherwise 60 s).
+    #[arg(long)]
+    budget_s: Option<f64>,
 }
+
+/// The most a predicted budget may be, per measurement set, when `--budget-s` does not say.
+const PREDICTED_BUDGET_CAP_S: f64 = 1800.0;
 
 impl SamplingArgs {
     /// The sampling rule, at least `frames` rounds; refuses percentages and budgets that make
@@ -134,22 +152,22 @@ impl SamplingArgs {
         if let Some(bad) = self.target_ci.filter(|c| !(*c > 0.0 && *c < 100.0)) {
             bail!("--target-ci: {bad} is not a percentage in (0, 100)");
         }
-        if !(self.budget_s.is_finite() && self.budget_s >= 0.0 && self.budget_s <= 86_400.0) {
-            bail!(
-                "--budget-s: {} is not between 0 and 86400 seconds",
-                self.budget_s
-            );
+        let budget = self.budget_s.unwrap_or(60.0);
+        if !(budget.is_finite() && (0.0..=86_400.0).contains(&budget)) {
+            bail!("--budget-s: {budget} is not between 0 and 86400 seconds");
         }
         let rounds = frames as usize;
         Ok(histencil_lab::stats::Sampling {
             min_rounds: rounds,
             target: self.target_ci.map(|c| c / 100.0),
-            budget: std::time::Duration::from_secs_f64(self.budget_s),
+            budget: std::time::Duration::from_secs_f64(budget),
             max_rounds: if self.target_ci.is_some() {
                 histencil_lab::MAX_ROUNDS.max(rounds)
             } else {
                 rounds
             },
+            until_decided: false,
+            predict_budget: false,
         })
     }
 }
@@ -322,7 +340,15 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     {
         bail!("--light-sizes: {bad} is not a percentage in (0, 100]");
     }
-    let sampling = args.sampling.sampling(args.run.frames)?;
+    let mut sampling = args.sampling.sampling(args.run.frames)?;
+    if args.until == Until::Decided && args.sampling.target_ci.is_none() {
+        sampling.until_decided = true;
+        sampling.max_rounds = histencil_lab::MAX_ROUNDS.max(sampling.min_rounds);
+        if args.sampling.budget_s.is_none() {
+            sampling.predict_budget = true;
+            sampling.budget = std::time::Duration::from_secs_f64(PREDICTED_BUDGET_CAP_S);
+        }
+    }
     let least = histencil_lab::stats::MIN_VERDICT_ROUNDS;
     if sampling.max_rounds < least {
         eprintln!(
@@ -335,6 +361,8 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
         CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
     settings.target_ci = sampling.target;
     settings.budget = sampling.budget;
+    settings.until_decided = sampling.until_decided;
+    settings.predict_budget = sampling.predict_budget;
     settings.scene = crate::load_scene_arg(&args.scene, lights)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;

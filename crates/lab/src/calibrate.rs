@@ -336,6 +336,8 @@ mod tests {
                 stop: crate::stats::Stop::Rounds,
                 widest: 0.0,
                 seconds: 0.0,
+                open: 0,
+                prediction: None,
             },
             measurements: vec![],
         };

@@ -144,6 +144,36 @@ impl Verdict {
         }
     }
 
+    /// How many rounds in all a ratio now at `ratio` (from `ratio.samples` rounds) would need
+    /// for a verdict at `margin`, if its interval kept its centre and narrowed as the
+    /// interval of a median does, like 1/sqrt(rounds): the distance from the median to the
+    /// margin edge the verdict needs, against the interval's present half-width on that side.
+    /// Never below [`MIN_VERDICT_ROUNDS`]; `None` where no number of rounds decides it (a
+    /// median on an edge) or nothing was sampled.
+    pub fn rounds_to_decide(ratio: &Interval, margin: f64) -> Option<usize> {
+        let (lo_edge, hi_edge) = (1.0 - margin, 1.0 + margin);
+        let m = ratio.median;
+        if ratio.samples == 0 || !m.is_finite() {
+            return None;
+        }
+        // How far the interval must stay from the median, and how far it reaches now.
+        let (room, reach) = if m < lo_edge {
+            (lo_edge - m, ratio.hi - m)
+        } else if m > hi_edge {
+            (m - hi_edge, m - ratio.lo)
+        } else {
+            let room = (m - lo_edge).min(hi_edge - m);
+            (room, (ratio.hi - m).max(m - ratio.lo))
+        };
+        if room <= 0.0 {
+            return None;
+        }
+        let scale = (reach / room).max(0.0);
+        // Less a hair: 2.0000000000000004 squared is no reason for one more round.
+        let rounds = (ratio.samples as f64 * scale * scale - 1e-9).ceil();
+        Some((rounds as usize).max(MIN_VERDICT_ROUNDS))
+    }
+
     /// Whether the data decided something: faster, slower or within the margin.
     pub fn decided(self) -> bool {
         self != Verdict::Undecided
@@ -181,6 +211,14 @@ pub struct Sampling {
     /// A cap on rounds, whatever the budget (the interval of the median narrows like
     /// 1/sqrt(rounds); past a few hundred rounds more buys little).
     pub max_rounds: usize,
+    /// Stop once every verdict the measurement tracks is decided (after `min_rounds`), instead
+    /// of at `min_rounds` or at a width target: what a question needs answered, not an interval
+    /// width chosen beforehand.
+    pub until_decided: bool,
+    /// Predict the budget from a pilot: after `max(min_rounds, MIN_VERDICT_ROUNDS)` rounds, the
+    /// budget becomes the time the slowest open verdict needs at the pilot's rate
+    /// ([`Verdict::rounds_to_decide`]), a tenth over, and never more than `budget`.
+    pub predict_budget: bool,
 }
 
 /// Why a measurement stopped sampling.
@@ -194,6 +232,8 @@ pub enum Stop {
     Budget,
     /// `max_rounds` ran out first.
     MaxRounds,
+    /// Every tracked verdict was decided.
+    Decided,
 }
 
 impl Stop {
@@ -203,6 +243,7 @@ impl Stop {
             Stop::Target => "target reached",
             Stop::Budget => "budget spent",
             Stop::MaxRounds => "round cap",
+            Stop::Decided => "every verdict decided",
         }
     }
 }
@@ -215,28 +256,41 @@ impl Sampling {
             target: None,
             budget: std::time::Duration::MAX,
             max_rounds: n.max(1),
+            until_decided: false,
+            predict_budget: false,
         }
     }
 
     /// Whether to stop after `rounds` rounds taking `elapsed`, with the tracked intervals now
-    /// `widths` wide (relative half-widths), and why. Pure, so the rule is unit-tested.
+    /// `widths` wide (relative half-widths) and `open` tracked verdicts undecided, under
+    /// `budget` (the sampling's own, or a pilot's prediction), and why. Pure, so the rule is
+    /// unit-tested.
     pub fn stop(
         &self,
         rounds: usize,
         widths: &[f64],
+        open: usize,
         elapsed: std::time::Duration,
+        budget: std::time::Duration,
     ) -> Option<Stop> {
         if rounds < self.min_rounds {
             return None;
         }
-        let Some(target) = self.target else {
-            return Some(Stop::Rounds);
-        };
-        if widths.iter().all(|w| *w <= target) {
-            Some(Stop::Target)
-        } else if rounds >= self.max_rounds {
+        if self.until_decided {
+            if open == 0 {
+                return Some(Stop::Decided);
+            }
+        } else {
+            let Some(target) = self.target else {
+                return Some(Stop::Rounds);
+            };
+            if widths.iter().all(|w| *w <= target) {
+                return Some(Stop::Target);
+            }
+        }
+        if rounds >= self.max_rounds {
             Some(Stop::MaxRounds)
-        } else if elapsed >= self.budget {
+        } else if elapsed >= budget {
             Some(Stop::Budget)
         } else {
             None
@@ -252,27 +306,93 @@ pub struct Sampled {
     /// The widest tracked interval at the end (relative half-width).
     pub widest: f64,
     pub seconds: f64,
+    /// Tracked verdicts still undecided at the end.
+    pub open: usize,
+    /// The pilot's prediction, where the budget was predicted.
+    pub prediction: Option<Prediction>,
+}
+
+/// What a pilot predicted: after `pilot_rounds` rounds in `pilot_seconds`, `rounds` in all
+/// would decide every tracked verdict (`None`: some verdict sits on a margin's edge, where no
+/// number of rounds decides it), and the budget that follows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prediction {
+    pub pilot_rounds: usize,
+    pub pilot_seconds: f64,
+    pub rounds: Option<usize>,
+    pub budget_seconds: f64,
+}
+
+impl Prediction {
+    /// The prediction after `pilot_rounds` rounds in `pilot_seconds`, with `open` holding each
+    /// undecided verdict's rounds to decide; the budget at most `cap` seconds. With nothing
+    /// open, the pilot's own time; with a verdict that cannot be decided, the pilot's own time
+    /// too (more rounds would only spend the budget).
+    pub fn of(pilot_rounds: usize, pilot_seconds: f64, open: &[Option<usize>], cap: f64) -> Self {
+        let rounds = open
+            .iter()
+            .try_fold(pilot_rounds, |most, r| r.map(|r| most.max(r)));
+        let per_round = pilot_seconds / pilot_rounds.max(1) as f64;
+        let budget_seconds = match rounds {
+            Some(r) if !open.is_empty() => (per_round * r as f64 * 1.1).min(cap),
+            _ => pilot_seconds,
+        };
+        Prediction {
+            pilot_rounds,
+            pilot_seconds,
+            rounds,
+            budget_seconds,
+        }
+    }
 }
 
 /// Runs rounds of `round` until `sampling` says stop; `widths` gives the tracked intervals'
 /// relative half-widths after each round.
 pub fn sample<E>(
     sampling: &Sampling,
-    mut round: impl FnMut(usize) -> Result<(), E>,
+    round: impl FnMut(usize) -> Result<(), E>,
     widths: impl Fn() -> Vec<f64>,
 ) -> Result<Sampled, E> {
+    sample_deciding(sampling, round, widths, Vec::new)
+}
+
+/// [`sample`], with `open` giving, for each tracked verdict still undecided, the rounds in all
+/// its interval predicts would decide it ([`Verdict::rounds_to_decide`]): what
+/// [`Sampling::until_decided`] stops on and [`Sampling::predict_budget`] predicts from.
+pub fn sample_deciding<E>(
+    sampling: &Sampling,
+    mut round: impl FnMut(usize) -> Result<(), E>,
+    widths: impl Fn() -> Vec<f64>,
+    open: impl Fn() -> Vec<Option<usize>>,
+) -> Result<Sampled, E> {
     let start = std::time::Instant::now();
+    let pilot = sampling.min_rounds.max(MIN_VERDICT_ROUNDS);
+    let mut budget = sampling.budget;
+    let mut prediction = None;
     let mut rounds = 0;
     loop {
         round(rounds)?;
         rounds += 1;
         let w = widths();
-        if let Some(stop) = sampling.stop(rounds, &w, start.elapsed()) {
+        let o = open();
+        if sampling.predict_budget && rounds == pilot {
+            let p = Prediction::of(
+                rounds,
+                start.elapsed().as_secs_f64(),
+                &o,
+                sampling.budget.as_secs_f64(),
+            );
+            budget = std::time::Duration::from_secs_f64(p.budget_seconds);
+            prediction = Some(p);
+        }
+        if let Some(stop) = sampling.stop(rounds, &w, o.len(), start.elapsed(), budget) {
             return Ok(Sampled {
                 rounds,
                 stop,
                 widest: w.iter().copied().fold(0.0, f64::max),
                 seconds: start.elapsed().as_secs_f64(),
+                open: o.len(),
+                prediction,
             });
         }
     }
@@ -283,6 +403,50 @@ mod tests {
     use super::*;
 
     #[test]
+    fn rounds_to_decide_scale_with_the_square_of_reach_over_room() {
+        let at = |lo: f64, median: f64, hi: f64, samples: usize| Interval {
+            lo,
+            median,
+            hi,
+            samples,
+        };
+        // Slower by 20 %, the interval reaching 0.9 above 1.05 edge: room 0.15, reach 0.3,
+        // four times the rounds.
+        assert_eq!(
+            Verdict::rounds_to_decide(&at(0.9, 1.2, 1.3, 10), MARGIN),
+            Some(40)
+        );
+        // Decided with room to spare: the minimum.
+        assert_eq!(
+            Verdict::rounds_to_decide(&at(1.1, 1.2, 1.3, 12), MARGIN),
+            Some(10)
+        );
+        assert_eq!(
+            Verdict::rounds_to_decide(&at(1.1, 1.2, 1.3, 4), MARGIN),
+            Some(10)
+        );
+        // Within the margin: the nearer edge counts.
+        assert_eq!(
+            Verdict::rounds_to_decide(&at(0.96, 1.0, 1.08, 10), MARGIN),
+            Some(26)
+        );
+        // Faster: the upper side.
+        assert_eq!(
+            Verdict::rounds_to_decide(&at(0.7, 0.8, 1.1, 10), MARGIN),
+            Some(40)
+        );
+        // On an edge no number of rounds decides.
+        assert_eq!(
+            Verdict::rounds_to_decide(&at(1.0, 1.05, 1.1, 10), MARGIN),
+            None
+        );
+        assert_eq!(
+            Verdict::rounds_to_decide(&at(0.0, 0.0, 0.0, 0), MARGIN),
+            None
+        );
+    }
+
+    #[test]
     fn sampling_stops_at_the_target_the_budget_or_the_cap_never_before_the_minimum() {
         use std::time::Duration;
         let s = Sampling {
@@ -290,23 +454,34 @@ mod tests {
             target: Some(0.03),
             budget: Duration::from_secs(10),
             max_rounds: 100,
+            until_decided: false,
+            predict_budget: false,
         };
+        let b = s.budget;
         let narrow = [0.01, 0.03];
         let wide = [0.01, 0.2];
         let early = Duration::from_secs(1);
-        assert_eq!(s.stop(4, &narrow, early), None, "the minimum comes first");
-        assert_eq!(s.stop(4, &wide, Duration::from_secs(60)), None);
-        assert_eq!(s.stop(5, &narrow, early), Some(Stop::Target));
-        assert_eq!(s.stop(5, &wide, early), None);
         assert_eq!(
-            s.stop(9, &wide, Duration::from_secs(10)),
+            s.stop(4, &narrow, 0, early, b),
+            None,
+            "the minimum comes first"
+        );
+        assert_eq!(s.stop(4, &wide, 0, Duration::from_secs(60), b), None);
+        assert_eq!(s.stop(5, &narrow, 0, early, b), Some(Stop::Target));
+        assert_eq!(s.stop(5, &wide, 0, early, b), None);
+        assert_eq!(
+            s.stop(9, &wide, 0, Duration::from_secs(10), b),
             Some(Stop::Budget)
         );
-        assert_eq!(s.stop(100, &wide, early), Some(Stop::MaxRounds));
-        assert_eq!(s.stop(5, &[f64::INFINITY], early), None, "no interval yet");
+        assert_eq!(s.stop(100, &wide, 0, early, b), Some(Stop::MaxRounds));
+        assert_eq!(
+            s.stop(5, &[f64::INFINITY], 0, early, b),
+            None,
+            "no interval yet"
+        );
         let fixed = Sampling::rounds(3);
-        assert_eq!(fixed.stop(2, &wide, early), None);
-        assert_eq!(fixed.stop(3, &wide, early), Some(Stop::Rounds));
+        assert_eq!(fixed.stop(2, &wide, 0, early, b), None);
+        assert_eq!(fixed.stop(3, &wide, 0, early, b), Some(Stop::Rounds));
         let mut n = 0;
         let round = |_| {
             n += 1;
@@ -315,6 +490,47 @@ mod tests {
         let sampled = sample(&fixed, round, || vec![0.5]).unwrap();
         assert_eq!((n, sampled.rounds, sampled.stop), (3, 3, Stop::Rounds));
         assert_eq!(sampled.widest, 0.5);
+        // Until decided: open verdicts keep it going past the minimum, to the budget.
+        let deciding = Sampling {
+            until_decided: true,
+            ..s
+        };
+        assert_eq!(deciding.stop(5, &narrow, 1, early, b), None);
+        assert_eq!(deciding.stop(5, &wide, 0, early, b), Some(Stop::Decided));
+        assert_eq!(deciding.stop(9, &narrow, 2, b, b), Some(Stop::Budget));
+    }
+
+    #[test]
+    fn a_pilot_predicts_the_budget_its_slowest_verdict_needs() {
+        use std::time::Duration;
+        // 10 rounds in 20 s; verdicts needing 40 and 25 rounds: 40 rounds, 88 s.
+        let p = Prediction::of(10, 20.0, &[Some(40), Some(25)], 600.0);
+        assert_eq!(p.rounds, Some(40));
+        assert!((p.budget_seconds - 88.0).abs() < 1e-9, "{p:?}");
+        // At most the cap.
+        assert_eq!(
+            Prediction::of(10, 20.0, &[Some(4000)], 600.0).budget_seconds,
+            600.0
+        );
+        // Nothing open, or a verdict on an edge: no more than the pilot.
+        assert_eq!(Prediction::of(10, 20.0, &[], 600.0).budget_seconds, 20.0);
+        let edge = Prediction::of(10, 20.0, &[Some(40), None], 600.0);
+        assert_eq!((edge.rounds, edge.budget_seconds), (None, 20.0));
+        // The rule end to end: a verdict that never decides stops at the pilot's budget.
+        let s = Sampling {
+            min_rounds: 2,
+            target: None,
+            budget: Duration::from_secs(600),
+            max_rounds: 1000,
+            until_decided: true,
+            predict_budget: true,
+        };
+        let sampled = sample_deciding(&s, |_| Ok::<_, ()>(()), Vec::new, || vec![None]).unwrap();
+        assert_eq!(
+            (sampled.rounds, sampled.stop, sampled.open),
+            (10, Stop::Budget, 1)
+        );
+        assert_eq!(sampled.prediction.unwrap().rounds, None);
     }
 
     #[test]

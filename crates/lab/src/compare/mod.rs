@@ -6,7 +6,9 @@ mod report;
 
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, Timing};
-use crate::stats::{median_interval, ratio_interval, sample, Interval, Sampled, Sampling, Verdict};
+use crate::stats::{
+    median_interval, ratio_interval, sample_deciding, Interval, Sampled, Sampling, Verdict,
+};
 use crate::variants::{brdf_palette, light_size_scene, with_brdf_count, with_one_brdf};
 use crate::Result;
 use histencil_brdf::BrdfId;
@@ -39,7 +41,17 @@ pub struct CompareSettings {
     /// Busy threads run beside the measurement (`compare --beside-load`): the same run under
     /// contention, for the quiet-against-loaded test of the verdicts (`compare merge`).
     pub beside_load: usize,
+    /// Sample until the talk's cells ([`TALK_ROWS`] at 2 BRDFs and up; each light size's
+    /// stencil-against-branching) are decided, instead of `frames` rounds or `target_ci`.
+    pub until_decided: bool,
+    /// Let a pilot of [`crate::stats::MIN_VERDICT_ROUNDS`] rounds predict the budget
+    /// ([`crate::stats::Prediction`]); `budget` is then its cap.
+    pub predict_budget: bool,
 }
+
+/// The rows whose cost of an extra BRDF is the talk's question: branching against stencil on
+/// the consoles and on today's GPUs.
+pub const TALK_ROWS: [&str; 4] = ["branching", "stencil x360", "stencil ps3", "stencil native"];
 
 impl CompareSettings {
     /// The talk's set-up: `huge-lights`, 1 to 3 BRDFs, lights from 0.1 % to 100 % of the screen.
@@ -55,6 +67,8 @@ impl CompareSettings {
             brdf_counts: vec![1, 2, 3],
             light_sizes: vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0],
             beside_load: 0,
+            until_decided: false,
+            predict_budget: false,
         }
     }
 }
@@ -537,6 +551,8 @@ pub fn run_compare(
         target: settings.target_ci,
         budget: settings.budget,
         max_rounds: MAX_ROUNDS,
+        until_decided: settings.until_decided,
+        predict_budget: settings.predict_budget,
     };
     let samples = std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; renderers.len()]);
     let mut bookkeeping = vec![vec![Vec::new(); rows_spec.len()]; renderers.len()];
@@ -552,7 +568,24 @@ pub fn run_compare(
             })
             .collect::<Vec<_>>()
     };
-    let table_sampled = sample(
+    // The talk's cells still undecided, each with the rounds its interval predicts it needs.
+    let talk_open = || {
+        let s = samples.borrow();
+        let mut open = Vec::new();
+        for count in 1..s.len() {
+            for (row, (name, _)) in rows_spec.iter().enumerate() {
+                if !TALK_ROWS.contains(name) {
+                    continue;
+                }
+                let ratio = ratio_interval(&s[count][row], &s[0][row]);
+                if !Verdict::of(&ratio).decided() {
+                    open.push(Verdict::rounds_to_decide(&ratio, crate::stats::MARGIN));
+                }
+            }
+        }
+        open
+    };
+    let table_sampled = sample_deciding(
         &sampling,
         |round| -> Result<()> {
             progress(&format!("round {}", round + 1));
@@ -572,6 +605,7 @@ pub fn run_compare(
             Ok(())
         },
         overhead_widths,
+        talk_open,
     )?;
     let mut samples = samples.into_inner();
     let single_samples = single_samples.into_inner();
@@ -639,7 +673,16 @@ pub fn run_compare(
                 .map(|(a, b)| ratio_interval(&s[a], &s[b]).relative_half_width())
                 .to_vec()
         };
-        let sampled = sample(
+        let stencil_open = || {
+            let s = samples.borrow();
+            let ratio = ratio_interval(&s[1], &s[0]);
+            if Verdict::of(&ratio).decided() {
+                Vec::new()
+            } else {
+                vec![Verdict::rounds_to_decide(&ratio, crate::stats::MARGIN)]
+            }
+        };
+        let sampled = sample_deciding(
             &sampling,
             |_| -> Result<()> {
                 for (i, technique) in size_techniques(side).into_iter().enumerate() {
@@ -649,6 +692,7 @@ pub fn run_compare(
                 Ok(())
             },
             pair_widths,
+            stencil_open,
         )?;
         let samples = samples.into_inner();
         let timings = samples.clone().map(Timing::from_samples);

@@ -136,6 +136,20 @@ impl CompareReport {
                 .map_or(String::new(), |c| format!(", target ±{:.1} %", 100.0 * c)),
             100.0 * t.widest
         );
+        if let Some(p) = &t.prediction {
+            let predicted = match p.rounds {
+                Some(r) => format!("{r} rounds in all would decide the talk's cells"),
+                None => "some cell sits on a margin's edge, where no number of rounds decides it"
+                    .to_owned(),
+            };
+            let _ = writeln!(
+                md,
+                "Budget: a pilot of {} rounds ({:.1} s) predicted that {predicted}, so the \
+                 budget was {:.0} s. Outcome: {} rounds, {} of the talk's cells (branching and \
+                 stencil at 2 BRDFs and up) still undecided.\n",
+                p.pilot_rounds, p.pilot_seconds, p.budget_seconds, t.rounds, t.open
+            );
+        }
         md += "## Lighting time against BRDF count\n\n";
         md += "Overheads are against each row's own 1-BRDF time in this run; the error column is \
                the worst over the BRDF counts.\n\n";
@@ -546,7 +560,26 @@ fn cell_text(row: &Row, i: usize) -> String {
         return t;
     }
     let (ratio, verdict) = row.overhead_ratio(i);
-    format!("{t} ({})", percent_text(&ratio, verdict))
+    format!(
+        "{t} ({}{})",
+        percent_text(&ratio, verdict),
+        more_rounds(&ratio, verdict)
+    )
+}
+
+/// For an undecided ratio: how many more rounds would decide it at the interval's present rate
+/// (`; about 23 more rounds`), or that none would (a median on a margin's edge).
+fn more_rounds(ratio: &crate::stats::Interval, verdict: Verdict) -> String {
+    if verdict.decided() {
+        return String::new();
+    }
+    match Verdict::rounds_to_decide(ratio, MARGIN) {
+        Some(n) => format!(
+            "; about {} more rounds",
+            n.saturating_sub(ratio.samples).max(1)
+        ),
+        None => "; on the margin's edge".to_owned(),
+    }
 }
 
 /// A ratio's interval as a change in percent with its verdict: `+12.3 % [+10.1, +14.0], slower`.
@@ -667,6 +700,15 @@ fn sampled_json(s: &crate::stats::Sampled) -> Value {
     });
     if s.widest.is_finite() {
         out["widest_relative_half_width"] = json!(s.widest);
+    }
+    out["undecided"] = json!(s.open);
+    if let Some(p) = &s.prediction {
+        out["prediction"] = json!({
+            "pilot_rounds": p.pilot_rounds,
+            "pilot_seconds": p.pilot_seconds,
+            "rounds": p.rounds,
+            "budget_seconds": p.budget_seconds,
+        });
     }
     out
 }
