@@ -420,3 +420,35 @@ fn the_demo_shows_each_failure_next_to_a_fix_that_matches_forward() {
         );
     }
 }
+
+/// By default `compare` samples until the talk's cells are decided, within a budget a 10-round
+/// pilot predicts: the run says what the pilot predicted, stops when the cells are decided or
+/// the predicted budget is spent, never before the pilot, and the report carries both.
+#[test]
+fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget() {
+    let mut settings = CompareSettings::talk(48, 27, 2);
+    settings.light_sizes = vec![1.0];
+    settings.until_decided = true;
+    settings.predict_budget = true;
+    // The cap: a run that cannot decide stops here at the latest.
+    settings.budget = std::time::Duration::from_secs(60);
+    let report = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
+    use histencil_lab::stats::{Stop, MIN_VERDICT_ROUNDS};
+    let t = report.sampled;
+    let p = t.prediction.expect("a pilot's prediction");
+    assert_eq!(p.pilot_rounds, MIN_VERDICT_ROUNDS);
+    assert!(t.rounds >= MIN_VERDICT_ROUNDS, "{t:?}");
+    assert!(p.budget_seconds <= 60.0, "{p:?}");
+    match t.stop {
+        Stop::Decided => assert_eq!(t.open, 0, "{t:?}"),
+        Stop::Budget | Stop::MaxRounds => assert!(t.open > 0, "{t:?}"),
+        other => panic!("stopped by {other:?}"),
+    }
+    let dir = output_dir().join("compare-decided");
+    report.write(&dir).unwrap();
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("Budget: a pilot of 10 rounds"), "{md}");
+    let json = read_json(&dir.join("report.json"));
+    assert_eq!(json["table_sampling"]["prediction"]["pilot_rounds"], 10);
+    assert_eq!(json["table_sampling"]["undecided"], t.open);
+}
