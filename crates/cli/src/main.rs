@@ -48,10 +48,12 @@ enum Command {
     /// platform backend, the per-BRDF breakdown, a light-size sweep, each next to its error
     /// against forward; writes report.md, report.json and PNG plots.
     Compare(lab::CompareArgs),
-    /// The talk's questions asked of today's GPUs: per platform (the consoles, AMD's GFX9-11
-    /// pretests and GFX12 AND/OR tiles as modelled from AMD's driver sources, native Vulkan)
-    /// whether the engine's bits break culling, what flush or reset it needs, how many BRDFs it
-    /// culls hierarchically, and the simulator's tiles and fragments on frames captured here.
+    /// The talk's questions asked of today's GPUs: per platform (the consoles, NVIDIA's ZCull
+    /// stencil criterion assumed to cull as the PS3's, AMD's GFX9-11 pretests and GFX12 AND/OR
+    /// tiles as modelled from AMD's driver sources, native Vulkan) whether the engine's bits
+    /// break culling, what flush or reset it needs, how many BRDFs it culls hierarchically, and
+    /// the simulator's tiles and fragments on frames captured here; and what the native plan's
+    /// draws cost an Adreno's low-resolution Z.
     TodaysGpus(lab::TodaysGpusArgs),
     /// A scene at scale (default: the generated `town`): load time and device memory, then
     /// G-buffer, lighting and frame time of stencil (native, PS3-like) and branching next to

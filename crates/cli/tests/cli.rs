@@ -681,9 +681,9 @@ fn todays_gpus_asks_the_talks_questions_of_every_platform() {
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("todays-gpus.json")).unwrap()).unwrap();
     let platforms = json["platforms"].as_array().unwrap();
-    assert_eq!(platforms.len(), 6, "{stdout}");
+    assert_eq!(platforms.len(), 7, "{stdout}");
     let scene = |i: usize| &platforms[i]["scenes"][0];
-    let needed = scene(5)["fragments_the_frame_needs"].as_u64().unwrap();
+    let needed = scene(6)["fragments_the_frame_needs"].as_u64().unwrap();
     for (i, p) in platforms.iter().enumerate() {
         let effect = scene(i)["engine_bits"].as_str().unwrap();
         let name = p["platform"].as_str().unwrap();
@@ -693,7 +693,9 @@ fn todays_gpus_asks_the_talks_questions_of_every_platform() {
             assert_eq!(shaded, Some(needed), "{name}");
         }
     }
-    for amd in [3, 4] {
+    // NVIDIA's ZCull criterion is assumed to cull as the PS3's: the same counts.
+    assert_eq!(scene(3)["with_engine_bits"], scene(2)["with_engine_bits"]);
+    for amd in [4, 5] {
         let culled = scene(amd)["with_engine_bits"]["tiles_culled"]
             .as_u64()
             .unwrap();
@@ -709,5 +711,16 @@ fn todays_gpus_asks_the_talks_questions_of_every_platform() {
     assert_eq!(json["gpu_disagreements"].as_array().unwrap().len(), 0);
     assert_eq!(depth_id["gpu_ids_stats"], depth_id["stats"]);
     assert!(stdout.contains("the GPU's counts equal"), "{stdout}");
+    // Adreno's LRZ: the native plan's mask draws write stencil and lose its test; nothing
+    // writes depth, so nothing leaves it invalid.
+    let lrz = &json["adreno_lrz"][0];
+    let draws = lrz["draws"].as_u64().unwrap();
+    let without_test = lrz["without_lrz_test"].as_u64().unwrap();
+    assert!(without_test > 0 && without_test < draws, "{lrz}");
+    assert_eq!(lrz["leaving_lrz_invalid"], 0, "{lrz}");
+    assert!(
+        stdout.contains("## Adreno: what the mask passes cost LRZ"),
+        "{stdout}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -28,16 +28,20 @@ pub enum Platform {
     X360NoZeroing,
     X360,
     Ps3,
+    /// NVIDIA's ZCull stencil criterion, assumed to cull as the PS3's (the documented fields
+    /// are the RSX's; what a region stores and when is not public).
+    NvidiaZcull,
     AmdPretest,
     AmdAndOr,
     Native,
 }
 
 impl Platform {
-    pub const ALL: [Platform; 6] = [
+    pub const ALL: [Platform; 7] = [
         Platform::X360NoZeroing,
         Platform::X360,
         Platform::Ps3,
+        Platform::NvidiaZcull,
         Platform::AmdPretest,
         Platform::AmdAndOr,
         Platform::Native,
@@ -48,10 +52,16 @@ impl Platform {
             Platform::X360NoZeroing => "360-like, engine bits kept (the talk's failure)",
             Platform::X360 => "360-like, zeroing (the talk's fix)",
             Platform::Ps3 => "PS3-like",
+            Platform::NvidiaZcull => {
+                "NVIDIA ZCull's stencil criterion (Turing to Blackwell), assumed to cull as the \
+                 PS3's: its fields are the RSX's; what a region holds, and whether the driver \
+                 programs it, is not public"
+            }
             Platform::AmdPretest => "amd-pretest (GFX9-11 with pretests, as PAL allows)",
             Platform::AmdAndOr => "amd-andor (GFX12)",
             Platform::Native => {
-                "native: no hierarchical stencil through Vulkan (RADV and AMDVLK on GFX9-11, Intel, Adreno)"
+                "native: no hierarchical stencil through Vulkan (AMD GFX9-11, Intel, Adreno, Mali, \
+                 Apple, PowerVR; NVK)"
             }
         }
     }
@@ -61,6 +71,10 @@ impl Platform {
         match self {
             Platform::X360NoZeroing | Platform::X360 | Platform::Ps3 => {
                 "a flush between each mask pass's hi-stencil write and the shade passes testing it"
+            }
+            Platform::NvidiaZcull => {
+                "as the PS3 (assumed); a criterion change invalidates unless told not to \
+                 (`NO_INVALIDATE`), at a cost not public"
             }
             Platform::AmdPretest => {
                 "none within the frame (pretests bound before the G-buffer); changing one needs an \
@@ -77,7 +91,7 @@ impl Platform {
     /// How many BRDFs the hierarchy can cull by their id.
     pub fn brdfs_culled(self) -> &'static str {
         match self {
-            Platform::X360NoZeroing | Platform::X360 | Platform::Ps3 => {
+            Platform::X360NoZeroing | Platform::X360 | Platform::Ps3 | Platform::NvidiaZcull => {
                 "every BRDF a light touches (a mask pass and a flush each)"
             }
             Platform::AmdPretest => {
@@ -99,7 +113,7 @@ impl Platform {
                 zero_preserved: true,
                 save_restore: false,
             },
-            Platform::Ps3 => Backend::Ps3,
+            Platform::Ps3 | Platform::NvidiaZcull => Backend::Ps3,
             Platform::AmdPretest => Backend::AmdPretest,
             Platform::AmdAndOr => Backend::AmdAndOr,
             Platform::Native => Backend::Native,
@@ -154,6 +168,48 @@ pub struct TodaysGpusReport {
     /// depth would cull of them (`histencil_model::depth_id`), with the engine's bits, from the
     /// G-buffer; then the same model on the id image the GPU wrote.
     pub depth_id: Vec<(usize, TileStats, TileStats)>,
+    /// Per scene: what the native plan's draws cost Adreno's LRZ ([`LrzCost`]).
+    pub lrz: Vec<LrzCost>,
+}
+
+/// What a plan's draws cost a Qualcomm Adreno's low-resolution Z (LRZ), by the rules of Mesa's
+/// turnip (`src/freedreno/vulkan/tu_lrz.cc`): a draw that writes stencil runs without the LRZ
+/// test (and, writing depth too, would leave LRZ invalid for the rest of the render pass); a
+/// draw that tests stencil with a compare other than ALWAYS writes no LRZ. The light passes
+/// write no depth, so what the talk's technique costs an Adreno is the test on its mask draws.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LrzCost {
+    /// Light-volume and full-screen draws in the plan.
+    pub draws: usize,
+    /// Draws that write stencil: no LRZ test for them.
+    pub without_test: usize,
+    /// Draws that test stencil: no LRZ write for them.
+    pub without_write: usize,
+    /// Draws that write both depth and stencil: LRZ invalid after them.
+    pub invalidating: usize,
+}
+
+impl LrzCost {
+    /// The count over `plan`'s passes. Pure.
+    pub fn of(plan: &FramePlan) -> LrzCost {
+        let mut cost = LrzCost::default();
+        for step in &plan.steps {
+            let histencil_model::Step::Pass { pass, .. } = step else {
+                continue;
+            };
+            let state = &pass.state;
+            cost.draws += 1;
+            let writes = state.writes_stencil();
+            let tests = [state.front, state.back]
+                .iter()
+                .flatten()
+                .any(|f| f.compare != histencil_model::CompareOp::Always);
+            cost.without_test += usize::from(writes);
+            cost.without_write += usize::from(tests);
+            cost.invalidating += usize::from(writes && state.depth.write);
+        }
+        cost
+    }
 }
 
 impl TodaysGpusReport {
@@ -208,6 +264,7 @@ pub fn run_todays_gpus(
         Platform::ALL.iter().map(|p| (*p, Vec::new())).collect();
     let mut tile_size = 0;
     let mut depth_id = Vec::new();
+    let mut lrz = Vec::new();
     for scene in scenes {
         progress(&scene.name);
         let renderer = &mut Renderer::new(ctx, scene.clone(), width, height)?;
@@ -233,6 +290,7 @@ pub fn run_todays_gpus(
         let native_at = Platform::ALL.iter().position(|p| *p == Platform::Native);
         let native_plan = &plans[native_at.expect("native is a platform")];
         let native = counts_of(&with_bits, Platform::Native, native_plan);
+        lrz.push(LrzCost::of(native_plan));
         for ((platform, per_scene), plan) in counts.iter_mut().zip(&plans) {
             per_scene.push(SceneCounts {
                 with_bits: counts_of(&with_bits, *platform, plan),
@@ -251,6 +309,7 @@ pub fn run_todays_gpus(
         scenes: scenes.iter().map(|s| s.name.clone()).collect(),
         counts,
         depth_id,
+        lrz,
     })
 }
 
@@ -345,6 +404,22 @@ impl TodaysGpusReport {
                 list.join(", ")
             );
         }
+        md += "\n## Adreno: what the mask passes cost LRZ\n\nA Qualcomm Adreno culls by a low-resolution \
+               depth (LRZ) that holds no stencil. By the rules of Mesa's turnip \
+               (`tu_lrz.cc`), a draw that writes stencil runs without the LRZ test, and a draw \
+               that tests stencil writes no LRZ; one writing depth and stencil would leave LRZ \
+               invalid after it. Counted on the native plan of each scene (an Adreno is the \
+               native platform): the light passes write no depth, so the talk's technique costs \
+               LRZ the test on its mask draws, and nothing after them.\n\n| scene | draws | \
+               without the LRZ test (write stencil) | without LRZ writes (test stencil) | \
+               leaving LRZ invalid |\n|---|---|---|---|---|\n";
+        for (scene, c) in self.scenes.iter().zip(&self.lrz) {
+            let _ = writeln!(
+                md,
+                "| `{scene}` | {} | {} | {} | {} |",
+                c.draws, c.without_test, c.without_write, c.invalidating
+            );
+        }
         md += "\nNot yet in this table: the per-extra-BRDF cost of the talk's technique and of \
                the depth-id technique, which need timings on the hardware itself \
                (`histencil compare` on it).\n";
@@ -364,6 +439,10 @@ impl TodaysGpusReport {
             "tile_size": self.tile_size,
             "engine_bits": ENGINE_BITS,
             "scenes": self.scenes,
+            "adreno_lrz": self.lrz.iter().map(|c| json!({
+                "draws": c.draws, "without_lrz_test": c.without_test,
+                "without_lrz_write": c.without_write, "leaving_lrz_invalid": c.invalidating,
+            })).collect::<Vec<_>>(),
             "depth_id": self.depth_id.iter().map(|(passes, s, gpu)| json!({
                 "passes": passes, "stats": stats(s), "gpu_ids_stats": stats(gpu),
             })).collect::<Vec<_>>(),
