@@ -82,6 +82,24 @@ pub enum InjectedFault {
     Flaky(String),
 }
 
+/// A device-limit refusal: a skip where the device is below a need histencil states
+/// (`histencil_vk::NEEDS`), for it cannot run the configuration; a failure where the device meets
+/// every stated need, for then the code needs more than its own table says (a regression the
+/// table must not hide as skips).
+fn device_limit_outcome(ctx: &Context, why: String) -> Outcome {
+    let limits = ctx.device_limits();
+    let below = histencil_vk::NEEDS
+        .iter()
+        .any(|n| limits.get(n.limit) < n.most);
+    if below {
+        Outcome::Skipped(why)
+    } else {
+        Outcome::Failed(format!(
+            "{why}, more than histencil's own NEEDS table states, on a device that meets it"
+        ))
+    }
+}
+
 /// What an injected hang or crash does: never return, or abort the process.
 fn strike(fault: &InjectedFault) {
     match fault {
@@ -458,7 +476,12 @@ impl Group<'_> {
                 // A device below a limit the lighting needs runs none of the group: skips that
                 // name the limit, as a missing depth format's do.
                 let skip = match &outcome {
-                    Err(histencil_vk::Error::DeviceLimit(why)) => Some(why.clone()),
+                    Err(histencil_vk::Error::DeviceLimit(why)) => {
+                        match device_limit_outcome(self.ctx, why.clone()) {
+                            Outcome::Skipped(why) => Some(why),
+                            _ => None,
+                        }
+                    }
                     _ => None,
                 };
                 let reason = match outcome {
@@ -493,9 +516,13 @@ impl Group<'_> {
                 started(&self.full_name(case));
             }
             self.inject_runner_fault(case);
+            // A fault armed for this case and not struck (it ended before waiting on the GPU)
+            // never passes to the next one.
+            let disarm = || drop(self.armed.lock().unwrap_or_else(|e| e.into_inner()).take());
             if let Some(why) = self.injected_flake(case) {
                 let mut r = self.result(case);
                 r.outcome = Outcome::Failed(why);
+                disarm();
                 emit(r);
                 continue;
             }
@@ -507,6 +534,7 @@ impl Group<'_> {
                 r.seconds = start.elapsed().as_secs_f64();
             }
             r.accepted += std::mem::take(&mut setup_accepted);
+            disarm();
             emit(r);
         }
     }
@@ -545,7 +573,9 @@ impl Group<'_> {
                 }
                 _ => false,
             };
-            if hits && self.options.trace_steps {
+            // A reference case waits on nothing (its frame was rendered with the group's
+            // setup): it strikes at once, as every case did before the step trace.
+            if hits && self.options.trace_steps && case.config.is_some() {
                 *self.armed.lock().unwrap_or_else(|e| e.into_inner()) = Some(fault.clone());
             } else if hits {
                 strike(fault);
@@ -638,7 +668,7 @@ impl Group<'_> {
             // tiled kernels' 7 storage buffers, say) cannot run it: a skip that says why, as a
             // missing depth format is.
             Err(histencil_vk::Error::DeviceLimit(why)) => {
-                r.outcome = Outcome::Skipped(why);
+                r.outcome = device_limit_outcome(self.ctx, why);
                 return r;
             }
             Err(e) => {

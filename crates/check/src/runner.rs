@@ -621,6 +621,9 @@ impl Worker<'_> {
                 self.in_flight = self.take(rest).map(|c| (c, Instant::now()));
             }
             "result" => {
+                // What comes after a case's result (the next case's setup, a teardown) is not
+                // that case's step.
+                self.step = None;
                 let parsed = serde_json::from_str(rest)
                     .ok()
                     .and_then(|v: Value| Record::from_json(&v));

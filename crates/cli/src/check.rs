@@ -62,6 +62,11 @@ pub struct CheckArgs {
     /// and `?` wildcards), as deqp-runner's `gtest-runner` runs a group.
     #[arg(long = "gtest_filter")]
     gtest_filter: Option<String>,
+    /// Print --baseline in googletest spelling (`Group.name,Status`, comments dropped), the
+    /// form deqp-runner's gtest-runner reads, and exit: one baseline file kept in
+    /// `scene/case` spelling serves both runners.
+    #[arg(long, requires = "baseline")]
+    print_gtest_baseline: bool,
     /// Write JUnit XML here (a testsuite per scene, a testcase per configuration).
     #[arg(long)]
     junit: Option<PathBuf>,
@@ -281,10 +286,19 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     }
     // Every case's googletest name, over the whole matrix of these scenes, so that a case list
     // or baseline in either spelling selects the same cases.
+    let gtest_mode = args.gtest_list_tests || args.gtest_filter.is_some();
     let names = match gtest_names(&scenes, &options) {
         Ok(n) => n,
-        Err(e) => return usage(e),
+        // Two cases that would share a googletest name matter only where that name is used.
+        Err(e) if gtest_mode => return usage(e),
+        Err(e) => {
+            eprintln!("histencil check: no googletest names for this run: {e}");
+            histencil_check::gtest::GtestNames::default()
+        }
     };
+    if args.print_gtest_baseline {
+        return print_gtest_baseline(args.baseline.as_deref(), &names);
+    }
     if let Some(only) = options.only.take() {
         let full = |name: String| names.full_name(&name).map(str::to_owned).unwrap_or(name);
         options.only = Some(only.into_iter().map(full).collect());
@@ -307,6 +321,27 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         Ok(p) => p,
         Err(e) => return usage(e),
     };
+    if let (Some(only), Some(path)) = (&options.only, &args.caselist) {
+        // A name that selects nothing (a typo, another run's scene) would shrink the run
+        // silently.
+        let planned_names: HashSet<String> = planned
+            .iter()
+            .map(|(s, c)| format!("{}/{}", scenes[*s].name, c.name()))
+            .collect();
+        let mut unmatched: Vec<&String> = only
+            .iter()
+            .filter(|n| !planned_names.contains(*n))
+            .collect();
+        unmatched.sort();
+        if let Some(first) = unmatched.first() {
+            eprintln!(
+                "histencil check: {} name(s) in {} select no case of this run (scenes, --quick), \
+                 the first `{first}`",
+                unmatched.len(),
+                path.display()
+            );
+        }
+    }
     let (mut cases, mut skipped) = (Vec::new(), Vec::new());
     for (position, (scene, case)) in planned.iter().enumerate() {
         let planned = PlannedCase {
@@ -430,6 +465,39 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
             })
         }
     }
+}
+
+/// `--print-gtest-baseline`: the baseline's lines with googletest names; a name that is no case
+/// of the matrix is refused (deqp-runner would never match it, and the failure it expects would
+/// fail the run).
+fn print_gtest_baseline(
+    path: Option<&std::path::Path>,
+    names: &histencil_check::gtest::GtestNames,
+) -> ExitCode {
+    let Some(path) = path else {
+        return usage("--print-gtest-baseline needs --baseline");
+    };
+    let baseline = match Baseline::load(path) {
+        Ok(b) => b,
+        Err(e) => return usage(e),
+    };
+    let mut out = String::new();
+    for (name, status) in &baseline.expected {
+        let gtest = names
+            .gtest_name(name)
+            .or_else(|| names.full_name(name).map(|_| name.as_str()));
+        match gtest {
+            Some(g) => out.push_str(&format!("{g},{status}\n")),
+            None => {
+                return usage(format!(
+                    "{}: `{name}` is no case of this matrix (scenes, --quick)",
+                    path.display()
+                ))
+            }
+        }
+    }
+    print!("{out}");
+    ExitCode::SUCCESS
 }
 
 /// Every case of `scenes`' matrix (whatever `options.only` selects), named for googletest.

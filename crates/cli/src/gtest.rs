@@ -52,7 +52,8 @@ fn pin_and_reexec(out: &Path) -> std::io::Error {
     });
     command.args(std::env::args_os().skip(1));
     for (name, value) in std::env::vars().filter(|(n, _)| crate::check::muting_variable(n)) {
-        eprintln!(
+        // On stdout, outside any test: gtest-runner reports every stderr line as an error.
+        println!(
             "histencil check: {name}={value} is cleared: the validation settings the verdict \
              rests on are pinned"
         );
@@ -107,8 +108,11 @@ pub fn run(
         Event::Finished(result, _) => {
             let record = Record::from_result(result);
             if record.scene == "device" {
-                // The canary and the teardown check: if either fails, no verdict of this
-                // process can be trusted, and no test may pass on it.
+                // The canary (before a context's first case) and the teardown check (after its
+                // last): a failing one stops the process with exit 3, which gtest-runner
+                // charges as a Crash to the last test it saw end (the teardown's case, or the
+                // previous context's); the reason is on stderr, in its log. Tests that ended
+                // before keep their results: they ran under a context whose canary passed.
                 if record.status.is_failure() {
                     eprintln!(
                         "histencil check: {}: {} {}",

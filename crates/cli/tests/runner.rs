@@ -590,3 +590,51 @@ fn the_gtest_face_lists_runs_and_maps_names_one_to_one() {
     assert_eq!(listed(&gtest_list), listed(&full_list));
     assert_eq!(listed(&gtest_list).lines().count(), 2);
 }
+
+/// A fault aimed at a case that never waits on the GPU (the forward reference, rendered with
+/// its group's setup) strikes that case, and one aimed at a case that stops before it waits (a
+/// first flaky run) never passes to the next: each fault lands on the case it names.
+#[test]
+fn an_injected_fault_lands_on_the_case_it_names() {
+    let dir = fresh_dir("fault-aim");
+    let out = dir.join("out");
+    let o = command(&SLICE)
+        .args(["--jobs", "1", "--inject-fault"])
+        .arg("crash=forward-reference-d32s8-7x5")
+        .args([
+            "--inject-fault",
+            "flaky=stencil-native-auto-p00-lightmap-d32s8-7x5",
+        ])
+        .args([
+            "--inject-fault",
+            "hang=stencil-native-auto-p00-lightmap-d32s8-7x5",
+        ])
+        .args(["--timeout", "10"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let failing: Vec<(String, String)> = statuses(&out)
+        .into_iter()
+        .filter(|(_, s)| s != "Pass")
+        .collect();
+    assert_eq!(
+        failing,
+        [
+            (
+                "brdfs-3/forward-reference-d32s8-7x5".to_owned(),
+                "Crash".to_owned()
+            ),
+            // Its first run fails by the flake and ends before the armed hang strikes; the
+            // hang does not pass to the next case (which would time out), it strikes only the
+            // rerun of its own.
+            (
+                "brdfs-3/stencil-native-auto-p00-lightmap-d32s8-7x5".to_owned(),
+                "Fail".to_owned()
+            ),
+        ],
+        "{}",
+        text(&o)
+    );
+}

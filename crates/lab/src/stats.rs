@@ -313,34 +313,43 @@ pub struct Sampled {
 }
 
 /// What a pilot predicted: after `pilot_rounds` rounds in `pilot_seconds`, `rounds` in all
-/// would decide every tracked verdict (`None`: some verdict sits on a margin's edge, where no
-/// number of rounds decides it), and the budget that follows.
+/// would decide every open verdict that rounds can decide (`None`: none can), `on_edge` verdicts
+/// sit on a margin's edge where no number of rounds decides them, and the budget that follows.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prediction {
     pub pilot_rounds: usize,
     pub pilot_seconds: f64,
     pub rounds: Option<usize>,
+    pub on_edge: usize,
     pub budget_seconds: f64,
 }
 
 impl Prediction {
     /// The prediction after `pilot_rounds` rounds in `pilot_seconds`, with `open` holding each
-    /// undecided verdict's rounds to decide; the budget at most `cap` seconds. With nothing
-    /// open, the pilot's own time; with a verdict that cannot be decided, the pilot's own time
-    /// too (more rounds would only spend the budget).
+    /// undecided verdict's rounds to decide (`None` for one on a margin's edge); the budget at
+    /// most `cap` seconds: the slowest decidable verdict's rounds at the pilot's pace, a tenth
+    /// over. With nothing decidable open, the pilot's own time (more rounds would only spend
+    /// the budget).
     pub fn of(pilot_rounds: usize, pilot_seconds: f64, open: &[Option<usize>], cap: f64) -> Self {
-        let rounds = open
-            .iter()
-            .try_fold(pilot_rounds, |most, r| r.map(|r| most.max(r)));
+        let on_edge = open.iter().filter(|r| r.is_none()).count();
         let per_round = pilot_seconds / pilot_rounds.max(1) as f64;
-        let budget_seconds = match rounds {
-            Some(r) if !open.is_empty() => (per_round * r as f64 * 1.1).min(cap),
-            _ => pilot_seconds,
+        let (rounds, budget_seconds) = if open.is_empty() {
+            // Decided already: the pilot was enough.
+            (Some(pilot_rounds), pilot_seconds)
+        } else {
+            match open.iter().flatten().copied().max() {
+                Some(r) => {
+                    let r = r.max(pilot_rounds);
+                    (Some(r), (per_round * r as f64 * 1.1).min(cap))
+                }
+                None => (None, pilot_seconds),
+            }
         };
         Prediction {
             pilot_rounds,
             pilot_seconds,
             rounds,
+            on_edge,
             budget_seconds,
         }
     }
@@ -512,10 +521,14 @@ mod tests {
             Prediction::of(10, 20.0, &[Some(4000)], 600.0).budget_seconds,
             600.0
         );
-        // Nothing open, or a verdict on an edge: no more than the pilot.
+        // Nothing open: no more than the pilot.
         assert_eq!(Prediction::of(10, 20.0, &[], 600.0).budget_seconds, 20.0);
+        // A verdict on an edge does not cost the others their rounds.
         let edge = Prediction::of(10, 20.0, &[Some(40), None], 600.0);
-        assert_eq!((edge.rounds, edge.budget_seconds), (None, 20.0));
+        assert_eq!((edge.rounds, edge.on_edge), (Some(40), 1));
+        assert!((edge.budget_seconds - 88.0).abs() < 1e-9, "{edge:?}");
+        let only_edge = Prediction::of(10, 20.0, &[None], 600.0);
+        assert_eq!((only_edge.rounds, only_edge.budget_seconds), (None, 20.0));
         // The rule end to end: a verdict that never decides stops at the pilot's budget.
         let s = Sampling {
             min_rounds: 2,

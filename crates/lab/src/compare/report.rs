@@ -137,11 +137,17 @@ impl CompareReport {
             100.0 * t.widest
         );
         if let Some(p) = &t.prediction {
-            let predicted = match p.rounds {
+            let mut predicted = match p.rounds {
                 Some(r) => format!("{r} rounds in all would decide the talk's cells"),
-                None => "some cell sits on a margin's edge, where no number of rounds decides it"
-                    .to_owned(),
+                None => "no number of rounds would decide the talk's open cells".to_owned(),
             };
+            if p.on_edge > 0 {
+                let _ = write!(
+                    predicted,
+                    " ({} on a margin's edge, which no number of rounds decides)",
+                    p.on_edge
+                );
+            }
             let _ = writeln!(
                 md,
                 "Budget: a pilot of {} rounds ({:.1} s) predicted that {predicted}, so the \
@@ -707,6 +713,7 @@ fn sampled_json(s: &crate::stats::Sampled) -> Value {
             "pilot_rounds": p.pilot_rounds,
             "pilot_seconds": p.pilot_seconds,
             "rounds": p.rounds,
+            "on_margin_edge": p.on_edge,
             "budget_seconds": p.budget_seconds,
         });
     }

@@ -252,10 +252,11 @@ pub(crate) fn transition(
 
 /// A global memory barrier: every write recorded before is visible to every access after.
 ///
-/// The hi-stencil emulation and split light passes hand buffers and attachments between
-/// fragment shaders, attachments, copies and compute many times a frame; one broad barrier
-/// between those phases is simpler to get right than a precise one per hand-over, and costs the
-/// same on a driver that serialises them anyway.
+/// Split light passes (draws that share the statistics buffer), the depth-id and tiled passes
+/// hand buffers and attachments between fragment shaders, attachments and compute; one broad
+/// barrier between those phases is simpler to get right than a precise one per hand-over. The
+/// hi-stencil emulation's own bookkeeping (reset, flush, save) uses [`buffer_barrier`] instead:
+/// its hand-overs are few and known, and a full wait there would count against the console.
 ///
 /// The stages are the ones histencil records (named rather than `ALL_COMMANDS`, which the
 /// best-practices layer flags); synchronisation validation in every test run would report a
@@ -280,9 +281,118 @@ pub(crate) fn memory_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
 }
 
+/// How a buffer is used, as [`ImageAccess`] says it of an image: the stages and accesses a
+/// barrier between two uses waits for or makes visible (the table kajiya's `vk-sync` keeps).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BufferAccess {
+    /// Written by a fill or a copy.
+    TransferWrite,
+    /// Read by a copy.
+    TransferRead,
+    /// Read by fragment shaders as a storage buffer.
+    FragmentRead,
+    /// Read and written (atomics) by fragment shaders as a storage buffer.
+    FragmentReadWrite,
+    /// Written by compute shaders as a storage buffer.
+    ComputeWrite,
+}
+
+/// The stages and access mask of a [`BufferAccess`]. Pure, so it is unit-tested.
+pub fn buffer_access_info(access: BufferAccess) -> (vk::PipelineStageFlags2, vk::AccessFlags2) {
+    use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
+    match access {
+        BufferAccess::TransferWrite => (S::ALL_TRANSFER, A::TRANSFER_WRITE),
+        BufferAccess::TransferRead => (S::ALL_TRANSFER, A::TRANSFER_READ),
+        BufferAccess::FragmentRead => (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
+        BufferAccess::FragmentReadWrite => (
+            S::FRAGMENT_SHADER,
+            A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+        ),
+        BufferAccess::ComputeWrite => (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+    }
+}
+
+/// The barrier between `from` (every way `buffers` may have been used last) and `to` (every
+/// way they are used next), whole buffers: a dependency on those stages alone, not the full wait
+/// of [`memory_barrier`]. Only writes are made available; a read before needs only the
+/// execution dependency.
+pub(crate) fn buffer_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    buffers: &[vk::Buffer],
+    from: &[BufferAccess],
+    to: &[BufferAccess],
+) {
+    let union = |accesses: &[BufferAccess], writes_only: bool| {
+        accesses.iter().fold(
+            (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
+            |(s, a), x| {
+                let (stage, access) = buffer_access_info(*x);
+                let access = if writes_only {
+                    access
+                        & (vk::AccessFlags2::TRANSFER_WRITE
+                            | vk::AccessFlags2::SHADER_STORAGE_WRITE)
+                } else {
+                    access
+                };
+                (s | stage, a | access)
+            },
+        )
+    };
+    let (src_stage, src_access) = union(from, true);
+    let (dst_stage, dst_access) = union(to, false);
+    let barriers: Vec<vk::BufferMemoryBarrier2> = buffers
+        .iter()
+        .map(|buffer| {
+            vk::BufferMemoryBarrier2::default()
+                .src_stage_mask(src_stage)
+                .src_access_mask(src_access)
+                .dst_stage_mask(dst_stage)
+                .dst_access_mask(dst_access)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(*buffer)
+                .offset(0)
+                .size(vk::WHOLE_SIZE)
+        })
+        .collect();
+    let dependency = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);
+    // SAFETY: `cmd` is recording outside rendering (the callers' contract) and the buffers are
+    // alive; the barrier names only stages and accesses those buffers support.
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn buffer_accesses_name_their_stage_and_only_writes_are_made_available() {
+        use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
+        let all = [
+            BufferAccess::TransferWrite,
+            BufferAccess::TransferRead,
+            BufferAccess::FragmentRead,
+            BufferAccess::FragmentReadWrite,
+            BufferAccess::ComputeWrite,
+        ];
+        for access in all {
+            let (stage, mask) = buffer_access_info(access);
+            assert!(!stage.is_empty() && !mask.is_empty(), "{access:?}");
+            assert!(
+                !stage.contains(S::ALL_COMMANDS),
+                "{access:?}: name the stage"
+            );
+            let writes = mask.intersects(A::TRANSFER_WRITE | A::SHADER_STORAGE_WRITE);
+            let named_write = matches!(
+                access,
+                BufferAccess::TransferWrite
+                    | BufferAccess::FragmentReadWrite
+                    | BufferAccess::ComputeWrite
+            );
+            assert_eq!(writes, named_write, "{access:?}");
+        }
+    }
 
     #[test]
     fn every_access_but_nothing_has_a_real_layout_and_stage() {

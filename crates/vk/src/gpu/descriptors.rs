@@ -240,7 +240,7 @@ pub(crate) fn create_set_layout(
     ctx.set_counts
         .lock()
         .unwrap_or_else(|e| e.into_inner())
-        .insert(layout, counts);
+        .insert(layout, vec![counts]);
     Ok(layout)
 }
 
@@ -481,10 +481,10 @@ pub(crate) fn create_pipeline_layout(
     let counts: Vec<SetCounts> = {
         let known = ctx.set_counts.lock().unwrap_or_else(|e| e.into_inner());
         sets.iter()
-            .map(|s| known.get(s).copied().unwrap_or_default())
+            .flat_map(|s| known.get(s).cloned().unwrap_or_default())
             .collect()
     };
-    for (limit, need) in layout_needs(&counts, push_constant_bytes) {
+    for (limit, need) in layout_needs(&counts, sets.len() as u32, push_constant_bytes) {
         ctx.need(limit, need, &format!("pipeline layout `{name}`"))?;
     }
     let ranges = [vk::PushConstantRange::default()

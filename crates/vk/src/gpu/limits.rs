@@ -139,9 +139,9 @@ pub struct Need {
     pub instead: Option<&'static str>,
 }
 
-/// What histencil's own pipelines need at most. `tests/tests/limits.rs` builds every
-/// technique, the alpha lightmaps and the emulations on one context and holds this table to
-/// what was recorded, so it cannot drift from the code.
+/// What histencil's own pipelines need at most. `tests/tests/techniques.rs` builds every
+/// technique on one context and holds this table to what was recorded (`assert_needs_hold`), so
+/// it cannot drift from the code.
 pub const NEEDS: &[Need] = &[
     Need {
         limit: Limit::BoundDescriptorSets,
@@ -275,19 +275,70 @@ pub fn describe(needs: &[Need], device: &DeviceLimits) -> String {
     )
 }
 
-/// Every descriptor a pipeline layout's sets give each stage, by kind: what the per-stage and
-/// per-set limits are checked against.
+/// The descriptors of a set layout's bindings that share one stage mask, by kind: what the
+/// per-stage and per-set limits are checked against (a layout is one or more of these).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct SetCounts {
-    /// The stages the set's bindings are visible to.
+    /// The stages these bindings are visible to.
     pub stages: vk::ShaderStageFlags,
     /// Uniform buffers, storage buffers, sampled images, samplers, storage images.
     pub kinds: [u32; 5],
 }
 
-/// The per-stage and per-layout needs of a pipeline layout made of `sets` with
-/// `push_constant_bytes`: `(limit, need)` pairs, the largest over its stages.
-pub(crate) fn layout_needs(sets: &[SetCounts], push_constant_bytes: u32) -> Vec<(Limit, u32)> {
+impl SetCounts {
+    /// The counts of an engine's layout from the bindings it was created with, one entry per
+    /// distinct stage mask (descriptor types histencil's limits do not track are not counted).
+    pub fn of_bindings(bindings: &[vk::DescriptorSetLayoutBinding]) -> Vec<SetCounts> {
+        let mut groups: Vec<SetCounts> = Vec::new();
+        for b in bindings {
+            let kind = match b.descriptor_type {
+                vk::DescriptorType::UNIFORM_BUFFER | vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC => {
+                    0
+                }
+                vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::STORAGE_BUFFER_DYNAMIC => {
+                    1
+                }
+                vk::DescriptorType::SAMPLED_IMAGE | vk::DescriptorType::UNIFORM_TEXEL_BUFFER => 2,
+                vk::DescriptorType::SAMPLER => 3,
+                vk::DescriptorType::STORAGE_IMAGE | vk::DescriptorType::STORAGE_TEXEL_BUFFER => 4,
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER => {
+                    // A sampled image and a sampler, each counted against its limit.
+                    let g = group(&mut groups, b.stage_flags);
+                    g.kinds[2] += b.descriptor_count;
+                    g.kinds[3] += b.descriptor_count;
+                    continue;
+                }
+                _ => continue,
+            };
+            group(&mut groups, b.stage_flags).kinds[kind] += b.descriptor_count;
+        }
+        groups
+    }
+}
+
+/// The entry of `groups` for `stages`, added where missing.
+fn group(groups: &mut Vec<SetCounts>, stages: vk::ShaderStageFlags) -> &mut SetCounts {
+    let at = match groups.iter().position(|g| g.stages == stages) {
+        Some(i) => i,
+        None => {
+            groups.push(SetCounts {
+                stages,
+                kinds: [0; 5],
+            });
+            groups.len() - 1
+        }
+    };
+    &mut groups[at]
+}
+
+/// The per-stage and per-layout needs of a pipeline layout of `set_count` sets whose bindings
+/// are `sets` (a set may be several entries, one per stage mask), with `push_constant_bytes`:
+/// `(limit, need)` pairs, the largest over its stages.
+pub(crate) fn layout_needs(
+    sets: &[SetCounts],
+    set_count: u32,
+    push_constant_bytes: u32,
+) -> Vec<(Limit, u32)> {
     let per_stage = [
         Limit::PerStageUniformBuffers,
         Limit::PerStageStorageBuffers,
@@ -296,7 +347,7 @@ pub(crate) fn layout_needs(sets: &[SetCounts], push_constant_bytes: u32) -> Vec<
         Limit::PerStageStorageImages,
     ];
     let mut needs = vec![
-        (Limit::BoundDescriptorSets, sets.len() as u32),
+        (Limit::BoundDescriptorSets, set_count),
         (Limit::PushConstantsSize, push_constant_bytes),
     ];
     let stages = [
@@ -418,7 +469,7 @@ mod tests {
             stages: vk::ShaderStageFlags::COMPUTE,
             kinds: [0, 4, 0, 0, 1],
         };
-        let needs = layout_needs(&[frame, gbuffer, tiled], 96);
+        let needs = layout_needs(&[frame, gbuffer, tiled], 3, 96);
         let get = |l| needs.iter().find(|(n, _)| *n == l).map(|&(_, v)| v);
         assert_eq!(get(Limit::BoundDescriptorSets), Some(3));
         assert_eq!(get(Limit::PushConstantsSize), Some(96));
@@ -429,5 +480,25 @@ mod tests {
         // The layout: every set.
         assert_eq!(get(Limit::SetStorageBuffers), Some(5));
         assert_eq!(get(Limit::SetSampledImages), Some(3));
+        // An engine's layout, from its bindings: a combined image sampler counts as both, and
+        // each stage mask apart.
+        let bindings = [
+            vk::DescriptorSetLayoutBinding::default()
+                .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                .descriptor_count(2)
+                .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+            vk::DescriptorSetLayoutBinding::default()
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::COMPUTE),
+        ];
+        let engine = SetCounts::of_bindings(&bindings);
+        assert_eq!(engine.len(), 2);
+        let needs = layout_needs(&engine, 1, 0);
+        let get = |l| needs.iter().find(|(n, _)| *n == l).map(|&(_, v)| v);
+        assert_eq!(get(Limit::PerStageSampledImages), Some(2));
+        assert_eq!(get(Limit::PerStageSamplers), Some(2));
+        assert_eq!(get(Limit::PerStageStorageBuffers), Some(1));
+        assert_eq!(get(Limit::BoundDescriptorSets), Some(1));
     }
 }

@@ -24,7 +24,7 @@
 //! count the fragments they shade.
 
 use crate::gpu::access::{
-    access_info, memory_barrier, transition, Contents, ImageAccess, ImageRef,
+    access_info, buffer_barrier, transition, BufferAccess, Contents, ImageAccess, ImageRef,
 };
 use crate::gpu::compute::ComputePipeline;
 use crate::gpu::context::Context;
@@ -294,16 +294,44 @@ impl HiStencilSurface {
     /// Outside rendering, before lighting: every tile passes, no tile is marked, statistics zero.
     pub fn record_reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         let d = &ctx.device;
+        let surface = [
+            self.active.handle,
+            self.pending.handle,
+            self.touched.handle,
+            self.stats.handle,
+        ];
+        // Every way a frame uses the surface: light shaders read the active tiles and count
+        // into the touched marks and statistics, the tile update writes pending tiles, a flush
+        // copies them.
+        let frame_uses = [
+            BufferAccess::FragmentRead,
+            BufferAccess::FragmentReadWrite,
+            BufferAccess::ComputeWrite,
+            BufferAccess::TransferRead,
+            BufferAccess::TransferWrite,
+        ];
         // The previous frame's lighting (in flight, in an earlier submission) may still use
         // the surface.
-        memory_barrier(ctx, cmd);
+        buffer_barrier(
+            ctx,
+            cmd,
+            &surface,
+            &frame_uses,
+            &[BufferAccess::TransferWrite],
+        );
         unsafe {
             d.cmd_fill_buffer(cmd, self.active.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.touched.handle, 0, vk::WHOLE_SIZE, 0);
             d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
         }
-        memory_barrier(ctx, cmd);
+        buffer_barrier(
+            ctx,
+            cmd,
+            &surface,
+            &[BufferAccess::TransferWrite],
+            &frame_uses,
+        );
         self.unflushed = false;
         // The frame's first touch draw clears the touch image whole, so no frame depends on
         // what an earlier one (recorded, perhaps never submitted) left there.
@@ -312,14 +340,44 @@ impl HiStencilSurface {
 
     /// Outside rendering: pending state becomes active.
     pub fn record_flush(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
-        // Light shaders may still be reading the active surface.
-        memory_barrier(ctx, cmd);
+        let (pending, active) = ([self.pending.handle], [self.active.handle]);
+        // The tile updates wrote the pending tiles; light shaders may still read the active
+        // ones.
+        buffer_barrier(
+            ctx,
+            cmd,
+            &pending,
+            &[BufferAccess::ComputeWrite],
+            &[BufferAccess::TransferRead],
+        );
+        buffer_barrier(
+            ctx,
+            cmd,
+            &active,
+            &[BufferAccess::FragmentRead, BufferAccess::TransferWrite],
+            &[BufferAccess::TransferWrite],
+        );
         let region = [vk::BufferCopy::default().size(self.pending.size)];
         unsafe {
             ctx.device
                 .cmd_copy_buffer(cmd, self.pending.handle, self.active.handle, &region)
         };
-        memory_barrier(ctx, cmd);
+        // The next tile updates overwrite the pending tiles the copy read; the light shaders
+        // read the new active ones.
+        buffer_barrier(
+            ctx,
+            cmd,
+            &pending,
+            &[BufferAccess::TransferRead],
+            &[BufferAccess::ComputeWrite],
+        );
+        buffer_barrier(
+            ctx,
+            cmd,
+            &active,
+            &[BufferAccess::TransferWrite],
+            &[BufferAccess::FragmentRead, BufferAccess::TransferWrite],
+        );
         self.unflushed = false;
     }
 
@@ -523,6 +581,15 @@ impl HiStencilSurface {
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
     pub fn record_save(&self, ctx: &Context, cmd: vk::CommandBuffer, depth_stencil: &mut ImageRef) {
+        let saved = [self.saved.handle];
+        // The last restore (an earlier frame's) read what this copy overwrites.
+        buffer_barrier(
+            ctx,
+            cmd,
+            &saved,
+            &[BufferAccess::FragmentRead],
+            &[BufferAccess::TransferWrite],
+        );
         copy_image_to_buffer(
             ctx,
             cmd,
@@ -537,7 +604,13 @@ impl HiStencilSurface {
             ImageAccess::DepthStencilAttachment,
             Contents::Keep,
         );
-        memory_barrier(ctx, cmd);
+        buffer_barrier(
+            ctx,
+            cmd,
+            &saved,
+            &[BufferAccess::TransferWrite],
+            &[BufferAccess::FragmentRead],
+        );
     }
 
     /// Makes the statistics visible to the host; record after the last lighting draw.

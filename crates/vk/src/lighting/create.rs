@@ -43,6 +43,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         let mut layouts = self.set_layouts.to_vec();
         if let LightHooks::Engine(engine) = hooks {
+            engine.register_layouts(ctx);
             layouts[1] = engine.decode_layout;
             layouts.extend(engine.visibility_layout);
         }

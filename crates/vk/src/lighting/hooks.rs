@@ -47,10 +47,29 @@ pub struct EngineHooks {
     pub(crate) visibility_layout: Option<vk::DescriptorSetLayout>,
     /// The formats of the images the decode hook reads, in [`crate::LightingTargets::gbuffer`]
     /// order.
-    pub(crate) surface_formats: Vec<vk::Format>,
+    pub(crate) surface_formats: Box<[vk::Format]>,
     /// Why the tiled technique's kernels cannot bind these layouts, if they cannot (a binding
     /// the kernels read is not visible to the compute stage).
     pub(crate) tiled_refusal: Option<String>,
+    /// What the decode and visibility layouts hold, from their bindings: what the pipeline
+    /// layouts made with them are checked against the device's limits with.
+    /// (Shared: the hooks are cloned into every lighting, and kept small.)
+    pub(crate) layout_counts: LayoutCounts,
+}
+
+/// What each of an engine's layouts holds ([`EngineHooks::register_layouts`]).
+pub(crate) type LayoutCounts =
+    std::sync::Arc<Vec<(vk::DescriptorSetLayout, Vec<crate::gpu::limits::SetCounts>)>>;
+
+impl EngineHooks {
+    /// Tells `ctx` what the engine's layouts hold, so the pipeline layouts made with them are
+    /// checked against the device's limits like histencil's own.
+    pub(crate) fn register_layouts(&self, ctx: &crate::Context) {
+        let mut known = ctx.set_counts.lock().unwrap_or_else(|e| e.into_inner());
+        for (layout, counts) in self.layout_counts.iter() {
+            known.insert(*layout, counts.clone());
+        }
+    }
 }
 
 impl EngineHooks {
@@ -87,12 +106,23 @@ impl EngineHooks {
             visibility: visibility.map(|v| v.bindings),
         };
         let tiled_refusal = check_modules(&modules, &layouts)?;
+        let mut layout_counts = vec![(
+            decode.layout,
+            crate::gpu::limits::SetCounts::of_bindings(decode.bindings),
+        )];
+        layout_counts.extend(visibility.map(|v| {
+            (
+                v.layout,
+                crate::gpu::limits::SetCounts::of_bindings(v.bindings),
+            )
+        }));
         Ok(Self {
             modules,
             decode_layout: decode.layout,
             visibility_layout: visibility.map(|v| v.layout),
-            surface_formats: surface_formats.to_vec(),
+            surface_formats: surface_formats.into(),
             tiled_refusal,
+            layout_counts: std::sync::Arc::new(layout_counts),
         })
     }
 }

@@ -171,8 +171,9 @@ pub struct Context {
     pub(crate) limits_used: crate::gpu::limits::LimitsUsed,
     /// What each set layout made on this context holds, by stage and kind: what a pipeline
     /// layout built from them is checked against.
-    pub(crate) set_counts:
-        Mutex<std::collections::HashMap<vk::DescriptorSetLayout, crate::gpu::limits::SetCounts>>,
+    pub(crate) set_counts: Mutex<
+        std::collections::HashMap<vk::DescriptorSetLayout, Vec<crate::gpu::limits::SetCounts>>,
+    >,
     /// `depthBounds` is enabled on the device and histencil's pipelines take the depth bounds
     /// test as dynamic state: the renderer confines lights to their depth ranges
     /// ([`histencil_model::FramePlan::with_depth_bounds`]). Off on an engine's device, whose
@@ -188,10 +189,13 @@ pub struct Context {
 /// What [`Context::observe_steps`] calls with each step.
 pub type StepObserver = Box<dyn Fn(&str) + Send + Sync>;
 
+/// A step observer as the context keeps it: cloned out of the lock before it is called.
+type SharedObserver = Arc<dyn Fn(&str) + Send + Sync>;
+
 /// The labelled regions open on the context's command buffers, for the step observer.
 #[derive(Default)]
 struct Steps {
-    observer: Option<StepObserver>,
+    observer: Option<SharedObserver>,
     open: Vec<String>,
     /// The outermost regions recorded since the last wait: what a fence wait waits for.
     since_wait: Vec<String>,
@@ -467,19 +471,25 @@ impl Context {
     /// shade-ggx`), and before each fence wait what the GPU is given (`waiting on the GPU for
     /// gbuffer, lighting, tonemap, readback`). A runner that prints them learns,
     /// when the process crashes or hangs, what was being recorded or waited on (`histencil
-    /// check`'s workers do). `None` stops it. Without an observer a step costs one lock.
+    /// check`'s workers do). `None` stops it. Without an observer a step costs one lock. The
+    /// observer is called with no lock of the context's held, so it may call back into the
+    /// context.
     pub fn observe_steps(&self, observer: Option<StepObserver>) {
         let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
-        steps.observer = observer;
+        steps.observer = observer.map(Arc::from);
         steps.open.clear();
+        steps.since_wait.clear();
     }
 
     /// Tells the observer that `what` begins (a fence wait, a submission), after the regions
     /// recorded last.
     pub(crate) fn step(&self, what: &str) {
-        let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
-        let work = std::mem::take(&mut steps.since_wait);
-        if let Some(observer) = &steps.observer {
+        let (observer, work) = {
+            let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
+            let work = std::mem::take(&mut steps.since_wait);
+            (steps.observer.clone(), work)
+        };
+        if let Some(observer) = observer {
             let work = if work.is_empty() {
                 "work recorded without a label".to_owned()
             } else {
@@ -491,17 +501,21 @@ impl Context {
 
     /// Opens a debug label region on a command buffer; pair with [`Context::end_label`].
     pub(crate) fn begin_label(&self, cmd: vk::CommandBuffer, label: &str) {
-        {
+        let observed = {
             let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
-            if steps.observer.is_some() {
-                if steps.open.is_empty() {
-                    steps.since_wait.push(label.to_owned());
+            match steps.observer.clone() {
+                Some(observer) => {
+                    if steps.open.is_empty() {
+                        steps.since_wait.push(label.to_owned());
+                    }
+                    steps.open.push(label.to_owned());
+                    Some((observer, steps.open.join(" / ")))
                 }
-                steps.open.push(label.to_owned());
-                if let Some(observer) = &steps.observer {
-                    observer(&format!("recording {}", steps.open.join(" / ")));
-                }
+                None => None,
             }
+        };
+        if let Some((observer, open)) = observed {
+            observer(&format!("recording {open}"));
         }
         if let Some(dd) = &self.debug_device {
             let name = CString::new(label).expect("labels contain no NUL");
