@@ -9,8 +9,8 @@ use crate::gpu::teardown::build;
 use ash::vk;
 
 /// What a binding holds: the subset of Vulkan's descriptor types histencil's shaders use
-/// (separate images and samplers, no combined image samplers). The order is
-/// [`crate::gpu::limits::SetCounts`]'s.
+/// (separate images and samplers, no combined image samplers). The order is that of the
+/// per-kind counts the device limits are checked with (`limits::SetCounts`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
     /// A `uniform` block (`UNIFORM_BUFFER`).
