@@ -182,6 +182,22 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                 Err(Error::BadFrame(m)) => assert!(m.contains("a pass of its own"), "{m}"),
                 other => panic!("depth-id with branching mixed tiles was accepted: {other:?}"),
             }
+            // A light made NaN (after its frame was built, say): refused by both techniques,
+            // which plan nothing, as plan_frame refuses it, not shaded as nothing.
+            let mut broken = lights.clone();
+            broken[0].position.x = f32::NAN;
+            let nan = TiledFrame {
+                lights: &broken,
+                ..frame
+            };
+            match lighting.record_tiled(cmd, &nan, &mut images.refs()) {
+                Err(Error::BadFrame(m)) => assert!(m.contains("light 0: "), "{m}"),
+                other => panic!("a NaN light was accepted by tiled: {other:?}"),
+            }
+            match lighting.record_depth_id(cmd, &nan, &mut images.refs()) {
+                Err(Error::BadFrame(m)) => assert!(m.contains("light 0: "), "{m}"),
+                other => panic!("a NaN light was accepted by depth-id: {other:?}"),
+            }
             d.end_command_buffer(cmd).unwrap();
         }
         drop(other);

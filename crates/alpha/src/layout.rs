@@ -209,6 +209,15 @@ pub enum LayoutError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A light the plan cannot weigh (a NaN or infinity, ...), as a scene's validation refuses
+    /// it ([`histencil_scene::Light::problem`]).
+    #[error("light {index}: {reason}")]
+    BadLight {
+        /// Its index in the lights given.
+        index: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
 }
 
 /// Diameter in pixels that a sphere of `radius` at `centre` covers on a `viewport_height`-pixel

@@ -83,11 +83,17 @@ impl Default for ChoiceSettings {
 /// assert_eq!((placed.shape.tile_width, placed.shape.tile_height), (chosen.side, chosen.side));
 /// assert_eq!((placed.region.width, placed.region.height), placed.shape.size());
 /// assert!(!placed.downgraded);
+///
+/// // A light made NaN is refused, as the lighting refuses it when it records.
+/// let nan = [Light::point(Vec3::new(f32::NAN, 1.0, 0.0), 4.0, Vec3::ONE)];
+/// let refused = plan_entities(&[], &viewer, &nan, 720, MAX_ATLAS_SIDE, &settings);
+/// assert!(matches!(refused, Err(LayoutError::BadLight { index: 0, .. })));
 /// # Ok::<(), LayoutError>(())
 /// ```
 ///
 /// # Errors
 /// [`LayoutError::BadEntity`] for an entity [`AlphaEntity::problem`] refuses,
+/// [`LayoutError::BadLight`] for a light [`histencil_scene::Light::problem`] refuses,
 /// [`LayoutError::BadResolution`] for a forced side outside 2..=[`crate::MAX_FORCED_SIDE`], and
 /// [`LayoutError::AtlasFull`] when the regions do not fit even halved.
 pub fn plan_entities(
@@ -107,6 +113,15 @@ pub fn plan_entities(
         .find_map(|(i, e)| e.problem().map(|r| (i, r)))
     {
         return Err(LayoutError::BadEntity { index, reason });
+    }
+    // A light made NaN would weigh every entity's choice by nothing; refused as the lighting
+    // refuses it at record time.
+    if let Some((index, reason)) = lights
+        .iter()
+        .enumerate()
+        .find_map(|(i, l)| l.problem().map(|r| (i, r)))
+    {
+        return Err(LayoutError::BadLight { index, reason });
     }
     let parameters: Vec<Parameters> = entities
         .iter()

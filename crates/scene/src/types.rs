@@ -491,6 +491,15 @@ fn camera_problem(c: &Camera) -> Option<String> {
     })
 }
 
+impl Light {
+    /// Why this light cannot be lit with (a NaN or infinity, a colour out of range, a position
+    /// outside the world, a bad spot cone...), as a scene's validation says it; `None` when it
+    /// can. A renderer holds every frame's lights to it, whatever technique records them.
+    pub fn problem(&self) -> Option<String> {
+        light_problem(self)
+    }
+}
+
 fn light_problem(l: &Light) -> Option<String> {
     let problem = |p: &str| Some(p.to_owned());
     if !finite3(l.position) || !finite3(l.color) || !l.radius.is_finite() {

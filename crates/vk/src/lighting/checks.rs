@@ -75,7 +75,7 @@ pub(super) fn check_frame(
     frame: &LightingFrame,
     targets: &LightingTargets,
 ) -> Result<()> {
-    check_slot_and_lights(desc, frame.slot, frame.lights.len())?;
+    check_slot_and_lights(desc, frame.slot, frame.lights)?;
     if let Some(l) = frame
         .plan
         .lights
@@ -112,8 +112,22 @@ pub(super) fn check_frame(
     check_targets(desc, &frame.hook_sets, targets)
 }
 
-/// Checks a frame's slot and light count against the lighting's description.
-pub(super) fn check_slot_and_lights(desc: &LightingDesc, slot: u32, lights: usize) -> Result<()> {
+/// Checks a frame's slot and lights against the lighting's description: the count, and every
+/// light as a scene's validation holds it (a light made NaN after its frame was planned, or on
+/// a technique that plans nothing, is refused here, not shaded as nothing).
+pub(super) fn check_slot_and_lights(
+    desc: &LightingDesc,
+    slot: u32,
+    lights: &[histencil_scene::Light],
+) -> Result<()> {
+    if let Some((index, problem)) = lights
+        .iter()
+        .enumerate()
+        .find_map(|(i, l)| l.problem().map(|p| (i, p)))
+    {
+        return Err(bad(format!("light {index}: {problem}")));
+    }
+    let lights = lights.len();
     if slot >= desc.frames_in_flight {
         return Err(bad(format!(
             "slot {slot} of {} frames in flight",

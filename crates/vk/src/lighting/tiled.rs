@@ -91,7 +91,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                     .to_owned(),
             ));
         }
-        check_slot_and_lights(&self.desc, frame.slot, frame.lights.len())?;
+        check_slot_and_lights(&self.desc, frame.slot, frame.lights)?;
         check_targets(&self.desc, &frame.hook_sets, targets)?;
         if let Some(why) = self.desc.hooks.tiled_refusal() {
             return Err(bad(format!(
