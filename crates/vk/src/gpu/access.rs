@@ -312,38 +312,34 @@ pub fn buffer_access_info(access: BufferAccess) -> (vk::PipelineStageFlags2, vk:
     }
 }
 
-/// The barrier between `from` (every way `buffers` may have been used last) and `to` (every
-/// way they are used next), whole buffers: a dependency on those stages alone, not the full wait
-/// of [`memory_barrier`]. Only writes are made available; a read before needs only the
-/// execution dependency.
-pub(crate) fn buffer_barrier(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    buffers: &[vk::Buffer],
-    from: &[BufferAccess],
-    to: &[BufferAccess],
-) {
-    let union = |accesses: &[BufferAccess], writes_only: bool| {
-        accesses.iter().fold(
-            (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
-            |(s, a), x| {
-                let (stage, access) = buffer_access_info(*x);
-                let access = if writes_only {
-                    access
-                        & (vk::AccessFlags2::TRANSFER_WRITE
-                            | vk::AccessFlags2::SHADER_STORAGE_WRITE)
-                } else {
-                    access
-                };
-                (s | stage, a | access)
-            },
-        )
-    };
-    let (src_stage, src_access) = union(from, true);
-    let (dst_stage, dst_access) = union(to, false);
-    let barriers: Vec<vk::BufferMemoryBarrier2> = buffers
+/// One buffer's hand-over: every way it may have been used last, and every way it is used next.
+pub(crate) type HandOver<'a> = (vk::Buffer, &'a [BufferAccess], &'a [BufferAccess]);
+
+/// The stages and, where `writes_only`, only the write accesses of `accesses` together.
+fn union(
+    accesses: &[BufferAccess],
+    writes_only: bool,
+) -> (vk::PipelineStageFlags2, vk::AccessFlags2) {
+    let writes = vk::AccessFlags2::TRANSFER_WRITE | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+    accesses.iter().fold(
+        (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
+        |(s, a), x| {
+            let (stage, access) = buffer_access_info(*x);
+            let access = if writes_only { access & writes } else { access };
+            (s | stage, a | access)
+        },
+    )
+}
+
+/// One barrier command for every hand-over, each whole buffer from its `from` uses to its `to`
+/// uses: a dependency on those stages alone, not the full wait of [`memory_barrier`]. Only writes
+/// are made available; a read before needs only the execution dependency.
+pub(crate) fn buffer_barrier(ctx: &Context, cmd: vk::CommandBuffer, hand_overs: &[HandOver]) {
+    let barriers: Vec<vk::BufferMemoryBarrier2> = hand_overs
         .iter()
-        .map(|buffer| {
+        .map(|&(buffer, from, to)| {
+            let (src_stage, src_access) = union(from, true);
+            let (dst_stage, dst_access) = union(to, false);
             vk::BufferMemoryBarrier2::default()
                 .src_stage_mask(src_stage)
                 .src_access_mask(src_access)
@@ -351,7 +347,7 @@ pub(crate) fn buffer_barrier(
                 .dst_access_mask(dst_access)
                 .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                 .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(*buffer)
+                .buffer(buffer)
                 .offset(0)
                 .size(vk::WHOLE_SIZE)
         })

@@ -312,26 +312,17 @@ impl HiStencilSurface {
         ];
         // The previous frame's lighting (in flight, in an earlier submission) may still use
         // the surface.
-        buffer_barrier(
-            ctx,
-            cmd,
-            &surface,
-            &frame_uses,
-            &[BufferAccess::TransferWrite],
-        );
+        let fill = [BufferAccess::TransferWrite];
+        let before = surface.map(|b| (b, &frame_uses[..], &fill[..]));
+        buffer_barrier(ctx, cmd, &before);
         unsafe {
             d.cmd_fill_buffer(cmd, self.active.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.touched.handle, 0, vk::WHOLE_SIZE, 0);
             d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
         }
-        buffer_barrier(
-            ctx,
-            cmd,
-            &surface,
-            &[BufferAccess::TransferWrite],
-            &frame_uses,
-        );
+        let after = surface.map(|b| (b, &fill[..], &frame_uses[..]));
+        buffer_barrier(ctx, cmd, &after);
         self.unflushed = false;
         // The frame's first touch draw clears the touch image whole, so no frame depends on
         // what an earlier one (recorded, perhaps never submitted) left there.
@@ -340,22 +331,17 @@ impl HiStencilSurface {
 
     /// Outside rendering: pending state becomes active.
     pub fn record_flush(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
-        let (pending, active) = ([self.pending.handle], [self.active.handle]);
+        use BufferAccess::{ComputeWrite, FragmentRead, TransferRead, TransferWrite};
+        let (pending, active) = (self.pending.handle, self.active.handle);
         // The tile updates wrote the pending tiles; light shaders may still read the active
         // ones.
         buffer_barrier(
             ctx,
             cmd,
-            &pending,
-            &[BufferAccess::ComputeWrite],
-            &[BufferAccess::TransferRead],
-        );
-        buffer_barrier(
-            ctx,
-            cmd,
-            &active,
-            &[BufferAccess::FragmentRead, BufferAccess::TransferWrite],
-            &[BufferAccess::TransferWrite],
+            &[
+                (pending, &[ComputeWrite], &[TransferRead]),
+                (active, &[FragmentRead, TransferWrite], &[TransferWrite]),
+            ],
         );
         let region = [vk::BufferCopy::default().size(self.pending.size)];
         unsafe {
@@ -367,16 +353,10 @@ impl HiStencilSurface {
         buffer_barrier(
             ctx,
             cmd,
-            &pending,
-            &[BufferAccess::TransferRead],
-            &[BufferAccess::ComputeWrite],
-        );
-        buffer_barrier(
-            ctx,
-            cmd,
-            &active,
-            &[BufferAccess::TransferWrite],
-            &[BufferAccess::FragmentRead, BufferAccess::TransferWrite],
+            &[
+                (pending, &[TransferRead], &[ComputeWrite]),
+                (active, &[TransferWrite], &[FragmentRead, TransferWrite]),
+            ],
         );
         self.unflushed = false;
     }
@@ -581,15 +561,10 @@ impl HiStencilSurface {
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
     pub fn record_save(&self, ctx: &Context, cmd: vk::CommandBuffer, depth_stencil: &mut ImageRef) {
-        let saved = [self.saved.handle];
+        use BufferAccess::{FragmentRead, TransferWrite};
+        let saved = self.saved.handle;
         // The last restore (an earlier frame's) read what this copy overwrites.
-        buffer_barrier(
-            ctx,
-            cmd,
-            &saved,
-            &[BufferAccess::FragmentRead],
-            &[BufferAccess::TransferWrite],
-        );
+        buffer_barrier(ctx, cmd, &[(saved, &[FragmentRead], &[TransferWrite])]);
         copy_image_to_buffer(
             ctx,
             cmd,
@@ -604,13 +579,7 @@ impl HiStencilSurface {
             ImageAccess::DepthStencilAttachment,
             Contents::Keep,
         );
-        buffer_barrier(
-            ctx,
-            cmd,
-            &saved,
-            &[BufferAccess::TransferWrite],
-            &[BufferAccess::FragmentRead],
-        );
+        buffer_barrier(ctx, cmd, &[(saved, &[TransferWrite], &[FragmentRead])]);
     }
 
     /// Makes the statistics visible to the host; record after the last lighting draw.

@@ -341,13 +341,17 @@ impl LightHooks {
         } else {
             4
         };
-        if sets > ctx.max_bound_descriptor_sets {
+        // How many sets a pipeline layout may hold (an engine's visibility hook needs 5).
+        let bindable = ctx
+            .device_limits()
+            .get(crate::gpu::limits::Limit::BoundDescriptorSets);
+        if sets > bindable {
             return Err(Error::BadSetup(format!(
                 "a visibility hook binds set 4, and this device binds at most {} sets (the \
                  spec's minimum is 4): declare the visibility hook's resources in the decode \
                  hook's set 1 instead (its layout, its sets), and give the hooks no visibility \
                  layout",
-                ctx.max_bound_descriptor_sets
+                bindable
             )));
         }
         Ok(())

@@ -162,8 +162,6 @@ pub struct Context {
     pub(crate) timestamp_period_ns: f64,
     pub(crate) max_image_dimension: u32,
     pub(crate) max_storage_buffer_range: u32,
-    /// How many descriptor sets a pipeline layout may hold (an engine's visibility hook needs 5).
-    pub(crate) max_bound_descriptor_sets: u32,
     /// The device's values of the limits histencil checks ([`crate::Limit`]).
     pub(crate) limits: crate::gpu::limits::DeviceLimits,
     /// The largest need of each limit met on this context, for the reports and the test that
@@ -349,7 +347,6 @@ impl Context {
             timestamp_period_ns: f64::from(props.limits.timestamp_period),
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
-            max_bound_descriptor_sets: props.limits.max_bound_descriptor_sets,
             limits: crate::gpu::limits::DeviceLimits::new(&props.limits),
             limits_used: Default::default(),
             set_counts: Default::default(),

@@ -331,8 +331,6 @@ impl Context {
             timestamp_period_ns: f64::from(limits.timestamp_period),
             max_image_dimension: limits.max_image_dimension2_d,
             max_storage_buffer_range: limits.max_storage_buffer_range,
-            max_bound_descriptor_sets: device_limits
-                .get(crate::gpu::limits::Limit::BoundDescriptorSets),
             limits: device_limits,
             limits_used: Default::default(),
             set_counts: Default::default(),
