@@ -69,6 +69,10 @@ pub struct CompareArgs {
     /// --target-ci's width).
     #[arg(long, value_enum, default_value_t = Until::Decided, conflicts_with = "target_ci")]
     until: Until,
+    /// With --until decided and no --budget-s: the most the pilot's predicted budget may be,
+    /// per measurement set, in seconds (a lent machine's time, say).
+    #[arg(long, default_value_t = PREDICTED_BUDGET_CAP_S, conflicts_with = "budget_s")]
+    budget_cap_s: f64,
     /// Run this many busy threads beside the measurement: the same run under contention, to
     /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
@@ -345,8 +349,12 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
         sampling.until_decided = true;
         sampling.max_rounds = histencil_lab::MAX_ROUNDS.max(sampling.min_rounds);
         if args.sampling.budget_s.is_none() {
+            let cap = args.budget_cap_s;
+            if !(cap.is_finite() && cap > 0.0 && cap <= 86_400.0) {
+                bail!("--budget-cap-s: {cap} is not between 0 and 86400 seconds");
+            }
             sampling.predict_budget = true;
-            sampling.budget = std::time::Duration::from_secs_f64(PREDICTED_BUDGET_CAP_S);
+            sampling.budget = std::time::Duration::from_secs_f64(cap);
         }
     }
     let least = histencil_lab::stats::MIN_VERDICT_ROUNDS;
