@@ -40,15 +40,13 @@ fn main() {
             let size = sizes[(round + 1) % 2];
             // Before: a new lighting at the new size, its pipelines made again.
             let start = Instant::now();
-            // SAFETY: nothing was recorded with it.
-            unsafe { lighting.destroy() };
+            lighting.destroy().unwrap();
             lighting = DeferredLighting::new(&ctx, &desc(size)).unwrap();
             lighting.prepare(&plan).unwrap();
             remade.push(start.elapsed().as_secs_f64() * 1e3);
             // Now: the same lighting resized (back to the other size, so every round resizes).
             let start = Instant::now();
-            // SAFETY: nothing is in flight.
-            unsafe { lighting.resize(extent(sizes[round % 2])) }.unwrap();
+            lighting.resize(extent(sizes[round % 2])).unwrap();
             lighting.prepare(&plan).unwrap();
             resized.push(start.elapsed().as_secs_f64() * 1e3);
             assert_eq!(
@@ -57,8 +55,7 @@ fn main() {
                 "a resize made pipelines"
             );
         }
-        // SAFETY: nothing was recorded with it.
-        unsafe { lighting.destroy() };
+        lighting.destroy().unwrap();
         let summary = |v: &mut Vec<f64>| {
             v.sort_by(f64::total_cmp);
             (v[v.len() / 2], v[0], v[v.len() - 1])

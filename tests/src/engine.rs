@@ -140,6 +140,7 @@ pub struct EngineImage {
     pub view: vk::ImageView,
     pub format: vk::Format,
     pub extent: vk::Extent2D,
+    pub usage: vk::ImageUsageFlags,
     allocation: gpu_allocator::vulkan::Allocation,
 }
 
@@ -151,6 +152,7 @@ impl EngineImage {
             view: self.view,
             format: self.format,
             extent: self.extent,
+            usage: self.usage,
             state,
         }
     }
@@ -219,6 +221,7 @@ impl Engine {
             .subresource_range(range);
         let view = unsafe { d.create_image_view(&view_info, None) }.expect("view");
         EngineImage {
+            usage,
             image,
             view,
             format,

@@ -99,8 +99,10 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
             let plan = plan_frame(&layout, &inputs, &settings).unwrap();
             plans_differ |= last_plan.as_ref().is_some_and(|p| *p != plan);
             unsafe {
-                // The engine waits for the frame that last used this slot, nothing more.
+                // The engine waits for the frame that last used this slot, nothing more, and
+                // says so.
                 d.wait_for_fences(&[slot.fence], true, u64::MAX).unwrap();
+                lighting.slot_finished((f % IN_FLIGHT) as u32).unwrap();
                 d.reset_fences(&[slot.fence]).unwrap();
                 d.reset_command_pool(slot.pool, vk::CommandPoolResetFlags::empty())
                     .unwrap();
@@ -144,6 +146,10 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
         assert!(plans_differ, "the moving lights never changed the plan");
         let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
         unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        for slot in 0..IN_FLIGHT as u32 {
+            // SAFETY: every slot's fence was waited for just above.
+            unsafe { lighting.slot_finished(slot) }.unwrap();
+        }
         engine_hdr_last = hdr_floats(readback.bytes());
         let timings = lighting
             .step_timings(((FRAMES - 1) % IN_FLIGHT) as u32)
@@ -178,10 +184,9 @@ fn an_engine_lights_its_own_images_with_two_frames_in_flight() {
         assert_same_hdr(&expected.images.hdr.unwrap().into_raw(), &engine_hdr_last);
 
         drop(reference);
-        // SAFETY: every slot's fence was waited for above: the GPU is done with the lighting,
-        // and the engine frees it without a device-wide wait (the validation layer would see
-        // objects destroyed in use).
-        unsafe { lighting.destroy() };
+        // Every slot's fence was waited for and declared above: the engine frees the lighting
+        // without a device-wide wait (the validation layer would see objects destroyed in use).
+        lighting.destroy().unwrap();
         drop(renderer);
         unsafe {
             for s in &slots {

@@ -235,6 +235,7 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
                 lighting.record(cmd, &frame, &mut targets).unwrap();
                 copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
                 engine.submit_and_wait(pool, cmd);
+                lighting.slot_finished(0).unwrap();
             }
             hdr_floats(readback.bytes())
         };
@@ -315,9 +316,9 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         unsafe {
             d.end_command_buffer(cmd).unwrap();
             d.destroy_command_pool(pool, None);
-            // SAFETY: every frame was waited for.
-            engines.destroy();
-            histencils.destroy();
+            // Every frame was waited for and declared finished.
+            engines.destroy().unwrap();
+            histencils.destroy().unwrap();
             d.destroy_descriptor_pool(set_pool, None);
             d.destroy_descriptor_set_layout(set_layout, None);
         }

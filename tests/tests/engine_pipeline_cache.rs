@@ -63,10 +63,11 @@ fn an_engines_pipeline_cache_serves_every_lighting_on_its_device() {
                 lighting.record_tiled(cmd, &frame, &mut targets).unwrap();
                 copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
                 engine.submit_and_wait(pool, cmd);
+                lighting.slot_finished(0).unwrap();
             }
             assert!(lighting.tiled_pipeline_count() > 0);
-            // SAFETY: its frame was waited for.
-            unsafe { lighting.destroy() };
+            // Its frame was waited for and declared finished.
+            lighting.destroy().unwrap();
             images.free(&engine);
             engine.free_buffer(readback);
         }

@@ -78,6 +78,7 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
                 }
                 copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
                 engine.submit_and_wait(pool, cmd);
+                lighting.slot_finished(0).unwrap();
             }
             let hdr = hdr_floats(readback.bytes());
             images.free(&engine);
@@ -90,13 +91,13 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
         let made = (lighting.pipeline_count(), lighting.tiled_pipeline_count());
         assert!(made.0 > 0 && made.1 > 0, "{made:?}");
 
-        // SAFETY: every frame above was waited for.
-        let refused = unsafe { lighting.resize(extent((0, 64))) };
+        // Every frame above was waited for and declared finished.
+        let refused = lighting.resize(extent((0, 64)));
         assert!(
             matches!(refused, Err(histencil_vk::Error::BadSetup(_))),
             "{refused:?}"
         );
-        unsafe { lighting.resize(extent(large)) }.unwrap();
+        lighting.resize(extent(large)).unwrap();
         let stencil_hdr = frame(&mut lighting, &large_renderer, large, false);
         let tiled_hdr = frame(&mut lighting, &large_renderer, large, true);
         assert_eq!(
@@ -124,8 +125,7 @@ fn a_resize_keeps_every_pipeline_and_lights_the_new_size_exactly() {
             assert_same_hdr(&expected.images.hdr.unwrap().into_raw(), &engine_hdr);
         }
         drop(reference);
-        // SAFETY: every frame was waited for.
-        unsafe { lighting.destroy() };
+        lighting.destroy().unwrap();
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
     engine.destroy().assert_clean();

@@ -89,6 +89,7 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
             let (side, mixed) = tiling(f);
             unsafe {
                 d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+                lighting.slot_finished((f % IN_FLIGHT) as u32).unwrap();
                 d.reset_fences(&[fence]).unwrap();
                 d.reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
                     .unwrap();
@@ -122,6 +123,10 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
         }
         let fences: Vec<_> = slots.iter().map(|s| s.2).collect();
         unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        for slot in 0..IN_FLIGHT as u32 {
+            // SAFETY: every slot's fence was waited for just above.
+            unsafe { lighting.slot_finished(slot) }.unwrap();
+        }
         // histencil's renderer lighting each captured frame's state with the same tiling.
         let readback_hdr = Readback {
             hdr: true,
@@ -202,8 +207,8 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
         }
         drop(other);
 
-        // SAFETY: every slot's fence was waited for above.
-        unsafe { lighting.destroy() };
+        // Every slot's fence was waited for and declared finished above.
+        lighting.destroy().unwrap();
         drop(renderer);
         engine.free_frame_slots(&slots);
         images.free(&engine);

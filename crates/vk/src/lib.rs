@@ -58,7 +58,8 @@ pub use lighting::hooks::{
 };
 pub use lighting::lut::{LutEvaluator, LutTables};
 pub use lighting::{
-    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, TiledFrame,
+    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, StillInFlight,
+    TiledFrame,
 };
 pub use passes::light_pipelines::BrdfSource;
 pub use renderer::capture::SimulatorInputs;

@@ -223,6 +223,7 @@ impl Gpu {
                 view,
                 format,
                 extent,
+                usage,
                 state: ImageState::UNDEFINED,
             },
             allocation,

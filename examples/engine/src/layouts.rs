@@ -88,6 +88,7 @@ pub unsafe fn time(
             let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
             d.queue_submit2(gpu.queue, &[submit], frame.fence).unwrap();
             d.wait_for_fences(&[frame.fence], true, u64::MAX).unwrap();
+            l.lighting.slot_finished(0).unwrap();
             let steps = l.lighting.step_timings(0).unwrap().expect("a timed frame");
             out.push(steps.groups.iter().map(|g| g.1).sum::<f64>());
         }

@@ -4,12 +4,13 @@
 //! fences with two frames in flight. histencil plans each frame on plain data
 //! (`histencil::model::plan_frame`) and records its stencil-masked light volumes into the engine's
 //! command buffer (`histencil::vk::DeferredLighting`), alternating the PS3-like and native
-//! platform behaviours. Its glass sphere and smoke cloud are lit by histencil's per-entity
+//! platform behaviours, with one frame by the tiled technique and one by depth ids. Its glass sphere and smoke cloud are lit by histencil's per-entity
 //! lightmaps (`histencil::vk::AlphaLightmaps`, into the engine's own atlas) and drawn by the
 //! engine's own alpha shaders, which sample them through histencil's `lightmap_sample.glsl`. The
-//! last frame of each backend is compared with histencil's forward reference of the same state
-//! (lighting) and with histencil's own lightmap frame (alpha), and the engine's stencil bits are
-//! checked to survive lighting.
+//! last frame of each technique and backend (stencil PS3-like, stencil native, tiled, depth-id)
+//! is compared with the engine's forward reference of the same state (lighting) and with
+//! histencil's own lightmap frame (alpha), and on each stencil frame the engine's stencil bits
+//! are checked to survive lighting; the verdict line names every frame it compared.
 
 mod alpha;
 mod device;
@@ -106,6 +107,23 @@ fn technique(f: usize) -> Technique {
     }
 }
 
+/// How the verdict names a frame's technique.
+fn technique_name(technique: Technique) -> &'static str {
+    match technique {
+        Technique::Stencil {
+            backend: Backend::Ps3,
+            ..
+        } => "stencil PS3-like",
+        Technique::Stencil {
+            backend: Backend::Native,
+            ..
+        } => "stencil native",
+        Technique::Tiled { .. } => "tiled",
+        Technique::DepthId { .. } => "depth-id",
+        _ => "other",
+    }
+}
+
 /// Frame `f`'s platform behaviour: PS3-like and native in turn.
 fn backend(f: usize) -> Backend {
     if f % 2 == 0 {
@@ -142,7 +160,7 @@ struct Slot {
     alpha_set: vk::DescriptorSet,
 }
 
-/// What the last frame of each backend copies back.
+/// What the last frame of each technique and backend copies back.
 struct Capture {
     frame: usize,
     /// HDR after lighting, and after the alpha pass.
@@ -343,7 +361,8 @@ fn main() {
             MemoryLocation::GpuToCpu,
         )
     };
-    let mut captures: Vec<Capture> = [FRAMES - 2, FRAMES - 1]
+    // The last frame of each: PS3-like and native stencil (even and odd frames), tiled, depth-id.
+    let mut captures: Vec<Capture> = [FRAMES - 4, FRAMES - 3, TILED_FRAME, DEPTH_ID_FRAME]
         .map(|frame| Capture {
             frame,
             lit: readback("lit-readback", pixels * 8),
@@ -354,7 +373,7 @@ fn main() {
         })
         .into();
 
-    // One forward reference per captured frame: both may be in flight at once.
+    // One forward reference per captured frame: two may be in flight at once.
     let mut references: Vec<reference::ForwardReference> = captures
         .iter()
         .map(|_| {
@@ -374,8 +393,10 @@ fn main() {
         let (view, lights, plan) = plan(&layout, &brdf_bounds, f, backend(f));
         let capture = captures.iter().position(|c| c.frame == f);
         unsafe {
-            // Wait for the frame that last used this slot: the only wait, and the engine's own.
+            // Wait for the frame that last used this slot: the only wait, and the engine's own;
+            // then tell the lighting, which refuses to record a slot still in flight.
             d.wait_for_fences(&[slot.fence], true, u64::MAX).unwrap();
+            lighting.slot_finished((f % IN_FLIGHT) as u32).unwrap();
             d.reset_fences(&[slot.fence]).unwrap();
             slot.camera.write(bytemuck::bytes_of(&CameraBlock {
                 view: view.world_to_view,
@@ -540,6 +561,10 @@ fn main() {
     }
     let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
     unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+    for slot in 0..IN_FLIGHT as u32 {
+        // SAFETY: every slot's fence was waited for just above.
+        unsafe { lighting.slot_finished(slot) }.unwrap();
+    }
     let engine_ms = started.elapsed().as_secs_f64() * 1e3 / FRAMES as f64;
 
     // The lighting's time with the compact G-buffer against histencil's 40-byte layout, on the
@@ -609,6 +634,10 @@ fn main() {
     // of the same state for the frame time.
     let mut worst = 0u8;
     let mut intact = true;
+    // What each captured frame was and what it showed, for the verdict line; how many of them
+    // tested the engine's stencil bits.
+    let mut compared = Vec::new();
+    let mut stencil_frames = 0;
     let mut renderer_ms = 0.0;
     let (mut alpha_worst, mut alpha_mean, mut forward_mean) = (0u8, 0.0f64, 0.0f64);
     let mut alpha_pixels = usize::MAX;
@@ -626,7 +655,8 @@ fn main() {
         // Lighting: the engine's forward reference of the same state (its shadows, its G-buffer's
         // rounding) against the engine's HDR before its alpha pass.
         let lit = half_floats(&c.lit);
-        worst = worst.max(max_difference(&half_floats(&c.reference), &lit, |_| true).0);
+        let difference = max_difference(&half_floats(&c.reference), &lit, |_| true).0;
+        worst = worst.max(difference);
         // histencil's own forward frame knows no shadows: the pixels where the engine's differs
         // from it are the shadowed ones. The alpha comparisons below skip them.
         let mut opaque =
@@ -661,12 +691,24 @@ fn main() {
         let before = c.stencil_before.bytes();
         let after = c.stencil_after.bytes();
         let marked = before.iter().filter(|s| **s & ENGINE_MASK != 0).count();
-        intact &= marked > 0
-            && before
-                .iter()
-                .zip(after)
-                .all(|(b, a)| (b ^ a) & ENGINE_MASK == 0);
+        let kept = (before.iter().zip(after)).all(|(b, a)| (b ^ a) & ENGINE_MASK == 0);
         let technique = technique(c.frame);
+        // Only the stencil technique touches stencil: its frames are the ones that test the bits.
+        let mut what = format!(
+            "{} {}: {difference}/255",
+            c.frame,
+            technique_name(technique)
+        );
+        if let Technique::Stencil { .. } = technique {
+            stencil_frames += 1;
+            intact &= marked > 0 && kept;
+            what += if marked > 0 && kept {
+                ", engine bits intact"
+            } else {
+                ", engine bits NOT intact"
+            };
+        }
+        compared.push(what);
         let timed = Instant::now();
         let runs = 5;
         for _ in 0..runs {
@@ -702,10 +744,12 @@ fn main() {
     unsafe {
         let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
         d.wait_for_fences(&fences, true, u64::MAX).unwrap();
-        // The GPU is done with every frame: histencil's parts are freed without the
-        // device-wide wait that dropping them would do.
-        lighting.destroy();
-        histencil_lighting.destroy();
+        // The GPU is done with every frame, and the lightings were told: histencil's parts
+        // are freed without the device-wide wait that dropping them would do.
+        lighting.destroy().expect("every slot declared finished");
+        histencil_lighting
+            .destroy()
+            .expect("every slot declared finished");
         lightmaps.destroy();
         for s in slots.drain(..) {
             d.destroy_fence(s.fence, None);
@@ -742,14 +786,17 @@ fn main() {
     gpu.destroy();
     let messages = device::MESSAGES.load(Ordering::SeqCst);
     println!(
-        "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward, \
-         engine stencil bits {}, {messages} validation messages, G-buffer {bytes} bytes per \
-         pixel, {SHADOWED_LIGHTS} shadowed lights, frame {TILED_FRAME} tiled and frame {DEPTH_ID_FRAME} by depth ids through the hooks",
+        "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward \
+         over frames {}; engine stencil bits {} on {stencil_frames} stencil frames; {messages} \
+         validation messages, G-buffer {bytes} bytes per pixel, {SHADOWED_LIGHTS} shadowed \
+         lights, through the hooks",
+        compared.join("; "),
         if intact { "intact" } else { "NOT intact" }
     );
     let alpha_ok = alpha_worst <= ALPHA_TOLERANCE && alpha_pixels > 0;
     // The shadow must darken something, or the visibility hook went unused.
-    if worst > 1 || !alpha_ok || !intact || messages > 0 || shadowed_pixels == 0 {
+    let bits_tested = stencil_frames > 0;
+    if worst > 1 || !alpha_ok || !intact || !bits_tested || messages > 0 || shadowed_pixels == 0 {
         std::process::exit(1);
     }
 }

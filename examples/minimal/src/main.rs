@@ -142,7 +142,7 @@ unsafe fn run() -> Fallible<(String, bool)> {
             .format(format)
             .subresource_range(whole(aspect_of(format)));
         let view = device.create_image_view(&view_info, None)?;
-        Ok(ImageRef { image, view, format, extent: EXTENT, state: ImageState::UNDEFINED })
+        Ok(ImageRef { image, view, format, extent: EXTENT, usage, state: ImageState::UNDEFINED })
     };
     use vk::ImageUsageFlags as Usage;
     let mut targets = LightingTargets {
@@ -276,6 +276,7 @@ unsafe fn run() -> Fallible<(String, bool)> {
     let submit = vk::SubmitInfo::default().command_buffers(std::slice::from_ref(&cmd));
     device.queue_submit(queue, &[submit], fence)?;
     device.wait_for_fences(&[fence], true, u64::MAX)?;
+    lighting.slot_finished(0)?;
 
     // A pixel is lit when a colour channel is above zero: a positive half float has bits set.
     let hdr = memory.last().and_then(Allocation::mapped_slice).ok_or("a mapped readback")?;

@@ -53,6 +53,10 @@ pub struct ImageRef {
     pub format: vk::Format,
     /// Its size in pixels.
     pub extent: vk::Extent2D,
+    /// The usage it was created with (`VkImageCreateInfo::usage`): a recording that would use
+    /// it otherwise is refused before anything is recorded, as Vulkan would not say until its
+    /// barriers and views were already wrong.
+    pub usage: vk::ImageUsageFlags,
     /// Where it stands now; updated by every recording that uses it.
     pub state: ImageState,
 }
@@ -145,6 +149,25 @@ pub enum ImageAccess {
     TransferSource,
 }
 
+impl ImageAccess {
+    /// The image usage this access needs (`VkImageCreateInfo::usage`).
+    pub fn usage(self) -> vk::ImageUsageFlags {
+        use vk::ImageUsageFlags as U;
+        match self {
+            ImageAccess::Nothing => U::empty(),
+            ImageAccess::ColorAttachment => U::COLOR_ATTACHMENT,
+            ImageAccess::DepthStencilAttachment => U::DEPTH_STENCIL_ATTACHMENT,
+            ImageAccess::StencilAttachmentDepthSampled => U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED,
+            ImageAccess::FragmentSampled
+            | ImageAccess::ComputeSampled
+            | ImageAccess::ComputeDepthStencilSampled
+            | ImageAccess::ComputeDepthSampled => U::SAMPLED,
+            ImageAccess::ComputeStorage | ImageAccess::FragmentStorage => U::STORAGE,
+            ImageAccess::TransferSource => U::TRANSFER_SRC,
+        }
+    }
+}
+
 /// The layout, stages and access mask of an [`ImageAccess`]. Pure, so it is unit-tested.
 pub fn access_info(
     access: ImageAccess,
@@ -223,6 +246,13 @@ pub(crate) fn transition(
     next: ImageAccess,
     contents: Contents,
 ) {
+    // The frame checks refuse targets without the usage their recording needs; an access here
+    // that they did not foresee is histencil's bug.
+    debug_assert!(
+        image.usage.contains(next.usage()),
+        "{next:?} on an image with usage {:?}: the frame checks missed it",
+        image.usage
+    );
     let ImageState {
         layout: old_layout,
         stage: src_stage,

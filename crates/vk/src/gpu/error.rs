@@ -105,6 +105,11 @@ pub enum Error {
     /// A frame that does not fit its lighting or lightmaps (an engine's input at record time).
     #[error("bad lighting frame: {0}")]
     BadFrame(String),
+    /// A call that rewrites or frees what a recorded frame uses, while that frame is not known
+    /// finished: a slot recorded again, a resize or a destroy before the engine said the GPU
+    /// finished (`DeferredLighting::slot_finished`). Nothing was changed.
+    #[error("frames in flight: {0}")]
+    InFlight(String),
     /// A description or hooks refused at creation (an engine's input when it makes a
     /// [`crate::DeferredLighting`], [`crate::AlphaLightmaps`] or [`crate::EngineHooks`]): said
     /// as such, not as a frame's fault.

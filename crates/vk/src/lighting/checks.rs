@@ -143,6 +143,83 @@ pub(super) fn check_slot_and_lights(
     Ok(())
 }
 
+/// The image usages a recording needs of each target, each with the reason (for the refusal).
+#[derive(Default)]
+pub(super) struct UsageNeeds {
+    pub gbuffer: Vec<(vk::ImageUsageFlags, &'static str)>,
+    pub depth_stencil: Vec<(vk::ImageUsageFlags, &'static str)>,
+    pub hdr: Vec<(vk::ImageUsageFlags, &'static str)>,
+}
+
+impl UsageNeeds {
+    /// The talk's light passes recording `plan`; `hierarchy` when an AMD GPU's tiles are
+    /// emulated (its tile updates read the stencil like the consoles').
+    pub fn light_passes(desc: &LightingDesc, plan: &FramePlan, hierarchy: bool) -> Self {
+        use vk::ImageUsageFlags as U;
+        let mut needs = Self {
+            gbuffer: vec![(U::SAMPLED, "the light shaders sample it")],
+            depth_stencil: vec![(U::DEPTH_STENCIL_ATTACHMENT, "the light passes attach it")],
+            hdr: vec![(U::COLOR_ATTACHMENT, "the light passes add light into it")],
+        };
+        if writes_hi_stencil(plan) || hierarchy {
+            let why = "the hi-stencil emulation's tile update reads its stencil";
+            needs.depth_stencil.push((U::SAMPLED, why));
+        }
+        if desc.hooks.samples_depth() {
+            let why = "the engine's decode hook samples its depth";
+            needs.depth_stencil.push((U::SAMPLED, why));
+        }
+        if (plan.steps.iter()).any(|s| matches!(s, Step::SavePreserved { .. })) {
+            let why = "the 360-like save copies its stencil out";
+            needs.depth_stencil.push((U::TRANSFER_SRC, why));
+        }
+        needs
+    }
+
+    /// The tiled technique's kernels, or with `depth_id` the depth-id technique's passes.
+    pub fn tiled(desc: &LightingDesc, depth_id: bool) -> Self {
+        use vk::ImageUsageFlags as U;
+        let mut needs = Self {
+            gbuffer: vec![(U::SAMPLED, "the tile classification and shading sample it")],
+            depth_stencil: Vec::new(),
+            hdr: vec![(U::STORAGE, "the tiled shading stores light into it")],
+        };
+        if desc.hooks.samples_depth() {
+            let why = "the engine's decode hook samples its depth";
+            needs.depth_stencil.push((U::SAMPLED, why));
+            if depth_id {
+                let why = "the depth-id passes attach its stencil while sampling its depth";
+                needs.depth_stencil.push((U::DEPTH_STENCIL_ATTACHMENT, why));
+            }
+        }
+        needs
+    }
+}
+
+/// Refuses a target made without a usage its recording needs, naming the usage and why: Vulkan
+/// itself would only say so after histencil's barriers and views were recorded wrong.
+pub(super) fn check_usage(targets: &LightingTargets, needs: &UsageNeeds) -> Result<()> {
+    let check = |what: &str, image: &ImageRef, needs: &[(vk::ImageUsageFlags, &str)]| match needs
+        .iter()
+        .find(|(u, _)| !image.usage.contains(*u))
+    {
+        Some((usage, why)) => Err(bad(format!(
+            "{what} was made without {usage:?} usage (it has {:?}), and {why}",
+            image.usage
+        ))),
+        None => Ok(()),
+    };
+    for (i, image) in targets.gbuffer.iter().enumerate() {
+        check(&format!("G-buffer image {i}"), image, &needs.gbuffer)?;
+    }
+    check(
+        "the depth-stencil target",
+        &targets.depth_stencil,
+        &needs.depth_stencil,
+    )?;
+    check("the HDR target", &targets.hdr, &needs.hdr)
+}
+
 /// Checks the hook sets and every target's extent and format against the description.
 pub(super) fn check_targets(
     desc: &LightingDesc,

@@ -6,8 +6,10 @@
 //!
 //! Frames in flight: each of the `frames_in_flight` slots has its own uniform and light buffers
 //! and descriptor sets, written when a frame is recorded into that slot. The caller cycles the
-//! slots and records into one again only after the GPU finished the frame that last used it
-//! (the engine's own fence per frame in flight does this).
+//! slots and, once its own fence says the GPU finished a slot's frame, says so
+//! ([`DeferredLighting::slot_finished`]); a slot is recorded again, and the lighting resized or
+//! destroyed, only then: histencil submits nothing and sees no fence, so it is told, and it
+//! refuses ([`Error::InFlight`]) rather than rewrite what the GPU may still read.
 //!
 //! The G-buffer contract (`crates/vk/shaders/include/gbuffer_write.glsl` writes it, `gbuffer.glsl` reads
 //! it): [`crate::GBUFFER_FORMATS`] in that order, each pixel's BRDF slot in the stencil's BRDF
@@ -21,7 +23,10 @@ pub mod hooks;
 pub(crate) mod lut;
 mod tiled;
 
-use checks::{bad, bad_setup, check_desc, check_frame, needs_hi_stencil, writes_hi_stencil};
+use checks::{
+    bad, bad_setup, check_desc, check_frame, check_usage, needs_hi_stencil, writes_hi_stencil,
+    UsageNeeds,
+};
 pub use frames::{gbuffer_stencil_reference, LightingDesc, LightingFrame, TiledFrame};
 
 use crate::gpu::access::LightingTargets;
@@ -56,6 +61,9 @@ struct Slot {
     timer: SlotTimer,
     /// The hi-stencil emulation's bookkeeping against the technique (`Emulation`).
     emulation: SlotTimer,
+    /// Recorded into, and not yet declared finished (`slot_finished`): its buffers, sets and
+    /// stencil view belong to that frame.
+    pending: bool,
 }
 
 /// The lighting passes of the talk, recorded into an engine's frames.
@@ -113,8 +121,9 @@ struct Slot {
 ///         tile_stats: false,
 ///         hook_sets: HookSets::default(),
 ///     };
-///     // SAFETY: `cmd` is recording on the lighting's device, the images' states are true, and
-///     // the frame two frames ago (the last one in this slot) has finished on the GPU.
+///     // SAFETY: `cmd` is recording on the lighting's device and the images' states are true.
+///     // (The engine's fence for this slot was waited on, and `slot_finished` said so, before:
+///     // a slot still in flight is refused.)
 ///     unsafe { lighting.record(cmd, &frame, &mut targets)? };
 ///     Ok(targets) // each image's state now, for the engine's next barrier
 /// }
@@ -140,8 +149,32 @@ pub struct DeferredLighting<C: Deref<Target = Context>> {
     tiled: Vec<(TileSide, TiledLighting)>,
     /// The depth-id technique per tile side, made at its first frame with that side.
     depth_id: Vec<(TileSide, DepthIdPass)>,
-    in_flight: InFlight,
 }
+
+/// What a refused [`DeferredLighting::destroy`] gives back: the value, whole, and why.
+pub struct StillInFlight<T> {
+    /// What was not destroyed; dropping it waits for the device, then frees it.
+    pub value: T,
+    /// [`Error::InFlight`], naming the slots.
+    pub error: Error,
+}
+
+impl<T> std::fmt::Display for StillInFlight<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.error.fmt(f)
+    }
+}
+
+/// The error alone: the value it holds need not be `Debug` (a lighting is not).
+impl<T> std::fmt::Debug for StillInFlight<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StillInFlight")
+            .field("error", &self.error)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<T> std::error::Error for StillInFlight<T> {}
 
 impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// Creates the pipeline layout, the light volumes, the hi-stencil emulation and every slot's
@@ -176,7 +209,6 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             volumes: None,
             tiled: Vec::new(),
             depth_id: Vec::new(),
-            in_flight: InFlight::default(),
             pipelines: LightPipelines::new(
                 vk::PipelineLayout::null(),
                 desc.hooks.modules(),
@@ -197,12 +229,11 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// else. A resize to the same extent does nothing; a failure leaves the lighting as it was.
     ///
     /// # Errors
-    /// [`Error::BadSetup`] for a zero extent; allocation errors.
-    ///
-    /// # Safety
-    /// The GPU has finished every command buffer this lighting recorded into (wait for your
-    /// frames in flight first, as for any resize of your own targets).
-    pub unsafe fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
+    /// [`Error::BadSetup`] for a zero extent; [`Error::InFlight`] while a slot recorded into
+    /// is not declared finished ([`DeferredLighting::slot_finished`]: wait for your frames in
+    /// flight first, as for any resize of your own targets); allocation errors.
+    pub fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
+        self.none_in_flight("resize")?;
         if extent.width == 0 || extent.height == 0 {
             return Err(bad_setup(format!(
                 "a {}x{} lighting extent",
@@ -234,6 +265,61 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// What this lighting was made for.
     pub fn desc(&self) -> &LightingDesc {
         &self.desc
+    }
+
+    /// Says the GPU has finished the frame last recorded into `slot`, so the slot may be
+    /// recorded again and, once every slot is finished, the lighting resized or destroyed. An
+    /// engine calls it after waiting for that frame's fence (or timeline value); a slot whose
+    /// command buffer was recorded and never submitted (reset or freed instead) may be declared
+    /// finished too. Declaring a slot never recorded, or twice, is harmless.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] for a slot past `frames_in_flight`.
+    ///
+    /// # Safety
+    /// Every command buffer that recorded `slot` through this lighting has finished executing
+    /// on the GPU, or will never be submitted: histencil rewrites that slot's buffers,
+    /// descriptor sets and stencil view at its next recording, and frees them at a resize or
+    /// destroy, trusting this.
+    pub unsafe fn slot_finished(&mut self, slot: u32) -> Result<()> {
+        let frames = self.slots.len();
+        let slot = self.slots.get_mut(slot as usize).ok_or_else(|| {
+            bad(format!(
+                "slot_finished({slot}) of {frames} frames in flight"
+            ))
+        })?;
+        slot.pending = false;
+        Ok(())
+    }
+
+    /// Whether a slot is recorded into and not yet declared finished.
+    pub fn in_flight(&self) -> bool {
+        self.slots.iter().any(|s| s.pending)
+    }
+
+    /// Refuses `what` while a slot is in flight, naming the slots.
+    fn none_in_flight(&self, what: &str) -> Result<()> {
+        let pending: Vec<String> = (self.slots.iter().enumerate())
+            .filter(|(_, s)| s.pending)
+            .map(|(i, _)| i.to_string())
+            .collect();
+        if pending.is_empty() {
+            return Ok(());
+        }
+        Err(Error::InFlight(format!(
+            "{what} while slot {} may still be read by the GPU: wait for those frames, and say              so with DeferredLighting::slot_finished, first",
+            pending.join(", ")
+        )))
+    }
+
+    /// Refuses a recording into `slot` while its last frame is not declared finished.
+    fn slot_free(&self, slot: u32) -> Result<()> {
+        match self.slots.get(slot as usize) {
+            Some(s) if s.pending => Err(Error::InFlight(format!(
+                "slot {slot} recorded again before DeferredLighting::slot_finished({slot}) said                  the GPU finished its last frame: its buffers, sets and stencil view are that                  frame's until then"
+            ))),
+            _ => Ok(()),
+        }
     }
 
     /// Creates every light pipeline `plan` uses, so the first frame that needs them does not
@@ -274,8 +360,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ///
     /// # Errors
     /// [`Error::BadFrame`] when the frame does not fit this lighting (see [`LightingFrame`]), or
-    /// the view's projection cannot be inverted per pixel; pipeline creation errors. Nothing is
-    /// recorded on an error.
+    /// the view's projection cannot be inverted per pixel; [`Error::InFlight`] when
+    /// `frame.slot` was recorded and not declared finished since
+    /// ([`DeferredLighting::slot_finished`]); pipeline creation errors. Nothing is recorded on
+    /// an error.
     ///
     /// # Safety
     /// - `cmd` is in the recording state, on a queue family with graphics, from the device of
@@ -285,8 +373,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ///   each subresource is in, and the stages and accesses of the last commands before it that
     ///   touched it (`ImageState::UNDEFINED` discards contents, so not for the G-buffer or
     ///   depth-stencil).
-    /// - The GPU has finished every command buffer that recorded into `frame.slot` before;
-    ///   this call rewrites that slot's buffers and descriptor sets.
+    /// - What [`DeferredLighting::slot_finished`] was told is true (the slot itself is checked).
     pub unsafe fn record(
         &mut self,
         cmd: vk::CommandBuffer,
@@ -310,6 +397,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ) -> Result<()> {
         let (count_stats, source) = (frame.tile_stats, frame.brdf_source);
         check_frame(&self.desc, frame, targets)?;
+        let needs = UsageNeeds::light_passes(&self.desc, frame.plan, hierarchy.is_some());
+        check_usage(targets, &needs)?;
+        self.slot_free(frame.slot)?;
         if frame.plan.uses_depth_bounds() && !self.ctx.depth_bounds() {
             return Err(Error::BadFrame(
                 "the plan confines lights to their depth ranges (FramePlan::with_depth_bounds), \
@@ -373,7 +463,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         let timer = slot.timer.active();
         let emulation = slot.emulation.active();
-        self.in_flight.mark();
+        slot.pending = true;
         pass.record(targets, hi_stencil, timer, emulation)
     }
 
@@ -456,15 +546,19 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         })
     }
 
-    /// Frees everything now, without the device-wide wait that dropping does once this has
-    /// recorded (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
+    /// Frees everything now, without the device-wide wait that dropping does while a slot is
+    /// in flight (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
     /// device): an engine that submits from other threads frees through this, once its own
-    /// fences say the GPU is done.
+    /// fences say the GPU is done and [`DeferredLighting::slot_finished`] was told so.
     ///
-    /// # Safety
-    /// The GPU has finished every command buffer recorded with this lighting.
-    pub unsafe fn destroy(mut self) {
-        self.in_flight.clear();
+    /// # Errors
+    /// [`StillInFlight`] while a slot is not declared finished: it holds the lighting, whole
+    /// and unchanged, and the error naming the slots (dropping it waits for the device).
+    pub fn destroy(self) -> std::result::Result<(), Box<StillInFlight<Self>>> {
+        match self.none_in_flight("destroy") {
+            Ok(()) => Ok(()),
+            Err(error) => Err(Box::new(StillInFlight { value: self, error })),
+        }
     }
 
     /// Points the LUT technique at `tables` (one per material, in the order of the G-buffer's
@@ -493,13 +587,17 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
 }
 
 impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
-    /// Once this has recorded, waits for the device to go idle (so nothing else may use any
-    /// of its queues meanwhile; [`DeferredLighting::destroy`] does not wait), then frees
-    /// everything, also after a creation that failed half way.
+    /// While a slot is in flight (recorded, not declared finished), waits for the device to
+    /// go idle (so nothing else may use any of its queues meanwhile); then frees everything,
+    /// also after a creation that failed half way.
     fn drop(&mut self) {
         let ctx: &Context = &self.ctx;
         let d = &ctx.device;
-        self.in_flight.wait(ctx);
+        let mut in_flight = InFlight::default();
+        if self.in_flight() {
+            in_flight.mark();
+        }
+        in_flight.wait(ctx);
         self.pipelines.destroy(ctx);
         for (_, t) in &mut self.tiled {
             t.destroy(ctx);

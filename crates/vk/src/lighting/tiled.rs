@@ -2,7 +2,7 @@
 //! classification, the light lists, then the tiled kernels or the depth-id passes
 //! (`crate::passes::tiled`, `crate::passes::depth_id`).
 
-use super::checks::{bad, check_slot_and_lights, check_targets};
+use super::checks::{bad, check_slot_and_lights, check_targets, check_usage, UsageNeeds};
 use super::{DeferredLighting, TiledFrame};
 use crate::gpu::access::LightingTargets;
 use crate::gpu::context::Context;
@@ -27,7 +27,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ///
     /// # Errors
     /// [`Error::BadFrame`](crate::Error::BadFrame) when the frame does not fit this lighting (slot, light count, target
-    /// extents and formats), or the HDR format is not `R16G16B16A16_SFLOAT` (the kernels store
+    /// extents and formats), [`Error::InFlight`](crate::Error::InFlight) for a slot not declared
+    /// finished since its last frame, or the HDR format is not `R16G16B16A16_SFLOAT` (the kernels store
     /// to it as `rgba16f`); pipeline creation errors. Nothing is recorded on an error.
     ///
     /// # Safety
@@ -93,6 +94,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         check_slot_and_lights(&self.desc, frame.slot, frame.lights)?;
         check_targets(&self.desc, &frame.hook_sets, targets)?;
+        let needs = UsageNeeds::tiled(&self.desc, shade == TiledShade::DepthId);
+        check_usage(targets, &needs)?;
+        self.slot_free(frame.slot)?;
         if let Some(why) = self.desc.hooks.tiled_refusal() {
             return Err(bad(format!(
                 "the tiled technique's kernels cannot bind the hooks: {why}"
@@ -130,7 +134,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             decode: decode_set,
             visibility: frame.hook_sets.visibility,
         };
-        self.in_flight.mark();
+        slot.pending = true;
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;

@@ -199,7 +199,10 @@ impl Renderer<'_> {
 
     /// Resets the frame's command pool (its one command buffer; resetting pools, not single
     /// buffers, is what the best-practices layer asks for) and begins the command buffer.
-    pub(super) fn begin_commands(&self) -> Result<vk::CommandBuffer> {
+    pub(super) fn begin_commands(&mut self) -> Result<vk::CommandBuffer> {
+        // SAFETY: the renderer waits for every frame it submits before it returns, so slot 0's
+        // last frame has finished, or was never submitted (an error before the submit).
+        unsafe { self.lighting.slot_finished(0)? };
         let (d, cmd) = (&self.ctx.device, self.cmd);
         unsafe {
             d.reset_command_pool(self.command_pool, vk::CommandPoolResetFlags::empty())

@@ -1,0 +1,230 @@
+//! What an engine gets for breaking the frames-in-flight and image-usage rules: an error naming
+//! the rule, never a crash or a flood of validation messages. Before these checks, a resize with
+//! a frame in flight freed the hi-stencil buffers under it (four "in use" messages, then
+//! SIGSEGV on lavapipe), a destroy in flight destroyed pipelines in use, a slot recorded twice
+//! rewrote the buffers and stencil view a pending frame reads, and G-buffer images made without
+//! `SAMPLED` drew 286 messages from histencil's own barriers. Each case here is refused before
+//! anything is recorded, and the validation layer (synchronisation validation on) stays silent.
+
+use ash::vk;
+use histencil_tests::engine::{lighting_desc, plain_frame, stencil_plan, Engine, EngineTargets};
+use histencil_vk::{
+    Backend, Context, DeferredLighting, Error, HookSets, LightingFrame, MixedTiles, Renderer,
+    TileClassify, TileSide, TiledFrame,
+};
+
+const SIZE: vk::Extent2D = vk::Extent2D {
+    width: 48,
+    height: 32,
+};
+
+/// What each case gets: the engine, a lighting made for `SIZE` on its lent device, a PS3-like
+/// frame of `brdfs-3` (its plan writes hi-stencil) and a tiled frame, both in slot 0, and the
+/// engine's targets. The case frees the lighting; the helper frees the rest and holds the
+/// validation log empty.
+struct Case<'a> {
+    engine: &'a Engine,
+    renderer: &'a Renderer<'a>,
+    lighting: DeferredLighting<&'a Context>,
+    frame: LightingFrame<'a>,
+    tiled: TiledFrame<'a>,
+    images: &'a EngineTargets,
+}
+
+fn on_a_lighting(case: impl FnOnce(Case)) {
+    let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
+    scene.normalise_lights();
+    let engine = Engine::start();
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let ds_format = ctx.depth_stencil_format().vk();
+        let renderer = Renderer::new(&ctx, scene.clone(), SIZE.width, SIZE.height).unwrap();
+        let layout = *renderer.stencil_layout();
+        let brdfs = renderer.brdfs().to_vec();
+        let desc = lighting_desc(layout, brdfs.clone(), SIZE, ds_format, scene.lights.len());
+        let lighting = DeferredLighting::new(&ctx, &desc).unwrap();
+        let view = scene.camera.view_desc(1.5);
+        let plan = stencil_plan(&scene, &layout, &brdfs, &view, Backend::Ps3);
+        let images = engine.lighting_targets(SIZE, ds_format);
+        case(Case {
+            engine: &engine,
+            renderer: &renderer,
+            lighting,
+            frame: plain_frame(&view, &scene.lights, &plan, HookSets::default()),
+            tiled: TiledFrame {
+                slot: 0,
+                view: &view,
+                lights: &scene.lights,
+                clear_hdr: true,
+                side: TileSide::Sixteen,
+                mixed: MixedTiles::PerBrdf,
+                classify: TileClassify::for_context(&ctx),
+                hook_sets: HookSets::default(),
+            },
+            images: &images,
+        });
+        images.free(&engine);
+        drop(renderer);
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
+    }
+    engine.destroy().assert_clean();
+}
+
+#[test]
+fn a_slot_in_flight_is_not_recorded_resized_or_destroyed_until_declared_finished() {
+    on_a_lighting(|case| {
+        let Case {
+            engine,
+            renderer,
+            mut lighting,
+            frame,
+            tiled,
+            images,
+        } = case;
+        let mut targets = images.refs();
+        let d = &engine.device;
+        let slots = engine.frame_slots(2);
+        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let (_, first, fence) = slots[0];
+        unsafe {
+            d.reset_fences(&[fence]).unwrap();
+            d.begin_command_buffer(first, &begin).unwrap();
+            renderer.record_gbuffer(first, &mut targets).unwrap();
+            lighting.record(first, &frame, &mut targets).unwrap();
+            d.end_command_buffer(first).unwrap();
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(first)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], fence).unwrap();
+        }
+        assert!(lighting.in_flight());
+
+        // The frame may still run: slot 0 again, a resize and a destroy are refused.
+        let (_, second, _) = slots[1];
+        unsafe {
+            d.begin_command_buffer(second, &begin).unwrap();
+            let again = lighting.record(second, &frame, &mut targets.clone());
+            let m = match again {
+                Err(Error::InFlight(m)) => m,
+                other => panic!("slot 0 recorded again in flight: {other:?}"),
+            };
+            assert!(
+                m.contains("slot 0") && m.contains("slot_finished(0)"),
+                "{m}"
+            );
+            let again = lighting.record_tiled(second, &tiled, &mut targets.clone());
+            assert!(matches!(again, Err(Error::InFlight(_))), "{again:?}");
+            d.end_command_buffer(second).unwrap();
+        }
+        let bigger = vk::Extent2D {
+            width: 96,
+            height: 64,
+        };
+        match lighting.resize(bigger) {
+            Err(Error::InFlight(m)) => assert!(m.starts_with("resize while slot 0"), "{m}"),
+            other => panic!("a resize in flight: {other:?}"),
+        }
+        assert_eq!(
+            lighting.desc().extent,
+            SIZE,
+            "a refused resize changes nothing"
+        );
+        let refused = lighting.destroy().expect_err("a destroy in flight");
+        assert!(matches!(refused.error, Error::InFlight(_)), "{refused}");
+        let mut lighting = refused.value;
+        // A slot past frames_in_flight cannot be declared.
+        let past = unsafe { lighting.slot_finished(1) };
+        assert!(matches!(past, Err(Error::BadFrame(_))), "{past:?}");
+
+        // Once the engine waited and said so, all three go through.
+        unsafe {
+            d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+            lighting.slot_finished(0).unwrap();
+        }
+        assert!(!lighting.in_flight());
+        lighting.resize(bigger).unwrap();
+        lighting.destroy().unwrap();
+        engine.free_frame_slots(&slots);
+    });
+}
+
+#[test]
+fn targets_without_the_usage_their_recording_needs_are_refused_naming_it() {
+    use vk::ImageUsageFlags as U;
+    on_a_lighting(|case| {
+        let Case {
+            engine,
+            mut lighting,
+            frame,
+            tiled,
+            images,
+            ..
+        } = case;
+        // Each case: the targets with one usage taken away, and the words the refusal names.
+        let without = |pick: &dyn Fn(&mut histencil_vk::LightingTargets)| {
+            let mut t = images.refs();
+            pick(&mut t);
+            t
+        };
+        let cases: [(&str, histencil_vk::LightingTargets, bool, &str); 4] = [
+            (
+                "G-buffer image 0 was made without SAMPLED",
+                without(&|t| t.gbuffer[0].usage = U::COLOR_ATTACHMENT),
+                false,
+                "sample it",
+            ),
+            (
+                "the depth-stencil target was made without SAMPLED",
+                without(&|t| t.depth_stencil.usage = U::DEPTH_STENCIL_ATTACHMENT),
+                false,
+                "hi-stencil",
+            ),
+            (
+                "the HDR target was made without COLOR_ATTACHMENT",
+                without(&|t| t.hdr.usage = U::STORAGE),
+                false,
+                "add light",
+            ),
+            (
+                "the HDR target was made without STORAGE",
+                without(&|t| t.hdr.usage = U::COLOR_ATTACHMENT),
+                true,
+                "stores light",
+            ),
+        ];
+        let (pool, cmd) = engine.command_buffer();
+        let d = &engine.device;
+        unsafe {
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            for (expected, mut targets, is_tiled, why) in cases {
+                let before = targets.clone();
+                let result = if is_tiled {
+                    lighting.record_tiled(cmd, &tiled, &mut targets)
+                } else {
+                    lighting.record(cmd, &frame, &mut targets)
+                };
+                match result {
+                    Err(Error::BadFrame(m)) => {
+                        assert!(m.starts_with(expected) && m.contains(why), "{m}")
+                    }
+                    other => panic!("{expected}: accepted: {other:?}"),
+                }
+                assert_eq!(
+                    format!("{:?}", targets.hdr.state),
+                    format!("{:?}", before.hdr.state),
+                    "nothing recorded"
+                );
+            }
+            d.end_command_buffer(cmd).unwrap();
+            d.destroy_command_pool(pool, None);
+        }
+        assert!(
+            !lighting.in_flight(),
+            "a refused recording leaves no slot in flight"
+        );
+        lighting.destroy().unwrap();
+    });
+}
