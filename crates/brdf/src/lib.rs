@@ -22,8 +22,8 @@
 //! holds a model with its parameters and evaluates it as the f64 reference or the f32 spelling.
 //!
 //! [`lut`] bakes the talk's look-up tables and measures their error against resolution;
-//! [`encoding`] measures what G-buffer quantisation adds; [`eval_csv`] reads and writes the
-//! `brdf-eval` case files.
+//! [`encoding`] measures what G-buffer quantisation adds; `eval_csv` (with the `files` feature,
+//! as `Brdf::parse`) reads and writes the `brdf-eval` case files.
 //!
 //! [`BrdfId`] is the renderer's list of shading models stored in the G-buffer and stencil.
 
@@ -31,6 +31,7 @@
 
 pub mod cases;
 pub mod encoding;
+#[cfg(feature = "files")]
 pub mod eval_csv;
 mod id;
 pub mod lut;

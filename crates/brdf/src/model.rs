@@ -4,6 +4,7 @@
 use crate::id::BrdfId;
 use crate::models;
 use crate::vector::{c, Real, V3};
+#[cfg(feature = "files")]
 use serde_json::{Map, Value};
 
 /// A BRDF's value in two parts: `f_r * cos(theta_L) = tint * tinted + white`.
@@ -162,11 +163,13 @@ pub enum BrdfError {
 }
 
 /// Reads the numeric parameters of one model, refusing unknown keys.
+#[cfg(feature = "files")]
 struct Params<'a> {
     model: &'static str,
     map: &'a Map<String, Value>,
 }
 
+#[cfg(feature = "files")]
 impl<'a> Params<'a> {
     fn new(
         model: &'static str,
@@ -278,6 +281,7 @@ pub mod ranges {
     pub const RADIUS_MM: Range = Range::new(1e-6, f64::MAX);
 }
 
+#[cfg(feature = "files")]
 impl Brdf {
     /// Parses a model name and its parameters, e.g. `ggx` with `{"perceptual_roughness": 0.5}`.
     /// Every parameter is held to its [`ranges`].
@@ -361,7 +365,9 @@ impl Brdf {
             _ => unreachable!("every name in MODEL_NAMES is handled"),
         })
     }
+}
 
+impl Brdf {
     /// Each parameter with its name and range.
     fn named_params(&self) -> Vec<(&'static str, f64, Range)> {
         use ranges::*;
@@ -392,7 +398,7 @@ impl Brdf {
         }
     }
 
-    /// Holds every parameter to its [`ranges`]: what [`Brdf::parse`] accepts, for a `Brdf` built
+    /// Holds every parameter to its [`ranges`]: what `Brdf::parse` accepts (with the `files` feature), for a `Brdf` built
     /// in code.
     pub fn check(&self) -> Result<(), BrdfError> {
         let model = self.name();
@@ -533,7 +539,7 @@ impl Brdf {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "files"))]
 mod tests {
     use super::*;
     use serde_json::json;

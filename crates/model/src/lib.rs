@@ -50,6 +50,7 @@
 pub mod amd;
 mod backend;
 mod chooser;
+#[cfg(feature = "files")]
 mod costs_json;
 pub mod depth_bounds;
 pub mod depth_id;
@@ -67,6 +68,7 @@ mod view;
 
 pub use backend::{Native, PlatformBackend, PlatformCaps, Ps3Like, X360Like};
 pub use chooser::{CostModel, TalkFigures};
+#[cfg(feature = "files")]
 pub use costs_json::{CostsError, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
 pub use depth_bounds::DepthRange;
 pub use footprint::{Footprint, Span};
