@@ -162,6 +162,7 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
             };
             unsafe {
                 d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+                lightmaps.slot_finished(slot as u32).unwrap();
                 d.reset_fences(&[fence]).unwrap();
                 d.reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
                     .unwrap();
@@ -175,6 +176,10 @@ fn an_engine_lights_its_alpha_entities_with_two_frames_in_flight() {
         }
         let fences: Vec<_> = slots.iter().map(|s| s.2).collect();
         unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        for slot in 0..slots.len() as u32 {
+            // SAFETY: every slot's fence was waited for just above.
+            unsafe { lightmaps.slot_finished(slot) }.unwrap();
+        }
         assert_eq!(
             lightmaps.timings(0).unwrap(),
             None,
@@ -539,6 +544,12 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
         };
         let atlas = || atlas_image.as_ref(ImageState::UNDEFINED);
         refuse("slot", &LightmapFrame { slot: 2, ..frame }, &mut atlas());
+        // An atlas said to lack COLOR_ATTACHMENT: refused, naming the usage, not drawn into.
+        let no_attachment = ImageRef {
+            usage: U::SAMPLED,
+            ..atlas()
+        };
+        refuse("atlas usage", &frame, &mut no_attachment.clone());
         refuse(
             "entity count",
             &LightmapFrame {
@@ -626,11 +637,27 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
         refuse_directional("direction format", &mut directional, &other_format);
         refuse_directional("direction extent", &mut directional, &small_image);
         drop(directional);
+
+        // A slot recorded, then recorded again or destroyed before it is declared finished:
+        // refused (the command buffer is never submitted, so it may then be declared).
+        let mut atlas_now = atlas();
+        unsafe { lightmaps.record(cmd, &frame, &mut atlas_now) }.expect("a frame that fits");
+        assert!(lightmaps.in_flight());
+        let again = unsafe { lightmaps.record(cmd, &frame, &mut atlas_now) };
+        match again {
+            Err(Error::InFlight(m)) => assert!(m.contains("slot_finished(0)"), "{m}"),
+            other => panic!("slot 0 recorded again in flight: {other:?}"),
+        }
+        let refused = lightmaps.destroy().expect_err("a destroy in flight");
+        assert!(matches!(refused.error, Error::InFlight(_)), "{refused}");
+        let mut lightmaps = refused.value;
         unsafe {
             d.end_command_buffer(cmd).unwrap();
             d.destroy_command_pool(pool, None);
+            // SAFETY: the command buffer was never submitted, and its pool is gone.
+            lightmaps.slot_finished(0).unwrap();
         }
-        drop(lightmaps);
+        lightmaps.destroy().expect("no slot in flight");
         for image in [atlas_image, small_image, other_format] {
             engine.free_image(image);
         }

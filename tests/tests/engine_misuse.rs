@@ -9,8 +9,8 @@
 use ash::vk;
 use histencil_tests::engine::{lighting_desc, plain_frame, stencil_plan, Engine, EngineTargets};
 use histencil_vk::{
-    Backend, Context, DeferredLighting, Error, HookSets, LightingFrame, MixedTiles, Renderer,
-    TileClassify, TileSide, TiledFrame,
+    Backend, Cause, Context, DeferredLighting, Error, HookSets, LightingFrame, MixedTiles,
+    Renderer, TileClassify, TileSide, TiledFrame,
 };
 
 const SIZE: vk::Extent2D = vk::Extent2D {
@@ -107,7 +107,10 @@ fn a_slot_in_flight_is_not_recorded_resized_or_destroyed_until_declared_finished
             d.begin_command_buffer(second, &begin).unwrap();
             let again = lighting.record(second, &frame, &mut targets.clone());
             let m = match again {
-                Err(Error::InFlight(m)) => m,
+                Err(e @ Error::InFlight(_)) => {
+                    assert_eq!(e.cause(), Cause::Usage, "the caller's to prevent");
+                    e.to_string()
+                }
                 other => panic!("slot 0 recorded again in flight: {other:?}"),
             };
             assert!(
@@ -207,8 +210,10 @@ fn targets_without_the_usage_their_recording_needs_are_refused_naming_it() {
                     lighting.record(cmd, &frame, &mut targets)
                 };
                 match result {
-                    Err(Error::BadFrame(m)) => {
-                        assert!(m.starts_with(expected) && m.contains(why), "{m}")
+                    Err(e @ Error::BadFrame(_)) => {
+                        assert_eq!(e.cause(), Cause::Usage, "{e}");
+                        let m = e.to_string();
+                        assert!(m.contains(expected) && m.contains(why), "{m}")
                     }
                     other => panic!("{expected}: accepted: {other:?}"),
                 }

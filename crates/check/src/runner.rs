@@ -158,7 +158,7 @@ pub fn run(
     skipped: Vec<Record>,
     options: &RunnerOptions,
     report: &mut RunReport,
-) -> std::io::Result<()> {
+) -> RunResult<()> {
     let start = Instant::now();
     std::fs::create_dir_all(options.out.join("workers"))?;
     let mut run = Run {
@@ -243,13 +243,11 @@ pub fn run(
     for r in &report.records {
         text.push_str(&report::results_line(r));
     }
-    histencil_vk::write_atomically(&options.out.join("results.csv"), text.as_bytes())
-        .map_err(std::io::Error::other)?;
+    histencil_vk::write_atomically(&options.out.join("results.csv"), text.as_bytes())?;
     histencil_vk::write_atomically(
         &options.out.join("failures.csv"),
         report::failures_csv(report).as_bytes(),
-    )
-    .map_err(std::io::Error::other)?;
+    )?;
     Ok(())
 }
 
@@ -281,7 +279,7 @@ impl Run<'_> {
         cases: &[PlannedCase],
         rerun: bool,
         classify: impl Fn(Record) -> Record,
-    ) -> std::io::Result<HashMap<String, Record>> {
+    ) -> RunResult<HashMap<String, Record>> {
         let queue = Queue {
             batches: Mutex::new(batches(cases, self.options.cases_per_worker).into()),
             next_id: AtomicUsize::new(self.queue_ids.load(Ordering::SeqCst)),
@@ -290,7 +288,7 @@ impl Run<'_> {
         let mut records = HashMap::new();
         let mut last_progress = Instant::now();
         let halt = self.halt.clone();
-        let started = std::thread::scope(|scope| -> std::io::Result<()> {
+        let started = std::thread::scope(|scope| -> RunResult<()> {
             let mut handles = Vec::new();
             for _ in 0..self.options.jobs.max(1) {
                 let tx = tx.clone();
@@ -346,7 +344,7 @@ impl Run<'_> {
             for h in handles {
                 h.join().expect("a worker thread panicked")?;
             }
-            written
+            Ok(written?)
         });
         self.queue_ids
             .store(queue.next_id.load(Ordering::SeqCst), Ordering::SeqCst);
@@ -396,7 +394,7 @@ fn work(
     options: &RunnerOptions,
     halt: &AtomicBool,
     tx: &mpsc::Sender<Message>,
-) -> std::io::Result<()> {
+) -> RunResult<()> {
     loop {
         if halt.load(Ordering::SeqCst) || options.stop.load(Ordering::SeqCst) {
             return Ok(());
@@ -448,7 +446,7 @@ fn run_worker(
     options: &RunnerOptions,
     halt: &AtomicBool,
     tx: &mpsc::Sender<Message>,
-) -> std::io::Result<(WorkerInfo, Vec<PlannedCase>)> {
+) -> RunResult<(WorkerInfo, Vec<PlannedCase>)> {
     let dir = options.out.join("workers");
     let list = dir.join(format!("batch-{id}.txt"));
     let log_path = dir.join(format!("worker-{id}.log"));
@@ -543,11 +541,11 @@ fn run_worker(
                     return Ok((worker.info, worker.pending));
                 }
                 if status.code() == Some(NO_DEVICE_EXIT) && worker.info.cases == 0 {
-                    return Err(std::io::Error::other(NoDevice(format!(
+                    return Err(RunnerError::NoDevice(format!(
                         "a worker found no Vulkan device, no validation layer or not the \
                          expected driver{}",
                         log_tail(&log_path)
-                    ))));
+                    )));
                 }
                 let how = match (
                     status.code(),
@@ -567,18 +565,25 @@ fn run_worker(
     }
 }
 
-/// The error a run ends with when a worker has no device, no validation layer, or not the
-/// driver `--expect-driver` names: nothing can run.
-#[derive(Debug)]
-pub struct NoDevice(pub String);
-
-impl std::fmt::Display for NoDevice {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
+/// Why a run ended before its report, sorted by what its caller does about it: no device is
+/// the machine's (the CLI's exit 3, a CI job's "no GPU here"), the rest is the runner's own
+/// trouble with files and processes (exit 6).
+#[derive(Debug, thiserror::Error)]
+pub enum RunnerError {
+    /// A worker has no device, no validation layer, or not the driver `--expect-driver` names:
+    /// nothing can run.
+    #[error("{0}")]
+    NoDevice(String),
+    /// A file the run writes, or a worker process, failed.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// A report file could not be written whole (nothing half-written is left).
+    #[error(transparent)]
+    Output(#[from] histencil_vk::Error),
 }
 
-impl std::error::Error for NoDevice {}
+/// What the runner's steps return.
+pub type RunResult<T> = std::result::Result<T, RunnerError>;
 
 /// One worker process as its thread follows it.
 struct Worker<'a> {

@@ -454,10 +454,10 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("histencil: {e:#}");
-            let no_device = e
-                .downcast_ref::<std::io::Error>()
-                .and_then(|e| e.get_ref())
-                .is_some_and(|e| e.is::<runner::NoDevice>());
+            let no_device = matches!(
+                e.downcast_ref::<runner::RunnerError>(),
+                Some(runner::RunnerError::NoDevice(_))
+            );
             ExitCode::from(if no_device {
                 EXIT_NO_DEVICE
             } else {

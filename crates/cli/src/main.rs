@@ -260,6 +260,8 @@ enum BackendArg {
     X360,
     X360NoZeroing,
     X360SaveRestore,
+    /// PS3-like hi-stencil with a read mask; also the model of NVIDIA's ZCull stencil
+    /// criterion (its documented fields are the RSX's; what a region holds is assumed).
     Ps3,
     Native,
     /// AMD GFX9-11 with two hierarchical-stencil pretests, modelled from AMD's driver sources

@@ -427,7 +427,8 @@ fn sigterm_leaves_reports_of_what_finished() {
         assert!(start.elapsed().as_secs() < 120, "no results streamed");
         std::thread::sleep(std::time::Duration::from_millis(200));
     }
-    // SAFETY: signalling our own child.
+    // SAFETY: `kill` takes plain integers; the pid is our own child's, not yet waited for, so
+    // it cannot have been reused by another process.
     unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
     let code = child.wait().unwrap().code();
     assert_eq!(code, Some(5), "stopped early with nothing failing: exit 5");

@@ -14,7 +14,9 @@
 //!    [`StencilLayout`], BRDF ids, formats, frames in flight, [`LightHooks`] for an engine's own
 //!    G-buffer decode and shadows, compiled by `histencil-build`).
 //! 3. Per frame, plan on plain data ([`plan_frame`] with [`PlanInputs`] and [`PlanSettings`]) and
-//!    record ([`DeferredLighting::record`] with a [`LightingFrame`] and [`LightingTargets`]).
+//!    record ([`DeferredLighting::record`] with a [`LightingFrame`] and [`LightingTargets`]);
+//!    once the engine's fence says a frame finished, [`DeferredLighting::slot_finished`] with its
+//!    slot (a slot still in flight is refused).
 //! 4. Translucent entities: [`plan_entities`] then [`AlphaLightmaps::record`].
 //!
 //! Steps 1 to 3, given what an engine has: its device as `lent`, a recording command buffer
@@ -36,7 +38,9 @@
 //! #     hdr: ImageRef,
 //! # ) -> std::result::Result<(), Box<dyn std::error::Error>> {
 //! // Once: lend the device (made with REQUIREMENTS' features), make the lighting.
-//! let ctx = Context::from_raw(lent)?;
+//! // SAFETY: `lent` holds the engine's live handles, made and kept (outliving `ctx`) as
+//! // `Context::from_raw`'s # Safety asks.
+//! let ctx = unsafe { Context::from_raw(lent)? };
 //! let layout = StencilLayout::new(brdfs.len() as u32, 0)?;
 //! let desc = LightingDesc {
 //!     layout,
@@ -74,9 +78,12 @@
 //!     tile_stats: false,
 //!     hook_sets: HookSets::default(),
 //! };
-//! lighting.record(cmd, &frame, &mut targets)?;
+//! // SAFETY: `cmd` is recording, outside any render pass, on the lent device; the images'
+//! // states are those the engine's barriers left; slot 0 has not been recorded before.
+//! unsafe { lighting.record(cmd, &frame, &mut targets)? };
 //! // Each `targets` image's `state` is where the commands leave it: the engine's next
-//! // barrier starts there. Submitting and waiting are the engine's.
+//! // barrier starts there. Submitting and waiting are the engine's; once this frame's fence
+//! // is signalled: `lighting.slot_finished(frame.slot)?`, before the slot is recorded again.
 //! # Ok(())
 //! # }
 //! ```
@@ -105,11 +112,12 @@ pub use histencil_model::{
 
 // The device, the lighting, the hooks.
 pub use histencil_vk::{
-    aspect_of, gbuffer_stencil_reference, Backend, BorrowedDevice, BrdfSource, Context,
+    aspect_of, gbuffer_stencil_reference, Backend, BorrowedDevice, BrdfSource, Cause, Context,
     DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks, Error, HookSetLayout,
     HookSets, ImageRef, ImageState, LightHooks, LightModules, LightingBreakdown, LightingDesc,
-    LightingFrame, LightingTargets, LutTables, MixedTiles, Result, TileClassify, TileSide,
-    TileStats, TiledFrame, ValidationLog, ValidationMessage, GBUFFER_FORMATS, REQUIREMENTS,
+    LightingFrame, LightingTargets, LutTables, MixedTiles, Result, StillInFlight, TileClassify,
+    TileSide, TileStats, TiledFrame, ValidationLog, ValidationMessage, GBUFFER_FORMATS,
+    REQUIREMENTS,
 };
 
 // Lightmaps for translucent entities.

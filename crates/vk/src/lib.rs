@@ -39,7 +39,7 @@ pub use alpha::{
 pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};
 pub use gpu::debug::{ValidationLog, ValidationMessage};
 pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
-pub use gpu::error::{Error, Result};
+pub use gpu::error::{Cause, Error, Result};
 pub use gpu::limits::{describe as describe_limits, DeviceLimits, Limit, Need, NEEDS};
 pub use gpu::quirks::{Quirk, QuirkRule, Quirks, QUIRKS};
 pub use gpu::readback::{FrameImages, Readback};

@@ -397,6 +397,7 @@ fn main() {
             // then tell the lighting, which refuses to record a slot still in flight.
             d.wait_for_fences(&[slot.fence], true, u64::MAX).unwrap();
             lighting.slot_finished((f % IN_FLIGHT) as u32).unwrap();
+            lightmaps.slot_finished((f % IN_FLIGHT) as u32).unwrap();
             d.reset_fences(&[slot.fence]).unwrap();
             slot.camera.write(bytemuck::bytes_of(&CameraBlock {
                 view: view.world_to_view,
@@ -534,7 +535,8 @@ fn main() {
                 layout: &regions,
                 timestamps: false,
             };
-            // SAFETY: as for the lighting; the atlas state is the one the engine tracks.
+            // SAFETY: as for the lighting; the atlas state and usage are the ones the engine
+            // tracks; this slot was declared finished after its fence wait above.
             lightmaps
                 .record(slot.cmd, &lightmap_frame, &mut atlas)
                 .expect("lightmaps recorded");
@@ -564,6 +566,8 @@ fn main() {
     for slot in 0..IN_FLIGHT as u32 {
         // SAFETY: every slot's fence was waited for just above.
         unsafe { lighting.slot_finished(slot) }.unwrap();
+        // SAFETY: likewise, and the alpha draws reading the entity records were in those frames.
+        unsafe { lightmaps.slot_finished(slot) }.unwrap();
     }
     let engine_ms = started.elapsed().as_secs_f64() * 1e3 / FRAMES as f64;
 
@@ -750,7 +754,7 @@ fn main() {
         histencil_lighting
             .destroy()
             .expect("every slot declared finished");
-        lightmaps.destroy();
+        lightmaps.destroy().expect("every slot declared finished");
         for s in slots.drain(..) {
             d.destroy_fence(s.fence, None);
             d.destroy_command_pool(s.pool, None);

@@ -488,16 +488,89 @@ pub fn run_compare(
             "the BRDF counts must start at 1: overheads are against the 1-BRDF time".into(),
         ));
     }
-    let (w, h, frames) = (settings.width, settings.height, settings.frames);
     // Spins until the report is made, when it drops.
     let _load = crate::measure::BusyThreads::start(settings.beside_load);
-    let new_renderer = |scene: Scene| -> Result<Renderer> {
-        let desc = RendererDesc {
-            cost_model: settings.costs,
-            ..RendererDesc::new(w, h)
-        };
-        Ok(Renderer::with_desc(ctx, scene, &desc)?)
+    let sampling = Sampling {
+        min_rounds: settings.frames.max(1),
+        target: settings.target_ci,
+        budget: settings.budget,
+        max_rounds: MAX_ROUNDS,
+        until_decided: settings.until_decided,
+        predict_budget: settings.predict_budget,
     };
+    let mut table = measure_table(ctx, settings, &sampling, progress)?;
+    // The stencil rows' per-pass breakdown, on the widest column's renderer.
+    let mut breakdowns = Vec::new();
+    if let Some((brdfs, renderer)) = table.widest.as_mut() {
+        for (name, technique) in table_rows()
+            .iter()
+            .filter(|(n, _)| n.starts_with("stencil"))
+        {
+            progress(&format!("{brdfs} BRDF(s): {name} pass breakdown"));
+            breakdowns.push(breakdown(
+                renderer,
+                name,
+                *technique,
+                *brdfs,
+                settings.frames,
+            )?);
+        }
+    }
+    drop(table.widest);
+    let sizes = measure_sizes(ctx, settings, &sampling, progress)?;
+    Ok(CompareReport {
+        device: ctx.device_name().to_owned(),
+        driver: ctx.driver().to_string(),
+        scene: settings.scene.name.clone(),
+        scene_lights: settings.scene.lights.len(),
+        width: settings.width,
+        height: settings.height,
+        frames: settings.frames,
+        rows: table.rows,
+        breakdowns,
+        sizes,
+        sampled: table.sampled,
+        target_ci: settings.target_ci,
+        lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
+        beside_load: settings.beside_load,
+        depth_bounds: ctx.depth_bounds(),
+        costs: table.costs,
+        costs_calibrated: settings.costs.is_some(),
+        depth_id: table.depth_id,
+    })
+}
+
+/// A renderer of `scene` at the settings' size, with their costs.
+fn renderer_for<'c>(
+    ctx: &'c Context,
+    settings: &CompareSettings,
+    scene: Scene,
+) -> Result<Renderer<'c>> {
+    let desc = RendererDesc {
+        cost_model: settings.costs,
+        ..RendererDesc::new(settings.width, settings.height)
+    };
+    Ok(Renderer::with_desc(ctx, scene, &desc)?)
+}
+
+/// The talk's table as measured: its rows, how its sampling went, the costs and depth-id
+/// counts, and the widest column's renderer, for the breakdown.
+struct Table<'c> {
+    rows: Vec<Row>,
+    sampled: Sampled,
+    costs: CostModel,
+    depth_id: Vec<(usize, TileStats)>,
+    widest: Option<(usize, Renderer<'c>)>,
+}
+
+/// Every technique at every BRDF count of the settings, and each BRDF alone, sampled in
+/// interleaved rounds until `sampling` stops; each cell with its error against forward.
+fn measure_table<'c>(
+    ctx: &'c Context,
+    settings: &CompareSettings,
+    sampling: &Sampling,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Table<'c>> {
     let rows_spec = table_rows();
     let mut rows: Vec<Row> = rows_spec
         .iter()
@@ -506,7 +579,6 @@ pub fn run_compare(
             cells: vec![],
         })
         .collect();
-    let mut breakdowns = Vec::new();
     let mut costs = None;
     // Every renderer, reference and error first (the error frames warm every technique up),
     // then the timed rounds, interleaved: one frame of every technique at every BRDF count
@@ -514,7 +586,7 @@ pub fn run_compare(
     let mut renderers = Vec::new();
     let mut depth_id = Vec::new();
     for &brdfs in &settings.brdf_counts {
-        let mut renderer = new_renderer(with_brdf_count(&settings.scene, brdfs))?;
+        let mut renderer = renderer_for(ctx, settings, with_brdf_count(&settings.scene, brdfs))?;
         costs.get_or_insert(renderer.cost_model(Backend::Native));
         progress(&format!("{brdfs} BRDF(s): forward reference and errors"));
         let reference = frame(&mut renderer, Shading::Forward)?;
@@ -534,7 +606,7 @@ pub fn run_compare(
     let mut singles = Vec::new();
     for &brdf in models.iter().skip(1) {
         progress(&format!("{} alone: warm-up", brdf.id().name()));
-        let mut renderer = new_renderer(with_one_brdf(&settings.scene, brdf))?;
+        let mut renderer = renderer_for(ctx, settings, with_one_brdf(&settings.scene, brdf))?;
         for (_, technique) in &rows_spec {
             lighting_ms(&mut renderer, *technique)?;
         }
@@ -546,14 +618,6 @@ pub fn run_compare(
     }
     let single_samples =
         std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; singles.len()]);
-    let sampling = Sampling {
-        min_rounds: frames.max(1),
-        target: settings.target_ci,
-        budget: settings.budget,
-        max_rounds: MAX_ROUNDS,
-        until_decided: settings.until_decided,
-        predict_budget: settings.predict_budget,
-    };
     let samples = std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; renderers.len()]);
     let mut bookkeeping = vec![vec![Vec::new(); rows_spec.len()]; renderers.len()];
     // The widths a verdict rests on: every overhead ratio against the 1-BRDF cell.
@@ -586,7 +650,7 @@ pub fn run_compare(
         open
     };
     let table_sampled = sample_deciding(
-        &sampling,
+        sampling,
         |round| -> Result<()> {
             progress(&format!("round {}", round + 1));
             for (count, (_, renderer, _)) in renderers.iter_mut().enumerate() {
@@ -646,20 +710,34 @@ pub fn run_compare(
             });
         }
     }
-    if let Some((brdfs, renderer, _)) = renderers.last_mut() {
-        for (name, technique) in rows_spec.iter().filter(|(n, _)| n.starts_with("stencil")) {
-            progress(&format!("{brdfs} BRDF(s): {name} pass breakdown"));
-            breakdowns.push(breakdown(renderer, name, *technique, *brdfs, frames)?);
-        }
-    }
-    let aspect = w as f32 / h as f32;
+    let widest = renderers
+        .pop()
+        .map(|(brdfs, renderer, _)| (brdfs, renderer));
+    Ok(Table {
+        rows,
+        sampled: table_sampled,
+        costs: costs.expect("at least one BRDF count"),
+        depth_id,
+        widest,
+    })
+}
+
+/// The light-size sweep: at each coverage of the settings, branching, stencil, adaptive, tiled
+/// and depth-id interleaved until `sampling` stops, with their worst error against forward.
+fn measure_sizes(
+    ctx: &Context,
+    settings: &CompareSettings,
+    sampling: &Sampling,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<SizePoint>> {
+    let aspect = settings.width as f32 / settings.height as f32;
     let side = TileSide::for_context(ctx);
     let mut sizes = Vec::new();
     for &coverage in &settings.light_sizes {
         progress(&format!("light size {:.1} %", coverage * 100.0));
         let scene = light_size_scene(coverage, aspect);
         let lights = scene.lights.len();
-        let mut renderer = new_renderer(scene)?;
+        let mut renderer = renderer_for(ctx, settings, scene)?;
         let reference = frame(&mut renderer, Shading::Forward)?;
         let mut error = ImageError::default();
         for technique in size_techniques(side) {
@@ -683,7 +761,7 @@ pub fn run_compare(
             }
         };
         let sampled = sample_deciding(
-            &sampling,
+            sampling,
             |_| -> Result<()> {
                 for (i, technique) in size_techniques(side).into_iter().enumerate() {
                     let (ms, _) = lighting_ms(&mut renderer, technique)?;
@@ -710,26 +788,7 @@ pub fn run_compare(
             sampled,
         });
     }
-    Ok(CompareReport {
-        device: ctx.device_name().to_owned(),
-        driver: ctx.driver().to_string(),
-        scene: settings.scene.name.clone(),
-        scene_lights: settings.scene.lights.len(),
-        width: w,
-        height: h,
-        frames,
-        rows,
-        breakdowns,
-        sizes,
-        sampled: table_sampled,
-        target_ci: settings.target_ci,
-        lp_num_threads: std::env::var("LP_NUM_THREADS").ok(),
-        beside_load: settings.beside_load,
-        depth_bounds: ctx.depth_bounds(),
-        costs: costs.expect("at least one BRDF count"),
-        costs_calibrated: settings.costs.is_some(),
-        depth_id,
-    })
+    Ok(sizes)
 }
 
 /// The depth-id row's frame counted: the model's hierarchical depth on the GPU's id image.

@@ -385,7 +385,7 @@ mod tests {
         symlink("/dev/zero", dir.join("zero.bin")).unwrap();
         symlink("/etc", dir.join("etc")).unwrap();
         let fifo = std::ffi::CString::new(dir.join("fifo.bin").to_str().unwrap()).unwrap();
-        // SAFETY: a valid NUL-terminated path.
+        // SAFETY: `fifo` is a NUL-terminated path (`CString`) that outlives the call.
         assert_eq!(unsafe { libc::mkfifo(fifo.as_ptr(), 0o600) }, 0);
         let refused = [
             ("/etc/passwd", "absolute"),

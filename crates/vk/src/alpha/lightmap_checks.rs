@@ -4,6 +4,7 @@
 use super::lightmaps::{AlphaLightmapsDesc, LightmapFrame};
 use crate::gpu::access::ImageRef;
 use crate::gpu::error::{Error, Result};
+use ash::vk;
 
 /// A direction map fits when these lightmaps make one, in their format, at the atlas's extent.
 pub(super) fn check_direction(
@@ -16,6 +17,16 @@ pub(super) fn check_direction(
             "these lightmaps were made without a direction format (AlphaLightmapsDesc)".into(),
         ));
     };
+    if !direction
+        .usage
+        .contains(vk::ImageUsageFlags::COLOR_ATTACHMENT)
+    {
+        return Err(bad(format!(
+            "the direction map was made without COLOR_ATTACHMENT usage (it has {:?}), and the \
+             lightmap pass clears and draws into it",
+            direction.usage
+        )));
+    }
     if direction.format != format {
         return Err(bad(format!(
             "the direction map is {:?}, these lightmaps make {format:?}",
@@ -41,6 +52,13 @@ pub(super) fn check_frame(
     frame: &LightmapFrame,
     atlas: &ImageRef,
 ) -> Result<()> {
+    if !atlas.usage.contains(vk::ImageUsageFlags::COLOR_ATTACHMENT) {
+        return Err(bad(format!(
+            "the lightmap atlas was made without COLOR_ATTACHMENT usage (it has {:?}), and the \
+             lightmap pass clears and draws into it",
+            atlas.usage
+        )));
+    }
     if frame.slot >= desc.frames_in_flight {
         return Err(bad(format!(
             "slot {} of {} frames in flight",

@@ -7,7 +7,9 @@
 //! [`AlphaLightmaps::entity_buffer`].
 //!
 //! Frames in flight work as in [`crate::DeferredLighting`]: each slot has its own buffers and
-//! sets, rewritten when a frame is recorded into it; the buffers grow when a frame needs more.
+//! sets, rewritten when a frame is recorded into it (the buffers grow when a frame needs more),
+//! and a slot is recorded again, or the lightmaps destroyed, only once the engine said its last
+//! frame finished ([`AlphaLightmaps::slot_finished`]; [`Error::InFlight`] otherwise).
 
 use super::gpu::{frame_records, AlphaDrawPush, FrameRecords};
 use super::lightmap_checks::{bad, check_direction, check_frame};
@@ -22,8 +24,9 @@ use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::resources::Buffer;
 use crate::gpu::state::{apply, FULLSCREEN};
-use crate::gpu::teardown::InFlight;
+use crate::gpu::teardown::{declare_finished, refuse_in_flight, refuse_slot_in_flight, InFlight};
 use crate::gpu::timing::{LightmapTimings, SlotTimer};
+use crate::lighting::StillInFlight;
 use crate::passes::{begin_all_cleared, CLEAR_BLACK};
 use crate::shaders;
 use ash::vk;
@@ -80,6 +83,8 @@ struct Slot {
     entity_lights: Vec<Vec<u32>>,
     /// Timestamps of the last frame in this slot, when it asked for them.
     timer: SlotTimer,
+    /// Recorded into, and not yet declared finished (`slot_finished`).
+    pending: bool,
 }
 
 const STORAGE_NAMES: [&str; 4] = [
@@ -116,8 +121,9 @@ const STORAGE_NAMES: [&str; 4] = [
 ///     let plan = plan_entities(entities, &viewer, lights, 720, atlas.extent.width, &settings)?;
 ///     let layout = plan.layout;
 ///     let frame = LightmapFrame { slot, view, lights, entities, layout: &layout, timestamps: false };
-///     // SAFETY: `cmd` records on the lightmaps' device, the atlas state is true, and the last
-///     // frame recorded into `slot` has finished on the GPU.
+///     // SAFETY: `cmd` records on the lightmaps' device outside any render pass, and the atlas
+///     // state and usage are true. (The slot is checked: the engine said `slot_finished(slot)`
+///     // once its fence for the slot's last frame was signalled.)
 ///     unsafe { lightmaps.record(cmd, &frame, atlas)? };
 ///     // The engine's alpha shaders read `lightmaps.entity_buffer(slot)` and the atlas, once
 ///     // its barrier takes the atlas from `atlas.state` to a shader read.
@@ -137,7 +143,6 @@ pub struct AlphaLightmaps<C: Deref<Target = Context>> {
     directional_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
-    in_flight: InFlight,
 }
 
 impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
@@ -173,7 +178,6 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             directional_pipeline: vk::Pipeline::null(),
             pool: vk::DescriptorPool::null(),
             slots: Vec::new(),
-            in_flight: InFlight::default(),
         };
         // On an error `this` drops, destroying what exists so far.
         this.create()?;
@@ -236,6 +240,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         let info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(2 * slots)
             .pool_sizes(&sizes);
+        // SAFETY: `info` and `sizes` outlive the call; `new` refused no frames in flight, so
+        // `max_sets` and every size's count are non-zero.
         self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
             .call("vkCreateDescriptorPool")?;
         ctx.name(self.pool, "lightmap-descriptor-pool");
@@ -243,6 +249,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         let alloc = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(self.pool)
             .set_layouts(&layouts);
+        // SAFETY: the pool was made above from this device with room for exactly these sets
+        // (two per slot) and their descriptors; both set layouts were made above and are live.
         let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .call("vkAllocateDescriptorSets")?;
         for (i, pair) in sets.chunks(2).enumerate() {
@@ -288,6 +296,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                 alpha_set,
                 entity_lights: Vec::new(),
                 timer: SlotTimer::default(),
+                pending: false,
             };
             write_frame_set(ctx, frame_set, slot.uniforms.handle, slot.lights.handle);
             write_storage_buffers(ctx, alpha_set, &slot.storage.each_ref().map(|b| b.handle));
@@ -296,16 +305,57 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         Ok(())
     }
 
-    /// Frees everything now, without the device-wide wait that dropping does once these have
-    /// recorded (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
+    /// Frees everything now, without the device-wide wait that dropping does while a slot is
+    /// in flight (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
     /// device): an engine that submits from other threads frees through this, once its own
-    /// fences say the GPU is done.
+    /// fences say the GPU is done and [`Self::slot_finished`] was told so. Every draw of yours
+    /// that read an [`Self::entity_buffer`] must be finished too (in the same frames, as a rule).
+    ///
+    /// # Errors
+    /// [`StillInFlight`] while a slot is not declared finished: it holds the lightmaps, whole,
+    /// and the error naming the slots (dropping it waits for the device).
+    pub fn destroy(self) -> std::result::Result<(), Box<StillInFlight<Self>>> {
+        match self.none_in_flight("destroy") {
+            Ok(()) => Ok(()),
+            Err(error) => Err(Box::new(StillInFlight { value: self, error })),
+        }
+    }
+
+    /// Says the GPU has finished the frame last recorded into `slot` (and your draws that read
+    /// its [`Self::entity_buffer`]), so the slot may be recorded again and, once every slot is,
+    /// the lightmaps destroyed without a wait. A slot recorded and never submitted may be
+    /// declared finished too; declaring one never recorded, or twice, is harmless.
+    ///
+    /// # Errors
+    /// [`Error::BadFrame`] for a slot past `frames_in_flight`.
     ///
     /// # Safety
-    /// The GPU has finished every command buffer recorded with these lightmaps, and every draw
-    /// of yours that read an [`Self::entity_buffer`].
-    pub unsafe fn destroy(mut self) {
-        self.in_flight.clear();
+    /// Every command buffer that recorded `slot` through these lightmaps, or read its entity
+    /// buffer, has finished executing on the GPU, or will never be submitted: the next
+    /// recording rewrites (and may replace) that slot's buffers and sets, trusting this.
+    pub unsafe fn slot_finished(&mut self, slot: u32) -> Result<()> {
+        let frames = self.slots.len();
+        declare_finished(
+            self.slots.get_mut(slot as usize).map(|s| &mut s.pending),
+            slot,
+            frames,
+        )
+    }
+
+    /// Whether a slot is recorded into and not yet declared finished.
+    pub fn in_flight(&self) -> bool {
+        self.slots.iter().any(|s| s.pending)
+    }
+
+    /// Refuses `what` while a slot is in flight, naming the slots.
+    fn none_in_flight(&self, what: &str) -> Result<()> {
+        refuse_in_flight(self.slots.iter().map(|s| s.pending), what, "AlphaLightmaps")
+    }
+
+    /// Refuses a recording into `slot` while its last frame is not declared finished.
+    fn slot_free(&self, slot: u32) -> Result<()> {
+        let pending = self.slots.get(slot as usize).is_some_and(|s| s.pending);
+        refuse_slot_in_flight(pending, slot, "AlphaLightmaps", "buffers and sets")
     }
 
     /// What these lightmaps were made for.
@@ -351,12 +401,12 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// is recorded on an error.
     ///
     /// # Safety
-    /// - `cmd` is in the recording state, on a queue family with graphics, from the device of
-    ///   the context these lightmaps were made with.
-    /// - `atlas` is live, from that device, with usage `COLOR_ATTACHMENT` (and whatever the
-    ///   engine samples it with), and its `state` is true when `cmd` executes.
-    /// - The GPU has finished every command buffer that recorded into `frame.slot` before;
-    ///   this call rewrites (and may replace) that slot's buffers and descriptor sets.
+    /// - `cmd` is in the recording state, outside any render pass, on a queue family with
+    ///   graphics, from the device of the context these lightmaps were made with.
+    /// - `atlas` is live, from that device, its `usage` is what it was created with (which
+    ///   must hold `COLOR_ATTACHMENT`; checked), and its `state` is true when `cmd` executes.
+    /// - What [`Self::slot_finished`] was told is true (the slot itself is checked:
+    ///   [`Error::InFlight`] for one recorded and not declared finished since).
     pub unsafe fn record(
         &mut self,
         cmd: vk::CommandBuffer,
@@ -400,6 +450,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// Checks `frame` and writes its records, lights and uniforms into its slot.
     pub(crate) fn write_frame(&mut self, frame: &LightmapFrame, atlas: &ImageRef) -> Result<()> {
         check_frame(&self.desc, frame, atlas)?;
+        self.slot_free(frame.slot)?;
         let viewer = Viewer::from_view(frame.view)
             .ok_or_else(|| bad("the view's world-to-view matrix cannot be inverted".into()))?;
         let e = atlas.extent;
@@ -474,8 +525,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         direction: Option<&mut ImageRef>,
     ) {
         let ctx: &Context = &self.ctx;
-        self.in_flight.mark();
         let slot = &mut self.slots[slot as usize];
+        slot.pending = true;
         // Queries are reset outside rendering, as Vulkan requires.
         let mut timer = slot.timer.active();
         if let Some(t) = timer.as_deref_mut() {
@@ -495,6 +546,12 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             }
         };
         let d = &ctx.device;
+        // SAFETY: `cmd` is recording on this context's device (the # Safety of `record` and
+        // `record_directional`, and `AlphaLighting` records into the renderer's own), inside
+        // the rendering begun above. The pipeline is non-null: the directional one only with a
+        // direction map, which `check_direction` (or `AlphaLighting`'s desc) ties to a direction
+        // format; it and the layout were made by `create` and live as long as `self`. The
+        // slot's sets were written by `write_frame` and match the layout's sets 0 and 1.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
             d.cmd_bind_descriptor_sets(
@@ -523,6 +580,10 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                     light,
                     ..Default::default()
                 };
+                // SAFETY: inside the rendering begun above, with the pipeline and sets bound,
+                // the dynamic state set (`apply`, `set_region`); the push is `AlphaDrawPush` at
+                // offset 0, the layout's graphics-stage range; the full-screen triangle reads
+                // no vertex buffer.
                 unsafe {
                     d.cmd_push_constants(
                         cmd,
@@ -538,6 +599,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                 t.mark(ctx, cmd, "entity".to_owned(), Some(index as u32));
             }
         }
+        // SAFETY: ends the rendering `begin_all_cleared` began on `cmd` above.
         unsafe { d.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }
@@ -560,7 +622,11 @@ impl<C: Deref<Target = Context>> Drop for AlphaLightmaps<C> {
     fn drop(&mut self) {
         let ctx: &Context = &self.ctx;
         let d = &ctx.device;
-        self.in_flight.wait(ctx);
+        let mut in_flight = InFlight::default();
+        if self.in_flight() {
+            in_flight.mark();
+        }
+        in_flight.wait(ctx);
         for slot in &mut self.slots {
             slot.uniforms.destroy(ctx);
             slot.lights.destroy(ctx);
@@ -569,6 +635,10 @@ impl<C: Deref<Target = Context>> Drop for AlphaLightmaps<C> {
             }
             slot.timer.destroy(ctx);
         }
+        // SAFETY: the GPU is done with these: the device went idle above once they had
+        // recorded, or `destroy`'s caller promised so (its # Safety). Each was made by `create`
+        // from `ctx.device`, or is null (no direction format, or a creation that failed half
+        // way), which destroying ignores.
         unsafe {
             d.destroy_pipeline(self.pipeline, None);
             d.destroy_pipeline(self.directional_pipeline, None);
@@ -620,6 +690,9 @@ pub(crate) fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: Region) {
             height: r.height,
         },
     };
+    // SAFETY: `cmd` is recording on this context's device: `record_pass`, the one caller, is
+    // recording its pass (see there). One viewport and scissor, at 0, of the region's shape:
+    // non-zero and inside the atlas, as `check_frame` held every region before the recording.
     unsafe {
         ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
         ctx.device.cmd_set_scissor(cmd, 0, &[scissor]);

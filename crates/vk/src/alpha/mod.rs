@@ -151,6 +151,9 @@ struct Parts {
 impl Parts {
     fn destroy(&mut self, ctx: &Context) {
         let d = &ctx.device;
+        // SAFETY: each handle was made from this device by `AlphaLighting::create` and is taken
+        // out as it goes, so none is destroyed twice; the GPU is done with them: a creation that
+        // failed recorded nothing, and `AlphaLighting::destroy` waits for the device first.
         unsafe {
             if let Some(s) = self.sampler.take() {
                 d.destroy_sampler(s, None);
@@ -351,6 +354,10 @@ impl<'c> AlphaLighting<'c> {
             // Only a recorded pass writes its queries.
             timestamps: timestamps && lit,
         };
+        // SAFETY: the renderer, this lighting's one user, waits for each frame it submits
+        // before it records the next, and records nothing after a wait that failed
+        // (`Renderer::begin_commands`): slot 0's last frame has finished.
+        unsafe { self.lightmaps.slot_finished(0)? };
         self.lightmaps.write_frame(&frame, &self.lightmap)?;
         let direction = match mode {
             AlphaMode::Lightmap => None,
@@ -369,6 +376,9 @@ impl<'c> AlphaLighting<'c> {
     }
 
     fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, push: AlphaDrawPush) {
+        // SAFETY: `record_alpha`, the one caller, pushes inside its HDR rendering on `cmd` (the
+        // renderer's, recording) with a pipeline of this layout bound; the push is
+        // `AlphaDrawPush` at offset 0, the layout's graphics-stage range.
         unsafe {
             ctx.device.cmd_push_constants(
                 cmd,
@@ -417,6 +427,7 @@ impl<'c> AlphaLighting<'c> {
         let particle = match create_pipeline(ctx, &particles) {
             Ok(p) => p,
             Err(e) => {
+                // SAFETY: `object` was made just above from this device and never recorded.
                 unsafe { ctx.device.destroy_pipeline(object, None) };
                 return Err(e);
             }
@@ -447,6 +458,10 @@ impl<'c> AlphaLighting<'c> {
         } = *inputs;
         let [object_pipeline, particle_pipeline] = self.pipelines(ctx, mode)?;
         ctx.begin_label(cmd, "alpha");
+        // SAFETY: `cmd` is the renderer's, recording and outside rendering (the passes before
+        // ended theirs). The sets match the layout's sets 0 to 2 (`create` made it from their
+        // layouts): the renderer's frame set, the lightmaps' slot 0 alpha set (written by
+        // `record_lightmaps` this frame) and the lightmap set; all live as long as `self`.
         unsafe {
             ctx.device.cmd_bind_descriptor_sets(
                 cmd,
@@ -464,6 +479,7 @@ impl<'c> AlphaLighting<'c> {
         for image in [&mut self.lightmap, &mut self.direction_map] {
             if image.state.layout == vk::ImageLayout::UNDEFINED {
                 begin_cleared(ctx, cmd, image, CLEAR_BLACK);
+                // SAFETY: ends the rendering `begin_cleared` began on `cmd` just above.
                 unsafe { ctx.device.cmd_end_rendering(cmd) };
             }
             transition(
@@ -481,6 +497,9 @@ impl<'c> AlphaLighting<'c> {
         for &entity in &self.order {
             match entity {
                 EntityKey::Object(i) => {
+                    // SAFETY: inside the HDR rendering begun above, whose attachments' formats
+                    // (HDR_FORMAT, the context's depth-stencil) the pipeline was made for; it
+                    // lives in `self.pipelines` until `destroy`.
                     unsafe {
                         d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, object_pipeline);
                     }
@@ -494,6 +513,8 @@ impl<'c> AlphaLighting<'c> {
                 }
                 EntityKey::System(i) => {
                     let (first, count) = self.sprite_ranges[i];
+                    // SAFETY: as for the object pipeline above; `sprites` is a live vertex
+                    // buffer of this device (`VERTEX_BUFFER` usage, made by `create`).
                     unsafe {
                         d.cmd_bind_pipeline(
                             cmd,
@@ -508,10 +529,14 @@ impl<'c> AlphaLighting<'c> {
                         ..Default::default()
                     };
                     self.push(ctx, cmd, push);
+                    // SAFETY: the particle pipeline, sets, sprites and dynamic state are bound
+                    // and set above; `first..first + count` is this system's range of the
+                    // sprite buffer (`sprite_ranges`, from `create`).
                     unsafe { d.cmd_draw(cmd, count, 1, first, 0) };
                 }
             }
         }
+        // SAFETY: ends the HDR rendering `begin_hdr_rendering` began on `cmd` above.
         unsafe { d.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
         Ok(())
@@ -528,6 +553,8 @@ impl<'c> AlphaLighting<'c> {
             sampler: Some(self.sampler),
             pipelines: self.pipelines.iter().flatten().flatten().copied().collect(),
         };
+        // SAFETY: the wait needs only that nothing else uses the device's queues meanwhile: the
+        // one caller is the renderer's Drop, which has just made the same wait (see there).
         unsafe {
             let _ = ctx.device.device_wait_idle();
         }
@@ -548,6 +575,8 @@ fn create_sampler(ctx: &Context) -> Result<vk::Sampler> {
         .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
         .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
         .max_lod(0.0);
+    // SAFETY: a plain create info (no anisotropy, no compare, no chained structs), valid for
+    // the call.
     let sampler = unsafe { ctx.device.create_sampler(&info, None) }.call("vkCreateSampler")?;
     ctx.name(sampler, "alpha-lightmap-sampler");
     Ok(sampler)
@@ -570,6 +599,7 @@ fn create_lightmap_set(
     let info = vk::DescriptorPoolCreateInfo::default()
         .max_sets(1)
         .pool_sizes(&sizes);
+    // SAFETY: `info` and `sizes` outlive the call; one set, and every count non-zero.
     let pool =
         unsafe { ctx.device.create_descriptor_pool(&info, None) }.call("vkCreateDescriptorPool")?;
     ctx.name(pool, "alpha-descriptor-pool");
@@ -578,6 +608,8 @@ fn create_lightmap_set(
     let alloc = vk::DescriptorSetAllocateInfo::default()
         .descriptor_pool(pool)
         .set_layouts(&layouts);
+    // SAFETY: `pool` was made just above from this device with room for this one set of
+    // `layout`, the caller's live `ALPHA_LIGHTMAP_SET` layout.
     let sets =
         unsafe { ctx.device.allocate_descriptor_sets(&alloc) }.call("vkAllocateDescriptorSets")?;
     ctx.name(sets[0], "alpha-lightmap-set");
@@ -599,5 +631,7 @@ fn write_lightmap_set(
         .dst_binding(2)
         .descriptor_type(vk::DescriptorType::SAMPLER)
         .image_info(&filter);
+    // SAFETY: `set` was just allocated (`create_lightmap_set`) and no command buffer uses it;
+    // binding 2 is the layout's sampler (`ALPHA_LIGHTMAP_SET`) and `sampler` is live.
     unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
 }

@@ -158,10 +158,12 @@ impl ImageAccess {
             ImageAccess::ColorAttachment => U::COLOR_ATTACHMENT,
             ImageAccess::DepthStencilAttachment => U::DEPTH_STENCIL_ATTACHMENT,
             ImageAccess::StencilAttachmentDepthSampled => U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED,
-            ImageAccess::FragmentSampled
-            | ImageAccess::ComputeSampled
-            | ImageAccess::ComputeDepthStencilSampled
-            | ImageAccess::ComputeDepthSampled => U::SAMPLED,
+            ImageAccess::FragmentSampled | ImageAccess::ComputeSampled => U::SAMPLED,
+            // The read-only depth-stencil layouts are an attachment's: Vulkan allows barriers
+            // into them only for images with DEPTH_STENCIL_ATTACHMENT usage.
+            ImageAccess::ComputeDepthStencilSampled | ImageAccess::ComputeDepthSampled => {
+                U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED
+            }
             ImageAccess::ComputeStorage | ImageAccess::FragmentStorage => U::STORAGE,
             ImageAccess::TransferSource => U::TRANSFER_SRC,
         }
@@ -276,6 +278,11 @@ pub(crate) fn transition(
         .subresource_range(subresource_range(image.aspect()));
     let barriers = [barrier];
     let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+    // SAFETY: `cmd` is the caller's, recording outside rendering (transitions go between
+    // passes; the renderer's frame, `submit_once`'s, or an engine's under `record`'s # Safety).
+    // `image` is live with every aspect of its format named; its `state` is true when `cmd`
+    // runs (histencil's bookkeeping, or the engine's promise for its `ImageRef`s), so the old
+    // layout is right, and `dependency` lives until the call returns.
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
     image.state = ImageState::after(next);
 }
@@ -308,6 +315,9 @@ pub(crate) fn memory_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
         .dst_stage_mask(stages)
         .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
     let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
+    // SAFETY: `cmd` is the caller's, recording outside rendering (the callers barrier between
+    // their compute and render phases); the stages are all ones a graphics queue supports,
+    // and `dependency` lives until the call returns.
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
 }
 
@@ -417,6 +427,49 @@ mod tests {
                     | BufferAccess::ComputeWrite
             );
             assert_eq!(writes, named_write, "{access:?}");
+        }
+    }
+
+    /// Each access's usage holds what its layout needs: Vulkan allows a barrier into a layout
+    /// only for images with that layout's usage (VUID-VkImageMemoryBarrier2-oldLayout-01208 to
+    /// -01212, -01658), so the frame checks built on `usage` refuse what the layer would.
+    #[test]
+    fn every_access_needs_the_usage_its_layout_requires() {
+        use vk::{ImageLayout as L, ImageUsageFlags as U};
+        let all = [
+            ImageAccess::Nothing,
+            ImageAccess::ColorAttachment,
+            ImageAccess::DepthStencilAttachment,
+            ImageAccess::StencilAttachmentDepthSampled,
+            ImageAccess::FragmentSampled,
+            ImageAccess::ComputeSampled,
+            ImageAccess::ComputeStorage,
+            ImageAccess::FragmentStorage,
+            ImageAccess::ComputeDepthStencilSampled,
+            ImageAccess::ComputeDepthSampled,
+            ImageAccess::TransferSource,
+        ];
+        for access in all {
+            let (layout, ..) = access_info(access);
+            let required = match layout {
+                L::UNDEFINED => U::empty(),
+                L::COLOR_ATTACHMENT_OPTIMAL => U::COLOR_ATTACHMENT,
+                L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL => U::DEPTH_STENCIL_ATTACHMENT,
+                L::DEPTH_STENCIL_READ_ONLY_OPTIMAL
+                | L::DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL => {
+                    U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED
+                }
+                L::SHADER_READ_ONLY_OPTIMAL => U::SAMPLED,
+                // GENERAL itself needs nothing; histencil uses it for storage images only.
+                L::GENERAL => U::STORAGE,
+                L::TRANSFER_SRC_OPTIMAL => U::TRANSFER_SRC,
+                other => panic!("{access:?}: layout {other:?} not in this table"),
+            };
+            assert!(
+                access.usage().contains(required),
+                "{access:?}: {layout:?} needs {required:?}, usage() says {:?}",
+                access.usage()
+            );
         }
     }
 

@@ -64,6 +64,10 @@ impl ComputePipeline {
     /// Binds the pipeline and `set` as set 0, and pushes `push` at offset 0.
     pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, set: vk::DescriptorSet, push: &[u8]) {
         let d = &ctx.device;
+        // SAFETY: `cmd` is the caller's, recording on this device (`submit_once`'s, or a
+        // lighting's under `record`'s # Safety). The pipeline and layout are live (`self`), and
+        // `set` is a live set of `set_layout`. Both callers push exactly the layout's
+        // `push_bytes` (4 for a case count, `size_of::<UpdatePush>()` for the tile update).
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             d.cmd_bind_descriptor_sets(
@@ -80,6 +84,10 @@ impl ComputePipeline {
 
     /// Destroys what exists (null handles are ignored by Vulkan).
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the objects are this value's own, from `ctx.device`; null ones (a creation
+        // that failed half way) are no-ops. Owners destroy them once no pending work uses the
+        // pipeline (a case kernel's runs wait for their fence; the tile update's owner after
+        // its lighting waited, teardown.rs), the pipeline before the layouts it was made with.
         unsafe {
             ctx.device.destroy_pipeline(self.pipeline, None);
             ctx.device.destroy_pipeline_layout(self.layout, None);
@@ -155,12 +163,20 @@ impl CaseKernel {
             // Host writes to the inputs are visible at submit; only the results need a
             // barrier, towards the host read after the fence.
             self.compute.bind(ctx, cmd, set, &count.to_le_bytes());
+            // SAFETY: `cmd` is `submit_once`'s, recording outside rendering, with the pipeline
+            // and its set bound just above. The group count stays within the spec's minimum
+            // `maxComputeWorkGroupCount[0]` (65535) up to 65535 * 64 cases; nothing checks a
+            // longer list (the evaluators' callers pass test-sized ones).
             unsafe {
                 ctx.device
                     .cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1)
             };
             host_readable(ctx, cmd, vk::PipelineStageFlags2::COMPUTE_SHADER);
         });
+        // SAFETY: the pool (and its set) was made above for this dispatch alone. When
+        // `submit_once` succeeded its fence wait left the GPU done with it; when it failed
+        // before the submit nothing used it. After a failed fence wait the dispatch may still
+        // be pending, and freeing the pool then is unsound (as in `submit_once`).
         unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
         recorded
     }

@@ -93,8 +93,15 @@ impl ValidationLog {
     }
 }
 
-/// The debug-utils callback. `user_data` points at the context's `ValidationLog`, which outlives the
-/// messenger (the context destroys the messenger before dropping its log handle).
+/// The debug-utils callback. `user_data` points at the context's `ValidationLog`, which outlives
+/// the messenger (the context destroys the messenger before dropping its log handle).
+///
+/// # Safety
+/// Called by the Vulkan loader or a layer only, as `PFN_vkDebugUtilsMessengerCallbackEXT`:
+/// `data` is null or points at a valid callback-data struct whose `p_message_id_name` and
+/// `p_message` are null or NUL-terminated, all for the duration of the call; `user_data` is
+/// null or the pointer [`ValidationLog::messenger_create_info`] set, to a `ValidationLog` kept
+/// alive (by an `Arc`) until the messenger is destroyed.
 pub(crate) unsafe extern "system" fn messenger_callback(
     severity: vk::DebugUtilsMessageSeverityFlagsEXT,
     _kind: vk::DebugUtilsMessageTypeFlagsEXT,
@@ -109,15 +116,21 @@ pub(crate) unsafe extern "system" fn messenger_callback(
         return vk::FALSE;
     };
     if !data.is_null() && !user_data.is_null() {
-        // SAFETY: the layer passes a valid callback-data struct; user_data is the log (see above).
+        // SAFETY: the caller upholds this fn's # Safety: non-null, `data` points at a valid
+        // callback-data struct, alive and unchanged for this call; the reference ends with it.
         let data = unsafe { &*data };
         let text = |p: *const std::ffi::c_char| {
             if p.is_null() {
                 String::new()
             } else {
+                // SAFETY: this fn's # Safety: the struct's non-null strings are NUL-terminated
+                // and live for the call; the text is copied out before it returns.
                 unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
             }
         };
+        // SAFETY: this fn's # Safety: non-null, `user_data` is `Arc::as_ptr` of a live
+        // `ValidationLog`, whose `Arc` outlives the messenger. Only a shared reference is made:
+        // the log is `Sync` (a `Mutex`), as callbacks may come from several threads at once.
         let log = unsafe { &*(user_data as *const ValidationLog) };
         let id = text(data.p_message_id_name);
         // The canary's deliberate call is the one call the layer is asked to stop (a callback's

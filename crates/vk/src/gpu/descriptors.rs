@@ -227,6 +227,8 @@ pub(crate) fn create_set_layout(
 ) -> Result<vk::DescriptorSetLayout> {
     let bindings = layout_bindings(set, stages);
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+    // SAFETY: `info` and `bindings` live until the call returns; the tables give each binding
+    // a distinct number, one descriptor of a plain type, and no immutable samplers.
     let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
         .call("vkCreateDescriptorSetLayout")?;
     ctx.name(layout, name);
@@ -256,6 +258,7 @@ pub(crate) fn create_storage_buffer_set(
     let sizes = [vk::DescriptorPoolSize::default()
         .ty(vk::DescriptorType::STORAGE_BUFFER)
         .descriptor_count(buffers.len() as u32)];
+    // SAFETY: the create info and `sizes` live until the call returns; one set at most.
     let pool = unsafe {
         d.create_descriptor_pool(
             &vk::DescriptorPoolCreateInfo::default()
@@ -267,6 +270,8 @@ pub(crate) fn create_storage_buffer_set(
     .call("vkCreateDescriptorPool")?;
     ctx.name(pool, &format!("{name}-descriptor-pool"));
     let layouts = [layout];
+    // SAFETY: `pool` was just made and is ours alone (its external synchronisation), sized for
+    // one set of storage buffers; `layout` is a live set layout of this device (the caller's).
     let allocated = unsafe {
         d.allocate_descriptor_sets(
             &vk::DescriptorSetAllocateInfo::default()
@@ -278,6 +283,7 @@ pub(crate) fn create_storage_buffer_set(
     let set = match allocated {
         Ok(sets) => sets[0],
         Err(e) => {
+            // SAFETY: the pool was just made here, holds no set and is unused.
             unsafe { d.destroy_descriptor_pool(pool, None) };
             return Err(e);
         }
@@ -312,6 +318,9 @@ pub(crate) fn write_frame_set(
             .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
             .buffer_info(&ssbo),
     ];
+    // SAFETY: `writes` and the buffer infos they point at live until the call returns. Every
+    // caller passes a set of a `FRAME_SET` layout that no pending command buffer uses (fresh,
+    // or a slot's after the slot finished) and live buffers with uniform / storage usage.
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 
@@ -371,6 +380,10 @@ fn write_in_order<'a, T>(
             attach(write, &infos[i..=i])
         })
         .collect();
+    // SAFETY: `writes` and the `infos` they point at live until the call returns; binding `i`
+    // of `set` has type `ty` (the callers' layouts). Every caller updates a set that no pending
+    // command buffer uses: a fresh one, a slot's whose frame finished (`slot_finished`), or one
+    // whose owner refuses while in flight or whose caller promises it (`set_lut_tables`).
     unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
 }
 
@@ -420,6 +433,7 @@ pub(crate) fn sets_of(
     let pool_info = vk::DescriptorPoolCreateInfo::default()
         .max_sets(count)
         .pool_sizes(&sizes);
+    // SAFETY: `pool_info` and `sizes` live until the call returns.
     let pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
         .call("vkCreateDescriptorPool")?;
     ctx.name(pool, &format!("{name}-pool"));
@@ -427,6 +441,8 @@ pub(crate) fn sets_of(
     let alloc = vk::DescriptorSetAllocateInfo::default()
         .descriptor_pool(pool)
         .set_layouts(&layouts);
+    // SAFETY: `pool` was just made and is ours alone, sized for `count` sets of `sizes`;
+    // `layout` is a live set layout of this device whose bindings `sizes` covers (the caller's).
     match unsafe { ctx.device.allocate_descriptor_sets(&alloc) }.call("vkAllocateDescriptorSets") {
         Ok(sets) => {
             for (i, set) in sets.iter().enumerate() {
@@ -435,6 +451,7 @@ pub(crate) fn sets_of(
             Ok((pool, sets))
         }
         Err(e) => {
+            // SAFETY: the pool was just made here, holds no set and is unused.
             unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
             Err(e)
         }
@@ -462,6 +479,7 @@ pub(crate) fn pass_layouts(
     ) {
         Ok(layout) => Ok((own, layout)),
         Err(e) => {
+            // SAFETY: `own` was just made here and nothing uses it: its pipeline layout failed.
             unsafe { ctx.device.destroy_descriptor_set_layout(own, None) };
             Err(e)
         }
@@ -493,6 +511,8 @@ pub(crate) fn create_pipeline_layout(
     let info = vk::PipelineLayoutCreateInfo::default()
         .set_layouts(sets)
         .push_constant_ranges(&ranges);
+    // SAFETY: `info`, `sets` and `ranges` live until the call returns; the limits the layout
+    // needs were checked against the device just above.
     let layout =
         unsafe { ctx.device.create_pipeline_layout(&info, None) }.call("vkCreatePipelineLayout")?;
     ctx.name(layout, name);
@@ -521,6 +541,9 @@ impl Descriptors {
 
     /// Frees the pool (and with it the set) and the layout; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the pool and layout are this value's own; null ones (empty, or destroyed
+        // before) are no-ops. Owners call `destroy` only once the GPU is done with the set
+        // (teardown.rs: after their fence wait or device idle, or on a failed creation).
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);
             ctx.device

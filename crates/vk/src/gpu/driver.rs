@@ -78,7 +78,9 @@ fn c_text(bytes: &[std::ffi::c_char]) -> String {
 /// The driver properties of `physical_device`.
 ///
 /// # Safety
-/// `physical_device` was enumerated from `instance`, which supports Vulkan 1.2 or later.
+/// `physical_device` was enumerated from the live `instance`, and both are at Vulkan 1.2 or
+/// later (the instance was created with such an `apiVersion`): `VkPhysicalDeviceDriverProperties`
+/// is core there.
 pub(crate) unsafe fn driver_info(
     instance: &ash::Instance,
     physical_device: vk::PhysicalDevice,
@@ -86,7 +88,9 @@ pub(crate) unsafe fn driver_info(
 ) -> DriverInfo {
     let mut driver = vk::PhysicalDeviceDriverProperties::default();
     let mut props = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-    // SAFETY: the caller's promise.
+    // SAFETY: the caller upholds this fn's # Safety: `physical_device` is `instance`'s, and
+    // both are at Vulkan 1.2 or later, where `get_physical_device_properties2` (1.1) and the
+    // chained `driver` struct (1.2) are core. `props` and `driver` outlive the call.
     unsafe { instance.get_physical_device_properties2(physical_device, &mut props) };
     let api_version = version_text(props.properties.api_version);
     let driver_version = props.properties.driver_version;
@@ -171,6 +175,7 @@ impl Context {
             // SAFETY: invalid on purpose (size zero). A listening layer stops it; a muted one
             // passes it to the driver, and a buffer made of it is destroyed before any use.
             if let Ok(buffer) = unsafe { self.device.create_buffer(&info, None) } {
+                // SAFETY: the buffer was just made, never bound or used.
                 unsafe { self.device.destroy_buffer(buffer, None) };
             }
         }

@@ -1,6 +1,10 @@
 use ash::vk;
 
-/// What can go wrong in the renderer that a caller cannot prevent by calling it correctly.
+/// What can go wrong in histencil, sorted by who can prevent it ([`Error::cause`]): the caller
+/// (a frame or description that does not fit, a slot still in flight: fix the call), the device
+/// (no loader, no suitable device, a format or limit it lacks, a Vulkan call or allocation that
+/// failed: choose another configuration or device), the data (a scene, layout or plan the
+/// renderer cannot take: fix the content), or the output (a file that could not be written).
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// The Vulkan loader, or the validation layer that was asked for, is not installed.
@@ -127,6 +131,51 @@ pub enum Error {
         /// The I/O or encoder error.
         message: String,
     },
+}
+
+/// Who can prevent an [`Error`], and so what a caller does about it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cause {
+    /// The caller broke the API's rules (a frame, description or slot that does not fit): a
+    /// bug in the calling code, never worth retrying as it is.
+    Usage,
+    /// The device, driver or loader cannot do it (or failed doing it): another device, format
+    /// or configuration may; a test skips it, a CI job names it.
+    Device,
+    /// The content (scene, layout, plan, tables) cannot be rendered as asked.
+    Data,
+    /// A file could not be written.
+    Output,
+}
+
+impl Error {
+    /// Who can prevent this error ([`Cause`]), as wgpu-hal tells a device error from a usage
+    /// error: what an engine logs as its own bug, and what it reports as the player's GPU.
+    pub fn cause(&self) -> Cause {
+        match self {
+            Error::BadFrame(_)
+            | Error::BadSetup(_)
+            | Error::InFlight(_)
+            | Error::Unsupported(_) => Cause::Usage,
+            Error::Loading(_)
+            | Error::NoDevice(_)
+            | Error::MissingFormat(_)
+            | Error::DeviceLimit(_)
+            | Error::Vulkan { .. }
+            | Error::Allocation { .. }
+            | Error::BadResolution { .. }
+            | Error::LutTooLarge { .. } => Cause::Device,
+            Error::Scene(_)
+            | Error::Layout(_)
+            | Error::Plan(_)
+            | Error::Lut(_)
+            | Error::Lightmap(_)
+            | Error::TooManyMaterials { .. }
+            | Error::LutTexturedParameters { .. }
+            | Error::LutUntabulable { .. } => Cause::Data,
+            Error::Output { .. } => Cause::Output,
+        }
+    }
 }
 
 /// The crate's result, with [`Error`] unless said otherwise.

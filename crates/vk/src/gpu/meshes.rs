@@ -94,6 +94,12 @@ impl GpuMesh {
 
     /// Binds and draws the whole mesh.
     pub(crate) fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        // SAFETY: `cmd` is the caller's, recording inside a rendering with a graphics pipeline
+        // bound whose vertex input reads binding 0 (the passes' contract). The buffers are
+        // live, made with VERTEX_BUFFER / INDEX_BUFFER usage and filled before any draw
+        // (uploaded and waited for, or written through their mapping); `index_count` u32
+        // indices, each naming a vertex of the mesh (`Scene::validate` checks imported
+        // meshes; the built-in shapes are made so).
         unsafe {
             ctx.device
                 .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.handle], &[0]);

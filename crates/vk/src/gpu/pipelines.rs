@@ -57,6 +57,10 @@ pub struct PipelineDesc<'a> {
 pub(crate) fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<vk::ShaderModule> {
     let words = ash::util::read_spv(&mut Cursor::new(spirv)).expect("build.rs wrote valid SPIR-V");
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
+    // SAFETY: `info` and `words` live until the call returns; `words` is whole SPIR-V words
+    // (`read_spv` checked the length and magic) compiled from histencil's shaders, by build.rs
+    // with glslc or, for an engine's light shaders, by `histencil_build` as the # Safety of
+    // `EngineHooks::new` promises.
     let module =
         unsafe { ctx.device.create_shader_module(&info, None) }.call("vkCreateShaderModule")?;
     ctx.name(module, name);
@@ -101,10 +105,16 @@ pub(crate) fn create_compute_pipeline(
     let info = [vk::ComputePipelineCreateInfo::default()
         .stage(stage)
         .layout(layout)];
+    // SAFETY: `info`, `stage`, the specialisation entries and bytes live until the call
+    // returns; `shader` and `layout` are live objects of this device. The cache is null or the
+    // context's: histencil's own, made without EXTERNALLY_SYNCHRONIZED (so Vulkan synchronises
+    // it), or an engine's, used only inside histencil's calls as `BorrowedDevice` tells it.
     let created = unsafe {
         ctx.device
             .create_compute_pipelines(ctx.pipeline_cache, &info, None)
     };
+    // SAFETY: the module was made above for this pipeline alone; a made pipeline no longer
+    // needs it.
     unsafe { ctx.device.destroy_shader_module(shader, None) };
     let pipeline = created
         .map_err(|(_, e)| e)
@@ -199,6 +209,7 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
         Some((name, spirv)) => match create_module(ctx, name, spirv) {
             Ok(m) => Some(m),
             Err(e) => {
+                // SAFETY: the vertex module was made above and nothing uses it yet.
                 unsafe { ctx.device.destroy_shader_module(vertex_module, None) };
                 return Err(e);
             }
@@ -308,10 +319,17 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     if has_depth {
         info = info.depth_stencil_state(&depth_stencil);
     }
+    // SAFETY: `info` and every struct it points at (stages, specialisation, vertex input,
+    // fixed state, blend attachments, dynamic states, the rendering formats) live until the
+    // call returns. The modules and `desc.layout` are live objects of this device; dynamic
+    // rendering is enabled (`REQUIREMENTS`), as is the depth bounds test when its dynamic
+    // states are named (`ctx.depth_bounds`). The cache is synchronised as for compute.
     let result = unsafe {
         ctx.device
             .create_graphics_pipelines(ctx.pipeline_cache, &[info], None)
     };
+    // SAFETY: the modules were made above for this pipeline alone; a made pipeline no longer
+    // needs them.
     unsafe {
         ctx.device.destroy_shader_module(vertex_module, None);
         if let Some(m) = fragment_module {

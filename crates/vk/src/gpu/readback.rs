@@ -74,6 +74,11 @@ pub(crate) fn copy_image_to_buffer(
             height: image.extent.height,
             depth: 1,
         });
+    // SAFETY: `cmd` is the caller's, recording outside rendering (a renderer's frame or
+    // capture, or an engine's under `record`'s # Safety). The transition just put `image` in
+    // TRANSFER_SRC_OPTIMAL; `aspect` is one aspect of its format, and every caller's `buffer`
+    // has TRANSFER_DST usage and room for the whole extent at that aspect's texel size
+    // (`ReadbackBuffers::new` and the like).
     unsafe {
         ctx.device.cmd_copy_image_to_buffer(
             cmd,
@@ -98,6 +103,8 @@ pub(crate) fn host_readable(ctx: &Context, cmd: vk::CommandBuffer, stage: vk::Pi
         .src_access_mask(writes)
         .dst_stage_mask(vk::PipelineStageFlags2::HOST)
         .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    // SAFETY: `cmd` is the caller's, recording outside rendering; `barrier` lives until the
+    // call returns and names only stages and accesses the queue family supports.
     unsafe {
         ctx.device.cmd_pipeline_barrier2(
             cmd,

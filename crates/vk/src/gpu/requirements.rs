@@ -67,7 +67,8 @@ impl DeviceRequirements {
         physical_device: vk::PhysicalDevice,
         family: u32,
     ) -> bool {
-        // SAFETY: the caller's promise.
+        // SAFETY: the caller upholds this fn's # Safety: `physical_device` belongs to the live
+        // `instance` (a Vulkan 1.0 query, needing nothing more).
         let families =
             unsafe { instance.get_physical_device_queue_family_properties(physical_device) };
         families.get(family as usize).is_some_and(|f| {
@@ -81,13 +82,16 @@ impl DeviceRequirements {
     /// promises that separately ([`crate::Context::from_raw`]).
     ///
     /// # Safety
-    /// `physical_device` was enumerated from `instance`, which is alive.
+    /// `physical_device` was enumerated from `instance`, which is alive and was created with an
+    /// `apiVersion` of 1.3 or later (the features are read with `vkGetPhysicalDeviceFeatures2`,
+    /// Vulkan 1.3's among them).
     pub unsafe fn missing(
         &self,
         instance: &ash::Instance,
         physical_device: vk::PhysicalDevice,
     ) -> Vec<String> {
-        // SAFETY: the caller's promise.
+        // SAFETY: the caller upholds this fn's # Safety: `physical_device` belongs to the live
+        // `instance`.
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
         let mut missing = Vec::new();
         if props.api_version < self.api_version {
@@ -102,7 +106,9 @@ impl DeviceRequirements {
         }
         let mut features13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut features13);
-        // SAFETY: the caller's promise; the chain holds only structs Vulkan 1.3 knows.
+        // SAFETY: this fn's # Safety: `physical_device` is `instance`'s, an instance of 1.3 or
+        // later, and the device is at 1.3 too (checked just above): the query (core in 1.1)
+        // and the chained `features13` are both supported. Both structs outlive the call.
         unsafe { instance.get_physical_device_features2(physical_device, &mut features) };
         let core = features.features;
         let wanted = [
@@ -129,7 +135,7 @@ impl DeviceRequirements {
             }
         }
         if !self.device_extensions.is_empty() {
-            // SAFETY: the caller's promise.
+            // SAFETY: this fn's # Safety: `physical_device` belongs to the live `instance`.
             let available =
                 unsafe { instance.enumerate_device_extension_properties(physical_device) }
                     .unwrap_or_default();

@@ -75,22 +75,30 @@ impl Buffer {
             .size(size.max(4))
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: `info` lives until the call returns; its size is non-zero (`max(4)`) and
+        // its sharing mode exclusive, so it names no queue families.
         let handle = unsafe { ctx.device.create_buffer(&info, None) }.call("vkCreateBuffer")?;
         ctx.name(handle, name);
+        // SAFETY: `handle` was just created from `ctx.device`.
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(handle) };
         let allocation = match allocate(ctx, name, requirements, location, true) {
             Ok(a) => a,
             Err(e) => {
+                // SAFETY: `handle` is unbound and unused: nothing has seen it but the name.
                 unsafe { ctx.device.destroy_buffer(handle, None) };
                 return Err(e);
             }
         };
+        // SAFETY: the memory goes to `bind_buffer_memory` with its offset, as gpu-allocator's
+        // # Safety allows; `destroy` frees the allocation only after destroying the buffer.
         let (memory, offset) = (unsafe { allocation.memory() }, allocation.offset());
         let mut made = Self {
             handle,
             size,
             allocation: Some(allocation),
         };
+        // SAFETY: `handle` is not yet bound; the allocation was made from its requirements
+        // (size, alignment, memory type), so `offset` is aligned and the range fits.
         let bound = unsafe { ctx.device.bind_buffer_memory(handle, memory, offset) };
         if let Err(e) = bound.call("vkBindBufferMemory") {
             made.destroy(ctx);
@@ -161,6 +169,10 @@ impl Buffer {
 
     /// Frees the buffer and its memory; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the buffer is this value's own, from `ctx.device`; a null one (empty, or
+        // destroyed before) is a no-op. Owners call `destroy` only once the GPU is done with
+        // it (teardown.rs: after their fence wait or device idle, or on a creation that failed
+        // before any submission), and the memory is freed only after the buffer is gone.
         unsafe { ctx.device.destroy_buffer(self.handle, None) };
         self.handle = vk::Buffer::null();
         if let Some(a) = self.allocation.take() {
@@ -226,12 +238,17 @@ impl Image {
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)
             .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: `info` lives until the call returns: a 2D, single-sample, exclusive image of
+        // an extent the callers checked (`check_extent` and the like: non-zero, within
+        // `max_image_dimension`) and a format they chose for its usage.
         let handle = unsafe { ctx.device.create_image(&info, None) }.call("vkCreateImage")?;
         ctx.name(handle, name);
+        // SAFETY: `handle` was just created from `ctx.device`.
         let requirements = unsafe { ctx.device.get_image_memory_requirements(handle) };
         let allocation = match allocate(ctx, name, requirements, MemoryLocation::GpuOnly, false) {
             Ok(a) => a,
             Err(e) => {
+                // SAFETY: `handle` is unbound and unused: nothing has seen it but the name.
                 unsafe { ctx.device.destroy_image(handle, None) };
                 return Err(e);
             }
@@ -242,6 +259,9 @@ impl Image {
             .view_type(vk::ImageViewType::TYPE_2D)
             .format(format)
             .subresource_range(subresource_range(aspect).level_count(mip_levels));
+        // SAFETY: the image is not yet bound, and the allocation was made from its requirements
+        // and is passed with its offset (gpu-allocator's `memory` # Safety); the view's info
+        // names that image, once bound, with its own format and mip levels.
         let view = unsafe {
             ctx.device
                 .bind_image_memory(handle, allocation.memory(), allocation.offset())
@@ -255,6 +275,7 @@ impl Image {
         let view = match view {
             Ok(v) => v,
             Err(e) => {
+                // SAFETY: the image has no view and no use yet; it goes before its memory.
                 unsafe { ctx.device.destroy_image(handle, None) };
                 free(ctx, allocation);
                 return Err(e);
@@ -276,6 +297,10 @@ impl Image {
 
     /// Frees the image, its view and its memory; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the view and image are this value's own, from `ctx.device`; null ones (empty,
+        // or destroyed before) are no-ops. Owners call `destroy` only once the GPU is done with
+        // them (see `Buffer::destroy`); the view goes before its image, the image before its
+        // memory.
         unsafe {
             ctx.device.destroy_image_view(self.target.view, None);
             ctx.device.destroy_image(self.target.image, None);

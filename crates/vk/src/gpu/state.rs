@@ -110,6 +110,10 @@ pub(crate) fn apply_bounded(
     let enabled = state.front.is_some() || state.back.is_some();
     if ctx.depth_bounds {
         let bounds = bounds.filter(|_| state.depth_bounds);
+        // SAFETY: `cmd` is the caller's, recording on this device. `depthBounds` is enabled
+        // (`ctx.depth_bounds` is set only where `Context::new` enabled it). The bounds must lie
+        // in [0, 1] (no VK_EXT_depth_range_unrestricted): `FramePlan::with_depth_bounds`
+        // clamps its ranges so; a hand-made plan's public `depth_range` is not checked here.
         unsafe {
             d.cmd_set_depth_bounds_test_enable(cmd, bounds.is_some());
             if let Some(b) = bounds {
@@ -117,6 +121,9 @@ pub(crate) fn apply_bounded(
             }
         }
     }
+    // SAFETY: `cmd` is the caller's, recording on this device (the renderer's, or an engine's
+    // under `record`'s # Safety). These commands set core Vulkan 1.3 dynamic state and take
+    // only plain values; the masks and reference widen from the model's 8-bit ones.
     unsafe {
         d.cmd_set_cull_mode(cmd, cull_mode(state.cull));
         d.cmd_set_depth_test_enable(cmd, state.depth.compare.is_some());

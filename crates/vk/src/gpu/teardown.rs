@@ -11,7 +11,7 @@
 //!   the whole is made; dropped before [`Owned::keep`], it destroys its part.
 
 use crate::gpu::context::Context;
-use crate::gpu::error::Result;
+use crate::gpu::error::{Error, Result};
 
 /// A value made of Vulkan objects and allocations that frees them all. It must accept being
 /// destroyed twice, and when only some of its parts exist.
@@ -115,11 +115,66 @@ impl InFlight {
     /// Waits for the device to go idle if the object may still be in use.
     pub fn wait(&self, ctx: &Context) {
         if self.0 {
-            // SAFETY: a device wait; the queues' external synchronisation is the Drop's
-            // documented condition.
+            // SAFETY: `vkDeviceWaitIdle` needs every queue of the device externally
+            // synchronised. The callers are the engine-facing objects' Drops, whose condition
+            // on a lent device is `Context::from_raw`'s # Safety (nothing else uses a queue
+            // while one that recorded is dropped). On an owned context only histencil submits
+            // (`submit_once`, a renderer's frame), and nothing here stops another thread
+            // sharing the context from doing so during the wait.
             unsafe {
                 let _ = ctx.device.device_wait_idle();
             }
         }
     }
+}
+
+/// Refuses `what` (a resize, a destroy) of `owner` (`DeferredLighting`, `AlphaLightmaps`) while
+/// a slot holds a recorded frame not declared finished (`pending`, one flag a slot), naming the
+/// slots: the engine said nothing of their fences yet, so the GPU may still read them.
+pub(crate) fn refuse_in_flight(
+    pending: impl Iterator<Item = bool>,
+    what: &str,
+    owner: &str,
+) -> Result<()> {
+    let slots: Vec<String> = (pending.enumerate())
+        .filter(|(_, pending)| *pending)
+        .map(|(i, _)| i.to_string())
+        .collect();
+    if slots.is_empty() {
+        return Ok(());
+    }
+    Err(Error::InFlight(format!(
+        "{what} while slot {} may still be read by the GPU: wait for those frames, and say so \
+         with {owner}::slot_finished, first",
+        slots.join(", ")
+    )))
+}
+
+/// Refuses a recording into `slot` of `owner` while its last frame (`pending`) is not declared
+/// finished: what the slot `holds` is that frame's until then.
+pub(crate) fn refuse_slot_in_flight(
+    pending: bool,
+    slot: u32,
+    owner: &str,
+    holds: &str,
+) -> Result<()> {
+    if !pending {
+        return Ok(());
+    }
+    Err(Error::InFlight(format!(
+        "slot {slot} recorded again before {owner}::slot_finished({slot}) said the GPU finished \
+         its last frame: its {holds} are that frame's until then"
+    )))
+}
+
+/// Clears a slot's `pending` flag, as an engine's `slot_finished(slot)` declares it (`None`: a
+/// slot past the `frames` in flight, refused).
+pub(crate) fn declare_finished(pending: Option<&mut bool>, slot: u32, frames: usize) -> Result<()> {
+    let pending = pending.ok_or_else(|| {
+        Error::BadFrame(format!(
+            "slot_finished({slot}) of {frames} frames in flight"
+        ))
+    })?;
+    *pending = false;
+    Ok(())
 }

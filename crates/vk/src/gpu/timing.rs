@@ -190,6 +190,7 @@ fn timestamp_pool(ctx: &Context, name: &str, marks: u32) -> Result<vk::QueryPool
     let info = vk::QueryPoolCreateInfo::default()
         .query_type(vk::QueryType::TIMESTAMP)
         .query_count(marks * QUERIES_PER_MARK);
+    // SAFETY: `info` lives until the call returns; a timestamp pool needs no statistics flags.
     let pool = unsafe { ctx.device.create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
     ctx.name(pool, name);
     Ok(pool)
@@ -197,6 +198,9 @@ fn timestamp_pool(ctx: &Context, name: &str, marks: u32) -> Result<vk::QueryPool
 
 /// Resets the queries of the first `marks` marks of `pool`.
 fn reset_marks(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, marks: u32) {
+    // SAFETY: `cmd` is the caller's, recording outside rendering (`StepTimer::reset` says so,
+    // `begin_frame` runs before any pass). Both callers pass `marks` equal to the pool's own
+    // count (`MAX_MARKS`, `capacity`), so the range is the pool's queries.
     unsafe {
         ctx.device
             .cmd_reset_query_pool(cmd, pool, 0, marks * QUERIES_PER_MARK)
@@ -207,6 +211,10 @@ fn reset_marks(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, marks
 fn write_timestamp(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, index: u32) {
     let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
     for query in index * QUERIES_PER_MARK..(index + 1) * QUERIES_PER_MARK {
+        // SAFETY: `cmd` is the caller's, recording; its queue family has timestamps
+        // (`REQUIREMENTS.timestamps`). `query` is in the pool (the callers assert `index`
+        // below its mark count) and was reset earlier in the same recording (`begin_frame`,
+        // `StepTimer::reset`), so it is unavailable, as a timestamp write needs.
         unsafe { ctx.device.cmd_write_timestamp2(cmd, bottom, pool, query) };
     }
 }
@@ -215,6 +223,10 @@ fn write_timestamp(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, i
 fn read_ticks(ctx: &Context, pool: vk::QueryPool, count: usize) -> Result<Vec<u64>> {
     let per_mark = QUERIES_PER_MARK as usize;
     let mut ticks = vec![0u64; count * per_mark];
+    // SAFETY: `pool` is live and holds at least `count` marks (the callers count only the marks
+    // their last recording wrote, which `mark` asserts fit), and `ticks` has room for each of
+    // those queries at 64 bits. Reading while that frame is pending is allowed: WAIT waits for
+    // it (for a frame never submitted the spec allows VK_ERROR_DEVICE_LOST, an error).
     unsafe {
         ctx.device
             .get_query_pool_results(
@@ -272,6 +284,8 @@ impl Timestamps {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the pool is this value's own; a null one is a no-op. The renderer destroys
+        // it in its Drop after waiting for the device to go idle, or on a failed creation.
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
         self.pool = vk::QueryPool::null();
     }
@@ -352,6 +366,11 @@ impl StepTimer {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the pool is this timer's own and destroyed once: `SlotTimer`, its only owner,
+        // drops the timer right after. No pending frame writes it: a slot's timer is replaced
+        // only when the slot records again, so after its last frame finished (`slot_finished`),
+        // and the lighting's or lightmaps' Drop destroys it after waiting (`InFlight`) or once
+        // every slot finished.
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
     }
 }

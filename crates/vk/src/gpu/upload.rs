@@ -18,8 +18,12 @@ pub(crate) fn submit_once(
 ) -> Result<()> {
     let d = &ctx.device;
     let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
+    // SAFETY: `pool_info` lives until the call returns and names the context's queue family.
     let command_pool = unsafe { d.create_command_pool(&pool_info, None) };
+    // SAFETY: a default (unsignalled) fence; the info lives until the call returns.
     let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) };
+    // Set once the submit succeeded and until its wait did: `cmd` may still be pending.
+    let mut pending = false;
     let done = (|| -> Result<()> {
         let command_pool = command_pool.call("vkCreateCommandPool")?;
         ctx.name(command_pool, &format!("{name}-command-pool"));
@@ -28,28 +32,49 @@ pub(crate) fn submit_once(
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(command_pool)
             .command_buffer_count(1);
+        // SAFETY: `command_pool` was just made and is used by this thread alone (its external
+        // synchronisation); `alloc` lives until the call returns.
         let cmd =
             unsafe { d.allocate_command_buffers(&alloc) }.call("vkAllocateCommandBuffers")?[0];
         ctx.name(cmd, &format!("{name}-commands"));
         let begin = vk::CommandBufferBeginInfo::default()
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: `cmd` was just allocated, so it is in the initial state; `begin` outlives it.
         unsafe { d.begin_command_buffer(cmd, &begin) }.call("vkBeginCommandBuffer")?;
         ctx.begin_label(cmd, name);
         record(cmd);
         ctx.end_label(cmd);
+        // SAFETY: `cmd` is recording, outside any rendering (`record` ends what it begins), and
+        // its labels are closed. The submit names only `cmd` and the unsignalled, unused
+        // `fence`; `cmds` and `submit` live until it returns. `ctx.queue` is externally
+        // synchronised by `Context::from_raw`'s # Safety on a lent device; on an owned one
+        // nothing stops two threads sharing the context from submitting at once.
         unsafe {
             d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
             let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
             d.queue_submit2(ctx.queue, &[submit], fence)
                 .call("vkQueueSubmit2")?;
+            pending = true;
             // Creation waits for its own one-off work, as buffer creation does; frames never
             // come through here.
             ctx.step("waiting on the GPU");
             d.wait_for_fences(&[fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
-                .call("vkWaitForFences")
+                .call("vkWaitForFences")?;
+            pending = false;
+            Ok(())
         }
     })();
+    if pending {
+        // The wait failed (a timeout, a lost device) with `cmd` submitted: wait for the whole
+        // device before freeing what `cmd` and the caller's buffers may still be used by (on a
+        // lost device this returns at once, and nothing runs any more).
+        // SAFETY: a device wait; the queue's external synchronisation is as for the submit.
+        let _ = unsafe { d.device_wait_idle() };
+    }
+    // SAFETY: the fence and the pool (freeing `cmd` with it) were made above and are used by
+    // nothing else, and the GPU is done with them: the fence wait succeeded, or nothing was
+    // submitted, or the device went idle (or was lost) just above.
     unsafe {
         if let Ok(fence) = fence {
             d.destroy_fence(fence, None);
@@ -122,6 +147,9 @@ pub(crate) fn upload(
                 let region = vk::BufferCopy::default()
                     .src_offset(offset)
                     .size(b.bytes.len() as u64);
+                // SAFETY: `cmd` is `submit_once`'s, recording outside rendering. `src` (the
+                // staging buffer, TRANSFER_SRC) holds this chunk at `offset`, and `b.dst` is a
+                // live buffer the caller made with TRANSFER_DST of at least `bytes.len()`.
                 unsafe { d.cmd_copy_buffer(cmd, src, b.dst, &[region]) };
             }
         }
@@ -143,6 +171,8 @@ pub(crate) fn upload(
                     .subresource_range(whole(i.levels.len() as u32))
             })
             .collect();
+        // SAFETY: `cmd` is recording outside rendering; `to_transfer` lives until the call
+        // returns and names live colour images the caller made, every level of each.
         unsafe {
             d.cmd_pipeline_barrier2(
                 cmd,
@@ -171,6 +201,10 @@ pub(crate) fn upload(
                         })
                 })
                 .collect();
+            // SAFETY: `cmd` is recording outside rendering; the image (the caller's, with
+            // TRANSFER_DST usage and these levels) is in TRANSFER_DST_OPTIMAL (the barrier
+            // above), and the staging buffer holds each level's tightly packed RGBA8 texels at
+            // its `offset`, 16-byte aligned and so a multiple of the texel size.
             unsafe {
                 d.cmd_copy_buffer_to_image(
                     cmd,
@@ -212,6 +246,8 @@ pub(crate) fn upload(
                     | vk::AccessFlags2::UNIFORM_READ
                     | vk::AccessFlags2::SHADER_STORAGE_READ,
             )];
+        // SAFETY: `cmd` is recording outside rendering; the barrier structs live until the
+        // call returns and name the images just copied to, in TRANSFER_DST_OPTIMAL.
         unsafe {
             d.cmd_pipeline_barrier2(
                 cmd,

@@ -88,6 +88,9 @@ fn write_read_only_view(ctx: &Context, set: vk::DescriptorSet, binding: u32, vie
         .dst_binding(binding)
         .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
         .image_info(&image);
+    // SAFETY: `set` and `view` were made from this context's device; the set is not bound by a
+    // pending command buffer (the surface's sets are written at creation, at a resize once no
+    // slot is in flight, and per slot once that slot's frame is declared finished).
     unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
 }
 
@@ -130,6 +133,9 @@ impl Destroy for HiStencilSurface {
         if let Some(mut update) = self.update.take() {
             update.destroy(ctx);
         }
+        // SAFETY: the pool and views were made from this context's device, or are null (a
+        // surface made half way), which destroying ignores; the GPU is done with them: the
+        // owner destroys the surface once no frame that used it is in flight (teardown rule).
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);
             for view in self.views.drain(..) {
@@ -155,21 +161,9 @@ impl HiStencilSurface {
     /// The surface for `extent`, with an update set for each of `slots` frames in flight; a
     /// failure half way frees what was made.
     pub fn new(ctx: &Context, extent: vk::Extent2D, slots: u32) -> Result<Self> {
-        let frame = TileRect::frame(extent);
-        let (tiles_x, tile_bytes) = (frame.width, u64::from(frame.width * frame.height) * 4);
-        use vk::BufferUsageFlags as U;
-        let gpu = |name, size, usage| Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly);
-        let storage = U::STORAGE_BUFFER | U::TRANSFER_DST;
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         build(ctx, |h: &mut Self| {
-            h.extent = extent;
-            h.tiles_x = tiles_x;
-            h.active = gpu("hi-stencil-active", tile_bytes, storage)?;
-            let pending_usage = storage | U::TRANSFER_SRC;
-            h.pending = gpu("hi-stencil-pending", tile_bytes, pending_usage)?;
-            h.touched = gpu("hi-stencil-touched", tile_bytes, storage)?;
-            use vk::ImageUsageFlags as I;
-            let touch_usage = I::DEPTH_STENCIL_ATTACHMENT | I::SAMPLED;
-            h.touch = Image::new(ctx, "hi-stencil-touch", TOUCH_FORMAT, extent, touch_usage)?;
+            h.make_sized(ctx, extent)?;
             h.stats = Buffer::new(
                 ctx,
                 "hi-stencil-stats",
@@ -177,7 +171,6 @@ impl HiStencilSurface {
                 storage,
                 MemoryLocation::GpuToCpu,
             )?;
-            h.saved = gpu("saved-stencil", stencil_bytes(extent), storage)?;
             let update = ComputePipeline::new(
                 ctx,
                 "hi-stencil-update",
@@ -191,27 +184,32 @@ impl HiStencilSurface {
         })
     }
 
+    /// Makes the parts `extent` sizes, into this surface's empty fields: the tile surfaces, the
+    /// touch image and the saved-stencil buffer (what `new` makes first and `resize` anew).
+    fn make_sized(&mut self, ctx: &Context, extent: vk::Extent2D) -> Result<()> {
+        let frame = TileRect::frame(extent);
+        let tile_bytes = u64::from(frame.width * frame.height) * 4;
+        use vk::BufferUsageFlags as U;
+        let gpu = |name, size, usage| Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly);
+        let storage = U::STORAGE_BUFFER | U::TRANSFER_DST;
+        self.extent = extent;
+        self.tiles_x = frame.width;
+        self.active = gpu("hi-stencil-active", tile_bytes, storage)?;
+        self.pending = gpu("hi-stencil-pending", tile_bytes, storage | U::TRANSFER_SRC)?;
+        self.touched = gpu("hi-stencil-touched", tile_bytes, storage)?;
+        use vk::ImageUsageFlags as I;
+        let touch_usage = I::DEPTH_STENCIL_ATTACHMENT | I::SAMPLED;
+        self.touch = Image::new(ctx, "hi-stencil-touch", TOUCH_FORMAT, extent, touch_usage)?;
+        self.saved = gpu("saved-stencil", stencil_bytes(extent), storage)?;
+        Ok(())
+    }
+
     /// The surface for a new `extent`: the tile surfaces, the touch image and the saved-stencil
     /// buffer made anew, the update pipeline and sets kept (the sets re-pointed). A failure
     /// leaves the surface as it was. The GPU has finished every frame that used it.
     pub fn resize(&mut self, ctx: &Context, extent: vk::Extent2D) -> Result<()> {
-        let frame = TileRect::frame(extent);
-        let (tiles_x, tile_bytes) = (frame.width, u64::from(frame.width * frame.height) * 4);
-        use vk::BufferUsageFlags as U;
-        let gpu = |name, size, usage| Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly);
-        let storage = U::STORAGE_BUFFER | U::TRANSFER_DST;
         let mut fresh = Self::default();
-        let made = (|| -> Result<()> {
-            fresh.active = gpu("hi-stencil-active", tile_bytes, storage)?;
-            fresh.pending = gpu("hi-stencil-pending", tile_bytes, storage | U::TRANSFER_SRC)?;
-            fresh.touched = gpu("hi-stencil-touched", tile_bytes, storage)?;
-            use vk::ImageUsageFlags as I;
-            let touch_usage = I::DEPTH_STENCIL_ATTACHMENT | I::SAMPLED;
-            fresh.touch = Image::new(ctx, "hi-stencil-touch", TOUCH_FORMAT, extent, touch_usage)?;
-            fresh.saved = gpu("saved-stencil", stencil_bytes(extent), storage)?;
-            Ok(())
-        })();
-        if let Err(e) = made {
+        if let Err(e) = fresh.make_sized(ctx, extent) {
             fresh.destroy(ctx);
             return Err(e);
         }
@@ -222,14 +220,10 @@ impl HiStencilSurface {
         std::mem::swap(&mut self.saved, &mut fresh.saved);
         // `fresh` holds the old extent's objects now, and nothing else.
         fresh.destroy(ctx);
-        self.extent = extent;
-        self.tiles_x = tiles_x;
+        (self.extent, self.tiles_x) = (fresh.extent, fresh.tiles_x);
         self.marker = 0;
         self.unflushed = false;
-        for &set in &self.sets {
-            write_storage_buffers(ctx, set, &[self.pending.handle]);
-            write_read_only_view(ctx, set, 1, self.touch.view);
-        }
+        self.point_sets(ctx);
         Ok(())
     }
 
@@ -247,11 +241,16 @@ impl HiStencilSurface {
         ];
         (self.pool, self.sets) = sets_of(ctx, "hi-stencil-update-set", layout, slots, &sizes)?;
         self.views = vec![vk::ImageView::null(); slots as usize];
+        self.point_sets(ctx);
+        Ok(())
+    }
+
+    /// Points every slot's update set at the pending surface and the touch image.
+    fn point_sets(&self, ctx: &Context) {
         for &set in &self.sets {
             write_storage_buffers(ctx, set, &[self.pending.handle]);
             write_read_only_view(ctx, set, 1, self.touch.view);
         }
-        Ok(())
     }
 
     /// Points `slot`'s update set at a stencil-aspect view of `depth_stencil`, made anew (the
@@ -263,6 +262,8 @@ impl HiStencilSurface {
         depth_stencil: &ImageRef,
     ) -> Result<()> {
         let (set, view) = (self.sets[slot as usize], &mut self.views[slot as usize]);
+        // SAFETY: the slot's last view is ours (or null) and no pending frame reads it: the
+        // lighting records into a slot only once its last frame is declared finished.
         unsafe { ctx.device.destroy_image_view(*view, None) };
         *view = vk::ImageView::null();
         let info = vk::ImageViewCreateInfo::default()
@@ -275,6 +276,9 @@ impl HiStencilSurface {
                     .level_count(1)
                     .layer_count(1),
             );
+        // SAFETY: `info` names the caller's live depth-stencil image (the # Safety of the
+        // lighting's `record`), whose usage holds SAMPLED (checked by `check_usage`), and a
+        // stencil aspect its depth-stencil format has.
         *view = unsafe { ctx.device.create_image_view(&info, None) }.call("vkCreateImageView")?;
         ctx.name(*view, &format!("hi-stencil-stencil-view-{slot}"));
         write_read_only_view(ctx, set, 2, *view);
@@ -315,6 +319,9 @@ impl HiStencilSurface {
         let fill = [BufferAccess::TransferWrite];
         let before = surface.map(|b| (b, &frame_uses[..], &fill[..]));
         buffer_barrier(ctx, cmd, &before);
+        // SAFETY: `cmd` is recording outside rendering (the lighting pass resets before it
+        // begins rendering); the buffers are ours, made with TRANSFER_DST, and the barrier above
+        // orders the fills after every earlier use.
         unsafe {
             d.cmd_fill_buffer(cmd, self.active.handle, 0, vk::WHOLE_SIZE, 1);
             d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
@@ -344,6 +351,9 @@ impl HiStencilSurface {
             ],
         );
         let region = [vk::BufferCopy::default().size(self.pending.size)];
+        // SAFETY: `cmd` is recording outside rendering (a flush closes rendering first); both
+        // buffers are ours and of one size, pending with TRANSFER_SRC and active with
+        // TRANSFER_DST, and the barrier above orders the copy after their earlier uses.
         unsafe {
             ctx.device
                 .cmd_copy_buffer(cmd, self.pending.handle, self.active.handle, &region)
@@ -401,6 +411,9 @@ impl HiStencilSurface {
             min_depth: marker,
             max_depth: marker,
         };
+        // SAFETY: `cmd` is recording outside rendering (the write's bookkeeping split it); the
+        // touch image is ours, transitioned to an attachment above, and `info` lives until the
+        // call returns.
         unsafe {
             ctx.device.cmd_begin_rendering(cmd, &info);
             ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
@@ -410,6 +423,7 @@ impl HiStencilSurface {
 
     /// Ends the touch draw's rendering.
     pub fn end_touch(&self, ctx: &Context, cmd: vk::CommandBuffer) {
+        // SAFETY: `cmd` is inside the rendering `begin_touch` began, its one caller's pairing.
         unsafe { ctx.device.cmd_end_rendering(cmd) };
     }
 
@@ -502,6 +516,8 @@ impl HiStencilSurface {
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(ctx, cmd, set, bytemuck::bytes_of(push));
         let groups = push.rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
+        // SAFETY: `cmd` is recording outside rendering with the update pipeline and its set
+        // bound just above; the set's images were transitioned to the layouts it reads.
         unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
         let attached = ImageAccess::DepthStencilAttachment;
         transition(ctx, cmd, depth_stencil, attached, Contents::Keep);

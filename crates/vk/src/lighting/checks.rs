@@ -95,6 +95,14 @@ pub(super) fn check_frame(
                 .into(),
         ));
     }
+    // The light shader rejects a console's tiles after the early depth and stencil tests, which
+    // would already have written stencil: the emulation would diverge from the model. (A GPU
+    // hierarchy's rejected tile holds no fragment passing the stencil test, so it cannot.)
+    if (frame.plan.passes()).any(|p| p.state.tests_hi_stencil() && p.state.writes_stencil()) {
+        return Err(Error::Unsupported(
+            "a hi-stencil test in a pass that writes stencil",
+        ));
+    }
     if frame.plan.depth != frame.view.depth {
         return Err(bad(format!(
             "the plan is for {:?} depth, the view is {:?}",
@@ -176,8 +184,10 @@ impl UsageNeeds {
         needs
     }
 
-    /// The tiled technique's kernels, or with `depth_id` the depth-id technique's passes.
-    pub fn tiled(desc: &LightingDesc, depth_id: bool) -> Self {
+    /// The tiled technique's kernels and the depth-id technique's passes (alike here: both
+    /// sample the G-buffer, store into the HDR image and, with a decode hook that reads depth,
+    /// read it in the light passes' read-only layout).
+    pub fn tiled(desc: &LightingDesc) -> Self {
         use vk::ImageUsageFlags as U;
         let mut needs = Self {
             gbuffer: vec![(U::SAMPLED, "the tile classification and shading sample it")],
@@ -187,10 +197,9 @@ impl UsageNeeds {
         if desc.hooks.samples_depth() {
             let why = "the engine's decode hook samples its depth";
             needs.depth_stencil.push((U::SAMPLED, why));
-            if depth_id {
-                let why = "the depth-id passes attach its stencil while sampling its depth";
-                needs.depth_stencil.push((U::DEPTH_STENCIL_ATTACHMENT, why));
-            }
+            let why = "its depth is read in DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL, a layout \
+                       Vulkan allows only for attachments";
+            needs.depth_stencil.push((U::DEPTH_STENCIL_ATTACHMENT, why));
         }
         needs
     }

@@ -90,6 +90,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(sets_per_slot * slots + 2)
             .pool_sizes(&sizes);
+        // SAFETY: `info` and the `sizes` it points at outlive the call; `check_desc` refused no
+        // frames in flight, so `max_sets` and every size's count are non-zero.
         self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }
             .call("vkCreateDescriptorPool")?;
         ctx.name(self.pool, "lighting-descriptor-pool");
@@ -104,6 +106,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let alloc = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(self.pool)
             .set_layouts(&layouts);
+        // SAFETY: the pool was made above from this device for exactly these sets (`max_sets`
+        // counts them, its sizes their descriptors), and the layouts are live, made above.
         let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .call("vkAllocateDescriptorSets")?;
         self.hi_stencil_set = sets[0];

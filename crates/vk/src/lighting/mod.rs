@@ -36,7 +36,9 @@ use crate::gpu::error::{Error, Result};
 use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
 use crate::gpu::meshes::LightVolumes;
 use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::{Destroy, InFlight};
+use crate::gpu::teardown::{
+    declare_finished, refuse_in_flight, refuse_slot_in_flight, Destroy, InFlight,
+};
 use crate::gpu::timing::{LightingBreakdown, SlotTimer};
 use crate::hi_stencil::{GpuHierarchy, HiStencilSurface};
 use crate::lighting::hooks::HookSets;
@@ -283,13 +285,11 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// destroy, trusting this.
     pub unsafe fn slot_finished(&mut self, slot: u32) -> Result<()> {
         let frames = self.slots.len();
-        let slot = self.slots.get_mut(slot as usize).ok_or_else(|| {
-            bad(format!(
-                "slot_finished({slot}) of {frames} frames in flight"
-            ))
-        })?;
-        slot.pending = false;
-        Ok(())
+        declare_finished(
+            self.slots.get_mut(slot as usize).map(|s| &mut s.pending),
+            slot,
+            frames,
+        )
     }
 
     /// Whether a slot is recorded into and not yet declared finished.
@@ -299,27 +299,22 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
 
     /// Refuses `what` while a slot is in flight, naming the slots.
     fn none_in_flight(&self, what: &str) -> Result<()> {
-        let pending: Vec<String> = (self.slots.iter().enumerate())
-            .filter(|(_, s)| s.pending)
-            .map(|(i, _)| i.to_string())
-            .collect();
-        if pending.is_empty() {
-            return Ok(());
-        }
-        Err(Error::InFlight(format!(
-            "{what} while slot {} may still be read by the GPU: wait for those frames, and say              so with DeferredLighting::slot_finished, first",
-            pending.join(", ")
-        )))
+        refuse_in_flight(
+            self.slots.iter().map(|s| s.pending),
+            what,
+            "DeferredLighting",
+        )
     }
 
     /// Refuses a recording into `slot` while its last frame is not declared finished.
     fn slot_free(&self, slot: u32) -> Result<()> {
-        match self.slots.get(slot as usize) {
-            Some(s) if s.pending => Err(Error::InFlight(format!(
-                "slot {slot} recorded again before DeferredLighting::slot_finished({slot}) said                  the GPU finished its last frame: its buffers, sets and stencil view are that                  frame's until then"
-            ))),
-            _ => Ok(()),
-        }
+        let pending = self.slots.get(slot as usize).is_some_and(|s| s.pending);
+        refuse_slot_in_flight(
+            pending,
+            slot,
+            "DeferredLighting",
+            "buffers, sets and stencil view",
+        )
     }
 
     /// Creates every light pipeline `plan` uses, so the first frame that needs them does not
@@ -366,8 +361,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// an error.
     ///
     /// # Safety
-    /// - `cmd` is in the recording state, on a queue family with graphics, from the device of
-    ///   the context this lighting was made with.
+    /// - `cmd` is in the recording state, outside any render pass, on a queue family with
+    ///   graphics, from the device of the context this lighting was made with.
     /// - The images of `targets` are live, from that device, with the usages
     ///   [`LightingTargets`] lists, and their `state`s are true when `cmd` executes: the layout
     ///   each subresource is in, and the stages and accesses of the last commands before it that
@@ -380,7 +375,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &LightingFrame,
         targets: &mut LightingTargets,
     ) -> Result<()> {
-        self.record_emulating(cmd, frame, targets, None)
+        // SAFETY: the caller upholds this fn's # Safety, which is `record_emulating`'s; with
+        // no hierarchy it needs nothing more.
+        unsafe { self.record_emulating(cmd, frame, targets, None) }
     }
 
     /// [`DeferredLighting::record`], emulating `hierarchy`, the hierarchical stencil of an AMD
@@ -617,6 +614,10 @@ impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
         if let Some(v) = self.volumes.as_mut() {
             v.destroy(ctx);
         }
+        // SAFETY: the GPU is done with the pool, the layouts and the sets: no slot is pending
+        // (`slot_finished`'s # Safety) or the device went idle above, and the pipelines made
+        // with the layout are destroyed. Each handle was made from `ctx.device` by `create`,
+        // or is still null after a creation that failed half way (a no-op).
         unsafe {
             d.destroy_descriptor_pool(self.pool, None);
             d.destroy_pipeline_layout(self.pipeline_layout, None);

@@ -41,7 +41,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &TiledFrame,
         targets: &mut LightingTargets,
     ) -> Result<()> {
-        self.record_tiled_with(cmd, frame, targets, TiledShade::Kernels, |_, _| {})
+        // SAFETY: the caller upholds this fn's # Safety, which is `record_tiled_with`'s.
+        unsafe { self.record_tiled_with(cmd, frame, targets, TiledShade::Kernels, |_, _| {}) }
     }
 
     /// Records `frame` lit by the depth-id technique, as Bevy's deferred renderer lights its
@@ -68,7 +69,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &TiledFrame,
         targets: &mut LightingTargets,
     ) -> Result<()> {
-        self.record_tiled_with(cmd, frame, targets, TiledShade::DepthId, |_, _| {})
+        // SAFETY: the caller upholds this fn's # Safety: `record_tiled_with`'s, and the hook
+        // resources readable by the fragment shaders the depth-id passes shade with.
+        unsafe { self.record_tiled_with(cmd, frame, targets, TiledShade::DepthId, |_, _| {}) }
     }
 
     /// [`DeferredLighting::record_tiled`], calling `between` with the pass's name after the
@@ -94,7 +97,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         check_slot_and_lights(&self.desc, frame.slot, frame.lights)?;
         check_targets(&self.desc, &frame.hook_sets, targets)?;
-        let needs = UsageNeeds::tiled(&self.desc, shade == TiledShade::DepthId);
+        let needs = UsageNeeds::tiled(&self.desc);
         check_usage(targets, &needs)?;
         self.slot_free(frame.slot)?;
         if let Some(why) = self.desc.hooks.tiled_refusal() {
@@ -171,6 +174,13 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         slot: u32,
         buffer: &Buffer,
     ) {
+        // A recording of the slot's depth-id image: the slot is in flight until declared
+        // finished, as after any recording (its caller, the renderer, declared it first).
+        debug_assert!(
+            self.slot_free(slot).is_ok(),
+            "slot {slot} copied while in flight"
+        );
+        self.slots[slot as usize].pending = true;
         let (_, pass) = self
             .depth_id
             .iter_mut()

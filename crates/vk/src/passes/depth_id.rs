@@ -77,6 +77,10 @@ pub(crate) struct DepthIdPass {
 impl Destroy for DepthIdPass {
     fn destroy(&mut self, ctx: &Context) {
         let d = &ctx.device;
+        // SAFETY: every handle is null or was made by `new` from this device, and is nulled (or
+        // drained) as it goes, so a second call destroys nothing. The GPU is done with them:
+        // `build` destroys after a failed `new` (nothing recorded), the lighting's Drop after
+        // its slots finished or the device went idle.
         unsafe {
             for p in self.shade.drain(..).chain([self.copy]) {
                 d.destroy_pipeline(p, None);
@@ -234,6 +238,12 @@ impl DepthIdPass {
         let graphics = vk::PipelineBindPoint::GRAPHICS;
         let layout = self.pipeline_layout;
         let (sets, visibility) = bound;
+        // SAFETY: `cmd` is recording outside rendering (`record_tiled_with`'s # Safety, the one
+        // caller, whose tiled passes record no rendering); the id image was just transitioned
+        // to a depth attachment and `info` names only it, over its extent. The sets match the
+        // layout `new` made from `DepthIdDesc::set_layouts` (sets 0 to 2, and 4 only when the
+        // hooks have a visibility layout); `push` is the tiled technique's `PUSH_BYTES`, the
+        // layout's fragment range.
         unsafe {
             d.cmd_begin_rendering(cmd, &info);
             d.cmd_set_scissor(cmd, 0, &[area]);
@@ -266,6 +276,9 @@ impl DepthIdPass {
         // The copy: every surface pixel's slot as its depth (the shader writes the depth).
         ctx.begin_label(cmd, "depth-id-copy");
         apply(ctx, cmd, &state(CompareOp::Always, true));
+        // SAFETY: inside the rendering begun above, with sets, push constants, scissor and the
+        // pass state bound or set; the copy pipeline was made by `new` for a depth-only
+        // `ID_FORMAT` attachment, this one; the full-screen triangle reads no vertex buffer.
         unsafe {
             d.cmd_set_viewport(cmd, 0, &[viewport(None)]);
             d.cmd_bind_pipeline(cmd, graphics, self.copy);
@@ -278,6 +291,7 @@ impl DepthIdPass {
         apply(ctx, cmd, &state(CompareOp::Equal, false));
         for (s, pipeline) in self.shade.iter().enumerate() {
             ctx.begin_label(cmd, &format!("depth-id-shade-{s}"));
+            // SAFETY: as for the copy above; the viewport's depth is one in [0, 1].
             unsafe {
                 d.cmd_set_viewport(cmd, 0, &[viewport(Some(depth_of(s)))]);
                 d.cmd_bind_pipeline(cmd, graphics, *pipeline);
@@ -285,6 +299,7 @@ impl DepthIdPass {
             }
             ctx.end_label(cmd);
         }
+        // SAFETY: ends the rendering begun on `cmd` above.
         unsafe { d.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }

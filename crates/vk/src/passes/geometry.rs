@@ -216,6 +216,7 @@ impl MeshPasses {
                 None => oriented(OPAQUE, depth),
             })
         });
+        // SAFETY: ends the rendering `begin_rendering` began on `cmd` above.
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }
@@ -256,6 +257,10 @@ impl MeshPasses {
 
     /// Frees the pipelines and layouts; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the handles are null or were made by `new` from this device, and reset to
+        // null after, so a second call destroys nothing. The GPU is done with them: the
+        // renderer's Drop waits for the device first, and `build` and `Owned` destroy them
+        // before any frame recorded.
         unsafe {
             for p in [self.gbuffer, self.forward, self.emissive] {
                 ctx.device.destroy_pipeline(p, None);
@@ -285,6 +290,10 @@ impl Draw<'_> {
     /// constants.
     fn objects(&self, state_of: impl Fn(usize) -> Option<PassState>) {
         let (d, cmd, inputs) = (&self.ctx.device, self.cmd, self.inputs);
+        // SAFETY: `cmd` is recording inside the rendering the pass began (`record_gbuffer`,
+        // `hdr_pass`) into attachments of the formats the pipeline was made for (`MeshFormats`;
+        // `Renderer::record_gbuffer` checks an engine's images). The pipeline and layout were
+        // made by `new` and live as long as `self`; the frame set is of set 0's layout.
         unsafe {
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             d.cmd_bind_descriptor_sets(
@@ -308,6 +317,8 @@ impl Draw<'_> {
             let set = inputs.material_sets[i];
             if bound != Some(set) {
                 bound = Some(set);
+                // SAFETY: as above; `set` is the object's material set, allocated from
+                // `material_layout`, set 1 of this layout (`GpuMaterials::new`).
                 unsafe {
                     d.cmd_bind_descriptor_sets(
                         cmd,
@@ -324,6 +335,8 @@ impl Draw<'_> {
                 &object.material,
                 inputs.material_indices[i],
             );
+            // SAFETY: as above; the push is `DrawPush` at offset 0, the layout's graphics-stage
+            // range (`PUSH_CONSTANT_BYTES` is its size).
             unsafe {
                 d.cmd_push_constants(
                     cmd,
@@ -357,6 +370,7 @@ impl Draw<'_> {
             depth,
         );
         self.objects(state_of);
+        // SAFETY: ends the rendering `begin_hdr_rendering` began on `cmd` above.
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         ctx.end_label(cmd);
     }

@@ -195,6 +195,9 @@ impl LightPipelines {
     /// Frees the pipelines made so far (not the layout); a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
         for (_, p) in self.pipelines.drain() {
+            // SAFETY: `p` was made by `prepare` from this device and is drained from the map, so
+            // destroyed once; the lighting's Drop, the one caller, has its slots finished or
+            // the device idle first.
             unsafe { ctx.device.destroy_pipeline(p, None) };
         }
     }

@@ -15,7 +15,7 @@ use super::light_pipelines::{
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
 use crate::gpu::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result};
+use crate::gpu::error::Result;
 use crate::gpu::gpu_types::LightDrawPush;
 use crate::gpu::meshes::LightVolumes;
 use crate::gpu::state::{apply_bounded, FULLSCREEN};
@@ -130,6 +130,7 @@ impl Rendering {
 
     fn close(&mut self, pass: &LightingPass) {
         if self.open {
+            // SAFETY: `open` says `cmd` is inside the rendering `Rendering::open` began.
             unsafe { pass.ctx.device.cmd_end_rendering(pass.cmd) };
             self.open = false;
         }
@@ -175,10 +176,48 @@ impl Emulation {
             .count() as u32;
         2 * ops + 2
     }
+}
 
-    /// Ends the span before it: `group` names what it timed.
-    fn mark(timer: &mut Option<&mut StepTimer>, pass: &LightingPass, group: &str) {
-        if let Some(t) = timer.as_deref_mut() {
+/// The two optional timers a recording writes: a timestamp after every step of the plan, and
+/// the emulator's bookkeeping timed apart from the technique ([`Emulation`]). Every recorded
+/// step goes through [`Timers::step`], every piece of bookkeeping through
+/// [`Timers::bookkeeping`], so labels and timestamps are written in one place.
+struct Timers<'t> {
+    steps: Option<&'t mut StepTimer>,
+    emulation: Option<&'t mut StepTimer>,
+}
+
+impl Timers<'_> {
+    /// Records `body` as one step: inside the debug label `label`, then a step timestamp
+    /// closing the span, named by `group` (the pass group and the scene light it lit).
+    fn step<R>(
+        &mut self,
+        pass: &LightingPass,
+        label: &str,
+        group: impl FnOnce() -> (String, Option<u32>),
+        body: impl FnOnce(&mut Self) -> R,
+    ) -> R {
+        pass.ctx.begin_label(pass.cmd, label);
+        let result = body(self);
+        pass.ctx.end_label(pass.cmd);
+        if let Some(t) = self.steps.as_deref_mut() {
+            let (group, light) = group();
+            t.mark(pass.ctx, pass.cmd, group, light);
+        }
+        result
+    }
+
+    /// Records `body`, the emulator's bookkeeping: the span before it closes as the platform's
+    /// technique, `body`'s own span as bookkeeping.
+    fn bookkeeping(&mut self, pass: &LightingPass, body: impl FnOnce()) {
+        self.mark(pass, Emulation::TECHNIQUE);
+        body();
+        self.mark(pass, Emulation::BOOKKEEPING);
+    }
+
+    /// Ends the emulation timer's span before it: `group` names what it timed.
+    fn mark(&mut self, pass: &LightingPass, group: &str) {
+        if let Some(t) = self.emulation.as_deref_mut() {
             t.mark(pass.ctx, pass.cmd, group.into(), None);
         }
     }
@@ -199,11 +238,14 @@ impl LightingPass<'_> {
         &self,
         targets: &mut LightingTargets,
         hi_stencil: &mut HiStencilSurface,
-        mut timer: Option<&mut StepTimer>,
-        mut emulation: Option<&mut StepTimer>,
+        timer: Option<&mut StepTimer>,
+        emulation: Option<&mut StepTimer>,
     ) -> Result<()> {
         let (ctx, cmd) = (self.ctx, self.cmd);
-        let d = &ctx.device;
+        let mut timers = Timers {
+            steps: timer,
+            emulation,
+        };
         ctx.begin_label(cmd, "lighting");
         for image in targets.gbuffer.iter_mut() {
             transition(
@@ -214,128 +256,129 @@ impl LightingPass<'_> {
                 Contents::Keep,
             );
         }
-        if let Some(t) = timer.as_deref_mut() {
+        if let Some(t) = timers.steps.as_deref_mut() {
             t.reset(ctx, cmd);
         }
-        if let Some(t) = emulation.as_deref_mut() {
+        if let Some(t) = timers.emulation.as_deref_mut() {
             t.reset(ctx, cmd);
             t.start(ctx, cmd);
         }
         hi_stencil.record_reset(ctx, cmd);
-        Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
-        unsafe {
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline_layout,
-                0,
-                self.sets,
-                &[],
-            );
-            if let Some(set) = self.visibility_set {
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.pipeline_layout,
-                    VISIBILITY_SET_INDEX,
-                    &[set],
-                    &[],
-                );
-            }
-        }
+        timers.mark(self, Emulation::BOOKKEEPING);
+        self.bind_sets();
         let mut rendering = Rendering {
             open: false,
             cleared: !self.clear_hdr,
         };
         rendering.open(self, targets);
-        if let Some(t) = timer.as_deref_mut() {
+        if let Some(t) = timers.steps.as_deref_mut() {
             t.start(ctx, cmd);
         }
+        // Each planned light's passes sit inside one label of its own.
         let mut current_light = None;
+        let mut light_label = |light: Option<usize>| {
+            if current_light == light {
+                return;
+            }
+            if current_light.is_some() {
+                ctx.end_label(cmd);
+            }
+            current_light = light;
+            if let Some(light) = light {
+                let input = self.plan.lights[light].input;
+                ctx.begin_label(cmd, &format!("light-{input}"));
+            }
+        };
         let touches = plan_touches(self.plan);
         for (index, step) in self.plan.steps.iter().enumerate() {
             match step {
                 Step::Pass { light, pass } => {
-                    if current_light != Some(*light) {
-                        if current_light.is_some() {
-                            ctx.end_label(cmd);
-                        }
-                        current_light = Some(*light);
-                        let input = self.plan.lights[*light].input;
-                        ctx.begin_label(cmd, &format!("light-{input}"));
-                    }
+                    light_label(Some(*light));
                     let scene_light = self.plan.lights[*light].input as u32;
-                    ctx.begin_label(cmd, &pass.label());
-                    let test = self.hierarchy.as_ref().and_then(|h| h.test_for(pass));
-                    if let Some(test) = test {
-                        Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
-                        rendering.close(self);
-                        let rect = tile_rect(self.extent, self.screen_rect(*light, pass));
-                        let ds = &mut targets.depth_stencil;
-                        hi_stencil.record_evaluate(ctx, cmd, self.slot, ds, test, rect);
-                        Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
-                    }
-                    let tested = test.is_some();
-                    let bounded = (pass, self.plan.lights[*light].depth_range);
-                    self.record_pass(targets, &mut rendering, index, bounded, scene_light, tested)?;
-                    if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
-                        Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
-                        rendering.split(self);
-                        let touched = touches[index].expect("every write has its touch");
-                        let write = (*light, pass, &hi, touched);
-                        self.record_write_tiles(targets, hi_stencil, write);
-                        Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
-                    }
-                    ctx.end_label(cmd);
-                    if let Some(t) = timer.as_deref_mut() {
+                    let group = || {
                         let group = pass_group(pass.kind, self.brdfs, self.brdf_source);
-                        t.mark(ctx, cmd, group, Some(scene_light));
-                    }
+                        (group, Some(scene_light))
+                    };
+                    timers.step(self, &pass.label(), group, |timers| {
+                        let test = self.hierarchy.as_ref().and_then(|h| h.test_for(pass));
+                        if let Some(test) = test {
+                            timers.bookkeeping(self, || {
+                                rendering.close(self);
+                                let rect = tile_rect(self.extent, self.screen_rect(*light, pass));
+                                let ds = &mut targets.depth_stencil;
+                                hi_stencil.record_evaluate(ctx, cmd, self.slot, ds, test, rect);
+                            });
+                        }
+                        let bounded = (pass, self.plan.lights[*light].depth_range);
+                        let tested = test.is_some();
+                        self.record_pass(
+                            targets,
+                            &mut rendering,
+                            index,
+                            bounded,
+                            scene_light,
+                            tested,
+                        );
+                        if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
+                            timers.bookkeeping(self, || {
+                                rendering.split(self);
+                                let touched = touches[index].expect("every write has its touch");
+                                let write = (*light, pass, &hi, touched);
+                                self.record_write_tiles(targets, hi_stencil, write);
+                            });
+                        }
+                    });
                 }
                 Step::FlushHiStencil => {
-                    ctx.begin_label(cmd, "flush-hi-stencil");
-                    Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
-                    rendering.close(self);
-                    hi_stencil.record_flush(ctx, cmd);
-                    Emulation::mark(&mut emulation, self, Emulation::BOOKKEEPING);
-                    ctx.end_label(cmd);
-                    if let Some(t) = timer.as_deref_mut() {
-                        t.mark(ctx, cmd, "flush".into(), None);
-                    }
+                    let group = || ("flush".to_owned(), None);
+                    timers.step(self, "flush-hi-stencil", group, |timers| {
+                        timers.bookkeeping(self, || {
+                            rendering.close(self);
+                            hi_stencil.record_flush(ctx, cmd);
+                        })
+                    });
                 }
                 Step::SavePreserved { .. } => {
-                    ctx.begin_label(cmd, "save-preserved");
-                    rendering.close(self);
-                    hi_stencil.record_save(ctx, cmd, &mut targets.depth_stencil);
-                    ctx.end_label(cmd);
-                    if let Some(t) = timer.as_deref_mut() {
-                        t.mark(ctx, cmd, "save-preserved".into(), None);
-                    }
+                    let group = || ("save-preserved".to_owned(), None);
+                    timers.step(self, "save-preserved", group, |_| {
+                        rendering.close(self);
+                        hi_stencil.record_save(ctx, cmd, &mut targets.depth_stencil);
+                    });
                 }
                 Step::RestorePreserved { mask } => {
-                    if current_light.take().is_some() {
-                        ctx.end_label(cmd);
-                    }
-                    ctx.begin_label(cmd, "restore-preserved");
-                    rendering.open(self, targets);
-                    self.record_restore(*mask);
-                    ctx.end_label(cmd);
-                    if let Some(t) = timer.as_deref_mut() {
-                        t.mark(ctx, cmd, "restore-preserved".into(), None);
-                    }
+                    light_label(None);
+                    let group = || ("restore-preserved".to_owned(), None);
+                    timers.step(self, "restore-preserved", group, |_| {
+                        rendering.open(self, targets);
+                        self.record_restore(*mask);
+                    });
                 }
             }
         }
-        if current_light.is_some() {
-            ctx.end_label(cmd);
-        }
+        light_label(None);
         rendering.close(self);
-        Emulation::mark(&mut emulation, self, Emulation::TECHNIQUE);
+        timers.mark(self, Emulation::TECHNIQUE);
         if self.count_stats {
             hi_stencil.record_stats_readable(ctx, cmd);
         }
         ctx.end_label(cmd);
         Ok(())
+    }
+
+    /// Binds the frame's sets, and the engine's visibility set where it has one.
+    fn bind_sets(&self) {
+        let (d, cmd, layout) = (&self.ctx.device, self.cmd, self.pipeline_layout);
+        let graphics = vk::PipelineBindPoint::GRAPHICS;
+        // SAFETY: `cmd` is recording (LightingPass's contract); the sets and the layout were
+        // made from this context's device by the lighting, and the sets match the layout's set
+        // layouts from set 0 (and the visibility layout at VISIBILITY_SET_INDEX).
+        unsafe {
+            d.cmd_bind_descriptor_sets(cmd, graphics, layout, 0, self.sets, &[]);
+            if let Some(set) = self.visibility_set {
+                let first = VISIBILITY_SET_INDEX;
+                d.cmd_bind_descriptor_sets(cmd, graphics, layout, first, &[set], &[]);
+            }
+        }
     }
 
     /// Where plan light `light`'s `pass` lies on screen: its light's rectangle for a volume,
@@ -358,18 +401,12 @@ impl LightingPass<'_> {
         (pass, bounds): (&Pass, Option<DepthRange>),
         scene_light: u32,
         hierarchy_tested: bool,
-    ) -> Result<()> {
+    ) {
         let state = &pass.state;
-        // A hierarchy's rejected tile holds no fragment passing the stencil test, so a pass that
-        // also writes stencil writes nothing there either: only a console's test, which rules
-        // on state written by another pass, could diverge.
-        if state.tests_hi_stencil() && state.writes_stencil() {
-            // The light shader rejects tiles after early depth / stencil tests, which would
-            // already have written stencil: the emulation would diverge from the model.
-            return Err(Error::Unsupported(
-                "a hi-stencil test in a pass that writes stencil",
-            ));
-        }
+        debug_assert!(
+            !(state.tests_hi_stencil() && state.writes_stencil()),
+            "check_frame refuses a hi-stencil test in a pass that writes stencil"
+        );
         let shades = matches!(pass.kind, PassKind::Shade(_));
         let mut flags = 0;
         if state.tests_hi_stencil() || hierarchy_tested {
@@ -410,7 +447,6 @@ impl LightingPass<'_> {
         let tests = self.hierarchy.is_some();
         let key = pipeline_key(pass, self.brdfs, self.count_stats, self.brdf_source, tests);
         self.draw(key, state, (pass.geometry, bounds), push);
-        Ok(())
     }
 
     /// Outside rendering, after the hi-stencil write `hi` of plan light `light`'s `pass`: the
@@ -494,6 +530,9 @@ impl LightingPass<'_> {
     ) {
         let (ctx, cmd) = (self.ctx, self.cmd);
         let d = &ctx.device;
+        // SAFETY: `cmd` is inside the lighting's rendering (`record_pass` opens it before each
+        // draw); the pipeline was made for this plan's pass state (`prepare_pipelines`) with
+        // `pipeline_layout`, whose push range holds a `LightDrawPush`.
         unsafe {
             d.cmd_bind_pipeline(
                 cmd,
@@ -510,6 +549,8 @@ impl LightingPass<'_> {
         }
         apply_bounded(ctx, cmd, state, bounds);
         match geometry {
+            // SAFETY: inside rendering with a full-screen pipeline bound just above, which draws
+            // its triangle from the vertex index alone.
             Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
             Geometry::Volume => {
                 let kind = &self.lights[push.light_index as usize].kind;

@@ -100,6 +100,10 @@ pub(crate) fn begin_rendering(
         min_depth: 0.0,
         max_depth: 1.0,
     };
+    // SAFETY: `cmd` is recording outside rendering: each pass begins here after the one before
+    // ended its own, and the callers' contracts say `cmd` records. They transitioned every
+    // attachment to the layout it is named with, and `extent` (non-zero) is theirs: the render
+    // area, viewport and scissor lie inside them.
     unsafe {
         ctx.device.cmd_begin_rendering(cmd, &info);
         ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);

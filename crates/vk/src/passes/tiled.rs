@@ -203,6 +203,10 @@ pub(crate) struct TiledSets {
 impl Destroy for TiledLighting {
     fn destroy(&mut self, ctx: &Context) {
         let d = &ctx.device;
+        // SAFETY: every handle is null or was made by `new` from this device, and is nulled
+        // (or drained) as it goes, so a second call destroys nothing. The GPU is done with them:
+        // `build` destroys after a failed `new` (nothing recorded), the lighting's Drop after
+        // its slots finished or the device went idle.
         unsafe {
             let single = [
                 self.classify,
@@ -444,6 +448,10 @@ impl TiledLighting {
             .dst_binding(4)
             .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
             .image_info(&image);
+        // SAFETY: `slot`'s set is not in use: `record_tiled_with`, the one caller, refused a
+        // slot not declared finished (`slot_free`; `slot_finished`'s # Safety). Binding 4 is
+        // `TILED_SET`'s storage image, and `hdr` is the caller's live view with `STORAGE` usage
+        // (`record_tiled`'s # Safety, `check_usage`), in `GENERAL` when the kernels run.
         unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
     }
 
@@ -495,6 +503,9 @@ impl TiledLighting {
         );
         // Each slot's dispatch starts at zero tiles.
         let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
+        // SAFETY: `cmd` is recording outside rendering (`record_tiled_with`'s # Safety, the one
+        // caller). `reset` is the dispatch buffer's exact size, `(MIXED_SLOT + 1) * 16` bytes,
+        // a multiple of 4 under 64 KiB; both buffers are live with `TRANSFER_DST` usage.
         unsafe {
             d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
             // Every tile's light mask starts empty; the light lists set bits.
@@ -512,6 +523,10 @@ impl TiledLighting {
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
             ),
         );
+        // SAFETY: as above for `cmd`. The sets match the layout made in `new`: the lighting's
+        // frame and decode sets (sets 0 and 1), this slot's tiled set (2) and the visibility
+        // hook's (4, its layout there when it has a set); the push is `TiledPush`, the layout's
+        // compute range.
         unsafe {
             let bound = [sets.frame, sets.decode, self.sets[sets.slot as usize]];
             let compute = vk::PipelineBindPoint::COMPUTE;
@@ -528,6 +543,8 @@ impl TiledLighting {
                 bytemuck::bytes_of(&push),
             );
         }
+        // SAFETY: as above for `cmd`; both classification pipelines were made by `new` with
+        // this layout, whose sets and push constants are bound just above.
         unsafe {
             let (x, y) = self.tiles_xy;
             let (pipeline, groups) = match shape {
@@ -554,6 +571,9 @@ impl TiledLighting {
         // A workgroup per light, in rows of at most the guaranteed workgroup count.
         const ROW: u32 = 65535;
         let groups = (lights.min(ROW), lights.div_ceil(ROW));
+        // SAFETY: `cmd` is recording outside rendering, after `record_classify` bound this
+        // layout's sets and push constants (`record_tiled_with`, the one caller); the pipeline
+        // was made by `new` with that layout; at most 65535 groups along each axis.
         unsafe {
             let d = &ctx.device;
             d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.light_lists);
@@ -573,6 +593,9 @@ impl TiledLighting {
         let branching = (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
         for (slot, pipeline) in self.shade.iter().enumerate().chain(branching) {
             ctx.begin_label(cmd, &format!("tiled-shade-{slot}"));
+            // SAFETY: as in `record_light_lists`; `slot <= MIXED_SLOT` (at most `MAX_SLOTS`
+            // kernels, checked in `new`), so the arguments at `slot * 16` lie inside the
+            // dispatch buffer, which has `INDIRECT_BUFFER` usage.
             unsafe {
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);
                 d.cmd_dispatch_indirect(cmd, self.dispatch.handle, (slot * 16) as u64);
@@ -617,5 +640,8 @@ fn buffer_barrier(
         .dst_stage_mask(dst.0)
         .dst_access_mask(dst.1)];
     let info = vk::DependencyInfo::default().memory_barriers(&barrier);
+    // SAFETY: `cmd` is recording outside rendering (the record fns above, inside
+    // `record_tiled_with`), from a graphics and compute queue family, which supports the
+    // transfer, compute and indirect stages named.
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &info) };
 }

@@ -98,6 +98,10 @@ impl Tonemap {
             &[color_attachment(&targets.ldr, Load::Clear(CLEAR_BLACK))],
             None,
         );
+        // SAFETY: `cmd` is the renderer's, recording, inside the rendering begun above into
+        // the LDR target, of the format the pipeline was made for. The pipeline, layout and set
+        // were made by `new` and live as long as `self`; the frame set is of set 0's layout and
+        // `self.set` samples the HDR target, transitioned above for fragment reads.
         unsafe {
             ctx.device
                 .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
@@ -118,6 +122,10 @@ impl Tonemap {
 
     /// Frees the pipeline, the set's pool and the layouts; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the handles are null or were made by `new` from this device, and reset to
+        // null after, so a second call destroys nothing. The GPU is done with them: the
+        // renderer's Drop waits for the device first, and `build` and `Owned` destroy them
+        // before any frame recorded.
         unsafe {
             ctx.device.destroy_pipeline(self.pipeline, None);
             ctx.device.destroy_descriptor_pool(self.pool, None);

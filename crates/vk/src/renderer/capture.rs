@@ -192,6 +192,10 @@ impl FootprintCapture {
                 light_index: light.0,
                 ..Default::default()
             };
+            // SAFETY: `cmd` is recording (the caller, `Renderer::simulator_inputs`, began it)
+            // and inside the rendering `begin_cleared` began above; the pipeline was made by
+            // `new` with `pipeline_layout`, from this device, and lives until `destroy`; the
+            // push is `LightDrawPush` at offset 0, within the layout's graphics-stage range.
             unsafe {
                 ctx.device
                     .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
@@ -217,6 +221,7 @@ impl FootprintCapture {
                 },
             );
             volumes.draw(ctx, cmd, &light.1.kind);
+            // SAFETY: ends the rendering `begin_cleared` began on `cmd` in this iteration.
             unsafe { ctx.device.cmd_end_rendering(cmd) };
             copy_image_to_buffer(
                 ctx,
@@ -265,6 +270,10 @@ impl FootprintCapture {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the pipeline was made by `new` from this device. Its one user,
+        // `Renderer::simulator_inputs`, destroys the capture after `submit_and_wait` waited for
+        // the frames that drew with it, or after an error before their submit (a failed fence
+        // wait aside: the frame may then still be pending).
         unsafe { ctx.device.destroy_pipeline(self.pipeline, None) };
         for image in &mut self.faces {
             image.destroy(ctx);

@@ -184,6 +184,7 @@ impl<'c> Renderer<'c> {
             command_pool,
             cmd,
             fence,
+            unfinished: std::cell::Cell::new(false),
             timestamps: timestamps.keep(),
             readback,
         })
@@ -203,6 +204,8 @@ impl FrameSubmission {
         build(ctx, |s: &mut Self| {
             let pool_info =
                 vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
+            // SAFETY: `pool_info` is valid for the call and names the context's queue family,
+            // one of this device's.
             s.command_pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
                 .call("vkCreateCommandPool")?;
             ctx.name(s.command_pool, "frame-command-pool");
@@ -210,9 +213,12 @@ impl FrameSubmission {
                 .command_pool(s.command_pool)
                 .level(vk::CommandBufferLevel::PRIMARY)
                 .command_buffer_count(1);
+            // SAFETY: the pool was made just above from this device and is used by nothing else
+            // yet (it is not shared with another thread).
             s.cmd = unsafe { ctx.device.allocate_command_buffers(&alloc) }
                 .call("vkAllocateCommandBuffers")?[0];
             ctx.name(s.cmd, "frame-commands");
+            // SAFETY: a default (unsignalled) fence create info, valid for the call.
             s.fence = unsafe {
                 ctx.device
                     .create_fence(&vk::FenceCreateInfo::default(), None)
@@ -226,6 +232,9 @@ impl FrameSubmission {
 
 impl Destroy for FrameSubmission {
     fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the handles are null or were made by `new` from this device; only a failed
+        // `new` (`build`) or `Renderer::with_desc` (`Owned`) destroys through here, before the
+        // command buffer was ever submitted, so no queue uses the fence or the pool.
         unsafe {
             ctx.device.destroy_fence(self.fence, None);
             ctx.device.destroy_command_pool(self.command_pool, None);
@@ -237,6 +246,12 @@ impl Destroy for FrameSubmission {
 impl Drop for Renderer<'_> {
     fn drop(&mut self) {
         let ctx = self.ctx;
+        // SAFETY: the fence and the pool were made from this device by `FrameSubmission::new`
+        // and are destroyed only here; the wait leaves the GPU done with them (a lost device,
+        // whose error is ignored, runs nothing more). The wait needs every queue of the device
+        // unused meanwhile: this renderer submits nothing now; a lent device's other users are
+        // kept off by `Context::from_raw`'s # Safety (nothing guards an owned context shared
+        // by renderers on several threads).
         unsafe {
             let _ = ctx.device.device_wait_idle();
             ctx.device.destroy_fence(self.fence, None);
@@ -246,7 +261,8 @@ impl Drop for Renderer<'_> {
         self.readback.destroy(ctx);
         self.tonemap.destroy(ctx);
         if let Some(t) = self.lut_tables.take() {
-            // SAFETY: the device is idle (above).
+            // SAFETY: `LutTables::destroy`'s # Safety holds: the device was waited idle above,
+            // so every frame recorded with the tables has finished.
             unsafe { t.destroy() };
         }
         if let Some(a) = self.alpha.as_mut() {

@@ -5,7 +5,7 @@
 use super::{Frame, Renderer};
 use crate::alpha::AlphaInputs;
 use crate::gpu::access::LightingTargets;
-use crate::gpu::error::{Result, VkCall};
+use crate::gpu::error::{Error, Result, VkCall};
 use crate::gpu::readback::Readback;
 use crate::gpu::targets::GBUFFER_FORMATS;
 use crate::gpu::timing::FrameTimings;
@@ -165,7 +165,8 @@ impl Renderer<'_> {
             let mut targets = self.targets.lighting();
             let timestamps = &mut self.timestamps;
             let classified = |cmd, pass| timestamps.mark(ctx, cmd, pass);
-            // SAFETY: as for `record` below.
+            // SAFETY: as for `record_emulating` below; and the HDR target has `STORAGE` usage
+            // (`Targets::new`), and the built-in hooks bind no engine resources.
             unsafe {
                 self.lighting
                     .record_tiled_with(cmd, &frame, &mut targets, shade, classified)?
@@ -186,8 +187,10 @@ impl Renderer<'_> {
             hook_sets: HookSets::default(),
         };
         let mut targets = self.targets.lighting();
-        // SAFETY: `cmd` records on this context's device; the targets' states are the ones this
-        // renderer tracks; it waits for every frame, so slot 0 is free.
+        // SAFETY: `cmd` was begun by `begin_commands` on this context's device, the one the
+        // lighting was made with, and every pass before this one ended its rendering; the
+        // targets are the renderer's own, with the states it tracks (`Targets::lit` after each
+        // pass); `begin_commands` declared slot 0 finished after the last frame's wait.
         unsafe {
             self.lighting
                 .record_emulating(cmd, &frame, &mut targets, hierarchy)?
@@ -200,10 +203,20 @@ impl Renderer<'_> {
     /// Resets the frame's command pool (its one command buffer; resetting pools, not single
     /// buffers, is what the best-practices layer asks for) and begins the command buffer.
     pub(super) fn begin_commands(&mut self) -> Result<vk::CommandBuffer> {
-        // SAFETY: the renderer waits for every frame it submits before it returns, so slot 0's
-        // last frame has finished, or was never submitted (an error before the submit).
+        if self.unfinished.get() {
+            return Err(Error::InFlight(
+                "the renderer's last frame was submitted and waiting for it failed (a timeout or \
+                 a lost device): it records nothing more"
+                    .into(),
+            ));
+        }
+        // SAFETY: every frame `submit_and_wait` submitted was waited for (`unfinished` is
+        // clear), so slot 0's last frame has finished, or was never submitted (an error before
+        // the submit).
         unsafe { self.lighting.slot_finished(0)? };
         let (d, cmd) = (&self.ctx.device, self.cmd);
+        // SAFETY: the pool and its one command buffer were made from this device and are used
+        // by this renderer alone (`&mut self`); the buffer is not pending, as said above.
         unsafe {
             d.reset_command_pool(self.command_pool, vk::CommandPoolResetFlags::empty())
                 .call("vkResetCommandPool")?;
@@ -218,6 +231,11 @@ impl Renderer<'_> {
     /// Ends, submits and waits for the frame's command buffer.
     pub(super) fn submit_and_wait(&self) -> Result<()> {
         let (ctx, cmd) = (self.ctx, self.cmd);
+        // SAFETY: `cmd` is recording (`begin_commands`) and outside rendering: every pass ends
+        // its own. The fence is this renderer's, unsignalled (reset after each wait, created
+        // unsignalled) and not in use by another submit. The queue's external synchronisation
+        // is `Context::from_raw`'s # Safety on a lent device; on an owned one nothing stops two
+        // renderers sharing the context from submitting at once from two threads.
         unsafe {
             ctx.device
                 .end_command_buffer(cmd)
@@ -227,10 +245,12 @@ impl Renderer<'_> {
             ctx.device
                 .queue_submit2(ctx.queue, &[submit], self.fence)
                 .call("vkQueueSubmit2")?;
+            self.unfinished.set(true);
             ctx.step("waiting on the GPU");
             ctx.device
                 .wait_for_fences(&[self.fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")?;
+            self.unfinished.set(false);
             ctx.device
                 .reset_fences(&[self.fence])
                 .call("vkResetFences")?;

@@ -354,6 +354,8 @@ impl GpuMaterials {
             .chain(&plan.samplers)
             .enumerate()
         {
+            // SAFETY: `sampler_info` is a plain create info (no anisotropy, no compare, no
+            // chained structs), valid for the call.
             let sampler = unsafe { ctx.device.create_sampler(&sampler_info(s), None) }
                 .call("vkCreateSampler")?;
             ctx.name(sampler, &format!("material-sampler-{i}"));
@@ -413,6 +415,8 @@ impl GpuMaterials {
         let pool_info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(count)
             .pool_sizes(&sizes);
+        // SAFETY: `pool_info` and `sizes` outlive the call; `plan_materials` always plans the
+        // default set first, so `max_sets` and every size's count are non-zero.
         self.pool = unsafe { ctx.device.create_descriptor_pool(&pool_info, None) }
             .call("vkCreateDescriptorPool")?;
         ctx.name(self.pool, "material-descriptor-pool");
@@ -420,6 +424,8 @@ impl GpuMaterials {
         let alloc = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(self.pool)
             .set_layouts(&layouts);
+        // SAFETY: the pool was made above from this device with room for exactly these sets
+        // and their descriptors; `layout` is the mesh passes' live set 1 layout (`new`).
         let sets = unsafe { ctx.device.allocate_descriptor_sets(&alloc) }
             .call("vkAllocateDescriptorSets")?;
         let records = self.records.as_ref().expect("made before the sets").handle;
@@ -460,6 +466,10 @@ impl GpuMaterials {
                         .image_info(info),
                 );
             }
+            // SAFETY: `set` was just allocated and no command buffer uses it yet; each write
+            // matches a binding of `MATERIAL_SET` (material.glsl); the record's offset is a
+            // multiple of 256 (every device's largest uniform alignment); the textures and
+            // samplers were made above, the textures uploaded and left shader-read-only.
             unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
         }
         self.object_sets = plan.object_sets.iter().map(|&s| sets[s as usize]).collect();
@@ -468,6 +478,9 @@ impl GpuMaterials {
 
     /// Frees the textures, samplers, records and sets; a second call does nothing.
     pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the pool and samplers are null or were made by `fill` from this device, and
+        // the GPU is done with them: the renderer's Drop destroys these after its device wait,
+        // `build` and `Owned` before any frame used them. A second call finds null and none.
         unsafe {
             ctx.device.destroy_descriptor_pool(self.pool, None);
             for s in self.samplers.drain(..) {

@@ -131,6 +131,9 @@ pub struct Renderer<'c> {
     command_pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
+    /// A frame was submitted and its fence wait failed (a timeout, a lost device): the command
+    /// buffer may still be pending, so the renderer records nothing more.
+    unfinished: std::cell::Cell<bool>,
     timestamps: Timestamps,
     readback: ReadbackBuffers,
 }
@@ -233,8 +236,9 @@ impl<'c> Renderer<'c> {
                 });
             }
             let tables = LutTables::new(self.ctx, &self.materials, self.desc.lut_resolution)?;
-            // SAFETY: the renderer keeps the tables until it drops them or bakes new ones, and
-            // it waits for every frame it submits.
+            // SAFETY: `tables` moves into `self.lut_tables` below and is freed only by the
+            // renderer's Drop, after its device wait; they are the first tables (baked once),
+            // so no command buffer reads earlier ones.
             unsafe { self.lighting.set_lut_tables(&tables) };
             self.lut_tables = Some(tables);
         }

@@ -67,6 +67,9 @@ impl Renderer<'_> {
                     continue;
                 }
                 let cmd = self.begin_commands()?;
+                // SAFETY: `cmd` was just begun by `begin_commands`, outside rendering; the
+                // frame set's layout is made identical to the lighting's frame set layout, set 0
+                // of `layout` (`Descriptors::new`), and both live as long as the renderer.
                 unsafe {
                     ctx.device.cmd_bind_descriptor_sets(
                         cmd,

@@ -272,6 +272,8 @@ impl Context {
     /// - every handle in `lent` is valid and outlives this context and everything made with it;
     /// - `device` was created from `physical_device` of `instance` with at least the features of
     ///   [`REQUIREMENTS`] enabled, and `queue` is a queue of `queue_family` on it;
+    /// - `instance` was created with an `apiVersion` of 1.3 or later, as [`REQUIREMENTS`] asks:
+    ///   histencil queries and records through it with Vulkan 1.1 to 1.3 commands;
     /// - `allocator` was created for `device`;
     /// - `debug_utils` is true only if `VK_EXT_debug_utils` is enabled on `instance`;
     /// - while histencil's owned-device tools ([`crate::Renderer`]) submit to `queue` and wait,
@@ -295,7 +297,8 @@ impl Context {
             memory_budget,
             pipeline_cache,
         } = lent;
-        // SAFETY: the caller's promise that `physical_device` belongs to `instance`.
+        // SAFETY: `missing`'s # Safety, by this fn's: `physical_device` belongs to the live
+        // `instance`, which was created for Vulkan 1.3.
         let missing = unsafe { REQUIREMENTS.missing(&instance, physical_device) };
         if !missing.is_empty() {
             return Err(Error::NoDevice(format!(
@@ -303,7 +306,8 @@ impl Context {
                 missing.join(", ")
             )));
         }
-        // SAFETY: as above.
+        // SAFETY: `queue_family_fits`'s # Safety: `physical_device` belongs to the live
+        // `instance` (this fn's # Safety).
         if !unsafe { REQUIREMENTS.queue_family_fits(&instance, physical_device, queue_family) } {
             return Err(Error::NoDevice(format!(
                 "queue family {queue_family} of the lent device cannot draw, compute and write \
@@ -312,7 +316,7 @@ impl Context {
         }
         let depth_stencil_named = depth_stencil.is_some();
         let depth_stencil = pick_depth_stencil_format(&instance, physical_device, depth_stencil)?;
-        // SAFETY: as above.
+        // SAFETY: `physical_device` belongs to the live `instance` (this fn's # Safety).
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
         let device_name = props
             .device_name_as_c_str()
@@ -320,7 +324,8 @@ impl Context {
             .unwrap_or_default();
         let debug_device =
             debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
-        // SAFETY: the caller's promise; histencil requires Vulkan 1.3.
+        // SAFETY: `driver_info`'s # Safety: `physical_device` belongs to `instance`, created for
+        // Vulkan 1.3 (this fn's # Safety), and supports 1.3 (`missing` above found nothing).
         let mut driver =
             unsafe { crate::gpu::driver::driver_info(&instance, physical_device, None) };
         let quirks = Quirks::of(QUIRKS, driver.id, driver.version);
@@ -459,6 +464,11 @@ impl Context {
                 .object_handle(handle)
                 .object_name(&name);
             // Naming is best effort: a failure here changes nothing the renderer does.
+            // SAFETY: `dd` is loaded for `self.device`, whose instance has VK_EXT_debug_utils
+            // enabled (`Context::new` enabled it wherever it makes `dd`; `from_raw`'s caller
+            // promises it with `debug_utils`). Every caller names the device, or a live object
+            // of it, right after making it and before any other thread can reach it (the
+            // handle's external synchronisation); `info` and `name` outlive the call.
             let _ = unsafe { dd.set_debug_utils_object_name(&info) };
         }
     }
@@ -517,6 +527,9 @@ impl Context {
         if let Some(dd) = &self.debug_device {
             let name = CString::new(label).expect("labels contain no NUL");
             let info = vk::DebugUtilsLabelEXT::default().label_name(&name);
+            // SAFETY: every caller passes the command buffer of this device it is recording
+            // (`submit_once`'s, the renderer's, or an engine's under the # Safety of the
+            // `unsafe fn record*` it called), held by this thread; `info` outlives the call.
             unsafe { dd.cmd_begin_debug_utils_label(cmd, &info) };
         }
     }
@@ -529,6 +542,8 @@ impl Context {
             }
         }
         if let Some(dd) = &self.debug_device {
+            // SAFETY: `cmd` is recording, as for `begin_label`, and every caller pairs this
+            // with a `begin_label` it recorded earlier into the same `cmd`.
             unsafe { dd.cmd_end_debug_utils_label(cmd) };
         }
     }
@@ -542,6 +557,14 @@ impl Drop for Context {
             unsafe { ManuallyDrop::drop(&mut self.allocator) };
             return;
         }
+        // SAFETY: every handle here is this context's own, destroyed once, here. The wait
+        // leaves no submitted work running (a lost device, whose error is ignored, runs none);
+        // its external synchronisation of the queue holds because `&mut self` means no
+        // renderer or lighting of this context is left to submit. histencil's objects borrow
+        // or share the context and are destroyed before it (one leaked by `mem::forget` is a
+        // child left alive, which the validation layer reports). Children go before parents:
+        // the allocator's memory and the cache before the device, then the messenger (whose
+        // user data `validation` is dropped only after this) and the instance.
         unsafe {
             let _ = self.device.device_wait_idle();
             // The allocator frees its memory blocks; it must go before the device. An owned

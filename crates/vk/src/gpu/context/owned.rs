@@ -31,7 +31,8 @@ pub(super) fn pick_depth_stencil_format(
         .iter()
         .copied()
         .find(|f| {
-            // SAFETY: `pd` was enumerated from `instance`, which is alive.
+            // SAFETY: both callers pass a `pd` of the live `instance`: `Context::new` enumerated
+            // it, and `from_raw`'s caller promises it.
             let props = unsafe { instance.get_physical_device_format_properties(pd, f.vk()) };
             props.optimal_tiling_features.contains(needed)
         })
@@ -56,7 +57,11 @@ struct Partial {
 impl Drop for Partial {
     fn drop(&mut self) {
         // SAFETY: every handle here was created by `Context::new` and nothing else holds it: a
-        // successful `new` takes them out (leaving `None` / null) before this runs.
+        // successful `new` takes them out (leaving `None` / null) before this runs. The device
+        // has no child objects yet (nothing is created on it before the allocator, the last
+        // step that can fail) and no queue work; the device and the messenger go before the
+        // instance they belong to. `entry` (the loader) and `validation` (the messengers' user
+        // data) are declared before the `Partial`, so they are dropped after it.
         unsafe {
             if let Some(device) = self.device.take() {
                 device.destroy_device(None);
@@ -81,8 +86,12 @@ impl Context {
     /// [`Error::NoDevice`] when no device meets [`REQUIREMENTS`] (or matches the filter);
     /// [`Error::MissingFormat`] when it cannot attach the depth-stencil format asked for.
     pub fn new(desc: ContextDesc) -> Result<Self> {
-        // SAFETY: loading the system Vulkan loader; nothing else runs inside it yet.
+        // SAFETY: dlopen of the system's Vulkan loader, trusted as every Vulkan program trusts
+        // it; the `Entry` keeps the library loaded for as long as the context holds it, past
+        // the last call through the instance and device it hands out (see `Drop`).
         let entry = unsafe { ash::Entry::load() }.map_err(|e| Error::Loading(e.to_string()))?;
+        // SAFETY: a global command of the loader just loaded; `None` asks for the extensions of
+        // the implementation and the implicit layers.
         let available_exts = unsafe { entry.enumerate_instance_extension_properties(None) }
             .call("vkEnumerateInstanceExtensionProperties")?;
         let has_ext = |name: &CStr| {
@@ -94,6 +103,7 @@ impl Context {
         let mut layer_text = None;
         let mut layer_settings_ext = false;
         if desc.validation {
+            // SAFETY: a global command of the loaded loader, taking no handle.
             let layers = unsafe { entry.enumerate_instance_layer_properties() }
                 .call("vkEnumerateInstanceLayerProperties")?;
             let Some(layer) = layers
@@ -107,6 +117,8 @@ impl Context {
                 ));
             };
             layer_text = Some(crate::gpu::driver::layer_version(layer));
+            // SAFETY: a global command; `VALIDATION_LAYER` is a NUL-terminated `'static` name
+            // of a layer found installed just above.
             let layer_exts =
                 unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
                     .call("vkEnumerateInstanceExtensionProperties")?;
@@ -164,11 +176,15 @@ impl Context {
         let extensions_without: Vec<_> = extensions
             .iter()
             .copied()
-            // SAFETY: every pointer in `extensions` is a NUL-terminated extension name.
+            // SAFETY: every pointer in `extensions` is `as_ptr` of a `'static` NUL-terminated
+            // extension name (`ash::ext::*::NAME`).
             .filter(|&e| unsafe { CStr::from_ptr(e) } != ash::ext::layer_settings::NAME)
             .collect();
         let validation = Arc::new(ValidationLog::default());
-        // SAFETY: the context keeps `validation` until after it destroys the messenger.
+        // SAFETY: `validation` outlives every messenger made from this info: the one chained into
+        // instance creation (called until vkDestroyInstance) and the one created below. On an
+        // error `partial`, declared after `validation`, destroys both first; the context keeps
+        // its `Arc` until after its Drop has destroyed the messenger and the instance.
         let messenger_info = unsafe { ValidationLog::messenger_create_info(&validation) };
         // Chained into instance creation too, so messages from vkCreateInstance are caught.
         let mut messenger_for_create = messenger_info;
@@ -191,11 +207,18 @@ impl Context {
         // extension (the check's settings file, its cleared environment, its canary), and the
         // report says so.
         let mut settings_way = "through VK_EXT_layer_settings";
+        // SAFETY: `instance_info` and all it points at live until the call returns: `app_info`,
+        // the `'static` layer and extension names, and the chained `validation_features`,
+        // `messenger_for_create` and `layer_settings` (whose `p_values` point at `off` / `on`,
+        // alive to the end of `new`). A layer or extension missing fails the call with an error
+        // (ERROR_EXTENSION_NOT_PRESENT, the retry below), not undefined behaviour.
         let created = unsafe { entry.create_instance(&instance_info, None) };
         let instance = match created {
             Err(vk::Result::ERROR_EXTENSION_NOT_PRESENT) if pin_settings => {
                 settings_way = "from the environment (the loader refused VK_EXT_layer_settings)";
                 let retry = without_settings.enabled_extension_names(&extensions_without);
+                // SAFETY: as the first try: the same live structs, less VK_EXT_layer_settings
+                // (`without_settings` was copied before `layer_settings` joined the chain).
                 unsafe { entry.create_instance(&retry, None) }
             }
             other => {
@@ -217,6 +240,9 @@ impl Context {
             let di = ash::ext::debug_utils::Instance::new(&entry, &instance);
             // A fresh copy: messenger_for_create's pNext was rewritten by push_next.
             if desc.validation {
+                // SAFETY: `di` is loaded from the live `instance`, which enables
+                // VK_EXT_debug_utils (`debug_utils` is true); `messenger_info` is a fresh copy
+                // with no pNext, and its user data `validation` outlives the messenger (above).
                 partial.messenger =
                     unsafe { di.create_debug_utils_messenger(&messenger_info, None) }
                         .call("vkCreateDebugUtilsMessengerEXT")?;
@@ -250,9 +276,14 @@ impl Context {
             .queue_create_infos(&queue_infos)
             .enabled_features(&features)
             .push_next(&mut features13);
+        // SAFETY: `physical_device` is `instance`'s and passed `REQUIREMENTS.missing`, so it has
+        // every feature asked for (`depthBounds` only where it reported it); `queue_family`
+        // fits, one queue at priority 1.0. `device_info` and the arrays and `features13` it
+        // points at live until the call returns.
         let device = unsafe { instance.create_device(physical_device, &device_info, None) }
             .call("vkCreateDevice")?;
         partial.device = Some(device.clone());
+        // SAFETY: queue 0 of `queue_family` is the one queue `queue_infos` asked for.
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let debug_device =
             debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
@@ -279,7 +310,8 @@ impl Context {
         // SAFETY: `physical_device` was enumerated from `instance`.
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
         let limits = props.limits;
-        // SAFETY: as above; the instance asks for Vulkan 1.3.
+        // SAFETY: `driver_info`'s # Safety: `physical_device` is `instance`'s, the instance was
+        // created for Vulkan 1.3, and the device supports 1.3 (it passed `REQUIREMENTS.missing`).
         let mut driver =
             unsafe { crate::gpu::driver::driver_info(&instance, physical_device, layer_text) };
         let quirks = if desc.general_path {
@@ -306,6 +338,7 @@ impl Context {
         };
         // A cache of histencil's own, destroyed with the device; without one (a driver that
         // refuses) pipelines are made uncached.
+        // SAFETY: `device` is live; the default create info has no initial data to validate.
         let pipeline_cache =
             unsafe { device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default(), None) }
                 .unwrap_or_default();
@@ -351,23 +384,28 @@ impl Context {
         instance: &ash::Instance,
         filter: Option<&str>,
     ) -> Result<(vk::PhysicalDevice, u32, String)> {
+        // SAFETY: `instance` is live (the caller's, created just before).
         let devices =
             unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
         let mut candidates = Vec::new();
         let mut seen = Vec::new();
         for pd in devices {
+            // SAFETY: `pd` was just enumerated from the live `instance`.
             let props = unsafe { instance.get_physical_device_properties(pd) };
             let name = props
                 .device_name_as_c_str()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
             seen.push(name.clone());
-            // SAFETY: `pd` was just enumerated from the live `instance`.
+            // SAFETY: `missing`'s # Safety: `pd` was just enumerated from the live `instance`,
+            // which `Context::new` created for Vulkan 1.3.
             if !unsafe { REQUIREMENTS.missing(instance, pd) }.is_empty() {
                 continue;
             }
+            // SAFETY: as above.
             let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
             let Some(family) = (0..families.len() as u32)
+                // SAFETY: `queue_family_fits`'s # Safety: `pd` was enumerated from `instance`.
                 .find(|&f| unsafe { REQUIREMENTS.queue_family_fits(instance, pd, f) })
             else {
                 continue;
