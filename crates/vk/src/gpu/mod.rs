@@ -5,6 +5,7 @@
 //! knows nothing of lighting.
 
 pub mod access;
+pub(crate) mod attachments;
 pub(crate) mod compute;
 pub(crate) mod context;
 pub(crate) mod debug;

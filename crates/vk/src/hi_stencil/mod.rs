@@ -26,6 +26,7 @@
 use crate::gpu::access::{
     access_info, buffer_barrier, transition, BufferAccess, Contents, ImageAccess, ImageRef,
 };
+use crate::gpu::attachments::{depth_stencil_attachment, Load};
 use crate::gpu::compute::ComputePipeline;
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
@@ -34,7 +35,6 @@ use crate::gpu::readback::{copy_image_to_buffer, host_readable};
 use crate::gpu::resources::{Buffer, Image};
 use crate::gpu::state::compare_op;
 use crate::gpu::teardown::{build, Destroy};
-use crate::passes::{depth_stencil_attachment, Load};
 use crate::shader_consts::HI_STENCIL_UPDATE_GROUP;
 use crate::shaders;
 use ash::vk;

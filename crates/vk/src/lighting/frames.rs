@@ -2,7 +2,7 @@
 
 use crate::lighting::hooks::{HookSets, LightHooks};
 use crate::passes::light_pipelines::BrdfSource;
-use crate::renderer::technique::{MixedTiles, TileClassify, TileSide};
+use crate::passes::tiled::{MixedTiles, TileClassify, TileSide};
 use ash::vk;
 use histencil_brdf::BrdfId;
 use histencil_model::{FramePlan, StencilLayout, ViewDesc};

@@ -10,8 +10,8 @@ use crate::gpu::error::Result;
 use crate::gpu::resources::Buffer;
 use crate::lighting::hooks::LightHooks;
 use crate::passes::depth_id::{DepthIdDesc, DepthIdPass};
+use crate::passes::tiled::{MixedTiles, TileSide};
 use crate::passes::tiled::{TiledDesc, TiledLighting, TiledSets, TiledShade};
-use crate::renderer::technique::{MixedTiles, TileSide};
 use ash::vk;
 use std::ops::Deref;
 

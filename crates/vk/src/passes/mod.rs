@@ -20,47 +20,9 @@ use crate::gpu::context::Context;
 use ash::vk;
 use histencil_model::DepthConvention;
 
-/// How a pass treats an attachment at the start of rendering.
-#[derive(Clone, Copy)]
-pub(crate) enum Load {
-    Clear(vk::ClearValue),
-    Keep,
-}
-
-pub(crate) fn color_attachment(
-    image: &ImageRef,
-    load: Load,
-) -> vk::RenderingAttachmentInfo<'static> {
-    attachment(image, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, load)
-}
-
-pub(crate) fn depth_stencil_attachment(
-    image: &ImageRef,
-    load: Load,
-) -> vk::RenderingAttachmentInfo<'static> {
-    attachment(
-        image,
-        vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
-        load,
-    )
-}
-
-fn attachment(
-    image: &ImageRef,
-    layout: vk::ImageLayout,
-    load: Load,
-) -> vk::RenderingAttachmentInfo<'static> {
-    let (op, clear) = match load {
-        Load::Clear(v) => (vk::AttachmentLoadOp::CLEAR, v),
-        Load::Keep => (vk::AttachmentLoadOp::LOAD, vk::ClearValue::default()),
-    };
-    vk::RenderingAttachmentInfo::default()
-        .image_view(image.view)
-        .image_layout(layout)
-        .load_op(op)
-        .store_op(vk::AttachmentStoreOp::STORE)
-        .clear_value(clear)
-}
+pub(crate) use crate::gpu::attachments::{
+    attachment, color_attachment, depth_stencil_attachment, Load,
+};
 
 pub(crate) const CLEAR_BLACK: vk::ClearValue = vk::ClearValue {
     color: vk::ClearColorValue { float32: [0.0; 4] },
