@@ -18,6 +18,7 @@ pub(crate) mod meshes;
 pub(crate) mod pipelines;
 pub(crate) mod quirks;
 pub(crate) mod readback;
+pub(crate) mod recording;
 pub(crate) mod requirements;
 pub(crate) mod resources;
 pub(crate) mod spirv_bindings;

@@ -32,6 +32,7 @@ use crate::gpu::context::Context;
 use crate::gpu::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::readback::{copy_image_to_buffer, host_readable};
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
 use crate::gpu::state::compare_op;
 use crate::gpu::teardown::{build, Destroy};
@@ -296,7 +297,8 @@ impl HiStencilSurface {
     }
 
     /// Outside rendering, before lighting: every tile passes, no tile is marked, statistics zero.
-    pub fn record_reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+    pub fn record_reset(&mut self, rec: &Recording) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         let d = &ctx.device;
         let surface = [
             self.active.handle,
@@ -337,7 +339,8 @@ impl HiStencilSurface {
     }
 
     /// Outside rendering: pending state becomes active.
-    pub fn record_flush(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+    pub fn record_flush(&mut self, rec: &Recording) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         use BufferAccess::{ComputeWrite, FragmentRead, TransferRead, TransferWrite};
         let (pending, active) = (self.pending.handle, self.active.handle);
         // The tile updates wrote the pending tiles; light shaders may still read the active
@@ -376,7 +379,8 @@ impl HiStencilSurface {
     /// fragment's depth, and sets the viewport and scissor. The caller draws the write's volume
     /// with the touch pipeline (`LightShader::TouchTiles`) and the write's faces, then calls
     /// [`Self::end_touch`].
-    pub fn begin_touch(&mut self, ctx: &Context, cmd: vk::CommandBuffer, rect: TileRect) {
+    pub fn begin_touch(&mut self, rec: &Recording, rect: TileRect) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         // The image is cleared whole at the frame's first touch draw and when the markers run
         // out, so no pixel outside this draw's area can hold its marker, and the draw renders
         // its rectangle only (a CPU rasteriser pays for a rendering's whole area).
@@ -419,12 +423,15 @@ impl HiStencilSurface {
             ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
             ctx.device.cmd_set_scissor(cmd, 0, &[area]);
         }
+        rec.began_rendering();
     }
 
     /// Ends the touch draw's rendering.
-    pub fn end_touch(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        // SAFETY: `cmd` is inside the rendering `begin_touch` began, its one caller's pairing.
-        unsafe { ctx.device.cmd_end_rendering(cmd) };
+    pub fn end_touch(&self, rec: &Recording) {
+        // SAFETY: `inside` checks (in debug builds) that rendering is open: the rendering
+        // `begin_touch` began, its one caller's pairing.
+        unsafe { rec.ctx().device.cmd_end_rendering(rec.inside()) };
+        rec.ended_rendering();
     }
 
     /// Outside rendering, after a write draw touched `tiles`, in a frame recorded into `slot`
@@ -433,15 +440,14 @@ impl HiStencilSurface {
     /// the stencil in place. Leaves the depth-stencil image attached-ready.
     pub fn record_update(
         &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         slot: u32,
         depth_stencil: &mut ImageRef,
         hi: &HiStencilState,
         tiles: WriteTiles,
     ) {
         if self.unflushed {
-            self.record_flush(ctx, cmd);
+            self.record_flush(rec);
         }
         self.unflushed = true;
         let WriteTiles { touched, rect } = tiles;
@@ -463,7 +469,7 @@ impl HiStencilSurface {
             marker,
             ..self.update_push(rect)
         };
-        self.dispatch_update(ctx, cmd, slot, depth_stencil, &push);
+        self.dispatch_update(rec.ctx(), rec.outside(), slot, depth_stencil, &push);
     }
 
     /// The update's settings over the tiles of `rect`, evaluating nothing yet (mode 0, no
@@ -532,8 +538,7 @@ impl HiStencilSurface {
     /// depth-stencil image attached-ready.
     pub fn record_evaluate(
         &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         slot: u32,
         depth_stencil: &mut ImageRef,
         test: TileTest,
@@ -570,13 +575,14 @@ impl HiStencilSurface {
             value2: u32::from(second.1),
             ..self.update_push(rect)
         };
-        self.dispatch_update(ctx, cmd, slot, depth_stencil, &push);
+        self.dispatch_update(rec.ctx(), rec.outside(), slot, depth_stencil, &push);
         // The tiles outside `rect` are not the draw's: active there is whatever it was.
-        self.record_flush(ctx, cmd);
+        self.record_flush(rec);
     }
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
-    pub fn record_save(&self, ctx: &Context, cmd: vk::CommandBuffer, depth_stencil: &mut ImageRef) {
+    pub fn record_save(&self, rec: &Recording, depth_stencil: &mut ImageRef) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         use BufferAccess::{FragmentRead, TransferWrite};
         let saved = self.saved.handle;
         // The last restore (an earlier frame's) read what this copy overwrites.
@@ -599,8 +605,12 @@ impl HiStencilSurface {
     }
 
     /// Makes the statistics visible to the host; record after the last lighting draw.
-    pub fn record_stats_readable(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        host_readable(ctx, cmd, vk::PipelineStageFlags2::FRAGMENT_SHADER);
+    pub fn record_stats_readable(&self, rec: &Recording) {
+        host_readable(
+            rec.ctx(),
+            rec.outside(),
+            vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        );
     }
 
     /// The statistics of the last frame that counted; `flushes` is the caller's to fill in.

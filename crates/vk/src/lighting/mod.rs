@@ -35,6 +35,7 @@ use crate::gpu::descriptors::{write_sampled_images, write_storage_buffers};
 use crate::gpu::error::{Error, Result};
 use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
 use crate::gpu::meshes::LightVolumes;
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::teardown::{
     declare_finished, refuse_in_flight, refuse_slot_in_flight, Destroy, InFlight,
@@ -435,9 +436,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         if source == BrdfSource::Table {
             sets.push(self.lut_set);
         }
+        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a
+        // graphics queue family, outside any render pass; this call alone records into it now.
+        let rec = unsafe { Recording::new(ctx, cmd) };
         let pass = LightingPass {
             ctx,
-            cmd,
+            rec: &rec,
             plan: frame.plan,
             lights: frame.lights,
             brdfs: &self.desc.brdfs,
@@ -461,7 +465,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let timer = slot.timer.active();
         let emulation = slot.emulation.active();
         slot.pending = true;
-        pass.record(targets, hi_stencil, timer, emulation)
+        let recorded = pass.record(targets, hi_stencil, timer, emulation);
+        rec.finish();
+        recorded
     }
 
     /// Of the last frame recorded into `slot`, once the GPU has finished it: the time the

@@ -18,6 +18,7 @@ use crate::gpu::context::Context;
 use crate::gpu::error::Result;
 use crate::gpu::gpu_types::LightDrawPush;
 use crate::gpu::meshes::LightVolumes;
+use crate::gpu::recording::Recording;
 use crate::gpu::state::{apply_bounded, FULLSCREEN};
 use crate::gpu::timing::StepTimer;
 use crate::hi_stencil::{
@@ -54,8 +55,8 @@ pub fn pass_group(kind: PassKind, brdfs: &[BrdfId], source: BrdfSource) -> Strin
 pub struct LightingPass<'a> {
     /// The device the commands are recorded for.
     pub ctx: &'a Context,
-    /// The command buffer being recorded, outside any rendering.
-    pub cmd: vk::CommandBuffer,
+    /// The command buffer being recorded, and whether rendering is open in it.
+    pub(crate) rec: &'a Recording<'a>,
     /// The model's steps for this frame, in order.
     pub plan: &'a FramePlan,
     /// The frame's lights; a planned light's index points here and into the light buffer.
@@ -92,17 +93,17 @@ pub struct LightingPass<'a> {
     pub hierarchy: Option<GpuHierarchy>,
 }
 
-/// Whether the HDR and depth-stencil attachments are bound. Hi-stencil writes, flushes and the
+/// The lighting's rendering into the HDR and depth-stencil attachments, open or not as the
+/// recording says ([`Recording::is_rendering`]). Hi-stencil writes, flushes and the
 /// preserved-bit copy happen outside rendering, so the lighting pass is split around them.
 struct Rendering {
-    open: bool,
     /// The HDR target needs no clear (done by the first opening, or not asked for).
     cleared: bool,
 }
 
 impl Rendering {
     fn open(&mut self, pass: &LightingPass, targets: &mut LightingTargets) {
-        if self.open {
+        if pass.rec.is_rendering() {
             return;
         }
         let hdr = if self.cleared {
@@ -118,21 +119,22 @@ impl Rendering {
         };
         begin_hdr_rendering_as(
             pass.ctx,
-            pass.cmd,
+            pass.rec.outside(),
             attachments,
             pass.extent,
             (hdr, Load::Keep),
             depth,
         );
-        self.open = true;
+        pass.rec.began_rendering();
         self.cleared = true;
     }
 
     fn close(&mut self, pass: &LightingPass) {
-        if self.open {
-            // SAFETY: `open` says `cmd` is inside the rendering `Rendering::open` began.
-            unsafe { pass.ctx.device.cmd_end_rendering(pass.cmd) };
-            self.open = false;
+        if pass.rec.is_rendering() {
+            // SAFETY: the recording says the command buffer is inside rendering, the one
+            // `Rendering::open` began (the touch draw ends its own).
+            unsafe { pass.ctx.device.cmd_end_rendering(pass.rec.inside()) };
+            pass.rec.ended_rendering();
         }
     }
 
@@ -140,7 +142,7 @@ impl Rendering {
     /// buffer cannot be ordered inside one dynamic rendering instance.
     fn split(&mut self, pass: &LightingPass) {
         self.close(pass);
-        memory_barrier(pass.ctx, pass.cmd);
+        memory_barrier(pass.ctx, pass.rec.outside());
     }
 }
 
@@ -197,12 +199,12 @@ impl Timers<'_> {
         group: impl FnOnce() -> (String, Option<u32>),
         body: impl FnOnce(&mut Self) -> R,
     ) -> R {
-        pass.ctx.begin_label(pass.cmd, label);
+        pass.ctx.begin_label(pass.rec.any(), label);
         let result = body(self);
-        pass.ctx.end_label(pass.cmd);
+        pass.ctx.end_label(pass.rec.any());
         if let Some(t) = self.steps.as_deref_mut() {
             let (group, light) = group();
-            t.mark(pass.ctx, pass.cmd, group, light);
+            t.mark(pass.ctx, pass.rec.any(), group, light);
         }
         result
     }
@@ -218,7 +220,7 @@ impl Timers<'_> {
     /// Ends the emulation timer's span before it: `group` names what it timed.
     fn mark(&mut self, pass: &LightingPass, group: &str) {
         if let Some(t) = self.emulation.as_deref_mut() {
-            t.mark(pass.ctx, pass.cmd, group.into(), None);
+            t.mark(pass.ctx, pass.rec.any(), group.into(), None);
         }
     }
 }
@@ -241,7 +243,8 @@ impl LightingPass<'_> {
         timer: Option<&mut StepTimer>,
         emulation: Option<&mut StepTimer>,
     ) -> Result<()> {
-        let (ctx, cmd) = (self.ctx, self.cmd);
+        // Labels and timestamps, which Vulkan allows inside and outside rendering.
+        let (ctx, cmd) = (self.ctx, self.rec.any());
         let mut timers = Timers {
             steps: timer,
             emulation,
@@ -250,24 +253,24 @@ impl LightingPass<'_> {
         for image in targets.gbuffer.iter_mut() {
             transition(
                 ctx,
-                cmd,
+                self.rec.outside(),
                 image,
                 ImageAccess::FragmentSampled,
                 Contents::Keep,
             );
         }
+        // Query resets are outside rendering.
         if let Some(t) = timers.steps.as_deref_mut() {
-            t.reset(ctx, cmd);
+            t.reset(ctx, self.rec.outside());
         }
         if let Some(t) = timers.emulation.as_deref_mut() {
-            t.reset(ctx, cmd);
+            t.reset(ctx, self.rec.outside());
             t.start(ctx, cmd);
         }
-        hi_stencil.record_reset(ctx, cmd);
+        hi_stencil.record_reset(self.rec);
         timers.mark(self, Emulation::BOOKKEEPING);
         self.bind_sets();
         let mut rendering = Rendering {
-            open: false,
             cleared: !self.clear_hdr,
         };
         rendering.open(self, targets);
@@ -306,7 +309,7 @@ impl LightingPass<'_> {
                                 rendering.close(self);
                                 let rect = tile_rect(self.extent, self.screen_rect(*light, pass));
                                 let ds = &mut targets.depth_stencil;
-                                hi_stencil.record_evaluate(ctx, cmd, self.slot, ds, test, rect);
+                                hi_stencil.record_evaluate(self.rec, self.slot, ds, test, rect);
                             });
                         }
                         let bounded = (pass, self.plan.lights[*light].depth_range);
@@ -334,7 +337,7 @@ impl LightingPass<'_> {
                     timers.step(self, "flush-hi-stencil", group, |timers| {
                         timers.bookkeeping(self, || {
                             rendering.close(self);
-                            hi_stencil.record_flush(ctx, cmd);
+                            hi_stencil.record_flush(self.rec);
                         })
                     });
                 }
@@ -342,7 +345,7 @@ impl LightingPass<'_> {
                     let group = || ("save-preserved".to_owned(), None);
                     timers.step(self, "save-preserved", group, |_| {
                         rendering.close(self);
-                        hi_stencil.record_save(ctx, cmd, &mut targets.depth_stencil);
+                        hi_stencil.record_save(self.rec, &mut targets.depth_stencil);
                     });
                 }
                 Step::RestorePreserved { mask } => {
@@ -359,7 +362,7 @@ impl LightingPass<'_> {
         rendering.close(self);
         timers.mark(self, Emulation::TECHNIQUE);
         if self.count_stats {
-            hi_stencil.record_stats_readable(ctx, cmd);
+            hi_stencil.record_stats_readable(self.rec);
         }
         ctx.end_label(cmd);
         Ok(())
@@ -367,7 +370,7 @@ impl LightingPass<'_> {
 
     /// Binds the frame's sets, and the engine's visibility set where it has one.
     fn bind_sets(&self) {
-        let (d, cmd, layout) = (&self.ctx.device, self.cmd, self.pipeline_layout);
+        let (d, cmd, layout) = (&self.ctx.device, self.rec.any(), self.pipeline_layout);
         let graphics = vk::PipelineBindPoint::GRAPHICS;
         // SAFETY: `cmd` is recording (LightingPass's contract); the sets and the layout were
         // made from this context's device by the lighting, and the sets match the layout's set
@@ -463,7 +466,7 @@ impl LightingPass<'_> {
     ) {
         let rect = tile_rect(self.extent, self.screen_rect(light, pass));
         if touched == TouchedTiles::Drawn && !rect.is_empty() {
-            hi_stencil.begin_touch(self.ctx, self.cmd, rect);
+            hi_stencil.begin_touch(self.rec, rect);
             let state = PassState {
                 cull: pass.state.cull,
                 depth: DepthState {
@@ -479,11 +482,11 @@ impl LightingPass<'_> {
             };
             let key = (Geometry::Volume, LightShader::TouchTiles);
             self.draw(key, &state, (Geometry::Volume, None), push);
-            hi_stencil.end_touch(self.ctx, self.cmd);
+            hi_stencil.end_touch(self.rec);
         }
-        let (ctx, ds) = (self.ctx, &mut targets.depth_stencil);
+        let ds = &mut targets.depth_stencil;
         let tiles = WriteTiles { touched, rect };
-        hi_stencil.record_update(ctx, self.cmd, self.slot, ds, hi, tiles);
+        hi_stencil.record_update(self.rec, self.slot, ds, hi, tiles);
     }
 
     /// Writes the saved preserved bits of `mask` back: one pass zeroes them, then one pass per
@@ -528,7 +531,7 @@ impl LightingPass<'_> {
         (geometry, bounds): (Geometry, Option<DepthRange>),
         push: LightDrawPush,
     ) {
-        let (ctx, cmd) = (self.ctx, self.cmd);
+        let (ctx, cmd) = (self.ctx, self.rec.inside());
         let d = &ctx.device;
         // SAFETY: `cmd` is inside the lighting's rendering (`record_pass` opens it before each
         // draw); the pipeline was made for this plan's pass state (`prepare_pipelines`) with
