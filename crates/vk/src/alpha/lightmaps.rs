@@ -22,6 +22,7 @@ use crate::gpu::descriptors::{
 use crate::gpu::error::{Error, Result, VkCall};
 use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::state::{apply, FULLSCREEN};
 use crate::gpu::teardown::{declare_finished, refuse_in_flight, refuse_slot_in_flight, InFlight};
@@ -414,7 +415,9 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         atlas: &mut ImageRef,
     ) -> Result<()> {
         self.write_frame(frame, atlas)?;
-        self.record_pass(cmd, frame.slot, frame.layout, atlas, None);
+        // SAFETY: this fn's # Safety: `cmd` is recording on the lightmaps' device, on a graphics
+        // queue family, outside any render pass; this call alone records into it now.
+        unsafe { self.record_pass(cmd, frame.slot, frame.layout, atlas, None) };
         Ok(())
     }
 
@@ -443,7 +446,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     ) -> Result<()> {
         check_direction(&self.desc, atlas, direction)?;
         self.write_frame(frame, atlas)?;
-        self.record_pass(cmd, frame.slot, frame.layout, atlas, Some(direction));
+        // SAFETY: as in `record`, whose # Safety this fn's is.
+        unsafe { self.record_pass(cmd, frame.slot, frame.layout, atlas, Some(direction)) };
         Ok(())
     }
 
@@ -516,7 +520,11 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// Records the lightmap pass of the frame last written into `slot`: clears `atlas` (and
     /// `direction`, which makes it the directional pass), then one additive draw per (entity,
     /// light that reaches it) over the entity's region.
-    pub(crate) fn record_pass(
+    ///
+    /// # Safety
+    /// As [`Recording::new`]: `cmd` is recording on this context's device, on a graphics queue
+    /// family, outside any render pass, and only this call records into it meanwhile.
+    pub(crate) unsafe fn record_pass(
         &mut self,
         cmd: vk::CommandBuffer,
         slot: u32,
@@ -525,6 +533,9 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         direction: Option<&mut ImageRef>,
     ) {
         let ctx: &Context = &self.ctx;
+        // SAFETY: this fn's # Safety is `Recording::new`'s.
+        let rec = unsafe { Recording::new(ctx, cmd) };
+        let cmd = rec.outside();
         let slot = &mut self.slots[slot as usize];
         slot.pending = true;
         // Queries are reset outside rendering, as Vulkan requires.
@@ -545,6 +556,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                 self.pipeline
             }
         };
+        rec.began_rendering();
         let d = &ctx.device;
         // SAFETY: `cmd` is recording on this context's device (the # Safety of `record` and
         // `record_directional`, and `AlphaLighting` records into the renderer's own), inside
@@ -599,9 +611,12 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                 t.mark(ctx, cmd, "entity".to_owned(), Some(index as u32));
             }
         }
-        // SAFETY: ends the rendering `begin_all_cleared` began on `cmd` above.
-        unsafe { d.cmd_end_rendering(cmd) };
+        // SAFETY: ends the rendering `begin_all_cleared` began on `cmd` above (`inside` checks
+        // it is open).
+        unsafe { d.cmd_end_rendering(rec.inside()) };
+        rec.ended_rendering();
         ctx.end_label(cmd);
+        rec.finish();
     }
 
     /// Sets 0 and 1 of the alpha pipelines (frame, alpha), for histencil's own alpha pass.

@@ -364,8 +364,13 @@ impl<'c> AlphaLighting<'c> {
             AlphaMode::Directional => Some(&mut *self.direction_map),
             AlphaMode::Forward | AlphaMode::Probe => return Ok(()),
         };
-        self.lightmaps
-            .record_pass(cmd, 0, &self.layout, &mut self.lightmap, direction);
+        // SAFETY: the renderer's command buffer is recording on this device, outside rendering
+        // between its passes (`Renderer::record_deferred` and the alpha pass after it), and
+        // only this call records into it now.
+        unsafe {
+            self.lightmaps
+                .record_pass(cmd, 0, &self.layout, &mut self.lightmap, direction)
+        };
         Ok(())
     }
 

@@ -7,6 +7,7 @@ use super::{DeferredLighting, TiledFrame};
 use crate::gpu::access::LightingTargets;
 use crate::gpu::context::Context;
 use crate::gpu::error::Result;
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::lighting::hooks::LightHooks;
 use crate::passes::depth_id::{DepthIdDesc, DepthIdPass};
@@ -138,15 +139,18 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             visibility: frame.hook_sets.visibility,
         };
         slot.pending = true;
+        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a
+        // graphics queue family, outside any render pass; this call alone records into it now.
+        let rec = unsafe { Recording::new(ctx, cmd) };
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
-        tiled.record_classify(ctx, cmd, &sets, targets, depth_sampled, clear, mixed, shape);
+        tiled.record_classify(&rec, &sets, targets, depth_sampled, clear, mixed, shape);
         between(cmd, "tile-classify");
-        tiled.record_light_lists(ctx, cmd, frame.lights.len() as u32);
+        tiled.record_light_lists(&rec, frame.lights.len() as u32);
         between(cmd, "tile-lights");
         match shade {
-            TiledShade::Kernels => tiled.record_shade(ctx, cmd, mixed),
+            TiledShade::Kernels => tiled.record_shade(&rec, mixed),
             TiledShade::DepthId => {
                 let side = frame.side;
                 let (_, pass) = self
@@ -159,9 +163,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                     sets.visibility,
                 );
                 let push = tiled.push_bytes(clear, mixed);
-                pass.record(ctx, cmd, frame.slot, bound, &push, targets, depth_sampled);
+                pass.record(&rec, frame.slot, bound, &push, targets, depth_sampled);
             }
         }
+        rec.finish();
         Ok(())
     }
 

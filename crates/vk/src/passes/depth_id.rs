@@ -23,6 +23,7 @@ use crate::gpu::descriptors::create_pipeline_layout;
 use crate::gpu::error::Result;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::readback::copy_image_to_buffer;
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
 use crate::gpu::state::apply;
 use crate::gpu::teardown::{build, Destroy};
@@ -191,14 +192,14 @@ impl DepthIdPass {
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         slot: u32,
         bound: ([vk::DescriptorSet; 3], Option<vk::DescriptorSet>),
         push: &[u8],
         targets: &mut LightingTargets,
         depth_sampled: bool,
     ) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         let d = &ctx.device;
         ctx.begin_label(cmd, "depth-id");
         // The light lists' masks, from compute to the shade passes (the images by their
@@ -238,8 +239,8 @@ impl DepthIdPass {
         let graphics = vk::PipelineBindPoint::GRAPHICS;
         let layout = self.pipeline_layout;
         let (sets, visibility) = bound;
-        // SAFETY: `cmd` is recording outside rendering (`record_tiled_with`'s # Safety, the one
-        // caller, whose tiled passes record no rendering); the id image was just transitioned
+        // SAFETY: `cmd` is recording outside rendering (`rec.outside()` above checks it in debug
+        // builds; the tiled passes before record no rendering); the id image was just transitioned
         // to a depth attachment and `info` names only it, over its extent. The sets match the
         // layout `new` made from `DepthIdDesc::set_layouts` (sets 0 to 2, and 4 only when the
         // hooks have a visibility layout); `push` is the tiled technique's `PUSH_BYTES`, the
@@ -253,6 +254,7 @@ impl DepthIdPass {
             }
             d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::FRAGMENT, 0, push);
         }
+        rec.began_rendering();
         let viewport = |depth: Option<f32>| vk::Viewport {
             x: 0.0,
             y: 0.0,
@@ -299,8 +301,9 @@ impl DepthIdPass {
             }
             ctx.end_label(cmd);
         }
-        // SAFETY: ends the rendering begun on `cmd` above.
-        unsafe { d.cmd_end_rendering(cmd) };
+        // SAFETY: ends the rendering begun on `cmd` above (`inside` checks it is open).
+        unsafe { d.cmd_end_rendering(rec.inside()) };
+        rec.ended_rendering();
         ctx.end_label(cmd);
     }
 }

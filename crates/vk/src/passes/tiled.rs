@@ -19,6 +19,7 @@ use crate::gpu::error::{Error, Result};
 use crate::gpu::limits::Limit;
 use crate::gpu::pipelines::create_compute_pipeline;
 use crate::gpu::quirks::Quirk;
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::teardown::{build, Destroy};
 use crate::passes::light_modules::LightModules;
@@ -464,8 +465,7 @@ impl TiledLighting {
     #[allow(clippy::too_many_arguments)]
     pub fn record_classify(
         &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         sets: &TiledSets,
         targets: &mut LightingTargets,
         depth_sampled: bool,
@@ -473,6 +473,7 @@ impl TiledLighting {
         mixed: MixedTiles,
         shape: TileClassify,
     ) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         let d = &ctx.device;
         let push = self.push(clear, mixed);
         ctx.begin_label(cmd, "tiled-classify");
@@ -503,8 +504,8 @@ impl TiledLighting {
         );
         // Each slot's dispatch starts at zero tiles.
         let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
-        // SAFETY: `cmd` is recording outside rendering (`record_tiled_with`'s # Safety, the one
-        // caller). `reset` is the dispatch buffer's exact size, `(MIXED_SLOT + 1) * 16` bytes,
+        // SAFETY: `cmd` is recording outside rendering (`rec.outside()` checks it in debug
+        // builds; `Recording::new`'s # Safety). `reset` is the dispatch buffer's exact size, `(MIXED_SLOT + 1) * 16` bytes,
         // a multiple of 4 under 64 KiB; both buffers are live with `TRANSFER_DST` usage.
         unsafe {
             d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
@@ -566,7 +567,8 @@ impl TiledLighting {
     /// Records the light lists of `lights` lights, after [`TiledLighting::record_classify`] in
     /// the same command buffer (whose sets and push constants stay bound): each light's bit in
     /// the masks of the tiles it can reach, for [`TiledLighting::record_shade`].
-    pub fn record_light_lists(&self, ctx: &Context, cmd: vk::CommandBuffer, lights: u32) {
+    pub fn record_light_lists(&self, rec: &Recording, lights: u32) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         ctx.begin_label(cmd, "tiled-light-lists");
         // A workgroup per light, in rows of at most the guaranteed workgroup count.
         const ROW: u32 = 65535;
@@ -587,7 +589,8 @@ impl TiledLighting {
     /// [`MixedTiles::Branching`] one over the mixed tiles, after
     /// [`TiledLighting::record_classify`] with the same `mixed` in the same command buffer
     /// (whose sets and push constants stay bound); the HDR target stays in `GENERAL`.
-    pub fn record_shade(&self, ctx: &Context, cmd: vk::CommandBuffer, mixed: MixedTiles) {
+    pub fn record_shade(&self, rec: &Recording, mixed: MixedTiles) {
+        let (ctx, cmd) = (rec.ctx(), rec.outside());
         let d = &ctx.device;
         ctx.begin_label(cmd, "tiled-shade");
         let branching = (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
