@@ -157,6 +157,14 @@ impl Error {
             | Error::BadSetup(_)
             | Error::InFlight(_)
             | Error::Unsupported(_) => Cause::Usage,
+            // A zero size is the caller's (a minimised window, say); one past the device's
+            // largest image is the device's.
+            Error::BadResolution { width: 0, .. } | Error::BadResolution { height: 0, .. } => {
+                Cause::Usage
+            }
+            // A table or atlas resolution is a setting the caller chose.
+            Error::Lut(histencil_brdf::lut::LutError::Resolution(_))
+            | Error::Lightmap(histencil_alpha::LayoutError::BadResolution(_)) => Cause::Usage,
             Error::Loading(_)
             | Error::NoDevice(_)
             | Error::MissingFormat(_)
@@ -189,5 +197,35 @@ pub(crate) trait VkCall<T> {
 impl<T> VkCall<T> for Result<T, vk::Result> {
     fn call(self, call: &'static str) -> Result<T> {
         self.map_err(|result| Error::Vulkan { call, result })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The variants whose cause depends on what they hold are sorted by it: a size or a
+    /// resolution the caller chose is the caller's, one past the device's limit the device's.
+    #[test]
+    fn causes_follow_who_can_prevent_the_error() {
+        let resolution = |width, height| Error::BadResolution {
+            width,
+            height,
+            reason: String::new(),
+        };
+        assert_eq!(resolution(0, 720).cause(), Cause::Usage);
+        assert_eq!(resolution(1280, 0).cause(), Cause::Usage);
+        assert_eq!(resolution(100_000, 720).cause(), Cause::Device);
+        let lut = histencil_brdf::lut::LutError::Resolution(1);
+        assert_eq!(Error::Lut(lut).cause(), Cause::Usage);
+        let lightmap = histencil_alpha::LayoutError::BadResolution(0);
+        assert_eq!(Error::Lightmap(lightmap).cause(), Cause::Usage);
+        let lost = Error::Vulkan {
+            call: "vkWaitForFences",
+            result: vk::Result::ERROR_DEVICE_LOST,
+        };
+        assert_eq!(lost.cause(), Cause::Device);
+        assert_eq!(Error::InFlight(String::new()).cause(), Cause::Usage);
+        assert_eq!(Error::DeviceLimit(String::new()).cause(), Cause::Device);
     }
 }

@@ -22,8 +22,9 @@ impl<'a> Recording<'a> {
     /// Starts tracking `cmd`, outside rendering.
     ///
     /// # Safety
-    /// `cmd` is in the recording state, was allocated from `ctx`'s device on a queue family with
-    /// graphics and compute, and is outside any render pass or dynamic rendering; until this
+    /// `cmd` is in the recording state, was allocated from `ctx`'s device on a queue family
+    /// that supports what its users record (graphics for rendering and draws, compute for
+    /// dispatches), and is outside any render pass or dynamic rendering; until this
     /// value is dropped only this value's users record into it, and they begin and end
     /// rendering through [`Recording::began_rendering`] and [`Recording::ended_rendering`].
     pub unsafe fn new(ctx: &'a Context, cmd: vk::CommandBuffer) -> Self {

@@ -219,9 +219,9 @@ impl HiStencilSurface {
         std::mem::swap(&mut self.touched, &mut fresh.touched);
         std::mem::swap(&mut self.touch, &mut fresh.touch);
         std::mem::swap(&mut self.saved, &mut fresh.saved);
+        (self.extent, self.tiles_x) = (fresh.extent, fresh.tiles_x);
         // `fresh` holds the old extent's objects now, and nothing else.
         fresh.destroy(ctx);
-        (self.extent, self.tiles_x) = (fresh.extent, fresh.tiles_x);
         self.marker = 0;
         self.unflushed = false;
         self.point_sets(ctx);

@@ -346,7 +346,7 @@ impl LightHooks {
             .device_limits()
             .get(crate::gpu::limits::Limit::BoundDescriptorSets);
         if sets > bindable {
-            return Err(Error::BadSetup(format!(
+            return Err(Error::DeviceLimit(format!(
                 "a visibility hook binds set 4, and this device binds at most {} sets (the \
                  spec's minimum is 4): declare the visibility hook's resources in the decode \
                  hook's set 1 instead (its layout, its sets), and give the hooks no visibility \

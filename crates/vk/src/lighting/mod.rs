@@ -363,7 +363,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ///
     /// # Safety
     /// - `cmd` is in the recording state, outside any render pass, on a queue family with
-    ///   graphics, from the device of the context this lighting was made with.
+    ///   graphics and compute (the context's own family fits), from the device of the context
+    ///   this lighting was made with.
     /// - The images of `targets` are live, from that device, with the usages
     ///   [`LightingTargets`] lists, and their `state`s are true when `cmd` executes: the layout
     ///   each subresource is in, and the stages and accesses of the last commands before it that
@@ -436,8 +437,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         if source == BrdfSource::Table {
             sets.push(self.lut_set);
         }
-        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a
-        // graphics queue family, outside any render pass; this call alone records into it now.
+        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
+        // family with graphics and compute, outside any render pass; this call alone records
+        // into it now.
         let rec = unsafe { Recording::new(ctx, cmd) };
         let pass = LightingPass {
             ctx,

@@ -139,16 +139,17 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             visibility: frame.hook_sets.visibility,
         };
         slot.pending = true;
-        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a
-        // graphics queue family, outside any render pass; this call alone records into it now.
+        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
+        // family with graphics and compute, outside any render pass; this call alone records
+        // into it now (`between` records through `rec`).
         let rec = unsafe { Recording::new(ctx, cmd) };
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
         tiled.record_classify(&rec, &sets, targets, depth_sampled, clear, mixed, shape);
-        between(cmd, "tile-classify");
+        between(rec.outside(), "tile-classify");
         tiled.record_light_lists(&rec, frame.lights.len() as u32);
-        between(cmd, "tile-lights");
+        between(rec.outside(), "tile-lights");
         match shade {
             TiledShade::Kernels => tiled.record_shade(&rec, mixed),
             TiledShade::DepthId => {

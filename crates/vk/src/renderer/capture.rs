@@ -133,8 +133,8 @@ pub(crate) struct FootprintCapture {
 impl FootprintCapture {
     pub fn new(ctx: &Context, layout: vk::PipelineLayout, extent: vk::Extent2D) -> Result<Self> {
         if ctx.depth_stencil_format != vk::Format::D32_SFLOAT_S8_UINT {
-            return Err(Error::Unsupported(
-                "simulator inputs need a 32-bit float depth buffer (D32_SFLOAT_S8_UINT)",
+            return Err(Error::MissingFormat(
+                "simulator inputs need a 32-bit float depth buffer (D32_SFLOAT_S8_UINT)".into(),
             ));
         }
         let formats = [DEPTH_FORMAT];

@@ -184,7 +184,7 @@ impl<'c> Renderer<'c> {
             command_pool,
             cmd,
             fence,
-            unfinished: std::cell::Cell::new(false),
+            unfinished: std::cell::Cell::new(None),
             timestamps: timestamps.keep(),
             readback,
         })

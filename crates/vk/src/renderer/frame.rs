@@ -203,15 +203,16 @@ impl Renderer<'_> {
     /// Resets the frame's command pool (its one command buffer; resetting pools, not single
     /// buffers, is what the best-practices layer asks for) and begins the command buffer.
     pub(super) fn begin_commands(&mut self) -> Result<vk::CommandBuffer> {
-        if self.unfinished.get() {
-            return Err(Error::InFlight(
-                "the renderer's last frame was submitted and waiting for it failed (a timeout or \
-                 a lost device): it records nothing more"
-                    .into(),
-            ));
+        // The renderer's last frame was submitted and waiting for it failed (a timeout or a
+        // lost device): it records nothing more, and says why as the wait did (a device error).
+        if let Some(result) = self.unfinished.get() {
+            return Err(Error::Vulkan {
+                call: "vkWaitForFences (an earlier frame's; the renderer records nothing more)",
+                result,
+            });
         }
         // SAFETY: every frame `submit_and_wait` submitted was waited for (`unfinished` is
-        // clear), so slot 0's last frame has finished, or was never submitted (an error before
+        // `None`), so slot 0's last frame has finished, or was never submitted (an error before
         // the submit).
         unsafe { self.lighting.slot_finished(0)? };
         let (d, cmd) = (&self.ctx.device, self.cmd);
@@ -245,12 +246,22 @@ impl Renderer<'_> {
             ctx.device
                 .queue_submit2(ctx.queue, &[submit], self.fence)
                 .call("vkQueueSubmit2")?;
-            self.unfinished.set(true);
+            // Until the wait succeeds, a failure of it is what every later frame reports.
+            self.unfinished.set(Some(vk::Result::TIMEOUT));
             ctx.step("waiting on the GPU");
-            ctx.device
-                .wait_for_fences(&[self.fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
-                .call("vkWaitForFences")?;
-            self.unfinished.set(false);
+            let waited = ctx.device.wait_for_fences(
+                &[self.fence],
+                true,
+                crate::gpu::context::FENCE_TIMEOUT_NS,
+            );
+            if let Err(result) = waited {
+                self.unfinished.set(Some(result));
+                return Err(Error::Vulkan {
+                    call: "vkWaitForFences",
+                    result,
+                });
+            }
+            self.unfinished.set(None);
             ctx.device
                 .reset_fences(&[self.fence])
                 .call("vkResetFences")?;

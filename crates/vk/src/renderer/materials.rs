@@ -251,7 +251,7 @@ pub fn check_images(ctx: &Context, scene: &Scene) -> Result<()> {
         .iter()
         .find(|i| i.width > max || i.height > max)
     {
-        Some(image) => Err(Error::BadFrame(format!(
+        Some(image) => Err(Error::DeviceLimit(format!(
             "image `{}` is {}x{}; this device allows at most {max} texels per side",
             image.name, image.width, image.height
         ))),

@@ -131,9 +131,10 @@ pub struct Renderer<'c> {
     command_pool: vk::CommandPool,
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
-    /// A frame was submitted and its fence wait failed (a timeout, a lost device): the command
-    /// buffer may still be pending, so the renderer records nothing more.
-    unfinished: std::cell::Cell<bool>,
+    /// A frame was submitted and its fence wait failed (a timeout, a lost device), with what
+    /// it returned: the command buffer may still be pending, so the renderer records nothing
+    /// more and says so with that result.
+    unfinished: std::cell::Cell<Option<vk::Result>>,
     timestamps: Timestamps,
     readback: ReadbackBuffers,
 }

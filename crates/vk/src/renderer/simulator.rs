@@ -25,8 +25,9 @@ impl Renderer<'_> {
     /// finite or at infinity.
     ///
     /// # Errors
-    /// [`crate::Error::Unsupported`] for a forward frame (it has no stencil plan) and without a
-    /// 32-bit float depth buffer (the simulator compares f32 depths), besides the errors of
+    /// [`crate::Error::Unsupported`] for a forward frame (it has no stencil plan);
+    /// [`crate::Error::MissingFormat`] without a 32-bit float depth buffer (the simulator
+    /// compares f32 depths); besides the errors of
     /// [`Renderer::plan`] and of Vulkan calls.
     pub fn simulator_inputs(&mut self, desc: impl Into<FrameDesc>) -> Result<SimulatorInputs> {
         let desc = &desc.into();
