@@ -48,10 +48,6 @@ fn two_target_bindings() -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
 /// script, as an engine's build script compiles its hooks (`histencil_build`).
 const TWO_TARGET: LightModules = include!(concat!(env!("OUT_DIR"), "/histencil_light_modules.rs"));
 
-fn two_target_modules() -> LightModules {
-    TWO_TARGET
-}
-
 /// `EngineHooks::new` with a null decode layout of `bindings` and no visibility layout (the
 /// shadow bindings sit in set 1): the checks use no handle.
 fn hooks(
@@ -68,7 +64,7 @@ fn hooks(
 
 #[test]
 fn the_two_target_hooks_compile_and_fit_the_layout_the_book_gives() {
-    let modules = two_target_modules();
+    let modules = TWO_TARGET;
     let bindings = two_target_bindings();
     hooks(modules, &bindings).expect("the layout the hooks' headers declare");
     // The BRDF parameters' block left out of the layout: refused, naming it.
@@ -81,7 +77,7 @@ fn the_two_target_hooks_compile_and_fit_the_layout_the_book_gives() {
         Err(e @ Error::BadSetup(_)) => e.to_string(),
         other => panic!("expected a setup error, got {other:?}"),
     };
-    // CHECK: the reflected name of a uniform block is its instance name (`two_target_brdfs`).
+    // The reflected name of a uniform block is its instance name (`two_target_brdfs`).
     let words = "deferred_light: reads set 1 binding 3 (`two_target_brdfs`), a uniform buffer, \
                  and the decode layout (set 1) has no such binding";
     assert!(err.contains(words), "{err}\nshould say: {words}");
@@ -89,9 +85,7 @@ fn the_two_target_hooks_compile_and_fit_the_layout_the_book_gives() {
 
 #[test]
 fn the_two_target_hooks_make_light_pipelines_the_validation_layer_accepts() {
-    // First: compiling sets environment variables, which no thread may do while the Vulkan
-    // loader reads them.
-    let modules = two_target_modules();
+    let modules = TWO_TARGET;
     let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
     scene.normalise_lights();
     let engine = Engine::start();

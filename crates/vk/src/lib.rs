@@ -46,6 +46,7 @@ pub use gpu::readback::{FrameImages, Readback};
 pub use gpu::requirements::{DeviceRequirements, REQUIREMENTS};
 pub use gpu::spirv_bindings::{reflect_bindings, ModuleBindings, Resource, ResourceKind};
 pub use gpu::targets::{check_extent, GBUFFER_FORMATS};
+pub use gpu::teardown::StillInFlight;
 #[cfg(feature = "tools")]
 pub use gpu::timing::median_of_sorted;
 pub use gpu::timing::{FrameTimings, LightingBreakdown, LightmapTimings};
@@ -58,8 +59,7 @@ pub use lighting::hooks::{
 };
 pub use lighting::lut::{LutEvaluator, LutTables};
 pub use lighting::{
-    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, StillInFlight,
-    TiledFrame,
+    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, TiledFrame,
 };
 pub use passes::light_pipelines::BrdfSource;
 pub use renderer::capture::SimulatorInputs;

@@ -25,9 +25,8 @@ use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::state::{apply, FULLSCREEN};
-use crate::gpu::teardown::{declare_finished, refuse_in_flight, refuse_slot_in_flight, InFlight};
+use crate::gpu::teardown::{DestroyResult, PendingSlots};
 use crate::gpu::timing::{LightmapTimings, SlotTimer};
-use crate::lighting::StillInFlight;
 use crate::passes::{begin_all_cleared, CLEAR_BLACK};
 use crate::shaders;
 use ash::vk;
@@ -84,8 +83,6 @@ struct Slot {
     entity_lights: Vec<Vec<u32>>,
     /// Timestamps of the last frame in this slot, when it asked for them.
     timer: SlotTimer,
-    /// Recorded into, and not yet declared finished (`slot_finished`).
-    pending: bool,
 }
 
 const STORAGE_NAMES: [&str; 4] = [
@@ -144,6 +141,8 @@ pub struct AlphaLightmaps<C: Deref<Target = Context>> {
     directional_pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     slots: Vec<Slot>,
+    /// The slots recorded into and not yet declared finished (`slot_finished`).
+    pending: PendingSlots,
 }
 
 impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
@@ -179,6 +178,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             directional_pipeline: vk::Pipeline::null(),
             pool: vk::DescriptorPool::null(),
             slots: Vec::new(),
+            pending: PendingSlots::new(desc.frames_in_flight, "AlphaLightmaps", "buffers and sets"),
         };
         // On an error `this` drops, destroying what exists so far.
         this.create()?;
@@ -297,7 +297,6 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                 alpha_set,
                 entity_lights: Vec::new(),
                 timer: SlotTimer::default(),
-                pending: false,
             };
             write_frame_set(ctx, frame_set, slot.uniforms.handle, slot.lights.handle);
             write_storage_buffers(ctx, alpha_set, &slot.storage.each_ref().map(|b| b.handle));
@@ -313,13 +312,10 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// that read an [`Self::entity_buffer`] must be finished too (in the same frames, as a rule).
     ///
     /// # Errors
-    /// [`StillInFlight`] while a slot is not declared finished: it holds the lightmaps, whole,
+    /// [`crate::StillInFlight`] while a slot is not declared finished: it holds the lightmaps, whole,
     /// and the error naming the slots (dropping it waits for the device).
-    pub fn destroy(self) -> std::result::Result<(), Box<StillInFlight<Self>>> {
-        match self.none_in_flight("destroy") {
-            Ok(()) => Ok(()),
-            Err(error) => Err(Box::new(StillInFlight { value: self, error })),
-        }
+    pub fn destroy(self) -> DestroyResult<Self> {
+        PendingSlots::destroy(self, |l| &l.pending)
     }
 
     /// Says the GPU has finished the frame last recorded into `slot` (and your draws that read
@@ -335,28 +331,12 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// buffer, has finished executing on the GPU, or will never be submitted: the next
     /// recording rewrites (and may replace) that slot's buffers and sets, trusting this.
     pub unsafe fn slot_finished(&mut self, slot: u32) -> Result<()> {
-        let frames = self.slots.len();
-        declare_finished(
-            self.slots.get_mut(slot as usize).map(|s| &mut s.pending),
-            slot,
-            frames,
-        )
+        self.pending.finished(slot)
     }
 
     /// Whether a slot is recorded into and not yet declared finished.
     pub fn in_flight(&self) -> bool {
-        self.slots.iter().any(|s| s.pending)
-    }
-
-    /// Refuses `what` while a slot is in flight, naming the slots.
-    fn none_in_flight(&self, what: &str) -> Result<()> {
-        refuse_in_flight(self.slots.iter().map(|s| s.pending), what, "AlphaLightmaps")
-    }
-
-    /// Refuses a recording into `slot` while its last frame is not declared finished.
-    fn slot_free(&self, slot: u32) -> Result<()> {
-        let pending = self.slots.get(slot as usize).is_some_and(|s| s.pending);
-        refuse_slot_in_flight(pending, slot, "AlphaLightmaps", "buffers and sets")
+        self.pending.any()
     }
 
     /// What these lightmaps were made for.
@@ -454,7 +434,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// Checks `frame` and writes its records, lights and uniforms into its slot.
     pub(crate) fn write_frame(&mut self, frame: &LightmapFrame, atlas: &ImageRef) -> Result<()> {
         check_frame(&self.desc, frame, atlas)?;
-        self.slot_free(frame.slot)?;
+        self.pending.refuse_slot(frame.slot)?;
         let viewer = Viewer::from_view(frame.view)
             .ok_or_else(|| bad("the view's world-to-view matrix cannot be inverted".into()))?;
         let e = atlas.extent;
@@ -536,8 +516,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         // SAFETY: this fn's # Safety is `Recording::new`'s.
         let rec = unsafe { Recording::new(ctx, cmd) };
         let cmd = rec.outside();
+        self.pending.recorded(slot);
         let slot = &mut self.slots[slot as usize];
-        slot.pending = true;
         // Queries are reset outside rendering, as Vulkan requires.
         let mut timer = slot.timer.active();
         if let Some(t) = timer.as_deref_mut() {
@@ -637,11 +617,7 @@ impl<C: Deref<Target = Context>> Drop for AlphaLightmaps<C> {
     fn drop(&mut self) {
         let ctx: &Context = &self.ctx;
         let d = &ctx.device;
-        let mut in_flight = InFlight::default();
-        if self.in_flight() {
-            in_flight.mark();
-        }
-        in_flight.wait(ctx);
+        self.pending.wait(ctx);
         for slot in &mut self.slots {
             slot.uniforms.destroy(ctx);
             slot.lights.destroy(ctx);

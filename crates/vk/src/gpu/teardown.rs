@@ -128,53 +128,120 @@ impl InFlight {
     }
 }
 
-/// Refuses `what` (a resize, a destroy) of `owner` (`DeferredLighting`, `AlphaLightmaps`) while
-/// a slot holds a recorded frame not declared finished (`pending`, one flag a slot), naming the
-/// slots: the engine said nothing of their fences yet, so the GPU may still read them.
-pub(crate) fn refuse_in_flight(
-    pending: impl Iterator<Item = bool>,
-    what: &str,
-    owner: &str,
-) -> Result<()> {
-    let slots: Vec<String> = (pending.enumerate())
-        .filter(|(_, pending)| *pending)
-        .map(|(i, _)| i.to_string())
-        .collect();
-    if slots.is_empty() {
-        return Ok(());
-    }
-    Err(Error::InFlight(format!(
-        "{what} while slot {} may still be read by the GPU: wait for those frames, and say so \
-         with {owner}::slot_finished, first",
-        slots.join(", ")
-    )))
+/// Which frame-in-flight slots of an engine-facing owner (`DeferredLighting`,
+/// `AlphaLightmaps`) hold a recorded frame the engine has not declared finished yet: histencil
+/// submits nothing and sees no fence, so the engine says so (`slot_finished`), and until then
+/// the slot is not recorded again, and the owner not resized or destroyed.
+pub(crate) struct PendingSlots {
+    pending: Vec<bool>,
+    /// The owner's name, for the refusals' advice (`DeferredLighting::slot_finished`).
+    owner: &'static str,
+    /// What a slot holds for its frame, for the refusals ("buffers and sets").
+    holds: &'static str,
 }
 
-/// Refuses a recording into `slot` of `owner` while its last frame (`pending`) is not declared
-/// finished: what the slot `holds` is that frame's until then.
-pub(crate) fn refuse_slot_in_flight(
-    pending: bool,
-    slot: u32,
-    owner: &str,
-    holds: &str,
-) -> Result<()> {
-    if !pending {
-        return Ok(());
+impl PendingSlots {
+    /// `slots` slots, none pending.
+    pub fn new(slots: u32, owner: &'static str, holds: &'static str) -> Self {
+        Self {
+            pending: vec![false; slots as usize],
+            owner,
+            holds,
+        }
     }
-    Err(Error::InFlight(format!(
-        "slot {slot} recorded again before {owner}::slot_finished({slot}) said the GPU finished \
-         its last frame: its {holds} are that frame's until then"
-    )))
+
+    /// A frame was recorded into `slot` (in range: the owner checked it).
+    pub fn recorded(&mut self, slot: u32) {
+        self.pending[slot as usize] = true;
+    }
+
+    /// The engine's `slot_finished(slot)`; a slot past the slots in flight is refused.
+    pub fn finished(&mut self, slot: u32) -> Result<()> {
+        let frames = self.pending.len();
+        let pending = self.pending.get_mut(slot as usize).ok_or_else(|| {
+            Error::BadFrame(format!(
+                "slot_finished({slot}) of {frames} frames in flight"
+            ))
+        })?;
+        *pending = false;
+        Ok(())
+    }
+
+    /// Whether a slot is pending.
+    pub fn any(&self) -> bool {
+        self.pending.contains(&true)
+    }
+
+    /// The owner's drop: waits for the device to go idle while a slot is pending (as
+    /// [`InFlight`] does), not otherwise.
+    pub fn wait(&self, ctx: &Context) {
+        InFlight(self.any()).wait(ctx);
+    }
+
+    /// Refuses `what` (a resize, a destroy) while a slot is pending, naming the slots.
+    pub fn refuse_while_any(&self, what: &str) -> Result<()> {
+        let slots: Vec<String> = (self.pending.iter().enumerate())
+            .filter(|(_, pending)| **pending)
+            .map(|(i, _)| i.to_string())
+            .collect();
+        if slots.is_empty() {
+            return Ok(());
+        }
+        Err(Error::InFlight(format!(
+            "{what} while slot {} may still be read by the GPU: wait for those frames, and say \
+             so with {}::slot_finished, first",
+            slots.join(", "),
+            self.owner
+        )))
+    }
+
+    /// Refuses a recording into `slot` while its last frame is pending: what the slot holds
+    /// is that frame's until then.
+    pub fn refuse_slot(&self, slot: u32) -> Result<()> {
+        if !self.pending.get(slot as usize).copied().unwrap_or(false) {
+            return Ok(());
+        }
+        Err(Error::InFlight(format!(
+            "slot {slot} recorded again before {}::slot_finished({slot}) said the GPU finished \
+             its last frame: its {} are that frame's until then",
+            self.owner, self.holds
+        )))
+    }
+
+    /// `value`'s destroy: refused while a slot is pending, with `value` handed back whole.
+    pub fn destroy<T>(value: T, slots: impl Fn(&T) -> &PendingSlots) -> DestroyResult<T> {
+        match slots(&value).refuse_while_any("destroy") {
+            Ok(()) => Ok(()),
+            Err(error) => Err(Box::new(StillInFlight { value, error })),
+        }
+    }
 }
 
-/// Clears a slot's `pending` flag, as an engine's `slot_finished(slot)` declares it (`None`: a
-/// slot past the `frames` in flight, refused).
-pub(crate) fn declare_finished(pending: Option<&mut bool>, slot: u32, frames: usize) -> Result<()> {
-    let pending = pending.ok_or_else(|| {
-        Error::BadFrame(format!(
-            "slot_finished({slot}) of {frames} frames in flight"
-        ))
-    })?;
-    *pending = false;
-    Ok(())
+/// What an engine-facing owner's `destroy` returns.
+pub(crate) type DestroyResult<T> = std::result::Result<(), Box<StillInFlight<T>>>;
+
+/// What a refused `destroy` (of a [`crate::DeferredLighting`] or [`crate::AlphaLightmaps`])
+/// gives back: the value, whole, and why.
+pub struct StillInFlight<T> {
+    /// What was not destroyed; dropping it waits for the device, then frees it.
+    pub value: T,
+    /// [`Error::InFlight`], naming the slots.
+    pub error: Error,
 }
+
+impl<T> std::fmt::Display for StillInFlight<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.error.fmt(f)
+    }
+}
+
+/// The error alone: the value it holds need not be `Debug` (a lighting is not).
+impl<T> std::fmt::Debug for StillInFlight<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StillInFlight")
+            .field("error", &self.error)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<T> std::error::Error for StillInFlight<T> {}

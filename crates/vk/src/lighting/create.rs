@@ -155,7 +155,6 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 gbuffer_set,
                 timer: SlotTimer::default(),
                 emulation: SlotTimer::default(),
-                pending: false,
             });
         }
         Ok(())

@@ -37,9 +37,7 @@ use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
 use crate::gpu::meshes::LightVolumes;
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::{
-    declare_finished, refuse_in_flight, refuse_slot_in_flight, Destroy, InFlight,
-};
+use crate::gpu::teardown::{Destroy, DestroyResult, PendingSlots};
 use crate::gpu::timing::{LightingBreakdown, SlotTimer};
 use crate::hi_stencil::{GpuHierarchy, HiStencilSurface};
 use crate::lighting::hooks::HookSets;
@@ -64,9 +62,6 @@ struct Slot {
     timer: SlotTimer,
     /// The hi-stencil emulation's bookkeeping against the technique (`Emulation`).
     emulation: SlotTimer,
-    /// Recorded into, and not yet declared finished (`slot_finished`): its buffers, sets and
-    /// stencil view belong to that frame.
-    pending: bool,
 }
 
 /// The lighting passes of the talk, recorded into an engine's frames.
@@ -152,32 +147,10 @@ pub struct DeferredLighting<C: Deref<Target = Context>> {
     tiled: Vec<(TileSide, TiledLighting)>,
     /// The depth-id technique per tile side, made at its first frame with that side.
     depth_id: Vec<(TileSide, DepthIdPass)>,
+    /// The slots recorded into and not yet declared finished (`slot_finished`): their buffers,
+    /// sets and stencil views belong to those frames.
+    pending: PendingSlots,
 }
-
-/// What a refused [`DeferredLighting::destroy`] gives back: the value, whole, and why.
-pub struct StillInFlight<T> {
-    /// What was not destroyed; dropping it waits for the device, then frees it.
-    pub value: T,
-    /// [`Error::InFlight`], naming the slots.
-    pub error: Error,
-}
-
-impl<T> std::fmt::Display for StillInFlight<T> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.error.fmt(f)
-    }
-}
-
-/// The error alone: the value it holds need not be `Debug` (a lighting is not).
-impl<T> std::fmt::Debug for StillInFlight<T> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("StillInFlight")
-            .field("error", &self.error)
-            .finish_non_exhaustive()
-    }
-}
-
-impl<T> std::error::Error for StillInFlight<T> {}
 
 impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// Creates the pipeline layout, the light volumes, the hi-stencil emulation and every slot's
@@ -208,6 +181,11 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             lut_set: vk::DescriptorSet::null(),
             lut_written: false,
             slots: Vec::new(),
+            pending: PendingSlots::new(
+                desc.frames_in_flight,
+                "DeferredLighting",
+                "buffers, sets and stencil view",
+            ),
             hi_stencil: None,
             volumes: None,
             tiled: Vec::new(),
@@ -236,7 +214,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// is not declared finished ([`DeferredLighting::slot_finished`]: wait for your frames in
     /// flight first, as for any resize of your own targets); allocation errors.
     pub fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
-        self.none_in_flight("resize")?;
+        self.pending.refuse_while_any("resize")?;
         if extent.width == 0 || extent.height == 0 {
             return Err(bad_setup(format!(
                 "a {}x{} lighting extent",
@@ -285,37 +263,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// descriptor sets and stencil view at its next recording, and frees them at a resize or
     /// destroy, trusting this.
     pub unsafe fn slot_finished(&mut self, slot: u32) -> Result<()> {
-        let frames = self.slots.len();
-        declare_finished(
-            self.slots.get_mut(slot as usize).map(|s| &mut s.pending),
-            slot,
-            frames,
-        )
+        self.pending.finished(slot)
     }
 
     /// Whether a slot is recorded into and not yet declared finished.
     pub fn in_flight(&self) -> bool {
-        self.slots.iter().any(|s| s.pending)
-    }
-
-    /// Refuses `what` while a slot is in flight, naming the slots.
-    fn none_in_flight(&self, what: &str) -> Result<()> {
-        refuse_in_flight(
-            self.slots.iter().map(|s| s.pending),
-            what,
-            "DeferredLighting",
-        )
-    }
-
-    /// Refuses a recording into `slot` while its last frame is not declared finished.
-    fn slot_free(&self, slot: u32) -> Result<()> {
-        let pending = self.slots.get(slot as usize).is_some_and(|s| s.pending);
-        refuse_slot_in_flight(
-            pending,
-            slot,
-            "DeferredLighting",
-            "buffers, sets and stencil view",
-        )
+        self.pending.any()
     }
 
     /// Creates every light pipeline `plan` uses, so the first frame that needs them does not
@@ -398,7 +351,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         check_frame(&self.desc, frame, targets)?;
         let needs = UsageNeeds::light_passes(&self.desc, frame.plan, hierarchy.is_some());
         check_usage(targets, &needs)?;
-        self.slot_free(frame.slot)?;
+        self.pending.refuse_slot(frame.slot)?;
         if frame.plan.uses_depth_bounds() && !self.ctx.depth_bounds() {
             return Err(Error::BadFrame(
                 "the plan confines lights to their depth ranges (FramePlan::with_depth_bounds), \
@@ -466,7 +419,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         let timer = slot.timer.active();
         let emulation = slot.emulation.active();
-        slot.pending = true;
+        self.pending.recorded(frame.slot);
         let recorded = pass.record(targets, hi_stencil, timer, emulation);
         rec.finish();
         recorded
@@ -557,13 +510,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// fences say the GPU is done and [`DeferredLighting::slot_finished`] was told so.
     ///
     /// # Errors
-    /// [`StillInFlight`] while a slot is not declared finished: it holds the lighting, whole
+    /// [`crate::StillInFlight`] while a slot is not declared finished: it holds the lighting, whole
     /// and unchanged, and the error naming the slots (dropping it waits for the device).
-    pub fn destroy(self) -> std::result::Result<(), Box<StillInFlight<Self>>> {
-        match self.none_in_flight("destroy") {
-            Ok(()) => Ok(()),
-            Err(error) => Err(Box::new(StillInFlight { value: self, error })),
-        }
+    pub fn destroy(self) -> DestroyResult<Self> {
+        PendingSlots::destroy(self, |l| &l.pending)
     }
 
     /// Points the LUT technique at `tables` (one per material, in the order of the G-buffer's
@@ -598,11 +548,7 @@ impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
     fn drop(&mut self) {
         let ctx: &Context = &self.ctx;
         let d = &ctx.device;
-        let mut in_flight = InFlight::default();
-        if self.in_flight() {
-            in_flight.mark();
-        }
-        in_flight.wait(ctx);
+        self.pending.wait(ctx);
         self.pipelines.destroy(ctx);
         for (_, t) in &mut self.tiled {
             t.destroy(ctx);

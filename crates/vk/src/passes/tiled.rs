@@ -450,9 +450,10 @@ impl TiledLighting {
             .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
             .image_info(&image);
         // SAFETY: `slot`'s set is not in use: `record_tiled_with`, the one caller, refused a
-        // slot not declared finished (`slot_free`; `slot_finished`'s # Safety). Binding 4 is
-        // `TILED_SET`'s storage image, and `hdr` is the caller's live view with `STORAGE` usage
-        // (`record_tiled`'s # Safety, `check_usage`), in `GENERAL` when the kernels run.
+        // slot not declared finished (`PendingSlots::refuse_slot`; `slot_finished`'s # Safety).
+        // Binding 4 is `TILED_SET`'s storage image, and `hdr` is the caller's live view with
+        // `STORAGE` usage (`record_tiled`'s # Safety, `check_usage`), in `GENERAL` when the
+        // kernels run.
         unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
     }
 
