@@ -164,6 +164,11 @@ impl ParamEncoding {
                 rho: s(rho, linear),
                 curvature_per_mm: s(curvature_per_mm, curvature),
             },
+            // Its ranges are the engine's: stored as they are, without a warp into [0, 1].
+            Brdf::Engine { id, params } => Brdf::Engine {
+                id,
+                params: params.map(|x| s(x, linear)),
+            },
         }
     }
 }

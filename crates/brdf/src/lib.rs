@@ -25,7 +25,9 @@
 //! [`encoding`] measures what G-buffer quantisation adds; `eval_csv` (with the `files` feature,
 //! as `Brdf::parse`) reads and writes the `brdf-eval` case files.
 //!
-//! [`BrdfId`] is the renderer's list of shading models stored in the G-buffer and stencil.
+//! [`BrdfId`] is the renderer's list of shading models stored in the G-buffer and stencil;
+//! [`BrdfSet`] adds an engine's own (GLSL functions, read from a `brdfs.toml` folder with the
+//! `files` feature) to the built-ins it keeps.
 
 #![warn(missing_docs)]
 
@@ -35,11 +37,17 @@ pub mod encoding;
 pub mod eval_csv;
 mod id;
 pub mod lut;
+#[cfg(feature = "files")]
+mod manifest;
 mod model;
 mod models;
+mod set;
 mod vector;
 
-pub use id::{BrdfId, UnknownBrdf};
+pub use id::{BrdfId, EngineBrdf, UnknownBrdf, ENGINE_FIRST, MAX_ENGINE_BRDFS};
+#[cfg(feature = "files")]
+pub use manifest::{ManifestError, MANIFEST};
 pub use model::{ranges, Brdf, BrdfError, Parts, Range, MODEL_NAMES};
 pub use models::*;
+pub use set::{BrdfSet, EngineBrdfSpec, EngineParam, SetError, MAX_ENGINE_PARAMS, MODEL_IDS};
 pub use vector::{normalize, Real, V3};

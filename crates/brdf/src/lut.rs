@@ -77,6 +77,9 @@ impl LutAxes {
             | Brdf::GltfMetalRough { .. } => LutAxes::Isotropic,
             Brdf::KajiyaKay { .. } => LutAxes::Fibre,
             Brdf::PennerSkin { .. } => LutAxes::SkinCurvature,
+            // Never baked: an engine BRDF has no CPU spelling, and the LUT technique refuses it
+            // as untabulable first (`Brdf::is_tabulable`). Its value depends on N, V and L.
+            Brdf::Engine { .. } => LutAxes::Isotropic,
         }
     }
 

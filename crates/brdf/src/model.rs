@@ -1,7 +1,7 @@
 //! A BRDF with its parameters: parsed from a name and a JSON object, evaluated in f64 or f32,
 //! and packed for the GLSL spelling (`crates/vk/shaders/include/brdf/eval.glsl`).
 
-use crate::id::BrdfId;
+use crate::id::{BrdfId, EngineBrdf};
 use crate::models;
 use crate::vector::{c, Real, V3};
 #[cfg(feature = "files")]
@@ -103,6 +103,16 @@ pub enum Brdf {
         /// 0 for a dielectric, 1 for a metal.
         metallic: f64,
     },
+    /// An engine's own BRDF ([`BrdfSet`](crate::BrdfSet)), evaluated by its GLSL only: it has
+    /// no CPU spelling, so [`Brdf::eval_parts`] gives NaN for it and every path that needs one
+    /// (the LUT's tables, the f64 reference) refuses it first.
+    Engine {
+        /// Which of the set's BRDFs.
+        id: EngineBrdf,
+        /// Its parameters in manifest order (`p.x`, `p.y`, `p.z` in its GLSL), each held to its
+        /// range by the set that parsed it.
+        params: [f64; 3],
+    },
 }
 
 /// Names accepted by [`Brdf::parse`], in id order ([`BrdfId::ALL`]).
@@ -151,6 +161,26 @@ pub enum BrdfError {
         rule: String,
         /// The value given, as written.
         value: String,
+    },
+    /// An engine BRDF's parameter outside its range or not a number.
+    #[error("{model}: parameter `{param}` must be {rule}, got {value}")]
+    BadEngineParam {
+        /// The BRDF's name.
+        model: &'static str,
+        /// The parameter refused.
+        param: String,
+        /// What its range allows, in words.
+        rule: String,
+        /// The value given, as written.
+        value: String,
+    },
+    /// A BRDF the lighting's set does not hold.
+    #[error("BRDF `{model}` is not in this lighting's BRDF set ({set})")]
+    NotInSet {
+        /// The BRDF's name.
+        model: &'static str,
+        /// The set's BRDFs, comma-separated.
+        set: String,
     },
     /// Two spellings of the same parameter were given (`alpha` and `perceptual_roughness`, ...).
     #[error("{model}: give exactly one of {options}")]
@@ -242,7 +272,8 @@ pub struct Range {
 }
 
 impl Range {
-    const fn new(min: f64, max: f64) -> Self {
+    /// The values from `min` to `max`, both included.
+    pub const fn new(min: f64, max: f64) -> Self {
         Self { min, max }
     }
 
@@ -251,7 +282,7 @@ impl Range {
         x.is_finite() && (self.min..=self.max).contains(&x)
     }
 
-    fn text(self) -> String {
+    pub(crate) fn text(self) -> String {
         if self.max == f64::MAX {
             format!("a finite number >= {}", self.min)
         } else {
@@ -280,6 +311,9 @@ pub mod ranges {
     /// Skin radius in mm, the reciprocal of the curvature's range.
     pub const RADIUS_MM: Range = Range::new(1e-6, f64::MAX);
 }
+
+/// What any parameter must be to reach the GPU as the number it is: finite in f32.
+const F32_FINITE: Range = Range::new(-(f32::MAX as f64), f32::MAX as f64);
 
 #[cfg(feature = "files")]
 impl Brdf {
@@ -395,6 +429,12 @@ impl Brdf {
             Brdf::GltfMetalRough { alpha, metallic } => {
                 vec![("alpha", alpha, ROUGHNESS), ("metallic", metallic, UNIT)]
             }
+            // The set holds them to the manifest's ranges; here only to what reaches the GPU.
+            Brdf::Engine { params, .. } => ["p.x", "p.y", "p.z"]
+                .into_iter()
+                .zip(params)
+                .map(|(name, x)| (name, x, F32_FINITE))
+                .collect(),
         }
     }
 
@@ -428,6 +468,7 @@ impl Brdf {
             Brdf::KajiyaKay { .. } => BrdfId::KajiyaKay,
             Brdf::PennerSkin { .. } => BrdfId::PennerSkin,
             Brdf::GltfMetalRough { .. } => BrdfId::GltfMetalRough,
+            Brdf::Engine { id, .. } => BrdfId::Engine(*id),
         }
     }
 
@@ -436,15 +477,16 @@ impl Brdf {
         self.id().index()
     }
 
-    /// The model's name as [`Brdf::parse`] accepts it and the case files write it.
+    /// The model's name as [`Brdf::parse`] (or its set) accepts it and the case files write it.
     pub fn name(&self) -> &'static str {
-        MODEL_NAMES[self.model_index() as usize]
+        self.id().name()
     }
 
     /// Whether the value is the tint times a function of the angles (no white part), which a
-    /// look-up table of `f / tint` can hold: every model but glTF's metallic-roughness.
+    /// look-up table of `f / tint` can hold, baked from a CPU spelling: every built-in model but
+    /// glTF's metallic-roughness. Not an engine's BRDF, which has no CPU spelling.
     pub fn is_tabulable(&self) -> bool {
-        !matches!(self, Brdf::GltfMetalRough { .. })
+        !matches!(self, Brdf::GltfMetalRough { .. } | Brdf::Engine { .. })
     }
 
     /// Only skin is coloured; every other model returns one value.
@@ -467,6 +509,9 @@ impl Brdf {
                 curvature_per_mm,
             } => [rho, curvature_per_mm, 0.0, 0.0],
             Brdf::GltfMetalRough { alpha, metallic } => [alpha, metallic, 0.0, 0.0],
+            Brdf::Engine {
+                params: [x, y, z], ..
+            } => [x, y, z, 0.0],
         }
     }
 
@@ -497,6 +542,13 @@ impl Brdf {
                 return Parts {
                     tinted: [tinted; 3],
                     white,
+                };
+            }
+            Brdf::Engine { .. } => {
+                let nan = R::nan();
+                return Parts {
+                    tinted: [nan; 3],
+                    white: nan,
                 };
             }
         };

@@ -39,6 +39,8 @@ fn material(id: BrdfId, variant: usize, tint: Vec3) -> Material {
             alpha: [0.36, 0.04][variant % 2],
             metallic: [0.0, 1.0][variant % 2],
         },
+        // Every caller here names one of BrdfId::ALL.
+        BrdfId::Engine(e) => unreachable!("an embedded scene names engine BRDF `{}`", e.name()),
     };
     Material::new(brdf, tint)
 }

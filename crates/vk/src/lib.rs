@@ -15,6 +15,7 @@
 // per pass or technique) and the hi-stencil emulation; the engine API (`DeferredLighting`, its
 // hooks, `AlphaLightmaps`); histencil's own renderer; and the tools its command line and lab use.
 mod alpha;
+mod brdf_modules;
 pub mod gpu;
 mod hi_stencil;
 mod lighting;
@@ -36,6 +37,7 @@ pub use alpha::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord, AlphaLightmaps,
     AlphaLightmapsDesc, AlphaMode, LightmapFrame,
 };
+pub use brdf_modules::{compile as compile_brdf_set, BrdfModules};
 pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};
 pub use gpu::debug::{ValidationLog, ValidationMessage};
 pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};

@@ -18,8 +18,9 @@ pub const HI_STENCIL_TILE: u32 = 8;
 pub const HI_STENCIL_UPDATE_GROUP: u32 = 64;
 
 /// BRDF model ids the tiled classification maps to slots (GLSL `TILED_MODELS`): at least
-/// `BrdfId::ALL.len()` (build.rs checks).
-pub const TILED_MODELS: u32 = 8;
+/// `histencil_brdf::MODEL_IDS`, the built-ins' and an engine set's (build.rs checks). Its push
+/// constants are then 116 bytes, within the 128 every device has.
+pub const TILED_MODELS: u32 = 24;
 
 /// `LightDraw.flags` bit: reject fragments in tiles the active hi-stencil surface marks failing.
 pub const LIGHT_DRAW_HI_STENCIL_TEST: u32 = 1;

@@ -131,6 +131,8 @@ const STORAGE_NAMES: [&str; 4] = [
 pub struct AlphaLightmaps<C: Deref<Target = Context>> {
     ctx: C,
     desc: AlphaLightmapsDesc,
+    /// The lightmap shaders: histencil's, or compiled for a BRDF set.
+    modules: &'static crate::BrdfModules,
     /// Frame and alpha set layouts: sets 0 and 1 of the lightmap pass (and of histencil's alpha
     /// pass).
     set_layouts: [vk::DescriptorSetLayout; 2],
@@ -153,6 +155,15 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     /// [`Error::BadSetup`] for no frames in flight or a depth-stencil atlas format; Vulkan and
     /// allocation errors.
     pub fn new(ctx: C, desc: &AlphaLightmapsDesc) -> Result<Self> {
+        Self::with_modules(ctx, desc, crate::BrdfModules::builtin())
+    }
+
+    /// As [`AlphaLightmaps::new`], lighting with the lightmap shaders of `modules` (a BRDF set's).
+    pub(crate) fn with_modules(
+        ctx: C,
+        desc: &AlphaLightmapsDesc,
+        modules: &'static crate::BrdfModules,
+    ) -> Result<Self> {
         let bad = |message: String| Error::BadSetup(message);
         if desc.frames_in_flight == 0 {
             return Err(bad("frames_in_flight must be at least 1".into()));
@@ -172,6 +183,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         let mut this = Self {
             ctx,
             desc: *desc,
+            modules,
             set_layouts: [vk::DescriptorSetLayout::null(); 2],
             pipeline_layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
@@ -202,7 +214,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         let plain = PipelineDesc {
             name: "alpha-lightmap-pipeline",
             vertex: ("fullscreen.vert", shaders::FULLSCREEN_VERT),
-            fragment: Some(("lightmap.frag", shaders::LIGHTMAP_FRAG)),
+            fragment: Some(("lightmap.frag", self.modules.lightmap)),
             layout: self.pipeline_layout,
             vertex_input: VertexInput::None,
             color_formats: &formats,
@@ -221,7 +233,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                     name: "alpha-lightmap-directional-pipeline",
                     fragment: Some((
                         "lightmap_directional.frag",
-                        shaders::LIGHTMAP_DIRECTIONAL_FRAG,
+                        self.modules.lightmap_directional,
                     )),
                     color_formats: &formats,
                     ..plain

@@ -193,16 +193,18 @@ impl<'c> AlphaLighting<'c> {
         extent: vk::Extent2D,
         forced_side: Option<u32>,
         frame_layout: vk::DescriptorSetLayout,
+        modules: &'static crate::BrdfModules,
     ) -> Result<Self> {
         let max_side = histencil_alpha::MAX_ATLAS_SIDE.min(ctx.max_image_dimension);
         let plan = plan_layout(scene, extent.height, forced_side, max_side)?;
-        let lightmaps = AlphaLightmaps::new(
+        let lightmaps = AlphaLightmaps::with_modules(
             ctx,
             &AlphaLightmapsDesc {
                 atlas_format: LIGHTMAP_FORMAT,
                 frames_in_flight: 1,
                 direction_format: Some(LIGHTMAP_FORMAT),
             },
+            modules,
         )?;
         let mut parts = Parts::default();
         match Self::create(ctx, scene, plan, lightmaps, frame_layout, &mut parts) {

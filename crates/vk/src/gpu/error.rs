@@ -123,6 +123,10 @@ pub enum Error {
     /// technique before its tables, ...): the message names it.
     #[error("not supported yet: {0}")]
     Unsupported(&'static str),
+    /// A BRDF set that cannot be compiled (the engine's GLSL, with its file and line), or a
+    /// material whose BRDF the lighting's set does not hold.
+    #[error("BRDF set: {0}")]
+    BrdfSet(String),
     /// A tool's output file could not be written (nothing half-written is left behind).
     #[error("cannot write `{path}`: {message}")]
     Output {
@@ -180,7 +184,8 @@ impl Error {
             | Error::Lightmap(_)
             | Error::TooManyMaterials { .. }
             | Error::LutTexturedParameters { .. }
-            | Error::LutUntabulable { .. } => Cause::Data,
+            | Error::LutUntabulable { .. }
+            | Error::BrdfSet(_) => Cause::Data,
             Error::Output { .. } => Cause::Output,
         }
     }

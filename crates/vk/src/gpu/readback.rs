@@ -170,7 +170,8 @@ impl ReadbackBuffers {
         ctx.end_label(cmd);
     }
 
-    pub fn read(&self, what: Readback) -> Result<FrameImages> {
+    /// The images `what` asks for; BRDF ids are named by `set`, the renderer's.
+    pub fn read(&self, what: Readback, set: &histencil_brdf::BrdfSet) -> Result<FrameImages> {
         let (w, h) = (self.extent.width, self.extent.height);
         let mut images = FrameImages::default();
         if what.ldr {
@@ -190,13 +191,18 @@ impl ReadbackBuffers {
         }
         if what.brdf_ids {
             // gbuffer-material is RGBA32F with the BRDF id in w, cleared to -1 (no geometry).
+            let by_index: Vec<Option<BrdfId>> = (0..histencil_brdf::MODEL_IDS)
+                .map(|i| set.by_index(i))
+                .collect();
             let ids = self
                 .material
                 .read()
                 .chunks_exact(16)
                 .map(|texel| {
                     let id = f32::from_le_bytes([texel[12], texel[13], texel[14], texel[15]]);
-                    (id >= 0.0).then(|| BrdfId::from_index(id as u32)).flatten()
+                    (id >= 0.0)
+                        .then(|| by_index.get(id as usize).copied().flatten())
+                        .flatten()
                 })
                 .collect();
             images.brdf_ids = Some(ids);

@@ -251,7 +251,7 @@ pub(super) fn check_targets(
         Ok(())
     };
     desc.hooks.check_sets(hook_sets)?;
-    if let LightHooks::Builtin = desc.hooks {
+    if desc.hooks.is_builtin_decode() {
         let names = [
             "G-buffer albedo",
             "G-buffer normal-depth",

@@ -29,7 +29,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             ("lut-set-layout", LUT_SET),
         ];
         let hooks = &self.desc.hooks;
-        let builtin = matches!(hooks, LightHooks::Builtin);
+        let builtin = hooks.is_builtin_decode();
         for (i, (name, set)) in named.into_iter().enumerate() {
             if i == 1 && !builtin {
                 continue;

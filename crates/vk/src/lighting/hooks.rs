@@ -24,7 +24,11 @@ pub enum LightHooks {
     /// every light unshadowed.
     #[default]
     Builtin,
-    /// The engine's hooks.
+    /// histencil's G-buffer and no shadows, as [`LightHooks::Builtin`], with the light shaders
+    /// compiled for a BRDF set of the engine's (`BrdfModules::light`, from
+    /// [`crate::compile_brdf_set`] or histencil-build).
+    BuiltinWithBrdfs(LightModules),
+    /// The engine's hooks (their modules compiled with its BRDF set, if it has one).
     Engine(EngineHooks),
 }
 
@@ -298,10 +302,16 @@ pub struct HookSets {
 }
 
 impl LightHooks {
+    /// Whether surfaces come from histencil's own G-buffer (no engine hooks).
+    pub(crate) fn is_builtin_decode(&self) -> bool {
+        !matches!(self, LightHooks::Engine(_))
+    }
+
     /// The modules the light pipelines are made from.
     pub(crate) fn modules(&self) -> LightModules {
         match self {
             LightHooks::Builtin => LightModules::BUILTIN,
+            LightHooks::BuiltinWithBrdfs(modules) => *modules,
             LightHooks::Engine(e) => e.modules,
         }
     }
@@ -315,7 +325,7 @@ impl LightHooks {
     /// The visibility set layout, if any.
     pub(crate) fn visibility_layout(&self) -> Option<vk::DescriptorSetLayout> {
         match self {
-            LightHooks::Builtin => None,
+            LightHooks::Builtin | LightHooks::BuiltinWithBrdfs(_) => None,
             LightHooks::Engine(e) => e.visibility_layout,
         }
     }
@@ -325,14 +335,14 @@ impl LightHooks {
     /// With histencil's built-in decode, also holds histencil's own light modules to its
     /// G-buffer layout by the check engines' hooks get ([`EngineHooks::new`]).
     pub(crate) fn check(&self, ctx: &Context) -> Result<()> {
-        if let LightHooks::Builtin = self {
+        if self.is_builtin_decode() {
             let stages = GRAPHICS_STAGES | vk::ShaderStageFlags::COMPUTE;
             let gbuffer = layout_bindings(GBUFFER_SET, stages);
             let layouts = HookLayouts {
                 decode: &gbuffer,
                 visibility: None,
             };
-            if let Some(why) = check_modules(&LightModules::BUILTIN, &layouts)? {
+            if let Some(why) = check_modules(&self.modules(), &layouts)? {
                 return Err(Error::BadSetup(why));
             }
         }
@@ -360,7 +370,7 @@ impl LightHooks {
     /// Why the tiled technique cannot be recorded with these hooks, if it cannot.
     pub(crate) fn tiled_refusal(&self) -> Option<&str> {
         match self {
-            LightHooks::Builtin => None,
+            LightHooks::Builtin | LightHooks::BuiltinWithBrdfs(_) => None,
             LightHooks::Engine(e) => e.tiled_refusal.as_deref(),
         }
     }
@@ -369,10 +379,10 @@ impl LightHooks {
     pub(crate) fn check_sets(&self, sets: &HookSets) -> Result<()> {
         let bad = |m: &str| Err(Error::BadFrame(m.to_owned()));
         match self {
-            LightHooks::Builtin if sets.decode.is_some() || sets.visibility.is_some() => {
+            _ if self.is_builtin_decode() && (sets.decode.is_some() || sets.visibility.is_some()) => {
                 bad("hook sets for a lighting with histencil's built-in hooks")
             }
-            LightHooks::Builtin => Ok(()),
+            LightHooks::Builtin | LightHooks::BuiltinWithBrdfs(_) => Ok(()),
             LightHooks::Engine(_) if sets.decode.is_none() => {
                 bad("no decode set for a lighting with the engine's decode hook (HookSets::decode)")
             }

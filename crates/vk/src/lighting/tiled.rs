@@ -198,7 +198,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// The set layout the decode hook binds at set 1: histencil's G-buffer's, or the engine's.
     fn decode_layout(&self) -> vk::DescriptorSetLayout {
         match &self.desc.hooks {
-            LightHooks::Builtin => self.set_layouts[1],
+            LightHooks::Builtin | LightHooks::BuiltinWithBrdfs(_) => self.set_layouts[1],
             LightHooks::Engine(engine) => engine.decode_layout,
         }
     }

@@ -96,11 +96,14 @@ pub fn gbuffer_stencil(
 }
 
 impl MeshPasses {
-    /// The pipelines and layouts; a failure half way frees what was made.
+    /// The pipelines and layouts, the forward reference shading with `forward` (`forward.frag`
+    /// as histencil builds it, or compiled for a BRDF set); a failure half way frees what was
+    /// made.
     pub fn new(
         ctx: &Context,
         frame_layout: vk::DescriptorSetLayout,
         formats: &MeshFormats,
+        forward: &'static [u8],
     ) -> Result<Self> {
         build(ctx, |p: &mut Self| {
             (p.material_layout, p.pipeline_layout) =
@@ -133,7 +136,7 @@ impl MeshPasses {
             )?;
             p.forward = create_pipeline(
                 ctx,
-                &fragment("forward-pipeline", ("forward.frag", shaders::FORWARD_FRAG)),
+                &fragment("forward-pipeline", ("forward.frag", forward)),
             )?;
             p.emissive = create_pipeline(
                 ctx,

@@ -48,6 +48,25 @@ fn distinct_materials(scene: &Scene) -> (Vec<Brdf>, Vec<u32>) {
 
 /// The stencil slot of BRDF `id`: its index among the BRDFs in use (as
 /// [`crate::LightingDesc::slot_of`] numbers them).
+/// Every object's and entity's BRDF is one of `set`'s, with its parameters in their ranges: a
+/// BRDF the shaders were not compiled with would shade black in silence.
+fn check_brdfs(scene: &Scene, set: &histencil_brdf::BrdfSet) -> Result<()> {
+    let objects = scene.objects.iter().map(|o| (&o.name, &o.material.brdf));
+    let alpha = scene
+        .alpha_objects
+        .iter()
+        .map(|o| (&o.name, &o.material.brdf));
+    let particles = scene
+        .particle_systems
+        .iter()
+        .map(|p| (&p.name, &p.material.brdf));
+    for (name, brdf) in objects.chain(alpha).chain(particles) {
+        set.check(brdf)
+            .map_err(|e| crate::Error::BrdfSet(format!("{name}: {e}")))?;
+    }
+    Ok(())
+}
+
 fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
     brdfs
         .iter()
@@ -81,6 +100,7 @@ impl<'c> Renderer<'c> {
             histencil_alpha::check_forced_side(side)?;
         }
         scene.validate()?;
+        check_brdfs(&scene, &desc.brdfs.set)?;
         crate::renderer::materials::check_images(ctx, &scene)?;
         scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
@@ -107,7 +127,11 @@ impl<'c> Renderer<'c> {
                 frames_in_flight: 1,
                 max_lights: scene.lights.len() as u32,
                 hi_stencil: true,
-                hooks: LightHooks::Builtin,
+                hooks: if desc.brdfs.is_builtin() {
+                    LightHooks::Builtin
+                } else {
+                    LightHooks::BuiltinWithBrdfs(desc.brdfs.light)
+                },
             },
         )?;
         // Each part is destroyed if a later one fails; `keep` hands it to the renderer.
@@ -143,7 +167,10 @@ impl<'c> Renderer<'c> {
             hdr: HDR_FORMAT,
             depth_stencil: ctx.depth_stencil_format,
         };
-        let mesh_passes = Owned::new(ctx, MeshPasses::new(ctx, frame_layout, &formats)?);
+        let mesh_passes = Owned::new(
+            ctx,
+            MeshPasses::new(ctx, frame_layout, &formats, desc.brdfs.forward)?,
+        );
         let maps = Owned::new(
             ctx,
             GpuMaterials::new(ctx, &scene, mesh_passes.material_layout)?,

@@ -95,7 +95,7 @@ impl Renderer<'_> {
         if let Some(alpha) = self.alpha.as_ref().filter(|_| desc.pass_timing) {
             timings.lightmaps = alpha.lightmap_timings()?;
         }
-        let images = self.readback.read(readback)?;
+        let images = self.readback.read(readback, &self.desc.brdfs.set)?;
         let tile_stats = match &deferred {
             Some((t, plan)) if desc.tile_stats && t.records_plan() => {
                 self.lighting.tile_stats(plan)

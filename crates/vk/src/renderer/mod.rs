@@ -80,6 +80,10 @@ pub struct RendererDesc {
     /// `None`: the talk's measurements fitted by [`CostModel::from_talk`] (360 figures for the
     /// 360-like backend, PS3 figures otherwise) with an assumed 5 us per extra draw.
     pub cost_model: Option<CostModel>,
+    /// The BRDFs it shades with and their shaders: histencil's own
+    /// ([`crate::BrdfModules::builtin`]), or an engine's set ([`crate::compile_brdf_set`]).
+    /// Every object's and entity's BRDF must be one of the set's.
+    pub brdfs: &'static crate::BrdfModules,
 }
 
 impl RendererDesc {
@@ -93,6 +97,7 @@ impl RendererDesc {
             lut_resolution: DEFAULT_LUT_RESOLUTION,
             lightmap_side: None,
             cost_model: None,
+            brdfs: crate::BrdfModules::builtin(),
         }
     }
 }
@@ -282,6 +287,7 @@ impl<'c> Renderer<'c> {
                 self.extent,
                 self.desc.lightmap_side,
                 self.descriptors.frame_layout,
+                self.desc.brdfs,
             )?);
         }
         Ok(self.alpha.as_mut())

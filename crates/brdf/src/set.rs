@@ -1,0 +1,606 @@
+//! The shading models a lighting is made for: histencil's own by name and an engine's own, each a
+//! GLSL function with a few lines of data. The talk's subject is an engine's artists choosing
+//! among many BRDFs; a set lets those be the engine's, not only histencil's eight.
+//!
+//! # The GLSL contract
+//! An engine BRDF is a function in a file of the engine's:
+//!
+//! ```glsl
+//! vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L)
+//! ```
+//!
+//! returning `f_r * N.L` of a white surface (the surface's tint multiplies it), as every built-in
+//! does. `p.xyz` are its parameters in the order its set declares them (`p.w` is 0); `N`, `V` and
+//! `L` are unit vectors pointing away from the surface (`V` may lie below the horizon along
+//! silhouettes, as interpolated normals give); `T` is histencil's fibre direction (world +Y
+//! projected onto the surface: not unit, zero where `N` is vertical). With a white part (as
+//! glTF's BRDF has: a dielectric's specular is not tinted), a second function
+//! `float name(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L)` gives the part added untinted. The file
+//! may use histencil's helpers (`brdf/common.glsl`: `PI`, `INV_PI`, `brdf_pow`,
+//! `brdf_normalize`, `brdf_above_horizon`), which are included before it.
+//!
+//! Every technique evaluates the same function: the per-BRDF light shaders specialised to its
+//! id, branching's switch, the tiled and depth-id kernels, the alpha lightmaps and the forward
+//! reference. [`BrdfSet::glsl_files`] writes what the shaders include to reach it.
+
+use std::path::{Path, PathBuf};
+
+use crate::id::{BrdfId, EngineBrdf, ENGINE_FIRST, MAX_ENGINE_BRDFS};
+use crate::model::{Brdf, BrdfError, Range};
+
+/// The most parameters an engine BRDF takes: histencil's G-buffer stores three per pixel (the
+/// fourth channel of its material texel is the BRDF id).
+pub const MAX_ENGINE_PARAMS: usize = 3;
+
+/// One parameter of an engine BRDF.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EngineParam {
+    /// Its name in glTF extras and scene files.
+    pub name: String,
+    /// The values accepted; a material's value outside it is refused, as a built-in's is.
+    pub range: Range,
+    /// The value of a material that does not give it.
+    pub default: f64,
+}
+
+/// An engine BRDF as its engine declares it (the manifest's `[[brdf]]` table).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EngineBrdfSpec {
+    /// Its name in glTF extras, scene files, plans and reports: lower case, digits and `_`,
+    /// starting with a letter, and none of the built-ins' names.
+    pub name: String,
+    /// The GLSL file defining its function, relative to the set's folder, `/`-separated.
+    pub glsl: String,
+    /// The function returning its tinted part (the contract in this module's docs).
+    pub function: String,
+    /// The function returning its white part, if it has one.
+    pub white: Option<String>,
+    /// Its parameters, at most [`MAX_ENGINE_PARAMS`], in the order `p.xyz` holds them.
+    pub params: Vec<EngineParam>,
+    /// Whether it reads `T`: said so a decode hook that gives no tangent can refuse it.
+    pub tangent: bool,
+}
+
+/// Why a set of BRDFs was refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SetError {
+    /// The set holds no BRDF at all.
+    #[error("the BRDF set is empty: name a built-in or declare a BRDF of your own")]
+    Empty,
+    /// A built-in named twice, or an engine name given twice.
+    #[error("BRDF `{0}` is named twice")]
+    Twice(String),
+    /// An engine BRDF named as a built-in is.
+    #[error("BRDF `{0}` has a built-in's name; give your own BRDF another")]
+    BuiltinName(String),
+    /// A name or GLSL identifier histencil cannot use as it is.
+    #[error("{what} `{name}` must be lower-case letters, digits and `_`, starting with a letter, at most 32 characters")]
+    BadName {
+        /// What was named: a BRDF, a parameter, a function.
+        what: &'static str,
+        /// The name given.
+        name: String,
+    },
+    /// More engine BRDFs than the tiled classification's ids hold.
+    #[error("{count} BRDFs of your own; a set holds at most {MAX_ENGINE_BRDFS}")]
+    TooMany {
+        /// How many were declared.
+        count: usize,
+    },
+    /// A BRDF with more parameters than the G-buffer stores.
+    #[error("BRDF `{brdf}` has {count} parameters; at most {MAX_ENGINE_PARAMS} (histencil's G-buffer stores three per pixel)")]
+    TooManyParams {
+        /// The BRDF.
+        brdf: String,
+        /// How many it declared.
+        count: usize,
+    },
+    /// A parameter whose range or default cannot be.
+    #[error("BRDF `{brdf}`, parameter `{param}`: {why}")]
+    BadParam {
+        /// The BRDF.
+        brdf: String,
+        /// The parameter.
+        param: String,
+        /// What is wrong, in words.
+        why: String,
+    },
+    /// A GLSL path that leaves the set's folder or is not a plain relative path.
+    #[error("BRDF `{brdf}`: `{path}` must be a relative path inside the BRDF folder (no `..`, no absolute path)")]
+    OutsideFolder {
+        /// The BRDF.
+        brdf: String,
+        /// The path given.
+        path: String,
+    },
+}
+
+/// The BRDFs a lighting is made for, in id order: the built-ins it names, then the engine's own
+/// (ids [`ENGINE_FIRST`] on). Fixed when the lighting is made, as its stencil layout is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BrdfSet {
+    builtins: Vec<BrdfId>,
+    engine: Vec<(EngineBrdf, EngineBrdfSpec)>,
+    /// The folder the engine's GLSL paths are relative to.
+    folder: Option<PathBuf>,
+}
+
+impl Default for BrdfSet {
+    /// histencil's eight, no engine BRDF: the shaders as histencil ships them.
+    fn default() -> Self {
+        Self {
+            builtins: BrdfId::ALL.to_vec(),
+            engine: Vec::new(),
+            folder: None,
+        }
+    }
+}
+
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars.next().is_some_and(|c| c.is_ascii_lowercase())
+        && chars.all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+        && name.len() <= 32
+}
+
+/// A GLSL function name: an identifier (any case), not reserved by GLSL (`gl_`, `__`).
+fn is_function_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars.next().is_some_and(|c| c.is_ascii_alphabetic())
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !name.starts_with("gl_")
+        && !name.contains("__")
+        && name.len() <= 64
+}
+
+/// Whether `path` is a plain relative path: `/`-separated names, none empty, `.` or `..`.
+pub(crate) fn is_confined(path: &str) -> bool {
+    !path.is_empty()
+        && path.split('/').all(|part| {
+            !part.is_empty()
+                && part != "."
+                && part != ".."
+                && part
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+        })
+}
+
+fn check_spec(spec: &EngineBrdfSpec) -> Result<(), SetError> {
+    let brdf = || spec.name.clone();
+    if !is_identifier(&spec.name) {
+        return Err(SetError::BadName {
+            what: "BRDF",
+            name: spec.name.clone(),
+        });
+    }
+    if BrdfId::ALL.iter().any(|b| b.name() == spec.name) {
+        return Err(SetError::BuiltinName(spec.name.clone()));
+    }
+    for function in std::iter::once(&spec.function).chain(&spec.white) {
+        if !is_function_name(function) {
+            return Err(SetError::BadName {
+                what: "GLSL function",
+                name: function.clone(),
+            });
+        }
+    }
+    if !is_confined(&spec.glsl) {
+        return Err(SetError::OutsideFolder {
+            brdf: brdf(),
+            path: spec.glsl.clone(),
+        });
+    }
+    if spec.params.len() > MAX_ENGINE_PARAMS {
+        return Err(SetError::TooManyParams {
+            brdf: brdf(),
+            count: spec.params.len(),
+        });
+    }
+    let finite = Range::new(-(f32::MAX as f64), f32::MAX as f64);
+    for (i, p) in spec.params.iter().enumerate() {
+        let bad = |why: String| SetError::BadParam {
+            brdf: brdf(),
+            param: p.name.clone(),
+            why,
+        };
+        if !is_identifier(&p.name) {
+            return Err(SetError::BadName {
+                what: "parameter",
+                name: p.name.clone(),
+            });
+        }
+        if spec.params[..i].iter().any(|q| q.name == p.name) {
+            return Err(bad("named twice".into()));
+        }
+        let Range { min, max } = p.range;
+        if !(finite.holds(min) && finite.holds(max) && min <= max) {
+            return Err(bad(format!(
+                "range [{min}, {max}] must be finite in f32 with min <= max"
+            )));
+        }
+        if !p.range.holds(p.default) {
+            return Err(bad(format!(
+                "default {} is outside its range [{min}, {max}]",
+                p.default
+            )));
+        }
+    }
+    Ok(())
+}
+
+impl BrdfSet {
+    /// The built-ins `builtins` (each at most once) and the engine's `engine` BRDFs, in the
+    /// order given: the `k`-th engine BRDF has id [`ENGINE_FIRST`] + `k`.
+    ///
+    /// # Errors
+    /// [`SetError`]: an empty set, a name given twice or a built-in's, a name or function that
+    /// is no identifier, more than [`MAX_ENGINE_BRDFS`] BRDFs or [`MAX_ENGINE_PARAMS`]
+    /// parameters, a range or default that cannot be, a GLSL path outside the folder.
+    pub fn new(builtins: &[BrdfId], engine: Vec<EngineBrdfSpec>) -> Result<Self, SetError> {
+        if builtins.is_empty() && engine.is_empty() {
+            return Err(SetError::Empty);
+        }
+        if engine.len() > MAX_ENGINE_BRDFS {
+            return Err(SetError::TooMany {
+                count: engine.len(),
+            });
+        }
+        for (i, b) in builtins.iter().enumerate() {
+            if !b.is_builtin() {
+                return Err(SetError::BadName {
+                    what: "built-in BRDF",
+                    name: b.name().into(),
+                });
+            }
+            if builtins[..i].contains(b) {
+                return Err(SetError::Twice(b.name().into()));
+            }
+        }
+        for (i, spec) in engine.iter().enumerate() {
+            check_spec(spec)?;
+            if engine[..i].iter().any(|s| s.name == spec.name) {
+                return Err(SetError::Twice(spec.name.clone()));
+            }
+        }
+        let engine = engine
+            .into_iter()
+            .enumerate()
+            .map(|(k, spec)| (EngineBrdf::new(k as u8, &spec.name), spec))
+            .collect();
+        Ok(Self {
+            builtins: builtins.to_vec(),
+            engine,
+            folder: None,
+        })
+    }
+
+    /// The set with its engine GLSL paths relative to `folder` (what [`BrdfSet::load`] gives).
+    pub fn with_folder(mut self, folder: PathBuf) -> Self {
+        self.folder = Some(folder);
+        self
+    }
+
+    /// The folder its engine GLSL paths are relative to, if it has one.
+    pub fn folder(&self) -> Option<&Path> {
+        self.folder.as_deref()
+    }
+
+    /// The engine's GLSL files, each as (its path in the set, where it is on disk); none
+    /// without a folder.
+    pub fn glsl_sources(&self) -> Vec<(&str, PathBuf)> {
+        let Some(folder) = &self.folder else {
+            return Vec::new();
+        };
+        let mut out: Vec<(&str, PathBuf)> = Vec::new();
+        for (_, spec) in &self.engine {
+            if !out.iter().any(|(p, _)| *p == spec.glsl) {
+                out.push((&spec.glsl, folder.join(&spec.glsl)));
+            }
+        }
+        out
+    }
+
+    /// Every BRDF of the set, in id order.
+    pub fn ids(&self) -> Vec<BrdfId> {
+        let engine = self.engine.iter().map(|(id, _)| BrdfId::Engine(*id));
+        self.builtins.iter().copied().chain(engine).collect()
+    }
+
+    /// The built-ins it holds.
+    pub fn builtins(&self) -> &[BrdfId] {
+        &self.builtins
+    }
+
+    /// The engine's BRDFs with their declarations, in id order.
+    pub fn engine(&self) -> impl Iterator<Item = (BrdfId, &EngineBrdfSpec)> {
+        self.engine
+            .iter()
+            .map(|(id, spec)| (BrdfId::Engine(*id), spec))
+    }
+
+    /// Whether the set holds no BRDF of the engine's: histencil's shaders as shipped, or a
+    /// selection of them, serve it.
+    pub fn is_builtin_only(&self) -> bool {
+        self.engine.is_empty()
+    }
+
+    /// Whether `id` is one of the set's BRDFs.
+    pub fn contains(&self, id: BrdfId) -> bool {
+        match id {
+            BrdfId::Engine(e) => self.engine.iter().any(|(own, _)| *own == e),
+            b => self.builtins.contains(&b),
+        }
+    }
+
+    /// The set's BRDF named `name`.
+    pub fn by_name(&self, name: &str) -> Option<BrdfId> {
+        self.ids().into_iter().find(|b| b.name() == name)
+    }
+
+    /// The set's BRDF of numeric id `index` (what a G-buffer stores).
+    pub fn by_index(&self, index: u32) -> Option<BrdfId> {
+        self.ids().into_iter().find(|b| b.index() == index)
+    }
+
+    /// The declaration of the engine BRDF `id`.
+    pub fn spec(&self, id: BrdfId) -> Option<&EngineBrdfSpec> {
+        let BrdfId::Engine(e) = id else { return None };
+        self.engine
+            .iter()
+            .find(|(own, _)| *own == e)
+            .map(|(_, spec)| spec)
+    }
+
+    /// The engine BRDF `name` with the parameters `given` (name, value); a parameter not given
+    /// takes its default. For an engine that builds its materials in code, and for the scene
+    /// readers (glTF extras, scene files).
+    ///
+    /// # Errors
+    /// [`BrdfError`]: a name the set does not hold (or a built-in's: use [`Brdf`]'s variants),
+    /// an unknown parameter, a value outside its range.
+    pub fn engine_brdf(&self, name: &str, given: &[(&str, f64)]) -> Result<Brdf, BrdfError> {
+        let Some((id, spec)) = self.engine.iter().find(|(_, s)| s.name == name) else {
+            return Err(BrdfError::UnknownModel(name.to_owned()));
+        };
+        let model = id.name();
+        let accepted = || {
+            let names: Vec<&str> = spec.params.iter().map(|p| p.name.as_str()).collect();
+            names.join(", ")
+        };
+        if let Some((unknown, _)) = given
+            .iter()
+            .find(|(g, _)| !spec.params.iter().any(|p| p.name == *g))
+        {
+            return Err(BrdfError::UnknownParam {
+                model,
+                param: (*unknown).to_owned(),
+                accepted: accepted(),
+            });
+        }
+        let mut params = [0.0; 3];
+        for (slot, p) in params.iter_mut().zip(&spec.params) {
+            let value = given
+                .iter()
+                .rev()
+                .find(|(g, _)| *g == p.name)
+                .map_or(p.default, |(_, x)| *x);
+            if !p.range.holds(value) {
+                return Err(BrdfError::BadEngineParam {
+                    model,
+                    param: p.name.clone(),
+                    rule: p.range.text(),
+                    value: value.to_string(),
+                });
+            }
+            *slot = value;
+        }
+        Ok(Brdf::Engine { id: *id, params })
+    }
+
+    /// Holds `brdf` to the set: a BRDF the set holds, with each engine parameter in its range
+    /// (a built-in's, to [`Brdf::check`]).
+    ///
+    /// # Errors
+    /// [`BrdfError`]: the BRDF is not in the set, or a parameter is out of its range.
+    pub fn check(&self, brdf: &Brdf) -> Result<(), BrdfError> {
+        if !self.contains(brdf.id()) {
+            return Err(BrdfError::NotInSet {
+                model: brdf.name(),
+                set: self
+                    .ids()
+                    .iter()
+                    .map(|b| b.name())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        let Brdf::Engine { id, params } = brdf else {
+            return brdf.check();
+        };
+        let spec = self.spec(BrdfId::Engine(*id)).expect("contains it");
+        for (p, x) in spec.params.iter().zip(params) {
+            if !p.range.holds(*x) {
+                return Err(BrdfError::BadEngineParam {
+                    model: id.name(),
+                    param: p.name.clone(),
+                    rule: p.range.text(),
+                    value: x.to_string(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The files the shaders include to evaluate the set (`brdf/eval.glsl` includes them), as
+    /// (path under the include folder, text). `engine_prefix` is the include path under which
+    /// the engine's GLSL files are found (a compiler copies them there, so their names cannot
+    /// hide histencil's own includes). For histencil's own set every file is empty of code and
+    /// the shaders are those histencil ships, byte for byte.
+    pub fn glsl_files(&self, engine_prefix: &str) -> [(&'static str, String); 4] {
+        let head =
+            "// Generated by histencil from a BRDF set (histencil_brdf::BrdfSet). Do not edit.\n";
+        let mut functions = String::from(head);
+        for b in BrdfId::ALL {
+            if !self.builtins.contains(&b) {
+                functions += &format!("#define BRDF_OMIT_{}\n", b.name().to_uppercase());
+            }
+        }
+        let (mut cases, mut parts, mut tinted) =
+            (head.to_owned(), head.to_owned(), head.to_owned());
+        let mut included: Vec<&str> = Vec::new();
+        for (id, spec) in self.engine() {
+            let constant = id.glsl_constant();
+            functions += &format!("#define {constant} {}u\n", id.index());
+            if !included.contains(&spec.glsl.as_str()) {
+                functions += &format!("#include \"{engine_prefix}/{}\"\n", spec.glsl);
+                included.push(&spec.glsl);
+            }
+            let call = |f: &str| format!("{f}(p, N, T, V, L)");
+            let tinted_part = call(&spec.function);
+            match &spec.white {
+                None => cases += &format!("    case {constant}:\n        return {tinted_part};\n"),
+                Some(white) => {
+                    let white = call(white);
+                    cases += &format!(
+                        "    case {constant}:\n        return {tinted_part} + vec3({white});\n"
+                    );
+                    parts += &format!(
+                        "    if (model == {constant}) {{\n        return BrdfParts({tinted_part}, {white});\n    }}\n"
+                    );
+                    tinted += &format!(
+                        "    if (model == {constant}) {{\n        return tint * {tinted_part} + {white};\n    }}\n"
+                    );
+                }
+            }
+        }
+        [
+            ("brdf_set/functions.glsl", functions),
+            ("brdf_set/eval_cases.glsl", cases),
+            ("brdf_set/parts.glsl", parts),
+            ("brdf_set/tinted.glsl", tinted),
+        ]
+    }
+}
+
+#[cfg(feature = "files")]
+impl BrdfSet {
+    /// A BRDF named in a scene file or glTF extras: one of the set's own with its parameters
+    /// (numbers; those left out take their defaults), or a built-in as [`Brdf::parse`] reads it.
+    ///
+    /// # Errors
+    /// [`BrdfError`], as [`BrdfSet::engine_brdf`] and [`Brdf::parse`] give it.
+    pub fn parse(
+        &self,
+        name: &str,
+        params: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<Brdf, BrdfError> {
+        let Some((id, _)) = self.engine.iter().find(|(_, s)| s.name == name) else {
+            return Brdf::parse(name, params);
+        };
+        let mut given = Vec::new();
+        for (key, value) in params {
+            let x = value.as_f64().ok_or_else(|| BrdfError::BadEngineParam {
+                model: id.name(),
+                param: key.clone(),
+                rule: "a number".into(),
+                value: value.to_string(),
+            })?;
+            given.push((key.as_str(), x));
+        }
+        self.engine_brdf(name, &given)
+    }
+}
+
+/// The first id after the set's last engine BRDF could take: ids below it are histencil's or an
+/// engine's, so a G-buffer value past it names no BRDF.
+pub const MODEL_IDS: u32 = ENGINE_FIRST + MAX_ENGINE_BRDFS as u32;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn toon() -> EngineBrdfSpec {
+        EngineBrdfSpec {
+            name: "toon".into(),
+            glsl: "toon.glsl".into(),
+            function: "toon".into(),
+            white: None,
+            params: vec![EngineParam {
+                name: "bands".into(),
+                range: Range::new(1.0, 8.0),
+                default: 3.0,
+            }],
+            tangent: false,
+        }
+    }
+
+    #[test]
+    fn ids_follow_the_builtins_and_parameters_take_defaults() {
+        let mut sheen = toon();
+        sheen.name = "sheen".into();
+        sheen.white = Some("sheen_white".into());
+        let set = BrdfSet::new(&[BrdfId::Ggx], vec![toon(), sheen]).unwrap();
+        let ids = set.ids();
+        assert_eq!(ids[0], BrdfId::Ggx);
+        assert_eq!(ids[1].index(), ENGINE_FIRST);
+        assert_eq!(ids[2].name(), "sheen");
+        assert_eq!(set.by_index(ENGINE_FIRST + 1), Some(ids[2]));
+        assert!(!set.contains(BrdfId::Lambert));
+        let b = set.engine_brdf("toon", &[]).unwrap();
+        assert_eq!(b.packed_params(), [3.0, 0.0, 0.0, 0.0]);
+        assert_eq!(b.name(), "toon");
+        set.check(&b).unwrap();
+        assert!(set.check(&Brdf::Lambert { rho: 1.0 }).is_err());
+        let files = set.glsl_files("engine");
+        assert!(files[0].1.contains("#define BRDF_OMIT_LAMBERT"));
+        assert!(!files[0].1.contains("BRDF_OMIT_GGX"));
+        assert!(files[0].1.contains("#include \"engine/toon.glsl\""));
+        // One include for two BRDFs of one file.
+        assert_eq!(files[0].1.matches("#include").count(), 1);
+        assert!(files[1].1.contains("return toon(p, N, T, V, L);"));
+        assert!(files[2]
+            .1
+            .contains("BrdfParts(toon(p, N, T, V, L), sheen_white("));
+        // histencil's own set: nothing but the header, so the shaders are as shipped.
+        for (_, text) in BrdfSet::default().glsl_files("engine") {
+            assert_eq!(text.lines().count(), 1, "{text}");
+        }
+    }
+
+    #[test]
+    fn every_bad_declaration_is_refused_with_its_reason() {
+        let err = |builtins: &[BrdfId], specs: Vec<EngineBrdfSpec>| {
+            BrdfSet::new(builtins, specs).unwrap_err().to_string()
+        };
+        let with = |f: &dyn Fn(&mut EngineBrdfSpec)| {
+            let mut s = toon();
+            f(&mut s);
+            err(&[], vec![s])
+        };
+        assert!(err(&[], vec![]).contains("empty"));
+        assert!(err(&[BrdfId::Ggx, BrdfId::Ggx], vec![]).contains("`ggx` is named twice"));
+        assert!(err(&[], vec![toon(), toon()]).contains("`toon` is named twice"));
+        assert!(with(&|s| s.name = "ggx".into()).contains("built-in's name"));
+        assert!(with(&|s| s.name = "Toon!".into()).contains("lower-case"));
+        assert!(with(&|s| s.function = "gl_x".into()).contains("GLSL function"));
+        assert!(with(&|s| s.glsl = "../x.glsl".into()).contains("inside the BRDF folder"));
+        assert!(with(&|s| s.glsl = "/etc/x.glsl".into()).contains("inside the BRDF folder"));
+        let four = |s: &mut EngineBrdfSpec| s.params = vec![s.params[0].clone(); 4];
+        assert!(with(&four).contains("4 parameters; at most 3"));
+        assert!(with(&|s| s.params[0].default = 9.0).contains("outside its range"));
+        assert!(with(&|s| s.params[0].range = Range::new(2.0, 1.0)).contains("min <= max"));
+        let many: Vec<EngineBrdfSpec> = (0..=MAX_ENGINE_BRDFS)
+            .map(|i| EngineBrdfSpec {
+                name: format!("b{i}"),
+                ..toon()
+            })
+            .collect();
+        assert!(err(&[], many).contains("17 BRDFs of your own; a set holds at most 16"));
+        let set = BrdfSet::new(&[], vec![toon()]).unwrap();
+        let e = |given: &[(&str, f64)]| set.engine_brdf("toon", given).unwrap_err().to_string();
+        assert!(e(&[("bands", 9.0)]).contains("`bands` must be a number in [1, 8], got 9"));
+        assert!(e(&[("steps", 2.0)]).contains("unknown parameter `steps` (accepted: bands)"));
+        assert!(set.engine_brdf("sheen", &[]).is_err());
+    }
+}

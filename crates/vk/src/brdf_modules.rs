@@ -1,0 +1,251 @@
+//! The shaders that evaluate BRDFs, for a BRDF set of an engine's
+//! ([`histencil_brdf::BrdfSet`]): every technique's light shaders, the alpha lightmaps and the
+//! forward reference, each compiled with the set's functions so that all of them shade with the
+//! same GLSL.
+//!
+//! An engine compiles them in its build script (histencil-build, beside its hooks); the command
+//! line and the lab compile them at run time here, with the same `glslc` and options, from the
+//! GLSL sources embedded in this crate. Why `glslc` and not a linked compiler: as for every
+//! histencil shader (histencil-build's crate docs), nothing to link, and the compiler's message
+//! names the engine's file and line, which [`compile`] keeps.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, OnceLock};
+
+use histencil_brdf::BrdfSet;
+
+use crate::lighting::hooks::LightModules;
+use crate::shaders;
+
+/// histencil's GLSL, as build.rs embeds it.
+mod sources {
+    include!(concat!(env!("OUT_DIR"), "/shader_sources.rs"));
+}
+
+/// Every module that evaluates a BRDF, compiled for one set, with the set.
+#[derive(Debug)]
+pub struct BrdfModules {
+    /// The set they evaluate.
+    pub set: BrdfSet,
+    /// The light shaders of every technique (with histencil's own decode and visibility).
+    pub light: LightModules,
+    /// `forward.frag`: the forward reference.
+    pub forward: &'static [u8],
+    /// `lightmap.frag`: the alpha entities' lightmaps.
+    pub lightmap: &'static [u8],
+    /// `lightmap_directional.frag`: their directional lightmaps.
+    pub lightmap_directional: &'static [u8],
+    /// `brdf_eval.comp`: the BRDF evaluator (the engine BRDFs' finiteness probe).
+    pub brdf_eval: &'static [u8],
+}
+
+/// The same modules: [`compile`] makes one per distinct set (its GLSL and its files' bytes), so
+/// identity is equality.
+impl PartialEq for BrdfModules {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+/// histencil's own set, as shipped.
+static BUILTIN_MODULES: OnceLock<BrdfModules> = OnceLock::new();
+
+impl BrdfModules {
+    /// histencil's eight BRDFs with the shaders as built.
+    pub fn builtin() -> &'static BrdfModules {
+        BUILTIN_MODULES.get_or_init(|| BrdfModules {
+            set: BrdfSet::default(),
+            light: LightModules::BUILTIN,
+            forward: shaders::FORWARD_FRAG,
+            lightmap: shaders::LIGHTMAP_FRAG,
+            lightmap_directional: shaders::LIGHTMAP_DIRECTIONAL_FRAG,
+            brdf_eval: shaders::BRDF_EVAL_COMP,
+        })
+    }
+
+    /// Whether these are histencil's own modules.
+    pub fn is_builtin(&self) -> bool {
+        std::ptr::eq(self, Self::builtin())
+    }
+}
+
+/// The stages that evaluate a BRDF (each includes `brdf/eval.glsl`), compiled per set.
+const STAGES: [&str; 9] = [
+    "deferred_light.frag",
+    "lut_light.frag",
+    "tile_shade.comp",
+    "tile_shade_8.comp",
+    "depth_id_shade.frag",
+    "forward.frag",
+    "lightmap.frag",
+    "lightmap_directional.frag",
+    "brdf_eval.comp",
+];
+
+/// A folder under the system's temporary one, removed with everything in it on drop (also when
+/// a compile fails half way).
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new() -> std::io::Result<Self> {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let path = std::env::temp_dir().join(format!(
+            "histencil-brdf-set-{}-{}",
+            std::process::id(),
+            N.fetch_add(1, Ordering::Relaxed)
+        ));
+        std::fs::create_dir_all(&path)?;
+        Ok(Self(path))
+    }
+
+    fn write(&self, relative: &str, text: &[u8]) -> Result<(), String> {
+        let path = self.0.join(relative);
+        let dir = path.parent().expect("a file in the scratch folder");
+        std::fs::create_dir_all(dir)
+            .and_then(|()| std::fs::write(&path, text))
+            .map_err(|e| format!("{}: {e}", path.display()))
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The engine folder's GLSL files (at any depth, by their paths in it), which its BRDFs'
+/// files may include from one another; links are followed only inside the folder.
+fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, String> {
+    fn walk(folder: &Path, dir: &Path, out: &mut Vec<(String, PathBuf)>) -> Result<(), String> {
+        let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        for entry in entries {
+            let path = entry.map_err(|e| e.to_string())?.path();
+            let Ok(real) = path.canonicalize() else {
+                continue;
+            };
+            if !real.starts_with(folder) {
+                continue;
+            }
+            if real.is_dir() {
+                walk(folder, &path, out)?;
+            } else if path.extension().is_some_and(|e| e == "glsl") {
+                let relative = path.strip_prefix(folder).expect("walked from the folder");
+                let parts: Vec<_> = relative
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                    .collect();
+                out.push((parts.join("/"), real));
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    walk(folder, folder, &mut out)?;
+    out.sort();
+    Ok(out)
+}
+
+/// Compiles every stage that evaluates a BRDF for `set`, with `glslc` (histencil-build's
+/// options); the same set (its generated GLSL and its files' contents) compiles once per
+/// process, and its modules live as long as the process, as a built-in module does.
+///
+/// # Errors
+/// A message: the set's files could not be read or written, `glslc` could not be run, or it
+/// refused a stage (its message, naming the engine's own file and line).
+pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
+    if set == &BrdfSet::default() {
+        return Ok(BrdfModules::builtin());
+    }
+    let generated = set.glsl_files("engine");
+    let files = match set.folder() {
+        Some(folder) => engine_files(folder)?,
+        None if set.is_builtin_only() => Vec::new(),
+        None => return Err("an engine BRDF set without its folder has no GLSL to compile".into()),
+    };
+    // What the modules are a function of: the generated GLSL and every engine file's bytes.
+    let mut key = String::new();
+    for (name, text) in &generated {
+        key += name;
+        key += text;
+    }
+    let mut contents = Vec::new();
+    for (relative, path) in &files {
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        key += relative;
+        key += &String::from_utf8_lossy(&bytes);
+        contents.push((relative.clone(), bytes));
+    }
+    static COMPILED: OnceLock<Mutex<HashMap<String, &'static BrdfModules>>> = OnceLock::new();
+    let cache = COMPILED.get_or_init(Default::default);
+    if let Some(done) = cache.lock().unwrap_or_else(|p| p.into_inner()).get(&key) {
+        return Ok(done);
+    }
+
+    let scratch = Scratch::new().map_err(|e| format!("a scratch folder for glslc: {e}"))?;
+    for (path, text) in sources::SOURCES {
+        scratch.write(path, text.as_bytes())?;
+    }
+    for (name, text) in &generated {
+        scratch.write(&format!("set/{name}"), text.as_bytes())?;
+    }
+    for (relative, bytes) in &contents {
+        scratch.write(&format!("set/engine/{relative}"), bytes)?;
+    }
+    let root = &scratch.0;
+    let includes = [
+        root.join("set"),
+        root.join("include"),
+        root.join("generated"),
+        root.join("hooks"),
+    ];
+    let includes: Vec<&Path> = includes.iter().map(PathBuf::as_path).collect();
+    let mut spirv = Vec::new();
+    for stage in STAGES {
+        let out = root.join(format!("{stage}.spv"));
+        let command =
+            histencil_build::glslc_command(&root.join("stages").join(stage), &includes, &out);
+        histencil_build::run_glslc(command, stage).map_err(|e| {
+            let mut message = match e {
+                histencil_build::BuildError::Compile { stage, message } => {
+                    format!("glslc refused {stage} compiled with the BRDF set:\n{message}")
+                }
+                other => other.to_string(),
+            };
+            // The engine's files by their own paths, histencil's by where they live in its tree.
+            if let Some(folder) = set.folder() {
+                let copied = root.join("set/engine").display().to_string();
+                message = message.replace(&copied, &folder.display().to_string());
+            }
+            message.replace(&root.display().to_string(), "histencil-vk/shaders")
+        })?;
+        let bytes = std::fs::read(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+        spirv.push(&*Box::leak(bytes.into_boxed_slice()));
+    }
+    let [deferred_light, lut_light, tile_shade, tile_shade_8, depth_id_shade, forward, lightmap, lightmap_directional, brdf_eval] =
+        spirv[..]
+    else {
+        unreachable!("one module per stage");
+    };
+    let modules: &'static BrdfModules = Box::leak(Box::new(BrdfModules {
+        set: set.clone(),
+        light: LightModules {
+            deferred_light,
+            lut_light,
+            tile_shade,
+            tile_shade_8,
+            depth_id_shade,
+            ..LightModules::BUILTIN
+        },
+        forward,
+        lightmap,
+        lightmap_directional,
+        brdf_eval,
+    }));
+    cache
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .insert(key, modules);
+    Ok(modules)
+}
