@@ -22,6 +22,9 @@ use std::time::Instant;
 pub struct CheckScene {
     pub name: String,
     pub scene: Scene,
+    /// The BRDFs its cases shade with, forward reference included: histencil's, or an
+    /// engine's set (`--brdfs`).
+    pub brdfs: &'static histencil_vk::BrdfModules,
 }
 
 impl CheckScene {
@@ -599,10 +602,14 @@ impl Group<'_> {
             let frame = renderer.render_frame(&forward)?;
             Ok(frame.images.ldr.expect("asked for"))
         };
-        let mut renderer = Renderer::new(self.ctx, scene.clone(), width, height)?;
+        let desc = histencil_vk::RendererDesc {
+            brdfs: self.scene.brdfs,
+            ..histencil_vk::RendererDesc::new(width, height)
+        };
+        let mut renderer = Renderer::with_desc(self.ctx, scene.clone(), &desc)?;
         let reference = forward(&mut renderer)?;
         let background = if cases.iter().any(|c| c.expect == Expect::Alpha) {
-            let mut bare = Renderer::new(self.ctx, scene.without_alpha(), width, height)?;
+            let mut bare = Renderer::with_desc(self.ctx, scene.without_alpha(), &desc)?;
             Some(forward(&mut bare)?)
         } else {
             None

@@ -42,6 +42,8 @@ pub struct CheckArgs {
     /// embedded scene).
     #[arg(long = "scene")]
     scenes: Vec<String>,
+    #[command(flatten)]
+    brdfs: crate::brdfs::BrdfsArg,
     /// Resolutions 1x1, 7x5 and 257x129 only; the full run adds 1280x720.
     #[arg(long)]
     quick: bool,
@@ -244,10 +246,14 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     } else {
         args.scenes.clone()
     };
+    let brdfs = match args.brdfs.modules() {
+        Ok(modules) => modules,
+        Err(e) => return usage(e),
+    };
     let mut scenes = Vec::new();
     for name in names {
-        match crate::load_scene_arg(&name, lights) {
-            Ok(scene) => scenes.push(CheckScene { name, scene }),
+        match crate::brdfs::load_scene(&name, lights, brdfs) {
+            Ok(scene) => scenes.push(CheckScene { name, scene, brdfs }),
             Err(e) => return usage(e),
         }
     }
@@ -577,6 +583,9 @@ fn run(
         worker_args.push("--no-default-lights".into());
     }
     worker_args.extend(["check".into(), "--worker".into()]);
+    if let Some(dir) = &args.brdfs.brdfs {
+        worker_args.extend(["--brdfs".into(), dir.clone().into_os_string()]);
+    }
     for scene in &args.scenes {
         worker_args.extend(["--scene".into(), scene.into()]);
     }

@@ -15,6 +15,7 @@ use std::process::ExitCode;
 
 mod brdf_eval;
 mod brdf_report;
+mod brdfs;
 mod check;
 mod gtest;
 mod lab;
@@ -207,6 +208,8 @@ struct RenderArgs {
     /// checks: what needs more is refused naming the limit (the driver line lists them).
     #[arg(long)]
     spec_minimum_limits: bool,
+    #[command(flatten)]
+    brdfs: brdfs::BrdfsArg,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -364,7 +367,16 @@ fn parse_byte(text: &str) -> Result<u8, String> {
 /// `Off`, announced on stderr; left unlit it gets a warning, since its black image is correct
 /// but looks like a failure.
 pub(crate) fn load_scene_arg(spec: &str, lights: DefaultLights) -> Result<histencil_scene::Scene> {
-    let imported = histencil_scene::load_scene_noted(spec)?;
+    load_scene_in(spec, lights, &histencil_brdf::BrdfSet::default())
+}
+
+/// [`load_scene_arg`] where a glTF file's extras may name one of `set`'s own BRDFs.
+pub(crate) fn load_scene_in(
+    spec: &str,
+    lights: DefaultLights,
+    set: &histencil_brdf::BrdfSet,
+) -> Result<histencil_scene::Scene> {
+    let imported = histencil_scene::load_scene_in(spec, set)?;
     for note in &imported.unrendered {
         eprintln!("histencil: scene `{spec}`: not rendered: {note}");
     }
@@ -385,7 +397,8 @@ pub(crate) fn load_scene_arg(spec: &str, lights: DefaultLights) -> Result<histen
 }
 
 fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
-    let scene = load_scene_arg(&args.scene, lights)?;
+    let modules = args.brdfs.modules()?;
+    let scene = brdfs::load_scene(&args.scene, lights, modules)?;
     let costs = lab::read_costs_arg(args.costs.as_deref())?;
     let outputs = [
         (Some(&args.out), ImageKind::Colour),
@@ -409,6 +422,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             lut_resolution: args.lut_resolution,
             lightmap_side: args.lightmap_resolution,
             cost_model: costs,
+            brdfs: modules,
             ..RendererDesc::new(args.width, args.height)
         };
         let mut renderer = Renderer::with_desc(ctx, scene, &desc)?;

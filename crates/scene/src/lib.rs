@@ -9,6 +9,7 @@
 
 mod alpha;
 mod alpha_scenes;
+mod brdf_set;
 mod embedded;
 #[cfg(feature = "gltf")]
 mod import;
@@ -22,12 +23,14 @@ mod types;
 
 pub use alpha::{AlphaObject, Particle, ParticleLayout, ParticleSystem, MAX_SLICES};
 pub use alpha_scenes::{glass_sphere, smoke_volume};
+pub use brdf_set::retarget_brdfs;
 pub use embedded::{embedded, embedded_names, EMBEDDED};
 #[cfg(feature = "gltf")]
 pub use import::{
-    import_gltf, import_gltf_noted, load_gltf, load_gltf_noted, load_scene, load_scene_noted,
-    material_from_gltf, ImportError, Imported, MaterialError, MAX_DECODED_IMAGE_BYTES,
-    MAX_IMAGE_FILE_BYTES, SUPPORTED_REQUIRED_EXTENSIONS,
+    import_gltf, import_gltf_in, import_gltf_noted, load_gltf, load_gltf_in, load_gltf_noted,
+    load_scene, load_scene_in, load_scene_noted, material_from_gltf, material_from_gltf_in,
+    ImportError, Imported, MaterialError, MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES,
+    SUPPORTED_REQUIRED_EXTENSIONS,
 };
 pub use light_rig::{
     default_light_rig, with_default_lights, DefaultLights, FILL_SHARE, KEY_RADIANCE,

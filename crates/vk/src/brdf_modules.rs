@@ -13,8 +13,10 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
-use histencil_brdf::BrdfSet;
+use histencil_brdf::{Brdf, BrdfSet, V3};
 
+use crate::gpu::context::Context;
+use crate::gpu::error::{Error, Result};
 use crate::lighting::hooks::LightModules;
 use crate::shaders;
 
@@ -248,4 +250,87 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
         .unwrap_or_else(|p| p.into_inner())
         .insert(key, modules);
     Ok(modules)
+}
+
+/// Unit vector at `elevation` degrees above the plane z = 0, `azimuth` degrees around +z.
+fn direction(elevation: f32, azimuth: f32) -> V3<f32> {
+    let (e, a) = (elevation.to_radians(), azimuth.to_radians());
+    [e.cos() * a.cos(), e.cos() * a.sin(), e.sin()]
+}
+
+/// The shading points every engine BRDF is probed at, about the normal +z with histencil's
+/// fibre tangent (+y): light and view from the pole to the horizon and below it, every azimuth
+/// quarter, and the hard cases (view along -N, which has no azimuth; light along the view; a
+/// vertical normal, whose fibre tangent is zero).
+fn probe_directions() -> Vec<[V3<f32>; 4]> {
+    let n = [0.0, 0.0, 1.0];
+    let t = [0.0, 1.0, 0.0];
+    let elevations = [90.0, 60.0, 30.0, 5.0, 0.0, -10.0];
+    let azimuths = [0.0, 90.0, 180.0, 270.0];
+    let mut out = Vec::new();
+    for le in elevations {
+        for ve in elevations {
+            for va in azimuths {
+                out.push([n, t, direction(ve, va), direction(le, 0.0)]);
+            }
+        }
+    }
+    let l = direction(45.0, 0.0);
+    out.push([n, t, [0.0, 0.0, -1.0], l]);
+    out.push([n, t, l, l]);
+    out.push([[0.0, 1.0, 0.0], [0.0; 3], l, [0.0, 1.0, 0.0]]);
+    out
+}
+
+/// Refuses an engine BRDF that returns NaN or an infinity anywhere it is probed (its parameters
+/// at their defaults, each at its ends, all at their ends, at [`probe_directions`]), naming the
+/// BRDF and the point: such a value is written into every technique's frame and the forward
+/// reference's alike, where no comparison between them can see it. Histencil's own BRDFs are
+/// held to their f64 reference instead, and pass at once.
+///
+/// # Errors
+/// [`Error::BrdfSet`] naming the BRDF, its parameters and the directions; Vulkan errors.
+pub fn probe_finite(ctx: &Context, modules: &BrdfModules) -> Result<()> {
+    if modules.set.is_builtin_only() {
+        return Ok(());
+    }
+    let directions = probe_directions();
+    let mut cases: Vec<(Brdf, [V3<f32>; 4])> = Vec::new();
+    for (id, spec) in modules.set.engine() {
+        let mut corners: Vec<Vec<(&str, f64)>> = vec![Vec::new()];
+        for p in &spec.params {
+            corners.push(vec![(p.name.as_str(), p.range.min)]);
+            corners.push(vec![(p.name.as_str(), p.range.max)]);
+        }
+        for end in [true, false] {
+            let all = spec.params.iter().map(|p| {
+                let x = if end { p.range.min } else { p.range.max };
+                (p.name.as_str(), x)
+            });
+            corners.push(all.collect());
+        }
+        for given in corners {
+            let brdf = modules
+                .set
+                .engine_brdf(id.name(), &given)
+                .expect("the set's own ranges");
+            cases.extend(directions.iter().map(|d| (brdf, *d)));
+        }
+    }
+    let mut evaluator = crate::BrdfEvaluator::with_module(ctx, modules.brdf_eval)?;
+    let values = evaluator.evaluate(ctx, &cases);
+    evaluator.destroy(ctx);
+    for ((brdf, [n, _, v, l]), parts) in cases.iter().zip(values?) {
+        let bad = parts.channels().into_iter().find(|x| !x.is_finite());
+        if let Some(x) = bad {
+            return Err(Error::BrdfSet(format!(
+                "engine BRDF `{}` returns {x} with parameters {:?} at N {n:?}, V {v:?}, L {l:?}: \
+                 it must be finite wherever it is evaluated (the forward reference would hold \
+                 the same non-number, so no comparison could see it)",
+                brdf.name(),
+                &brdf.packed_params()[..3],
+            )));
+        }
+    }
+    Ok(())
 }

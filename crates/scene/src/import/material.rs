@@ -3,7 +3,7 @@
 
 use crate::{Material, MAX_TINT};
 use glam::Vec3;
-use histencil_brdf::{Brdf, BrdfError};
+use histencil_brdf::{Brdf, BrdfError, BrdfSet};
 use serde_json::{Map, Value};
 
 /// Why a material's `extras` were refused.
@@ -37,6 +37,18 @@ pub fn material_from_gltf(
     metallic: f32,
     roughness: f32,
 ) -> Result<Material, MaterialError> {
+    material_from_gltf_in(&BrdfSet::default(), extras, base_color, metallic, roughness)
+}
+
+/// [`material_from_gltf`] where `"brdf"` may also name one of `set`'s own BRDFs, its
+/// parameters read by [`BrdfSet::parse`] (those left out take the manifest's defaults).
+pub fn material_from_gltf_in(
+    set: &BrdfSet,
+    extras: Option<&str>,
+    base_color: [f32; 4],
+    metallic: f32,
+    roughness: f32,
+) -> Result<Material, MaterialError> {
     let base_tint = Vec3::new(base_color[0], base_color[1], base_color[2]);
     let extras: Option<Map<String, Value>> = match extras {
         None => None,
@@ -56,7 +68,7 @@ pub fn material_from_gltf(
         None => base_tint,
         Some(value) => parse_tint(&value).ok_or(MaterialError::BadTint)?,
     };
-    Ok(Material::new(Brdf::parse(&name, &params)?, tint))
+    Ok(Material::new(set.parse(&name, &params)?, tint))
 }
 
 fn parse_tint(value: &Value) -> Option<Vec3> {

@@ -29,7 +29,8 @@ pub use buffers::MAX_IMPORT_BYTES;
 pub use document::SUPPORTED_REQUIRED_EXTENSIONS;
 pub use images::{MAX_DECODED_IMAGE_BYTES, MAX_IMAGE_FILE_BYTES};
 
-pub use material::{material_from_gltf, MaterialError};
+use histencil_brdf::BrdfSet;
+pub use material::{material_from_gltf, material_from_gltf_in, MaterialError};
 
 use crate::tangents;
 use crate::{
@@ -173,9 +174,14 @@ pub struct Imported {
 
 /// [`load_scene`] with the notes of what a glTF file holds but histencil does not render.
 pub fn load_scene_noted(spec: &str) -> Result<Imported, ImportError> {
+    load_scene_in(spec, &BrdfSet::default())
+}
+
+/// [`load_scene_noted`] where a glTF material's extras may name one of `set`'s own BRDFs.
+pub fn load_scene_in(spec: &str, set: &BrdfSet) -> Result<Imported, ImportError> {
     let lower = spec.to_ascii_lowercase();
     if lower.ends_with(".gltf") || lower.ends_with(".glb") {
-        load_gltf_noted(Path::new(spec))
+        load_gltf_in(Path::new(spec), set)
     } else {
         Ok(Imported {
             scene: crate::embedded(spec)?,
@@ -191,6 +197,11 @@ pub fn load_gltf(path: &Path) -> Result<Scene, ImportError> {
 
 /// [`load_gltf`] with the notes of what the file holds but histencil does not render.
 pub fn load_gltf_noted(path: &Path) -> Result<Imported, ImportError> {
+    load_gltf_in(path, &BrdfSet::default())
+}
+
+/// [`load_gltf_noted`] where a material's extras may name one of `set`'s own BRDFs.
+pub fn load_gltf_in(path: &Path, set: &BrdfSet) -> Result<Imported, ImportError> {
     let bytes = buffers::read_regular_file(path, ReadLimit::AtMost(MAX_IMPORT_BYTES)).map_err(
         |problem| ImportError::Io {
             path: path.display().to_string(),
@@ -201,7 +212,7 @@ pub fn load_gltf_noted(path: &Path) -> Result<Imported, ImportError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut imported = import_gltf_noted(&bytes, path.parent(), &name)?;
+    let mut imported = import_gltf_in(&bytes, path.parent(), &name, set)?;
     imported.scene.description = format!("glTF {}", path.display());
     Ok(imported)
 }
@@ -221,6 +232,16 @@ pub fn import_gltf_noted(
     base_dir: Option<&Path>,
     name: &str,
 ) -> Result<Imported, ImportError> {
+    import_gltf_in(bytes, base_dir, name, &BrdfSet::default())
+}
+
+/// [`import_gltf_noted`] where a material's extras may name one of `set`'s own BRDFs.
+pub fn import_gltf_in(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    name: &str,
+    set: &BrdfSet,
+) -> Result<Imported, ImportError> {
     let gltf = document::parse(bytes)?;
     let unrendered = notes::unrendered(&gltf.document);
     let buffers = buffers::load_buffers(&gltf.document, gltf.blob, base_dir)?;
@@ -229,6 +250,7 @@ pub fn import_gltf_noted(
         .extensions_used()
         .any(|e| e == attributes::MESH_QUANTIZATION);
     let mut importer = Importer {
+        set,
         buffers: &buffers,
         quantized,
         scene: Scene {
@@ -265,6 +287,8 @@ pub fn import_gltf_noted(
 }
 
 struct Importer<'a> {
+    /// The BRDFs a material's extras may name besides the built-ins.
+    set: &'a BrdfSet,
     buffers: &'a [Vec<u8>],
     /// The file uses `KHR_mesh_quantization`: integer attribute types are allowed.
     quantized: bool,
@@ -317,7 +341,8 @@ impl Importer<'_> {
         for primitive in mesh.primitives() {
             let gltf_material = primitive.material();
             let pbr = gltf_material.pbr_metallic_roughness();
-            let material = material_from_gltf(
+            let material = material_from_gltf_in(
+                self.set,
                 gltf_material.extras().as_ref().map(|raw| raw.get()),
                 pbr.base_color_factor(),
                 pbr.metallic_factor(),

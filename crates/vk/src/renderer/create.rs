@@ -101,6 +101,7 @@ impl<'c> Renderer<'c> {
         }
         scene.validate()?;
         check_brdfs(&scene, &desc.brdfs.set)?;
+        crate::brdf_modules::probe_finite(ctx, desc.brdfs)?;
         crate::renderer::materials::check_images(ctx, &scene)?;
         scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();

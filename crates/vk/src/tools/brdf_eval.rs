@@ -28,12 +28,13 @@ pub struct BrdfEvaluator {
 impl BrdfEvaluator {
     /// Makes the compute pipeline that runs `brdf_eval.comp`.
     pub fn new(ctx: &Context) -> Result<Self> {
-        let kernel = CaseKernel::new(
-            ctx,
-            "brdf-eval",
-            BRDF_EVAL_SET,
-            ("brdf-eval-comp", shaders::BRDF_EVAL_COMP),
-        )?;
+        Self::with_module(ctx, shaders::BRDF_EVAL_COMP)
+    }
+
+    /// As [`BrdfEvaluator::new`], with `brdf_eval.comp` compiled for a BRDF set
+    /// ([`crate::BrdfModules::brdf_eval`]): it evaluates the set's engine BRDFs too.
+    pub fn with_module(ctx: &Context, spirv: &'static [u8]) -> Result<Self> {
+        let kernel = CaseKernel::new(ctx, "brdf-eval", BRDF_EVAL_SET, ("brdf-eval-comp", spirv))?;
         Ok(Self { kernel })
     }
 

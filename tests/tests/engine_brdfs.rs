@@ -1,0 +1,272 @@
+//! An engine's own BRDFs through every technique (histencil_brdf::BrdfSet, compiled at run time
+//! by histencil_vk::compile_brdf_set), under the validation layer.
+//!
+//! An engine BRDF has no f64 reference, so what can be proven is that the engine's function is
+//! what every technique evaluates: an engine BRDF that spells Lambert with histencil's own GLSL
+//! gives the built-in Lambert's frames bit for bit, technique by technique (the same expression
+//! reaches every shader, only through the set's generated switch); and the example folder's
+//! BRDFs (`examples/brdfs`: a toon ramp, glTF's Charlie sheen with a white part) are held to
+//! the forward reference that shades with the same function.
+
+use histencil_brdf::{Brdf, BrdfId, BrdfSet, EngineBrdfSpec, EngineParam, Range};
+use histencil_tests::{assert_close, diff, lit_fraction, with_validated_context};
+use histencil_vk::{
+    Backend, BrdfModules, FlushPolicy, MixedTiles, Readback, Renderer, RendererDesc, Shading,
+    Technique, TileSide,
+};
+use image::RgbaImage;
+use std::path::{Path, PathBuf};
+
+const SIZE: u32 = 96;
+
+fn techniques() -> Vec<(&'static str, Shading)> {
+    let flush = FlushPolicy::Auto;
+    vec![
+        ("forward", Shading::Forward),
+        ("branching", Technique::DEFERRED.into()),
+        (
+            "stencil-ps3",
+            Technique::Stencil {
+                backend: Backend::Ps3,
+                flush,
+            }
+            .into(),
+        ),
+        (
+            "stencil-native",
+            Technique::Stencil {
+                backend: Backend::Native,
+                flush,
+            }
+            .into(),
+        ),
+        (
+            "tiled",
+            Technique::Tiled {
+                mixed: MixedTiles::PerBrdf,
+                side: TileSide::Eight,
+            }
+            .into(),
+        ),
+        (
+            "depth-id",
+            Technique::DepthId {
+                side: TileSide::Eight,
+            }
+            .into(),
+        ),
+    ]
+}
+
+fn render(
+    ctx: &histencil_vk::Context,
+    scene: &histencil_scene::Scene,
+    brdfs: &'static BrdfModules,
+    shading: Shading,
+) -> RgbaImage {
+    render_ids(ctx, scene, brdfs, shading).0
+}
+
+/// The frame and, deferred, the BRDF each pixel's G-buffer names.
+fn render_ids(
+    ctx: &histencil_vk::Context,
+    scene: &histencil_scene::Scene,
+    brdfs: &'static BrdfModules,
+    shading: Shading,
+) -> (RgbaImage, Option<Vec<Option<BrdfId>>>) {
+    let desc = RendererDesc {
+        brdfs,
+        ..RendererDesc::new(SIZE, SIZE)
+    };
+    let mut renderer = Renderer::with_desc(ctx, scene.clone(), &desc).expect("renderer");
+    let images = renderer
+        .render(shading, Readback::ALL)
+        .expect("frame")
+        .images;
+    (images.ldr.expect("asked for"), images.brdf_ids)
+}
+
+/// A folder of its own under the test output folder, holding `files`.
+fn folder(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = histencil_tests::output_dir().join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (file, text) in files {
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    dir
+}
+
+#[test]
+fn an_engine_brdf_spelling_lambert_gives_the_builtin_frames_bit_for_bit() {
+    let dir = folder(
+        "engine-brdfs-lambert",
+        &[(
+            "mine.glsl",
+            "vec3 my_lambert(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(brdf_lambert(p.x, N, L));\n}\n",
+        )],
+    );
+    let spec = EngineBrdfSpec {
+        name: "my_lambert".into(),
+        glsl: "mine.glsl".into(),
+        function: "my_lambert".into(),
+        white: None,
+        params: vec![EngineParam {
+            name: "rho".into(),
+            range: Range::new(0.0, 1.0),
+            default: 1.0,
+        }],
+        tangent: false,
+    };
+    // Only Blinn-Phong kept beside it: the others are left out of every switch.
+    let set = BrdfSet::new(&[BrdfId::BlinnPhong], vec![spec])
+        .unwrap()
+        .with_folder(dir.canonicalize().unwrap());
+    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    let builtin = histencil_scene::embedded("default").unwrap();
+    let mut engine = builtin.clone();
+    let mut swapped = 0;
+    for o in &mut engine.objects {
+        if let Brdf::Lambert { rho } = o.material.brdf {
+            o.material.brdf = set.engine_brdf("my_lambert", &[("rho", rho)]).unwrap();
+            swapped += 1;
+        }
+    }
+    assert!(swapped > 0);
+    with_validated_context(|ctx| {
+        for (name, shading) in techniques() {
+            let expected = render(ctx, &builtin, BrdfModules::builtin(), shading);
+            let actual = render(ctx, &engine, modules, shading);
+            let d = diff(&expected, &actual);
+            assert_eq!(
+                d.max, 0,
+                "{name}: the engine's Lambert differs from the built-in: {d:?}"
+            );
+            assert!(lit_fraction(&actual) > 0.2, "{name}: too dark");
+        }
+    });
+}
+
+#[test]
+fn the_example_brdfs_are_held_to_forward_by_every_technique() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/brdfs");
+    let set = BrdfSet::load(&dir).expect("examples/brdfs loads");
+    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
+    let pairs = histencil_scene::retarget_brdfs(&mut scene, &set);
+    let to: Vec<&str> = pairs.iter().map(|(_, to)| to.name()).collect();
+    assert_eq!(to, ["toon", "charlie_sheen", "toon"]);
+    with_validated_context(|ctx| {
+        let forward = render(ctx, &scene, modules, Shading::Forward);
+        assert!(lit_fraction(&forward) > 0.2);
+        // Not the built-ins' frame: the engine's functions shade it.
+        let builtin = histencil_scene::embedded("brdfs-3").unwrap();
+        let theirs = render(ctx, &builtin, BrdfModules::builtin(), Shading::Forward);
+        assert!(
+            diff(&forward, &theirs).max > 8,
+            "the engine BRDFs changed nothing"
+        );
+        let mut images = Vec::new();
+        for (name, shading) in techniques().into_iter().skip(1) {
+            let (image, ids) = render_ids(ctx, &scene, modules, shading);
+            // The G-buffer's ids read back as the engine's BRDFs, by name.
+            let named: Vec<&str> = ids.unwrap().iter().flatten().map(|b| b.name()).collect();
+            assert!(
+                named.contains(&"toon") && named.contains(&"charlie_sheen"),
+                "{name}"
+            );
+            assert_close(&format!("engine-brdfs-{name}"), &forward, &image, 1);
+            images.push((name, image));
+        }
+        // Stencil and branching light each pixel with one draw per light, in the same order,
+        // by the same function: bit-identical, as with the built-ins.
+        let d = diff(&images[0].1, &images[1].1);
+        assert_eq!(d.max, 0, "branching against stencil: {d:?}");
+    });
+}
+
+#[test]
+fn a_material_the_set_does_not_hold_and_a_non_finite_brdf_are_refused_before_recording() {
+    let scene = histencil_scene::embedded("default").unwrap();
+    let dir = folder(
+        "engine-brdfs-spiky",
+        &[(
+            "spiky.glsl",
+            "vec3 spiky(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(p.x / dot(N, L));\n}\n",
+        )],
+    );
+    let spec = EngineBrdfSpec {
+        name: "spiky".into(),
+        glsl: "spiky.glsl".into(),
+        function: "spiky".into(),
+        white: None,
+        params: vec![],
+        tangent: false,
+    };
+    let set = BrdfSet::new(&[], vec![spec])
+        .unwrap()
+        .with_folder(dir.canonicalize().unwrap());
+    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    with_validated_context(|ctx| {
+        let desc = RendererDesc {
+            brdfs: modules,
+            ..RendererDesc::new(SIZE, SIZE)
+        };
+        // The scene's Lambert is not in a set of the engine's BRDF alone.
+        let err = Renderer::with_desc(ctx, scene.clone(), &desc)
+            .err()
+            .unwrap();
+        assert!(
+            err.to_string()
+                .contains("is not in this lighting's BRDF set"),
+            "{err}"
+        );
+        let mut spiky = scene.clone();
+        histencil_scene::retarget_brdfs(&mut spiky, &set);
+        let err = Renderer::with_desc(ctx, spiky, &desc).err().unwrap();
+        let text = err.to_string();
+        assert!(text.contains("engine BRDF `spiky` returns"), "{text}");
+        assert_eq!(err.cause(), histencil_vk::Cause::Data);
+    });
+}
+
+#[test]
+fn glsl_that_does_not_compile_names_the_engine_file_and_line() {
+    let dir = folder(
+        "engine-brdfs-broken",
+        &[(
+            "broken.glsl",
+            "// line 1\nvec3 broken(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(p.x;\n}\n",
+        )],
+    );
+    let spec = EngineBrdfSpec {
+        name: "broken".into(),
+        glsl: "broken.glsl".into(),
+        function: "broken".into(),
+        white: None,
+        params: vec![],
+        tangent: false,
+    };
+    let real = dir.canonicalize().unwrap();
+    let set = BrdfSet::new(&[], vec![spec])
+        .unwrap()
+        .with_folder(real.clone());
+    let err = histencil_vk::compile_brdf_set(&set).unwrap_err();
+    let at = format!("{}:3:", real.join("broken.glsl").display());
+    assert!(err.contains(&at), "{err}");
+    // A function the file does not define: glslc names it.
+    let set = BrdfSet::new(
+        &[],
+        vec![EngineBrdfSpec {
+            name: "absent".into(),
+            glsl: "broken.glsl".into(),
+            function: "no_such_function".into(),
+            white: None,
+            params: vec![],
+            tangent: false,
+        }],
+    )
+    .unwrap()
+    .with_folder(real);
+    assert!(histencil_vk::compile_brdf_set(&set).is_err());
+}
