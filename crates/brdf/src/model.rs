@@ -130,7 +130,8 @@ pub const MODEL_NAMES: [&str; 8] = {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum BrdfError {
     /// The name is none of [`MODEL_NAMES`].
-    #[error("unknown BRDF `{0}` (known: {names})", names = MODEL_NAMES.join(", "))]
+    #[error("unknown BRDF `{0}` (known: {names}; an engine's own BRDFs are known only with its \
+             BRDF set: `--brdfs DIR` on the command line)", names = MODEL_NAMES.join(", "))]
     UnknownModel(String),
     /// A parameter the model does not take.
     #[error("{model}: unknown parameter `{param}` (accepted: {accepted})")]

@@ -724,3 +724,92 @@ fn todays_gpus_asks_the_talks_questions_of_every_platform() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--brdfs DIR`: each bad folder, and each scene its set cannot shade, is refused before any
+/// device work with a message naming the file (and line) at fault, and no output is left.
+#[test]
+fn a_bad_brdf_folder_is_refused_before_rendering_and_leaves_no_output() {
+    let root = std::env::temp_dir().join(format!("histencil-cli-brdfs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let toon = "vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) { return vec3(p.x * max(dot(N, L), 0.0)); }\n";
+    let manifest = "[[brdf]]\nname = \"toon\"\nglsl = \"toon.glsl\"\nparams = [{ name = \"rho\", min = 0, max = 1, default = 1 }]\n";
+    let cases: &[(&str, &str, &str, &str)] = &[
+        ("toml", "[[brdf]\n", toon, "brdfs.toml: not valid TOML"),
+        ("missing", "[[brdf]]\nname = \"toon\"\nglsl = \"nope.glsl\"\n", toon, "brdfs.toml:3: BRDF `toon`: GLSL file"),
+        ("outside", "[[brdf]]\nname = \"toon\"\nglsl = \"../toon.glsl\"\n", toon, "must be a relative path inside the BRDF folder"),
+        ("twice", &format!("{manifest}{manifest}"), toon, "BRDF `toon` is named twice"),
+        ("builtin", "[[brdf]]\nname = \"ggx\"\nglsl = \"toon.glsl\"\n", toon, "has a built-in's name"),
+        ("glsl", manifest, "vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n  return p.x;\n}\n", "toon.glsl:2: error"),
+        ("nan", manifest, "vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) { return vec3(p.x / dot(N, L)); }\n", "engine BRDF `toon` returns"),
+    ];
+    let out = root.join("out.png");
+    for (name, manifest, glsl, needle) in cases {
+        let dir = root.join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("brdfs.toml"), manifest).unwrap();
+        std::fs::write(dir.join("toon.glsl"), glsl).unwrap();
+        let (ok, _, stderr) = histencil(&[
+            "render",
+            "--scene",
+            "brdfs-1",
+            "--brdfs",
+            dir.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "9",
+            "--validate",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!ok, "{name}: succeeded");
+        assert!(!stderr.contains("panicked"), "{name}: {stderr}");
+        assert!(
+            stderr.contains(needle),
+            "{name}: expected `{needle}` in {stderr}"
+        );
+        assert!(!out.exists(), "{name}: left {}", out.display());
+    }
+    // A glTF material naming an engine BRDF without its folder, or a parameter out of range.
+    let gltf = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/brdfs/own-brdfs.gltf");
+    let gltf = gltf.to_str().unwrap();
+    let args = |brdfs: Option<&str>| {
+        let mut a = vec!["render", "--scene", gltf, "--width", "16", "--height", "9"];
+        if let Some(dir) = brdfs {
+            a.extend(["--brdfs", dir]);
+        }
+        a.extend(["--out", out.to_str().unwrap()]);
+        a.into_iter().map(str::to_owned).collect::<Vec<_>>()
+    };
+    let run = |a: Vec<String>| histencil(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let (ok, _, stderr) = run(args(None));
+    assert!(
+        !ok && stderr.contains("unknown BRDF") && stderr.contains("--brdfs DIR"),
+        "{stderr}"
+    );
+    let narrow = root.join("narrow");
+    std::fs::create_dir_all(&narrow).unwrap();
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/brdfs");
+    let text = std::fs::read_to_string(examples.join("brdfs.toml")).unwrap();
+    // `bands` up to 3 only: the file's 4 is out of range.
+    std::fs::write(
+        narrow.join("brdfs.toml"),
+        text.replace("max = 8, default = 3", "max = 3, default = 3"),
+    )
+    .unwrap();
+    for f in ["toon.glsl", "sheen.glsl"] {
+        std::fs::copy(examples.join(f), narrow.join(f)).unwrap();
+    }
+    let (ok, _, stderr) = run(args(Some(narrow.to_str().unwrap())));
+    assert!(
+        !ok && stderr.contains("toon: parameter `bands` must be a number in [1, 3], got 4"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+    // And the folder itself renders it.
+    let (ok, _, stderr) = run(args(Some(examples.to_str().unwrap())));
+    assert!(ok, "{stderr}");
+    assert!(out.exists());
+    let _ = std::fs::remove_dir_all(&root);
+}
