@@ -76,10 +76,12 @@ fn generated_glsl() -> String {
         "#define HI_STENCIL_UPDATE_GROUP {HI_STENCIL_UPDATE_GROUP}u"
     )
     .unwrap();
-    assert!(
-        histencil_brdf::MODEL_IDS <= TILED_MODELS,
-        "raise TILED_MODELS to histencil_brdf::MODEL_IDS"
-    );
+    const {
+        assert!(
+            histencil_brdf::MODEL_IDS <= TILED_MODELS,
+            "raise TILED_MODELS to histencil_brdf::MODEL_IDS"
+        )
+    };
     writeln!(s, "#define TILED_MODELS {TILED_MODELS}u").unwrap();
     for axes in histencil_brdf::lut::LutAxes::ALL {
         writeln!(s, "#define {} {}u", axes.glsl_constant(), axes.index()).unwrap();

@@ -418,6 +418,21 @@ fn fine_side(largest: u32) -> u32 {
     (2 * largest.min(ESTIMATED_SIDE_LIMIT)).clamp(64, ESTIMATED_SIDE_LIMIT)
 }
 
+/// The material the estimate shades with: the entity's own, or for an engine's BRDF (which has
+/// no CPU spelling, `histencil_brdf::Brdf::Engine`) a white Lambert surface of its tint. The
+/// estimate then follows how the incident light varies over the entity, which is what a
+/// lightmap's resolution and slices must follow, but not the BRDF's own angular detail: an
+/// engine BRDF's estimate is a guide, not the bound a built-in's is.
+fn estimated_material(material: Material) -> Material {
+    if material.brdf.id().is_builtin() {
+        return material;
+    }
+    Material {
+        brdf: histencil_brdf::Brdf::Lambert { rho: 1.0 },
+        ..material
+    }
+}
+
 /// The estimated error of `entity`'s lightmap at `slices x side`, lit by `lights` and seen by
 /// `viewer`. Dust and ribbons have nothing to choose and estimate to zero.
 pub fn estimate(
@@ -428,7 +443,7 @@ pub fn estimate(
     side: u32,
 ) -> Estimate {
     let lights = reaching(entity, lights);
-    let material = entity.material;
+    let material = estimated_material(entity.material);
     let replay = Replay::new(entity, viewer, &lights, &material, fine_side(side));
     replay.estimate(slices, side)
 }
@@ -446,7 +461,7 @@ pub fn choose_parameters(
 ) -> Parameters {
     let coverage = coverage_side(entity, viewer, viewport_height);
     let lights = reaching(entity, lights);
-    let material = entity.material;
+    let material = estimated_material(entity.material);
     let base = Parameters {
         kind: ParameterKind::Surface,
         slices: 1,

@@ -18,6 +18,13 @@
 //! //     include!(concat!(env!("OUT_DIR"), "/histencil_light_modules.rs"));
 //! ```
 //!
+//! An engine with shading models of its own declares them as a [`BrdfSet`] (in code, or read
+//! from a folder with `brdfs.toml` by [`brdf_folder`], feature `files`) and compiles the light
+//! shaders with them by [`compile_light_shaders_for`]: every technique then evaluates its
+//! functions. [`write_brdf_set`] gives the include folder for the engine's own shaders that
+//! include histencil's `light.glsl` (a forward pass, say) or need the set's ids (a G-buffer pass:
+//! `brdf_set/ids.glsl`).
+//!
 //! Why at build time and not at run time: histencil already compiles its shaders with `glslc`
 //! at build time, so an engine needs no new tool, links no shader compiler into its binary
 //! (linking shaderc needs per-distribution link flags; see histencil-vk's build script), and a
@@ -30,6 +37,8 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+pub use histencil_brdf::BrdfSet;
 
 /// The options every histencil shader is compiled with: Vulkan 1.3 semantics and SPIR-V 1.3 (from
 /// 1.4 glslang copies structs out of buffers with OpCopyLogical, which naga's SPIR-V reader, the
@@ -66,6 +75,9 @@ pub enum BuildError {
     NoHooks(PathBuf),
     /// `glslc` could not be run.
     NoGlslc(String),
+    /// The engine's BRDF folder or set was refused (the manifest's path and line), or one of
+    /// its GLSL files could not be read.
+    Brdfs(String),
     /// `glslc` rejected a stage compiled with the hooks.
     Compile {
         /// The stage's file name, one of [`HOOKED_STAGES`].
@@ -101,9 +113,10 @@ impl fmt::Display for BuildError {
             BuildError::Compile { stage, message } => {
                 write!(
                     f,
-                    "glslc failed on {stage} with the engine's hooks:\n{message}"
+                    "glslc failed on {stage} with the engine's hooks and BRDFs:\n{message}"
                 )
             }
+            BuildError::Brdfs(e) => write!(f, "{e}"),
             BuildError::Io(e) => write!(f, "{e}"),
         }
     }
@@ -162,52 +175,181 @@ fn dep_var(name: &'static str) -> Result<PathBuf, BuildError> {
 /// own, into `out_dir/histencil/`, and writes `out_dir/histencil_light_modules.rs`: a
 /// `LightModules { .. }` expression holding the SPIR-V, for `include!` where `LightModules` is in
 /// scope (`histencil::LightModules` or `histencil_vk::LightModules`). Tells cargo to
-/// rerun when a hook file or histencil's shaders change.
+/// rerun when a hook file or histencil's shaders change. histencil's own BRDFs; with an
+/// engine's, [`compile_light_shaders_for`].
 ///
 /// # Errors
 /// [`BuildError`]: not run from a direct dependent's build script, an empty hook folder, no
 /// `glslc`, a hook that does not compile (glslc's message names the file and line), I/O.
 pub fn compile_light_shaders(hook_folder: &Path, out_dir: &Path) -> Result<PathBuf, BuildError> {
+    if !HOOK_FILES.iter().any(|f| hook_folder.join(f).is_file()) {
+        for file in HOOK_FILES {
+            println!(
+                "cargo:rerun-if-changed={}",
+                hook_folder.join(file).display()
+            );
+        }
+        return Err(BuildError::NoHooks(hook_folder.to_owned()));
+    }
+    compile_light_shaders_for(Some(hook_folder), &BrdfSet::default(), out_dir)
+}
+
+/// Reads an engine's BRDF folder (`brdfs.toml` and the GLSL it names, as the command line's
+/// `--brdfs` takes it) and tells cargo to rerun when anything in it changes.
+///
+/// # Errors
+/// [`BuildError::Brdfs`] with the manifest's path and line.
+#[cfg(feature = "files")]
+pub fn brdf_folder(dir: &Path) -> Result<BrdfSet, BuildError> {
+    println!("cargo:rerun-if-changed={}", dir.display());
+    BrdfSet::load(dir).map_err(|e| BuildError::Brdfs(e.to_string()))
+}
+
+/// The engine's GLSL files in `folder` (any depth, `/`-separated paths), which its BRDFs' files
+/// may include from one another.
+fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
+    fn walk(folder: &Path, dir: &Path, out: &mut Vec<(String, PathBuf)>) -> Result<(), BuildError> {
+        let entries = std::fs::read_dir(dir)
+            .map_err(|e| BuildError::Brdfs(format!("{}: {e}", dir.display())))?;
+        for entry in entries {
+            let path = entry.map_err(|e| BuildError::Io(e.to_string()))?.path();
+            let Ok(real) = path.canonicalize() else {
+                continue;
+            };
+            if !real.starts_with(folder) {
+                continue;
+            }
+            if real.is_dir() {
+                walk(folder, &path, out)?;
+            } else if path.extension().is_some_and(|e| e == "glsl") {
+                let relative = path.strip_prefix(folder).expect("walked from the folder");
+                let parts: Vec<_> = relative
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                    .collect();
+                out.push((parts.join("/"), real));
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    walk(folder, folder, &mut out)?;
+    out.sort();
+    Ok(out)
+}
+
+/// Writes what histencil's shaders include to evaluate `set` under `out_dir/histencil/set/`
+/// (its `brdf_set/` files and a copy of the engine's GLSL under `engine/`, so that no name of
+/// the engine's can hide one of histencil's includes) and returns that folder. Search it before
+/// histencil's include folders (`DEP_HISTENCIL_INCLUDE`, `DEP_HISTENCIL_GENERATED`) when
+/// compiling a shader of your own that includes histencil's `light.glsl`, or include
+/// `brdf_set/ids.glsl` from it for the `BRDF_ENGINE_*` ids.
+///
+/// # Errors
+/// [`BuildError::Brdfs`] when the engine's files cannot be read (a set with engine BRDFs and no
+/// folder has none), [`BuildError::Io`] when the copies cannot be written.
+pub fn write_brdf_set(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, BuildError> {
+    let root = out_dir.join("histencil").join("set");
+    let write = |relative: &str, bytes: &[u8]| {
+        let path = root.join(relative);
+        let dir = path.parent().expect("a file under the set folder");
+        std::fs::create_dir_all(dir)
+            .and_then(|()| std::fs::write(&path, bytes))
+            .map_err(|e| BuildError::Io(format!("{}: {e}", path.display())))
+    };
+    for (name, text) in set.glsl_files("engine") {
+        write(name, text.as_bytes())?;
+    }
+    match set.folder() {
+        Some(folder) => {
+            for (relative, path) in engine_files(folder)? {
+                println!("cargo:rerun-if-changed={}", path.display());
+                let bytes = std::fs::read(&path)
+                    .map_err(|e| BuildError::Brdfs(format!("{}: {e}", path.display())))?;
+                write(&format!("engine/{relative}"), &bytes)?;
+            }
+        }
+        None if set.is_builtin_only() => {}
+        None => {
+            return Err(BuildError::Brdfs(
+                "a BRDF set with BRDFs of the engine's needs its folder (BrdfSet::with_folder)"
+                    .into(),
+            ))
+        }
+    }
+    Ok(root)
+}
+
+/// Compiles [`HOOKED_STAGES`] for the engine's BRDF `set`, with the hook files in `hook_folder`
+/// (if any) searched before histencil's own, into `out_dir/histencil/`, and writes
+/// `out_dir/histencil_light_modules.rs` (the `LightModules` expression, as
+/// [`compile_light_shaders`] does; its `brdfs` are the set's ids) and
+/// `out_dir/histencil_brdf_set.rs` (the set, [`BrdfSet::rust_expression`]), both for `include!`.
+///
+/// # Errors
+/// As [`compile_light_shaders`], and [`BuildError::Brdfs`]; glslc's message names the engine's
+/// own BRDF file and line.
+pub fn compile_light_shaders_for(
+    hook_folder: Option<&Path>,
+    set: &BrdfSet,
+    out_dir: &Path,
+) -> Result<PathBuf, BuildError> {
     let shaders = dep_var("SHADERS")?;
     let generated = dep_var("GENERATED")?;
     println!("cargo:rerun-if-env-changed=HISTENCIL_GLSLC");
-    println!("cargo:rerun-if-changed={}", hook_folder.display());
-    let mut any = false;
-    for file in HOOK_FILES {
-        let path = hook_folder.join(file);
-        println!("cargo:rerun-if-changed={}", path.display());
-        any |= path.is_file();
-    }
-    if !any {
-        return Err(BuildError::NoHooks(hook_folder.to_owned()));
+    if let Some(hooks) = hook_folder {
+        println!("cargo:rerun-if-changed={}", hooks.display());
+        for file in HOOK_FILES {
+            println!("cargo:rerun-if-changed={}", hooks.join(file).display());
+        }
     }
     let target = out_dir.join("histencil");
     std::fs::create_dir_all(&target)
         .map_err(|e| BuildError::Io(format!("{}: {e}", target.display())))?;
+    let set_folder = write_brdf_set(set, out_dir)?;
     let (include, defaults) = (shaders.join("include"), shaders.join("hooks"));
-    // The engine's folder first: `#include "surface_decode.glsl"` in a stage (whose own folder
-    // holds no hook) resolves there before histencil's defaults.
-    let includes = [
-        hook_folder,
+    // The engine's hooks first: `#include "surface_decode.glsl"` in a stage (whose own folder
+    // holds no hook) resolves there before histencil's defaults; the set's `brdf_set/` before
+    // histencil's generated (empty) one.
+    let mut includes: Vec<&Path> = hook_folder.into_iter().collect();
+    includes.extend([
+        set_folder.as_path(),
         include.as_path(),
         generated.as_path(),
         defaults.as_path(),
-    ];
+    ]);
     // Unqualified: the engine names it through `histencil` or `histencil_vk`, whichever it uses.
     let mut fields = String::from("LightModules {\n");
     for stage in HOOKED_STAGES {
         let source = shaders.join(stage);
         let out = target.join(format!("{stage}.spv"));
-        run_glslc(glslc_command(&source, &includes, &out), stage)?;
+        run_glslc(glslc_command(&source, &includes, &out), stage).map_err(|e| match e {
+            // The engine's BRDF files by their own paths, not their copies'.
+            BuildError::Compile { stage, message } => BuildError::Compile {
+                stage,
+                message: match set.folder() {
+                    Some(folder) => message.replace(
+                        &set_folder.join("engine").display().to_string(),
+                        &folder.display().to_string(),
+                    ),
+                    None => message,
+                },
+            },
+            other => other,
+        })?;
         let field = stage.split('.').next().unwrap_or(stage);
         fields += &format!(
             "    {field}: include_bytes!({:?}),\n",
             out.display().to_string()
         );
     }
-    fields += "}\n";
+    let ids: Vec<String> = set.ids().iter().map(|b| b.index().to_string()).collect();
+    fields += &format!("    brdfs: &[{}],\n}}\n", ids.join(", "));
     let rust = out_dir.join("histencil_light_modules.rs");
     std::fs::write(&rust, fields)
         .map_err(|e| BuildError::Io(format!("{}: {e}", rust.display())))?;
+    let set_rust = out_dir.join("histencil_brdf_set.rs");
+    std::fs::write(&set_rust, set.rust_expression())
+        .map_err(|e| BuildError::Io(format!("{}: {e}", set_rust.display())))?;
     Ok(rust)
 }

@@ -735,12 +735,42 @@ fn a_bad_brdf_folder_is_refused_before_rendering_and_leaves_no_output() {
     let manifest = "[[brdf]]\nname = \"toon\"\nglsl = \"toon.glsl\"\nparams = [{ name = \"rho\", min = 0, max = 1, default = 1 }]\n";
     let cases: &[(&str, &str, &str, &str)] = &[
         ("toml", "[[brdf]\n", toon, "brdfs.toml: not valid TOML"),
-        ("missing", "[[brdf]]\nname = \"toon\"\nglsl = \"nope.glsl\"\n", toon, "brdfs.toml:3: BRDF `toon`: GLSL file"),
-        ("outside", "[[brdf]]\nname = \"toon\"\nglsl = \"../toon.glsl\"\n", toon, "must be a relative path inside the BRDF folder"),
-        ("twice", &format!("{manifest}{manifest}"), toon, "BRDF `toon` is named twice"),
-        ("builtin", "[[brdf]]\nname = \"ggx\"\nglsl = \"toon.glsl\"\n", toon, "has a built-in's name"),
-        ("glsl", manifest, "vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n  return p.x;\n}\n", "toon.glsl:2: error"),
-        ("nan", manifest, "vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) { return vec3(p.x / dot(N, L)); }\n", "engine BRDF `toon` returns"),
+        (
+            "missing",
+            "[[brdf]]\nname = \"toon\"\nglsl = \"nope.glsl\"\n",
+            toon,
+            "brdfs.toml:3: BRDF `toon`: GLSL file",
+        ),
+        (
+            "outside",
+            "[[brdf]]\nname = \"toon\"\nglsl = \"../toon.glsl\"\n",
+            toon,
+            "must be a relative path inside the BRDF folder",
+        ),
+        (
+            "twice",
+            &format!("{manifest}{manifest}"),
+            toon,
+            "BRDF `toon` is named twice",
+        ),
+        (
+            "builtin",
+            "[[brdf]]\nname = \"ggx\"\nglsl = \"toon.glsl\"\n",
+            toon,
+            "has a built-in's name",
+        ),
+        (
+            "glsl",
+            manifest,
+            "vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n  return p.x;\n}\n",
+            "toon.glsl:2: error",
+        ),
+        (
+            "nan",
+            manifest,
+            "vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) { return vec3(p.x / dot(N, L)); }\n",
+            "engine BRDF `toon` returns",
+        ),
     ];
     let out = root.join("out.png");
     for (name, manifest, glsl, needle) in cases {

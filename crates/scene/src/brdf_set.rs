@@ -5,21 +5,27 @@
 use crate::Scene;
 use histencil_brdf::{BrdfId, BrdfSet};
 
-/// Gives the scene `set`'s engine BRDFs: each distinct BRDF its objects and alpha entities use,
-/// in id order (the stencil slots' order), becomes the set's next engine BRDF, from the first
-/// again after the last, with the manifest's default parameters; tints, maps and emission stay.
+/// Gives the scene's opaque objects `set`'s engine BRDFs: each distinct BRDF they use, in id
+/// order (the stencil slots' order), becomes the set's next engine BRDF, from the first again
+/// after the last, with the manifest's default parameters; tints, maps and emission stay.
 /// Returns what became what. A scene that already names one of the set's engine BRDFs (a glTF
 /// file made for them) and a set without engine BRDFs leave the scene as it is (no pairs).
+///
+/// Alpha entities keep theirs: their lightmaps are approximate, held to a bound measured on
+/// histencil's BRDFs, and the parameters chosen for them come from a CPU estimate that an
+/// engine BRDF has no spelling for; an entity a glTF file gives an engine BRDF is still lit by
+/// it (through the lightmaps compiled for the set).
 pub fn retarget_brdfs(scene: &mut Scene, set: &BrdfSet) -> Vec<(BrdfId, BrdfId)> {
     let engine: Vec<BrdfId> = set.engine().map(|(id, _)| id).collect();
-    let mut materials: Vec<&mut crate::Material> = scene
-        .objects
-        .iter_mut()
-        .map(|o| &mut o.material)
-        .chain(scene.alpha_objects.iter_mut().map(|o| &mut o.material))
-        .chain(scene.particle_systems.iter_mut().map(|p| &mut p.material))
-        .collect();
-    if engine.is_empty() || materials.iter().any(|m| !m.brdf.id().is_builtin()) {
+    let named = scene
+        .alpha_objects
+        .iter()
+        .map(|o| &o.material)
+        .chain(scene.particle_systems.iter().map(|p| &p.material))
+        .any(|m| !m.brdf.id().is_builtin());
+    let mut materials: Vec<&mut crate::Material> =
+        scene.objects.iter_mut().map(|o| &mut o.material).collect();
+    if engine.is_empty() || named || materials.iter().any(|m| !m.brdf.id().is_builtin()) {
         return Vec::new();
     }
     let mut used: Vec<BrdfId> = materials.iter().map(|m| m.brdf.id()).collect();
@@ -78,6 +84,20 @@ mod tests {
         }
         // Already the engine's: left alone.
         assert!(retarget_brdfs(&mut scene, &set).is_empty());
+        // Alpha entities keep theirs.
+        let mut alpha = crate::embedded("alpha").unwrap();
+        let kept: Vec<_> = alpha
+            .alpha_objects
+            .iter()
+            .map(|o| o.material.brdf)
+            .collect();
+        assert!(!retarget_brdfs(&mut alpha, &set).is_empty());
+        let after: Vec<_> = alpha
+            .alpha_objects
+            .iter()
+            .map(|o| o.material.brdf)
+            .collect();
+        assert_eq!(kept, after);
         // No engine BRDF in the set: left alone.
         let mut plain = crate::embedded("brdfs-3").unwrap();
         assert!(retarget_brdfs(&mut plain, &BrdfSet::default()).is_empty());

@@ -238,6 +238,7 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
             tile_shade,
             tile_shade_8,
             depth_id_shade,
+            brdfs: Box::leak(set.ids().iter().map(|b| b.index()).collect()),
             ..LightModules::BUILTIN
         },
         forward,

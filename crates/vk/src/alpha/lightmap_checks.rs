@@ -51,6 +51,7 @@ pub(super) fn check_frame(
     desc: &AlphaLightmapsDesc,
     frame: &LightmapFrame,
     atlas: &ImageRef,
+    set: &histencil_brdf::BrdfSet,
 ) -> Result<()> {
     if !atlas.usage.contains(vk::ImageUsageFlags::COLOR_ATTACHMENT) {
         return Err(bad(format!(
@@ -90,6 +91,10 @@ pub(super) fn check_frame(
     for (i, (entity, r)) in frame.entities.iter().zip(regions).enumerate() {
         if let Some(problem) = entity.problem() {
             return Err(bad(format!("alpha entity {i}: {problem}")));
+        }
+        // A BRDF the lightmap shaders were not compiled with would light it black in silence.
+        if let Err(e) = set.check(&entity.material.brdf) {
+            return Err(bad(format!("alpha entity {i}: {e}")));
         }
         let s = r.shape;
         let width = u64::from(s.columns) * u64::from(s.tile_width);

@@ -445,7 +445,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
 
     /// Checks `frame` and writes its records, lights and uniforms into its slot.
     pub(crate) fn write_frame(&mut self, frame: &LightmapFrame, atlas: &ImageRef) -> Result<()> {
-        check_frame(&self.desc, frame, atlas)?;
+        check_frame(&self.desc, frame, atlas, &self.modules.set)?;
         self.pending.refuse_slot(frame.slot)?;
         let viewer = Viewer::from_view(frame.view)
             .ok_or_else(|| bad("the view's world-to-view matrix cannot be inverted".into()))?;

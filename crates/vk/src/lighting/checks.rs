@@ -44,6 +44,17 @@ pub(super) fn check_desc(desc: &LightingDesc) -> Result<()> {
             )));
         }
     }
+    // A BRDF the light shaders were not compiled with would shade its pixels black in silence.
+    let compiled = desc.hooks.modules().brdfs;
+    if let Some(missing) = desc.brdfs.iter().find(|b| !compiled.contains(&b.index())) {
+        return Err(bad_setup(format!(
+            "BRDF `{missing}` (id {}) is not one the light shaders were compiled with (ids \
+             {compiled:?}): compile them for the engine's BRDF set \
+             (histencil_build::compile_light_shaders_for, or histencil::compile_brdf_set with \
+             LightHooks::BuiltinWithBrdfs)",
+            missing.index()
+        )));
+    }
     let slots = desc.layout.brdfs_in_use() as usize;
     if desc.brdfs.len() > slots {
         return Err(bad_setup(format!(

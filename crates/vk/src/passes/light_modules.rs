@@ -27,6 +27,10 @@ pub struct LightModules {
     pub depth_id_copy: &'static [u8],
     /// `depth_id_shade.frag`: the depth-id technique's shade pass.
     pub depth_id_shade: &'static [u8],
+    /// The BRDF ids (`BrdfId::index`) these shaders evaluate: histencil's eight, or a BRDF
+    /// set's (`histencil_build::compile_light_shaders_for` writes them). A lighting whose
+    /// `LightingDesc::brdfs` names another is refused, not shaded black.
+    pub brdfs: &'static [u32],
 }
 
 impl LightModules {
@@ -40,6 +44,7 @@ impl LightModules {
         tile_shade_8: shaders::TILE_SHADE_8_COMP,
         depth_id_copy: shaders::DEPTH_ID_COPY_FRAG,
         depth_id_shade: shaders::DEPTH_ID_SHADE_FRAG,
+        brdfs: &[0, 1, 2, 3, 4, 5, 6, 7],
     };
 
     /// Each module with its name, for checks and messages.
