@@ -205,8 +205,8 @@ pub fn brdf_folder(dir: &Path) -> Result<BrdfSet, BuildError> {
     BrdfSet::load(dir).map_err(|e| BuildError::Brdfs(e.to_string()))
 }
 
-/// The engine's GLSL files in `folder` (any depth, `/`-separated paths), which its BRDFs' files
-/// may include from one another.
+/// The engine's GLSL files in `folder` (any depth, `/`-separated paths, links followed only
+/// inside it), which its BRDFs' files may include from one another.
 fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
     fn walk(folder: &Path, dir: &Path, out: &mut Vec<(String, PathBuf)>) -> Result<(), BuildError> {
         let entries = std::fs::read_dir(dir)
@@ -238,20 +238,31 @@ fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
     Ok(out)
 }
 
-/// Writes what histencil's shaders include to evaluate `set` under `out_dir/histencil/set/`
-/// (its `brdf_set/` files and a copy of the engine's GLSL under `engine/`, so that no name of
-/// the engine's can hide one of histencil's includes) and returns that folder. Search it before
-/// histencil's include folders (`DEP_HISTENCIL_INCLUDE`, `DEP_HISTENCIL_GENERATED`) when
-/// compiling a shader of your own that includes histencil's `light.glsl`, or include
-/// `brdf_set/ids.glsl` from it for the `BRDF_ENGINE_*` ids.
+/// The stages that evaluate a BRDF (each includes `brdf/eval.glsl`): what a BRDF set is compiled
+/// into, in the order of `BrdfModules`' fields ([`compile_brdf_modules`]).
+pub const BRDF_STAGES: [&str; 9] = [
+    "deferred_light.frag",
+    "lut_light.frag",
+    "tile_shade.comp",
+    "tile_shade_8.comp",
+    "depth_id_shade.frag",
+    "forward.frag",
+    "lightmap.frag",
+    "lightmap_directional.frag",
+    "brdf_eval.comp",
+];
+
+/// Writes what histencil's shaders include to evaluate `set` into `folder` (its `brdf_set/`
+/// files, and a copy of the engine's GLSL under `engine/`, so that no name of the engine's can
+/// hide one of histencil's includes); returns the engine files copied, where they are on disk.
+/// Prints nothing: for a run-time compile as well as a build script's.
 ///
 /// # Errors
 /// [`BuildError::Brdfs`] when the engine's files cannot be read (a set with engine BRDFs and no
 /// folder has none), [`BuildError::Io`] when the copies cannot be written.
-pub fn write_brdf_set(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, BuildError> {
-    let root = out_dir.join("histencil").join("set");
+pub fn stage_brdf_set(set: &BrdfSet, folder: &Path) -> Result<Vec<PathBuf>, BuildError> {
     let write = |relative: &str, bytes: &[u8]| {
-        let path = root.join(relative);
+        let path = folder.join(relative);
         let dir = path.parent().expect("a file under the set folder");
         std::fs::create_dir_all(dir)
             .and_then(|()| std::fs::write(&path, bytes))
@@ -260,13 +271,14 @@ pub fn write_brdf_set(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, BuildErr
     for (name, text) in set.glsl_files("engine") {
         write(name, text.as_bytes())?;
     }
+    let mut copied = Vec::new();
     match set.folder() {
-        Some(folder) => {
-            for (relative, path) in engine_files(folder)? {
-                println!("cargo:rerun-if-changed={}", path.display());
+        Some(engine) => {
+            for (relative, path) in engine_files(engine)? {
                 let bytes = std::fs::read(&path)
                     .map_err(|e| BuildError::Brdfs(format!("{}: {e}", path.display())))?;
                 write(&format!("engine/{relative}"), &bytes)?;
+                copied.push(path);
             }
         }
         None if set.is_builtin_only() => {}
@@ -277,7 +289,96 @@ pub fn write_brdf_set(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, BuildErr
             ))
         }
     }
+    Ok(copied)
+}
+
+/// glslc's `message` about a stage compiled with a set staged in `staged` by
+/// [`stage_brdf_set`], with the engine's files named by their own paths, not their copies'.
+pub fn engine_paths(message: &str, set: &BrdfSet, staged: &Path) -> String {
+    match set.folder() {
+        Some(folder) => message.replace(
+            &staged.join("engine").display().to_string(),
+            &folder.display().to_string(),
+        ),
+        None => message.to_owned(),
+    }
+}
+
+/// [`stage_brdf_set`] into `out_dir/histencil/set/`, telling cargo to rerun when an engine file
+/// changes; returns that folder. Search it before histencil's include folders
+/// (`DEP_HISTENCIL_INCLUDE`, `DEP_HISTENCIL_GENERATED`) when compiling a shader of your own that
+/// includes histencil's `light.glsl`, or include `brdf_set/ids.glsl` from it for the
+/// `BRDF_ENGINE_*` ids.
+///
+/// # Errors
+/// As [`stage_brdf_set`].
+pub fn write_brdf_set(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, BuildError> {
+    let root = out_dir.join("histencil").join("set");
+    for path in stage_brdf_set(set, &root)? {
+        println!("cargo:rerun-if-changed={}", path.display());
+    }
     Ok(root)
+}
+
+/// Compiles [`BRDF_STAGES`] for `set` with histencil's own decode and visibility (its G-buffer,
+/// no shadows) into `out_dir/histencil/brdf-modules/`, and writes
+/// `out_dir/histencil_brdf_modules.rs`: a `BrdfModules { .. }` expression (the set, its light
+/// shaders, the forward reference, the lightmaps and the BRDF evaluator), for `include!` where
+/// `BrdfModules`, `LightModules` and the set's types are in scope (`histencil::*` and
+/// `histencil::brdf::*`). What histencil's `Renderer`, `AlphaLightmaps::with_modules` and
+/// `LightHooks::BuiltinWithBrdfs` take; an engine with hooks of its own compiles its light
+/// shaders with [`compile_light_shaders_for`].
+///
+/// # Errors
+/// As [`compile_light_shaders_for`].
+pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, BuildError> {
+    let shaders = dep_var("SHADERS")?;
+    let generated = dep_var("GENERATED")?;
+    println!("cargo:rerun-if-env-changed=HISTENCIL_GLSLC");
+    let target = out_dir.join("histencil").join("brdf-modules");
+    std::fs::create_dir_all(&target)
+        .map_err(|e| BuildError::Io(format!("{}: {e}", target.display())))?;
+    let set_folder = write_brdf_set(set, out_dir)?;
+    let (include, defaults) = (shaders.join("include"), shaders.join("hooks"));
+    let includes = [
+        set_folder.as_path(),
+        include.as_path(),
+        generated.as_path(),
+        defaults.as_path(),
+    ];
+    let mut spirv = Vec::new();
+    for stage in BRDF_STAGES {
+        let out = target.join(format!("{stage}.spv"));
+        run_glslc(glslc_command(&shaders.join(stage), &includes, &out), stage).map_err(
+            |e| match e {
+                BuildError::Compile { stage, message } => BuildError::Compile {
+                    stage,
+                    message: engine_paths(&message, set, &set_folder),
+                },
+                other => other,
+            },
+        )?;
+        spirv.push(format!("include_bytes!({:?})", out.display().to_string()));
+    }
+    let ids: Vec<String> = set.ids().iter().map(|b| b.index().to_string()).collect();
+    let expression = format!(
+        "BrdfModules {{\n    set: {set},\n    light: LightModules {{\n        deferred_light: {},\n        lut_light: {},\n        tile_shade: {},\n        tile_shade_8: {},\n        depth_id_shade: {},\n        brdfs: &[{ids}],\n        ..LightModules::BUILTIN\n    }},\n    forward: {},\n    lightmap: {},\n    lightmap_directional: {},\n    brdf_eval: {},\n}}\n",
+        spirv[0],
+        spirv[1],
+        spirv[2],
+        spirv[3],
+        spirv[4],
+        spirv[5],
+        spirv[6],
+        spirv[7],
+        spirv[8],
+        set = set.rust_expression(),
+        ids = ids.join(", "),
+    );
+    let rust = out_dir.join("histencil_brdf_modules.rs");
+    std::fs::write(&rust, expression)
+        .map_err(|e| BuildError::Io(format!("{}: {e}", rust.display())))?;
+    Ok(rust)
 }
 
 /// Compiles [`HOOKED_STAGES`] for the engine's BRDF `set`, with the hook files in `hook_folder`
@@ -327,13 +428,7 @@ pub fn compile_light_shaders_for(
             // The engine's BRDF files by their own paths, not their copies'.
             BuildError::Compile { stage, message } => BuildError::Compile {
                 stage,
-                message: match set.folder() {
-                    Some(folder) => message.replace(
-                        &set_folder.join("engine").display().to_string(),
-                        &folder.display().to_string(),
-                    ),
-                    None => message,
-                },
+                message: engine_paths(&message, set, &set_folder),
             },
             other => other,
         })?;

@@ -99,8 +99,9 @@ pub use histencil_model as model;
 pub use histencil_scene as scene;
 pub use histencil_vk as vk;
 
-// BRDFs and lights.
-pub use histencil_brdf::{Brdf, BrdfId};
+// BRDFs (histencil's and an engine's own) and lights.
+pub use histencil_brdf::{Brdf, BrdfId, BrdfSet, EngineBrdfSpec, EngineParam};
+pub use histencil_vk::{compile_brdf_set, BrdfModules};
 pub use histencil_scene::{Light, LightKind, Material, Mesh, ParticleLayout, ParticleSystem};
 
 // Planning (no Vulkan).

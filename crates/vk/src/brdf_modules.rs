@@ -72,19 +72,6 @@ impl BrdfModules {
     }
 }
 
-/// The stages that evaluate a BRDF (each includes `brdf/eval.glsl`), compiled per set.
-const STAGES: [&str; 9] = [
-    "deferred_light.frag",
-    "lut_light.frag",
-    "tile_shade.comp",
-    "tile_shade_8.comp",
-    "depth_id_shade.frag",
-    "forward.frag",
-    "lightmap.frag",
-    "lightmap_directional.frag",
-    "brdf_eval.comp",
-];
-
 /// A folder under the system's temporary one, removed with everything in it on drop (also when
 /// a compile fails half way).
 struct Scratch(PathBuf);
@@ -117,38 +104,6 @@ impl Drop for Scratch {
     }
 }
 
-/// The engine folder's GLSL files (at any depth, by their paths in it), which its BRDFs'
-/// files may include from one another; links are followed only inside the folder.
-fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, String> {
-    fn walk(folder: &Path, dir: &Path, out: &mut Vec<(String, PathBuf)>) -> Result<(), String> {
-        let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        for entry in entries {
-            let path = entry.map_err(|e| e.to_string())?.path();
-            let Ok(real) = path.canonicalize() else {
-                continue;
-            };
-            if !real.starts_with(folder) {
-                continue;
-            }
-            if real.is_dir() {
-                walk(folder, &path, out)?;
-            } else if path.extension().is_some_and(|e| e == "glsl") {
-                let relative = path.strip_prefix(folder).expect("walked from the folder");
-                let parts: Vec<_> = relative
-                    .components()
-                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
-                    .collect();
-                out.push((parts.join("/"), real));
-            }
-        }
-        Ok(())
-    }
-    let mut out = Vec::new();
-    walk(folder, folder, &mut out)?;
-    out.sort();
-    Ok(out)
-}
-
 /// Compiles every stage that evaluates a BRDF for `set`, with `glslc` (histencil-build's
 /// options); the same set (its generated GLSL and its files' contents) compiles once per
 /// process, and its modules live as long as the process, as a built-in module does.
@@ -160,67 +115,50 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
     if set == &BrdfSet::default() {
         return Ok(BrdfModules::builtin());
     }
-    let generated = set.glsl_files("engine");
-    let files = match set.folder() {
-        Some(folder) => engine_files(folder)?,
-        None if set.is_builtin_only() => Vec::new(),
-        None => return Err("an engine BRDF set without its folder has no GLSL to compile".into()),
-    };
+    let scratch = Scratch::new().map_err(|e| format!("a scratch folder for glslc: {e}"))?;
+    let staged = scratch.0.join("set");
+    let copied = histencil_build::stage_brdf_set(set, &staged).map_err(|e| e.to_string())?;
     // What the modules are a function of: the generated GLSL and every engine file's bytes.
-    let mut key = String::new();
-    for (name, text) in &generated {
-        key += name;
-        key += text;
+    let mut key: Vec<u8> = Vec::new();
+    for (name, text) in set.glsl_files("engine") {
+        key.extend(name.bytes().chain(text.bytes()).chain([0]));
     }
-    let mut contents = Vec::new();
-    for (relative, path) in &files {
+    for path in &copied {
         let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        key += relative;
-        key += &String::from_utf8_lossy(&bytes);
-        contents.push((relative.clone(), bytes));
+        key.extend(path.display().to_string().bytes().chain(bytes).chain([0]));
     }
-    static COMPILED: OnceLock<Mutex<HashMap<String, &'static BrdfModules>>> = OnceLock::new();
+    static COMPILED: OnceLock<Mutex<HashMap<Vec<u8>, &'static BrdfModules>>> = OnceLock::new();
     let cache = COMPILED.get_or_init(Default::default);
     if let Some(done) = cache.lock().unwrap_or_else(|p| p.into_inner()).get(&key) {
         return Ok(done);
     }
 
-    let scratch = Scratch::new().map_err(|e| format!("a scratch folder for glslc: {e}"))?;
     for (path, text) in sources::SOURCES {
         scratch.write(path, text.as_bytes())?;
     }
-    for (name, text) in &generated {
-        scratch.write(&format!("set/{name}"), text.as_bytes())?;
-    }
-    for (relative, bytes) in &contents {
-        scratch.write(&format!("set/engine/{relative}"), bytes)?;
-    }
     let root = &scratch.0;
     let includes = [
-        root.join("set"),
+        staged.clone(),
         root.join("include"),
         root.join("generated"),
         root.join("hooks"),
     ];
     let includes: Vec<&Path> = includes.iter().map(PathBuf::as_path).collect();
     let mut spirv = Vec::new();
-    for stage in STAGES {
+    for stage in histencil_build::BRDF_STAGES {
         let out = root.join(format!("{stage}.spv"));
         let command =
             histencil_build::glslc_command(&root.join("stages").join(stage), &includes, &out);
         histencil_build::run_glslc(command, stage).map_err(|e| {
-            let mut message = match e {
+            let message = match e {
                 histencil_build::BuildError::Compile { stage, message } => {
                     format!("glslc refused {stage} compiled with the BRDF set:\n{message}")
                 }
                 other => other.to_string(),
             };
             // The engine's files by their own paths, histencil's by where they live in its tree.
-            if let Some(folder) = set.folder() {
-                let copied = root.join("set/engine").display().to_string();
-                message = message.replace(&copied, &folder.display().to_string());
-            }
-            message.replace(&root.display().to_string(), "histencil-vk/shaders")
+            histencil_build::engine_paths(&message, set, &staged)
+                .replace(&root.display().to_string(), "histencil-vk/shaders")
         })?;
         let bytes = std::fs::read(&out).map_err(|e| format!("{}: {e}", out.display()))?;
         spirv.push(&*Box::leak(bytes.into_boxed_slice()));

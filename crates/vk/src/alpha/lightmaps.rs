@@ -159,7 +159,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     }
 
     /// As [`AlphaLightmaps::new`], lighting with the lightmap shaders of `modules` (a BRDF set's).
-    pub(crate) fn with_modules(
+    pub fn with_modules(
         ctx: C,
         desc: &AlphaLightmapsDesc,
         modules: &'static crate::BrdfModules,
