@@ -37,7 +37,7 @@ pub mod encoding;
 pub mod eval_csv;
 mod id;
 pub mod lut;
-#[cfg(feature = "files")]
+#[cfg(feature = "manifest")]
 mod manifest;
 mod model;
 mod models;
@@ -45,7 +45,7 @@ mod set;
 mod vector;
 
 pub use id::{BrdfId, EngineBrdf, UnknownBrdf, ENGINE_FIRST, MAX_ENGINE_BRDFS};
-#[cfg(feature = "files")]
+#[cfg(feature = "manifest")]
 pub use manifest::{ManifestError, MANIFEST};
 pub use model::{ranges, Brdf, BrdfError, Parts, Range, MODEL_NAMES};
 pub use models::*;

@@ -101,8 +101,8 @@ pub use histencil_vk as vk;
 
 // BRDFs (histencil's and an engine's own) and lights.
 pub use histencil_brdf::{Brdf, BrdfId, BrdfSet, EngineBrdfSpec, EngineParam};
-pub use histencil_vk::{compile_brdf_set, BrdfModules};
 pub use histencil_scene::{Light, LightKind, Material, Mesh, ParticleLayout, ParticleSystem};
+pub use histencil_vk::{compile_brdf_set, BrdfModules};
 
 // Planning (no Vulkan).
 pub use histencil_model::{

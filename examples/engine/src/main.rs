@@ -27,14 +27,14 @@ use gpu_allocator::MemoryLocation;
 use histencil::vk::gpu_types::FrameUniforms;
 use histencil::{
     mesh_bounds, plan_entities, plan_frame, AlphaEntity, AlphaEntityKind, AlphaLightmaps,
-    AlphaLightmapsDesc, Backend, BrdfSource, ChoiceSettings, Context, DeferredLighting,
-    DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSetLayout, HookSets, ImageState,
-    LightHooks, LightModules, LightingDesc, LightingFrame, LightingTargets, LightmapFrame,
-    MixedTiles, Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice,
-    TileClassify, TileSide, TiledFrame, View, ViewDesc, Viewer,
+    AlphaLightmapsDesc, Backend, BrdfModules, BrdfSource, ChoiceSettings, Context,
+    DeferredLighting, DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSetLayout, HookSets,
+    ImageState, LightHooks, LightModules, LightingDesc, LightingFrame, LightingTargets,
+    LightmapFrame, MixedTiles, Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout,
+    TechniqueChoice, TileClassify, TileSide, TiledFrame, View, ViewDesc, Viewer,
 };
 // histencil's own renderer, as the reference the engine's frames are compared with.
-use histencil::vk::{AlphaMode, FrameDesc, Readback, Renderer, Shading, Technique};
+use histencil::vk::{AlphaMode, FrameDesc, Readback, Renderer, RendererDesc, Shading, Technique};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 use world::{AlphaWorld, World};
@@ -51,6 +51,13 @@ const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 /// histencil's light shaders compiled with the engine's decode hook (build.rs).
 const LIGHT_MODULES: LightModules =
     include!(concat!(env!("OUT_DIR"), "/histencil_light_modules.rs"));
+/// The engine's own BRDFs (`../brdfs`) and every module that evaluates them with histencil's
+/// own G-buffer (build.rs): the lighting the compact layout is timed against, the lightmaps and
+/// histencil's Renderer of the same state.
+static BRDF_MODULES: std::sync::LazyLock<BrdfModules> = std::sync::LazyLock::new(|| {
+    use histencil::brdf::{BrdfId, BrdfSet, EngineBrdfSpec, EngineParam, Range};
+    include!(concat!(env!("OUT_DIR"), "/histencil_brdf_modules.rs"))
+});
 /// The engine's lightmap atlas: what its alpha entities need at this size fits easily.
 const ATLAS_SIDE: u32 = 256;
 
@@ -178,7 +185,8 @@ fn main() {
         width: WIDTH,
         height: HEIGHT,
     };
-    let world = World::new();
+    let brdf_modules: &'static BrdfModules = &BRDF_MODULES;
+    let world = World::new(&brdf_modules.set);
     // histencil's bits where this engine wants them: the culling bit at 5, the BRDF field from
     // bit 1; bits 6 and 7 are the engine's.
     let layout = StencilLayout::with_positions(
@@ -250,13 +258,14 @@ fn main() {
         extent,
         U::COLOR_ATTACHMENT | U::TRANSFER_SRC | U::STORAGE,
     );
-    let mut lightmaps = AlphaLightmaps::new(
+    let mut lightmaps = AlphaLightmaps::with_modules(
         &ctx,
         &AlphaLightmapsDesc {
             atlas_format: HDR_FORMAT,
             frames_in_flight: IN_FLIGHT as u32,
             direction_format: None,
         },
+        brdf_modules,
     )
     .expect("lightmaps");
     let atlas_image = gpu.image(
@@ -582,7 +591,7 @@ fn main() {
     let mut histencil_lighting = DeferredLighting::new(
         &ctx,
         &LightingDesc {
-            hooks: LightHooks::Builtin,
+            hooks: LightHooks::BuiltinWithBrdfs(brdf_modules.light),
             ..lighting.desc().clone()
         },
     )
@@ -663,8 +672,12 @@ fn main() {
         worst = worst.max(difference);
         // histencil's own forward frame knows no shadows: the pixels where the engine's differs
         // from it are the shadowed ones. The alpha comparisons below skip them.
+        let desc = RendererDesc {
+            brdfs: brdf_modules,
+            ..RendererDesc::new(WIDTH, HEIGHT)
+        };
         let mut opaque =
-            Renderer::new(&ctx, scene.without_alpha(), WIDTH, HEIGHT).expect("reference renderer");
+            Renderer::with_desc(&ctx, scene.without_alpha(), &desc).expect("reference renderer");
         let forward = hdr_of(&mut opaque, FrameDesc::new(Shading::Forward, hdr_only));
         let unshadowed: Vec<bool> = pixel_differences(&forward, &lit)
             .into_iter()
@@ -673,7 +686,7 @@ fn main() {
         shadowed_pixels = shadowed_pixels.min(unshadowed.iter().filter(|u| !**u).count());
         let keep = |p: usize| unshadowed[p];
         // Alpha: histencil's own lightmap frame of the same state, and the per-pixel reference.
-        let mut renderer = Renderer::new(&ctx, scene, WIDTH, HEIGHT).expect("reference renderer");
+        let mut renderer = Renderer::with_desc(&ctx, scene, &desc).expect("reference renderer");
         let with_alpha = |alpha| FrameDesc {
             alpha,
             ..FrameDesc::new(Shading::Forward, hdr_only)
@@ -789,11 +802,18 @@ fn main() {
     drop(ctx);
     gpu.destroy();
     let messages = device::MESSAGES.load(Ordering::SeqCst);
+    let names: Vec<&str> = brdf_modules
+        .set
+        .engine()
+        .map(|(_, s)| s.name.as_str())
+        .collect();
+    let own = world.brdfs.iter().filter(|b| !b.is_builtin()).count();
+    let names = names.join(", ");
     println!(
         "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward \
          over frames {}; engine stencil bits {} on {stencil_frames} stencil frames; {messages} \
          validation messages, G-buffer {bytes} bytes per pixel, {SHADOWED_LIGHTS} shadowed \
-         lights, through the hooks",
+         lights, {own} BRDFs of its own ({names}), through the hooks",
         compared.join("; "),
         if intact { "intact" } else { "NOT intact" }
     );

@@ -1,9 +1,10 @@
-//! The engine's world: a floor and eight boxes in four BRDFs, a glass sphere and a smoke cloud
+//! The engine's world: a floor and eight boxes in six BRDFs (two of them the engine's own, from
+//! `../brdfs`), a glass sphere and a smoke cloud
 //! (translucent), 64 point lights and a camera, all animated by frame number. Its own types;
 //! `histencil_scene` for its procedural meshes and particles and for the forward reference.
 
 use glam::{Mat4, Quat, Vec3};
-use histencil::brdf::{Brdf, BrdfId};
+use histencil::brdf::{Brdf, BrdfId, BrdfSet};
 use histencil::model::Aabb;
 use histencil::scene::{
     uv_sphere, AlphaObject, Camera, Light, Material, Mesh, Object as SceneObject, ParticleLayout,
@@ -34,7 +35,13 @@ pub struct World {
 }
 
 impl World {
-    pub fn new() -> Self {
+    /// The world, its engine BRDFs (`toon`, `charlie_sheen`) from `set`: the third parameter
+    /// of each is 1, which the compact G-buffer does not store.
+    pub fn new(set: &BrdfSet) -> Self {
+        let own = |name: &str, given: &[(&str, f64)]| {
+            set.engine_brdf(name, given)
+                .expect("a BRDF of the engine's set")
+        };
         let mut objects = vec![Object {
             transform: Mat4::from_scale_rotation_translation(
                 Vec3::new(8.0, 0.1, 8.0),
@@ -56,6 +63,11 @@ impl World {
                 sigma: 0.5,
             },
             Brdf::BlinnPhong { exponent: 40.0 },
+            own("toon", &[("bands", 3.0), ("softness", 0.25), ("rho", 1.0)]),
+            own(
+                "charlie_sheen",
+                &[("rho", 0.5), ("roughness", 0.4), ("sheen", 1.0)],
+            ),
         ];
         for i in 0..8 {
             let angle = i as f32 * std::f32::consts::TAU / 8.0;
@@ -66,7 +78,7 @@ impl World {
                     Quat::from_rotation_y(angle * 0.7),
                     Vec3::new(3.0 * angle.cos(), height, 3.0 * angle.sin()),
                 ),
-                brdf: brdfs[i % 3],
+                brdf: brdfs[i % brdfs.len()],
                 tint: Vec3::new(0.9, 0.5 + 0.05 * i as f32, 0.3 + 0.08 * i as f32),
                 stencil: DYNAMIC,
             });

@@ -7,16 +7,22 @@
 //   target 1  R16G16B16A16_UNORM  xy: octahedral unit normal; zw: the BRDF's first two packed
 //                                 parameters divided by compact_param_scale
 //
-// The third packed parameter (GGX's f90) is 1 for every material of this engine, so it is not
-// stored. Clear: all zeros (the depth attachment's far plane marks "no geometry").
+// The third packed parameter (GGX's f90, the toon ramp's albedo, the sheen's strength) is 1 for
+// every material of this engine, so it is not stored. Clear: all zeros (the depth attachment's far plane marks "no geometry").
 #ifndef COMPACT_GBUFFER_GLSL
 #define COMPACT_GBUFFER_GLSL
 
 #include "generated.glsl"
+// The engine's own BRDFs' ids (BRDF_ENGINE_*), from its BRDF set (build.rs).
+#include "brdf_set/ids.glsl"
 
-// Parameters are stored in [0, 1]: Blinn-Phong's exponent is divided by 2048, the others are
-// already there (Lambert rho, Oren-Nayar rho and sigma, GGX alpha and f0).
+// Parameters are stored in [0, 1]: Blinn-Phong's exponent is divided by 2048 and the toon
+// ramp's band count and edge by 8; the others are already there (Lambert rho, Oren-Nayar rho
+// and sigma, GGX alpha and f0, the sheen's base albedo and roughness).
 float compact_param_scale(uint model) {
+    if (model == BRDF_ENGINE_TOON) {
+        return 8.0;
+    }
     return model == BRDF_BLINN_PHONG ? 2048.0 : 1.0;
 }
 
