@@ -48,6 +48,11 @@ pub struct CompareArgs {
     /// and 3 models for the table's columns.
     #[arg(long, default_value = "huge-lights")]
     scene: String,
+    /// With it, the columns' models are the folder's BRDFs first (each with its defaults), then
+    /// the built-ins it keeps, and the light-size wall is striped in the first three: the
+    /// talk's question asked of your shading models.
+    #[command(flatten)]
+    brdfs: crate::brdfs::BrdfsArg,
     #[command(flatten)]
     run: RunArgs,
     /// Light sizes of the light-size sweep, in percent of the screen.
@@ -371,7 +376,8 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     settings.budget = sampling.budget;
     settings.until_decided = sampling.until_decided;
     settings.predict_budget = sampling.predict_budget;
-    settings.scene = crate::load_scene_arg(&args.scene, lights)?;
+    settings.brdfs = args.brdfs.modules()?;
+    settings.scene = crate::brdfs::load_scene(&args.scene, lights, settings.brdfs)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
     settings.costs = read_costs_arg(args.costs.as_deref())?;
     settings.beside_load = usize::from(args.beside_load);

@@ -34,6 +34,10 @@ pub struct CompareSettings {
     pub budget: std::time::Duration,
     /// The adaptive technique's costs; `None`: fitted to the talk's figures.
     pub costs: Option<CostModel>,
+    /// The BRDFs it shades with: histencil's, or an engine's set (`compare --brdfs`), whose own
+    /// BRDFs the scene should then name (`histencil_scene::retarget_brdfs`): the columns fold
+    /// onto the scene's models first.
+    pub brdfs: &'static histencil_vk::BrdfModules,
     /// BRDF counts of the table's columns (the talk's 1, 2, 3).
     pub brdf_counts: Vec<usize>,
     /// Screen coverages of the light-size sweep, 0..=1.
@@ -64,6 +68,7 @@ impl CompareSettings {
             target_ci: None,
             budget: std::time::Duration::from_secs(60),
             costs: None,
+            brdfs: histencil_vk::BrdfModules::builtin(),
             brdf_counts: vec![1, 2, 3],
             light_sizes: vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0],
             beside_load: 0,
@@ -387,6 +392,12 @@ pub struct CompareReport {
     pub driver: String,
     pub scene: String,
     pub scene_lights: usize,
+    /// The models the columns fold the scene onto, in order: the 1-BRDF column's first, each
+    /// wider column adding the next (`brdf_palette`); an engine's own BRDFs by their names.
+    pub models: Vec<String>,
+    /// The engine BRDF set the run shaded with (`compare --brdfs`), as its BRDFs' names; empty
+    /// for histencil's own.
+    pub engine_brdfs: Vec<String>,
     pub width: u32,
     pub height: u32,
     pub frames: usize,
@@ -523,6 +534,19 @@ pub fn run_compare(
         driver: ctx.driver().to_string(),
         scene: settings.scene.name.clone(),
         scene_lights: settings.scene.lights.len(),
+        models: brdf_palette(
+            &settings.scene,
+            settings.brdf_counts.iter().copied().max().unwrap_or(1),
+        )
+        .iter()
+        .map(|b| b.name().to_owned())
+        .collect(),
+        engine_brdfs: settings
+            .brdfs
+            .set
+            .engine()
+            .map(|(_, spec)| spec.name.clone())
+            .collect(),
         width: settings.width,
         height: settings.height,
         frames: settings.frames,
@@ -548,6 +572,7 @@ fn renderer_for<'c>(
 ) -> Result<Renderer<'c>> {
     let desc = RendererDesc {
         cost_model: settings.costs,
+        brdfs: settings.brdfs,
         ..RendererDesc::new(settings.width, settings.height)
     };
     Ok(Renderer::with_desc(ctx, scene, &desc)?)
@@ -571,7 +596,11 @@ fn measure_table<'c>(
     sampling: &Sampling,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Table<'c>> {
-    let rows_spec = table_rows();
+    // The LUT's tables are baked on the CPU, which an engine's BRDF has no spelling for.
+    let rows_spec: Vec<_> = table_rows()
+        .into_iter()
+        .filter(|(name, _)| settings.brdfs.set.is_builtin_only() || *name != "lut")
+        .collect();
     let mut rows: Vec<Row> = rows_spec
         .iter()
         .map(|(name, _)| Row {
@@ -735,7 +764,9 @@ fn measure_sizes(
     let mut sizes = Vec::new();
     for &coverage in &settings.light_sizes {
         progress(&format!("light size {:.1} %", coverage * 100.0));
-        let scene = light_size_scene(coverage, aspect);
+        let mut scene = light_size_scene(coverage, aspect);
+        // An engine's set: the wall striped in its BRDFs instead of histencil's three.
+        histencil_scene::retarget_brdfs(&mut scene, &settings.brdfs.set);
         let lights = scene.lights.len();
         let mut renderer = renderer_for(ctx, settings, scene)?;
         let reference = frame(&mut renderer, Shading::Forward)?;

@@ -30,6 +30,28 @@ impl CompareReport {
         Ok([md, js].into_iter().chain(plots).collect())
     }
 
+    /// Which BRDFs the columns are: the talk's question is asked of these models.
+    fn models_line(&self) -> String {
+        let named: Vec<String> = self.models.iter().map(|m| format!("`{m}`")).collect();
+        let (first, rest) = named
+            .split_first()
+            .map_or(("none", &[][..]), |(f, r)| (f.as_str(), r));
+        let mut line = format!("Models: the 1-BRDF column is {first}");
+        for (i, m) in rest.iter().enumerate() {
+            line += &format!(", the {}-BRDF column adds {m}", i + 2);
+        }
+        if self.engine_brdfs.is_empty() {
+            line + " (histencil's own BRDFs)."
+        } else {
+            let own: Vec<String> = self.engine_brdfs.iter().map(|m| format!("`{m}`")).collect();
+            line + &format!(
+                ". Shaded with an engine's BRDF set (`--brdfs`: {}); the LUT row is left out, its \
+                 tables being baked on the CPU, where an engine's BRDF has no spelling.",
+                own.join(", ")
+            )
+        }
+    }
+
     /// Every figure of the run; all numbers are finite.
     pub fn json(&self) -> Value {
         let c = &self.costs;
@@ -39,6 +61,8 @@ impl CompareReport {
             "settings": {
                 "scene": self.scene,
                 "scene_lights": self.scene_lights,
+                "models": self.models,
+                "engine_brdfs": self.engine_brdfs,
                 "width": self.width,
                 "height": self.height,
                 "frames": self.frames,
@@ -103,6 +127,7 @@ impl CompareReport {
             self.device, self.driver, self.scene, self.scene_lights, self.width, self.height,
             self.frames, 100.0 * MARGIN, 100.0 * MARGIN, MIN_VERDICT_ROUNDS
         );
+        let _ = writeln!(md, "{}\n", self.models_line());
         let t = &self.sampled;
         if let Some(n) = &self.lp_num_threads {
             let _ = writeln!(md, "Environment: `LP_NUM_THREADS={n}`.\n");
