@@ -270,3 +270,29 @@ fn glsl_that_does_not_compile_names_the_engine_file_and_line() {
     .with_folder(real);
     assert!(histencil_vk::compile_brdf_set(&set).is_err());
 }
+
+/// The lab takes the same folder: `calibrate --brdfs` fits costs on a wall striped in the
+/// engine's BRDFs, and `compare --brdfs` folds its columns onto them and names them.
+#[test]
+fn the_lab_measures_the_engine_brdfs() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/brdfs");
+    let modules = histencil_vk::compile_brdf_set(&BrdfSet::load(&dir).unwrap()).unwrap();
+    let sampling = histencil_lab::stats::Sampling::rounds(2);
+    with_validated_context(|ctx| {
+        let c = histencil_lab::calibrate_with(ctx, (64, 36), modules, &sampling, &mut |_| {})
+            .unwrap()
+            .costs;
+        assert!(c.shade_ms > 0.0 && c.pass_overhead_ms.is_finite(), "{c:?}");
+        let mut settings = histencil_lab::compare::CompareSettings::talk(64, 36, 2);
+        settings.brdfs = modules;
+        settings.light_sizes = vec![1.0];
+        settings.scene = histencil_scene::embedded("huge-lights").unwrap();
+        histencil_scene::retarget_brdfs(&mut settings.scene, &modules.set);
+        let report = histencil_lab::run_compare(ctx, &settings, &mut |_| {}).unwrap();
+        assert_eq!(report.models, ["toon", "charlie_sheen", "lambert"]);
+        assert!(report.rows.iter().all(|r| r.name != "lut"));
+        assert!(report
+            .markdown()
+            .contains("the 2-BRDF column adds `charlie_sheen`"));
+    });
+}

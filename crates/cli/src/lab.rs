@@ -213,6 +213,10 @@ pub struct SweepArgs {
 pub struct CalibrateArgs {
     #[command(flatten)]
     run: RunArgs,
+    /// The wall striped in the folder's BRDFs: the costs of your shading models, for
+    /// `--costs` of `render --technique adaptive` and `compare`.
+    #[command(flatten)]
+    brdfs: crate::brdfs::BrdfsArg,
     /// Where the costs go (read back by `--costs`).
     #[arg(long, default_value = "out/costs.json")]
     out: PathBuf,
@@ -437,9 +441,11 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     steady_llvmpipe();
     histencil_vk::check_output_file(&args.out)?;
     let sampling = args.sampling.sampling(args.run.frames)?;
+    let modules = args.brdfs.modules()?;
     let calibration = on_device(args.run.device(), |ctx| {
         let c = with_spinner(|step| {
-            histencil_lab::calibrate(ctx, args.run.width, args.run.height, &sampling, step)
+            let size = (args.run.width, args.run.height);
+            histencil_lab::calibrate_with(ctx, size, modules, &sampling, step)
         });
         Ok(c?)
     })?;

@@ -24,7 +24,8 @@ use crate::variants::{light_size_scene, with_brdf_count};
 use crate::{LabError, Result};
 use histencil_model::{DepthIdCosts, TiledCosts, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
 use histencil_vk::{
-    Backend, Context, CostModel, FlushPolicy, MixedTiles, Renderer, Technique, TileSide,
+    Backend, BrdfModules, Context, CostModel, FlushPolicy, MixedTiles, Renderer, RendererDesc,
+    Technique, TileSide,
 };
 use serde_json::{json, Value};
 use std::path::Path;
@@ -78,6 +79,28 @@ pub fn calibrate(
     sampling: &Sampling,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Calibration> {
+    calibrate_with(
+        ctx,
+        (width, height),
+        BrdfModules::builtin(),
+        sampling,
+        progress,
+    )
+}
+
+/// [`calibrate`] with the wall striped in `brdfs`' engine BRDFs, when it has any (`calibrate
+/// --brdfs`): the costs are then those of the engine's shading models, averaged over them, which
+/// the adaptive technique takes through `--costs`.
+///
+/// # Errors
+/// As [`calibrate`].
+pub fn calibrate_with(
+    ctx: &Context,
+    (width, height): (u32, u32),
+    modules: &'static BrdfModules,
+    sampling: &Sampling,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Calibration> {
     // Before the wall is built: its shape follows the aspect ratio.
     histencil_vk::check_extent(ctx, width, height).map(drop)?;
     let aspect = width as f32 / height as f32;
@@ -102,7 +125,8 @@ pub fn calibrate(
     // Extra BRDFs each light touches, on average (small lights at the wall's edge miss one).
     let mut extra_brdfs = Vec::new();
     for (coverage, techniques) in &walls {
-        let wall = light_size_scene(*coverage, aspect);
+        let mut wall = light_size_scene(*coverage, aspect);
+        histencil_scene::retarget_brdfs(&mut wall, &modules.set);
         let lights = wall.lights.len() as f64;
         let touched = wall
             .lights
@@ -112,7 +136,11 @@ pub fn calibrate(
         extra_brdfs.push((touched / lights - 1.0).max(1e-6));
         for brdfs in [1, 3] {
             progress(&format!("coverage {coverage}, {brdfs} BRDF(s): building"));
-            let mut renderer = Renderer::new(ctx, with_brdf_count(&wall, brdfs), width, height)?;
+            let desc = RendererDesc {
+                brdfs: modules,
+                ..RendererDesc::new(width, height)
+            };
+            let mut renderer = Renderer::with_desc(ctx, with_brdf_count(&wall, brdfs), &desc)?;
             // Tiled is fitted from the 3-BRDF wall only.
             let measured = techniques
                 .iter()
