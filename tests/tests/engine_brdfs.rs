@@ -296,3 +296,55 @@ fn the_lab_measures_the_engine_brdfs() {
             .contains("the 2-BRDF column adds `charlie_sheen`"));
     });
 }
+
+/// A translucent entity with an engine BRDF is lit by it in every alpha mode: per pixel
+/// forward, by lightmap, by probe and by direction map, the glass sphere of `alpha` in Charlie
+/// sheen adds light above the same sphere in black (a Lambert of tint 0, which only darkens what
+/// is behind it), as its white Lambert twin does. A mode whose shader lacked the set's BRDF would
+/// shade it black. (The pane of `own-brdfs.gltf`, from the test scene `two-brdfs.gltf`, faces
+/// away from its lights: it is black whatever its BRDF.)
+#[test]
+fn an_alpha_entity_with_an_engine_brdf_is_lit_in_every_alpha_mode() {
+    use histencil_vk::{AlphaMode, FrameDesc};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/brdfs");
+    let set = BrdfSet::load(&dir).unwrap();
+    let modules = histencil_vk::compile_brdf_set(&set).unwrap();
+    let mut scene = histencil_scene::embedded("alpha").unwrap();
+    scene.alpha_objects[0].material.brdf = set.engine_brdf("charlie_sheen", &[]).unwrap();
+    let mut white = scene.clone();
+    white.alpha_objects[0].material.brdf = Brdf::Lambert { rho: 1.0 };
+    let mut black = white.clone();
+    black.alpha_objects[0].material.tint = glam::Vec3::ZERO;
+    let desc = RendererDesc {
+        brdfs: modules,
+        ..RendererDesc::new(SIZE, SIZE)
+    };
+    with_validated_context(|ctx| {
+        let light = |scene: &histencil_scene::Scene, alpha| {
+            let mut renderer = Renderer::with_desc(ctx, scene.clone(), &desc).unwrap();
+            let frame = FrameDesc {
+                alpha,
+                ..FrameDesc::new(Shading::Forward, Readback::ALL)
+            };
+            let ldr = renderer.render_frame(&frame).unwrap().images.ldr.unwrap();
+            ldr.pixels()
+                .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
+                .sum::<f64>()
+        };
+        for mode in [
+            AlphaMode::Forward,
+            AlphaMode::Lightmap,
+            AlphaMode::Probe,
+            AlphaMode::Directional,
+        ] {
+            let dark = light(&black, mode);
+            let lambert = light(&white, mode) - dark;
+            let sheen = light(&scene, mode) - dark;
+            assert!(lambert > 0.0, "{mode:?}: the white twin adds {lambert}");
+            assert!(
+                sheen > 0.05 * lambert,
+                "{mode:?}: the sheen glass adds {sheen} over a black one, its white Lambert twin {lambert}"
+            );
+        }
+    });
+}

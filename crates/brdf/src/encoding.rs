@@ -164,7 +164,7 @@ impl ParamEncoding {
                 rho: s(rho, linear),
                 curvature_per_mm: s(curvature_per_mm, curvature),
             },
-            // Its ranges are the engine's: stored as they are, without a warp into [0, 1].
+            // Its ranges are the engine's: no warp into [0, 1] (8-bit UNORM clamps to it).
             Brdf::Engine { id, params } => Brdf::Engine {
                 id,
                 params: params.map(|x| s(x, linear)),

@@ -251,7 +251,9 @@ impl BrdfSet {
                 names
                     .iter()
                     .map(|v| {
-                        let name = v.as_str().unwrap_or("");
+                        let name = v.as_str().ok_or_else(|| {
+                            root.error(line, "`builtins` must be a list of names".into())
+                        })?;
                         name.parse::<BrdfId>()
                             .map_err(|e| root.error(line, format!("`builtins`: {e}")))
                     })

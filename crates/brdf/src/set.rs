@@ -105,6 +105,14 @@ pub enum SetError {
         /// What is wrong, in words.
         why: String,
     },
+    /// A GLSL path that does not end in `.glsl` (the files copied for the compiler are those).
+    #[error("BRDF `{brdf}`: `{path}` must be a `.glsl` file")]
+    NotGlsl {
+        /// The BRDF.
+        brdf: String,
+        /// The path given.
+        path: String,
+    },
     /// A GLSL path that leaves the set's folder or is not a plain relative path.
     #[error("BRDF `{brdf}`: `{path}` must be a relative path inside the BRDF folder (no `..`, no absolute path)")]
     OutsideFolder {
@@ -191,6 +199,12 @@ fn check_spec(spec: &EngineBrdfSpec) -> Result<(), SetError> {
             path: spec.glsl.clone(),
         });
     }
+    if !spec.glsl.ends_with(".glsl") {
+        return Err(SetError::NotGlsl {
+            brdf: brdf(),
+            path: spec.glsl.clone(),
+        });
+    }
     if spec.params.len() > MAX_ENGINE_PARAMS {
         return Err(SetError::TooManyParams {
             brdf: brdf(),
@@ -212,6 +226,12 @@ fn check_spec(spec: &EngineBrdfSpec) -> Result<(), SetError> {
         }
         if spec.params[..i].iter().any(|q| q.name == p.name) {
             return Err(bad("named twice".into()));
+        }
+        // A glTF material's extras say `brdf` and `tint` for the model and the colour.
+        if matches!(p.name.as_str(), "brdf" | "tint") {
+            return Err(bad(
+                "`brdf` and `tint` name a material's model and colour in glTF extras".into(),
+            ));
         }
         let Range { min, max } = p.range;
         if !(finite.holds(min) && finite.holds(max) && min <= max) {
@@ -655,6 +675,8 @@ mod tests {
         let four = |s: &mut EngineBrdfSpec| s.params = vec![s.params[0].clone(); 4];
         assert!(with(&four).contains("4 parameters; at most 3"));
         assert!(with(&|s| s.params[0].default = 9.0).contains("outside its range"));
+        assert!(with(&|s| s.glsl = "toon.frag".into()).contains("must be a `.glsl` file"));
+        assert!(with(&|s| s.params[0].name = "tint".into()).contains("in glTF extras"));
         assert!(with(&|s| s.params[0].range = Range::new(2.0, 1.0)).contains("min <= max"));
         let many: Vec<EngineBrdfSpec> = (0..=MAX_ENGINE_BRDFS)
             .map(|i| EngineBrdfSpec {

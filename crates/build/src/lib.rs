@@ -19,7 +19,7 @@
 //! ```
 //!
 //! An engine with shading models of its own declares them as a [`BrdfSet`] (in code, or read
-//! from a folder with `brdfs.toml` by [`brdf_folder`], feature `files`) and compiles the light
+//! from a folder with `brdfs.toml` by `brdf_folder` with the feature `files`) and compiles the light
 //! shaders with them by [`compile_light_shaders_for`]: every technique then evaluates its
 //! functions. [`write_brdf_set`] gives the include folder for the engine's own shaders that
 //! include histencil's `light.glsl` (a forward pass, say) or need the set's ids (a G-buffer pass:
@@ -208,7 +208,12 @@ pub fn brdf_folder(dir: &Path) -> Result<BrdfSet, BuildError> {
 /// The engine's GLSL files in `folder` (any depth, `/`-separated paths, links followed only
 /// inside it), which its BRDFs' files may include from one another.
 fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
-    fn walk(folder: &Path, dir: &Path, out: &mut Vec<(String, PathBuf)>) -> Result<(), BuildError> {
+    fn walk(
+        folder: &Path,
+        dir: &Path,
+        seen: &mut Vec<PathBuf>,
+        out: &mut Vec<(String, PathBuf)>,
+    ) -> Result<(), BuildError> {
         let entries = std::fs::read_dir(dir)
             .map_err(|e| BuildError::Brdfs(format!("{}: {e}", dir.display())))?;
         for entry in entries {
@@ -220,7 +225,11 @@ fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
                 continue;
             }
             if real.is_dir() {
-                walk(folder, &path, out)?;
+                // A folder reached twice (through links) is walked once: no cycle.
+                if !seen.contains(&real) {
+                    seen.push(real.clone());
+                    walk(folder, &path, seen, out)?;
+                }
             } else if path.extension().is_some_and(|e| e == "glsl") {
                 let relative = path.strip_prefix(folder).expect("walked from the folder");
                 let parts: Vec<_> = relative
@@ -233,14 +242,28 @@ fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
         Ok(())
     }
     let mut out = Vec::new();
-    walk(folder, folder, &mut out)?;
+    let mut seen = vec![folder.to_owned()];
+    walk(folder, folder, &mut seen, &mut out)?;
     out.sort();
     Ok(out)
 }
 
+/// The set's ids and names, comma-separated, as `LightModules::brdfs` and `brdf_names` spell
+/// them: the light shaders' BRDFs by number and by name, so that a set whose id 8 is another
+/// BRDF cannot take these shaders.
+fn ids_and_names(set: &BrdfSet) -> (String, String) {
+    let ids: Vec<String> = set.ids().iter().map(|b| b.index().to_string()).collect();
+    let names: Vec<String> = set
+        .ids()
+        .iter()
+        .map(|b| format!("{:?}", b.name()))
+        .collect();
+    (ids.join(", "), names.join(", "))
+}
+
 /// The stages that evaluate a BRDF (each includes `brdf/eval.glsl`): what a BRDF set is compiled
 /// into, in the order of `BrdfModules`' fields ([`compile_brdf_modules`]).
-pub const BRDF_STAGES: [&str; 9] = [
+pub const BRDF_STAGES: [&str; 11] = [
     "deferred_light.frag",
     "lut_light.frag",
     "tile_shade.comp",
@@ -249,6 +272,8 @@ pub const BRDF_STAGES: [&str; 9] = [
     "forward.frag",
     "lightmap.frag",
     "lightmap_directional.frag",
+    "alpha_object.frag",
+    "particle.frag",
     "brdf_eval.comp",
 ];
 
@@ -268,6 +293,12 @@ pub fn stage_brdf_set(set: &BrdfSet, folder: &Path) -> Result<Vec<PathBuf>, Buil
             .and_then(|()| std::fs::write(&path, bytes))
             .map_err(|e| BuildError::Io(format!("{}: {e}", path.display())))
     };
+    // A file the engine has since removed must not stay includable from an earlier staging.
+    let engine_copies = folder.join("engine");
+    if engine_copies.exists() {
+        std::fs::remove_dir_all(&engine_copies)
+            .map_err(|e| BuildError::Io(format!("{}: {e}", engine_copies.display())))?;
+    }
     for (name, text) in set.glsl_files("engine") {
         write(name, text.as_bytes())?;
     }
@@ -360,9 +391,9 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
         )?;
         spirv.push(format!("include_bytes!({:?})", out.display().to_string()));
     }
-    let ids: Vec<String> = set.ids().iter().map(|b| b.index().to_string()).collect();
+    let (ids, names) = ids_and_names(set);
     let expression = format!(
-        "BrdfModules {{\n    set: {set},\n    light: LightModules {{\n        deferred_light: {},\n        lut_light: {},\n        tile_shade: {},\n        tile_shade_8: {},\n        depth_id_shade: {},\n        brdfs: &[{ids}],\n        ..LightModules::BUILTIN\n    }},\n    forward: {},\n    lightmap: {},\n    lightmap_directional: {},\n    brdf_eval: {},\n}}\n",
+        "BrdfModules {{\n    set: {set},\n    light: LightModules {{\n        deferred_light: {},\n        lut_light: {},\n        tile_shade: {},\n        tile_shade_8: {},\n        depth_id_shade: {},\n        brdfs: &[{ids}],\n        brdf_names: &[{names}],\n        ..LightModules::BUILTIN\n    }},\n    forward: {},\n    lightmap: {},\n    lightmap_directional: {},\n    alpha_object: {},\n    particle: {},\n    brdf_eval: {},\n}}\n",
         spirv[0],
         spirv[1],
         spirv[2],
@@ -372,8 +403,9 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
         spirv[6],
         spirv[7],
         spirv[8],
+        spirv[9],
+        spirv[10],
         set = set.rust_expression(),
-        ids = ids.join(", "),
     );
     let rust = out_dir.join("histencil_brdf_modules.rs");
     std::fs::write(&rust, expression)
@@ -438,8 +470,8 @@ pub fn compile_light_shaders_for(
             out.display().to_string()
         );
     }
-    let ids: Vec<String> = set.ids().iter().map(|b| b.index().to_string()).collect();
-    fields += &format!("    brdfs: &[{}],\n}}\n", ids.join(", "));
+    let (ids, names) = ids_and_names(set);
+    fields += &format!("    brdfs: &[{ids}],\n    brdf_names: &[{names}],\n}}\n");
     let rust = out_dir.join("histencil_light_modules.rs");
     std::fs::write(&rust, fields)
         .map_err(|e| BuildError::Io(format!("{}: {e}", rust.display())))?;

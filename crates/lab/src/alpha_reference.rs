@@ -25,8 +25,8 @@ impl AlphaReference {
             ..shading.into()
         };
         let forward = frame(renderer, forward_alpha)?;
-        let (w, h) = forward.dimensions();
-        let mut without = Renderer::new(ctx, renderer.scene().without_alpha(), w, h)?;
+        let mut without =
+            Renderer::with_desc(ctx, renderer.scene().without_alpha(), renderer.desc())?;
         let background = frame(&mut without, shading)?;
         Ok(Self {
             forward,

@@ -127,6 +127,7 @@ pub fn calibrate_with(
     for (coverage, techniques) in &walls {
         let mut wall = light_size_scene(*coverage, aspect);
         histencil_scene::retarget_brdfs(&mut wall, &modules.set);
+        crate::variants::check_palette(&wall, 3, &modules.set)?;
         let lights = wall.lights.len() as f64;
         let touched = wall
             .lights

@@ -35,6 +35,30 @@ pub fn brdf_palette(scene: &Scene, count: usize) -> Vec<Brdf> {
     palette
 }
 
+/// Refuses a palette of `count` models that `set` cannot shade: fewer engine BRDFs than the
+/// widest column, and none of the padding built-ins kept (`builtins = []`, say). Said before
+/// anything is measured, naming what the set offers.
+pub fn check_palette(
+    scene: &Scene,
+    count: usize,
+    set: &histencil_brdf::BrdfSet,
+) -> Result<(), crate::LabError> {
+    let palette = brdf_palette(scene, count);
+    match palette.iter().find(|b| !set.contains(b.id())) {
+        None => Ok(()),
+        Some(b) => {
+            let names: Vec<&str> = set.ids().iter().map(|id| id.name()).collect();
+            Err(crate::LabError::Settings(format!(
+                "the {count}-BRDF column needs {count} BRDFs, and its padding `{}` is not in the \
+                 BRDF set ({}): declare more BRDFs, or keep lambert, blinn_phong and \
+                 oren_nayar_full among the built-ins",
+                b.name(),
+                names.join(", ")
+            )))
+        }
+    }
+}
+
 /// `scene` with its objects' BRDFs folded onto `count` models (`brdf_palette`): object `i`
 /// takes model `i % count`. Tints are kept. Interleaving spreads every model over the scene,
 /// so a huge light touches all `count`, as in the talk's figures.

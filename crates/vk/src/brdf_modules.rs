@@ -38,6 +38,10 @@ pub struct BrdfModules {
     pub lightmap: &'static [u8],
     /// `lightmap_directional.frag`: their directional lightmaps.
     pub lightmap_directional: &'static [u8],
+    /// `alpha_object.frag`: translucent objects lit per pixel, by probe or by direction map.
+    pub alpha_object: &'static [u8],
+    /// `particle.frag`: particles, likewise.
+    pub particle: &'static [u8],
     /// `brdf_eval.comp`: the BRDF evaluator (the engine BRDFs' finiteness probe).
     pub brdf_eval: &'static [u8],
 }
@@ -62,6 +66,8 @@ impl BrdfModules {
             forward: shaders::FORWARD_FRAG,
             lightmap: shaders::LIGHTMAP_FRAG,
             lightmap_directional: shaders::LIGHTMAP_DIRECTIONAL_FRAG,
+            alpha_object: shaders::ALPHA_OBJECT_FRAG,
+            particle: shaders::PARTICLE_FRAG,
             brdf_eval: shaders::BRDF_EVAL_COMP,
         })
     }
@@ -119,7 +125,9 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
     let staged = scratch.0.join("set");
     let copied = histencil_build::stage_brdf_set(set, &staged).map_err(|e| e.to_string())?;
     // What the modules are a function of: the generated GLSL and every engine file's bytes.
-    let mut key: Vec<u8> = Vec::new();
+    // The declarations too: parameters' ranges and defaults are checked and probed from the
+    // set the modules carry.
+    let mut key: Vec<u8> = format!("{set:?}").into_bytes();
     for (name, text) in set.glsl_files("engine") {
         key.extend(name.bytes().chain(text.bytes()).chain([0]));
     }
@@ -163,7 +171,7 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
         let bytes = std::fs::read(&out).map_err(|e| format!("{}: {e}", out.display()))?;
         spirv.push(&*Box::leak(bytes.into_boxed_slice()));
     }
-    let [deferred_light, lut_light, tile_shade, tile_shade_8, depth_id_shade, forward, lightmap, lightmap_directional, brdf_eval] =
+    let [deferred_light, lut_light, tile_shade, tile_shade_8, depth_id_shade, forward, lightmap, lightmap_directional, alpha_object, particle, brdf_eval] =
         spirv[..]
     else {
         unreachable!("one module per stage");
@@ -177,11 +185,14 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
             tile_shade_8,
             depth_id_shade,
             brdfs: Box::leak(set.ids().iter().map(|b| b.index()).collect()),
+            brdf_names: Box::leak(set.ids().iter().map(|b| b.name()).collect()),
             ..LightModules::BUILTIN
         },
         forward,
         lightmap,
         lightmap_directional,
+        alpha_object,
+        particle,
         brdf_eval,
     }));
     cache
@@ -229,8 +240,22 @@ fn probe_directions() -> Vec<[V3<f32>; 4]> {
 ///
 /// # Errors
 /// [`Error::BrdfSet`] naming the BRDF, its parameters and the directions; Vulkan errors.
-pub fn probe_finite(ctx: &Context, modules: &BrdfModules) -> Result<()> {
+pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> {
     if modules.set.is_builtin_only() {
+        return Ok(());
+    }
+    // Once per modules and device: a check builds several renderers of one set.
+    static PROBED: OnceLock<Mutex<Vec<(usize, String)>>> = OnceLock::new();
+    let key = (
+        modules as *const BrdfModules as usize,
+        ctx.device_name().to_owned(),
+    );
+    let probed = PROBED.get_or_init(Default::default);
+    if probed
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .contains(&key)
+    {
         return Ok(());
     }
     let directions = probe_directions();
@@ -271,5 +296,6 @@ pub fn probe_finite(ctx: &Context, modules: &BrdfModules) -> Result<()> {
             )));
         }
     }
+    probed.lock().unwrap_or_else(|p| p.into_inner()).push(key);
     Ok(())
 }

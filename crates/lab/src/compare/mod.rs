@@ -499,6 +499,8 @@ pub fn run_compare(
             "the BRDF counts must start at 1: overheads are against the 1-BRDF time".into(),
         ));
     }
+    let widest = settings.brdf_counts.iter().copied().max().unwrap_or(1);
+    crate::variants::check_palette(&settings.scene, widest, &settings.brdfs.set)?;
     // Spins until the report is made, when it drops.
     let _load = crate::measure::BusyThreads::start(settings.beside_load);
     let sampling = Sampling {

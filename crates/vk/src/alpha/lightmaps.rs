@@ -197,6 +197,11 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         Ok(this)
     }
 
+    /// The shaders it lights with, and the BRDF set they evaluate.
+    pub fn modules(&self) -> &'static crate::BrdfModules {
+        self.modules
+    }
+
     fn create(&mut self) -> Result<()> {
         let ctx: &Context = &self.ctx;
         self.set_layouts[0] =

@@ -413,7 +413,7 @@ impl<'c> AlphaLighting<'c> {
         let objects = PipelineDesc {
             name: "alpha-object-pipeline",
             vertex: ("alpha_object.vert", shaders::ALPHA_OBJECT_VERT),
-            fragment: Some(("alpha_object.frag", shaders::ALPHA_OBJECT_FRAG)),
+            fragment: Some(("alpha_object.frag", self.lightmaps.modules().alpha_object)),
             layout: self.pipeline_layout,
             vertex_input: VertexInput::PositionNormalUv,
             color_formats: &hdr,
@@ -426,7 +426,7 @@ impl<'c> AlphaLighting<'c> {
         let particles = PipelineDesc {
             name: "alpha-particle-pipeline",
             vertex: ("particle.vert", shaders::PARTICLE_VERT),
-            fragment: Some(("particle.frag", shaders::PARTICLE_FRAG)),
+            fragment: Some(("particle.frag", self.lightmaps.modules().particle)),
             vertex_input: VertexInput::Sprite,
             ..objects
         };

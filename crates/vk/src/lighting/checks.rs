@@ -45,14 +45,21 @@ pub(super) fn check_desc(desc: &LightingDesc) -> Result<()> {
         }
     }
     // A BRDF the light shaders were not compiled with would shade its pixels black in silence.
-    let compiled = desc.hooks.modules().brdfs;
-    if let Some(missing) = desc.brdfs.iter().find(|b| !compiled.contains(&b.index())) {
+    let modules = desc.hooks.modules();
+    let compiled = || modules.brdfs.iter().zip(modules.brdf_names);
+    if let Some(missing) = desc
+        .brdfs
+        .iter()
+        .find(|b| !compiled().any(|(i, n)| *i == b.index() && *n == b.name()))
+    {
+        let known: Vec<String> = compiled().map(|(i, n)| format!("{n} ({i})")).collect();
         return Err(bad_setup(format!(
-            "BRDF `{missing}` (id {}) is not one the light shaders were compiled with (ids \
-             {compiled:?}): compile them for the engine's BRDF set \
+            "BRDF `{missing}` (id {}) is not one the light shaders were compiled with ({}): \
+             compile them for the engine's BRDF set \
              (histencil_build::compile_light_shaders_for, or histencil::compile_brdf_set with \
              LightHooks::BuiltinWithBrdfs)",
-            missing.index()
+            missing.index(),
+            known.join(", ")
         )));
     }
     let slots = desc.layout.brdfs_in_use() as usize;

@@ -31,6 +31,9 @@ pub struct LightModules {
     /// set's (`histencil_build::compile_light_shaders_for` writes them). A lighting whose
     /// `LightingDesc::brdfs` names another is refused, not shaded black.
     pub brdfs: &'static [u32],
+    /// Their names, in the order of `brdfs`: an id names another BRDF in another set, so a
+    /// lighting is held to both.
+    pub brdf_names: &'static [&'static str],
 }
 
 impl LightModules {
@@ -45,6 +48,16 @@ impl LightModules {
         depth_id_copy: shaders::DEPTH_ID_COPY_FRAG,
         depth_id_shade: shaders::DEPTH_ID_SHADE_FRAG,
         brdfs: &[0, 1, 2, 3, 4, 5, 6, 7],
+        brdf_names: &[
+            "lambert",
+            "blinn_phong",
+            "oren_nayar_full",
+            "oren_nayar_qualitative",
+            "ggx",
+            "kajiya_kay",
+            "penner_skin",
+            "gltf_metal_rough",
+        ],
     };
 
     /// Each module with its name, for checks and messages.

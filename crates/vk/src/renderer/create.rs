@@ -46,8 +46,6 @@ fn distinct_materials(scene: &Scene) -> (Vec<Brdf>, Vec<u32>) {
     (materials, indices)
 }
 
-/// The stencil slot of BRDF `id`: its index among the BRDFs in use (as
-/// [`crate::LightingDesc::slot_of`] numbers them).
 /// Every object's and entity's BRDF is one of `set`'s, with its parameters in their ranges: a
 /// BRDF the shaders were not compiled with would shade black in silence.
 fn check_brdfs(scene: &Scene, set: &histencil_brdf::BrdfSet) -> Result<()> {
@@ -67,6 +65,8 @@ fn check_brdfs(scene: &Scene, set: &histencil_brdf::BrdfSet) -> Result<()> {
     Ok(())
 }
 
+/// The stencil slot of BRDF `id`: its index among the BRDFs in use (as
+/// [`crate::LightingDesc::slot_of`] numbers them).
 fn slot_of(brdfs: &[BrdfId], id: BrdfId) -> u32 {
     brdfs
         .iter()

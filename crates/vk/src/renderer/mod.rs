@@ -155,6 +155,12 @@ impl<'c> Renderer<'c> {
         &self.scene
     }
 
+    /// What it was made with: a second renderer of a variant of its scene (without its alpha
+    /// entities, say) takes the same BRDF set, costs and sizes from here.
+    pub fn desc(&self) -> &RendererDesc {
+        &self.desc
+    }
+
     /// Where the culling bit, the BRDF field and the preserved bits sit in its stencil.
     pub fn stencil_layout(&self) -> &StencilLayout {
         &self.stencil_layout
