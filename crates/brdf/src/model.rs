@@ -314,7 +314,7 @@ pub mod ranges {
 }
 
 /// What any parameter must be to reach the GPU as the number it is: finite in f32.
-const F32_FINITE: Range = Range::new(-(f32::MAX as f64), f32::MAX as f64);
+pub(crate) const F32_FINITE: Range = Range::new(-(f32::MAX as f64), f32::MAX as f64);
 
 #[cfg(feature = "files")]
 impl Brdf {

@@ -26,7 +26,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::id::{BrdfId, EngineBrdf, ENGINE_FIRST, MAX_ENGINE_BRDFS};
-use crate::model::{Brdf, BrdfError, Range};
+use crate::model::{Brdf, BrdfError, Range, F32_FINITE};
 
 /// The most parameters an engine BRDF takes: histencil's G-buffer stores three per pixel (the
 /// fourth channel of its material texel is the BRDF id).
@@ -174,6 +174,20 @@ pub(crate) fn is_confined(path: &str) -> bool {
         })
 }
 
+/// Holds engine BRDF `model`'s parameter `p` to its range: one rule for a material built from
+/// the set and one handed back to it.
+fn held(model: &'static str, p: &EngineParam, x: f64) -> Result<(), BrdfError> {
+    if p.range.holds(x) {
+        return Ok(());
+    }
+    Err(BrdfError::BadEngineParam {
+        model,
+        param: p.name.clone(),
+        rule: p.range.text(),
+        value: x.to_string(),
+    })
+}
+
 fn check_spec(spec: &EngineBrdfSpec) -> Result<(), SetError> {
     let brdf = || spec.name.clone();
     if !is_identifier(&spec.name) {
@@ -211,7 +225,6 @@ fn check_spec(spec: &EngineBrdfSpec) -> Result<(), SetError> {
             count: spec.params.len(),
         });
     }
-    let finite = Range::new(-(f32::MAX as f64), f32::MAX as f64);
     for (i, p) in spec.params.iter().enumerate() {
         let bad = |why: String| SetError::BadParam {
             brdf: brdf(),
@@ -234,7 +247,7 @@ fn check_spec(spec: &EngineBrdfSpec) -> Result<(), SetError> {
             ));
         }
         let Range { min, max } = p.range;
-        if !(finite.holds(min) && finite.holds(max) && min <= max) {
+        if !(F32_FINITE.holds(min) && F32_FINITE.holds(max) && min <= max) {
             return Err(bad(format!(
                 "range [{min}, {max}] must be finite in f32 with min <= max"
             )));
@@ -304,21 +317,6 @@ impl BrdfSet {
     /// The folder its engine GLSL paths are relative to, if it has one.
     pub fn folder(&self) -> Option<&Path> {
         self.folder.as_deref()
-    }
-
-    /// The engine's GLSL files, each as (its path in the set, where it is on disk); none
-    /// without a folder.
-    pub fn glsl_sources(&self) -> Vec<(&str, PathBuf)> {
-        let Some(folder) = &self.folder else {
-            return Vec::new();
-        };
-        let mut out: Vec<(&str, PathBuf)> = Vec::new();
-        for (_, spec) in &self.engine {
-            if !out.iter().any(|(p, _)| *p == spec.glsl) {
-                out.push((&spec.glsl, folder.join(&spec.glsl)));
-            }
-        }
-        out
     }
 
     /// Every BRDF of the set, in id order.
@@ -405,14 +403,7 @@ impl BrdfSet {
                 .rev()
                 .find(|(g, _)| *g == p.name)
                 .map_or(p.default, |(_, x)| *x);
-            if !p.range.holds(value) {
-                return Err(BrdfError::BadEngineParam {
-                    model,
-                    param: p.name.clone(),
-                    rule: p.range.text(),
-                    value: value.to_string(),
-                });
-            }
+            held(model, p, value)?;
             *slot = value;
         }
         Ok(Brdf::Engine { id: *id, params })
@@ -440,14 +431,7 @@ impl BrdfSet {
         };
         let spec = self.spec(BrdfId::Engine(*id)).expect("contains it");
         for (p, x) in spec.params.iter().zip(params) {
-            if !p.range.holds(*x) {
-                return Err(BrdfError::BadEngineParam {
-                    model: id.name(),
-                    param: p.name.clone(),
-                    rule: p.range.text(),
-                    value: x.to_string(),
-                });
-            }
+            held(id.name(), p, *x)?;
         }
         Ok(())
     }

@@ -36,6 +36,17 @@ pub struct LightModules {
     pub brdf_names: &'static [&'static str],
 }
 
+/// histencil's own BRDFs' ids, in `BrdfId::ALL` order (as `MODEL_NAMES` names them).
+const BUILTIN_IDS: [u32; 8] = {
+    let mut ids = [0; 8];
+    let mut i = 0;
+    while i < ids.len() {
+        ids[i] = histencil_brdf::BrdfId::ALL[i].index();
+        i += 1;
+    }
+    ids
+};
+
 impl LightModules {
     /// histencil's own: its G-buffer, no shadows.
     pub const BUILTIN: LightModules = LightModules {
@@ -47,17 +58,8 @@ impl LightModules {
         tile_shade_8: shaders::TILE_SHADE_8_COMP,
         depth_id_copy: shaders::DEPTH_ID_COPY_FRAG,
         depth_id_shade: shaders::DEPTH_ID_SHADE_FRAG,
-        brdfs: &[0, 1, 2, 3, 4, 5, 6, 7],
-        brdf_names: &[
-            "lambert",
-            "blinn_phong",
-            "oren_nayar_full",
-            "oren_nayar_qualitative",
-            "ggx",
-            "kajiya_kay",
-            "penner_skin",
-            "gltf_metal_rough",
-        ],
+        brdfs: &BUILTIN_IDS,
+        brdf_names: &histencil_brdf::MODEL_NAMES,
     };
 
     /// Each module with its name, for checks and messages.
