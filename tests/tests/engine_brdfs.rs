@@ -291,6 +291,11 @@ fn the_lab_measures_the_engine_brdfs() {
         let report = histencil_lab::run_compare(ctx, &settings, &mut |_| {}).unwrap();
         assert_eq!(report.models, ["toon", "charlie_sheen", "lambert"]);
         assert!(report.rows.iter().all(|r| r.name != "lut"));
+        let why = report.lut_left_out.as_deref().unwrap_or_default();
+        assert!(
+            why.contains("`charlie_sheen`: it has a white part"),
+            "{why}"
+        );
         assert!(report
             .markdown()
             .contains("the 2-BRDF column adds `charlie_sheen`"));
@@ -346,5 +351,111 @@ fn an_alpha_entity_with_an_engine_brdf_is_lit_in_every_alpha_mode() {
                 "{mode:?}: the sheen glass adds {sheen} over a black one, its white Lambert twin {lambert}"
             );
         }
+    });
+}
+
+/// An engine BRDF's LUT table is filled by its own GLSL on the GPU, at histencil-brdf's grid
+/// points: one spelling GGX with histencil's GLSL fills the table that the built-in GGX's f64
+/// reference bakes, within the GLSL's own error against that reference (`brdf_gpu.rs`: 1e-2 of
+/// max(1, |value|) on hard cases, which grazing grid points are), and lights the LUT frame as the
+/// built-in's table does. A BRDF no table can hold is refused, saying why: Charlie sheen's white
+/// part, a BRDF reading the tangent.
+#[test]
+fn an_engine_brdfs_lut_table_is_filled_by_its_glsl() {
+    let dir = folder(
+        "engine-brdfs-ggx",
+        &[(
+            "mine.glsl",
+            "vec3 my_ggx(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(brdf_ggx(p.x, p.y, p.z, N, V, L));\n}\n",
+        )],
+    );
+    let params = ["alpha", "f0", "f90"].map(|name| EngineParam {
+        name: name.into(),
+        range: Range::new(0.0, 1.0),
+        default: 0.5,
+    });
+    let spec = |name: &str, tangent| EngineBrdfSpec {
+        name: name.into(),
+        glsl: "mine.glsl".into(),
+        function: "my_ggx".into(),
+        white: None,
+        params: params.to_vec(),
+        tangent,
+    };
+    let set = BrdfSet::new(
+        &BrdfId::ALL,
+        vec![spec("my_ggx", false), spec("combed", true)],
+    )
+    .unwrap()
+    .with_folder(dir.canonicalize().unwrap());
+    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    let builtin = histencil_scene::embedded("brdfs-3").unwrap();
+    let mut engine = builtin.clone();
+    let mut ggx = None;
+    for o in &mut engine.objects {
+        if let Brdf::Ggx { alpha, f0, f90 } = o.material.brdf {
+            ggx = Some(o.material.brdf);
+            let given = [("alpha", alpha), ("f0", f0), ("f90", f90)];
+            o.material.brdf = set.engine_brdf("my_ggx", &given).unwrap();
+        }
+    }
+    let ggx = ggx.expect("brdfs-3 has GGX");
+    let Brdf::Ggx { alpha, f0, f90 } = ggx else {
+        unreachable!()
+    };
+    let given = [("alpha", alpha), ("f0", f0), ("f90", f90)];
+    let mine = set.engine_brdf("my_ggx", &given).unwrap();
+    let lut: Shading = Technique::Lut {
+        backend: Backend::Native,
+        flush: FlushPolicy::Auto,
+    }
+    .into();
+    with_validated_context(|ctx| {
+        let cpu = histencil_vk::LutTables::new(ctx, &[ggx], 9).unwrap();
+        let gpu = histencil_vk::LutTables::with_modules(ctx, modules, &[mine], 9).unwrap();
+        let (c, g) = (&cpu.luts()[0], &gpu.luts()[0]);
+        assert_eq!((c.axes, c.values.len()), (g.axes, g.values.len()));
+        let mut worst = 0f64;
+        for (a, b) in c.values.iter().zip(&g.values) {
+            for k in 0..3 {
+                let scale = f64::from(a[k].abs()).max(1.0);
+                worst = worst.max(f64::from((a[k] - b[k]).abs()) / scale);
+            }
+        }
+        println!("engine GGX table against the built-in's, 9^3 points: {worst:.2e}");
+        assert!(worst <= 1e-2, "{worst:e}");
+
+        let theirs = render(ctx, &builtin, BrdfModules::builtin(), lut);
+        let ours = render(ctx, &engine, modules, lut);
+        assert!(lit_fraction(&ours) > 0.2);
+        assert_close("engine-brdfs-lut", &theirs, &ours, 1);
+        let forward = render(ctx, &engine, modules, Shading::Forward);
+        let e = diff(&forward, &ours);
+        let bound = histencil_check::judge::LUT;
+        assert!(e.max <= bound.max && e.mean <= bound.mean, "{e:?}");
+
+        let combed = set.engine_brdf("combed", &given).unwrap();
+        let err = histencil_vk::LutTables::with_modules(ctx, modules, &[combed], 9)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("`combed`: it reads the tangent"), "{err}");
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/brdfs");
+        let example = BrdfSet::load(&dir).unwrap();
+        let example_modules = histencil_vk::compile_brdf_set(&example).unwrap();
+        let mut sheen = histencil_scene::embedded("brdfs-3").unwrap();
+        histencil_scene::retarget_brdfs(&mut sheen, &example);
+        let desc = RendererDesc {
+            brdfs: example_modules,
+            ..RendererDesc::new(SIZE, SIZE)
+        };
+        let mut renderer = Renderer::with_desc(ctx, sheen, &desc).unwrap();
+        let err = renderer.render(lut, Readback::ALL).err().unwrap();
+        let text = err.to_string();
+        assert!(
+            text.contains("`charlie_sheen`: it has a white part"),
+            "{text}"
+        );
+        assert_eq!(err.cause(), histencil_vk::Cause::Data);
     });
 }

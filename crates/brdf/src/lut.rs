@@ -13,6 +13,13 @@
 //! | blinn_phong, oren_nayar_*, ggx | `theta_L`, `theta_V` in [0, pi/2], `phi` (azimuth between L and V about N) in [0, pi] | `res^3` |
 //! | kajiya_kay | angles `T^L`, `T^V` in [0, pi] | `res^2` |
 //! | penner_skin | `theta` (N to L) in [0, pi], curvature as `k / (k + 1)` with `k` in 1/mm | `res^2`, RGB |
+//! | an engine's, without white part or tangent | as blinn_phong | `res^3`, RGB |
+//!
+//! An engine BRDF ([`crate::BrdfSet`]) has no CPU spelling: its table is the same grid
+//! ([`Lut::grid`]) filled by its own GLSL on the GPU (histencil-vk's `LutTables`), then
+//! [`Lut::from_values`]. One that reads no tangent is taken to be isotropic, a function of the
+//! three angles; one that reads the tangent, or has a white part, is refused
+//! ([`crate::BrdfSet::tabulable`]).
 //!
 //! Every parameter is fixed at bake time except the skin's curvature, which varies per pixel and
 //! is therefore an axis: the "limited control over parameters" the talk warns about is real, a
@@ -77,8 +84,8 @@ impl LutAxes {
             | Brdf::GltfMetalRough { .. } => LutAxes::Isotropic,
             Brdf::KajiyaKay { .. } => LutAxes::Fibre,
             Brdf::PennerSkin { .. } => LutAxes::SkinCurvature,
-            // Never baked: an engine BRDF has no CPU spelling, and the LUT technique refuses it
-            // as untabulable first (`Brdf::is_tabulable`). Its value depends on N, V and L.
+            // An engine BRDF that a table can hold reads no tangent
+            // (`BrdfSet::tabulable`): a function of N, V and L, taken as isotropic.
             Brdf::Engine { .. } => LutAxes::Isotropic,
         }
     }
@@ -190,7 +197,33 @@ pub enum LutError {
          (its dielectric specular is white)"
     )]
     Untabulable(&'static str),
+    /// An engine BRDF a table cannot hold: one with a white part (as [`LutError::Untabulable`]),
+    /// or one that reads the tangent (the tables are over the three angles of an isotropic
+    /// BRDF; the fibre table's axes are Kajiya-Kay's own).
+    #[error("no look-up table for engine BRDF `{brdf}`: {reason}")]
+    EngineUntabulable {
+        /// Its name.
+        brdf: &'static str,
+        /// Why a table cannot hold it.
+        reason: &'static str,
+    },
+    /// Values handed to [`Lut::from_values`] that are not one per grid point.
+    #[error("a {resolution}-point table of {brdf} has {expected} grid points, not {given}")]
+    ValueCount {
+        /// The material's model.
+        brdf: &'static str,
+        /// Grid points per axis.
+        resolution: u32,
+        /// Grid points of the table.
+        expected: usize,
+        /// Values given.
+        given: usize,
+    },
 }
+
+/// One grid point of a table ([`Lut::grid`]): its directions `[N, T, V, L]`, and the material
+/// evaluated there.
+pub type GridPoint = ([V3<f64>; 4], Brdf);
 
 /// A baked table for one material.
 #[derive(Clone, Debug)]
@@ -222,14 +255,37 @@ impl Lut {
     pub fn bake(brdf: Brdf, resolution: u32) -> Result<Self, LutError> {
         Self::check_resolution(resolution)?;
         if !brdf.is_tabulable() {
-            return Err(LutError::Untabulable(brdf.name()));
+            return Err(match brdf {
+                Brdf::Engine { id, .. } => LutError::EngineUntabulable {
+                    brdf: id.name(),
+                    reason: "it has no CPU spelling; its table is baked by its GLSL \
+                             (histencil-vk's LutTables)",
+                },
+                _ => LutError::Untabulable(brdf.name()),
+            });
         }
+        let values = Self::grid(brdf, resolution)?
+            .into_iter()
+            .map(|(dirs, at)| at.reference(dirs).map(|x| x as f32))
+            .collect();
+        Self::from_values(brdf, resolution, values)
+    }
+
+    /// Every grid point of `brdf`'s table at `resolution` points per axis, first axis fastest:
+    /// its directions `[N, T, V, L]` and the material evaluated there (the skin's curvature is
+    /// an axis). What [`Lut::bake`] evaluates on the CPU, and what an engine BRDF's table is
+    /// evaluated at by its GLSL (histencil-vk's `LutTables`): the grid is one, whoever fills it.
+    ///
+    /// # Errors
+    /// [`LutError::Resolution`] outside `2..=`[`Lut::MAX_RESOLUTION`].
+    pub fn grid(brdf: Brdf, resolution: u32) -> Result<Vec<GridPoint>, LutError> {
+        Self::check_resolution(resolution)?;
         let axes = LutAxes::of(&brdf);
         let dims = axes.dimensions();
         let r = resolution as usize;
         let count = r.pow(dims as u32);
         let step = 1.0 / f64::from(resolution - 1);
-        let values = (0..count)
+        Ok((0..count)
             .map(|index| {
                 let mut u = [0.0; 3];
                 let mut rest = index;
@@ -245,9 +301,32 @@ impl Lut {
                     },
                     other => other,
                 };
-                at.reference(dirs).map(|x| x as f32)
+                (dirs, at)
             })
-            .collect();
+            .collect())
+    }
+
+    /// A table of `brdf` from its values at the points of [`Lut::grid`], in that order.
+    ///
+    /// # Errors
+    /// [`LutError::Resolution`], and [`LutError::ValueCount`] unless there is one value per
+    /// grid point.
+    pub fn from_values(
+        brdf: Brdf,
+        resolution: u32,
+        values: Vec<[f32; 3]>,
+    ) -> Result<Self, LutError> {
+        Self::check_resolution(resolution)?;
+        let axes = LutAxes::of(&brdf);
+        let expected = (resolution as usize).pow(axes.dimensions() as u32);
+        if values.len() != expected {
+            return Err(LutError::ValueCount {
+                brdf: brdf.name(),
+                resolution,
+                expected,
+                given: values.len(),
+            });
+        }
         Ok(Self {
             brdf,
             axes,
@@ -399,6 +478,32 @@ pub fn report_materials() -> Vec<Brdf> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_table_from_values_is_the_baked_one_and_counts_its_points() {
+        let ggx = Brdf::Ggx {
+            alpha: 0.16,
+            f0: 0.04,
+            f90: 1.0,
+        };
+        let baked = Lut::bake(ggx, 5).unwrap();
+        let grid = Lut::grid(ggx, 5).unwrap();
+        assert_eq!(grid.len(), 125);
+        let values = grid
+            .iter()
+            .map(|(dirs, at)| at.reference(*dirs).map(|x| x as f32))
+            .collect();
+        let again = Lut::from_values(ggx, 5, values).unwrap();
+        assert_eq!(again.values, baked.values);
+        assert!(matches!(
+            Lut::from_values(ggx, 5, vec![[0.0; 3]; 124]),
+            Err(LutError::ValueCount {
+                expected: 125,
+                given: 124,
+                ..
+            })
+        ));
+    }
 
     #[test]
     fn grid_points_are_reproduced_exactly() {

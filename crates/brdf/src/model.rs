@@ -105,7 +105,8 @@ pub enum Brdf {
     },
     /// An engine's own BRDF ([`BrdfSet`](crate::BrdfSet)), evaluated by its GLSL only: it has
     /// no CPU spelling, so [`Brdf::eval_parts`] gives NaN for it and every path that needs one
-    /// (the LUT's tables, the f64 reference) refuses it first.
+    /// (the f64 reference, [`crate::lut::Lut::bake`]) refuses it first; its LUT table is filled
+    /// by its GLSL on the GPU.
     Engine {
         /// Which of the set's BRDFs.
         id: EngineBrdf,
@@ -485,7 +486,8 @@ impl Brdf {
 
     /// Whether the value is the tint times a function of the angles (no white part), which a
     /// look-up table of `f / tint` can hold, baked from a CPU spelling: every built-in model but
-    /// glTF's metallic-roughness. Not an engine's BRDF, which has no CPU spelling.
+    /// glTF's metallic-roughness. Not an engine's BRDF, which has no CPU spelling: whether its
+    /// GLSL can fill a table is its set's to say ([`crate::BrdfSet::tabulable`]).
     pub fn is_tabulable(&self) -> bool {
         !matches!(self, Brdf::GltfMetalRough { .. } | Brdf::Engine { .. })
     }

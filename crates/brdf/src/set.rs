@@ -26,6 +26,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::id::{BrdfId, EngineBrdf, ENGINE_FIRST, MAX_ENGINE_BRDFS};
+use crate::lut::LutError;
 use crate::model::{Brdf, BrdfError, Range, F32_FINITE};
 
 /// The most parameters an engine BRDF takes: histencil's G-buffer stores three per pixel (the
@@ -436,6 +437,38 @@ impl BrdfSet {
         Ok(())
     }
 
+    /// Whether the LUT technique can hold `brdf` in a table: a built-in as
+    /// [`Brdf::is_tabulable`] says; an engine BRDF of this set when it has no white part (a table
+    /// holds `f / tint`) and reads no tangent (its table is over the three angles of an
+    /// isotropic BRDF, [`crate::lut::LutAxes::Isotropic`]).
+    ///
+    /// # Errors
+    /// [`LutError`] saying why not; [`LutError::EngineUntabulable`] for an engine BRDF this set
+    /// does not hold.
+    pub fn tabulable(&self, brdf: &Brdf) -> Result<(), LutError> {
+        let Brdf::Engine { id, .. } = brdf else {
+            return if brdf.is_tabulable() {
+                Ok(())
+            } else {
+                Err(LutError::Untabulable(brdf.name()))
+            };
+        };
+        let reason = match self.spec(BrdfId::Engine(*id)) {
+            None => "it is not in the BRDF set",
+            Some(spec) if spec.white.is_some() => {
+                "it has a white part, and a table holds the tint's factor alone"
+            }
+            Some(spec) if spec.tangent => {
+                "it reads the tangent, and a table is over the three angles of an isotropic BRDF"
+            }
+            Some(_) => return Ok(()),
+        };
+        Err(LutError::EngineUntabulable {
+            brdf: id.name(),
+            reason,
+        })
+    }
+
     /// The files the shaders include to evaluate the set (`brdf/eval.glsl` includes them), as
     /// (path under the include folder, text). `engine_prefix` is the include path under which
     /// the engine's GLSL files are found (a compiler copies them there, so their names cannot
@@ -580,6 +613,43 @@ mod tests {
             }],
             tangent: false,
         }
+    }
+
+    #[test]
+    fn a_table_holds_an_engine_brdf_without_white_part_or_tangent() {
+        let mut sheen = toon();
+        sheen.name = "sheen".into();
+        sheen.white = Some("sheen_white".into());
+        let mut hair = toon();
+        hair.name = "hair".into();
+        hair.tangent = true;
+        let set = BrdfSet::new(&[BrdfId::Ggx], vec![toon(), sheen, hair]).unwrap();
+        let of = |name: &str| set.engine_brdf(name, &[]).unwrap();
+        assert_eq!(set.tabulable(&of("toon")), Ok(()));
+        let refused = |name: &str| set.tabulable(&of(name)).unwrap_err().to_string();
+        assert!(refused("sheen").contains("`sheen`: it has a white part"));
+        assert!(refused("hair").contains("`hair`: it reads the tangent"));
+        let ggx = Brdf::Ggx {
+            alpha: 0.16,
+            f0: 0.04,
+            f90: 1.0,
+        };
+        assert_eq!(set.tabulable(&ggx), Ok(()));
+        let gltf = Brdf::GltfMetalRough {
+            alpha: 0.25,
+            metallic: 0.0,
+        };
+        assert!(matches!(
+            set.tabulable(&gltf),
+            Err(LutError::Untabulable(_))
+        ));
+        // Another set's engine BRDF: not this one's to tabulate.
+        let other = BrdfSet::new(&[], vec![toon()]).unwrap();
+        let toon_there = other.engine_brdf("toon", &[]).unwrap();
+        let mut renamed = toon();
+        renamed.name = "ramp".into();
+        let mine = BrdfSet::new(&[], vec![renamed]).unwrap();
+        assert!(mine.tabulable(&toon_there).is_err());
     }
 
     #[test]

@@ -398,6 +398,8 @@ pub struct CompareReport {
     /// The engine BRDF set the run shaded with (`compare --brdfs`), as its BRDFs' names; empty
     /// for histencil's own.
     pub engine_brdfs: Vec<String>,
+    /// Why the table has no LUT row (a model no table can hold), if it has none.
+    pub lut_left_out: Option<String>,
     pub width: u32,
     pub height: u32,
     pub frames: usize,
@@ -549,6 +551,7 @@ pub fn run_compare(
             .engine()
             .map(|(_, spec)| spec.name.clone())
             .collect(),
+        lut_left_out: lut_refusal(settings),
         width: settings.width,
         height: settings.height,
         frames: settings.frames,
@@ -590,6 +593,17 @@ struct Table<'c> {
     widest: Option<(usize, Renderer<'c>)>,
 }
 
+/// Why the table has no LUT row, if it has none: a model of its widest column that no table
+/// can hold (`BrdfSet::tabulable`: glTF's metallic-roughness, an engine BRDF with a white part
+/// or reading the tangent). An engine BRDF that a table can hold is baked by its own GLSL.
+fn lut_refusal(settings: &CompareSettings) -> Option<String> {
+    let widest = settings.brdf_counts.iter().copied().max().unwrap_or(1);
+    brdf_palette(&settings.scene, widest)
+        .iter()
+        .find_map(|b| settings.brdfs.set.tabulable(b).err())
+        .map(|e| e.to_string())
+}
+
 /// Every technique at every BRDF count of the settings, and each BRDF alone, sampled in
 /// interleaved rounds until `sampling` stops; each cell with its error against forward.
 fn measure_table<'c>(
@@ -598,10 +612,10 @@ fn measure_table<'c>(
     sampling: &Sampling,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Table<'c>> {
-    // The LUT's tables are baked on the CPU, which an engine's BRDF has no spelling for.
+    let lut_left_out = lut_refusal(settings).is_some();
     let rows_spec: Vec<_> = table_rows()
         .into_iter()
-        .filter(|(name, _)| settings.brdfs.set.is_builtin_only() || *name != "lut")
+        .filter(|(name, _)| !lut_left_out || *name != "lut")
         .collect();
     let mut rows: Vec<Row> = rows_spec
         .iter()

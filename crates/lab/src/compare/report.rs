@@ -40,15 +40,19 @@ impl CompareReport {
         for (i, m) in rest.iter().enumerate() {
             line += &format!(", the {}-BRDF column adds {m}", i + 2);
         }
-        if self.engine_brdfs.is_empty() {
+        let line = if self.engine_brdfs.is_empty() {
             line + " (histencil's own BRDFs)."
         } else {
             let own: Vec<String> = self.engine_brdfs.iter().map(|m| format!("`{m}`")).collect();
             line + &format!(
-                ". Shaded with an engine's BRDF set (`--brdfs`: {}); the LUT row is left out, its \
-                 tables being baked on the CPU, where an engine's BRDF has no spelling.",
+                ". Shaded with an engine's BRDF set (`--brdfs`: {}); its BRDFs' LUT tables are \
+                 filled by their own GLSL on the GPU.",
                 own.join(", ")
             )
+        };
+        match &self.lut_left_out {
+            None => line,
+            Some(why) => line + &format!(" The LUT row is left out: {why}."),
         }
     }
 
@@ -63,6 +67,7 @@ impl CompareReport {
                 "scene_lights": self.scene_lights,
                 "models": self.models,
                 "engine_brdfs": self.engine_brdfs,
+                "lut_left_out": self.lut_left_out,
                 "width": self.width,
                 "height": self.height,
                 "frames": self.frames,

@@ -83,19 +83,19 @@ pub enum Error {
         /// The name of its BRDF.
         brdf: &'static str,
     },
-    /// The LUT technique on a BRDF that a table divided by the tint cannot hold, or that has
-    /// no CPU spelling to bake one from (an engine's).
+    /// The LUT technique on a BRDF that a table divided by the tint cannot hold
+    /// ([`histencil_brdf::BrdfSet::tabulable`]).
     #[error(
-        "the LUT technique tabulates each material's BRDF divided by its tint, baked on the CPU, \
-         and object `{object}`'s {brdf} cannot be (glTF's metallic-roughness is not its tint \
-         times a function of the angles, its dielectric specular being white; an engine's own \
-         BRDF has no CPU spelling): light this scene with stencil, branching or adaptive"
+        "the LUT technique cannot light object `{object}`: {why} (a table holds a material's \
+         BRDF divided by its tint); light this scene with stencil, branching or adaptive"
     )]
     LutUntabulable {
         /// The scene object's name.
         object: String,
         /// The name of its BRDF.
         brdf: &'static str,
+        /// Why not.
+        why: histencil_brdf::lut::LutError,
     },
     /// The alpha entities could not be laid out in the lightmap atlas.
     #[error(transparent)]

@@ -1,5 +1,5 @@
-//! The LUT technique's tables on the GPU: every material's [`Lut`] baked by histencil-brdf,
-//! in one storage buffer of values with a header per table (`crates/vk/shaders/include/lut.glsl`), and an
+//! The LUT technique's tables on the GPU: every material's [`Lut`] baked by histencil-brdf (an
+//! engine BRDF's filled by its own GLSL at histencil-brdf's grid points), in one storage buffer of values with a header per table (`crates/vk/shaders/include/lut.glsl`), and an
 //! evaluator that runs the GLSL lookup on chosen directions so it can be held to
 //! [`Lut::lookup`].
 
@@ -10,8 +10,9 @@ use crate::gpu::error::{Error, Result};
 use crate::gpu::resources::Buffer;
 use crate::gpu::teardown::InFlight;
 use crate::shaders;
+use crate::{BrdfEvaluator, BrdfModules};
 use ash::vk;
-use histencil_brdf::lut::Lut;
+use histencil_brdf::lut::{Lut, LutAxes};
 use histencil_brdf::{Brdf, V3};
 use std::ops::Deref;
 
@@ -40,16 +41,57 @@ pub struct LutTables<C: Deref<Target = Context>> {
 
 impl<C: Deref<Target = Context>> LutTables<C> {
     /// Bakes a table of `resolution` points per axis for each of `materials` (a material's
-    /// index here is its table index) and uploads them.
+    /// index here is its table index) and uploads them: histencil's own BRDFs only
+    /// ([`LutTables::with_modules`] takes an engine's).
     ///
     /// # Errors
-    /// [`Error::Lut`] for a resolution histencil-brdf refuses, [`Error::LutTooLarge`] when the
-    /// values exceed the device's storage-buffer range, and allocation errors.
+    /// [`Error::Lut`] for a resolution histencil-brdf refuses or a material no table can hold,
+    /// [`Error::LutTooLarge`] when the values exceed the device's storage-buffer range, and
+    /// allocation errors.
     pub fn new(ctx: C, materials: &[Brdf], resolution: u32) -> Result<Self> {
-        let luts = materials
+        Self::with_modules(ctx, BrdfModules::builtin(), materials, resolution)
+    }
+
+    /// As [`LutTables::new`], for the BRDFs of `modules`' set: a built-in's table is baked from
+    /// its f64 reference on the CPU, an engine BRDF's is filled on the GPU by its own GLSL
+    /// (`modules.brdf_eval`) at the same grid points ([`Lut::grid`]) and read back, so that
+    /// [`LutTables::luts`] holds what the GPU looks up, whoever baked it.
+    ///
+    /// # Errors
+    /// As [`LutTables::new`]; [`Error::Lut`] also for an engine BRDF the set holds no table of
+    /// ([`histencil_brdf::BrdfSet::tabulable`]: a white part, or the tangent read), and
+    /// [`Error::BrdfSet`] for a material of a BRDF the set does not hold.
+    pub fn with_modules(
+        ctx: C,
+        modules: &'static BrdfModules,
+        materials: &[Brdf],
+        resolution: u32,
+    ) -> Result<Self> {
+        Lut::check_resolution(resolution)?;
+        for b in materials {
+            modules
+                .set
+                .check(b)
+                .map_err(|e| Error::BrdfSet(e.to_string()))?;
+            modules.set.tabulable(b)?;
+        }
+        // Before anything is baked: a table past the device's range is refused at once.
+        let bytes: u64 = materials
             .iter()
-            .map(|b| Lut::bake(*b, resolution))
-            .collect::<Result<Vec<_>, _>>()?;
+            .map(|b| u64::from(resolution).pow(LutAxes::of(b).dimensions() as u32) * 12)
+            .sum();
+        let limit = u64::from(ctx.max_storage_buffer_range);
+        if bytes > limit {
+            return Err(Error::LutTooLarge { bytes, limit });
+        }
+        let luts = if materials.iter().all(|b| !matches!(b, Brdf::Engine { .. })) {
+            materials
+                .iter()
+                .map(|b| Lut::bake(*b, resolution))
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            bake_with_glsl(&ctx, modules, materials, resolution)?
+        };
         let mut headers = Vec::with_capacity(luts.len());
         let mut values: Vec<f32> = Vec::new();
         for lut in &luts {
@@ -61,13 +103,8 @@ impl<C: Deref<Target = Context>> LutTables<C> {
             });
             values.extend(lut.values.iter().flatten());
         }
-        let bytes = (values.len() * 4) as u64;
         let owner = ctx;
         let ctx: &Context = &owner;
-        let limit = u64::from(ctx.max_storage_buffer_range);
-        if bytes > limit {
-            return Err(Error::LutTooLarge { bytes, limit });
-        }
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let mut headers =
             Buffer::with_data(ctx, "lut-headers", storage, bytemuck::cast_slice(&headers))?;
@@ -132,6 +169,43 @@ impl<C: Deref<Target = Context>> Drop for LutTables<C> {
         self.headers.destroy(&self.ctx);
         self.values.destroy(&self.ctx);
     }
+}
+
+/// Grid points evaluated per dispatch: 96 bytes of case and 16 of result each, 112 MiB a run
+/// at most, and within the case kernels' 65535 workgroups of 64.
+const BAKE_BATCH: usize = 1 << 20;
+
+/// Each material's table: a built-in's baked from its reference on the CPU, an engine BRDF's
+/// evaluated at the grid points by the set's own `brdf_eval.comp` (the function every
+/// technique shades with, white tint: a tabulable BRDF has no white part).
+fn bake_with_glsl(
+    ctx: &Context,
+    modules: &'static BrdfModules,
+    materials: &[Brdf],
+    resolution: u32,
+) -> Result<Vec<Lut>> {
+    let mut evaluator = BrdfEvaluator::with_module(ctx, modules.brdf_eval)?;
+    let baked = materials
+        .iter()
+        .map(|b| {
+            if !matches!(b, Brdf::Engine { .. }) {
+                return Ok(Lut::bake(*b, resolution)?);
+            }
+            let grid = Lut::grid(*b, resolution)?;
+            let mut values = Vec::with_capacity(grid.len());
+            for batch in grid.chunks(BAKE_BATCH) {
+                let cases: Vec<(Brdf, [V3<f32>; 4])> = batch
+                    .iter()
+                    .map(|(dirs, at)| (*at, dirs.map(|d| d.map(|x| x as f32))))
+                    .collect();
+                let parts = evaluator.evaluate(ctx, &cases)?;
+                values.extend(parts.into_iter().map(|p| p.tinted));
+            }
+            Ok(Lut::from_values(*b, resolution, values)?)
+        })
+        .collect();
+    evaluator.destroy(ctx);
+    baked
 }
 
 /// std430 mirror of `LutCase` in `crates/vk/shaders/lut_eval.comp`.

@@ -213,8 +213,9 @@ impl<'c> Renderer<'c> {
     /// # Errors
     /// [`crate::Error::LutTexturedParameters`] when an object's metallic-roughness map changes
     /// its BRDF's parameters per texel ([`histencil_scene::Material::parameters_vary`]),
-    /// [`crate::Error::LutUntabulable`] when an object's BRDF is not its tint times a function
-    /// of the angles ([`histencil_brdf::Brdf::is_tabulable`]: glTF's metallic-roughness),
+    /// [`crate::Error::LutUntabulable`] when a table cannot hold an object's BRDF
+    /// ([`histencil_brdf::BrdfSet::tabulable`]: glTF's metallic-roughness, an engine BRDF with a
+    /// white part or reading the tangent),
     /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
     /// [`LutTables::new`].
     pub fn lut_tables(&mut self) -> Result<&LutTables<&'c Context>> {
@@ -230,15 +231,17 @@ impl<'c> Renderer<'c> {
                     brdf: o.material.brdf.id().name(),
                 });
             }
-            if let Some(o) = self
+            let set = &self.desc.brdfs.set;
+            if let Some((o, why)) = self
                 .scene
                 .objects
                 .iter()
-                .find(|o| !o.material.brdf.is_tabulable())
+                .find_map(|o| set.tabulable(&o.material.brdf).err().map(|e| (o, e)))
             {
                 return Err(crate::Error::LutUntabulable {
                     object: o.name.clone(),
                     brdf: o.material.brdf.id().name(),
+                    why,
                 });
             }
             if self.materials.len() > MAX_MATERIALS {
@@ -247,7 +250,12 @@ impl<'c> Renderer<'c> {
                     max: MAX_MATERIALS,
                 });
             }
-            let tables = LutTables::new(self.ctx, &self.materials, self.desc.lut_resolution)?;
+            let tables = LutTables::with_modules(
+                self.ctx,
+                self.desc.brdfs,
+                &self.materials,
+                self.desc.lut_resolution,
+            )?;
             // SAFETY: `tables` moves into `self.lut_tables` below and is freed only by the
             // renderer's Drop, after its device wait; they are the first tables (baked once),
             // so no command buffer reads earlier ones.
