@@ -11,9 +11,9 @@
 //!   `k / (k + 1)` for skin curvature, the warps that spread 256 levels over what the eye sees.
 
 use crate::cases::{halton, sphere_point};
+use crate::half_float::round_to_f16;
 use crate::model::Brdf;
 use crate::vector::{angle_between, cross, normalize, V3};
-use half::f16;
 
 /// How the G-buffer stores the normal.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,7 +104,7 @@ impl ParamEncoding {
     /// One parameter through the encoding, with `warp(x, inverse)` mapping it into [0, 1].
     fn store(self, x: f64, warp: fn(f64, bool) -> f64) -> f64 {
         match self {
-            ParamEncoding::Float16 => f16::from_f64(x).to_f64(),
+            ParamEncoding::Float16 => round_to_f16(x),
             ParamEncoding::Unorm8 => warp(unorm8(warp(x, false)), true),
         }
     }

@@ -35,6 +35,7 @@ pub mod cases;
 pub mod encoding;
 #[cfg(feature = "files")]
 pub mod eval_csv;
+pub mod half_float;
 mod id;
 pub mod lut;
 #[cfg(feature = "manifest")]

@@ -1,6 +1,7 @@
 //! Tangents for a normal-mapped primitive that has none, generated as glTF asks: MikkTSpace
-//! (the `mikktspace` crate, the reference algorithm ported), so a normal map baked by the usual
-//! tools reads back the surface it was baked from.
+//! (the `bevy_mikktspace` crate: the reference algorithm in safe Rust, byte-identical to the C
+//! one, and no vector library an engine's own could clash with), so a normal map baked by the
+//! usual tools reads back the surface it was baked from.
 //!
 //! glTF's texture space has its origin at the top left and its normal maps' +Y up the image, so
 //! its bitangent `cross(N, T) * w` points along decreasing V; MikkTSpace's points along
@@ -33,7 +34,7 @@ impl Corners<'_> {
     }
 }
 
-impl mikktspace::Geometry for Corners<'_> {
+impl bevy_mikktspace::Geometry for Corners<'_> {
     fn num_faces(&self) -> usize {
         self.mesh.indices.len() / 3
     }
@@ -56,8 +57,17 @@ impl mikktspace::Geometry for Corners<'_> {
         [u, 1.0 - v]
     }
 
-    fn set_tangent_encoded(&mut self, tangent: [f32; 4], face: usize, vert: usize) {
-        self.tangents[face * 3 + vert] = tangent;
+    /// A corner the algorithm gives nothing (a degenerate triangle with no neighbour to
+    /// borrow from) keeps a zero tangent, which `generate` replaces.
+    fn set_tangent(
+        &mut self,
+        tangent: Option<bevy_mikktspace::TangentSpace>,
+        face: usize,
+        vert: usize,
+    ) {
+        if let Some(t) = tangent {
+            self.tangents[face * 3 + vert] = t.tangent_encoded();
+        }
     }
 }
 
@@ -74,11 +84,12 @@ pub(crate) fn generate(mesh: &mut Mesh, uv_set: u32, space: &Space) -> Result<()
         space,
         tangents: vec![[0.0; 4]; corners],
     };
-    // The port is unsafe code: a panic inside it must not take the importer down.
+    // A panic inside the algorithm (an index it did not expect) must not take the importer
+    // down; it has no error of its own to return yet.
     let made = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        mikktspace::generate_tangents(&mut geometry)
+        bevy_mikktspace::generate_tangents(&mut geometry)
     }));
-    if made.is_err() {
+    if !matches!(made, Ok(Ok(()))) {
         return Err("tangent generation failed on this geometry".into());
     }
     let tangents = geometry.tangents;

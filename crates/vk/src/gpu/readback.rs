@@ -182,7 +182,9 @@ impl ReadbackBuffers {
                 .hdr
                 .read()
                 .chunks_exact(2)
-                .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
+                .map(|b| {
+                    histencil_brdf::half_float::f16_bits_to_f32(u16::from_le_bytes([b[0], b[1]]))
+                })
                 .collect();
             images.hdr = Rgba32FImage::from_raw(w, h, floats);
         }
