@@ -384,14 +384,26 @@ fn compare_verdicts_do_not_reverse_under_background_load() {
 /// The demo's contact sheet shows the talk's failures: each failure frame visibly differs from
 /// its fix (mean over the tile above 5/255), and each fix is within 1/255 of forward. The first
 /// failure once equalled its fix because the demo rendered it without engine bits to mis-test.
+/// With histencil's BRDFs, and with an engine's (`demo --brdfs examples/brdfs`).
 #[test]
 fn the_demo_shows_each_failure_next_to_a_fix_that_matches_forward() {
-    let settings = histencil_lab::DemoSettings {
-        scene: histencil_scene::embedded("default").unwrap(),
-        width: 320,
-        height: 180,
-        frames: 1,
-    };
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/brdfs");
+    let set = histencil_brdf::BrdfSet::load(&dir).unwrap();
+    let engine = histencil_vk::compile_brdf_set(&set).unwrap();
+    for brdfs in [histencil_vk::BrdfModules::builtin(), engine] {
+        let mut scene = histencil_scene::embedded("default").unwrap();
+        histencil_scene::retarget_brdfs(&mut scene, &brdfs.set);
+        demo_holds(histencil_lab::DemoSettings {
+            scene,
+            width: 320,
+            height: 180,
+            frames: 1,
+            brdfs,
+        });
+    }
+}
+
+fn demo_holds(settings: histencil_lab::DemoSettings) {
     let report =
         with_validated_context(|ctx| histencil_lab::run_demo(ctx, settings, &mut |_| {}).unwrap());
     assert_eq!(report.failures.len(), 3);

@@ -234,6 +234,8 @@ pub struct DemoArgs {
     /// The contact sheet, in the format its extension names (`.png`, `.jpg` or `.jpeg`).
     #[arg(long, default_value = "out/demo.png")]
     out: PathBuf,
+    #[command(flatten)]
+    brdfs: crate::brdfs::BrdfsArg,
 }
 
 #[derive(clap::Args)]
@@ -508,11 +510,13 @@ pub fn scale(args: &ScaleArgs, lights: DefaultLights) -> Result<()> {
 
 pub fn demo(args: &DemoArgs, lights: DefaultLights) -> Result<()> {
     histencil_vk::check_image_output(&args.out, ImageKind::Colour)?;
+    let brdfs = args.brdfs.modules()?;
     let settings = histencil_lab::DemoSettings {
-        scene: crate::load_scene_arg(&args.scene, lights)?,
+        scene: crate::brdfs::load_scene(&args.scene, lights, brdfs)?,
         width: args.run.width,
         height: args.run.height,
         frames: args.run.frames as usize,
+        brdfs,
     };
     let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {

@@ -27,6 +27,9 @@ pub struct DemoSettings {
     pub height: u32,
     /// Timed frames per row (after one warm-up frame).
     pub frames: usize,
+    /// The BRDFs the scene is shaded with: histencil's own, or an engine's set
+    /// (`demo --brdfs`), which every object's BRDF must belong to.
+    pub brdfs: &'static histencil_vk::BrdfModules,
 }
 
 /// One row of the demo's table.
@@ -136,7 +139,11 @@ pub fn run_demo(
     settings: DemoSettings,
     step: &mut dyn FnMut(&str),
 ) -> Result<DemoReport> {
-    let mut renderer = Renderer::new(ctx, settings.scene, settings.width, settings.height)?;
+    let desc = histencil_vk::RendererDesc {
+        brdfs: settings.brdfs,
+        ..histencil_vk::RendererDesc::new(settings.width, settings.height)
+    };
+    let mut renderer = Renderer::with_desc(ctx, settings.scene, &desc)?;
     let layout = *renderer.stencil_layout();
     let preserved_mask = layout.preserved_mask();
     let all = Readback {
