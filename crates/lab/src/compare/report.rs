@@ -67,7 +67,6 @@ impl CompareReport {
                 "scene_lights": self.scene_lights,
                 "models": self.models,
                 "engine_brdfs": self.engine_brdfs,
-                "lut_left_out": self.lut_left_out,
                 "width": self.width,
                 "height": self.height,
                 "frames": self.frames,
@@ -107,6 +106,9 @@ impl CompareReport {
         }
         out["crossover"] = Value::Object(crossover);
         // Only what was set: the report's values are all present and finite.
+        if let Some(why) = &self.lut_left_out {
+            out["settings"]["lut_left_out"] = json!(why);
+        }
         if let Some(n) = &self.lp_num_threads {
             out["settings"]["environment"] = json!({ "LP_NUM_THREADS": n });
         }
