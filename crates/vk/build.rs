@@ -65,6 +65,7 @@ fn generated_glsl() -> String {
     // ALPHA_KINDS are spelled in include/alpha_entity.glsl, which engines include on its own.
     for (name, value) in LIGHT_KINDS
         .into_iter()
+        .chain(LIGHT_FALLOFFS)
         .chain(LIGHT_DRAW_FLAGS)
         .chain(ALPHA_MODES)
     {

@@ -220,3 +220,166 @@ fn sparse_positions_import_and_bad_ones_are_refused() {
         );
     }
 }
+
+/// A white Lambert floor (rho 1) under one `KHR_lights_punctual` light, held pixel by pixel to
+/// glTF's own equations in f64 (not to histencil's forward): radiance `I * F(d) * cone * N.L / pi`
+/// with `F = w / d^2`, `w = clamp(1 - (d / range)^4, 0, 1)` for a light with a `range`; `1 / d^2`
+/// up to the 1/255 cut for one without; a spot's cone the squared linear ramp of the Sample
+/// Viewer's `punctual.glsl`. Forward, stencil and tiled each, read back in HDR (f16: 2^-11
+/// relative), within 2e-3 of the value plus 2e-4 absolute (the floor's position, which this test
+/// recasts from the camera, against the rasteriser's). Before glTF's falloff, the squared window
+/// was 20 % darker at two thirds of the range.
+#[test]
+fn gltf_lights_fall_off_as_gltf_says() {
+    use glam::{DVec3, DVec4};
+    use histencil_tests::gltf_builder::{quad, Bin};
+    use std::f64::consts::PI;
+    const SIZE: (u32, u32) = (96, 96);
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    // (light, its node's position): the spot points straight down.
+    let cases = [
+        (
+            json!({"type": "point", "color": [1.0, 1.0, 1.0], "intensity": 10.0, "range": 6.0}),
+            [0.0, 1.0, 0.0],
+        ),
+        (
+            json!({"type": "point", "color": [1.0, 1.0, 1.0], "intensity": 10.0}),
+            [0.5, 1.0, -0.5],
+        ),
+        (
+            json!({"type": "spot", "color": [1.0, 1.0, 1.0], "intensity": 30.0, "range": 8.0,
+                   "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.7}}),
+            [0.0, 3.0, 0.0],
+        ),
+    ];
+    with_validated_context(|ctx| {
+        for (light, at) in &cases {
+            let mut bin = Bin::default();
+            let mut floor = quad(&mut bin);
+            floor["material"] = json!(0);
+            let doc = json!({
+                "asset": {"version": "2.0"},
+                "extensionsUsed": ["KHR_lights_punctual"],
+                "extensions": {"KHR_lights_punctual": {"lights": [light]}},
+                "materials": [{"name": "white", "extras": {"brdf": "lambert", "rho": 1.0},
+                               "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0]}}],
+                "meshes": [{"name": "floor", "primitives": [floor]}],
+                "cameras": [{"type": "perspective",
+                             "perspective": {"yfov": 1.3, "znear": 0.5, "zfar": 20.0}}],
+                "nodes": [
+                    {"name": "floor", "mesh": 0, "scale": [4.0, 1.0, 4.0]},
+                    {"name": "light", "extensions": {"KHR_lights_punctual": {"light": 0}},
+                     "translation": at, "rotation": [-h, 0.0, 0.0, h]},
+                    {"name": "camera", "camera": 0, "translation": [0.0, 6.0, 0.0],
+                     "rotation": [-h, 0.0, 0.0, h]}
+                ],
+                "scenes": [{"nodes": [0, 1, 2]}],
+                "scene": 0,
+                "bufferViews": bin.views,
+                "accessors": bin.accessors,
+                "buffers": [{"uri": "scene.bin", "byteLength": bin.bytes.len()}]
+            });
+            let text = serde_json::to_vec(&self_contained(&doc, &bin.bytes)).unwrap();
+            let scene = histencil_scene::import_gltf(&text, None, "falloff").unwrap();
+            let l = &scene.lights[0];
+            let (position, range) = (l.position.as_dvec3(), f64::from(l.radius));
+            let intensity = f64::from(l.color.x);
+            let unlimited = light.get("range").is_none();
+            let spot = light.get("spot").map(|s| {
+                let angle = |k: &str| s[k].as_f64().unwrap().cos();
+                (angle("outerConeAngle"), angle("innerConeAngle"))
+            });
+            let expected = |p: DVec3| -> f64 {
+                let to_light = position - p;
+                let d = to_light.length();
+                if d >= range {
+                    return 0.0;
+                }
+                let falloff = if unlimited {
+                    1.0 / (d * d)
+                } else {
+                    (1.0 - (d / range).powi(4)).clamp(0.0, 1.0) / (d * d)
+                };
+                let cone = spot.map_or(1.0, |(cos_outer, cos_inner)| {
+                    let c = (-to_light / d).dot(DVec3::NEG_Y);
+                    ((c - cos_outer) / (cos_inner - cos_outer))
+                        .clamp(0.0, 1.0)
+                        .powi(2)
+                });
+                let n_dot_l = (to_light.y / d).max(0.0);
+                intensity * falloff * cone * n_dot_l / PI
+            };
+            let aspect = SIZE.0 as f32 / SIZE.1 as f32;
+            let clip_to_world = (scene.camera.projection(aspect) * scene.camera.view())
+                .as_dmat4()
+                .inverse();
+            let unproject = |x: f64, y: f64, z: f64| {
+                let w: DVec4 = clip_to_world * DVec4::new(x, y, z, 1.0);
+                w.truncate() / w.w
+            };
+            let on_floor = |px: u32, py: u32| -> Option<DVec3> {
+                let x = (f64::from(px) + 0.5) / f64::from(SIZE.0) * 2.0 - 1.0;
+                let y = (f64::from(py) + 0.5) / f64::from(SIZE.1) * 2.0 - 1.0;
+                let (a, b) = (unproject(x, y, 0.2), unproject(x, y, 0.8));
+                let t = a.y / (a.y - b.y);
+                let p = a + (b - a) * t;
+                (p.x.abs() < 3.95 && p.z.abs() < 3.95).then_some(p)
+            };
+            let mut renderer = Renderer::new(ctx, scene.clone(), SIZE.0, SIZE.1).unwrap();
+            let techniques: [(&str, Shading); 3] = [
+                ("forward", Shading::Forward),
+                (
+                    "stencil",
+                    Technique::Stencil {
+                        backend: Backend::Native,
+                        flush: FlushPolicy::Auto,
+                    }
+                    .into(),
+                ),
+                (
+                    "tiled",
+                    Technique::Tiled {
+                        mixed: histencil_vk::MixedTiles::PerBrdf,
+                        side: histencil_vk::TileSide::Eight,
+                    }
+                    .into(),
+                ),
+            ];
+            for (name, shading) in techniques {
+                let readback = Readback {
+                    hdr: true,
+                    ..Readback::NONE
+                };
+                let hdr = renderer
+                    .render(shading, readback)
+                    .unwrap()
+                    .images
+                    .hdr
+                    .unwrap();
+                let (mut relative, mut lit, mut brightest) = (0f64, 0, 0f64);
+                for (px, py, got) in hdr.enumerate_pixels() {
+                    let Some(p) = on_floor(px, py) else {
+                        continue;
+                    };
+                    let want = expected(p);
+                    let got = f64::from(got[0]);
+                    let error = (got - want).abs() - (2e-3 * want + 2e-4);
+                    if want > 1e-2 {
+                        relative = relative.max((got / want - 1.0).abs());
+                    }
+                    lit += usize::from(want > 1e-3);
+                    brightest = brightest.max(want);
+                    assert!(
+                        error <= 0.0,
+                        "{light}, {name}: pixel ({px}, {py}) at {p:.3}: {got} where glTF gives {want}"
+                    );
+                }
+                assert!(
+                    lit > 2000 && brightest > 0.5,
+                    "{light}: {lit} lit, {brightest}"
+                );
+                println!("{light}, {name}: {lit} pixels lit, {relative:.1e} relative at most");
+            }
+        }
+    });
+}

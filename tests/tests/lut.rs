@@ -105,6 +105,7 @@ fn directionally_lit_room() -> Scene {
         position: Vec3::ZERO,
         radius: 1.0,
         color,
+        falloff: histencil_scene::Falloff::SquaredWindow,
     };
     scene.lights = vec![
         directional(Vec3::new(-0.4, -1.0, -0.5), Vec3::new(0.9, 0.85, 0.8)),

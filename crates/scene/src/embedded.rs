@@ -336,6 +336,7 @@ fn room(name: &str, description: String, models: &[BrdfId]) -> Scene {
             position: pos,
             radius: 9.0,
             color: Vec3::new(14.0, 12.0, 9.0),
+            falloff: crate::Falloff::SquaredWindow,
         });
     }
     lights.push(Light {
@@ -345,6 +346,7 @@ fn room(name: &str, description: String, models: &[BrdfId]) -> Scene {
         position: Vec3::ZERO,
         radius: 0.0,
         color: Vec3::new(0.08, 0.09, 0.12),
+        falloff: crate::Falloff::SquaredWindow,
     });
 
     Scene {

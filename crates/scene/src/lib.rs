@@ -46,7 +46,7 @@ pub use texture::{
 };
 pub use town::{TOWN_LIGHTS, TOWN_MATERIALS};
 pub use types::{
-    unit_direction, Camera, Light, LightKind, Material, Object, Scene, SceneError, Shape,
+    unit_direction, Camera, Falloff, Light, LightKind, Material, Object, Scene, SceneError, Shape,
     MAX_FAR_OVER_NEAR, MAX_LIGHT_COLOR, MAX_TINT, MAX_WORLD_COORDINATE, MIN_FOV_Y,
     RANGE_CAP_PER_EXTENT,
 };

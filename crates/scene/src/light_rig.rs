@@ -31,6 +31,7 @@ pub fn default_light_rig(camera: &Camera) -> [Light; 2] {
         position: Vec3::ZERO,
         radius: 0.0,
         color: Vec3::splat(radiance),
+        falloff: crate::Falloff::SquaredWindow,
     };
     [
         directional(key_from, KEY_RADIANCE),

@@ -361,6 +361,7 @@ fn lights(rng: &mut SplitMix) -> Vec<Light> {
             position,
             radius: 10.0,
             color: hue(rng.next_f32()) * 6.0,
+            falloff: crate::Falloff::SquaredWindow,
         });
     }
     lights

@@ -181,6 +181,36 @@ pub enum LightKind {
     },
 }
 
+/// How a point or spot light's intensity falls with distance `d` within its range `r`, and
+/// across a spot's cone. Every convention is exactly zero at and beyond `r`, which the light's
+/// volume encloses. With `x = d / r` and `w = clamp(1 - x^4, 0, 1)`, the radiance scale reaching
+/// a point is `color * falloff(d) * cone`:
+///
+/// | convention | `falloff(d)` | spot `cone`, with `c` the cosine to the axis |
+/// |---|---|---|
+/// | [`Falloff::SquaredWindow`] | `w^2 / d^2` | `smoothstep(cos outer, cos inner, c)` |
+/// | [`Falloff::Gltf`] | `w / d^2` | `t^2`, `t = clamp((c - cos outer) / (cos inner - cos outer), 0, 1)` |
+/// | [`Falloff::InverseSquare`] | `1 / d^2` | as [`Falloff::Gltf`] |
+///
+/// `d^2` is floored at `1e-4` (1 cm at a metre per unit), so a light on a surface stays finite.
+/// Lengths are in the scene's units (glTF's are metres); `color` is then in candela (point,
+/// spot) or lux (directional), and so is what arrives: `color / d^2` is illuminance in lux.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Falloff {
+    /// histencil's own, and Unreal's and Frostbite's: the window squared, so the light fades
+    /// smoothly (zero slope) into its range. Every embedded scene's lights.
+    #[default]
+    SquaredWindow,
+    /// `KHR_lights_punctual`'s recommended falloff and cone, as Khronos' glTF Sample Viewer
+    /// implements them (`punctual.glsl`): a glTF light with a `range`.
+    Gltf,
+    /// Inverse square unwindowed, cut at the range: a glTF light without `range`, which glTF
+    /// calls unlimited. The volume needs an end; the importer puts it where `color / d^2`
+    /// falls to 1/255 (the brightest channel), so what the cut drops is at most that, per unit
+    /// of the BRDF's `f * N.L`.
+    InverseSquare,
+}
+
 /// A light. `color` is linear RGB radiance scale (intensity folded in).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Light {
@@ -192,16 +222,20 @@ pub struct Light {
     pub radius: f32,
     /// Linear RGB radiance scale, the light's intensity folded in.
     pub color: Vec3,
+    /// How it falls off with distance and across a spot's cone (unused by a directional light).
+    pub falloff: Falloff,
 }
 
 impl Light {
-    /// A point light at `position`, reaching `radius`.
+    /// A point light at `position`, reaching `radius`, with histencil's falloff
+    /// ([`Falloff::SquaredWindow`]).
     pub fn point(position: Vec3, radius: f32, color: Vec3) -> Self {
         Self {
             kind: LightKind::Point,
             position,
             radius,
             color,
+            falloff: Falloff::SquaredWindow,
         }
     }
 

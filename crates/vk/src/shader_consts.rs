@@ -8,6 +8,15 @@ pub const LIGHT_KINDS: [(&str, u32); 3] = [
     ("LIGHT_DIRECTIONAL", 2),
 ];
 
+/// GLSL `LIGHT_FALLOFF_*`, stored in `Light.direction.w`: `histencil_scene::Falloff::code` of
+/// each convention (a test holds them together). Read by build.rs.
+#[allow(dead_code)]
+pub const LIGHT_FALLOFFS: [(&str, u32); 3] = [
+    ("LIGHT_FALLOFF_SQUARED_WINDOW", 0),
+    ("LIGHT_FALLOFF_GLTF", 1),
+    ("LIGHT_FALLOFF_INVERSE_SQUARE", 2),
+];
+
 /// Side of a hi-stencil tile in pixels (GLSL `HI_STENCIL_TILE`): one flag of the emulated coarse
 /// surface covers this many pixels squared, like the 8x8 granularity of console hi-stencil.
 pub const HI_STENCIL_TILE: u32 = 8;

@@ -157,6 +157,7 @@ pub fn spot_light(frame: usize) -> Light {
         position,
         radius: 12.0,
         color: Vec3::new(60.0, 56.0, 48.0),
+        falloff: histencil::scene::Falloff::SquaredWindow,
     }
 }
 

@@ -7,9 +7,11 @@
 //!   `alphaMode: BLEND` makes the primitive an [`AlphaObject`] with the base colour's alpha as its
 //!   opacity. It then needs `TEXCOORD_0` as its lightmap layout: unique and inside `[0, 1]^2`.
 //!   `MASK` is drawn opaque.
-//! - **Lights:** from `KHR_lights_punctual`. `color * intensity` is the light's radiance scale:
-//!   the renderer's falloff is the same `1/d^2` as glTF's, windowed to zero at the range. A light
-//!   without a `range` gets the distance at which `intensity / d^2` falls to 1/255. Spot cones
+//! - **Lights:** from `KHR_lights_punctual`. `color * intensity` is the light's radiance scale,
+//!   falling off as glTF recommends and Khronos' Sample Viewer draws it ([`Falloff::Gltf`]:
+//!   `w / d^2` with `w = clamp(1 - (d / range)^4, 0, 1)`, spot cones a squared linear ramp). A
+//!   light without a `range` is unlimited in glTF: it falls off as `1 / d^2` up to the distance
+//!   where `intensity / d^2` is 1/255 and ends there ([`Falloff::InverseSquare`]). Spot cones
 //!   must stay within 80 degrees.
 //! - **Camera:** the first perspective camera met, else one framing the scene's bounds.
 //!
@@ -34,8 +36,8 @@ pub use material::{material_from_gltf, material_from_gltf_in, MaterialError};
 
 use crate::tangents;
 use crate::{
-    uv_transform, AlphaObject, Camera, Light, LightKind, MaterialMaps, Mesh, Object, Scene,
-    SceneError, Shape, Vertex, UV_IDENTITY,
+    uv_transform, AlphaObject, Camera, Falloff, Light, LightKind, MaterialMaps, Mesh, Object,
+    Scene, SceneError, Shape, Vertex, UV_IDENTITY,
 };
 use glam::{Mat4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -726,10 +728,15 @@ fn import_light(
     let color = Vec3::from(light.color()) * intensity;
     let position = world.transform_point3(Vec3::ZERO);
     let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
-    let radius = match light.range() {
-        Some(range) if range.is_finite() && range > 0.0 => range,
+    // glTF's falloff: windowed once within a `range`; without one glTF's light is unlimited,
+    // so its volume ends where `color / d^2` falls to 1/255 and it is unwindowed up to there.
+    let (radius, falloff) = match light.range() {
+        Some(range) if range.is_finite() && range > 0.0 => (range, Falloff::Gltf),
         Some(_) => return Err(bad("range must be finite and positive")),
-        None => (255.0 * color.max_element()).sqrt().max(1e-3),
+        None => (
+            (255.0 * color.max_element()).sqrt().max(1e-3),
+            Falloff::InverseSquare,
+        ),
     };
     let kind = match light.kind() {
         Kind::Point => LightKind::Point,
@@ -755,6 +762,7 @@ fn import_light(
         position,
         radius,
         color,
+        falloff,
     })
 }
 

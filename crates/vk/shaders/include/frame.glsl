@@ -21,7 +21,8 @@ layout(set = 0, binding = 0, std140) uniform Frame {
 struct Light {
     vec4 position_radius; // xyz position, w range (contribution is zero at and beyond it)
     vec4 color_kind;      // rgb radiance scale, w: LIGHT_* kind
-    vec4 direction;       // xyz normalized direction the light travels (spot, directional)
+    vec4 direction;       // xyz normalized direction the light travels (spot, directional),
+                          // w: LIGHT_FALLOFF_* (histencil_scene::Falloff)
     vec4 spot;            // x cos(outer), y cos(inner), z tan(outer)
 };
 

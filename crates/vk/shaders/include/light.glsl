@@ -7,13 +7,30 @@
 #include "brdf/eval.glsl"
 #include "surface.glsl"
 
-// Windowed inverse square: exactly zero at d >= range, so a volume that circumscribes the range
-// sphere never misses light and rasterising more than the sphere adds nothing.
-float range_falloff(float d, float range) {
+// Distance falloff within the range, by convention (histencil_scene::Falloff, whose docs give
+// the equations): exactly zero at d >= range, so a volume that circumscribes the range sphere
+// never misses light and rasterising more than the sphere adds nothing.
+float range_falloff(float d, float range, uint falloff) {
     float x = d / range;
     float x2 = x * x;
     float window = clamp(1.0 - x2 * x2, 0.0, 1.0);
-    return window * window / max(d * d, 1e-4);
+    float windowed = window * window;
+    if (falloff == LIGHT_FALLOFF_GLTF) {
+        windowed = window;
+    } else if (falloff == LIGHT_FALLOFF_INVERSE_SQUARE) {
+        windowed = d < range ? 1.0 : 0.0;
+    }
+    return windowed / max(d * d, 1e-4);
+}
+
+// A spot's scale at cosine c to its axis (histencil_scene::Falloff::cone): histencil's
+// smoothstep, or glTF's squared linear ramp.
+float spot_cone(vec4 spot, float c, uint falloff) {
+    if (falloff == LIGHT_FALLOFF_SQUARED_WINDOW) {
+        return smoothstep(spot.x, spot.y, c);
+    }
+    float t = clamp((c - spot.x) / max(spot.y - spot.x, 1e-3), 0.0, 1.0);
+    return t * t;
 }
 
 // Radiance scale arriving at P from the light, and the unit direction L towards it.
@@ -31,9 +48,10 @@ vec3 light_incident(Light light, vec3 P, out vec3 L) {
         return vec3(0.0);
     }
     L = to_light / d;
-    float a = range_falloff(d, range);
+    uint falloff = uint(light.direction.w);
+    float a = range_falloff(d, range, falloff);
     if (kind == LIGHT_SPOT) {
-        a *= smoothstep(light.spot.x, light.spot.y, dot(-L, light.direction.xyz));
+        a *= spot_cone(light.spot, dot(-L, light.direction.xyz), falloff);
     }
     return light.color_kind.rgb * a;
 }

@@ -125,7 +125,8 @@ pub struct GpuLight {
     pub position_radius: [f32; 4],
     /// rgb: radiance scale; w: the `LIGHT_*` kind code, as a float.
     pub color_kind: [f32; 4],
-    /// xyz: the normalised direction the light travels (spot and directional); w is 0.
+    /// xyz: the normalised direction the light travels (spot and directional); w: the
+    /// `LIGHT_FALLOFF_*` code of its [`histencil_scene::Falloff`], as a float.
     pub direction: [f32; 4],
     /// Spot cone: `(cos outer, cos inner, tan outer, 0)`; zero for other kinds.
     pub spot: [f32; 4],
@@ -160,7 +161,7 @@ impl GpuLight {
         Self {
             position_radius: light.position.extend(light.radius).to_array(),
             color_kind: light.color.extend(kind_code(kind)).to_array(),
-            direction: direction.extend(0.0).to_array(),
+            direction: direction.extend(light.falloff.code() as f32).to_array(),
             spot,
         }
     }
@@ -219,6 +220,19 @@ const _: () = assert!(PUSH_CONSTANT_BYTES <= 128);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_shaders_falloff_codes_are_the_scenes() {
+        use histencil_scene::Falloff;
+        let all = [
+            Falloff::SquaredWindow,
+            Falloff::Gltf,
+            Falloff::InverseSquare,
+        ];
+        for (falloff, (_, code)) in all.into_iter().zip(crate::shader_consts::LIGHT_FALLOFFS) {
+            assert_eq!(falloff.code(), code, "{falloff:?}");
+        }
+    }
 
     /// The camera's own uniforms and those rebuilt from its matrices agree: the engine path and
     /// histencil's reconstruct the same rays.
