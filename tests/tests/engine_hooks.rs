@@ -354,10 +354,13 @@ fn an_engine_names_brdfs_and_the_lighting_gives_their_stencil_slots() {
             )
         };
         for (slot, brdf) in brdfs.iter().enumerate() {
+            let reference = desc.stencil_reference(*brdf);
             assert_eq!(
-                desc.stencil_reference(*brdf),
+                reference,
                 histencil_vk::gbuffer_stencil_reference(&layout, slot as u32)
             );
+            // One write mask for every BRDF: an engine's pipelines can bake it in.
+            assert_eq!(reference.unwrap().1, desc.stencil_write_mask());
         }
         assert_eq!(
             desc.stencil_reference(BrdfId::PennerSkin),

@@ -25,7 +25,7 @@
 //! ([`GBUFFER_FORMATS`]):
 //! ```no_run
 //! # use ash::vk;
-//! # use histencil::*;
+//! # use histencil::prelude::*;
 //! # unsafe fn light_a_frame(
 //! #     lent: BorrowedDevice,
 //! #     cmd: vk::CommandBuffer,
@@ -99,31 +99,42 @@ pub use histencil_model as model;
 pub use histencil_scene as scene;
 pub use histencil_vk as vk;
 
-// BRDFs (histencil's and an engine's own) and lights.
-pub use histencil_brdf::{Brdf, BrdfId, BrdfSet, EngineBrdfSpec, EngineParam};
-pub use histencil_scene::{Light, LightKind, Material, Mesh, ParticleLayout, ParticleSystem};
-pub use histencil_vk::{compile_brdf_set, BrdfModules};
+/// Every type an engine names, and nothing else: `use histencil::prelude::*;` brings no module
+/// (`vk`, `model`, `scene`, ...) and no `Result` into the engine's own namespace, where they
+/// would meet its own `vk` (ash's), `model` crate or `Result`. The crate root re-exports all of
+/// it too, beside the modules and [`Result`].
+pub mod prelude {
+    // BRDFs (histencil's and an engine's own) and lights.
+    pub use histencil_brdf::{Brdf, BrdfId, BrdfSet, EngineBrdfSpec, EngineParam};
+    pub use histencil_scene::{
+        Falloff, Light, LightKind, Material, Mesh, ParticleLayout, ParticleSystem,
+    };
+    pub use histencil_vk::{compile_brdf_set, BrdfModules};
 
-// Planning (no Vulkan).
-pub use histencil_model::{
-    plan_frame, Aabb, DepthConvention, FarPlane, FlushPolicy, FramePlan, LightShape, Perspective,
-    PlanError, PlanInputs, PlanSettings, StencilBits, StencilLayout, TechniqueChoice, View,
-    ViewDesc,
-};
+    // Planning (no Vulkan).
+    pub use histencil_model::{
+        plan_frame, Aabb, DepthConvention, FarPlane, FlushPolicy, FramePlan, LightShape,
+        Perspective, PlanError, PlanInputs, PlanSettings, StencilBits, StencilLayout,
+        TechniqueChoice, View, ViewDesc,
+    };
 
-// The device, the lighting, the hooks.
-pub use histencil_vk::{
-    aspect_of, gbuffer_stencil_reference, Backend, BorrowedDevice, BrdfSource, Cause, Context,
-    DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks, Error, HookSetLayout,
-    HookSets, ImageRef, ImageState, LightHooks, LightModules, LightingBreakdown, LightingDesc,
-    LightingFrame, LightingTargets, LutTables, MixedTiles, Result, StillInFlight, TileClassify,
-    TileSide, TileStats, TiledFrame, ValidationLog, ValidationMessage, GBUFFER_FORMATS,
-    REQUIREMENTS,
-};
+    // The device, the lighting, the hooks.
+    pub use histencil_vk::{
+        aspect_of, gbuffer_stencil_reference, Backend, BorrowedDevice, BrdfSource, Cause, Context,
+        DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks, Error,
+        HookSetLayout, HookSets, ImageRef, ImageState, LightHooks, LightModules, LightingBreakdown,
+        LightingDesc, LightingFrame, LightingTargets, LutTables, MixedTiles, StillInFlight,
+        TileClassify, TileSide, TileStats, TiledFrame, ValidationLog, ValidationMessage,
+        GBUFFER_FORMATS, REQUIREMENTS,
+    };
 
-// Lightmaps for translucent entities.
-pub use histencil_alpha::{plan_entities, ChoiceSettings, Viewer};
-pub use histencil_vk::{
-    mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame,
-    LightmapTimings,
-};
+    // Lightmaps for translucent entities.
+    pub use histencil_alpha::{plan_entities, ChoiceSettings, Viewer};
+    pub use histencil_vk::{
+        mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaLightmaps, AlphaLightmapsDesc,
+        LightmapFrame, LightmapTimings,
+    };
+}
+
+pub use histencil_vk::Result;
+pub use prelude::*;

@@ -11,8 +11,8 @@ use ash::vk;
 use glam::Vec3;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator};
 use gpu_allocator::{vulkan::AllocatorCreateDesc, MemoryLocation};
+use histencil::prelude::*;
 use histencil::vk::access::ImageAccess;
-use histencil::*;
 use std::sync::{Arc, Mutex};
 
 const EXTENT: vk::Extent2D = vk::Extent2D { width: 64, height: 64 };

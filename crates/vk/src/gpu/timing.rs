@@ -95,10 +95,12 @@ impl FrameTimings {
 
     /// The summed time of `passes` (those the frame ran; [`crate::Shading::lighting_passes`]
     /// for its lighting) without the hi-stencil emulator's bookkeeping, which lies inside the
-    /// lighting pass: the platform's technique (all of it on the native backend).
+    /// lighting pass: the platform's technique (all of it on the native backend). Never
+    /// negative: a frame with nothing to light is all bookkeeping, and the two timers' rounding
+    /// must not print it as `-0.000 ms`.
     pub fn technique_ms(&self, passes: &[&str]) -> f64 {
         let sum: f64 = passes.iter().filter_map(|p| self.pass_ms(p)).sum();
-        sum - self.bookkeeping_ms.unwrap_or(0.0)
+        (sum - self.bookkeeping_ms.unwrap_or(0.0)).max(0.0)
     }
 
     /// Per-pass median over frames of the same technique.

@@ -48,6 +48,16 @@ impl LightingDesc {
     pub fn stencil_reference(&self, brdf: BrdfId) -> Option<(u8, u8)> {
         gbuffer_stencil_reference(&self.layout, self.slot_of(brdf)?)
     }
+
+    /// The stencil write mask of every G-buffer draw, whatever its BRDF: the BRDF field and the
+    /// culling bit ([`LightingDesc::stencil_reference`]'s mask, one for all). An engine can bake
+    /// it into its G-buffer pipelines and set only the reference per draw
+    /// (`VK_DYNAMIC_STATE_STENCIL_REFERENCE`). Clear these bits to 0 before the G-buffer pass;
+    /// a pixel no surface covers keeps 0, slot 0's id, and is left unlit because the decode
+    /// hook returns false there (histencil's does at the far plane).
+    pub fn stencil_write_mask(&self) -> u8 {
+        self.layout.brdf_mask() | self.layout.culling_mask()
+    }
 }
 
 /// One frame's lighting.
@@ -107,6 +117,7 @@ pub fn gbuffer_stencil_reference(layout: &StencilLayout, slot: u32) -> Option<(u
     (slot < layout.brdfs_in_use()).then(|| {
         (
             layout.brdf_reference(slot),
+            // LightingDesc::stencil_write_mask's, which has no layout of its own to take.
             layout.brdf_mask() | layout.culling_mask(),
         )
     })
