@@ -233,3 +233,65 @@ fn targets_without_the_usage_their_recording_needs_are_refused_naming_it() {
         lighting.destroy().unwrap();
     });
 }
+
+/// A resize past the device's limits is refused with `DeviceLimit` before anything is made, and
+/// leaves the lighting as it was: past `maxImageDimension2D`, and (where the device's
+/// `maxStorageBufferRange` is below its largest square image's pixel count) a hi-stencil
+/// saved-stencil buffer past `maxStorageBufferRange`. Before, with no memory budget set, both
+/// returned `Ok(())` with validation messages. The lighting then resizes and records as ever.
+#[test]
+fn a_resize_past_the_devices_limits_is_refused_before_anything_is_made() {
+    on_a_lighting(|case| {
+        let Case {
+            engine,
+            mut lighting,
+            ..
+        } = case;
+        // SAFETY: the engine's instance and physical device are live.
+        let limits = unsafe {
+            engine
+                .instance
+                .get_physical_device_properties(engine.physical_device)
+        }
+        .limits;
+        let max = limits.max_image_dimension2_d;
+        let mut past = vec![vk::Extent2D {
+            width: max + 1,
+            height: 8,
+        }];
+        // One byte of saved stencil per pixel: the widest square past the storage range.
+        let side = (f64::from(limits.max_storage_buffer_range).sqrt() as u32 + 1).min(max);
+        if u64::from(side) * u64::from(side) > u64::from(limits.max_storage_buffer_range) {
+            past.push(vk::Extent2D {
+                width: side,
+                height: side,
+            });
+        }
+        for extent in past {
+            println!("resize to {}x{}", extent.width, extent.height);
+            match lighting.resize(extent) {
+                Err(e @ Error::DeviceLimit(_)) => {
+                    assert_eq!(e.cause(), Cause::Device);
+                    let m = e.to_string();
+                    assert!(
+                        m.contains("maxImageDimension2D") || m.contains("maxStorageBufferRange"),
+                        "{m}"
+                    );
+                }
+                other => panic!("a resize to {extent:?}: {other:?}"),
+            }
+            assert_eq!(
+                lighting.desc().extent,
+                SIZE,
+                "a refused resize changes nothing"
+            );
+        }
+        let bigger = vk::Extent2D {
+            width: 96,
+            height: 64,
+        };
+        lighting.resize(bigger).unwrap();
+        assert_eq!(lighting.desc().extent, bigger);
+        lighting.destroy().unwrap();
+    });
+}

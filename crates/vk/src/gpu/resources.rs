@@ -71,6 +71,16 @@ impl Buffer {
         usage: vk::BufferUsageFlags,
         location: MemoryLocation,
     ) -> Result<Self> {
+        // histencil binds its storage buffers whole, so one past the device's
+        // maxStorageBufferRange could never be bound: refused here, for every buffer, before
+        // anything is made (Vulkan would make it and leave the bind to the validation layer).
+        let range = u64::from(ctx.max_storage_buffer_range);
+        if usage.contains(vk::BufferUsageFlags::STORAGE_BUFFER) && size > range {
+            return Err(Error::DeviceLimit(format!(
+                "buffer `{name}` needs {size} bytes, past this device's maxStorageBufferRange \
+                 ({range})"
+            )));
+        }
         let info = vk::BufferCreateInfo::default()
             .size(size.max(4))
             .usage(usage)
@@ -222,6 +232,15 @@ impl Image {
         usage: vk::ImageUsageFlags,
         mip_levels: u32,
     ) -> Result<Self> {
+        // Refused here for every image, before anything is made: Vulkan leaves an image past
+        // maxImageDimension2D to the validation layer.
+        let max = ctx.max_image_dimension;
+        if extent.width > max || extent.height > max {
+            return Err(Error::DeviceLimit(format!(
+                "image `{name}` of {}x{} is past this device's maxImageDimension2D ({max})",
+                extent.width, extent.height
+            )));
+        }
         let aspect = crate::gpu::access::aspect_of(format);
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)

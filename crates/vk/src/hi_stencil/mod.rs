@@ -205,6 +205,11 @@ impl HiStencilSurface {
         Ok(())
     }
 
+    /// The extent its surfaces are made for.
+    pub fn extent(&self) -> vk::Extent2D {
+        self.extent
+    }
+
     /// The surface for a new `extent`: the tile surfaces, the touch image and the saved-stencil
     /// buffer made anew, the update pipeline and sets kept (the sets re-pointed). A failure
     /// leaves the surface as it was. The GPU has finished every frame that used it.

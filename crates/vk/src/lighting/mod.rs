@@ -150,6 +150,9 @@ pub struct DeferredLighting<C: Deref<Target = Context>> {
     /// The slots recorded into and not yet declared finished (`slot_finished`): their buffers,
     /// sets and stencil views belong to those frames.
     pending: PendingSlots,
+    /// Set when a resize failed half way and undoing it failed too (an allocation, twice):
+    /// its parts are at two extents, so every recording is refused until a resize succeeds.
+    torn: Option<String>,
 }
 
 impl<C: Deref<Target = Context>> DeferredLighting<C> {
@@ -186,6 +189,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 "DeferredLighting",
                 "buffers, sets and stencil view",
             ),
+            torn: None,
             hi_stencil: None,
             volumes: None,
             tiled: Vec::new(),
@@ -207,12 +211,17 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// Makes the lighting fit targets of a new `extent`, keeping every pipeline (viewport and
     /// scissor are dynamic state; the tile side, not the extent, shapes the tiled kernels): the
     /// hi-stencil tile surface and the tiled technique's tile buffers are made anew, nothing
-    /// else. A resize to the same extent does nothing; a failure leaves the lighting as it was.
+    /// else. A resize to the same extent does nothing. All or nothing: an extent past the
+    /// device's limits is refused before anything is made, and a part that cannot be made
+    /// (memory) undoes the parts already resized, so the lighting stays at its old extent.
     ///
     /// # Errors
-    /// [`Error::BadSetup`] for a zero extent; [`Error::InFlight`] while a slot recorded into
-    /// is not declared finished ([`DeferredLighting::slot_finished`]: wait for your frames in
-    /// flight first, as for any resize of your own targets); allocation errors.
+    /// [`Error::BadSetup`] for a zero extent; [`Error::DeviceLimit`] for an extent whose images
+    /// pass `maxImageDimension2D` or whose buffers pass `maxStorageBufferRange`;
+    /// [`Error::InFlight`] while a slot recorded into is not declared finished
+    /// ([`DeferredLighting::slot_finished`]: wait for your frames in flight first, as for any
+    /// resize of your own targets); allocation errors. Should undoing fail as well (memory
+    /// again), every recording is refused until a resize succeeds.
     pub fn resize(&mut self, extent: vk::Extent2D) -> Result<()> {
         self.pending.refuse_while_any("resize")?;
         if extent.width == 0 || extent.height == 0 {
@@ -221,15 +230,43 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 extent.width, extent.height
             )));
         }
-        if extent == self.desc.extent {
+        if extent == self.desc.extent && self.torn.is_none() {
             return Ok(());
         }
+        let max = self.ctx.max_image_dimension;
+        if extent.width > max || extent.height > max {
+            return Err(Error::DeviceLimit(format!(
+                "a {}x{} lighting extent is past this device's maxImageDimension2D ({max})",
+                extent.width, extent.height
+            )));
+        }
+        let old = self.desc.extent;
+        if let Err(e) = self.resize_parts(extent) {
+            // Each part resizes whole or not at all; put back those that did.
+            if let Err(undo) = self.resize_parts(old) {
+                self.torn = Some(format!(
+                    "a resize to {}x{} failed ({e}), and so did undoing it ({undo})",
+                    extent.width, extent.height
+                ));
+            }
+            return Err(e);
+        }
+        self.desc.extent = extent;
+        self.torn = None;
+        Ok(())
+    }
+
+    /// Resizes every part made for an extent to `extent`; stops at the first that fails, which
+    /// is left as it was (each part's own resize is all or nothing).
+    fn resize_parts(&mut self, extent: vk::Extent2D) -> Result<()> {
         let ctx: &Context = &self.ctx;
         if self.desc.hi_stencil {
             let surface = self.hi_stencil.as_mut().expect("made with the lighting");
-            surface.resize(ctx, extent)?;
-            let buffers = surface.light_set_buffers();
-            write_storage_buffers(ctx, self.hi_stencil_set, &buffers);
+            if surface.extent() != extent {
+                surface.resize(ctx, extent)?;
+                let buffers = surface.light_set_buffers();
+                write_storage_buffers(ctx, self.hi_stencil_set, &buffers);
+            }
         }
         for (_, tiled) in &mut self.tiled {
             tiled.resize(ctx, extent)?;
@@ -237,8 +274,18 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         for (_, depth_id) in &mut self.depth_id {
             depth_id.resize(ctx, extent)?;
         }
-        self.desc.extent = extent;
         Ok(())
+    }
+
+    /// Refuses a recording while a failed resize left the parts at two extents.
+    fn refuse_if_torn(&self) -> Result<()> {
+        match &self.torn {
+            None => Ok(()),
+            Some(why) => Err(Error::BadFrame(format!(
+                "{why}: the lighting's parts are at two extents; resize it again before \
+                 recording"
+            ))),
+        }
     }
 }
 
@@ -352,6 +399,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let needs = UsageNeeds::light_passes(&self.desc, frame.plan, hierarchy.is_some());
         check_usage(targets, &needs)?;
         self.pending.refuse_slot(frame.slot)?;
+        self.refuse_if_torn()?;
         if frame.plan.uses_depth_bounds() && !self.ctx.depth_bounds() {
             return Err(Error::BadFrame(
                 "the plan confines lights to their depth ranges (FramePlan::with_depth_bounds), \

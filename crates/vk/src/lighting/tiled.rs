@@ -101,6 +101,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let needs = UsageNeeds::tiled(&self.desc);
         check_usage(targets, &needs)?;
         self.pending.refuse_slot(frame.slot)?;
+        self.refuse_if_torn()?;
         if let Some(why) = self.desc.hooks.tiled_refusal() {
             return Err(bad(format!(
                 "the tiled technique's kernels cannot bind the hooks: {why}"
