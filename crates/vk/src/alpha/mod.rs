@@ -560,11 +560,8 @@ impl<'c> AlphaLighting<'c> {
             sampler: Some(self.sampler),
             pipelines: self.pipelines.iter().flatten().flatten().copied().collect(),
         };
-        // SAFETY: the wait needs only that nothing else uses the device's queues meanwhile: the
-        // one caller is the renderer's Drop, which has just made the same wait (see there).
-        unsafe {
-            let _ = ctx.device.device_wait_idle();
-        }
+        // The one caller is the renderer's Drop, which has just made the same wait (see there).
+        let _ = ctx.wait_idle();
         parts.destroy(ctx);
         self.lightmap.destroy(ctx);
         self.direction_map.destroy(ctx);

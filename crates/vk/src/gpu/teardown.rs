@@ -115,15 +115,12 @@ impl InFlight {
     /// Waits for the device to go idle if the object may still be in use.
     pub fn wait(&self, ctx: &Context) {
         if self.0 {
-            // SAFETY: `vkDeviceWaitIdle` needs every queue of the device externally
-            // synchronised. The callers are the engine-facing objects' Drops, whose condition
-            // on a lent device is `Context::from_raw`'s # Safety (nothing else uses a queue
-            // while one that recorded is dropped). On an owned context only histencil submits
-            // (`submit_once`, a renderer's frame), and nothing here stops another thread
-            // sharing the context from doing so during the wait.
-            unsafe {
-                let _ = ctx.device.device_wait_idle();
-            }
+            // `vkDeviceWaitIdle` needs every queue of the device externally synchronised:
+            // histencil's own submits (`submit_once`, a renderer's frame) wait for the queue's
+            // lock (`Context::wait_idle`), and on a lent device the engine's are kept off by
+            // `Context::from_raw`'s # Safety (nothing else uses a queue while one that recorded
+            // is dropped).
+            let _ = ctx.wait_idle();
         }
     }
 }

@@ -46,15 +46,14 @@ pub(crate) fn submit_once(
         ctx.end_label(cmd);
         // SAFETY: `cmd` is recording, outside any rendering (`record` ends what it begins), and
         // its labels are closed. The submit names only `cmd` and the unsignalled, unused
-        // `fence`; `cmds` and `submit` live until it returns. `ctx.queue` is externally
-        // synchronised by `Context::from_raw`'s # Safety on a lent device; on an owned one
-        // nothing stops two threads sharing the context from submitting at once.
+        // `fence`; `cmds` and `submit` live until it returns. `Context::submit` holds the
+        // queue's lock against histencil's other submits, and `Context::from_raw`'s # Safety
+        // keeps a lent device's other users off.
         unsafe {
             d.end_command_buffer(cmd).call("vkEndCommandBuffer")?;
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
             let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            d.queue_submit2(ctx.queue, &[submit], fence)
-                .call("vkQueueSubmit2")?;
+            ctx.submit(&[submit], fence).call("vkQueueSubmit2")?;
             pending = true;
             // Creation waits for its own one-off work, as buffer creation does; frames never
             // come through here.
@@ -69,8 +68,7 @@ pub(crate) fn submit_once(
         // The wait failed (a timeout, a lost device) with `cmd` submitted: wait for the whole
         // device before freeing what `cmd` and the caller's buffers may still be used by (on a
         // lost device this returns at once, and nothing runs any more).
-        // SAFETY: a device wait; the queue's external synchronisation is as for the submit.
-        let _ = unsafe { d.device_wait_idle() };
+        let _ = ctx.wait_idle();
     }
     // SAFETY: the fence and the pool (freeing `cmd` with it) were made above and are used by
     // nothing else, and the GPU is done with them: the fence wait succeeded, or nothing was

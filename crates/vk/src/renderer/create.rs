@@ -274,14 +274,15 @@ impl Destroy for FrameSubmission {
 impl Drop for Renderer<'_> {
     fn drop(&mut self) {
         let ctx = self.ctx;
+        // The wait needs every queue of the device unused meanwhile: this renderer submits
+        // nothing now, other renderers and lightings on the context wait for the queue's lock
+        // (`Context::wait_idle`), and a lent device's other users are kept off by
+        // `Context::from_raw`'s # Safety.
+        let _ = ctx.wait_idle();
         // SAFETY: the fence and the pool were made from this device by `FrameSubmission::new`
-        // and are destroyed only here; the wait leaves the GPU done with them (a lost device,
-        // whose error is ignored, runs nothing more). The wait needs every queue of the device
-        // unused meanwhile: this renderer submits nothing now; a lent device's other users are
-        // kept off by `Context::from_raw`'s # Safety (nothing guards an owned context shared
-        // by renderers on several threads).
+        // and are destroyed only here; the wait above left the GPU done with them (a lost
+        // device, whose error is ignored, runs nothing more).
         unsafe {
-            let _ = ctx.device.device_wait_idle();
             ctx.device.destroy_fence(self.fence, None);
             ctx.device.destroy_command_pool(self.command_pool, None);
         }

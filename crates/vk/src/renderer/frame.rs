@@ -234,18 +234,16 @@ impl Renderer<'_> {
         let (ctx, cmd) = (self.ctx, self.cmd);
         // SAFETY: `cmd` is recording (`begin_commands`) and outside rendering: every pass ends
         // its own. The fence is this renderer's, unsignalled (reset after each wait, created
-        // unsignalled) and not in use by another submit. The queue's external synchronisation
-        // is `Context::from_raw`'s # Safety on a lent device; on an owned one nothing stops two
-        // renderers sharing the context from submitting at once from two threads.
+        // unsignalled) and not in use by another submit. `Context::submit` holds the queue's
+        // lock against histencil's other submits (renderers sharing the context on several
+        // threads), and `Context::from_raw`'s # Safety keeps a lent device's other users off.
         unsafe {
             ctx.device
                 .end_command_buffer(cmd)
                 .call("vkEndCommandBuffer")?;
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
             let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            ctx.device
-                .queue_submit2(ctx.queue, &[submit], self.fence)
-                .call("vkQueueSubmit2")?;
+            ctx.submit(&[submit], self.fence).call("vkQueueSubmit2")?;
             // Until the wait succeeds, a failure of it is what every later frame reports.
             self.unfinished.set(Some(vk::Result::TIMEOUT));
             ctx.step("waiting on the GPU");

@@ -143,6 +143,10 @@ pub struct Context {
     pub(crate) device: ash::Device,
     pub(crate) queue: vk::Queue,
     pub(crate) queue_family: u32,
+    /// Held by every submit and device-wide wait histencil makes: Vulkan requires a queue's
+    /// host access to be externally synchronised, and renderers and lightings sharing one
+    /// context may submit from several threads ([`Context::submit`]).
+    queue_lock: Mutex<()>,
     pub(crate) allocator: ManuallyDrop<Arc<Mutex<Allocator>>>,
     debug_instance: Option<ash::ext::debug_utils::Instance>,
     debug_device: Option<ash::ext::debug_utils::Device>,
@@ -258,6 +262,34 @@ impl MemoryAccount {
 }
 
 impl Context {
+    /// Submits `submits` to the context's queue under the queue's lock (`queue_lock`), so no
+    /// two of histencil's submits, nor a submit and a device-wide wait, meet on the queue.
+    ///
+    /// # Safety
+    /// As `vkQueueSubmit2`: the command buffers are executable, the fence unsignalled and not
+    /// in use, and what the submits name lives until they complete. On a lent device the
+    /// engine's own access to the queue is synchronised with histencil's
+    /// (`Context::from_raw`'s # Safety).
+    pub(crate) unsafe fn submit(
+        &self,
+        submits: &[vk::SubmitInfo2],
+        fence: vk::Fence,
+    ) -> ash::prelude::VkResult<()> {
+        let _queue = self.queue_lock.lock().unwrap_or_else(|p| p.into_inner());
+        // SAFETY: the caller's, above; the lock makes this thread's access the only one of
+        // histencil's.
+        unsafe { self.device.queue_submit2(self.queue, submits, fence) }
+    }
+
+    /// `vkDeviceWaitIdle` under the queue's lock: it counts as an access to every queue of the
+    /// device.
+    pub(crate) fn wait_idle(&self) -> ash::prelude::VkResult<()> {
+        let _queue = self.queue_lock.lock().unwrap_or_else(|p| p.into_inner());
+        // SAFETY: the device is live; histencil's own queue access is held off by the lock,
+        // an engine's by `Context::from_raw`'s # Safety.
+        unsafe { self.device.device_wait_idle() }
+    }
+
     /// A context on an engine's device. Nothing is created but the debug-utils function table;
     /// dropping the context destroys nothing of the engine's. Validation messages go to the
     /// engine's messenger ([`ValidationLog::messenger_create_info`] routes them into a log), so
@@ -355,6 +387,7 @@ impl Context {
             limits: crate::gpu::limits::DeviceLimits::new(&props.limits),
             limits_used: Default::default(),
             set_counts: Default::default(),
+            queue_lock: Mutex::new(()),
             steps: Default::default(),
             depth_bounds: false,
             quirks,

@@ -367,6 +367,7 @@ impl Context {
             limits: device_limits,
             limits_used: Default::default(),
             set_counts: Default::default(),
+            queue_lock: Mutex::new(()),
             steps: Default::default(),
             depth_bounds,
             quirks,
