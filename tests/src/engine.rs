@@ -111,7 +111,7 @@ impl Engine {
             physical_device: self.physical_device,
             queue_family,
             queue: unsafe { self.device.get_device_queue(self.queue_family, 0) },
-            allocator: self.allocator.clone(),
+            allocator: Some(self.allocator.clone()),
             debug_utils: true,
             depth_stencil: None,
             memory_budget: None,

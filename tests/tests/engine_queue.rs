@@ -183,3 +183,65 @@ fn two_renderers_on_one_context_render_from_two_threads() {
         });
     });
 }
+
+/// An engine that lends no allocator (it allocates with VMA, or its own code) gets histencil's
+/// private one on its device, beside the engine's own: the engine holds images of its own
+/// allocator's while histencil's lighting, LUT tables and renderer allocate through the private
+/// one, the frame is the one a context lent the engine's allocator renders, bit for bit, nothing
+/// of histencil's lands in the engine's allocator, and everything is freed with the context
+/// (the validation layer reports any memory left when the engine destroys its device).
+#[test]
+fn a_lent_device_without_an_allocator_gets_a_private_one() {
+    use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+    let scene = histencil_scene::embedded("brdfs-3").unwrap();
+    let stencil = Technique::Stencil {
+        backend: Backend::Ps3,
+        flush: FlushPolicy::Auto,
+    };
+    let engine = Engine::start();
+    let own = engine.image(
+        "engine-own-image",
+        vk::Format::R8G8B8A8_UNORM,
+        vk::Extent2D {
+            width: 64,
+            height: 64,
+        },
+        vk::ImageUsageFlags::SAMPLED,
+    );
+    let engines_bytes = || {
+        engine
+            .allocator
+            .lock()
+            .unwrap()
+            .generate_report()
+            .total_allocated_bytes
+    };
+    let held = engines_bytes();
+    let frame = |lent: BorrowedDevice| {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(lent) }.expect("context");
+        let lighting = DeferredLighting::new(&ctx, &lighting_desc(&ctx)).expect("lighting");
+        let tables = LutTables::new(&ctx, &report_materials(), 4).expect("tables");
+        let mut renderer = Renderer::new(&ctx, scene.clone(), 48, 32).unwrap();
+        let image = renderer.render(stencil, Readback::ALL).unwrap().images.ldr;
+        assert!(ctx.memory_in_use() > 0);
+        drop((renderer, lighting));
+        // SAFETY: no command buffer was recorded with them.
+        unsafe { tables.destroy() };
+        assert!(ctx.validation_log().is_empty(), "messages go to the engine");
+        image.unwrap()
+    };
+    let theirs = frame(engine.lend(engine.queue_family));
+    let private = frame(BorrowedDevice {
+        allocator: None,
+        ..engine.lend(engine.queue_family)
+    });
+    assert!(private == theirs, "the frames differ");
+    assert_eq!(
+        engines_bytes(),
+        held,
+        "histencil left nothing in the engine's allocator"
+    );
+    engine.free_image(own);
+    engine.destroy().assert_clean();
+}

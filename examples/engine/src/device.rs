@@ -148,7 +148,7 @@ impl Gpu {
             physical_device: self.physical_device,
             queue_family: self.queue_family,
             queue: self.queue,
-            allocator: self.allocator.clone(),
+            allocator: Some(self.allocator.clone()),
             debug_utils: true,
             depth_stencil: Some(DepthStencilFormat::D32S8),
             // The most of this engine's memory histencil's lighting and lightmaps may hold.

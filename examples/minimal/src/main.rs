@@ -93,7 +93,7 @@ unsafe fn run() -> Fallible<(String, bool)> {
         physical_device,
         queue_family,
         queue,
-        allocator: allocator.clone(),
+        allocator: Some(allocator.clone()),
         debug_utils: true,
         depth_stencil: Some(DepthStencilFormat::D32S8),
         memory_budget: None,

@@ -112,9 +112,16 @@ pub struct BorrowedDevice {
     /// The queue of `queue_family` that histencil's own tools (the renderer, the evaluators)
     /// submit to; the engine-facing parts submit nothing.
     pub queue: vk::Queue,
-    /// The engine's allocator for `device`; histencil's allocations are named `histencil`-side
-    /// and freed before its objects are dropped.
-    pub allocator: Arc<Mutex<Allocator>>,
+    /// The engine's allocator for `device`, if it has one (gpu-allocator's): histencil's
+    /// allocations are named `histencil`-side and freed before its objects are dropped.
+    /// `None`: histencil allocates through a private allocator of its own on `device`, freed
+    /// with the context. That is sound beside whatever the engine allocates with (VMA, its
+    /// own): each allocator holds `VkDeviceMemory` objects of its own and sub-allocates only
+    /// within them, so nothing aliases. What it costs: memory blocks of its own (32 MiB
+    /// device-local, 8 MiB host-visible, each allocated when first needed, with
+    /// [`BorrowedDevice::memory_budget`] bounding what histencil takes in all) and a few of the
+    /// device's `maxMemoryAllocationCount` (at least 4096).
+    pub allocator: Option<Arc<Mutex<Allocator>>>,
     /// `VK_EXT_debug_utils` is enabled on `instance`: histencil then names its objects and
     /// labels its passes (the engine's messenger receives any validation message).
     pub debug_utils: bool,
@@ -261,6 +268,29 @@ impl MemoryAccount {
     }
 }
 
+/// histencil's own allocator on an engine's device that lends none
+/// ([`BorrowedDevice::allocator`]): blocks smaller than gpu-allocator's defaults (256 and 64
+/// MiB), since it sits beside the engine's own memory.
+fn private_allocator(
+    instance: &ash::Instance,
+    device: &ash::Device,
+    physical_device: vk::PhysicalDevice,
+) -> Result<Allocator> {
+    const MIB: u64 = 1 << 20;
+    Allocator::new(&gpu_allocator::vulkan::AllocatorCreateDesc {
+        instance: instance.clone(),
+        device: device.clone(),
+        physical_device,
+        debug_settings: Default::default(),
+        buffer_device_address: false,
+        allocation_sizes: gpu_allocator::AllocationSizes::new(32 * MIB, 8 * MIB),
+    })
+    .map_err(|e| Error::Allocation {
+        name: "histencil's private allocator".into(),
+        message: e.to_string(),
+    })
+}
+
 impl Context {
     /// Submits `submits` to the context's queue under the queue's lock (`queue_lock`), so no
     /// two of histencil's submits, nor a submit and a device-wide wait, meet on the queue.
@@ -306,7 +336,7 @@ impl Context {
     ///   [`REQUIREMENTS`] enabled, and `queue` is a queue of `queue_family` on it;
     /// - `instance` was created with an `apiVersion` of 1.3 or later, as [`REQUIREMENTS`] asks:
     ///   histencil queries and records through it with Vulkan 1.1 to 1.3 commands;
-    /// - `allocator` was created for `device`;
+    /// - `allocator`, if given, was created for `device`;
     /// - `debug_utils` is true only if `VK_EXT_debug_utils` is enabled on `instance`;
     /// - while histencil's owned-device tools ([`crate::Renderer`]) submit to `queue` and wait,
     ///   nothing else uses that queue (Vulkan requires queues to be externally synchronised);
@@ -329,6 +359,14 @@ impl Context {
             memory_budget,
             pipeline_cache,
         } = lent;
+        let allocator = match allocator {
+            Some(engines) => engines,
+            None => Arc::new(Mutex::new(private_allocator(
+                &instance,
+                &device,
+                physical_device,
+            )?)),
+        };
         // SAFETY: `missing`'s # Safety, by this fn's: `physical_device` belongs to the live
         // `instance`, which was created for Vulkan 1.3.
         let missing = unsafe { REQUIREMENTS.missing(&instance, physical_device) };
@@ -585,7 +623,9 @@ impl Context {
 impl Drop for Context {
     fn drop(&mut self) {
         if !self.owned {
-            // The engine's allocator, device and instance stay; only our reference goes.
+            // The engine's allocator, device and instance stay; only our reference goes. A
+            // private allocator (the engine lent none) goes with it, freeing its blocks while
+            // the engine's device still lives (`from_raw`'s # Safety).
             // SAFETY: dropped once, here, and never used again.
             unsafe { ManuallyDrop::drop(&mut self.allocator) };
             return;
