@@ -247,7 +247,15 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
 
     // A crash tearing the device down, after every case reported, fails the run as the worker's
     // own device row: the cases all passed, the verdict does not.
-    let o = command(&SLICE)
+    // A few cases suffice: the crash comes after the last.
+    let few = [
+        "--quick",
+        "--scene",
+        "brdfs-3",
+        "--filter",
+        "ps3-auto-p00-lightmap-d32s8-7x5",
+    ];
+    let o = command(&few)
         .args(["--jobs", "1", "--inject-fault", "crash=device/teardown-d32"])
         .arg("--out")
         .arg(dir.join("teardown"))
@@ -264,7 +272,7 @@ fn a_hung_case_times_out_a_crashed_one_crashes_and_the_run_goes_on() {
     let passed = teardown
         .iter()
         .filter(|(n, s)| n.starts_with("brdfs-3/") && s == "Pass");
-    assert_eq!(passed.count(), 65, "{teardown:?}");
+    assert_eq!(passed.count(), 4, "{teardown:?}");
 
     // --max-fails stops the run at the first failing case, and says so.
     let json = dir.join("max-fails.json");
