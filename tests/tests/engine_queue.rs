@@ -152,6 +152,17 @@ fn the_parts_can_move_between_threads() {
     sendable::<EngineRenderer>();
 }
 
+/// One PS3-like stencil frame of `brdfs-3`, tonemapped: what the two tests below compare.
+fn stencil_frame(renderer: &mut histencil_vk::Renderer) -> image::RgbaImage {
+    use histencil_vk::{Backend, FlushPolicy, Readback, Technique};
+    let stencil = Technique::Stencil {
+        backend: Backend::Ps3,
+        flush: FlushPolicy::Auto,
+    };
+    let images = renderer.render(stencil, Readback::ALL).unwrap().images;
+    images.ldr.unwrap()
+}
+
 /// Two renderers sharing one owned context render from two threads at once: histencil's submits
 /// and device-wide waits take the context's queue lock (`Context::submit`), as Vulkan requires a
 /// queue's host access to be externally synchronised (the validation layer's thread-safety
@@ -159,16 +170,9 @@ fn the_parts_can_move_between_threads() {
 /// of each thread is the frame one renderer makes alone.
 #[test]
 fn two_renderers_on_one_context_render_from_two_threads() {
-    use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+    use histencil_vk::Renderer;
     let scene = histencil_scene::embedded("brdfs-3").unwrap();
-    let stencil = Technique::Stencil {
-        backend: Backend::Ps3,
-        flush: FlushPolicy::Auto,
-    };
-    let frame = |renderer: &mut Renderer| {
-        let images = renderer.render(stencil, Readback::ALL).unwrap().images;
-        images.ldr.unwrap()
-    };
+    let frame = stencil_frame;
     histencil_tests::with_validated_context(|ctx| {
         let alone = frame(&mut Renderer::new(ctx, scene.clone(), 48, 32).unwrap());
         std::thread::scope(|threads| {
@@ -192,12 +196,8 @@ fn two_renderers_on_one_context_render_from_two_threads() {
 /// (the validation layer reports any memory left when the engine destroys its device).
 #[test]
 fn a_lent_device_without_an_allocator_gets_a_private_one() {
-    use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
+    use histencil_vk::Renderer;
     let scene = histencil_scene::embedded("brdfs-3").unwrap();
-    let stencil = Technique::Stencil {
-        backend: Backend::Ps3,
-        flush: FlushPolicy::Auto,
-    };
     let engine = Engine::start();
     let own = engine.image(
         "engine-own-image",
@@ -223,13 +223,13 @@ fn a_lent_device_without_an_allocator_gets_a_private_one() {
         let lighting = DeferredLighting::new(&ctx, &lighting_desc(&ctx)).expect("lighting");
         let tables = LutTables::new(&ctx, &report_materials(), 4).expect("tables");
         let mut renderer = Renderer::new(&ctx, scene.clone(), 48, 32).unwrap();
-        let image = renderer.render(stencil, Readback::ALL).unwrap().images.ldr;
+        let image = stencil_frame(&mut renderer);
         assert!(ctx.memory_in_use() > 0);
         drop((renderer, lighting));
         // SAFETY: no command buffer was recorded with them.
         unsafe { tables.destroy() };
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
-        image.unwrap()
+        image
     };
     let theirs = frame(engine.lend(engine.queue_family));
     let private = frame(BorrowedDevice {

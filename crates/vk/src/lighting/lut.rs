@@ -84,14 +84,7 @@ impl<C: Deref<Target = Context>> LutTables<C> {
         if bytes > limit {
             return Err(Error::LutTooLarge { bytes, limit });
         }
-        let luts = if materials.iter().all(|b| !matches!(b, Brdf::Engine { .. })) {
-            materials
-                .iter()
-                .map(|b| Lut::bake(*b, resolution))
-                .collect::<Result<Vec<_>, _>>()?
-        } else {
-            bake_with_glsl(&ctx, modules, materials, resolution)?
-        };
+        let luts = bake(&ctx, modules, materials, resolution)?;
         let mut headers = Vec::with_capacity(luts.len());
         let mut values: Vec<f32> = Vec::new();
         for lut in &luts {
@@ -177,34 +170,42 @@ const BAKE_BATCH: usize = 1 << 20;
 
 /// Each material's table: a built-in's baked from its reference on the CPU, an engine BRDF's
 /// evaluated at the grid points by the set's own `brdf_eval.comp` (the function every
-/// technique shades with, white tint: a tabulable BRDF has no white part).
-fn bake_with_glsl(
+/// technique shades with, white tint: a tabulable BRDF has no white part). The evaluator is
+/// made at the first engine BRDF, so histencil's own tables touch neither pipeline nor queue.
+fn bake(
     ctx: &Context,
     modules: &'static BrdfModules,
     materials: &[Brdf],
     resolution: u32,
 ) -> Result<Vec<Lut>> {
-    let mut evaluator = BrdfEvaluator::with_module(ctx, modules.brdf_eval)?;
+    let mut evaluator: Option<BrdfEvaluator> = None;
+    let mut on_gpu = |b: Brdf| -> Result<Lut> {
+        let evaluator = match &mut evaluator {
+            Some(e) => e,
+            None => evaluator.insert(BrdfEvaluator::with_module(ctx, modules.brdf_eval)?),
+        };
+        let grid = Lut::grid(b, resolution)?;
+        let mut values = Vec::with_capacity(grid.len());
+        for batch in grid.chunks(BAKE_BATCH) {
+            let cases: Vec<(Brdf, [V3<f32>; 4])> = batch
+                .iter()
+                .map(|(dirs, at)| (*at, dirs.map(|d| d.map(|x| x as f32))))
+                .collect();
+            let parts = evaluator.evaluate(ctx, &cases)?;
+            values.extend(parts.into_iter().map(|p| p.tinted));
+        }
+        Ok(Lut::from_values(b, resolution, values)?)
+    };
     let baked = materials
         .iter()
-        .map(|b| {
-            if !matches!(b, Brdf::Engine { .. }) {
-                return Ok(Lut::bake(*b, resolution)?);
-            }
-            let grid = Lut::grid(*b, resolution)?;
-            let mut values = Vec::with_capacity(grid.len());
-            for batch in grid.chunks(BAKE_BATCH) {
-                let cases: Vec<(Brdf, [V3<f32>; 4])> = batch
-                    .iter()
-                    .map(|(dirs, at)| (*at, dirs.map(|d| d.map(|x| x as f32))))
-                    .collect();
-                let parts = evaluator.evaluate(ctx, &cases)?;
-                values.extend(parts.into_iter().map(|p| p.tinted));
-            }
-            Ok(Lut::from_values(*b, resolution, values)?)
+        .map(|b| match b {
+            Brdf::Engine { .. } => on_gpu(*b),
+            _ => Ok(Lut::bake(*b, resolution)?),
         })
         .collect();
-    evaluator.destroy(ctx);
+    if let Some(mut e) = evaluator {
+        e.destroy(ctx);
+    }
     baked
 }
 

@@ -268,25 +268,24 @@ impl MemoryAccount {
     }
 }
 
-/// histencil's own allocator on an engine's device that lends none
-/// ([`BorrowedDevice::allocator`]): blocks smaller than gpu-allocator's defaults (256 and 64
-/// MiB), since it sits beside the engine's own memory.
-fn private_allocator(
+/// A gpu-allocator allocator on `device` with blocks of `sizes`: an owned context's, or the
+/// private one of a lent device whose engine lends none ([`BorrowedDevice::allocator`]).
+pub(super) fn make_allocator(
     instance: &ash::Instance,
     device: &ash::Device,
     physical_device: vk::PhysicalDevice,
+    sizes: gpu_allocator::AllocationSizes,
 ) -> Result<Allocator> {
-    const MIB: u64 = 1 << 20;
     Allocator::new(&gpu_allocator::vulkan::AllocatorCreateDesc {
         instance: instance.clone(),
         device: device.clone(),
         physical_device,
         debug_settings: Default::default(),
         buffer_device_address: false,
-        allocation_sizes: gpu_allocator::AllocationSizes::new(32 * MIB, 8 * MIB),
+        allocation_sizes: sizes,
     })
     .map_err(|e| Error::Allocation {
-        name: "histencil's private allocator".into(),
+        name: "allocator".into(),
         message: e.to_string(),
     })
 }
@@ -359,14 +358,6 @@ impl Context {
             memory_budget,
             pipeline_cache,
         } = lent;
-        let allocator = match allocator {
-            Some(engines) => engines,
-            None => Arc::new(Mutex::new(private_allocator(
-                &instance,
-                &device,
-                physical_device,
-            )?)),
-        };
         // SAFETY: `missing`'s # Safety, by this fn's: `physical_device` belongs to the live
         // `instance`, which was created for Vulkan 1.3.
         let missing = unsafe { REQUIREMENTS.missing(&instance, physical_device) };
@@ -386,6 +377,18 @@ impl Context {
         }
         let depth_stencil_named = depth_stencil.is_some();
         let depth_stencil = pick_depth_stencil_format(&instance, physical_device, depth_stencil)?;
+        // Once the device is known to fit: a private allocator of histencil's own when the
+        // engine lends none, with blocks smaller than gpu-allocator's defaults (256 and 64 MiB),
+        // since it sits beside the engine's own memory.
+        let allocator = match allocator {
+            Some(engines) => engines,
+            None => {
+                const MIB: u64 = 1 << 20;
+                let sizes = gpu_allocator::AllocationSizes::new(32 * MIB, 8 * MIB);
+                let private = make_allocator(&instance, &device, physical_device, sizes)?;
+                Arc::new(Mutex::new(private))
+            }
+        };
         // SAFETY: `physical_device` belongs to the live `instance` (this fn's # Safety).
         let props = unsafe { instance.get_physical_device_properties(physical_device) };
         let device_name = props

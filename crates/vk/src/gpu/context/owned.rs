@@ -7,7 +7,6 @@ use crate::gpu::debug::ValidationLog;
 use crate::gpu::error::{Error, Result, VkCall};
 use crate::gpu::requirements::REQUIREMENTS;
 use ash::vk;
-use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::CStr;
 use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex};
@@ -288,18 +287,8 @@ impl Context {
         let debug_device =
             debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
 
-        let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: instance.clone(),
-            device: device.clone(),
-            physical_device,
-            debug_settings: Default::default(),
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        })
-        .map_err(|e| Error::Allocation {
-            name: "allocator".into(),
-            message: e.to_string(),
-        })?;
+        let allocator =
+            super::make_allocator(&instance, &device, physical_device, Default::default())?;
 
         // From here the context owns every handle and its Drop destroys them.
         partial.device = None;
