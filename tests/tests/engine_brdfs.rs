@@ -279,10 +279,38 @@ fn the_lab_measures_the_engine_brdfs() {
     let modules = histencil_vk::compile_brdf_set(&BrdfSet::load(&dir).unwrap()).unwrap();
     let sampling = histencil_lab::stats::Sampling::rounds(2);
     with_validated_context(|ctx| {
-        let c = histencil_lab::calibrate_with(ctx, (64, 36), modules, &sampling, &mut |_| {})
-            .unwrap()
-            .costs;
+        let calibration =
+            histencil_lab::calibrate_with(ctx, (64, 36), modules, &sampling, &mut |_| {}).unwrap();
+        let c = calibration.costs;
         assert!(c.shade_ms > 0.0 && c.pass_overhead_ms.is_finite(), "{c:?}");
+        // Each engine BRDF weighed on its own (and the wall's padding), relative to their mean;
+        // the costs file carries the weights by name, and they read back for this set only.
+        let weights = &calibration.brdf_weights;
+        let names: Vec<&str> = weights.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["toon", "charlie_sheen", "lambert"]);
+        for (name, w) in weights {
+            assert!(
+                w.lo > 0.0 && w.lo <= w.median && w.median <= w.hi,
+                "{name}: {w:?}"
+            );
+        }
+        let path =
+            std::env::temp_dir().join(format!("histencil-weights-{}.json", std::process::id()));
+        calibration.write(&path).unwrap();
+        let read = histencil_lab::read_brdf_weights(&path, &modules.set)
+            .unwrap()
+            .unwrap();
+        let toon = modules.set.by_name("toon").unwrap();
+        assert_eq!(read.get(toon), weights[0].1.median as f32);
+        let builtin = &histencil_vk::BrdfModules::builtin().set;
+        let err = histencil_lab::read_brdf_weights(&path, builtin)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("`charlie_sheen`") && err.contains("another set"),
+            "{err}"
+        );
+        std::fs::remove_file(&path).unwrap();
         let mut settings = histencil_lab::compare::CompareSettings::talk(64, 36, 2);
         settings.brdfs = modules;
         settings.light_sizes = vec![1.0];

@@ -261,6 +261,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             shade_ms: 1.0,
             interval: None,
             tiled: None,
+            slot_weights: None,
         };
         let renderer = with_costs(free_stencil);
         assert_eq!(
@@ -274,6 +275,7 @@ fn adaptive_chooses_what_the_cost_model_says() {
             shade_ms: 1.0,
             interval: None,
             tiled: None,
+            slot_weights: None,
         };
         let renderer = with_costs(free_branching);
         assert_eq!(
@@ -281,6 +283,32 @@ fn adaptive_chooses_what_the_cost_model_says() {
             plan(&renderer, Technique::Branching { backend, flush })
         );
         assert_eq!(renderer.resolve(adaptive).unwrap(), adaptive);
+
+        // A stencil pass costs what a whole screen of branching's tax does: with every BRDF of
+        // the same cost branching is never dearer; with the scene's BRDFs weighed heavy
+        // (`calibrate`'s `brdf_weights`) their tax outweighs the passes on every light.
+        let balanced = CostModel {
+            pass_overhead_ms: 0.5,
+            stencil_per_brdf_ms: 0.0,
+            ..free_stencil
+        };
+        let renderer = with_costs(balanced);
+        assert_eq!(
+            plan(&renderer, adaptive),
+            plan(&renderer, Technique::Branching { backend, flush })
+        );
+        let set = &histencil_vk::BrdfModules::builtin().set;
+        let heavy: Vec<(String, f64)> = set.ids().iter().map(|b| (b.name().into(), 1e6)).collect();
+        let desc = RendererDesc {
+            cost_model: Some(balanced),
+            brdf_weights: Some(histencil_brdf::BrdfWeights::by_name(set, &heavy).unwrap()),
+            ..RendererDesc::new(SIZE, SIZE)
+        };
+        let renderer = Renderer::with_desc(ctx, scene.clone(), &desc).expect("renderer");
+        assert_eq!(
+            plan(&renderer, adaptive),
+            plan(&renderer, Technique::Stencil { backend, flush })
+        );
 
         // Costs with free tiles light the frame tiled (with the device's tiles, 8x8 on
         // lavapipe): the same image as the tiled technique, classification timed; costs with

@@ -44,6 +44,7 @@ mod model;
 mod models;
 mod set;
 mod vector;
+mod weights;
 
 pub use id::{BrdfId, EngineBrdf, UnknownBrdf, ENGINE_FIRST, MAX_ENGINE_BRDFS};
 #[cfg(feature = "manifest")]
@@ -52,3 +53,4 @@ pub use model::{ranges, Brdf, BrdfError, Parts, Range, MODEL_NAMES};
 pub use models::*;
 pub use set::{BrdfSet, EngineBrdfSpec, EngineParam, SetError, MAX_ENGINE_PARAMS, MODEL_IDS};
 pub use vector::{normalize, Real, V3};
+pub use weights::{BrdfWeights, WeightsError};

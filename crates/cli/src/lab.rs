@@ -326,9 +326,19 @@ fn with_spinner<T>(body: impl FnOnce(&mut dyn FnMut(&str)) -> T) -> T {
     out
 }
 
-/// The `--costs` file's cost model, if one was given.
-pub fn read_costs_arg(path: Option<&std::path::Path>) -> Result<Option<histencil_vk::CostModel>> {
-    Ok(path.map(histencil_lab::read_costs).transpose()?)
+/// The `--costs` file's cost model and its BRDF weights for `set`'s BRDFs, if one was given.
+pub fn read_costs_arg(
+    path: Option<&std::path::Path>,
+    set: &histencil_brdf::BrdfSet,
+) -> Result<(
+    Option<histencil_vk::CostModel>,
+    Option<histencil_brdf::BrdfWeights>,
+)> {
+    let Some(path) = path else {
+        return Ok((None, None));
+    };
+    let costs = histencil_lab::read_costs(path)?;
+    Ok((Some(costs), histencil_lab::read_brdf_weights(path, set)?))
 }
 
 /// llvmpipe's timings are steadiest with one rasteriser thread: at 320x180, 15 interleaved
@@ -385,7 +395,8 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     settings.brdfs = args.brdfs.modules()?;
     settings.scene = crate::brdfs::load_scene(&args.scene, lights, settings.brdfs)?;
     settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
-    settings.costs = read_costs_arg(args.costs.as_deref())?;
+    (settings.costs, settings.brdf_weights) =
+        read_costs_arg(args.costs.as_deref(), &settings.brdfs.set)?;
     settings.beside_load = usize::from(args.beside_load);
     let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {
@@ -467,12 +478,26 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         with(c.stencil_per_brdf_ms, 1),
         with(c.branch_tax_per_brdf_ms, 2),
         with(c.shade_ms, 3),
-        c.crossover_coverage()
-            .map_or("never".to_owned(), |x| format!(
-                "{:.2} % of the screen",
+        match c.crossover_coverage() {
+            Some(x) if x <= 1.0 => format!("{:.2} % of the screen", x * 100.0),
+            Some(x) => format!(
+                "no light (it would at {:.0} % of the screen, past the whole of it)",
                 x * 100.0
-            ))
+            ),
+            None => "no light".to_owned(),
+        }
     );
+    if !calibration.brdf_weights.is_empty() {
+        let weights: Vec<String> = calibration
+            .brdf_weights
+            .iter()
+            .map(|(name, w)| format!("{name} {:.3} [{:.3}, {:.3}]", w.median, w.lo, w.hi))
+            .collect();
+        println!(
+            "BRDF weights (shading alone over their mean; branching's tax is weighted by them): {}",
+            weights.join(", ")
+        );
+    }
     if let Some(t) = c.tiled {
         let iv = t.interval.unwrap_or_default();
         println!(

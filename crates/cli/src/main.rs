@@ -399,7 +399,7 @@ pub(crate) fn load_scene_in(
 fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
     let modules = args.brdfs.modules()?;
     let scene = brdfs::load_scene(&args.scene, lights, modules)?;
-    let costs = lab::read_costs_arg(args.costs.as_deref())?;
+    let (costs, brdf_weights) = lab::read_costs_arg(args.costs.as_deref(), &modules.set)?;
     let outputs = [
         (Some(&args.out), ImageKind::Colour),
         (args.hdr.as_ref(), ImageKind::Hdr),
@@ -422,6 +422,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             lut_resolution: args.lut_resolution,
             lightmap_side: args.lightmap_resolution,
             cost_model: costs,
+            brdf_weights,
             brdfs: modules,
             ..RendererDesc::new(args.width, args.height)
         };

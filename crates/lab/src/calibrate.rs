@@ -17,10 +17,16 @@
 //!
 //! The tiled technique's two costs come from its frames on the full-screen wall in 3 BRDFs
 //! (mixed tiles included): the classification pass per frame, and the shading per light.
+//!
+//! Each BRDF's weight (`brdf_weights`, what branching's tax is weighted by) is its full-screen
+//! 1-BRDF time per light over the mean of the weighed BRDFs' times in the same round: the wall's
+//! three BRDFs and every engine BRDF of the set. That time includes what every BRDF shares (the
+//! G-buffer decode, the light, the blend), so the weights understate how far apart the BRDFs'
+//! own code is: the chooser moves less on them than the code would justify, never more.
 
 use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::stats::{median_interval, sample, Interval, Sampled, Sampling};
-use crate::variants::{light_size_scene, with_brdf_count};
+use crate::variants::{brdf_palette, light_size_scene, with_brdf_count, with_one_brdf};
 use crate::{LabError, Result};
 use histencil_model::{DepthIdCosts, TiledCosts, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
 use histencil_vk::{
@@ -47,6 +53,9 @@ pub struct Calibration {
     /// The median over rounds of each round's fit, with the 95 % intervals in
     /// [`CostModel::interval`].
     pub costs: CostModel,
+    /// Each weighed BRDF's name and weight with its 95 % interval (see the module doc): what
+    /// the costs file's `brdf_weights` holds.
+    pub brdf_weights: Vec<(String, Interval)>,
     /// How the sampling ended.
     pub sampled: Sampled,
     /// `(what, lighting time)` of every measured frame kind.
@@ -161,8 +170,34 @@ pub fn calibrate_with(
             renderers.push((renderer, lights));
         }
     }
+    // Each weighed BRDF alone on the full-screen wall, with single-BRDF lights.
+    let weighed = weighed_brdfs(aspect, &modules.set);
+    let first_weighed = kinds.len();
+    for brdf in &weighed {
+        let name = brdf.id().name();
+        progress(&format!("{name} alone: building"));
+        let mut wall = light_size_scene(1.0, aspect);
+        histencil_scene::retarget_brdfs(&mut wall, &modules.set);
+        let lights = wall.lights.len() as f64;
+        let desc = RendererDesc {
+            brdfs: modules,
+            ..RendererDesc::new(width, height)
+        };
+        let mut renderer = Renderer::with_desc(ctx, with_one_brdf(&wall, *brdf), &desc)?;
+        for _ in 0..WARM_UP_FRAMES {
+            renderer.render(stencil, histencil_vk::Readback::NONE)?;
+        }
+        kinds.push(Kind {
+            what: format!("{name} alone, coverage 1"),
+            renderer: renderers.len(),
+            technique: stencil,
+            per_light_ms: Vec::new(),
+            classify_ms: Vec::new(),
+        });
+        renderers.push((renderer, lights));
+    }
     // Kinds in push order: full 1 BRDF (branching, stencil, depth-id), full 3 (branching,
-    // stencil, tiled, depth-id), small 1 (stencil), small 3 (stencil).
+    // stencil, tiled, depth-id), small 1 (stencil), small 3 (stencil), then each weighed BRDF.
     let full_lights = renderers[0].1;
     let fit = |k: &[Kind], round: usize| -> [f64; FITTED] {
         let t = |i: usize| k[i].per_light_ms[round];
@@ -223,6 +258,7 @@ pub fn calibrate_with(
     let m = |i: usize| intervals[i].median.max(0.0);
     let iv = |i: usize| (intervals[i].lo.max(0.0), intervals[i].hi.max(0.0));
     let costs = CostModel {
+        slot_weights: None,
         pass_overhead_ms: m(0),
         stencil_per_brdf_ms: m(1),
         branch_tax_per_brdf_ms: m(2),
@@ -239,8 +275,26 @@ pub fn calibrate_with(
             }),
         }),
     };
+    let kinds = kinds.into_inner();
+    let weights_per_round: Vec<Vec<f64>> = (0..sampled.rounds)
+        .map(|round| {
+            let times: Vec<f64> = kinds[first_weighed..]
+                .iter()
+                .map(|k| k.per_light_ms[round])
+                .collect();
+            let mean = times.iter().sum::<f64>() / times.len() as f64;
+            times.iter().map(|t| t / mean).collect()
+        })
+        .collect();
+    let brdf_weights = weighed
+        .iter()
+        .enumerate()
+        .map(|(i, brdf)| {
+            let of_rounds: Vec<f64> = weights_per_round.iter().map(|w| w[i]).collect();
+            (brdf.id().name().to_owned(), median_interval(&of_rounds))
+        })
+        .collect();
     let measurements = kinds
-        .into_inner()
         .into_iter()
         .map(|k| (k.what, Timing::from_samples(k.per_light_ms)))
         .collect();
@@ -251,9 +305,27 @@ pub fn calibrate_with(
         height,
         frames: sampled.rounds,
         costs,
+        brdf_weights,
         sampled,
         measurements,
     })
+}
+
+/// The BRDFs [`calibrate_with`] weighs: the full-screen wall's three, then every engine BRDF of
+/// `set` they leave out (with its defaults).
+fn weighed_brdfs(aspect: f32, set: &histencil_brdf::BrdfSet) -> Vec<histencil_brdf::Brdf> {
+    let mut wall = light_size_scene(1.0, aspect);
+    histencil_scene::retarget_brdfs(&mut wall, set);
+    let mut out = brdf_palette(&wall, 3);
+    for (id, _) in set.engine() {
+        if out.iter().all(|b| b.id() != id) {
+            out.push(
+                set.engine_brdf(id.name(), &[])
+                    .expect("an engine BRDF of the set with its defaults"),
+            );
+        }
+    }
+    out
 }
 
 impl Calibration {
@@ -288,6 +360,16 @@ impl Calibration {
         if let Some(x) = self.costs.crossover_coverage() {
             out["crossover_coverage"] = json!(x);
         }
+        if !self.brdf_weights.is_empty() {
+            let weights = |f: fn(&Interval) -> Value| -> serde_json::Map<String, Value> {
+                self.brdf_weights
+                    .iter()
+                    .map(|(name, w)| (name.clone(), f(w)))
+                    .collect()
+            };
+            out["brdf_weights"] = Value::Object(weights(|w| json!(w.median)));
+            out["brdf_weight_intervals"] = Value::Object(weights(|w| json!([w.lo, w.hi])));
+        }
         out
     }
 
@@ -320,12 +402,32 @@ fn costs_object<const N: usize>(
 
 /// Reads the costs a calibration wrote ([`CostModel::from_json`]), naming the file in errors.
 pub fn read_costs(path: &Path) -> Result<CostModel> {
-    let bad = |problem: String| LabError::Costs {
+    let text = std::fs::read_to_string(path).map_err(|e| bad_costs(path, e.to_string()))?;
+    CostModel::from_json(&text).map_err(|e| bad_costs(path, e.to_string()))
+}
+
+/// The BRDF weights of the costs at `path` for `set`'s BRDFs, or `None` where the file has
+/// none; a name `set` does not hold is refused (costs calibrated with other BRDFs).
+pub fn read_brdf_weights(
+    path: &Path,
+    set: &histencil_brdf::BrdfSet,
+) -> Result<Option<histencil_brdf::BrdfWeights>> {
+    let text = std::fs::read_to_string(path).map_err(|e| bad_costs(path, e.to_string()))?;
+    let named = histencil_model::brdf_weights_from_json(&text)
+        .map_err(|e| bad_costs(path, e.to_string()))?;
+    if named.is_empty() {
+        return Ok(None);
+    }
+    histencil_brdf::BrdfWeights::by_name(set, &named)
+        .map(Some)
+        .map_err(|e| bad_costs(path, e.to_string()))
+}
+
+fn bad_costs(path: &Path, problem: String) -> LabError {
+    LabError::Costs {
         path: path.display().to_string(),
         problem,
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
-    CostModel::from_json(&text).map_err(|e| bad(e.to_string()))
+    }
 }
 
 #[cfg(test)]
@@ -352,6 +454,7 @@ mod tests {
                     interval: Some([(0.2, 0.4), (0.7, 0.9)]),
                 }),
             }),
+            slot_weights: None,
         };
         let calibration = Calibration {
             device: "test".into(),
@@ -360,6 +463,26 @@ mod tests {
             height: 64,
             frames: 1,
             costs,
+            brdf_weights: vec![
+                (
+                    "ggx".into(),
+                    Interval {
+                        median: 1.2,
+                        lo: 1.1,
+                        hi: 1.3,
+                        samples: 5,
+                    },
+                ),
+                (
+                    "lambert".into(),
+                    Interval {
+                        median: 0.8,
+                        lo: 0.7,
+                        hi: 0.9,
+                        samples: 5,
+                    },
+                ),
+            ],
             sampled: Sampled {
                 rounds: 1,
                 stop: crate::stats::Stop::Rounds,
@@ -373,6 +496,15 @@ mod tests {
         let path = dir.join("costs.json");
         calibration.write(&path).unwrap();
         assert_eq!(read_costs(&path).unwrap(), costs);
+        let set = histencil_brdf::BrdfSet::new(&histencil_brdf::BrdfId::ALL, Vec::new()).unwrap();
+        let weights = read_brdf_weights(&path, &set).unwrap().unwrap();
+        assert_eq!(weights.get(histencil_brdf::BrdfId::Ggx), 1.2);
+        let two = histencil_brdf::BrdfSet::new(&[histencil_brdf::BrdfId::Ggx], Vec::new()).unwrap();
+        let err = read_brdf_weights(&path, &two).unwrap_err().to_string();
+        assert!(
+            err.contains("`lambert`") && err.contains("costs.json"),
+            "{err}"
+        );
         // Hand-written costs without intervals still read; a bad interval is named.
         std::fs::write(
             &path,
@@ -381,6 +513,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(read_costs(&path).unwrap().interval, None);
+        assert_eq!(read_brdf_weights(&path, &set).unwrap(), None);
         std::fs::write(
             &path,
             r#"{"pass_overhead_ms": 0, "stencil_per_brdf_ms": 1, "branch_tax_per_brdf_ms": 2,

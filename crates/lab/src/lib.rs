@@ -30,7 +30,7 @@ pub mod todays_gpus;
 mod variants;
 
 pub use alpha_reference::AlphaReference;
-pub use calibrate::{calibrate, calibrate_with, read_costs, Calibration};
+pub use calibrate::{calibrate, calibrate_with, read_brdf_weights, read_costs, Calibration};
 pub use compare::{run_compare, CompareReport, CompareSettings, MAX_ROUNDS};
 pub use demo::{run_demo, DemoReport, DemoSettings, FailureAndFix};
 pub use image_error::{image_error, ImageError};

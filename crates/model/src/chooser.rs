@@ -9,6 +9,13 @@
 //! Stencil costs a fixed overhead per extra pass, branching a tax per pixel: huge lights favour
 //! stencil, tiny ones branching (the talk's "tiny lights? try branching instead").
 //!
+//! Branching's tax is the code of the BRDFs a pixel does not take, run by its divergent
+//! neighbours: it grows with what those BRDFs cost. Where a calibration measured each BRDF's
+//! shading cost ([`SlotWeights`], 1 = the measured BRDFs' mean), a light's tax is weighted by the
+//! mean weight of the BRDFs it touches: `(n - 1) * mean(w) * c * branch_tax`. Stencil's extra
+//! passes (a mask, a culled render) and the shading every pixel does once with its own BRDF cost
+//! the same whatever the BRDF, so they keep no weight.
+//!
 //! Costs measured on a device come with 95 % intervals ([`CostModel::interval`]). The chooser
 //! takes stencil only where it is cheaper at every end of those intervals; where the intervals
 //! cannot tell the two apart it takes branching, the simpler technique (one draw per light, no
@@ -35,6 +42,38 @@ pub struct CostModel {
     /// adaptive technique then lights a frame tiled where that is surely cheaper
     /// ([`CostModel::prefers_tiled`]). `None` for the talk's consoles, which had no tiles.
     pub tiled: Option<crate::TiledCosts>,
+    /// Each BRDF slot's shading cost relative to the others, which weights branching's tax;
+    /// `None`: every BRDF costs the same (the talk's table has no per-BRDF figures).
+    pub slot_weights: Option<SlotWeights>,
+}
+
+/// Each stencil slot's BRDF shading cost relative to the mean of the BRDFs a calibration
+/// measured (1.0 for a BRDF as costly as their mean): indexed by slot, as
+/// [`crate::PlanInputs::brdf_bounds`] is, for every slot a stencil byte can hold (7 BRDF bits).
+/// A renderer makes it from its BRDFs' measured costs and its own slot order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlotWeights(pub [f32; SlotWeights::SLOTS]);
+
+impl SlotWeights {
+    /// Slots of the widest BRDF field: 7 bits beside the culling bit.
+    pub const SLOTS: usize = 128;
+
+    /// Every slot at 1.0: the unweighted model.
+    pub const UNIFORM: Self = Self([1.0; Self::SLOTS]);
+
+    /// The weight of a light touching `affected` slots beyond its first: `(n - 1)` times their
+    /// mean weight; `n - 1` when uniform. A slot past [`SlotWeights::SLOTS`] weighs 1.
+    pub fn extra(&self, affected: &[u32]) -> f64 {
+        let n = affected.len();
+        if n <= 1 {
+            return 0.0;
+        }
+        let sum: f64 = affected
+            .iter()
+            .map(|&s| self.0.get(s as usize).map_or(1.0, |&w| f64::from(w)))
+            .sum();
+        (n - 1) as f64 * sum / n as f64
+    }
 }
 
 /// One platform row of the talk's measurements (huge lights, milliseconds).
@@ -97,6 +136,7 @@ impl CostModel {
             shade_ms: figures.one_brdf,
             interval: None,
             tiled: None,
+            slot_weights: None,
         }
     }
 
@@ -114,19 +154,42 @@ impl CostModel {
             shade_ms: pick(3),
             interval: None,
             tiled: self.tiled,
+            slot_weights: self.slot_weights,
         }
     }
 
     /// Predicted extra time of `technique` for a light covering `coverage` (0..=1 of the
-    /// screen) and touching `brdfs` BRDFs.
+    /// screen) and touching `brdfs` BRDFs, each of the mean cost.
     pub fn extra_ms(&self, technique: LightTechnique, coverage: f64, brdfs: u32) -> f64 {
         let extra = f64::from(brdfs.saturating_sub(1));
+        self.weighted_extra_ms(technique, coverage, extra, extra)
+    }
+
+    /// [`CostModel::extra_ms`] for a light touching the stencil slots `affected`, branching's
+    /// tax weighted by their [`SlotWeights`].
+    pub fn extra_ms_for(&self, technique: LightTechnique, coverage: f64, affected: &[u32]) -> f64 {
+        let passes = affected.len().saturating_sub(1) as f64;
+        let weighted = self
+            .slot_weights
+            .unwrap_or(SlotWeights::UNIFORM)
+            .extra(affected);
+        self.weighted_extra_ms(technique, coverage, passes, weighted)
+    }
+
+    /// `passes` extra stencil passes, or branching's tax for `weighted` extra BRDFs.
+    fn weighted_extra_ms(
+        &self,
+        technique: LightTechnique,
+        coverage: f64,
+        passes: f64,
+        weighted: f64,
+    ) -> f64 {
         match technique {
             LightTechnique::SingleBrdf => 0.0,
             LightTechnique::Stencil => {
-                extra * (2.0 * self.pass_overhead_ms + coverage * self.stencil_per_brdf_ms)
+                passes * (2.0 * self.pass_overhead_ms + coverage * self.stencil_per_brdf_ms)
             }
-            LightTechnique::Branching => extra * coverage * self.branch_tax_per_brdf_ms,
+            LightTechnique::Branching => weighted * coverage * self.branch_tax_per_brdf_ms,
         }
     }
 
@@ -134,15 +197,25 @@ impl CostModel {
     /// most expensive prediction (upper interval ends) still undercuts branching's cheapest
     /// (lower ends); a tie, or a difference the intervals cannot resolve, goes to branching.
     pub fn choose(&self, coverage: f64, brdfs: u32) -> LightTechnique {
-        if brdfs <= 1 {
+        let uniform = Self {
+            slot_weights: None,
+            ..*self
+        };
+        uniform.choose_for(coverage, &(0..brdfs).collect::<Vec<_>>())
+    }
+
+    /// [`CostModel::choose`] for a light touching the stencil slots `affected`, with their
+    /// [`SlotWeights`].
+    pub fn choose_for(&self, coverage: f64, affected: &[u32]) -> LightTechnique {
+        if affected.len() <= 1 {
             return LightTechnique::SingleBrdf;
         }
         let stencil = self
             .at(true)
-            .extra_ms(LightTechnique::Stencil, coverage, brdfs);
+            .extra_ms_for(LightTechnique::Stencil, coverage, affected);
         let branching = self
             .at(false)
-            .extra_ms(LightTechnique::Branching, coverage, brdfs);
+            .extra_ms_for(LightTechnique::Branching, coverage, affected);
         if stencil < branching {
             LightTechnique::Stencil
         } else {
@@ -230,6 +303,7 @@ mod tests {
             shade_ms: 2.0,
             interval: None,
             tiled: None,
+            slot_weights: None,
         };
         let crossover = exact.crossover_coverage().unwrap();
         let just_above = crossover * 1.05;
@@ -244,6 +318,29 @@ mod tests {
             measured.choose(crossover * 0.5, 3),
             LightTechnique::Branching
         );
+    }
+
+    /// A light over costly BRDFs pays branching more tax than one over cheap ones: at a
+    /// coverage between the two crossovers the costly pair goes to stencil, the cheap pair to
+    /// branching; uniform weights reproduce the count-based choice.
+    #[test]
+    fn costly_brdfs_move_the_crossover_towards_stencil() {
+        let model = CostModel::from_talk(&TalkFigures::X360, OVERHEAD);
+        let crossover = model.crossover_coverage().unwrap();
+        let mut weights = SlotWeights::UNIFORM;
+        weights.0[..4].copy_from_slice(&[0.5, 0.5, 1.5, 1.5]);
+        let weighted = CostModel {
+            slot_weights: Some(weights),
+            ..model
+        };
+        let c = crossover * 0.9;
+        assert_eq!(weighted.choose_for(c, &[2, 3]), LightTechnique::Stencil);
+        assert_eq!(weighted.choose_for(c, &[0, 1]), LightTechnique::Branching);
+        assert_eq!(model.choose_for(c, &[2, 3]), model.choose(c, 2));
+        // The weights' mean over the light's slots: one costly and one cheap is the uniform tax.
+        assert_eq!(weights.extra(&[0, 2]), 1.0);
+        assert_eq!(weights.extra(&[0]), 0.0);
+        assert_eq!(SlotWeights::UNIFORM.extra(&[0, 1, 200]), 2.0);
     }
 
     #[test]

@@ -3,7 +3,9 @@
 //! and optionally the tiled technique's costs as `tiled` (the same shape: `classify_ms`,
 //! `shade_ms` and optional `intervals`), which may hold the depth-id technique's as `depth_id`
 //! (`per_brdf_ms`, `shade_ms`, optional `intervals`).
-//! Other keys (the device, the settings, the measurements) are the writer's and are ignored.
+//! Each BRDF's relative shading cost may come as `brdf_weights` (`{"<name>": weight}`, read by
+//! [`brdf_weights_from_json`]: names are the lighting's to resolve). Other keys (the device, the
+//! settings, the measurements) are the writer's and are ignored.
 //! Reading needs no device, so it is fuzzed and tested here.
 
 use crate::{CostModel, DepthIdCosts, TiledCosts};
@@ -71,8 +73,35 @@ impl CostModel {
             shade_ms: v[3],
             interval,
             tiled,
+            slot_weights: None,
         })
     }
+}
+
+/// The costs file's `brdf_weights` (a BRDF's name, its shading cost relative to the others), in
+/// the file's order; empty when it has none. Each weight finite and above 0.
+pub fn brdf_weights_from_json(text: &str) -> Result<Vec<(String, f64)>, CostsError> {
+    let value: Value =
+        serde_json::from_str(text).map_err(|e| CostsError(format!("not JSON: {e}")))?;
+    let Some(weights) = value.get("brdf_weights").filter(|v| !v.is_null()) else {
+        return Ok(Vec::new());
+    };
+    let weights = weights
+        .as_object()
+        .ok_or_else(|| CostsError("`brdf_weights` must be an object of BRDF names".into()))?;
+    weights
+        .iter()
+        .map(|(name, w)| {
+            w.as_f64()
+                .filter(|w| w.is_finite() && *w > 0.0)
+                .map(|w| (name.clone(), w))
+                .ok_or_else(|| {
+                    CostsError(format!(
+                        "`brdf_weights.{name}` must be a finite number above 0"
+                    ))
+                })
+        })
+        .collect()
 }
 
 /// The tiled costs' names in the file's `tiled` object.

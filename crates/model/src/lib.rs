@@ -67,9 +67,11 @@ mod tiles;
 mod view;
 
 pub use backend::{Native, PlatformBackend, PlatformCaps, Ps3Like, X360Like};
-pub use chooser::{CostModel, TalkFigures};
+pub use chooser::{CostModel, SlotWeights, TalkFigures};
 #[cfg(feature = "files")]
-pub use costs_json::{CostsError, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
+pub use costs_json::{
+    brdf_weights_from_json, CostsError, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS,
+};
 pub use depth_bounds::DepthRange;
 pub use footprint::{Footprint, Span};
 pub use frame::{

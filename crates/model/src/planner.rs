@@ -348,7 +348,7 @@ pub fn plan_frame(
             _ if affected.len() == 1 => LightTechnique::SingleBrdf,
             TechniqueChoice::Stencil => LightTechnique::Stencil,
             TechniqueChoice::Branching => LightTechnique::Branching,
-            TechniqueChoice::Adaptive(costs) => costs.choose(coverage, affected.len() as u32),
+            TechniqueChoice::Adaptive(costs) => costs.choose_for(coverage, &affected),
         };
         lights.push(PlannedLight {
             input: index,

@@ -90,8 +90,9 @@ impl CostModel {
             .map(|light| {
                 let c = light.coverage.unwrap_or(1.0);
                 let r = &light.request;
-                let n = r.affected.len() as u32;
-                costs.pass_overhead_ms + c * costs.shade_ms + costs.extra_ms(r.technique, c, n)
+                costs.pass_overhead_ms
+                    + c * costs.shade_ms
+                    + costs.extra_ms_for(r.technique, c, &r.affected)
             })
             .sum()
     }
@@ -187,6 +188,7 @@ mod tests {
             shade_ms: 1.0,
             interval: None,
             tiled,
+            slot_weights: None,
         }
     }
 

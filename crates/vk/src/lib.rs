@@ -54,7 +54,7 @@ pub use gpu::timing::median_of_sorted;
 pub use gpu::timing::{FrameTimings, LightingBreakdown, LightmapTimings};
 pub use gpu_types::ProjectionError;
 pub use histencil_model::{
-    CostModel, DepthIdCosts, FlushPolicy, FrameChoice, TileStats, TiledCosts,
+    CostModel, DepthIdCosts, FlushPolicy, FrameChoice, SlotWeights, TileStats, TiledCosts,
 };
 pub use lighting::hooks::{
     EngineHooks, HookSetLayout, HookSets, LightHooks, LightModules, DECODE_SET, VISIBILITY_SET,

@@ -34,6 +34,9 @@ pub struct CompareSettings {
     pub budget: std::time::Duration,
     /// The adaptive technique's costs; `None`: fitted to the talk's figures.
     pub costs: Option<CostModel>,
+    /// The BRDFs' weights of the same costs file ([`crate::read_brdf_weights`]); `None`: every
+    /// BRDF costs the same.
+    pub brdf_weights: Option<histencil_brdf::BrdfWeights>,
     /// The BRDFs it shades with: histencil's, or an engine's set (`compare --brdfs`), whose own
     /// BRDFs the scene should then name (`histencil_scene::retarget_brdfs`): the columns fold
     /// onto the scene's models first.
@@ -68,6 +71,7 @@ impl CompareSettings {
             target_ci: None,
             budget: std::time::Duration::from_secs(60),
             costs: None,
+            brdf_weights: None,
             brdfs: histencil_vk::BrdfModules::builtin(),
             brdf_counts: vec![1, 2, 3],
             light_sizes: vec![0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0],
@@ -577,6 +581,7 @@ fn renderer_for<'c>(
 ) -> Result<Renderer<'c>> {
     let desc = RendererDesc {
         cost_model: settings.costs,
+        brdf_weights: settings.brdf_weights,
         brdfs: settings.brdfs,
         ..RendererDesc::new(settings.width, settings.height)
     };

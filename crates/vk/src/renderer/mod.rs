@@ -80,6 +80,10 @@ pub struct RendererDesc {
     /// `None`: the talk's measurements fitted by [`CostModel::from_talk`] (360 figures for the
     /// 360-like backend, PS3 figures otherwise) with an assumed 5 us per extra draw.
     pub cost_model: Option<CostModel>,
+    /// Each BRDF's shading cost relative to the others, as `histencil calibrate` measured them
+    /// (its costs file's `brdf_weights`): the adaptive technique weights branching's tax by the
+    /// BRDFs each light touches. `None`: every BRDF costs the same.
+    pub brdf_weights: Option<histencil_brdf::BrdfWeights>,
     /// The BRDFs it shades with and their shaders: histencil's own
     /// ([`crate::BrdfModules::builtin`]), or an engine's set ([`crate::compile_brdf_set`]).
     /// Every object's and entity's BRDF must be one of the set's.
@@ -97,6 +101,7 @@ impl RendererDesc {
             lut_resolution: DEFAULT_LUT_RESOLUTION,
             lightmap_side: None,
             cost_model: None,
+            brdf_weights: None,
             brdfs: crate::BrdfModules::builtin(),
         }
     }
@@ -187,9 +192,10 @@ impl<'c> Renderer<'c> {
             .collect()
     }
 
-    /// The costs the adaptive technique uses with `backend`.
+    /// The costs the adaptive technique uses with `backend`, its BRDFs' weights
+    /// ([`RendererDesc::brdf_weights`]) put in their stencil slots.
     pub fn cost_model(&self, backend: Backend) -> CostModel {
-        self.desc.cost_model.unwrap_or_else(|| {
+        let mut costs = self.desc.cost_model.unwrap_or_else(|| {
             let figures = match backend {
                 Backend::X360 { .. } => TalkFigures::X360,
                 Backend::Ps3
@@ -199,7 +205,15 @@ impl<'c> Renderer<'c> {
                 | Backend::AmdAndOrUnmasked => TalkFigures::PS3,
             };
             CostModel::from_talk(&figures, ASSUMED_DRAW_OVERHEAD_MS)
-        })
+        });
+        if let Some(weights) = self.desc.brdf_weights {
+            let mut slots = histencil_model::SlotWeights::UNIFORM;
+            for (slot, id) in slots.0.iter_mut().zip(&self.brdfs) {
+                *slot = weights.get(*id);
+            }
+            costs.slot_weights = Some(slots);
+        }
+        costs
     }
 
     /// The LUT technique's table resolution ([`RendererDesc::lut_resolution`]).
