@@ -52,6 +52,23 @@ impl ValidationLog {
         self.lock().get(mark..).unwrap_or_default().to_vec()
     }
 
+    /// Removes the messages after `mark` that `about` matches and says how many went: for a
+    /// call that failed and was retried, whose refusal is reported another way.
+    pub(crate) fn forget_since(
+        &self,
+        mark: usize,
+        about: impl Fn(&ValidationMessage) -> bool,
+    ) -> usize {
+        let mut messages = self.lock();
+        let before = messages.len();
+        let mut index = 0;
+        messages.retain(|m| {
+            index += 1;
+            index <= mark || !about(m)
+        });
+        before - messages.len()
+    }
+
     /// Panics with every message when there is any: for tests.
     pub fn assert_clean(&self) {
         let problems = self.problems();

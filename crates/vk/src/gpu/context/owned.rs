@@ -205,7 +205,8 @@ impl Context {
         // vkCreateInstance. Then the settings stay pinned as they are for layers without the
         // extension (the check's settings file, its cleared environment, its canary), and the
         // report says so.
-        let mut settings_way = "through VK_EXT_layer_settings";
+        let mut settings_way = "through VK_EXT_layer_settings".to_owned();
+        let mark = validation.len();
         // SAFETY: `instance_info` and all it points at live until the call returns: `app_info`,
         // the `'static` layer and extension names, and the chained `validation_features`,
         // `messenger_for_create` and `layer_settings` (whose `p_values` point at `off` / `on`,
@@ -214,7 +215,19 @@ impl Context {
         let created = unsafe { entry.create_instance(&instance_info, None) };
         let instance = match created {
             Err(vk::Result::ERROR_EXTENSION_NOT_PRESENT) if pin_settings => {
-                settings_way = "from the environment (the loader refused VK_EXT_layer_settings)";
+                // The loader says why on the messenger chained in (`loader_validate_instance_
+                // extensions: Extension VK_EXT_layer_settings not found`): a refusal of a call
+                // that is retried, stated here instead, not a message about histencil's use.
+                let refusals =
+                    validation.forget_since(mark, |m| m.text.contains("VK_EXT_layer_settings"));
+                settings_way = format!(
+                    "from the environment (the loader refused VK_EXT_layer_settings{})",
+                    if refusals > 0 {
+                        format!("; its {refusals} message(s) saying so are not counted")
+                    } else {
+                        String::new()
+                    }
+                );
                 let retry = without_settings.enabled_extension_names(&extensions_without);
                 // SAFETY: as the first try: the same live structs, less VK_EXT_layer_settings
                 // (`without_settings` was copied before `layer_settings` joined the chain).
@@ -222,7 +235,8 @@ impl Context {
             }
             other => {
                 if !pin_settings {
-                    settings_way = "from the environment (the layer lacks VK_EXT_layer_settings)";
+                    settings_way =
+                        "from the environment (the layer lacks VK_EXT_layer_settings)".to_owned();
                 }
                 other
             }
