@@ -67,6 +67,11 @@ impl GtestNames {
         self.by_full.get(full).map(String::as_str)
     }
 
+    /// Every case as `(gtest name, scene/case)`, in the run's order.
+    pub fn iter(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.order.iter().map(|(g, f)| (g.as_str(), f.as_str()))
+    }
+
     /// `--gtest_list_tests`' output for the cases `keep` holds (by `scene/case`): a line
     /// `Group.` where the group changes, then each test indented by two spaces, in the run's
     /// order (no other line: deqp-runner refuses any).

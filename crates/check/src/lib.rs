@@ -10,6 +10,7 @@
 //! known-wrong configurations are cases too, expected to fail. [`report`] writes JUnit XML, JSON
 //! and a summary. `histencil check` is a thin wrapper over [`run_check`].
 
+pub mod baseline_update;
 pub mod bound;
 pub mod gtest;
 pub mod judge;

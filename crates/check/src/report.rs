@@ -563,29 +563,38 @@ pub fn results_line(r: &Record) -> String {
     format!("{},{},{:.3}\n", r.full_name(), r.status, r.seconds)
 }
 
-/// `failures.csv`: every matrix case that ended failing, as the failure it ended with
-/// (`scene/case,Fail`, `Crash` or `Timeout`) and expected failures as the failure they are, in
-/// the baseline's own format, so that the next baseline is a copy. Flakes and unexpected passes
-/// are left out (the baseline shrinks); device rows cannot be baselined.
+/// Every matrix case that ended failing, in run order, as the failure it ended with
+/// (`Fail`, `Crash` or `Timeout`), expected failures as the failure they are. Flakes and
+/// unexpected passes are left out (the baseline shrinks); device rows cannot be baselined.
+pub fn failing(report: &RunReport) -> Vec<(String, Status)> {
+    report
+        .records
+        .iter()
+        .filter(|r| r.scene != "device")
+        .filter_map(|r| {
+            let status = match r.status {
+                // The failure it was expected as, from the kind the worker or runner gave it.
+                Status::ExpectedFail => match r.failure_type.as_deref() {
+                    Some("crash") => Status::Crash,
+                    Some("timeout") => Status::Timeout,
+                    _ => Status::Fail,
+                },
+                s if s.is_failure() => s,
+                _ => return None,
+            };
+            Some((r.full_name(), status))
+        })
+        .collect()
+}
+
+/// `failures.csv`: [`failing`] in the baseline's own format, so that a run's failures are a
+/// baseline ([`crate::baseline_update`] keeps an old one's reasons).
 pub fn failures_csv(report: &RunReport) -> String {
     let mut out = String::from(
         "# histencil check failures, in --baseline format: copy to a baseline to expect them\n",
     );
-    for r in &report.records {
-        if r.scene == "device" {
-            continue;
-        }
-        let status = match r.status {
-            // The failure it was expected as, from the kind the worker or runner gave it.
-            Status::ExpectedFail => match r.failure_type.as_deref() {
-                Some("crash") => Status::Crash,
-                Some("timeout") => Status::Timeout,
-                _ => Status::Fail,
-            },
-            s if s.is_failure() => s,
-            _ => continue,
-        };
-        let _ = writeln!(out, "{},{status}", r.full_name());
+    for (name, status) in failing(report) {
+        let _ = writeln!(out, "{name},{status}");
     }
     out
 }

@@ -34,7 +34,7 @@ const EXIT_INCOMPLETE: u8 = 5;
 pub(crate) const EXIT_RUNNER: u8 = 6;
 
 #[derive(clap::Args)]
-#[command(args_conflicts_with_subcommands = true)]
+#[command(args_conflicts_with_subcommands = true, after_help = crate::suite::help())]
 pub struct CheckArgs {
     #[command(subcommand)]
     command: Option<CheckCommand>,
@@ -69,6 +69,17 @@ pub struct CheckArgs {
     /// `scene/case` spelling serves both runners.
     #[arg(long, requires = "baseline")]
     print_gtest_baseline: bool,
+    /// The prefix a deqp-runner suite entry gives histencil's cases (`histencil-`, as in
+    /// ci/mesa/histencil.toml): `--print-gtest-baseline` writes it before each name, and
+    /// `--baseline` keeps only the lines that carry it, without it (a driver's fails file holds
+    /// every suite's lines).
+    #[arg(long)]
+    gtest_prefix: Option<String>,
+    /// Print the cases of the matrix the --flakes files match, each as a regular expression of
+    /// its googletest name (after --gtest-prefix), and exit: the flakes list gtest-runner and a
+    /// suite entry read (histencil's own lists match either spelling).
+    #[arg(long, requires = "flakes")]
+    print_gtest_flakes: bool,
     /// Write JUnit XML here (a testsuite per scene, a testcase per configuration).
     #[arg(long)]
     junit: Option<PathBuf>,
@@ -169,8 +180,8 @@ enum ListFormat {
 
 #[derive(clap::Subcommand)]
 enum CheckCommand {
-    /// Join the JSON reports of several shards into one JUnit, JSON and summary; the exit code
-    /// is the joined run's.
+    /// Join the JSON reports of several shards into one JUnit, JSON and summary, and the
+    /// joined failures or the next baseline; the exit code is the joined run's.
     Merge(MergeArgs),
 }
 
@@ -183,6 +194,16 @@ struct MergeArgs {
     junit: Option<PathBuf>,
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Write the joined run's failures.csv here (every case that ended failing, expected or
+    /// not, in --baseline format).
+    #[arg(long)]
+    failures: Option<PathBuf>,
+    /// Rewrite this baseline (the one the shards ran with) as the next one: each line whose
+    /// case still fails as it says kept with its reason, a changed or new failure marked `#
+    /// NEEDS A REASON`, a line whose case now passes removed and listed on stderr; lines for
+    /// cases the run did not include stay.
+    #[arg(long)]
+    update_baseline: Option<PathBuf>,
 }
 
 fn parse_fault(text: &str) -> Result<InjectedFault, String> {
@@ -302,8 +323,15 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
             histencil_check::gtest::GtestNames::default()
         }
     };
+    if args.print_gtest_flakes {
+        return print_gtest_flakes(&args.flakes, args.gtest_prefix.as_deref(), &names);
+    }
     if args.print_gtest_baseline {
-        return print_gtest_baseline(args.baseline.as_deref(), &names);
+        return print_gtest_baseline(
+            args.baseline.as_deref(),
+            args.gtest_prefix.as_deref(),
+            &names,
+        );
     }
     if let Some(only) = options.only.take() {
         let full = |name: String| names.full_name(&name).map(str::to_owned).unwrap_or(name);
@@ -434,20 +462,13 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     if let Err(e) = histencil_vk::check_output_dir(&args.out) {
         return usage(e);
     }
-    let mut baseline = match &args.baseline {
-        Some(path) => match Baseline::load(path) {
+    let baseline = match &args.baseline {
+        Some(path) => match load_baseline(path, args.gtest_prefix.as_deref(), &names) {
             Ok(b) => b,
             Err(e) => return usage(e),
         },
         None => Baseline::default(),
     };
-    baseline.expected = std::mem::take(&mut baseline.expected)
-        .into_iter()
-        .map(|(name, status)| match names.full_name(&name) {
-            Some(full) => (full.to_owned(), status),
-            None => (name, status),
-        })
-        .collect();
     let mut flakes = Patterns::default();
     for path in &args.flakes {
         match Patterns::load(path) {
@@ -473,36 +494,110 @@ pub fn check(args: &CheckArgs, lights: DefaultLights) -> ExitCode {
     }
 }
 
-/// `--print-gtest-baseline`: the baseline's lines with googletest names; a name that is no case
-/// of the matrix is refused (deqp-runner would never match it, and the failure it expects would
-/// fail the run).
+/// The baseline at `path`, each line in `scene/case` spelling: with `prefix`, only the lines
+/// that carry it, without it. A line naming no case of this matrix (a baseline shared by a
+/// quick and a full job) is kept, matching nothing here, and counted on stderr, as
+/// `--print-gtest-baseline` does.
+fn load_baseline(
+    path: &std::path::Path,
+    prefix: Option<&str>,
+    names: &histencil_check::gtest::GtestNames,
+) -> Result<Baseline, histencil_check::lists::ListError> {
+    let mut baseline = Baseline::load(path)?;
+    let mut outside = Vec::new();
+    baseline.expected = std::mem::take(&mut baseline.expected)
+        .into_iter()
+        .filter_map(|(name, status)| match prefix {
+            Some(p) => name.strip_prefix(p).map(|n| (n.to_owned(), status)),
+            None => Some((name, status)),
+        })
+        .map(|(name, status)| {
+            let full = names
+                .full_name(&name)
+                .map(str::to_owned)
+                .or_else(|| names.gtest_name(&name).map(|_| name.clone()));
+            match full {
+                Some(full) => (full, status),
+                None => {
+                    outside.push(name.clone());
+                    (name, status)
+                }
+            }
+        })
+        .collect();
+    note_outside(path, &outside);
+    Ok(baseline)
+}
+
+/// Says on stderr how many baseline lines name no case of this matrix, and the first.
+fn note_outside(path: &std::path::Path, outside: &[String]) {
+    if let Some(first) = outside.first() {
+        eprintln!(
+            "histencil check: {} line(s) of {} name no case of this matrix (scenes, --quick), \
+             first `{first}`: kept, they match nothing here",
+            outside.len(),
+            path.display()
+        );
+    }
+}
+
+/// `--print-gtest-baseline`: the baseline's lines with googletest names, each after `prefix`.
+/// A line naming no case of this matrix is written as the naming rule spells it (a `scene/case`
+/// line's scene and case, each an identifier) and counted on stderr, as `--baseline` keeps it:
+/// both accept the same files.
 fn print_gtest_baseline(
     path: Option<&std::path::Path>,
+    prefix: Option<&str>,
     names: &histencil_check::gtest::GtestNames,
 ) -> ExitCode {
     let Some(path) = path else {
         return usage("--print-gtest-baseline needs --baseline");
     };
-    let baseline = match Baseline::load(path) {
+    let baseline = match load_baseline(path, None, names) {
         Ok(b) => b,
         Err(e) => return usage(e),
     };
     let mut out = String::new();
     for (name, status) in &baseline.expected {
-        let gtest = names
-            .gtest_name(name)
-            .or_else(|| names.full_name(name).map(|_| name.as_str()));
-        match gtest {
-            Some(g) => out.push_str(&format!("{g},{status}\n")),
-            None => {
-                return usage(format!(
-                    "{}: `{name}` is no case of this matrix (scenes, --quick)",
-                    path.display()
-                ))
-            }
-        }
+        let gtest = match (names.gtest_name(name), name.split_once('/')) {
+            (Some(g), _) => g.to_owned(),
+            (None, Some((scene, case))) => histencil_check::gtest::test_name(scene, case),
+            (None, None) => name.clone(),
+        };
+        out.push_str(&format!("{}{gtest},{status}\n", prefix.unwrap_or("")));
     }
     print!("{out}");
+    ExitCode::SUCCESS
+}
+
+/// `--print-gtest-flakes`: every case of the matrix a flakes pattern matches (in either
+/// spelling), as an anchored regular expression of `prefix` and its googletest name.
+fn print_gtest_flakes(
+    paths: &[PathBuf],
+    prefix: Option<&str>,
+    names: &histencil_check::gtest::GtestNames,
+) -> ExitCode {
+    let mut flakes = Patterns::default();
+    for path in paths {
+        match Patterns::load(path) {
+            Ok(p) => flakes.extend(p),
+            Err(e) => return usage(e),
+        }
+    }
+    // A gtest name is letters, digits, `_` and one `.`; the prefix is the user's.
+    let escape = |text: &str| -> String {
+        text.chars()
+            .flat_map(|c| {
+                let special = !(c.is_ascii_alphanumeric() || c == '_' || c == '-');
+                special.then_some('\\').into_iter().chain([c])
+            })
+            .collect()
+    };
+    for (gtest, full) in names.iter() {
+        if flakes.matches(full) || flakes.matches(gtest) {
+            println!("^{}{}$", escape(prefix.unwrap_or("")), escape(gtest));
+        }
+    }
     ExitCode::SUCCESS
 }
 
@@ -817,6 +912,52 @@ fn merge(args: &MergeArgs) -> ExitCode {
         eprintln!("histencil: {e:#}");
         return ExitCode::FAILURE;
     }
+    if let Some(path) = &args.failures {
+        if let Err(e) =
+            histencil_vk::write_atomically(path, report::failures_csv(&merged).as_bytes())
+        {
+            eprintln!("histencil: {e:#}");
+            return ExitCode::FAILURE;
+        }
+    }
+    if let Some(path) = &args.update_baseline {
+        if let Err(e) = update_baseline(path, &merged) {
+            eprintln!("histencil: {e:#}");
+            return ExitCode::FAILURE;
+        }
+    }
     print!("{}", report::summary(&merged));
     exit_code(&merged)
+}
+
+/// `check merge --update-baseline PATH`: PATH rewritten as the next baseline of `merged`
+/// ([`histencil_check::baseline_update`]), what changed on stderr.
+fn update_baseline(path: &std::path::Path, merged: &report::RunReport) -> anyhow::Result<()> {
+    let old = std::fs::read_to_string(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+    // Refuse what the runner would refuse before writing anything.
+    Baseline::parse(&old, &path.display().to_string())?;
+    let failing = report::failing(merged).into_iter().collect();
+    let ran: HashSet<String> = merged.records.iter().map(|r| r.full_name()).collect();
+    let update = histencil_check::baseline_update::update_baseline(&old, &failing, &|name| {
+        ran.contains(name)
+    });
+    histencil_vk::write_atomically(path, update.text.as_bytes())?;
+    eprintln!(
+        "histencil check: {}: {} line(s) kept with their reasons, {} changed and {} added \
+         (marked `# {}`), {} removed (now passing)",
+        path.display(),
+        update.kept,
+        update.changed.len(),
+        update.added.len(),
+        histencil_check::baseline_update::NEEDS_REASON,
+        update.now_pass.len()
+    );
+    for line in update.changed.iter().chain(&update.added) {
+        eprintln!("  needs a reason: {line}");
+    }
+    for line in &update.now_pass {
+        eprintln!("  now passes: {line}");
+    }
+    Ok(())
 }

@@ -84,6 +84,11 @@ pub fn run(
         let _ = writeln!(out, "{text}");
         let _ = out.flush();
     };
+    if let Some(settings) = crate::suite::settings_line(&|name| std::env::var(name).ok()) {
+        line(&plain(&format!(
+            "histencil check: settings from the environment: {settings}"
+        )));
+    }
     let gtest = |full: &str| names.gtest_name(full).unwrap_or(full).to_owned();
     let mut current: Option<String> = None;
     let mut failed = false;

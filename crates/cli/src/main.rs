@@ -19,6 +19,7 @@ mod brdfs;
 mod check;
 mod gtest;
 mod lab;
+mod suite;
 
 #[derive(Parser)]
 #[command(
@@ -786,7 +787,19 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    let cli = match Cli::try_parse() {
+    // Started as a googletest binary (a deqp-runner suite entry's `bin`): `check`'s gtest face,
+    // its settings from the environment.
+    let mut args: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    if suite::is_gtest_binary(&args) {
+        args = match suite::check_args(&args, &|name| std::env::var(name).ok()) {
+            Ok(args) => args,
+            Err(e) => {
+                eprintln!("histencil: {e}");
+                return ExitCode::from(2);
+            }
+        };
+    }
+    let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {
             // --help / --version
