@@ -4,6 +4,7 @@
 //! falls as the setting grows; calibration gives finite costs that `--costs` reads back into
 //! the adaptive technique.
 
+use histencil_lab::compare::talk_verdicts;
 use histencil_lab::stats::Sampling;
 use histencil_lab::{
     calibrate, light_size_scene, read_costs, run_compare, run_sweep, CompareSettings, SweepParam,
@@ -361,6 +362,23 @@ fn compare_verdicts_do_not_reverse_under_background_load() {
             );
         }
     }
+    // The talk's own verdicts (each stencil row against branching, paired by round) hold too,
+    // and report.json carries them: five platforms at 2 and 3 BRDFs.
+    let (talk_quiet, talk_loaded) = (talk_verdicts(&quiet.rows), talk_verdicts(&loaded.rows));
+    assert_eq!(talk_quiet.len(), 10);
+    for (a, b) in talk_quiet.iter().zip(&talk_loaded) {
+        println!(
+            "{} at {} BRDFs over branching: quiet {:.3} {}, loaded {:.3} {}",
+            a.technique,
+            a.brdfs,
+            a.ratio.median,
+            a.words(),
+            b.ratio.median,
+            b.words()
+        );
+        assert!(!a.verdict.reverses(b.verdict), "{}: reversed", a.technique);
+    }
+    assert_eq!(quiet.json()["talk_verdicts"].as_array().unwrap().len(), 10);
     let dirs = [("quiet", &quiet), ("loaded", &loaded)].map(|(name, report)| {
         let dir = output_dir().join(format!("compare-{name}"));
         std::fs::create_dir_all(&dir).unwrap();

@@ -68,8 +68,9 @@ pub struct CompareArgs {
     #[command(flatten)]
     sampling: SamplingArgs,
     /// When the table and each light size stop sampling: `decided`, once the talk's cells
-    /// (branching and stencil x360/ps3/native at 2 and 3 BRDFs; each size's stencil against
-    /// branching) are decided, at least --frames rounds, within a budget a 10-round pilot
+    /// (the overheads of branching and stencil x360/ps3/native at 2 and 3 BRDFs, every stencil
+    /// row against branching at 2 and 3 BRDFs; each size's stencil against branching) are
+    /// decided, at least --frames rounds, within a budget a 10-round pilot
     /// predicts unless --budget-s sets it; `rounds`, after --frames rounds exactly (or at
     /// --target-ci's width).
     #[arg(long, value_enum, default_value_t = Until::Decided, conflicts_with = "target_ci")]

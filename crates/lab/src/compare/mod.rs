@@ -268,6 +268,56 @@ impl Row {
     }
 }
 
+/// One of the talk's verdicts: a stencil row (one platform) against branching at one BRDF
+/// count, as the ratio of their lighting times in the same rounds (below 1: stencil faster).
+#[derive(Clone, Debug)]
+pub struct TalkVerdict {
+    /// The stencil row (`stencil ps3`, ...).
+    pub technique: &'static str,
+    pub brdfs: usize,
+    /// The row it is measured against: always `branching`.
+    pub against: &'static str,
+    /// Stencil's time over branching's, paired by round: the median with its 95 % interval.
+    pub ratio: Interval,
+    pub verdict: Verdict,
+}
+
+impl TalkVerdict {
+    /// Which is faster where the data can tell: `stencil faster`, `branching faster`,
+    /// `within ±5 %` or `undecided`.
+    pub fn words(&self) -> &'static str {
+        match self.verdict {
+            Verdict::Faster => "stencil faster",
+            Verdict::Slower => "branching faster",
+            other => other.word(),
+        }
+    }
+}
+
+/// The talk's question asked of `rows`: each stencil row against the branching row at every
+/// BRDF count above one, paired by round (the rounds interleave every row, so round `i` of two
+/// rows ran under the same load). Stencil's own time: the emulated platforms' bookkeeping is
+/// the emulator's, not the console's. Empty without a branching row.
+pub fn talk_verdicts(rows: &[Row]) -> Vec<TalkVerdict> {
+    let Some(branching) = rows.iter().find(|r| r.name == "branching") else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for row in rows.iter().filter(|r| r.name.starts_with("stencil")) {
+        for (cell, base) in row.cells.iter().zip(&branching.cells).skip(1) {
+            let ratio = ratio_interval(&cell.samples, &base.samples);
+            out.push(TalkVerdict {
+                technique: row.name,
+                brdfs: cell.brdfs,
+                against: branching.name,
+                ratio,
+                verdict: Verdict::of(&ratio),
+            });
+        }
+    }
+    out
+}
+
 /// The lighting pass of one technique split into the talk's groups, in total milliseconds.
 #[derive(Clone, Debug)]
 pub struct Breakdown {
@@ -670,17 +720,40 @@ fn measure_table<'c>(
         std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; singles.len()]);
     let samples = std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; renderers.len()]);
     let mut bookkeeping = vec![vec![Vec::new(); rows_spec.len()]; renderers.len()];
-    // The widths a verdict rests on: every overhead ratio against the 1-BRDF cell.
+    // The talk's verdicts: each stencil row against branching, at every count above one.
+    let branching_row = rows_spec.iter().position(|(n, _)| *n == "branching");
+    let against_branching: Vec<usize> = rows_spec
+        .iter()
+        .enumerate()
+        .filter(|(_, (n, _))| n.starts_with("stencil"))
+        .map(|(row, _)| row)
+        .collect();
+    let talk_ratios = |s: &[Vec<Vec<f64>>]| -> Vec<Interval> {
+        let Some(b) = branching_row else {
+            return Vec::new();
+        };
+        (1..s.len())
+            .flat_map(|count| {
+                against_branching
+                    .iter()
+                    .map(move |&row| ratio_interval(&s[count][row], &s[count][b]))
+            })
+            .collect()
+    };
+    // The widths a verdict rests on: every overhead ratio against the 1-BRDF cell, and the
+    // talk's verdicts.
     let overhead_widths = || {
         let s = samples.borrow();
-        (1..s.len())
+        let mut widths: Vec<f64> = (1..s.len())
             .flat_map(|count| {
                 let s = &s;
                 (0..rows_spec.len()).map(move |row| {
                     ratio_interval(&s[count][row], &s[0][row]).relative_half_width()
                 })
             })
-            .collect::<Vec<_>>()
+            .collect();
+        widths.extend(talk_ratios(&s).iter().map(Interval::relative_half_width));
+        widths
     };
     // The talk's cells still undecided, each with the rounds its interval predicts it needs.
     let talk_open = || {
@@ -695,6 +768,11 @@ fn measure_table<'c>(
                 if !Verdict::of(&ratio).decided() {
                     open.push(Verdict::rounds_to_decide(&ratio, crate::stats::MARGIN));
                 }
+            }
+        }
+        for ratio in talk_ratios(&s) {
+            if !Verdict::of(&ratio).decided() {
+                open.push(Verdict::rounds_to_decide(&ratio, crate::stats::MARGIN));
             }
         }
         open
@@ -952,8 +1030,54 @@ fn breakdown(
 
 #[cfg(test)]
 mod tests {
-    use super::{stencil_wins_from, sure_bounds};
+    use super::{stencil_wins_from, sure_bounds, talk_verdicts, Cell, Row};
     use crate::stats::Verdict::{Faster, Slower, Undecided, Within};
+
+    /// The talk's verdicts pair each stencil row with branching round by round, at the same
+    /// BRDF count: a load that slows a round slows both, and the ratio holds.
+    #[test]
+    fn the_talks_verdicts_pair_stencil_with_branching_by_round() {
+        let row = |name: &'static str, per_count: [f64; 3]| Row {
+            name,
+            cells: per_count
+                .iter()
+                .enumerate()
+                .map(|(i, ms)| Cell {
+                    brdfs: i + 1,
+                    // Every round twice as slow as the one before: only pairing survives it.
+                    samples: (0..12).map(|r| ms * f64::from(1 << (r % 3))).collect(),
+                    bookkeeping: Vec::new(),
+                    single_brdf: Vec::new(),
+                    error: Default::default(),
+                })
+                .collect(),
+        };
+        let rows = [
+            row("branching", [1.0, 2.0, 3.0]),
+            row("stencil ps3", [1.0, 1.6, 3.3]),
+            row("stencil native", [1.0, 2.02, 3.0]),
+            row("lut", [1.0, 1.0, 1.0]),
+        ];
+        let v = talk_verdicts(&rows);
+        let got: Vec<_> = v
+            .iter()
+            .map(|v| (v.technique, v.brdfs, v.verdict))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("stencil ps3", 2, Faster),
+                ("stencil ps3", 3, Slower),
+                ("stencil native", 2, Within),
+                ("stencil native", 3, Within),
+            ]
+        );
+        assert!((v[0].ratio.median - 0.8).abs() < 1e-12 && v[0].ratio.lo == v[0].ratio.hi);
+        assert_eq!(v[0].words(), "stencil faster");
+        assert_eq!(v[1].words(), "branching faster");
+        assert!(v.iter().all(|v| v.against == "branching"));
+        assert!(talk_verdicts(&rows[1..]).is_empty());
+    }
 
     #[test]
     fn the_crossover_bounds_rest_on_separated_intervals_only() {

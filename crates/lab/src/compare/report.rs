@@ -56,6 +56,47 @@ impl CompareReport {
         }
     }
 
+    /// The talk's question first: each platform's stencil technique against branching at 2
+    /// BRDFs and up, the ratio of their times in the same rounds.
+    fn talk_verdicts_markdown(&self) -> String {
+        let verdicts = super::talk_verdicts(&self.rows);
+        if verdicts.is_empty() {
+            return String::new();
+        }
+        let mut md = String::from(
+            "## The talk's question: stencil against branching\n\n\
+             Each platform's stencil technique over branching, both at the same BRDF count, \
+             paired by round (below 1: stencil faster); median [95 % interval], decided at \
+             ±5 % as every cell is. The emulated platforms' times are their technique's own, \
+             without the emulator's bookkeeping.\n\n",
+        );
+        let counts: Vec<usize> = {
+            let mut c: Vec<usize> = verdicts.iter().map(|v| v.brdfs).collect();
+            c.sort_unstable();
+            c.dedup();
+            c
+        };
+        let head: Vec<String> = counts.iter().map(|c| brdfs_label(*c)).collect();
+        md += &table_head(&head);
+        for chunk in verdicts.chunks(counts.len()) {
+            let cells: Vec<String> = chunk
+                .iter()
+                .map(|v| {
+                    format!(
+                        "{:.3}x [{:.3}, {:.3}] {}",
+                        v.ratio.median,
+                        v.ratio.lo,
+                        v.ratio.hi,
+                        v.words()
+                    )
+                })
+                .collect();
+            let _ = writeln!(md, "| {} | {} |", chunk[0].technique, cells.join(" | "));
+        }
+        md.push('\n');
+        md
+    }
+
     /// Every figure of the run; all numbers are finite.
     pub fn json(&self) -> Value {
         let c = &self.costs;
@@ -73,6 +114,13 @@ impl CompareReport {
                 "warm_up_frames": WARM_UP_FRAMES,
             },
             "table_sampling": sampled_json(&self.sampled),
+            "talk_verdicts": super::talk_verdicts(&self.rows).iter().map(|v| json!({
+                "technique": v.technique,
+                "brdfs": v.brdfs,
+                "against": v.against,
+                "ratio": interval_json(&v.ratio),
+                "verdict": v.words(),
+            })).collect::<Vec<_>>(),
             "rows": self.rows.iter().map(row_json).collect::<Vec<_>>(),
             "breakdown": self.breakdowns.iter().map(breakdown_json).collect::<Vec<_>>(),
             "light_sizes": self.sizes.iter().map(size_json).collect::<Vec<_>>(),
@@ -183,11 +231,13 @@ impl CompareReport {
             let _ = writeln!(
                 md,
                 "Budget: a pilot of {} rounds ({:.1} s) predicted that {predicted}, so the \
-                 budget was {:.0} s. Outcome: {} rounds, {} of the talk's cells (branching and \
-                 stencil at 2 BRDFs and up) still undecided.\n",
+                 budget was {:.0} s. Outcome: {} rounds, {} of the talk's cells (branching's \
+                 and stencil's overheads at 2 BRDFs and up, stencil against branching) still \
+                 undecided.\n",
                 p.pilot_rounds, p.pilot_seconds, p.budget_seconds, t.rounds, t.open
             );
         }
+        md += &self.talk_verdicts_markdown();
         md += "## Lighting time against BRDF count\n\n";
         md += "Overheads are against each row's own 1-BRDF time in this run; the error column is \
                the worst over the BRDF counts.\n\n";
