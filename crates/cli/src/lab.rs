@@ -83,9 +83,19 @@ pub struct CompareArgs {
     /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
     beside_load: u16,
+    /// A first answer in minutes (1 min 46 s on lavapipe with 2 cores, every talk verdict
+    /// decided): 320x180, light sizes 1, 10 and 100 %, each of the four
+    /// measurement sets (the table, three sizes) sampled until decided within at most 60 s. A
+    /// default run (1280x720, seven light sizes, up to 1800 s a set) takes hours on lavapipe
+    /// and is meant for a GPU; progress goes to stderr either way.
+    #[arg(long, conflicts_with_all = ["width", "height", "light_sizes", "budget_cap_s", "budget_s"])]
+    quick: bool,
     #[command(subcommand)]
     command: Option<CompareCommand>,
 }
+
+/// `compare --quick`'s size, light sizes (percent) and budget cap per set (seconds).
+const QUICK: (u32, u32, [f64; 3], f64) = (320, 180, [1.0, 10.0, 100.0], 60.0);
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Until {
@@ -142,7 +152,9 @@ fn compare_merge(args: &CompareMergeArgs) -> Result<()> {
 #[derive(clap::Args)]
 pub struct SamplingArgs {
     /// Keep sampling (past --frames rounds) until every tracked 95 % interval is within ±this
-    /// many percent, or --budget-s runs out. Without it, --frames rounds exactly.
+    /// many percent, or --budget-s runs out. Without it: calibrate takes --frames rounds
+    /// exactly; compare samples until its verdicts are decided (--until decided, its default),
+    /// or --frames rounds exactly with --until rounds.
     #[arg(long)]
     target_ci: Option<f64>,
     /// Seconds each measurement set (compare: the table, each light size) may sample for
@@ -316,8 +328,30 @@ fn progress_bar(steps: Option<u64>) -> ProgressBar {
     }
 }
 
-/// Runs `body` under a spinner that shows the step it last reported.
+/// Runs `body` under a spinner that shows the step it last reported, where stderr is a
+/// terminal; elsewhere (a CI log, a pipe) each step as a plain line with the seconds since the
+/// start, a round's line at most every 10 s (a GPU runs many a second).
 fn with_spinner<T>(body: impl FnOnce(&mut dyn FnMut(&str)) -> T) -> T {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        let start = std::time::Instant::now();
+        // When the last line went out, and what it was about (the text before `round`).
+        let mut last: Option<(std::time::Instant, String)> = None;
+        return body(&mut |what| {
+            let about = what.split("round ").next().unwrap_or(what).to_owned();
+            let recent = last.as_ref().is_some_and(|(t, a)| {
+                *a == about && t.elapsed().as_secs_f64() < 10.0 && what.contains("round ")
+            });
+            if recent {
+                return;
+            }
+            last = Some((std::time::Instant::now(), about));
+            eprintln!(
+                "histencil: {:>6.0} s  {what}",
+                start.elapsed().as_secs_f64()
+            );
+        });
+    }
     let bar = progress_bar(None);
     let out = body(&mut |what| {
         bar.set_message(what.to_owned());
@@ -359,11 +393,18 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     }
     steady_llvmpipe();
     histencil_vk::check_output_dir(&args.out)?;
-    if let Some(bad) = args
-        .light_sizes
-        .iter()
-        .find(|s| !(**s > 0.0 && **s <= 100.0))
-    {
+    let (width, height, light_sizes, budget_cap_s) = if args.quick {
+        (QUICK.0, QUICK.1, QUICK.2.to_vec(), QUICK.3)
+    } else {
+        let r = &args.run;
+        (
+            r.width,
+            r.height,
+            args.light_sizes.clone(),
+            args.budget_cap_s,
+        )
+    };
+    if let Some(bad) = light_sizes.iter().find(|s| !(**s > 0.0 && **s <= 100.0)) {
         bail!("--light-sizes: {bad} is not a percentage in (0, 100]");
     }
     let mut sampling = args.sampling.sampling(args.run.frames)?;
@@ -371,7 +412,7 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
         sampling.until_decided = true;
         sampling.max_rounds = histencil_lab::MAX_ROUNDS.max(sampling.min_rounds);
         if args.sampling.budget_s.is_none() {
-            let cap = args.budget_cap_s;
+            let cap = budget_cap_s;
             if !(cap.is_finite() && cap > 0.0 && cap <= 86_400.0) {
                 bail!("--budget-cap-s: {cap} is not between 0 and 86400 seconds");
             }
@@ -387,15 +428,14 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
             sampling.max_rounds
         );
     }
-    let mut settings =
-        CompareSettings::talk(args.run.width, args.run.height, args.run.frames as usize);
+    let mut settings = CompareSettings::talk(width, height, args.run.frames as usize);
     settings.target_ci = sampling.target;
     settings.budget = sampling.budget;
     settings.until_decided = sampling.until_decided;
     settings.predict_budget = sampling.predict_budget;
     settings.brdfs = args.brdfs.modules()?;
     settings.scene = crate::brdfs::load_scene(&args.scene, lights, settings.brdfs)?;
-    settings.light_sizes = args.light_sizes.iter().map(|s| s / 100.0).collect();
+    settings.light_sizes = light_sizes.iter().map(|s| s / 100.0).collect();
     (settings.costs, settings.brdf_weights) =
         read_costs_arg(args.costs.as_deref(), &settings.brdfs.set)?;
     settings.beside_load = usize::from(args.beside_load);

@@ -232,8 +232,9 @@ pub fn calibrate_with(
     };
     let sampled = sample(
         sampling,
-        |round| -> Result<()> {
-            progress(&format!("round {}", round + 1));
+        |start: &crate::stats::RoundStart| -> Result<()> {
+            progress(&start.line());
+            let round = start.index;
             let mut k = kinds.borrow_mut();
             for kind in k.iter_mut() {
                 let (renderer, lights) = &mut renderers[kind.renderer];

@@ -359,10 +359,50 @@ impl Prediction {
 /// relative half-widths after each round.
 pub fn sample<E>(
     sampling: &Sampling,
-    round: impl FnMut(usize) -> Result<(), E>,
+    round: impl FnMut(&RoundStart) -> Result<(), E>,
     widths: impl Fn() -> Vec<f64>,
 ) -> Result<Sampled, E> {
     sample_deciding(sampling, round, widths, Vec::new)
+}
+
+/// Where a sampling stands as a round starts: what a progress line says.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoundStart {
+    /// The round about to run, from 0.
+    pub index: usize,
+    /// Seconds since the sampling started.
+    pub seconds: f64,
+    /// The budget in force: the cap, or the pilot's prediction once made.
+    pub budget_seconds: f64,
+    /// The pilot's length while it runs (its prediction not made yet).
+    pub pilot: Option<usize>,
+    /// The rounds the pilot predicted would decide every open verdict.
+    pub predicted_rounds: Option<usize>,
+    /// The rounds a fixed-length sampling takes.
+    pub fixed_rounds: Option<usize>,
+    /// Verdicts still undecided after the last round (none before the first).
+    pub open: Option<usize>,
+}
+
+impl RoundStart {
+    /// `round 14 of about 40 (predicted), 3 verdicts open, 35 s of a 88 s budget`.
+    pub fn line(&self) -> String {
+        let n = self.index + 1;
+        let of = match (self.fixed_rounds, self.pilot, self.predicted_rounds) {
+            (Some(k), _, _) => format!(" of {k}"),
+            (None, Some(p), _) => format!(" of a {p}-round pilot"),
+            (None, None, Some(r)) => format!(" of about {} (predicted)", r.max(n)),
+            (None, None, None) => String::new(),
+        };
+        let open = match self.open {
+            Some(o) if self.fixed_rounds.is_none() => format!(", {o} verdicts open"),
+            _ => String::new(),
+        };
+        format!(
+            "round {n}{of}{open}, {:.0} s of a {:.0} s budget",
+            self.seconds, self.budget_seconds
+        )
+    }
 }
 
 /// [`sample`], with `open` giving, for each tracked verdict still undecided, the rounds in all
@@ -370,20 +410,31 @@ pub fn sample<E>(
 /// [`Sampling::until_decided`] stops on and [`Sampling::predict_budget`] predicts from.
 pub fn sample_deciding<E>(
     sampling: &Sampling,
-    mut round: impl FnMut(usize) -> Result<(), E>,
+    mut round: impl FnMut(&RoundStart) -> Result<(), E>,
     widths: impl Fn() -> Vec<f64>,
     open: impl Fn() -> Vec<Option<usize>>,
 ) -> Result<Sampled, E> {
     let start = std::time::Instant::now();
     let pilot = sampling.min_rounds.max(MIN_VERDICT_ROUNDS);
     let mut budget = sampling.budget;
-    let mut prediction = None;
+    let mut prediction: Option<Prediction> = None;
     let mut rounds = 0;
+    let mut still_open = None;
     loop {
-        round(rounds)?;
+        round(&RoundStart {
+            index: rounds,
+            seconds: start.elapsed().as_secs_f64(),
+            budget_seconds: budget.as_secs_f64(),
+            pilot: (sampling.predict_budget && prediction.is_none()).then_some(pilot),
+            predicted_rounds: prediction.as_ref().and_then(|p| p.rounds),
+            fixed_rounds: (sampling.target.is_none() && !sampling.until_decided)
+                .then_some(sampling.min_rounds),
+            open: still_open,
+        })?;
         rounds += 1;
         let w = widths();
         let o = open();
+        still_open = Some(o.len());
         if sampling.predict_budget && rounds == pilot {
             let p = Prediction::of(
                 rounds,
@@ -492,7 +543,7 @@ mod tests {
         assert_eq!(fixed.stop(2, &wide, 0, early, b), None);
         assert_eq!(fixed.stop(3, &wide, 0, early, b), Some(Stop::Rounds));
         let mut n = 0;
-        let round = |_| {
+        let round = |_: &RoundStart| {
             n += 1;
             Ok::<_, ()>(())
         };
@@ -538,12 +589,84 @@ mod tests {
             until_decided: true,
             predict_budget: true,
         };
-        let sampled = sample_deciding(&s, |_| Ok::<_, ()>(()), Vec::new, || vec![None]).unwrap();
+        let sampled = sample_deciding(
+            &s,
+            |_: &RoundStart| Ok::<_, ()>(()),
+            Vec::new,
+            || vec![None],
+        )
+        .unwrap();
         assert_eq!(
             (sampled.rounds, sampled.stop, sampled.open),
             (10, Stop::Budget, 1)
         );
         assert_eq!(sampled.prediction.unwrap().rounds, None);
+    }
+
+    #[test]
+    fn a_round_says_where_the_sampling_stands() {
+        let start = RoundStart {
+            index: 13,
+            seconds: 35.2,
+            budget_seconds: 88.0,
+            pilot: None,
+            predicted_rounds: Some(40),
+            fixed_rounds: None,
+            open: Some(3),
+        };
+        assert_eq!(
+            start.line(),
+            "round 14 of about 40 (predicted), 3 verdicts open, 35 s of a 88 s budget"
+        );
+        let pilot = RoundStart {
+            index: 0,
+            pilot: Some(10),
+            predicted_rounds: None,
+            open: None,
+            ..start
+        };
+        assert_eq!(
+            pilot.line(),
+            "round 1 of a 10-round pilot, 35 s of a 88 s budget"
+        );
+        let fixed = RoundStart {
+            fixed_rounds: Some(5),
+            ..start
+        };
+        assert!(
+            fixed.line().starts_with("round 14 of 5, 35 s"),
+            "{}",
+            fixed.line()
+        );
+        // Past the prediction, never "of about 40" at round 41.
+        let late = RoundStart { index: 44, ..start };
+        assert!(
+            late.line().starts_with("round 45 of about 45"),
+            "{}",
+            late.line()
+        );
+        // What the sampler hands each round: the pilot first, then its prediction.
+        let s = Sampling {
+            min_rounds: 2,
+            target: None,
+            budget: std::time::Duration::from_secs(600),
+            max_rounds: 1000,
+            until_decided: true,
+            predict_budget: true,
+        };
+        let mut seen = Vec::new();
+        sample_deciding(
+            &s,
+            |r: &RoundStart| {
+                seen.push((r.index, r.pilot, r.open));
+                Ok::<_, ()>(())
+            },
+            Vec::new,
+            || vec![None],
+        )
+        .unwrap();
+        assert_eq!(seen[0], (0, Some(10), None));
+        assert_eq!(seen[9], (9, Some(10), Some(1)));
     }
 
     #[test]

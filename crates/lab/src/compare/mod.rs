@@ -779,8 +779,8 @@ fn measure_table<'c>(
     };
     let table_sampled = sample_deciding(
         sampling,
-        |round| -> Result<()> {
-            progress(&format!("round {}", round + 1));
+        |start: &crate::stats::RoundStart| -> Result<()> {
+            progress(&format!("the table: {}", start.line()));
             for (count, (_, renderer, _)) in renderers.iter_mut().enumerate() {
                 for (row, (_, technique)) in rows_spec.iter().enumerate() {
                     let (ms, emulator) = lighting_ms(renderer, *technique)?;
@@ -892,7 +892,12 @@ fn measure_sizes(
         };
         let sampled = sample_deciding(
             sampling,
-            |_| -> Result<()> {
+            |start: &crate::stats::RoundStart| -> Result<()> {
+                progress(&format!(
+                    "light size {:.1} %: {}",
+                    coverage * 100.0,
+                    start.line()
+                ));
                 for (i, technique) in size_techniques(side).into_iter().enumerate() {
                     let (ms, _) = lighting_ms(&mut renderer, technique)?;
                     samples.borrow_mut()[i].push(ms);
