@@ -316,16 +316,10 @@ pub struct ScaleArgs {
 }
 
 /// A spinner with a message, or a bar when the number of steps is known.
-fn progress_bar(steps: Option<u64>) -> ProgressBar {
-    match steps {
-        Some(n) => ProgressBar::new(n).with_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
-                .expect("valid template"),
-        ),
-        None => ProgressBar::new_spinner().with_style(
-            ProgressStyle::with_template("{spinner} {elapsed} {msg}").expect("valid template"),
-        ),
-    }
+fn spinner() -> ProgressBar {
+    ProgressBar::new_spinner().with_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {msg}").expect("valid template"),
+    )
 }
 
 /// Runs `body` under a spinner that shows the step it last reported, where stderr is a
@@ -352,7 +346,7 @@ fn with_spinner<T>(body: impl FnOnce(&mut dyn FnMut(&str)) -> T) -> T {
             );
         });
     }
-    let bar = progress_bar(None);
+    let bar = spinner();
     let out = body(&mut |what| {
         bar.set_message(what.to_owned());
         bar.tick();
@@ -470,19 +464,20 @@ pub fn sweep(args: &SweepArgs, lights: DefaultLights) -> Result<()> {
         lights,
     )?;
     let report = on_device(args.run.device(), |ctx| {
-        let bar = progress_bar(Some(values.len() as u64));
-        bar.set_message(format!("{} on {}", param.name(), scene.name));
-        let report = histencil_lab::run_sweep(
-            ctx,
-            scene,
-            param,
-            &values,
-            args.run.width,
-            args.run.height,
-            args.run.frames as usize,
-            &mut |done, _| bar.set_position(done as u64),
-        );
-        bar.finish_and_clear();
+        let what = format!("{} on {}", param.name(), scene.name);
+        let total = values.len();
+        let report = with_spinner(|step| {
+            histencil_lab::run_sweep(
+                ctx,
+                scene,
+                param,
+                &values,
+                args.run.width,
+                args.run.height,
+                args.run.frames as usize,
+                &mut |done, _| step(&format!("{what}: {done} of {total} values measured")),
+            )
+        });
         Ok(report?)
     })?;
     for path in report.write(&args.out)? {
