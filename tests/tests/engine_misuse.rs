@@ -32,6 +32,11 @@ struct Case<'a> {
 }
 
 fn on_a_lighting(case: impl FnOnce(Case)) {
+    on_a_lighting_with(1, case);
+}
+
+/// [`on_a_lighting`] with `frames` frames in flight.
+fn on_a_lighting_with(frames: u32, case: impl FnOnce(Case)) {
     let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
     scene.normalise_lights();
     let engine = Engine::start();
@@ -42,7 +47,10 @@ fn on_a_lighting(case: impl FnOnce(Case)) {
         let renderer = Renderer::new(&ctx, scene.clone(), SIZE.width, SIZE.height).unwrap();
         let layout = *renderer.stencil_layout();
         let brdfs = renderer.brdfs().to_vec();
-        let desc = lighting_desc(layout, brdfs.clone(), SIZE, ds_format, scene.lights.len());
+        let desc = histencil_vk::LightingDesc {
+            frames_in_flight: frames,
+            ..lighting_desc(layout, brdfs.clone(), SIZE, ds_format, scene.lights.len())
+        };
         let lighting = DeferredLighting::new(&ctx, &desc).unwrap();
         let view = scene.camera.view_desc(1.5);
         let plan = stencil_plan(&scene, &layout, &brdfs, &view, Backend::Ps3);
@@ -148,6 +156,71 @@ fn a_slot_in_flight_is_not_recorded_resized_or_destroyed_until_declared_finished
         }
         assert!(!lighting.in_flight());
         lighting.resize(bigger).unwrap();
+        lighting.destroy().unwrap();
+        engine.free_frame_slots(&slots);
+    });
+}
+
+/// An engine that records frame-in-flight 1 into the command buffer of frame 0, still pending,
+/// would have slot 1's buffers read under frame 0's fence: refused, naming both slots, before
+/// anything is recorded; into its own command buffer it goes through.
+#[test]
+fn a_slot_recorded_into_another_pending_slots_command_buffer_is_refused() {
+    on_a_lighting_with(2, |case| {
+        let Case {
+            engine,
+            renderer,
+            mut lighting,
+            frame,
+            tiled,
+            images,
+        } = case;
+        let mut targets = images.refs();
+        let d = &engine.device;
+        let slots = engine.frame_slots(2);
+        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let (_, first, fence) = slots[0];
+        unsafe {
+            d.reset_fences(&[fence]).unwrap();
+            d.begin_command_buffer(first, &begin).unwrap();
+            renderer.record_gbuffer(first, &mut targets).unwrap();
+            lighting.record(first, &frame, &mut targets).unwrap();
+            d.end_command_buffer(first).unwrap();
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(first)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], fence).unwrap();
+        }
+        let slot_1 = LightingFrame { slot: 1, ..frame };
+        // Slot 1 into slot 0's command buffer (its frame pending): refused by either path. The
+        // command buffer is not begun again: the check comes before anything is recorded.
+        let wrong = unsafe { lighting.record(first, &slot_1, &mut targets.clone()) };
+        match wrong {
+            Err(Error::InFlight(m)) => assert!(
+                m.contains("slot 1") && m.contains("slot 0's frame") && m.contains("fence"),
+                "{m}"
+            ),
+            other => panic!("slot 1 into slot 0's command buffer: {other:?}"),
+        }
+        let tiled_1 = TiledFrame { slot: 1, ..tiled };
+        let wrong = unsafe { lighting.record_tiled(first, &tiled_1, &mut targets.clone()) };
+        assert!(matches!(wrong, Err(Error::InFlight(_))), "{wrong:?}");
+        // Into its own command buffer, beside the pending slot 0: recorded and run.
+        let (_, second, second_fence) = slots[1];
+        unsafe {
+            d.reset_fences(&[second_fence]).unwrap();
+            d.begin_command_buffer(second, &begin).unwrap();
+            lighting.record(second, &slot_1, &mut targets).unwrap();
+            d.end_command_buffer(second).unwrap();
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(second)];
+            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+            d.queue_submit2(queue, &[submit], second_fence).unwrap();
+            d.wait_for_fences(&[fence, second_fence], true, u64::MAX)
+                .unwrap();
+            lighting.slot_finished(0).unwrap();
+            lighting.slot_finished(1).unwrap();
+        }
         lighting.destroy().unwrap();
         engine.free_frame_slots(&slots);
     });

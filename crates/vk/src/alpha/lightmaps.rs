@@ -411,7 +411,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         frame: &LightmapFrame,
         atlas: &mut ImageRef,
     ) -> Result<()> {
-        self.write_frame(frame, atlas)?;
+        self.write_frame(cmd, frame, atlas)?;
         // SAFETY: this fn's # Safety: `cmd` is recording on the lightmaps' device, on a graphics
         // queue family, outside any render pass; this call alone records into it now.
         unsafe { self.record_pass(cmd, frame.slot, frame.layout, atlas, None) };
@@ -442,16 +442,22 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         direction: &mut ImageRef,
     ) -> Result<()> {
         check_direction(&self.desc, atlas, direction)?;
-        self.write_frame(frame, atlas)?;
+        self.write_frame(cmd, frame, atlas)?;
         // SAFETY: as in `record`, whose # Safety this fn's is.
         unsafe { self.record_pass(cmd, frame.slot, frame.layout, atlas, Some(direction)) };
         Ok(())
     }
 
-    /// Checks `frame` and writes its records, lights and uniforms into its slot.
-    pub(crate) fn write_frame(&mut self, frame: &LightmapFrame, atlas: &ImageRef) -> Result<()> {
+    /// Checks `frame` (to be recorded into `cmd`) and writes its records, lights and uniforms
+    /// into its slot.
+    pub(crate) fn write_frame(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        frame: &LightmapFrame,
+        atlas: &ImageRef,
+    ) -> Result<()> {
         check_frame(&self.desc, frame, atlas, &self.modules.set)?;
-        self.pending.refuse_slot(frame.slot)?;
+        self.pending.refuse_slot(frame.slot, cmd)?;
         let viewer = Viewer::from_view(frame.view)
             .ok_or_else(|| bad("the view's world-to-view matrix cannot be inverted".into()))?;
         let e = atlas.extent;
@@ -533,7 +539,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         // SAFETY: this fn's # Safety is `Recording::new`'s.
         let rec = unsafe { Recording::new(ctx, cmd) };
         let cmd = rec.outside();
-        self.pending.recorded(slot);
+        self.pending.recorded(slot, cmd);
         let slot = &mut self.slots[slot as usize];
         // Queries are reset outside rendering, as Vulkan requires.
         let mut timer = slot.timer.active();

@@ -360,7 +360,7 @@ impl<'c> AlphaLighting<'c> {
         // before it records the next, and records nothing after a wait that failed
         // (`Renderer::begin_commands`): slot 0's last frame has finished.
         unsafe { self.lightmaps.slot_finished(0)? };
-        self.lightmaps.write_frame(&frame, &self.lightmap)?;
+        self.lightmaps.write_frame(cmd, &frame, &self.lightmap)?;
         let direction = match mode {
             AlphaMode::Lightmap => None,
             AlphaMode::Directional => Some(&mut *self.direction_map),

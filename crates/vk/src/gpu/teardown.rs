@@ -12,6 +12,7 @@
 
 use crate::gpu::context::Context;
 use crate::gpu::error::{Error, Result};
+use ash::vk;
 
 /// A value made of Vulkan objects and allocations that frees them all. It must accept being
 /// destroyed twice, and when only some of its parts exist.
@@ -130,7 +131,8 @@ impl InFlight {
 /// submits nothing and sees no fence, so the engine says so (`slot_finished`), and until then
 /// the slot is not recorded again, and the owner not resized or destroyed.
 pub(crate) struct PendingSlots {
-    pending: Vec<bool>,
+    /// Per slot, the command buffer its pending frame was recorded into; `None`: not pending.
+    pending: Vec<Option<vk::CommandBuffer>>,
     /// The owner's name, for the refusals' advice (`DeferredLighting::slot_finished`).
     owner: &'static str,
     /// What a slot holds for its frame, for the refusals ("buffers and sets").
@@ -141,15 +143,15 @@ impl PendingSlots {
     /// `slots` slots, none pending.
     pub fn new(slots: u32, owner: &'static str, holds: &'static str) -> Self {
         Self {
-            pending: vec![false; slots as usize],
+            pending: vec![None; slots as usize],
             owner,
             holds,
         }
     }
 
-    /// A frame was recorded into `slot` (in range: the owner checked it).
-    pub fn recorded(&mut self, slot: u32) {
-        self.pending[slot as usize] = true;
+    /// A frame was recorded into `slot` (in range: the owner checked it), in `cmd`.
+    pub fn recorded(&mut self, slot: u32, cmd: vk::CommandBuffer) {
+        self.pending[slot as usize] = Some(cmd);
     }
 
     /// The engine's `slot_finished(slot)`; a slot past the slots in flight is refused.
@@ -160,13 +162,13 @@ impl PendingSlots {
                 "slot_finished({slot}) of {frames} frames in flight"
             ))
         })?;
-        *pending = false;
+        *pending = None;
         Ok(())
     }
 
     /// Whether a slot is pending.
     pub fn any(&self) -> bool {
-        self.pending.contains(&true)
+        self.pending.iter().any(Option::is_some)
     }
 
     /// The owner's drop: waits for the device to go idle while a slot is pending (as
@@ -178,7 +180,7 @@ impl PendingSlots {
     /// Refuses `what` (a resize, a destroy) while a slot is pending, naming the slots.
     pub fn refuse_while_any(&self, what: &str) -> Result<()> {
         let slots: Vec<String> = (self.pending.iter().enumerate())
-            .filter(|(_, pending)| **pending)
+            .filter(|(_, pending)| pending.is_some())
             .map(|(i, _)| i.to_string())
             .collect();
         if slots.is_empty() {
@@ -192,17 +194,27 @@ impl PendingSlots {
         )))
     }
 
-    /// Refuses a recording into `slot` while its last frame is pending: what the slot holds
-    /// is that frame's until then.
-    pub fn refuse_slot(&self, slot: u32) -> Result<()> {
-        if !self.pending.get(slot as usize).copied().unwrap_or(false) {
-            return Ok(());
+    /// Refuses a recording of `slot` into `cmd` while the slot's last frame is pending (what
+    /// the slot holds is that frame's until then), or while `cmd` is the command buffer of
+    /// another slot's pending frame: an engine recording frame-in-flight k into the command
+    /// buffer of frame j, whose slot k buffers would then be read under frame j's fence.
+    pub fn refuse_slot(&self, slot: u32, cmd: vk::CommandBuffer) -> Result<()> {
+        if self.pending.get(slot as usize).copied().flatten().is_some() {
+            return Err(Error::InFlight(format!(
+                "slot {slot} recorded again before {}::slot_finished({slot}) said the GPU \
+                 finished its last frame: its {} are that frame's until then",
+                self.owner, self.holds
+            )));
         }
-        Err(Error::InFlight(format!(
-            "slot {slot} recorded again before {}::slot_finished({slot}) said the GPU finished \
-             its last frame: its {} are that frame's until then",
-            self.owner, self.holds
-        )))
+        if let Some(other) = self.pending.iter().position(|p| *p == Some(cmd)) {
+            return Err(Error::InFlight(format!(
+                "slot {slot} recorded into command buffer {cmd:?}, which holds slot {other}'s \
+                 frame, still pending ({}::slot_finished({other}) has not said the GPU finished \
+                 it): record each slot into the command buffer its own fence guards",
+                self.owner
+            )));
+        }
+        Ok(())
     }
 
     /// `value`'s destroy: refused while a slot is pending, with `value` handed back whole.

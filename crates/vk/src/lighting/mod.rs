@@ -398,7 +398,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         check_frame(&self.desc, frame, targets)?;
         let needs = UsageNeeds::light_passes(&self.desc, frame.plan, hierarchy.is_some());
         check_usage(targets, &needs)?;
-        self.pending.refuse_slot(frame.slot)?;
+        self.pending.refuse_slot(frame.slot, cmd)?;
         self.refuse_if_torn()?;
         if frame.plan.uses_depth_bounds() && !self.ctx.depth_bounds() {
             return Err(Error::BadFrame(
@@ -467,7 +467,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         let timer = slot.timer.active();
         let emulation = slot.emulation.active();
-        self.pending.recorded(frame.slot);
+        self.pending.recorded(frame.slot, cmd);
         let recorded = pass.record(targets, hi_stencil, timer, emulation);
         rec.finish();
         recorded

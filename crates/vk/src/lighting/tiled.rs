@@ -100,7 +100,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         check_targets(&self.desc, &frame.hook_sets, targets)?;
         let needs = UsageNeeds::tiled(&self.desc);
         check_usage(targets, &needs)?;
-        self.pending.refuse_slot(frame.slot)?;
+        self.pending.refuse_slot(frame.slot, cmd)?;
         self.refuse_if_torn()?;
         if let Some(why) = self.desc.hooks.tiled_refusal() {
             return Err(bad(format!(
@@ -139,7 +139,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             decode: decode_set,
             visibility: frame.hook_sets.visibility,
         };
-        self.pending.recorded(frame.slot);
+        self.pending.recorded(frame.slot, cmd);
         // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
         // family with graphics and compute, outside any render pass; this call alone records
         // into it now (`between` records through `rec`).
@@ -184,10 +184,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         // A recording of the slot's depth-id image: the slot is in flight until declared
         // finished, as after any recording (its caller, the renderer, declared it first).
         debug_assert!(
-            self.pending.refuse_slot(slot).is_ok(),
+            self.pending.refuse_slot(slot, cmd).is_ok(),
             "slot {slot} copied while in flight"
         );
-        self.pending.recorded(slot);
+        self.pending.recorded(slot, cmd);
         let (_, pass) = self
             .depth_id
             .iter_mut()
