@@ -433,6 +433,7 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     (settings.costs, settings.brdf_weights) =
         read_costs_arg(args.costs.as_deref(), &settings.brdfs.set)?;
     settings.beside_load = usize::from(args.beside_load);
+    settings.first_row = true;
     let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {
             histencil_lab::run_compare(ctx, &settings, step)

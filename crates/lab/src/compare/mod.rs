@@ -54,7 +54,16 @@ pub struct CompareSettings {
     /// Let a pilot of [`crate::stats::MIN_VERDICT_ROUNDS`] rounds predict the budget
     /// ([`crate::stats::Prediction`]); `budget` is then its cap.
     pub predict_budget: bool,
+    /// Measure the talk's own branching row too ([`FIRST_ROW`]): per column, the uber shader
+    /// compiled with that column's BRDFs only (with `glslc`, at run time) and every pixel
+    /// taking the first. histencil's `branching` row compiles every BRDF of its set in at
+    /// every column and shades the column's BRDFs, so it measures another thing.
+    pub first_row: bool,
 }
+
+/// The talk's branching measurement: "three different BRDFs, only one used (branch always
+/// yields the first one)", the tax of branches compiled in and never taken.
+pub const FIRST_ROW: &str = "branching, first";
 
 /// The rows whose cost of an extra BRDF is the talk's question: branching against stencil on
 /// the consoles and on today's GPUs.
@@ -78,8 +87,36 @@ impl CompareSettings {
             beside_load: 0,
             until_decided: false,
             predict_budget: false,
+            first_row: false,
         }
     }
+}
+
+/// Per column (BRDF count), the modules of a set holding only that column's BRDFs (the
+/// palette's first `count`), for [`FIRST_ROW`]; or why the row is left out: an engine's set
+/// (its BRDFs' ids are their places in the set, which a subset would change), or a set
+/// `glslc` could not compile.
+fn first_row_modules(
+    settings: &CompareSettings,
+    palette: &[BrdfId],
+) -> std::result::Result<Vec<&'static histencil_vk::BrdfModules>, String> {
+    if !settings.brdfs.set.is_builtin_only() {
+        return Err(
+            "an engine's BRDF set cannot be cut to a column's BRDFs (its own BRDFs' \
+                    ids are their places in the set)"
+                .into(),
+        );
+    }
+    settings
+        .brdf_counts
+        .iter()
+        .map(|&count| {
+            let ids = &palette[..count.min(palette.len())];
+            let set = histencil_brdf::BrdfSet::new(ids, Vec::new()).map_err(|e| e.to_string())?;
+            histencil_vk::compile_brdf_set(&set)
+                .map_err(|e| format!("its shaders did not compile: {e}"))
+        })
+        .collect()
 }
 
 /// The table's rows: the technique and platform backend of each.
@@ -454,6 +491,8 @@ pub struct CompareReport {
     pub engine_brdfs: Vec<String>,
     /// Why the table has no LUT row (a model no table can hold), if it has none.
     pub lut_left_out: Option<String>,
+    /// Why [`FIRST_ROW`] was asked for and left out, if it was.
+    pub first_left_out: Option<String>,
     pub width: u32,
     pub height: u32,
     pub frames: usize,
@@ -606,6 +645,7 @@ pub fn run_compare(
             .map(|(_, spec)| spec.name.clone())
             .collect(),
         lut_left_out: lut_refusal(settings),
+        first_left_out: table.first_left_out,
         width: settings.width,
         height: settings.height,
         frames: settings.frames,
@@ -646,6 +686,7 @@ struct Table<'c> {
     costs: CostModel,
     depth_id: Vec<(usize, TileStats)>,
     widest: Option<(usize, Renderer<'c>)>,
+    first_left_out: Option<String>,
 }
 
 /// Why the table has no LUT row, if it has none: a model of its widest column that no table
@@ -716,6 +757,35 @@ fn measure_table<'c>(
     for (_, renderer, _) in &mut renderers {
         shares.push(pixel_shares(renderer, &palette)?);
     }
+    // The talk's branching row: per column, the column's BRDFs compiled in, the first shaded.
+    let branching_native = Technique::Branching {
+        backend: histencil_vk::Backend::Native,
+        flush: histencil_vk::FlushPolicy::Auto,
+    };
+    let mut first_renderers = Vec::new();
+    let mut first_left_out = None;
+    if settings.first_row {
+        match first_row_modules(settings, &palette) {
+            Ok(modules) => {
+                for (&brdfs, modules) in settings.brdf_counts.iter().zip(modules) {
+                    progress(&format!(
+                        "{FIRST_ROW}, {brdfs} BRDF(s) compiled in: reference"
+                    ));
+                    let desc_settings = CompareSettings {
+                        brdfs: modules,
+                        ..settings.clone()
+                    };
+                    let scene = with_brdf_count(&settings.scene, 1);
+                    let mut renderer = renderer_for(ctx, &desc_settings, scene)?;
+                    let reference = frame(&mut renderer, Shading::Forward)?;
+                    let error = image_error(&frame(&mut renderer, branching_native)?, &reference);
+                    first_renderers.push((brdfs, renderer, error));
+                }
+            }
+            Err(why) => first_left_out = Some(why),
+        }
+    }
+    let first_samples = std::cell::RefCell::new(vec![Vec::new(); first_renderers.len()]);
     let single_samples =
         std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; singles.len()]);
     let samples = std::cell::RefCell::new(vec![vec![Vec::new(); rows_spec.len()]; renderers.len()]);
@@ -794,6 +864,10 @@ fn measure_table<'c>(
                     single_samples.borrow_mut()[single][row].push(ms);
                 }
             }
+            for (count, (_, renderer, _)) in first_renderers.iter_mut().enumerate() {
+                let (ms, _) = lighting_ms(renderer, branching_native)?;
+                first_samples.borrow_mut()[count].push(ms);
+            }
             Ok(())
         },
         overhead_widths,
@@ -838,6 +912,23 @@ fn measure_table<'c>(
             });
         }
     }
+    if !first_renderers.is_empty() {
+        let samples = first_samples.into_inner();
+        rows.push(Row {
+            name: FIRST_ROW,
+            cells: first_renderers
+                .iter()
+                .zip(samples)
+                .map(|((brdfs, _, error), samples)| Cell {
+                    brdfs: *brdfs,
+                    samples,
+                    bookkeeping: Vec::new(),
+                    single_brdf: Vec::new(),
+                    error: *error,
+                })
+                .collect(),
+        });
+    }
     let widest = renderers
         .pop()
         .map(|(brdfs, renderer, _)| (brdfs, renderer));
@@ -847,6 +938,7 @@ fn measure_table<'c>(
         costs: costs.expect("at least one BRDF count"),
         depth_id,
         widest,
+        first_left_out,
     })
 }
 

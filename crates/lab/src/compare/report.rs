@@ -50,9 +50,26 @@ impl CompareReport {
                 own.join(", ")
             )
         };
-        match &self.lut_left_out {
+        let line = match &self.lut_left_out {
             None => line,
             Some(why) => line + &format!(" The LUT row is left out: {why}."),
+        };
+        let first = if self.rows.iter().any(|r| r.name == super::FIRST_ROW) {
+            format!(
+                " The `{}` row is the talk's own branching measurement: per column the uber \
+                 shader with that column's BRDFs only compiled in, and every pixel taking the \
+                 first (its 1-BRDF cell has one BRDF compiled in), so its overheads are the tax \
+                 of branches never taken. The `branching` row compiles every BRDF of the set in \
+                 at every column and shades the column's BRDFs: divergence and their own \
+                 arithmetic.",
+                super::FIRST_ROW
+            )
+        } else {
+            String::new()
+        };
+        match &self.first_left_out {
+            None => line + &first,
+            Some(why) => line + &format!(" The `{}` row is left out: {why}.", super::FIRST_ROW),
         }
     }
 
@@ -156,6 +173,9 @@ impl CompareReport {
         // Only what was set: the report's values are all present and finite.
         if let Some(why) = &self.lut_left_out {
             out["settings"]["lut_left_out"] = json!(why);
+        }
+        if let Some(why) = &self.first_left_out {
+            out["settings"]["first_row_left_out"] = json!(why);
         }
         if let Some(n) = &self.lp_num_threads {
             out["settings"]["environment"] = json!({ "LP_NUM_THREADS": n });
@@ -413,7 +433,8 @@ impl CompareReport {
             .map(|&i| brdfs_label(self.rows[0].cells[i].brdfs))
             .collect();
         md += &table_head(&head);
-        for row in &self.rows {
+        // The talk's branching row shades one BRDF at every column: nothing to weigh.
+        for row in self.rows.iter().filter(|r| r.name != super::FIRST_ROW) {
             let cells: Vec<String> = columns
                 .iter()
                 .map(|&i| {
