@@ -83,8 +83,9 @@ pub struct CompareArgs {
     /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
     beside_load: u16,
-    /// A first answer in minutes (1 min 46 s on lavapipe with 2 cores, every talk verdict
-    /// decided): 320x180, light sizes 1, 10 and 100 %, each of the four
+    /// A first answer in minutes (under 2 minutes on lavapipe with 2 cores, where its sets
+    /// decided 9 or 10 of the talk's 10 verdicts): 320x180, light sizes 1, 10 and 100 %, each
+    /// of the four
     /// measurement sets (the table, three sizes) sampled until decided within at most 60 s. A
     /// default run (1280x720, seven light sizes, up to 1800 s a set) takes hours on lavapipe
     /// and is meant for a GPU; progress goes to stderr either way.
