@@ -79,6 +79,30 @@ fn on_a_lighting_with(frames: u32, case: impl FnOnce(Case)) {
     engine.destroy().assert_clean();
 }
 
+/// Records `body` into `cmd` (begun here, ended here) and submits it with `fence`, reset first:
+/// a frame the GPU may still be running when this returns.
+fn submit(
+    engine: &Engine,
+    (cmd, fence): (vk::CommandBuffer, vk::Fence),
+    body: impl FnOnce(vk::CommandBuffer),
+) {
+    let d = &engine.device;
+    let begin =
+        vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+    // SAFETY: the engine's device, queue, command buffer and fence, none in use (the fence is
+    // unsignalled by its reset; the command buffer's last submission, if any, waited for).
+    unsafe {
+        let queue = d.get_device_queue(engine.queue_family, 0);
+        d.reset_fences(&[fence]).unwrap();
+        d.begin_command_buffer(cmd, &begin).unwrap();
+        body(cmd);
+        d.end_command_buffer(cmd).unwrap();
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+        d.queue_submit2(queue, &[submit], fence).unwrap();
+    }
+}
+
 #[test]
 fn a_slot_in_flight_is_not_recorded_resized_or_destroyed_until_declared_finished() {
     on_a_lighting(|case| {
@@ -93,20 +117,13 @@ fn a_slot_in_flight_is_not_recorded_resized_or_destroyed_until_declared_finished
         let mut targets = images.refs();
         let d = &engine.device;
         let slots = engine.frame_slots(2);
-        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
         let begin = vk::CommandBufferBeginInfo::default()
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         let (_, first, fence) = slots[0];
-        unsafe {
-            d.reset_fences(&[fence]).unwrap();
-            d.begin_command_buffer(first, &begin).unwrap();
-            renderer.record_gbuffer(first, &mut targets).unwrap();
-            lighting.record(first, &frame, &mut targets).unwrap();
-            d.end_command_buffer(first).unwrap();
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(first)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            d.queue_submit2(queue, &[submit], fence).unwrap();
-        }
+        submit(engine, (first, fence), |cmd| unsafe {
+            renderer.record_gbuffer(cmd, &mut targets).unwrap();
+            lighting.record(cmd, &frame, &mut targets).unwrap();
+        });
         assert!(lighting.in_flight());
 
         // The frame may still run: slot 0 again, a resize and a destroy are refused.
@@ -178,20 +195,11 @@ fn a_slot_recorded_into_another_pending_slots_command_buffer_is_refused() {
         let mut targets = images.refs();
         let d = &engine.device;
         let slots = engine.frame_slots(2);
-        let queue = unsafe { d.get_device_queue(engine.queue_family, 0) };
-        let begin = vk::CommandBufferBeginInfo::default()
-            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         let (_, first, fence) = slots[0];
-        unsafe {
-            d.reset_fences(&[fence]).unwrap();
-            d.begin_command_buffer(first, &begin).unwrap();
-            renderer.record_gbuffer(first, &mut targets).unwrap();
-            lighting.record(first, &frame, &mut targets).unwrap();
-            d.end_command_buffer(first).unwrap();
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(first)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            d.queue_submit2(queue, &[submit], fence).unwrap();
-        }
+        submit(engine, (first, fence), |cmd| unsafe {
+            renderer.record_gbuffer(cmd, &mut targets).unwrap();
+            lighting.record(cmd, &frame, &mut targets).unwrap();
+        });
         let slot_1 = LightingFrame { slot: 1, ..frame };
         // Slot 1 into slot 0's command buffer (its frame pending): refused by either path. The
         // command buffer is not begun again: the check comes before anything is recorded.
@@ -208,14 +216,10 @@ fn a_slot_recorded_into_another_pending_slots_command_buffer_is_refused() {
         assert!(matches!(wrong, Err(Error::InFlight(_))), "{wrong:?}");
         // Into its own command buffer, beside the pending slot 0: recorded and run.
         let (_, second, second_fence) = slots[1];
+        submit(engine, (second, second_fence), |cmd| unsafe {
+            lighting.record(cmd, &slot_1, &mut targets).unwrap();
+        });
         unsafe {
-            d.reset_fences(&[second_fence]).unwrap();
-            d.begin_command_buffer(second, &begin).unwrap();
-            lighting.record(second, &slot_1, &mut targets).unwrap();
-            d.end_command_buffer(second).unwrap();
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(second)];
-            let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
-            d.queue_submit2(queue, &[submit], second_fence).unwrap();
             d.wait_for_fences(&[fence, second_fence], true, u64::MAX)
                 .unwrap();
             lighting.slot_finished(0).unwrap();
