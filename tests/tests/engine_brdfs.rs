@@ -318,6 +318,12 @@ fn the_lab_measures_the_engine_brdfs() {
         histencil_scene::retarget_brdfs(&mut settings.scene, &modules.set);
         let report = histencil_lab::run_compare(ctx, &settings, &mut |_| {}).unwrap();
         assert_eq!(report.models, ["toon", "charlie_sheen", "lambert"]);
+        // The steady clock's canary renders the engine's set too: the table and the size.
+        let stability = report
+            .stability
+            .as_ref()
+            .expect("a steady clock by default");
+        assert_eq!(stability.sets.len(), 2, "{stability:?}");
         assert!(report.rows.iter().all(|r| r.name != "lut"));
         let why = report.lut_left_out.as_deref().unwrap_or_default();
         assert!(

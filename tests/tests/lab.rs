@@ -84,6 +84,9 @@ fn the_light_size_wall_is_lit_and_tiled_lights_it_as_forward() {
 #[test]
 fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
     let mut settings = CompareSettings::talk(64, 64, 2);
+    // The lab's tests run beside each other on CI's two cores: a steady clock would retake
+    // most rounds. Its own test is `the_steady_clock_sees_a_load_...`.
+    settings.clock = None;
     // Fewer light sizes than the command's seven keep the test short; each is a full run.
     settings.light_sizes = vec![0.01, 0.1, 1.0];
     // The talk's own branching row, each column's BRDFs compiled in with glslc.
@@ -345,6 +348,9 @@ fn compare_verdicts_do_not_reverse_under_background_load() {
     use histencil_lab::compare::merge::{DeviceReport, Merged};
     let mut settings = CompareSettings::talk(64, 64, 15);
     settings.light_sizes = vec![0.01, 1.0];
+    // Pairing by round is what this test holds, without the steady clock's retakes (which
+    // the busy threads would multiply).
+    settings.clock = None;
     let quiet = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
     settings.beside_load = std::thread::available_parallelism().map_or(2, |n| n.get());
     let loaded = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
@@ -466,6 +472,7 @@ fn demo_holds(settings: histencil_lab::DemoSettings) {
 fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget() {
     let mut settings = CompareSettings::talk(48, 27, 2);
     settings.light_sizes = vec![1.0];
+    settings.clock = None;
     settings.until_decided = true;
     settings.predict_budget = true;
     // The cap: a run that cannot decide stops here at the latest (short: the talk's verdicts
@@ -490,4 +497,63 @@ fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget()
     let json = read_json(&dir.join("report.json"));
     assert_eq!(json["table_sampling"]["prediction"]["pilot_rounds"], 10);
     assert_eq!(json["table_sampling"]["undecided"], t.open);
+}
+
+/// The steady clock sees conditions change part way: busy threads, two per core, start as the
+/// table's fourth round begins. That round's canary strays beyond the tolerance, the round is
+/// thrown away and retaken, and after the stated strays in a row the canary is warmed up again
+/// on a reference the load slowed; the report carries the record. (On llvmpipe the "clock" is
+/// the CPU's share, which the busy threads take; on a GPU it is the GPU's clock.)
+#[test]
+fn the_steady_clock_sees_a_load_that_starts_part_way_and_retakes_the_round() {
+    use histencil_lab::steady::ClockSettings;
+    let mut settings = CompareSettings::talk(160, 90, 6);
+    settings.brdf_counts = vec![1];
+    settings.light_sizes = Vec::new();
+    settings.beside_load = 2 * std::thread::available_parallelism().map_or(2, |n| n.get());
+    settings.load_from_round = Some(3);
+    // Under the load the canary hardly settles: short warm-ups keep the test short.
+    let clock = ClockSettings {
+        max_warm_up: std::time::Duration::from_secs(2),
+        ..ClockSettings::default()
+    };
+    settings.clock = Some(clock);
+    let tolerance = clock.tolerance;
+    let report = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
+    let stability = report
+        .stability
+        .as_ref()
+        .expect("a steady clock by default");
+    print!("{}", stability.markdown());
+    let table = &stability.sets[0];
+    assert_eq!(table.set, "the table");
+    assert_eq!(
+        report.sampled.rounds, 6,
+        "retaken rounds are not extra rounds"
+    );
+    let first = table
+        .retaken
+        .iter()
+        .find(|r| r.round == 3)
+        .expect("the round the load began in was retaken");
+    assert!(
+        first.canary_ms > first.reference_ms * (1.0 + tolerance),
+        "{first:?}"
+    );
+    let again = table
+        .warm_ups
+        .iter()
+        .find(|w| w.before_round == 3)
+        .expect("the canary warmed up again where the load began");
+    assert!(
+        again.reference_ms > first.reference_ms * (1.0 + tolerance),
+        "the new reference {} ms is the loaded clock's, against {} ms",
+        again.reference_ms,
+        first.reference_ms
+    );
+    let json = report.json();
+    assert_eq!(json["settings"]["beside_load_from_round"], 3);
+    let sets = json["stability"]["sets"].as_array().unwrap();
+    assert!(sets[0]["retaken"].as_array().unwrap().len() >= 3);
+    count_finite_numbers(&json["stability"], "stability");
 }

@@ -83,6 +83,19 @@ pub struct CompareArgs {
     /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
     beside_load: u16,
+    /// Start the --beside-load threads as the table's round N (from 1) begins instead of before
+    /// the run: conditions that change part way, which the steady clock must see (its rounds
+    /// retaken and its canary warmed up again there, in the report's "Steady clock").
+    #[arg(long, value_name = "N", requires = "beside_load", value_parser = clap::value_parser!(u32).range(1..))]
+    beside_load_from_round: Option<u32>,
+    /// The steady clock's tolerance in percent: a canary frame (branching's lighting at 1 BRDF,
+    /// timed between every two rounds after a warm-up until it settles) further than this from
+    /// its reference has its round thrown away and retaken.
+    #[arg(long, value_name = "PERCENT", default_value_t = 10.0)]
+    clock_tolerance: f64,
+    /// No steady clock: no canary, no warm-up until it settles, every round kept as taken.
+    #[arg(long, conflicts_with = "clock_tolerance")]
+    no_steady_clock: bool,
     /// A first answer in minutes (under 2 minutes on lavapipe with 2 cores, where its sets
     /// decided 9 or 10 of the talk's 10 verdicts): 320x180, light sizes 1, 10 and 100 %, each
     /// of the four
@@ -434,6 +447,15 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
     (settings.costs, settings.brdf_weights) =
         read_costs_arg(args.costs.as_deref(), &settings.brdfs.set)?;
     settings.beside_load = usize::from(args.beside_load);
+    settings.load_from_round = args.beside_load_from_round.map(|r| r as usize - 1);
+    let tolerance = args.clock_tolerance;
+    if !(tolerance > 0.0 && tolerance < 100.0) {
+        bail!("--clock-tolerance: {tolerance} is not a percentage in (0, 100)");
+    }
+    settings.clock = (!args.no_steady_clock).then_some(histencil_lab::steady::ClockSettings {
+        tolerance: tolerance / 100.0,
+        ..Default::default()
+    });
     settings.first_row = true;
     let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {

@@ -25,6 +25,7 @@ mod measure;
 mod plot;
 pub mod scale;
 pub mod stats;
+pub mod steady;
 pub mod sweep;
 pub mod todays_gpus;
 mod variants;

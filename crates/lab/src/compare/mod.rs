@@ -9,6 +9,7 @@ use crate::measure::{frame, Timing};
 use crate::stats::{
     median_interval, ratio_interval, sample_deciding, Interval, Sampled, Sampling, Verdict,
 };
+use crate::steady::{Clock, ClockSettings, Stability};
 use crate::variants::{brdf_palette, light_size_scene, with_brdf_count, with_one_brdf};
 use crate::Result;
 use histencil_brdf::BrdfId;
@@ -59,6 +60,14 @@ pub struct CompareSettings {
     /// taking the first. histencil's `branching` row compiles every BRDF of its set in at
     /// every column and shades the column's BRDFs, so it measures another thing.
     pub first_row: bool,
+    /// The steady clock under every set ([`crate::steady`]): a canary warmed up until it
+    /// settles and timed at every round's edges, straying rounds retaken; `None`: rounds kept
+    /// as taken.
+    pub clock: Option<ClockSettings>,
+    /// Start the `beside_load` threads as the table's round of this index begins, instead of
+    /// before the run: conditions that change part way, which the steady clock must see
+    /// (`compare --beside-load-from-round`).
+    pub load_from_round: Option<usize>,
 }
 
 /// The talk's branching measurement: "three different BRDFs, only one used (branch always
@@ -88,6 +97,8 @@ impl CompareSettings {
             until_decided: false,
             predict_budget: false,
             first_row: false,
+            clock: Some(ClockSettings::default()),
+            load_from_round: None,
         }
     }
 }
@@ -518,6 +529,10 @@ pub struct CompareReport {
     /// (`histencil_model::depth_id`, on the id image the GPU wrote): llvmpipe has none, so its
     /// times include no rejection.
     pub depth_id: Vec<(usize, TileStats)>,
+    /// The steady clock's record: its canary, warm-ups, retaken rounds; `None` without one.
+    pub stability: Option<Stability>,
+    /// The table's round at which the busy threads started, if they started part way.
+    pub load_from_round: Option<usize>,
 }
 
 impl CompareReport {
@@ -596,8 +611,14 @@ pub fn run_compare(
     }
     let widest = settings.brdf_counts.iter().copied().max().unwrap_or(1);
     crate::variants::check_palette(&settings.scene, widest, &settings.brdfs.set)?;
-    // Spins until the report is made, when it drops.
-    let _load = crate::measure::BusyThreads::start(settings.beside_load);
+    // Spins until the report is made, when it drops (from the table's round the settings say,
+    // if they say one: `measure_table` starts it there).
+    let _load = crate::measure::BusyThreads::start(if settings.load_from_round.is_some() {
+        0
+    } else {
+        settings.beside_load
+    });
+    let mut steady = SteadyClock::new(ctx, settings)?;
     let sampling = Sampling {
         min_rounds: settings.frames.max(1),
         target: settings.target_ci,
@@ -606,7 +627,7 @@ pub fn run_compare(
         until_decided: settings.until_decided,
         predict_budget: settings.predict_budget,
     };
-    let mut table = measure_table(ctx, settings, &sampling, progress)?;
+    let mut table = measure_table(ctx, settings, &sampling, &mut steady, progress)?;
     // The stencil rows' per-pass breakdown, on the widest column's renderer.
     let mut breakdowns = Vec::new();
     if let Some((brdfs, renderer)) = table.widest.as_mut() {
@@ -625,7 +646,7 @@ pub fn run_compare(
         }
     }
     drop(table.widest);
-    let sizes = measure_sizes(ctx, settings, &sampling, progress)?;
+    let sizes = measure_sizes(ctx, settings, &sampling, &mut steady, progress)?;
     Ok(CompareReport {
         device: ctx.device_name().to_owned(),
         driver: ctx.driver().to_string(),
@@ -660,7 +681,122 @@ pub fn run_compare(
         costs: table.costs,
         costs_calibrated: settings.costs.is_some(),
         depth_id: table.depth_id,
+        stability: steady.clock.map(Clock::into_stability),
+        load_from_round: settings
+            .load_from_round
+            .filter(|_| settings.beside_load > 0),
     })
+}
+
+/// The steady clock and its canary: branching's lighting on the settings' scene folded onto one
+/// BRDF, at the settings' size, a renderer of its own (the cells' renderers keep their state).
+struct SteadyClock<'c> {
+    clock: Option<Clock>,
+    renderer: Option<Renderer<'c>>,
+}
+
+/// The canary's technique.
+const CANARY: Technique = Technique::Branching {
+    backend: Backend::Native,
+    flush: FlushPolicy::Auto,
+};
+
+/// Frames one canary time is the median of: a single frame's hiccup (a scheduler's time
+/// slice on llvmpipe's cores) is not a change of conditions; a clock that moved moves all three.
+const CANARY_FRAMES: usize = 3;
+
+/// One canary time: the median lighting time of [`CANARY_FRAMES`] frames.
+fn canary_ms(renderer: &mut Renderer) -> Result<f64> {
+    let mut times = (0..CANARY_FRAMES)
+        .map(|_| lighting_ms(renderer, CANARY).map(|(ms, _)| ms))
+        .collect::<Result<Vec<f64>>>()?;
+    times.sort_by(f64::total_cmp);
+    Ok(histencil_vk::median_of_sorted(&times))
+}
+
+impl<'c> SteadyClock<'c> {
+    fn new(ctx: &'c Context, settings: &CompareSettings) -> Result<Self> {
+        let Some(clock_settings) = settings.clock else {
+            return Ok(Self {
+                clock: None,
+                renderer: None,
+            });
+        };
+        let scene = with_brdf_count(&settings.scene, 1);
+        let mut renderer = renderer_for(ctx, settings, scene)?;
+        // Its pipelines built before the first timed frame.
+        lighting_ms(&mut renderer, CANARY)?;
+        let workload = format!(
+            "the median of {CANARY_FRAMES} frames of branching's lighting on `{}` at 1 BRDF, \
+             {}x{}",
+            settings.scene.name, settings.width, settings.height
+        );
+        Ok(Self {
+            clock: Some(Clock::new(workload, clock_settings)),
+            renderer: Some(renderer),
+        })
+    }
+
+    /// Starts the set `name` (a warm-up where the canary strays).
+    fn begin_set(&mut self, name: &str, progress: &mut dyn FnMut(&str)) -> Result<()> {
+        let (Some(clock), Some(renderer)) = (self.clock.as_mut(), self.renderer.as_mut()) else {
+            return Ok(());
+        };
+        let mut canary = || canary_ms(renderer);
+        clock.begin_set(name, &mut canary)?;
+        if let Some(w) = clock
+            .stability()
+            .sets
+            .last()
+            .and_then(|s| s.warm_ups.last())
+        {
+            progress(&format!(
+                "{name}: steady clock warmed up in {} frames ({:.1} s), canary {:.3} ms{}",
+                w.times_ms.len(),
+                w.seconds,
+                w.reference_ms,
+                if w.settled { "" } else { " (not settled)" }
+            ));
+        }
+        Ok(())
+    }
+
+    /// Round `index` of the current set: `work`'s kept try ([`Clock::round`]), or `work` once
+    /// without a clock.
+    fn round<T>(
+        &mut self,
+        index: usize,
+        progress: &mut dyn FnMut(&str),
+        work: &mut dyn FnMut() -> Result<T>,
+    ) -> Result<T> {
+        let (Some(clock), Some(renderer)) = (self.clock.as_mut(), self.renderer.as_mut()) else {
+            return work();
+        };
+        let counts = |c: &Clock| {
+            let set = c.stability().sets.last();
+            set.map_or((0, 0), |s| (s.retaken.len(), s.warm_ups.len()))
+        };
+        let (retaken, warm_ups) = counts(clock);
+        let mut canary = || canary_ms(renderer);
+        let kept = clock.round(index, &mut canary, work)?;
+        let set = clock.stability().sets.last().expect("a set begun");
+        for r in &set.retaken[retaken..] {
+            progress(&format!(
+                "{}: round {} retaken, canary {:.3} ms against {:.3} ms",
+                set.set,
+                r.round + 1,
+                r.canary_ms,
+                r.reference_ms
+            ));
+        }
+        if let Some(w) = set.warm_ups.get(warm_ups..).and_then(<[_]>::last) {
+            progress(&format!(
+                "{}: conditions changed, canary warmed up again: {:.3} ms",
+                set.set, w.reference_ms
+            ));
+        }
+        Ok(kept)
+    }
 }
 
 /// A renderer of `scene` at the settings' size, with their costs.
@@ -700,12 +836,23 @@ fn lut_refusal(settings: &CompareSettings) -> Option<String> {
         .map(|e| e.to_string())
 }
 
+/// One round of the table: per column and row the technique's time and the emulator's, per
+/// BRDF alone and row, and per column of [`FIRST_ROW`].
+#[derive(Default)]
+struct RoundTimes {
+    cells: Vec<Vec<(f64, Option<f64>)>>,
+    singles: Vec<Vec<f64>>,
+    first: Vec<f64>,
+}
+
 /// Every technique at every BRDF count of the settings, and each BRDF alone, sampled in
-/// interleaved rounds until `sampling` stops; each cell with its error against forward.
+/// interleaved rounds until `sampling` stops, each round kept by the steady clock; each cell
+/// with its error against forward.
 fn measure_table<'c>(
     ctx: &'c Context,
     settings: &CompareSettings,
     sampling: &Sampling,
+    steady: &mut SteadyClock,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Table<'c>> {
     let lut_left_out = lut_refusal(settings).is_some();
@@ -847,25 +994,54 @@ fn measure_table<'c>(
         }
         open
     };
+    steady.begin_set("the table", progress)?;
+    let mut load = None;
     let table_sampled = sample_deciding(
         sampling,
         |start: &crate::stats::RoundStart| -> Result<()> {
             progress(&format!("the table: {}", start.line()));
-            for (count, (_, renderer, _)) in renderers.iter_mut().enumerate() {
-                for (row, (_, technique)) in rows_spec.iter().enumerate() {
-                    let (ms, emulator) = lighting_ms(renderer, *technique)?;
+            if settings.load_from_round == Some(start.index) && settings.beside_load > 0 {
+                progress(&format!(
+                    "the table: {} busy threads start beside the measurement",
+                    settings.beside_load
+                ));
+                load = Some(crate::measure::BusyThreads::start(settings.beside_load));
+            }
+            // One try of the round: every sample of it, committed only if the clock keeps it.
+            let mut one_try = || -> Result<RoundTimes> {
+                let mut times = RoundTimes::default();
+                for (_, renderer, _) in renderers.iter_mut() {
+                    let mut column = Vec::new();
+                    for (_, technique) in &rows_spec {
+                        column.push(lighting_ms(renderer, *technique)?);
+                    }
+                    times.cells.push(column);
+                }
+                for renderer in singles.iter_mut() {
+                    let mut alone = Vec::new();
+                    for (_, technique) in &rows_spec {
+                        alone.push(lighting_ms(renderer, *technique)?.0);
+                    }
+                    times.singles.push(alone);
+                }
+                for (_, renderer, _) in first_renderers.iter_mut() {
+                    times.first.push(lighting_ms(renderer, branching_native)?.0);
+                }
+                Ok(times)
+            };
+            let kept = steady.round(start.index, progress, &mut one_try)?;
+            for (count, column) in kept.cells.into_iter().enumerate() {
+                for (row, (ms, emulator)) in column.into_iter().enumerate() {
                     samples.borrow_mut()[count][row].push(ms);
                     bookkeeping[count][row].extend(emulator);
                 }
             }
-            for (single, renderer) in singles.iter_mut().enumerate() {
-                for (row, (_, technique)) in rows_spec.iter().enumerate() {
-                    let (ms, _) = lighting_ms(renderer, *technique)?;
+            for (single, alone) in kept.singles.into_iter().enumerate() {
+                for (row, ms) in alone.into_iter().enumerate() {
                     single_samples.borrow_mut()[single][row].push(ms);
                 }
             }
-            for (count, (_, renderer, _)) in first_renderers.iter_mut().enumerate() {
-                let (ms, _) = lighting_ms(renderer, branching_native)?;
+            for (count, ms) in kept.first.into_iter().enumerate() {
                 first_samples.borrow_mut()[count].push(ms);
             }
             Ok(())
@@ -873,6 +1049,7 @@ fn measure_table<'c>(
         overhead_widths,
         talk_open,
     )?;
+    drop(load);
     let mut samples = samples.into_inner();
     let single_samples = single_samples.into_inner();
     // Per column, row and round: the shares of each BRDF times its time alone (the first BRDF
@@ -948,6 +1125,7 @@ fn measure_sizes(
     ctx: &Context,
     settings: &CompareSettings,
     sampling: &Sampling,
+    steady: &mut SteadyClock,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<SizePoint>> {
     let aspect = settings.width as f32 / settings.height as f32;
@@ -982,16 +1160,19 @@ fn measure_sizes(
                 vec![Verdict::rounds_to_decide(&ratio, crate::stats::MARGIN)]
             }
         };
+        let set = format!("light size {:.1} %", coverage * 100.0);
+        steady.begin_set(&set, progress)?;
         let sampled = sample_deciding(
             sampling,
             |start: &crate::stats::RoundStart| -> Result<()> {
-                progress(&format!(
-                    "light size {:.1} %: {}",
-                    coverage * 100.0,
-                    start.line()
-                ));
-                for (i, technique) in size_techniques(side).into_iter().enumerate() {
-                    let (ms, _) = lighting_ms(&mut renderer, technique)?;
+                progress(&format!("{set}: {}", start.line()));
+                let mut one_try = || -> Result<Vec<f64>> {
+                    let techniques = size_techniques(side).into_iter();
+                    let times = techniques.map(|t| lighting_ms(&mut renderer, t).map(|(ms, _)| ms));
+                    times.collect()
+                };
+                let kept = steady.round(start.index, progress, &mut one_try)?;
+                for (i, ms) in kept.into_iter().enumerate() {
                     samples.borrow_mut()[i].push(ms);
                 }
                 Ok(())

@@ -181,6 +181,12 @@ impl CompareReport {
             out["settings"]["environment"] = json!({ "LP_NUM_THREADS": n });
         }
         out["settings"]["beside_load_threads"] = json!(self.beside_load);
+        if let Some(round) = self.load_from_round {
+            out["settings"]["beside_load_from_round"] = json!(round);
+        }
+        if let Some(stability) = &self.stability {
+            out["stability"] = stability.json();
+        }
         out["settings"]["depth_bounds"] = json!(self.depth_bounds);
         out
     }
@@ -208,9 +214,15 @@ impl CompareReport {
             let _ = writeln!(md, "Environment: `LP_NUM_THREADS={n}`.\n");
         }
         if self.beside_load > 0 {
+            let from = self.load_from_round.map_or(String::new(), |r| {
+                format!(
+                    ", from the table's round {} on (`--beside-load-from-round`)",
+                    r + 1
+                )
+            });
             let _ = writeln!(
                 md,
-                "Conditions: {} busy threads ran beside the measurement (`--beside-load`).\n",
+                "Conditions: {} busy threads ran beside the measurement (`--beside-load`){from}.\n",
                 self.beside_load
             );
         }
@@ -258,6 +270,9 @@ impl CompareReport {
             );
         }
         md += &self.talk_verdicts_markdown();
+        if let Some(stability) = &self.stability {
+            md += &stability.markdown();
+        }
         md += "## Lighting time against BRDF count\n\n";
         md += "Overheads are against each row's own 1-BRDF time in this run; the error column is \
                the worst over the BRDF counts.\n\n";

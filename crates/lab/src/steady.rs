@@ -1,0 +1,536 @@
+//! A steady clock under a measurement: a fixed reference workload (the canary) warmed up until
+//! its time settles, then timed at the edges of every round; a round whose canary strays beyond
+//! the tolerance is thrown away and retaken.
+//!
+//! Pairing by round cancels a change of speed that a whole round shares, not one that happens
+//! inside a round, and it does nothing for the milliseconds and medians a report also gives.
+//! GPUs move their clocks under load (boost, power and thermal limits: on an NVIDIA H200 the
+//! light-size samples of one technique spread 3.4x to 5.7x in one run, the first rounds slow),
+//! and llvmpipe shares its cores with whatever else runs. nvbench measures each sample's clock
+//! and throws throttled samples away; Google Benchmark and criterion warm up until stable. A
+//! canary asks no clock counter of the driver (Vulkan has none), so it works on every device:
+//! it sees what the measured work would see.
+//!
+//! The decisions are pure functions ([`settled`], [`strays`]) and [`Clock`] is generic over the
+//! canary and the round's work, so the whole policy is unit-tested without a GPU.
+
+use std::time::{Duration, Instant};
+
+/// How steady a clock must be, and how long to wait for it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClockSettings {
+    /// A canary time further than this from the reference (relative: `0.10` is ±10 %) strays.
+    pub tolerance: f64,
+    /// The warm-up has settled when the last `window` canary times lie within the tolerance of
+    /// each other (largest over smallest); their median is the reference.
+    pub window: usize,
+    /// The most canary frames one warm-up runs; it then takes the last window's median as the
+    /// reference and says it did not settle.
+    pub max_warm_up_frames: usize,
+    /// The most wall-clock time one warm-up takes, likewise.
+    pub max_warm_up: Duration,
+    /// Strays in a row after which the conditions are taken to have changed for good: the
+    /// canary is warmed up again and its new time becomes the reference. A round strays at most
+    /// twice this often; its last try is kept and flagged unsteady.
+    pub retakes_before_rewarm: usize,
+}
+
+impl Default for ClockSettings {
+    /// ±10 %: above llvmpipe's frame-to-frame noise at the lab's sizes on 2 cores (a canary
+    /// frame's time varies by a few percent there) and far below what a GPU's clock change or a
+    /// busy CPU does to a frame (1.5x to 5x).
+    fn default() -> Self {
+        Self {
+            tolerance: 0.10,
+            window: 5,
+            max_warm_up_frames: 200,
+            max_warm_up: Duration::from_secs(30),
+            retakes_before_rewarm: 3,
+        }
+    }
+}
+
+/// The reference of `times` if its last `window` lie within `tolerance` of each other (the
+/// largest at most `1 + tolerance` times the smallest): their median. `None` before `window`
+/// times or while they spread wider.
+pub fn settled(times: &[f64], window: usize, tolerance: f64) -> Option<f64> {
+    let window = window.max(1);
+    let last = times.get(times.len().checked_sub(window)?..)?;
+    let lo = last.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = last.iter().copied().fold(0.0, f64::max);
+    (lo > 0.0 && hi <= lo * (1.0 + tolerance)).then(|| median(last))
+}
+
+/// Whether a canary time of `ms` strays from `reference` beyond `tolerance` (either way: a
+/// faster clock is as much a change of conditions as a slower one).
+pub fn strays(ms: f64, reference: f64, tolerance: f64) -> bool {
+    !(ms.is_finite() && reference > 0.0 && (ms / reference - 1.0).abs() <= tolerance)
+}
+
+fn median(times: &[f64]) -> f64 {
+    let mut sorted = times.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    histencil_vk::median_of_sorted(&sorted)
+}
+
+/// One warm-up: the canary run until its time settled (or the caps ran out).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WarmUp {
+    /// The round it ran before (0: before the set's first; later: conditions changed there).
+    pub before_round: usize,
+    /// Every canary time it took, in order.
+    pub times_ms: Vec<f64>,
+    pub seconds: f64,
+    /// Whether the last window settled within the tolerance (otherwise a cap ended it).
+    pub settled: bool,
+    /// The reference it set: the last window's median.
+    pub reference_ms: f64,
+}
+
+/// A round thrown away because its canary strayed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Retake {
+    pub round: usize,
+    /// The canary time that strayed, and the reference it strayed from.
+    pub canary_ms: f64,
+    pub reference_ms: f64,
+}
+
+/// The canary after a kept round, and the reference in force then.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CanaryTime {
+    pub round: usize,
+    pub ms: f64,
+    pub reference_ms: f64,
+}
+
+/// How steady one measurement set's clock was.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SetStability {
+    /// The set (`the table`, `light size 3.0 %`).
+    pub set: String,
+    /// Warm-ups: at the set's start where the canary strayed from the last reference (or there
+    /// was none), and wherever strays in a row took the conditions to have changed.
+    pub warm_ups: Vec<WarmUp>,
+    /// The canary after each kept round, in round order.
+    pub canary: Vec<CanaryTime>,
+    pub retaken: Vec<Retake>,
+    /// Rounds kept though their canary strayed (their last try, after a new warm-up).
+    pub unsteady: Vec<usize>,
+}
+
+impl SetStability {
+    /// The kept rounds' canary times over the reference in force when each was taken: `(lowest,
+    /// highest)`; `None` without rounds.
+    pub fn canary_range(&self) -> Option<(f64, f64)> {
+        let ratios = self.canary.iter().map(|c| c.ms / c.reference_ms);
+        let lo = ratios.clone().fold(f64::INFINITY, f64::min);
+        let hi = ratios.fold(0.0, f64::max);
+        (!self.canary.is_empty()).then_some((lo, hi))
+    }
+}
+
+/// The steady clock's record of a run: what the canary was, and every set's stability.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stability {
+    /// What the canary renders, in words.
+    pub workload: String,
+    pub settings: ClockSettings,
+    pub sets: Vec<SetStability>,
+}
+
+impl Stability {
+    /// The record as JSON: the canary, the tolerance, and per set its warm-ups, kept rounds'
+    /// canary times (with the reference in force), retaken and unsteady rounds.
+    pub fn json(&self) -> serde_json::Value {
+        use serde_json::json;
+        let s = &self.settings;
+        json!({
+            "canary": self.workload,
+            "tolerance": s.tolerance,
+            "settle_window": s.window,
+            "retakes_before_rewarm": s.retakes_before_rewarm,
+            "sets": self.sets.iter().map(|set| json!({
+                "set": set.set,
+                "warm_ups": set.warm_ups.iter().map(|w| json!({
+                    "before_round": w.before_round,
+                    "frames": w.times_ms.len(),
+                    "seconds": w.seconds,
+                    "settled": w.settled,
+                    "reference_ms": w.reference_ms,
+                    "times_ms": w.times_ms,
+                })).collect::<Vec<_>>(),
+                "canary_ms": set.canary.iter().map(|c| c.ms).collect::<Vec<_>>(),
+                "canary_reference_ms": set.canary.iter().map(|c| c.reference_ms).collect::<Vec<_>>(),
+                "retaken": set.retaken.iter().map(|r| json!({
+                    "round": r.round,
+                    "canary_ms": r.canary_ms,
+                    "reference_ms": r.reference_ms,
+                })).collect::<Vec<_>>(),
+                "unsteady_rounds": set.unsteady,
+            })).collect::<Vec<_>>(),
+        })
+    }
+
+    /// A report's section: what the canary is and how steady each set's clock was.
+    pub fn markdown(&self) -> String {
+        use std::fmt::Write as _;
+        let tolerance = 100.0 * self.settings.tolerance;
+        let mut md = format!(
+            "## Steady clock\n\n\
+             Canary: {}, warmed up until {} canary times in a row agree within \
+             ±{tolerance:.0} % (their median is the reference), then timed between every two \
+             rounds; a round whose canary before or after strays beyond ±{tolerance:.0} % is \
+             thrown away and retaken, {} strays in a row warm the canary up again (the \
+             conditions changed for good), and a round that strays twice that often is kept \
+             and flagged unsteady.\n\n\
+             | set | warm-ups: canary times (s) -> reference | kept rounds' canary over its \
+             reference | rounds retaken | unsteady |\n|---|---|---|---|---|\n",
+            self.workload, self.settings.window, self.settings.retakes_before_rewarm
+        );
+        for set in &self.sets {
+            let warm: Vec<String> = set
+                .warm_ups
+                .iter()
+                .map(|w| {
+                    format!(
+                        "{}{} ({:.1} s) -> {:.3} ms{}",
+                        if w.before_round > 0 {
+                            format!("before round {}: ", w.before_round + 1)
+                        } else {
+                            String::new()
+                        },
+                        w.times_ms.len(),
+                        w.seconds,
+                        w.reference_ms,
+                        if w.settled { "" } else { ", not settled" }
+                    )
+                })
+                .collect();
+            let range = set
+                .canary_range()
+                .map_or("-".to_owned(), |(lo, hi)| format!("{:.3} to {:.3}", lo, hi));
+            let mut retaken: Vec<usize> = set.retaken.iter().map(|r| r.round + 1).collect();
+            retaken.dedup();
+            let list = |rounds: &[usize]| {
+                if rounds.is_empty() {
+                    "none".to_owned()
+                } else {
+                    let r: Vec<String> = rounds.iter().map(usize::to_string).collect();
+                    r.join(", ")
+                }
+            };
+            let unsteady: Vec<usize> = set.unsteady.iter().map(|r| r + 1).collect();
+            let _ = writeln!(
+                md,
+                "| {} | {} | {range} | {} ({} tries) | {} |",
+                set.set,
+                if warm.is_empty() {
+                    "none (the last reference held)".to_owned()
+                } else {
+                    warm.join("; ")
+                },
+                list(&retaken),
+                set.retaken.len(),
+                list(&unsteady)
+            );
+        }
+        md.push('\n');
+        md
+    }
+}
+
+/// The steady clock of a run: the reference in force and the record so far.
+pub struct Clock {
+    settings: ClockSettings,
+    reference_ms: Option<f64>,
+    /// The last canary time, if it did not stray: the next round's "before".
+    last_steady: Option<f64>,
+    record: Stability,
+}
+
+impl Clock {
+    pub fn new(workload: impl Into<String>, settings: ClockSettings) -> Self {
+        Self {
+            settings,
+            reference_ms: None,
+            last_steady: None,
+            record: Stability {
+                workload: workload.into(),
+                settings,
+                sets: Vec::new(),
+            },
+        }
+    }
+
+    /// The record so far.
+    pub fn stability(&self) -> &Stability {
+        &self.record
+    }
+
+    pub fn into_stability(self) -> Stability {
+        self.record
+    }
+
+    fn strays(&self, ms: f64) -> bool {
+        self.reference_ms
+            .is_none_or(|r| strays(ms, r, self.settings.tolerance))
+    }
+
+    fn set(&mut self) -> &mut SetStability {
+        if self.record.sets.is_empty() {
+            self.record.sets.push(SetStability::default());
+        }
+        self.record.sets.last_mut().expect("a set")
+    }
+
+    /// Starts the set `name`: one canary frame, and a warm-up unless it agrees with the
+    /// reference already set (between sets the device may have idled, or rebuilt pipelines).
+    pub fn begin_set<E>(
+        &mut self,
+        name: impl Into<String>,
+        canary: &mut dyn FnMut() -> Result<f64, E>,
+    ) -> Result<(), E> {
+        self.record.sets.push(SetStability {
+            set: name.into(),
+            ..SetStability::default()
+        });
+        let first = canary()?;
+        if self.strays(first) {
+            self.warm_up(0, vec![first], canary)?;
+        } else {
+            self.last_steady = Some(first);
+        }
+        Ok(())
+    }
+
+    /// Runs the canary until it settles or a cap runs out; its median becomes the reference.
+    fn warm_up<E>(
+        &mut self,
+        before_round: usize,
+        mut times: Vec<f64>,
+        canary: &mut dyn FnMut() -> Result<f64, E>,
+    ) -> Result<(), E> {
+        let s = self.settings;
+        let start = Instant::now();
+        let reference = loop {
+            if let Some(r) = settled(&times, s.window, s.tolerance) {
+                break Some(r);
+            }
+            if times.len() >= s.max_warm_up_frames || start.elapsed() >= s.max_warm_up {
+                break None;
+            }
+            times.push(canary()?);
+        };
+        let tail = &times[times.len().saturating_sub(s.window)..];
+        let reference_ms = reference.unwrap_or_else(|| median(tail));
+        self.reference_ms = Some(reference_ms);
+        self.last_steady = times.last().copied().filter(|t| !self.strays(*t));
+        let warm_up = WarmUp {
+            before_round,
+            times_ms: times,
+            seconds: start.elapsed().as_secs_f64(),
+            settled: reference.is_some(),
+            reference_ms,
+        };
+        self.set().warm_ups.push(warm_up);
+        Ok(())
+    }
+
+    /// Round `index` of the current set: `work` between two canary frames (the one before is
+    /// the last round's where it did not stray), kept where neither strays, else thrown away
+    /// and retaken; after [`ClockSettings::retakes_before_rewarm`] strays in a row the canary
+    /// is warmed up again, and after twice that the last try is kept and flagged unsteady.
+    /// Returns what the kept try's `work` returned: its samples, committed by the caller.
+    pub fn round<T, E>(
+        &mut self,
+        index: usize,
+        canary: &mut dyn FnMut() -> Result<f64, E>,
+        work: &mut dyn FnMut() -> Result<T, E>,
+    ) -> Result<T, E> {
+        let rewarm = self.settings.retakes_before_rewarm.max(1);
+        let mut strays_in_a_row = 0;
+        loop {
+            let last_try = strays_in_a_row >= 2 * rewarm;
+            let before = match self.last_steady.take() {
+                Some(ms) => ms,
+                None => canary()?,
+            };
+            let strayed = if self.strays(before) && !last_try {
+                before
+            } else {
+                let kept = work()?;
+                let after = canary()?;
+                let steady = !self.strays(before) && !self.strays(after);
+                if steady || last_try {
+                    let reference_ms = self.reference_ms.unwrap_or(0.0);
+                    let set = self.set();
+                    set.canary.push(CanaryTime {
+                        round: index,
+                        ms: after,
+                        reference_ms,
+                    });
+                    if !steady {
+                        set.unsteady.push(index);
+                    }
+                    self.last_steady = (!self.strays(after)).then_some(after);
+                    return Ok(kept);
+                }
+                if self.strays(before) {
+                    before
+                } else {
+                    after
+                }
+            };
+            let reference_ms = self.reference_ms.unwrap_or(0.0);
+            self.set().retaken.push(Retake {
+                round: index,
+                canary_ms: strayed,
+                reference_ms,
+            });
+            strays_in_a_row += 1;
+            if strays_in_a_row % rewarm == 0 {
+                self.warm_up(index, Vec::new(), canary)?;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_warm_up_settles_on_its_last_window_within_the_tolerance() {
+        assert_eq!(settled(&[1.0, 1.0], 3, 0.1), None);
+        assert_eq!(settled(&[3.0, 1.0, 1.05, 1.02], 3, 0.1), Some(1.02));
+        assert_eq!(settled(&[1.0, 1.2, 1.0], 3, 0.1), None);
+        assert_eq!(settled(&[0.0, 0.0, 0.0], 3, 0.1), None);
+        assert!(!strays(1.09, 1.0, 0.1) && strays(1.11, 1.0, 0.1) && strays(0.89, 1.0, 0.1));
+        assert!(strays(f64::NAN, 1.0, 0.1) && strays(1.0, 0.0, 0.1));
+    }
+
+    /// A canary that replays `times` (then repeats the last), counting its frames.
+    fn replay(times: Vec<f64>) -> impl FnMut() -> Result<f64, ()> {
+        let mut i = 0;
+        move || {
+            let t = times[i.min(times.len() - 1)];
+            i += 1;
+            Ok(t)
+        }
+    }
+
+    fn settings() -> ClockSettings {
+        ClockSettings {
+            window: 3,
+            ..ClockSettings::default()
+        }
+    }
+
+    /// Slow first frames (a GPU ramping its clock) are warm-up; the rounds then share the
+    /// canary frame between them: one per round.
+    #[test]
+    fn the_warm_up_waits_out_a_ramp_and_steady_rounds_cost_one_canary_each() {
+        let mut clock = Clock::new("test", settings());
+        let mut canary = replay(vec![3.0, 2.0, 1.0, 1.01, 0.99, 1.0]);
+        clock.begin_set("set", &mut canary).unwrap();
+        let w = &clock.stability().sets[0].warm_ups[0];
+        assert_eq!(
+            (w.times_ms.len(), w.settled, w.reference_ms),
+            (5, true, 1.0)
+        );
+        let mut works = 0;
+        for index in 0..4 {
+            let kept = clock
+                .round(index, &mut canary, &mut || {
+                    works += 1;
+                    Ok::<_, ()>(index)
+                })
+                .unwrap();
+            assert_eq!(kept, index);
+        }
+        let set = &clock.stability().sets[0];
+        assert_eq!(works, 4);
+        assert_eq!(set.canary.len(), 4);
+        assert!(set.retaken.is_empty() && set.unsteady.is_empty());
+    }
+
+    /// A round during which the clock moved is thrown away and retaken; a change that lasts
+    /// makes a new reference after the stated strays in a row, and the set goes on.
+    #[test]
+    fn a_straying_round_is_retaken_and_a_lasting_change_warms_up_again() {
+        let mut clock = Clock::new("test", settings());
+        // Settled at 1.0; round 0 steady; during round 1 a load starts and stays (2.0).
+        let mut times = vec![1.0, 1.0, 1.0, 1.0];
+        times.extend([2.0; 20]);
+        let mut canary = replay(times);
+        clock.begin_set("set", &mut canary).unwrap();
+        let mut kept = Vec::new();
+        for index in 0..3 {
+            let r = clock.round(index, &mut canary, &mut || Ok::<_, ()>(index));
+            kept.push(r.unwrap());
+        }
+        assert_eq!(kept, [0, 1, 2]);
+        let set = &clock.stability().sets[0];
+        let retaken: Vec<usize> = set.retaken.iter().map(|r| r.round).collect();
+        assert_eq!(
+            retaken,
+            [1, 1, 1],
+            "three strays in a row, then a new warm-up"
+        );
+        assert_eq!(set.warm_ups.len(), 2);
+        assert_eq!(
+            (set.warm_ups[1].before_round, set.warm_ups[1].reference_ms),
+            (1, 2.0)
+        );
+        assert!(set.unsteady.is_empty());
+        assert_eq!(set.canary_range(), Some((1.0, 1.0)));
+        assert_eq!(set.canary[2].reference_ms, 2.0);
+        // A one-round hiccup is retaken once, nothing else.
+        let mut clock = Clock::new("test", settings());
+        let mut canary = replay(vec![1.0, 1.0, 1.0, 1.0, 1.5, 1.0, 1.0, 1.0]);
+        clock.begin_set("set", &mut canary).unwrap();
+        for index in 0..3 {
+            clock
+                .round(index, &mut canary, &mut || Ok::<_, ()>(()))
+                .unwrap();
+        }
+        let set = &clock.stability().sets[0];
+        assert_eq!(set.retaken.len(), 1);
+        assert_eq!(set.warm_ups.len(), 1);
+        assert_eq!(set.canary.len(), 3);
+    }
+
+    /// A clock that never settles still ends: each warm-up at its cap, each round after twice
+    /// the strays in a row, kept and flagged.
+    #[test]
+    fn a_clock_that_never_settles_ends_every_round_flagged() {
+        let s = ClockSettings {
+            max_warm_up_frames: 6,
+            ..settings()
+        };
+        let mut clock = Clock::new("test", s);
+        let mut flip = false;
+        let mut canary = move || {
+            flip = !flip;
+            Ok::<_, ()>(if flip { 1.0 } else { 3.0 })
+        };
+        clock.begin_set("set", &mut canary).unwrap();
+        for index in 0..2 {
+            clock
+                .round(index, &mut canary, &mut || Ok::<_, ()>(()))
+                .unwrap();
+        }
+        let set = &clock.stability().sets[0];
+        assert!(!set.warm_ups[0].settled);
+        assert_eq!(set.unsteady, [0, 1]);
+        assert_eq!(set.canary.len(), 2);
+    }
+
+    #[test]
+    fn a_canary_error_ends_the_round() {
+        let mut clock = Clock::new("test", settings());
+        let mut canary = || Err::<f64, &str>("device lost");
+        assert_eq!(clock.begin_set("set", &mut canary), Err("device lost"));
+    }
+}
