@@ -27,7 +27,8 @@ pub struct ClockSettings {
     /// The most canary frames one warm-up runs; it then takes the last window's median as the
     /// reference and says it did not settle.
     pub max_warm_up_frames: usize,
-    /// The most wall-clock time one warm-up takes, likewise.
+    /// The most wall-clock time one warm-up takes, likewise (a GPU's clock ramps within a
+    /// second or two; a machine that needs longer is reported as not settled).
     pub max_warm_up: Duration,
     /// Strays in a row after which the conditions are taken to have changed for good: the
     /// canary is warmed up again and its new time becomes the reference. A round strays at most
@@ -44,7 +45,7 @@ impl Default for ClockSettings {
             tolerance: 0.10,
             window: 5,
             max_warm_up_frames: 200,
-            max_warm_up: Duration::from_secs(30),
+            max_warm_up: Duration::from_secs(10),
             retakes_before_rewarm: 3,
         }
     }
@@ -297,7 +298,7 @@ impl Clock {
         });
         let first = canary()?;
         if self.strays(first) {
-            self.warm_up(0, vec![first], canary)?;
+            self.warm_up(0, vec![first], None, canary)?;
         } else {
             self.last_steady = Some(first);
         }
@@ -309,15 +310,17 @@ impl Clock {
         &mut self,
         before_round: usize,
         mut times: Vec<f64>,
+        deadline: Option<Instant>,
         canary: &mut dyn FnMut() -> Result<f64, E>,
     ) -> Result<(), E> {
         let s = self.settings;
         let start = Instant::now();
+        let end = deadline.map_or(start + s.max_warm_up, |d| d.min(start + s.max_warm_up));
         let reference = loop {
             if let Some(r) = settled(&times, s.window, s.tolerance) {
                 break Some(r);
             }
-            if times.len() >= s.max_warm_up_frames || start.elapsed() >= s.max_warm_up {
+            if times.len() >= s.max_warm_up_frames || (!times.is_empty() && Instant::now() >= end) {
                 break None;
             }
             times.push(canary()?);
@@ -340,18 +343,20 @@ impl Clock {
     /// Round `index` of the current set: `work` between two canary frames (the one before is
     /// the last round's where it did not stray), kept where neither strays, else thrown away
     /// and retaken; after [`ClockSettings::retakes_before_rewarm`] strays in a row the canary
-    /// is warmed up again, and after twice that the last try is kept and flagged unsteady.
-    /// Returns what the kept try's `work` returned: its samples, committed by the caller.
+    /// is warmed up again, and after twice that, or once `deadline` (the set's budget) has
+    /// passed, the next try is kept and flagged unsteady where it strays. Returns what the
+    /// kept try's `work` returned: its samples, committed by the caller.
     pub fn round<T, E>(
         &mut self,
         index: usize,
+        deadline: Instant,
         canary: &mut dyn FnMut() -> Result<f64, E>,
         work: &mut dyn FnMut() -> Result<T, E>,
     ) -> Result<T, E> {
         let rewarm = self.settings.retakes_before_rewarm.max(1);
         let mut strays_in_a_row = 0;
         loop {
-            let last_try = strays_in_a_row >= 2 * rewarm;
+            let last_try = strays_in_a_row >= 2 * rewarm || Instant::now() >= deadline;
             let before = match self.last_steady.take() {
                 Some(ms) => ms,
                 None => canary()?,
@@ -390,7 +395,7 @@ impl Clock {
             });
             strays_in_a_row += 1;
             if strays_in_a_row % rewarm == 0 {
-                self.warm_up(index, Vec::new(), canary)?;
+                self.warm_up(index, Vec::new(), Some(deadline), canary)?;
             }
         }
     }
@@ -420,6 +425,10 @@ mod tests {
         }
     }
 
+    fn far() -> Instant {
+        Instant::now() + Duration::from_secs(3600)
+    }
+
     fn settings() -> ClockSettings {
         ClockSettings {
             window: 3,
@@ -442,7 +451,7 @@ mod tests {
         let mut works = 0;
         for index in 0..4 {
             let kept = clock
-                .round(index, &mut canary, &mut || {
+                .round(index, far(), &mut canary, &mut || {
                     works += 1;
                     Ok::<_, ()>(index)
                 })
@@ -467,7 +476,7 @@ mod tests {
         clock.begin_set("set", &mut canary).unwrap();
         let mut kept = Vec::new();
         for index in 0..3 {
-            let r = clock.round(index, &mut canary, &mut || Ok::<_, ()>(index));
+            let r = clock.round(index, far(), &mut canary, &mut || Ok::<_, ()>(index));
             kept.push(r.unwrap());
         }
         assert_eq!(kept, [0, 1, 2]);
@@ -492,7 +501,7 @@ mod tests {
         clock.begin_set("set", &mut canary).unwrap();
         for index in 0..3 {
             clock
-                .round(index, &mut canary, &mut || Ok::<_, ()>(()))
+                .round(index, far(), &mut canary, &mut || Ok::<_, ()>(()))
                 .unwrap();
         }
         let set = &clock.stability().sets[0];
@@ -518,13 +527,32 @@ mod tests {
         clock.begin_set("set", &mut canary).unwrap();
         for index in 0..2 {
             clock
-                .round(index, &mut canary, &mut || Ok::<_, ()>(()))
+                .round(index, far(), &mut canary, &mut || Ok::<_, ()>(()))
                 .unwrap();
         }
         let set = &clock.stability().sets[0];
         assert!(!set.warm_ups[0].settled);
         assert_eq!(set.unsteady, [0, 1]);
         assert_eq!(set.canary.len(), 2);
+    }
+
+    /// Past the set's budget a straying round is kept at once, flagged: retakes never take a
+    /// set beyond its budget.
+    #[test]
+    fn past_the_deadline_a_straying_round_is_kept_flagged() {
+        let mut clock = Clock::new("test", settings());
+        let mut canary = replay(vec![1.0, 1.0, 1.0, 2.0]);
+        clock.begin_set("set", &mut canary).unwrap();
+        let mut works = 0;
+        clock
+            .round(0, Instant::now(), &mut canary, &mut || {
+                works += 1;
+                Ok::<_, ()>(())
+            })
+            .unwrap();
+        let set = &clock.stability().sets[0];
+        assert_eq!((works, set.retaken.len()), (1, 0));
+        assert_eq!(set.unsteady, [0]);
     }
 
     #[test]

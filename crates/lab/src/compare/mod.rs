@@ -761,24 +761,28 @@ impl<'c> SteadyClock<'c> {
         Ok(())
     }
 
-    /// Round `index` of the current set: `work`'s kept try ([`Clock::round`]), or `work` once
-    /// without a clock.
+    /// The round `start` says: `work`'s kept try ([`Clock::round`]), retaken only while the
+    /// set's budget lasts; or `work` once without a clock.
     fn round<T>(
         &mut self,
-        index: usize,
+        start: &crate::stats::RoundStart,
         progress: &mut dyn FnMut(&str),
         work: &mut dyn FnMut() -> Result<T>,
     ) -> Result<T> {
         let (Some(clock), Some(renderer)) = (self.clock.as_mut(), self.renderer.as_mut()) else {
             return work();
         };
+        // A fixed number of rounds has no budget (`Duration::MAX`): a year stands for it.
+        let left = (start.budget_seconds - start.seconds).clamp(0.0, 3.2e7);
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs_f64(left);
+        let index = start.index;
         let counts = |c: &Clock| {
             let set = c.stability().sets.last();
             set.map_or((0, 0), |s| (s.retaken.len(), s.warm_ups.len()))
         };
         let (retaken, warm_ups) = counts(clock);
         let mut canary = || canary_ms(renderer);
-        let kept = clock.round(index, &mut canary, work)?;
+        let kept = clock.round(index, deadline, &mut canary, work)?;
         let set = clock.stability().sets.last().expect("a set begun");
         for r in &set.retaken[retaken..] {
             progress(&format!(
@@ -1029,7 +1033,7 @@ fn measure_table<'c>(
                 }
                 Ok(times)
             };
-            let kept = steady.round(start.index, progress, &mut one_try)?;
+            let kept = steady.round(start, progress, &mut one_try)?;
             for (count, column) in kept.cells.into_iter().enumerate() {
                 for (row, (ms, emulator)) in column.into_iter().enumerate() {
                     samples.borrow_mut()[count][row].push(ms);
@@ -1171,7 +1175,7 @@ fn measure_sizes(
                     let times = techniques.map(|t| lighting_ms(&mut renderer, t).map(|(ms, _)| ms));
                     times.collect()
                 };
-                let kept = steady.round(start.index, progress, &mut one_try)?;
+                let kept = steady.round(start, progress, &mut one_try)?;
                 for (i, ms) in kept.into_iter().enumerate() {
                     samples.borrow_mut()[i].push(ms);
                 }
