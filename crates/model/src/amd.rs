@@ -39,7 +39,8 @@
 
 use crate::backend::{Native, PlatformBackend, PlatformCaps};
 use crate::layout::StencilLayout;
-use crate::state::{CompareOp, FaceStencil};
+use crate::plan::Pass;
+use crate::state::{CompareOp, FaceStencil, StencilOp};
 use crate::tiles::TileSurface;
 
 /// GFX9-11 (Vega, RDNA 1-3) with pretests bound, as PAL allows and no Vulkan driver does: plans
@@ -83,6 +84,16 @@ pub trait TileHierarchy {
     fn may_pass(&self, tile: usize, face: &FaceStencil) -> bool;
     /// A draw wrote stencil in `tile`, whose pixels now hold `values`.
     fn written(&mut self, tile: usize, values: &[u8]);
+}
+
+/// The stencil test a GPU's own hierarchy applies to the tiles of `pass`, or `None` where it
+/// does not test the pass: it tests a pass whose stencil test (of the faces it rasterises) can
+/// fail and whose failing fragments keep their value, since a rejected tile runs no stencil op
+/// at all. A volume drawing both face sets has no one test and is not tested. The one decision
+/// the simulator and the GPU path (`histencil_vk`'s `GpuHierarchy::test_for`) both ask.
+pub fn hierarchy_test(pass: &Pass) -> Option<FaceStencil> {
+    let face = pass.state.stencil_for(pass.front_facing()?)?;
+    (face.compare != CompareOp::Always && face.fail == StencilOp::Keep).then_some(face)
 }
 
 /// Builds `hierarchy`'s state from the stencil the G-buffer pass left (as the hardware built it
@@ -320,7 +331,62 @@ impl TileHierarchy for AndOrTiles {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::state::StencilOp;
+    use crate::plan::{Geometry, PassKind};
+    use crate::state::{CullMode, DepthState, PassState};
+
+    /// One decision for the simulator and the GPU: the faces a pass rasterises decide which
+    /// stencil test the hierarchy applies; a test that cannot fail, a failing fragment that
+    /// writes, or a volume drawing both face sets is not tested (the simulator panicked on the
+    /// last where the GPU path said "not tested").
+    #[test]
+    fn the_hierarchy_tests_the_rasterised_faces_test_when_it_can_fail_and_keeps() {
+        let back_only = FaceStencil {
+            compare: CompareOp::NotEqual,
+            ..equal(0x0F, 2)
+        };
+        let pass = |geometry, cull, front: Option<FaceStencil>, back: Option<FaceStencil>| Pass {
+            kind: PassKind::Setup,
+            geometry,
+            state: PassState {
+                cull,
+                depth: DepthState::OFF,
+                front,
+                back,
+                color_write: false,
+                hi_stencil: None,
+                depth_bounds: false,
+            },
+        };
+        let (f, b) = (Some(equal(0x0F, 1)), Some(back_only));
+        assert_eq!(
+            hierarchy_test(&pass(Geometry::Volume, CullMode::Back, f, b)),
+            f
+        );
+        assert_eq!(
+            hierarchy_test(&pass(Geometry::Volume, CullMode::Front, f, b)),
+            b
+        );
+        assert_eq!(
+            hierarchy_test(&pass(Geometry::FullScreen, CullMode::Front, f, b)),
+            f
+        );
+        assert_eq!(
+            hierarchy_test(&pass(Geometry::Volume, CullMode::None, f, b)),
+            None
+        );
+        let always = FaceStencil {
+            compare: CompareOp::Always,
+            ..equal(0, 0)
+        };
+        let writes_on_fail = FaceStencil {
+            fail: StencilOp::Zero,
+            ..equal(0x0F, 1)
+        };
+        for face in [None, Some(always), Some(writes_on_fail)] {
+            let p = pass(Geometry::FullScreen, CullMode::Back, face, None);
+            assert_eq!(hierarchy_test(&p), None, "{face:?}");
+        }
+    }
 
     fn equal(mask: u8, reference: u8) -> FaceStencil {
         FaceStencil {

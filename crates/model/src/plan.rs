@@ -114,6 +114,18 @@ pub struct Pass {
 }
 
 impl Pass {
+    /// Which faces the pass rasterises: front faces (`Some(true)`: a full-screen pass, or a
+    /// volume culling back faces), back faces (`Some(false)`: a volume culling front faces), or
+    /// both (`None`: a volume culling neither, which no plan makes: each pixel would run the
+    /// pass's stencil ops twice).
+    pub fn front_facing(&self) -> Option<bool> {
+        match (self.geometry, self.state.cull) {
+            (Geometry::FullScreen, _) | (Geometry::Volume, CullMode::Back) => Some(true),
+            (Geometry::Volume, CullMode::Front) => Some(false),
+            (Geometry::Volume, CullMode::None) => None,
+        }
+    }
+
     /// A kebab-case label for debug markers and reports.
     pub fn label(&self) -> String {
         match self.kind {

@@ -8,7 +8,7 @@ use crate::footprint::Footprint;
 use crate::frame::{FramePlan, Step};
 use crate::layout::StencilLayout;
 use crate::plan::{Geometry, Pass, PassKind, Shader};
-use crate::state::{CompareOp, CullMode, StencilOp};
+
 use crate::tiles::{TileStats, TileSurface};
 
 /// Depth and stencil of the frame after the G-buffer pass.
@@ -237,20 +237,14 @@ impl Run<'_> {
         shading: &mut LightShading,
     ) {
         let state = &pass.state;
-        let front_facing = match (pass.geometry, state.cull) {
-            (Geometry::FullScreen, _) | (Geometry::Volume, CullMode::Back) => true,
-            (Geometry::Volume, CullMode::Front) => false,
-            (Geometry::Volume, CullMode::None) => {
-                panic!("a volume pass must cull one face set: {}", pass.label())
-            }
+        let Some(front_facing) = pass.front_facing() else {
+            panic!("a volume pass must cull one face set: {}", pass.label())
         };
         let face = state.stencil_for(front_facing);
         let hi_test = state.tests_hi_stencil();
-        // The GPU's own hierarchy tests draws that test stencil and whose stencil-fail op keeps
-        // the value (a rejected tile runs no stencil op at all).
-        let auto_test = self.hierarchy.is_some()
-            && !hi_test
-            && face.is_some_and(|f| f.compare != CompareOp::Always && f.fail == StencilOp::Keep);
+        // The GPU's own hierarchy tests what `hierarchy_test` says (the GPU path asks it too).
+        let auto_test =
+            self.hierarchy.is_some() && !hi_test && crate::amd::hierarchy_test(pass).is_some();
         let hi_write = state.hi_stencil.filter(|h| h.write);
         self.touched.clear();
         for y in footprint.y0..footprint.y0 + footprint.height {

@@ -9,7 +9,7 @@
 //! oracle: the same tiles tested and rejected, the same fragments shaded.
 
 use histencil_model::amd::{Pretest, PRETEST_SLOTS};
-use histencil_model::{CompareOp, CullMode, FaceStencil, Geometry, Pass, StencilOp};
+use histencil_model::{CompareOp, FaceStencil, Pass};
 
 /// What an AMD hierarchy asks of each tile's current stencil before a draw that tests stencil
 /// (`hi_stencil_update.comp`, modes 1 and 2).
@@ -40,20 +40,10 @@ pub enum GpuHierarchy {
 
 impl GpuHierarchy {
     /// What the hierarchy asks of each tile before `pass`, or `None` where it does not test the
-    /// pass: as the simulator decides, a pass is tested when the stencil test of the faces it
-    /// rasterises can fail and a failing fragment keeps its value (a rejected tile runs no
-    /// stencil op at all).
+    /// pass: the model's decision ([`histencil_model::amd::hierarchy_test`]), which the
+    /// simulator holds the GPU's frames to.
     pub fn test_for(&self, pass: &Pass) -> Option<TileTest> {
-        let front_facing = match (pass.geometry, pass.state.cull) {
-            (Geometry::FullScreen, _) | (Geometry::Volume, CullMode::Back) => true,
-            (Geometry::Volume, CullMode::Front) => false,
-            (Geometry::Volume, CullMode::None) => return None,
-        };
-        let face = pass.state.stencil_for(front_facing)?;
-        if face.compare == CompareOp::Always || face.fail != StencilOp::Keep {
-            return None;
-        }
-        Some(self.test_of(&face))
+        histencil_model::amd::hierarchy_test(pass).map(|face| self.test_of(&face))
     }
 
     fn test_of(&self, face: &FaceStencil) -> TileTest {

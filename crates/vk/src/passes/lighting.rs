@@ -225,9 +225,6 @@ impl Timers<'_> {
     }
 }
 
-/// The set index of an engine's visibility hook (hooks/light_visibility.glsl).
-const VISIBILITY_SET_INDEX: u32 = 4;
-
 /// A stamp per draw that is unique in the frame and never 0 (the cleared `touched` value).
 fn stamp(step: usize, count_draw: bool) -> u32 {
     2 * step as u32 + 1 + u32::from(count_draw)
@@ -374,11 +371,11 @@ impl LightingPass<'_> {
         let graphics = vk::PipelineBindPoint::GRAPHICS;
         // SAFETY: `cmd` is recording (LightingPass's contract); the sets and the layout were
         // made from this context's device by the lighting, and the sets match the layout's set
-        // layouts from set 0 (and the visibility layout at VISIBILITY_SET_INDEX).
+        // layouts from set 0 (and the visibility layout at VISIBILITY_SET).
         unsafe {
             d.cmd_bind_descriptor_sets(cmd, graphics, layout, 0, self.sets, &[]);
             if let Some(set) = self.visibility_set {
-                let first = VISIBILITY_SET_INDEX;
+                let first = crate::lighting::hooks::VISIBILITY_SET;
                 d.cmd_bind_descriptor_sets(cmd, graphics, layout, first, &[set], &[]);
             }
         }
