@@ -173,3 +173,67 @@ fn emulated_backends_time_their_bookkeeping_apart() {
         );
     });
 }
+
+/// While a frame runs, the wait tells the step observer how far the GPU has got, from the
+/// frame's own timestamps (each written once everything before it has finished): what a
+/// runner keeps of a hung worker names the GPU's step, not only the CPU's. Every progress line
+/// names the passes finished in the frame's order, each line further than the last, and a
+/// frame that outlasts the first 50 ms slice has at least one (the frame here takes most of a
+/// second on lavapipe; reading the timestamps of a pending frame is validation-clean).
+/// lavapipe's fence wait returns only once its queue thread has processed the whole frame,
+/// so there the one line says every pass is finished; a GPU shows the passes in between.
+#[test]
+fn a_running_frame_tells_the_observer_which_passes_the_gpu_finished() {
+    use std::sync::{Arc, Mutex};
+    let scene = histencil_scene::embedded("huge-lights").unwrap();
+    with_validated_context(|ctx| {
+        let mut renderer = Renderer::new(ctx, scene, 1280, 720).expect("renderer");
+        renderer.render(STENCIL, Readback::NONE).expect("warm-up");
+        let lines = Arc::new(Mutex::new(Vec::new()));
+        let seen = Arc::clone(&lines);
+        ctx.observe_steps(Some(Box::new(move |step: &str| {
+            seen.lock().unwrap().push(step.to_owned());
+        })));
+        let x360 = Technique::Stencil {
+            backend: Backend::X360 {
+                zero_preserved: true,
+                save_restore: false,
+            },
+            flush: FlushPolicy::Auto,
+        };
+        let start = std::time::Instant::now();
+        let frame = renderer.render(x360, Readback::NONE).expect("frame");
+        let took = start.elapsed();
+        ctx.observe_steps(None);
+        let lines = lines.lock().unwrap().clone();
+        let wait = "waiting on the GPU for gbuffer, lighting, tonemap";
+        let progress: Vec<&str> = lines
+            .iter()
+            .filter_map(|l| l.strip_prefix(wait)?.strip_prefix(": "))
+            .collect();
+        if took > std::time::Duration::from_millis(200) {
+            assert!(!progress.is_empty(), "no progress in {took:?}: {lines:?}");
+        }
+        let passes: Vec<&str> = frame.timings.passes.iter().map(|(name, _)| *name).collect();
+        let mut finished_before = 0;
+        for line in &progress {
+            let finished = match line.strip_prefix("the GPU has finished ") {
+                Some("every pass of the frame") => passes.len(),
+                Some(rest) => {
+                    let (done, next) = rest.split_once(", not ").expect("a next pass");
+                    let done: Vec<&str> = done.split(", ").collect();
+                    assert_eq!(done, passes[..done.len()], "{line}");
+                    assert_eq!(next, passes[done.len()], "{line}");
+                    done.len()
+                }
+                None => {
+                    assert!(line.starts_with("the GPU has begun") || line.contains("not begun"));
+                    0
+                }
+            };
+            assert!(finished >= finished_before, "{progress:?}");
+            finished_before = finished;
+        }
+        println!("{progress:#?}");
+    });
+}

@@ -30,6 +30,19 @@ pub enum Error {
         /// What it returned.
         result: vk::Result,
     },
+    /// Waiting for a frame failed: the GPU did not finish it within the fence timeout, or the
+    /// device was lost while it ran. `progress` says how far the GPU got, from the frame's own
+    /// timestamps (each written once every command before it has finished): the last pass
+    /// the GPU finished and the one it had not.
+    #[error("Vulkan call `{call}` failed: {result}; {progress}")]
+    GpuStalled {
+        /// The wait, as `vkWaitForFences`.
+        call: &'static str,
+        /// What it returned: `VK_TIMEOUT` or `VK_ERROR_DEVICE_LOST`.
+        result: vk::Result,
+        /// `the GPU has finished gbuffer, not lighting`, or why it cannot be read.
+        progress: String,
+    },
     /// The memory budget or gpu-allocator refused an allocation.
     #[error("GPU memory allocation `{name}` failed: {message}")]
     Allocation {
@@ -176,6 +189,7 @@ impl Error {
             | Error::MissingFormat(_)
             | Error::DeviceLimit(_)
             | Error::Vulkan { .. }
+            | Error::GpuStalled { .. }
             | Error::Allocation { .. }
             | Error::BadResolution { .. }
             | Error::LutTooLarge { .. } => Cause::Device,

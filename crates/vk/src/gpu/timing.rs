@@ -273,6 +273,37 @@ impl Timestamps {
         self.names.push(name);
     }
 
+    /// How many of the last recorded frame's marks the GPU has written, without waiting: a
+    /// bottom-of-pipe timestamp is written once every command before it has finished, so the
+    /// marks written name the passes the GPU has finished. `None` where the results cannot be
+    /// read (a lost device).
+    pub fn written(&self, ctx: &Context) -> Option<usize> {
+        let queries = self.names.len() * QUERIES_PER_MARK as usize;
+        // Per query its value and its availability (`WITH_AVAILABILITY`, 64-bit each).
+        let mut results = vec![[0u64; 2]; queries];
+        let flags = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY;
+        // SAFETY: the pool is live and holds the marks the last recording wrote (`mark` asserts
+        // they fit); `results` has a value and an availability word per query, the stride
+        // `[u64; 2]` gives. Without WAIT the call returns at once: NOT_READY where some query
+        // is unwritten, which writes the availability of every query and the values of the
+        // available ones only.
+        let read = unsafe {
+            ctx.device
+                .get_query_pool_results(self.pool, 0, &mut results, flags)
+        };
+        match read {
+            Ok(()) | Err(vk::Result::NOT_READY) => {}
+            Err(_) => return None,
+        }
+        let marks = results.chunks(QUERIES_PER_MARK as usize);
+        Some(marks.take_while(|m| m.iter().all(|q| q[1] != 0)).count())
+    }
+
+    /// The names of the last recorded frame's marks, `start` first.
+    pub fn names(&self) -> &[&'static str] {
+        &self.names
+    }
+
     pub fn read(&self, ctx: &Context) -> Result<FrameTimings> {
         let ticks = read_ticks(ctx, self.pool, self.names.len())?;
         let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * ctx.timestamp_period_ns * 1e-6;
@@ -290,6 +321,20 @@ impl Timestamps {
         // it in its Drop after waiting for the device to go idle, or on a failed creation.
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
         self.pool = vk::QueryPool::null();
+    }
+}
+
+/// What `written` of a frame's marks `names` (`start` first, then each pass's end) say of the
+/// GPU's progress: `the GPU has finished gbuffer, lighting, not tonemap`.
+pub(crate) fn progress_words(names: &[&str], written: usize) -> String {
+    match (written, names.get(written)) {
+        (0, _) => "the GPU has not begun the frame (its start timestamp is unwritten)".to_owned(),
+        (1, Some(next)) => format!("the GPU has begun the frame, not finished {next}"),
+        (n, Some(next)) => format!(
+            "the GPU has finished {}, not {next}",
+            names[1..n].join(", ")
+        ),
+        (_, None) => "the GPU has finished every pass of the frame".to_owned(),
     }
 }
 
@@ -429,6 +474,25 @@ crate::gpu::teardown::destroy_by_method!(Timestamps);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_marks_written_name_the_passes_the_gpu_finished() {
+        let names = ["start", "gbuffer", "lighting", "tonemap"];
+        let words = |n| progress_words(&names, n);
+        assert_eq!(
+            words(0),
+            "the GPU has not begun the frame (its start timestamp is unwritten)"
+        );
+        assert_eq!(
+            words(1),
+            "the GPU has begun the frame, not finished gbuffer"
+        );
+        assert_eq!(
+            words(3),
+            "the GPU has finished gbuffer, lighting, not tonemap"
+        );
+        assert_eq!(words(4), "the GPU has finished every pass of the frame");
+    }
 
     #[test]
     fn median_per_pass() {

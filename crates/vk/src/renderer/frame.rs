@@ -8,7 +8,7 @@ use crate::gpu::access::LightingTargets;
 use crate::gpu::error::{Error, Result, VkCall};
 use crate::gpu::readback::Readback;
 use crate::gpu::targets::GBUFFER_FORMATS;
-use crate::gpu::timing::FrameTimings;
+use crate::gpu::timing::{progress_words, FrameTimings};
 use crate::hi_stencil::GpuHierarchy;
 use crate::lighting::hooks::HookSets;
 use crate::lighting::{LightingFrame, TiledFrame};
@@ -246,17 +246,19 @@ impl Renderer<'_> {
             ctx.submit(&[submit], self.fence).call("vkQueueSubmit2")?;
             // Until the wait succeeds, a failure of it is what every later frame reports.
             self.unfinished.set(Some(vk::Result::TIMEOUT));
-            ctx.step("waiting on the GPU");
-            let waited = ctx.device.wait_for_fences(
-                &[self.fence],
-                true,
-                crate::gpu::context::FENCE_TIMEOUT_NS,
-            );
-            if let Err(result) = waited {
+            let step = ctx.step("waiting on the GPU");
+            if let Err(result) = self.wait_watching(step.as_deref()) {
                 self.unfinished.set(Some(result));
-                return Err(Error::Vulkan {
+                let progress = match self.timestamps.written(ctx) {
+                    Some(n) => progress_words(self.timestamps.names(), n),
+                    None => "the frame's timestamps cannot be read (the device is lost), so how \
+                             far the GPU got is unknown"
+                        .to_owned(),
+                };
+                return Err(Error::GpuStalled {
                     call: "vkWaitForFences",
                     result,
+                    progress,
                 });
             }
             self.unfinished.set(None);
@@ -265,6 +267,38 @@ impl Renderer<'_> {
                 .call("vkResetFences")?;
         }
         Ok(())
+    }
+
+    /// Waits for the frame's fence up to the context's fence timeout, in slices (50 ms, each
+    /// twice the last, at most 1 s); where the observer saw `step`, after each slice it is
+    /// told how far the GPU has got whenever that changed (the frame's timestamps: a runner
+    /// that kills a hung worker keeps the GPU's own step).
+    fn wait_watching(&self, step: Option<&str>) -> std::result::Result<(), vk::Result> {
+        let ctx = self.ctx;
+        let start = std::time::Instant::now();
+        let timeout = std::time::Duration::from_nanos(crate::gpu::context::FENCE_TIMEOUT_NS);
+        let mut slice = std::time::Duration::from_millis(50);
+        let mut told = None;
+        loop {
+            let left = timeout.saturating_sub(start.elapsed());
+            let wait = slice.min(left).as_nanos() as u64;
+            // SAFETY: the fence is this renderer's, submitted with the frame just now; a
+            // timed-out wait leaves it as it was, to be waited for again.
+            let waited = unsafe { ctx.device.wait_for_fences(&[self.fence], true, wait) };
+            match waited {
+                Err(vk::Result::TIMEOUT) if left > slice => {}
+                other => return other,
+            }
+            if let Some(step) = step {
+                let written = self.timestamps.written(ctx);
+                if written.is_some() && written != told {
+                    let n = written.unwrap_or_default();
+                    ctx.step_progress(step, &progress_words(self.timestamps.names(), n));
+                    told = written;
+                }
+            }
+            slice = (slice * 2).min(std::time::Duration::from_secs(1));
+        }
     }
 
     /// Records the G-buffer pass into the renderer's targets.

@@ -563,20 +563,35 @@ impl Context {
     }
 
     /// Tells the observer that `what` begins (a fence wait, a submission), after the regions
-    /// recorded last.
-    pub(crate) fn step(&self, what: &str) {
+    /// recorded last; returns the line it was told (`None` without an observer), which
+    /// [`Context::step_progress`] extends.
+    pub(crate) fn step(&self, what: &str) -> Option<String> {
         let (observer, work) = {
             let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
             let work = std::mem::take(&mut steps.since_wait);
             (steps.observer.clone(), work)
         };
+        let observer = observer?;
+        let work = if work.is_empty() {
+            "work recorded without a label".to_owned()
+        } else {
+            work.join(", ")
+        };
+        let line = format!("{what} for {work}");
+        observer(&line);
+        Some(line)
+    }
+
+    /// Tells the observer how far the GPU has got with the work a [`Context::step`] line named
+    /// (`waiting on the GPU for gbuffer, lighting: the GPU has finished gbuffer, not
+    /// lighting`): the last line a runner keeps, when the GPU hangs, names the GPU's own step.
+    pub(crate) fn step_progress(&self, step: &str, progress: &str) {
+        let observer = {
+            let steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
+            steps.observer.clone()
+        };
         if let Some(observer) = observer {
-            let work = if work.is_empty() {
-                "work recorded without a label".to_owned()
-            } else {
-                work.join(", ")
-            };
-            observer(&format!("{what} for {work}"));
+            observer(&format!("{step}: {progress}"));
         }
     }
 
