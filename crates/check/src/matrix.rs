@@ -13,7 +13,7 @@
 use crate::bound::{alpha_layers, exact_bound, lights_at_a_point, Accumulation, PixelPath};
 use crate::judge::Tolerance;
 use histencil_model::FlushPolicy;
-use histencil_vk::{AlphaMode, Backend, DepthStencilFormat, MixedTiles, Technique, TileSide};
+use histencil_vk::{AlphaMode, DepthStencilFormat, MixedTiles, Technique, TileSide};
 use std::fmt;
 
 /// The engine bits the G-buffer pass writes into the preserved stencil bits: the talk's example
@@ -71,75 +71,17 @@ impl Lighting {
     }
 }
 
-/// The platform behaviour, named as `histencil render --backend` names it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Platform {
-    X360,
-    X360NoZeroing,
-    X360SaveRestore,
-    Ps3,
-    Native,
-    /// AMD GFX9-11 with pretests (modelled from AMD's driver sources).
-    AmdPretest,
-    /// AMD GFX12's AND/OR tiles (modelled from AMD's driver sources).
-    AmdAndOr,
-    /// GFX12's tiles ignoring a test's read mask: only as a known-wrong case.
-    AmdAndOrUnmasked,
-}
+/// The platforms, named as `histencil render --backend` names them (one vocabulary, in the
+/// renderer's crate).
+pub use histencil_vk::Platform;
 
-impl Platform {
-    /// The backends the matrix runs (the no-zeroing one only as a known-wrong case).
-    pub const CHECKED: [Platform; 4] = [
-        Platform::X360,
-        Platform::X360SaveRestore,
-        Platform::Ps3,
-        Platform::Native,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Platform::X360 => "x360",
-            Platform::X360NoZeroing => "x360-no-zeroing",
-            Platform::X360SaveRestore => "x360-save-restore",
-            Platform::Ps3 => "ps3",
-            Platform::Native => "native",
-            Platform::AmdPretest => "amd-pretest",
-            Platform::AmdAndOr => "amd-andor",
-            Platform::AmdAndOrUnmasked => "amd-andor-unmasked",
-        }
-    }
-
-    pub fn backend(self) -> Backend {
-        match self {
-            Platform::X360 => Backend::X360 {
-                zero_preserved: true,
-                save_restore: false,
-            },
-            Platform::X360NoZeroing => Backend::X360 {
-                zero_preserved: false,
-                save_restore: false,
-            },
-            Platform::X360SaveRestore => Backend::X360 {
-                zero_preserved: true,
-                save_restore: true,
-            },
-            Platform::Ps3 => Backend::Ps3,
-            Platform::Native => Backend::Native,
-            Platform::AmdPretest => Backend::AmdPretest,
-            Platform::AmdAndOr => Backend::AmdAndOr,
-            Platform::AmdAndOrUnmasked => Backend::AmdAndOrUnmasked,
-        }
-    }
-
-    /// Whether the backend emulates a console's hi-stencil (and so has flushes to vary; AMD's
-    /// hierarchies follow stencil writes by themselves).
-    pub fn has_hi_stencil(self) -> bool {
-        matches!(
-            self,
-            Platform::X360 | Platform::X360NoZeroing | Platform::X360SaveRestore | Platform::Ps3
-        )
-    }
-}
+/// The platforms the matrix runs (the no-zeroing one only as a known-wrong case).
+pub const CHECKED: [Platform; 4] = [
+    Platform::X360,
+    Platform::X360SaveRestore,
+    Platform::Ps3,
+    Platform::Native,
+];
 
 pub fn flush_name(flush: FlushPolicy) -> &'static str {
     match flush {
@@ -366,7 +308,7 @@ fn lighting_configs(pattern: u8, alpha: AlphaMode) -> Vec<Config> {
             });
             continue;
         }
-        for platform in Platform::CHECKED {
+        for platform in CHECKED {
             // Deferred is branching on the native backend.
             if lighting == Lighting::Branching && platform == Platform::Native {
                 continue;

@@ -3,8 +3,8 @@
 use anyhow::{bail, Context as _, Result};
 use clap::{Parser, Subcommand};
 use histencil_alpha::ParameterKind;
-use histencil_check::matrix::Platform;
 use histencil_scene::{with_default_lights, DefaultLights};
+use histencil_vk::Platform;
 use histencil_vk::{
     AlphaMode, Context, ContextDesc, FlushPolicy, FrameDesc, ImageKind, MixedTiles, Readback,
     Renderer, RendererDesc, Shading, Technique, TileSide, TileStats,
@@ -129,11 +129,9 @@ struct RenderArgs {
     /// reference).
     #[arg(long, value_enum, default_value = "deferred")]
     technique: TechniqueArg,
-    /// Platform behaviour of the stencil plan: x360 (no hi-stencil read mask, zeroes preserved
-    /// bits), x360-no-zeroing (shows the talk's failure), x360-save-restore (zeroes, then writes
-    /// the bits back after lighting), ps3 (read mask), native (no hi-stencil).
+    /// Platform behaviour of the stencil plan.
     #[arg(long, value_enum, default_value = "native")]
-    backend: BackendArg,
+    backend: PlatformArg,
     /// When hi-stencil is flushed.
     #[arg(long, value_enum, default_value = "auto")]
     flush: FlushArg,
@@ -259,22 +257,19 @@ impl AlphaArg {
     }
 }
 
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum BackendArg {
-    X360,
-    X360NoZeroing,
-    X360SaveRestore,
-    /// PS3-like hi-stencil with a read mask; also the model of NVIDIA's ZCull stencil
-    /// criterion (its documented fields are the RSX's; what a region holds is assumed).
-    Ps3,
-    Native,
-    /// AMD GFX9-11 with two hierarchical-stencil pretests, modelled from AMD's driver sources
-    /// (not measured on AMD hardware): the native plan, the GPU's tiles emulated.
-    AmdPretest,
-    /// AMD GFX12's per-tile AND/OR of the stencil, modelled likewise.
-    AmdAndor,
-    /// GFX12's tiles ignoring a test's read mask: engine bits break culling (known-wrong).
-    AmdAndorUnmasked,
+/// A platform on the command line: histencil's own [`Platform`], named and described by it.
+#[derive(Clone, Copy)]
+struct PlatformArg(Platform);
+
+impl clap::ValueEnum for PlatformArg {
+    fn value_variants<'a>() -> &'a [Self] {
+        static ALL: std::sync::OnceLock<[PlatformArg; 8]> = std::sync::OnceLock::new();
+        ALL.get_or_init(|| Platform::ALL.map(PlatformArg))
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.0.name()).help(self.0.about()))
+    }
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -294,18 +289,7 @@ impl RenderArgs {
     }
 
     fn shading(&self, ctx: &Context) -> Shading {
-        // The check's platform vocabulary names the same five backends.
-        let backend = match self.backend {
-            BackendArg::X360 => Platform::X360,
-            BackendArg::X360NoZeroing => Platform::X360NoZeroing,
-            BackendArg::X360SaveRestore => Platform::X360SaveRestore,
-            BackendArg::Ps3 => Platform::Ps3,
-            BackendArg::Native => Platform::Native,
-            BackendArg::AmdPretest => Platform::AmdPretest,
-            BackendArg::AmdAndor => Platform::AmdAndOr,
-            BackendArg::AmdAndorUnmasked => Platform::AmdAndOrUnmasked,
-        }
-        .backend();
+        let backend = self.backend.0.backend();
         let flush = match self.flush {
             FlushArg::Auto => FlushPolicy::Auto,
             FlushArg::Always => FlushPolicy::Always,

@@ -14,7 +14,7 @@
 use crate::{write_file, Result};
 use histencil_model::{FlushPolicy, FramePlan, TileStats};
 use histencil_scene::Scene;
-use histencil_vk::{Backend, Context, FrameDesc, Renderer, SimulatorInputs, Technique};
+use histencil_vk::{Context, FrameDesc, Renderer, SimulatorInputs, Technique};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -22,7 +22,9 @@ use std::path::{Path, PathBuf};
 /// The engine's bits, as in the talk's 360 story (and `demo`, `check`).
 pub const ENGINE_BITS: u8 = 0xA0;
 
-/// One platform as the table describes it.
+/// One platform as the table describes it: the renderer's platforms ([`histencil_vk::Platform`])
+/// the talk's questions are asked of, and NVIDIA's ZCull criterion, a row of its own that runs
+/// as the PS3's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Platform {
     X360NoZeroing,
@@ -103,21 +105,21 @@ impl Platform {
         }
     }
 
+    /// The renderer's platform this row runs as (NVIDIA's ZCull criterion as the PS3's).
+    fn renderer_platform(self) -> histencil_vk::Platform {
+        use histencil_vk::Platform as P;
+        match self {
+            Platform::X360NoZeroing => P::X360NoZeroing,
+            Platform::X360 => P::X360,
+            Platform::Ps3 | Platform::NvidiaZcull => P::Ps3,
+            Platform::AmdPretest => P::AmdPretest,
+            Platform::AmdAndOr => P::AmdAndOr,
+            Platform::Native => P::Native,
+        }
+    }
+
     fn technique(self) -> Technique {
-        let backend = match self {
-            Platform::X360NoZeroing => Backend::X360 {
-                zero_preserved: false,
-                save_restore: false,
-            },
-            Platform::X360 => Backend::X360 {
-                zero_preserved: true,
-                save_restore: false,
-            },
-            Platform::Ps3 | Platform::NvidiaZcull => Backend::Ps3,
-            Platform::AmdPretest => Backend::AmdPretest,
-            Platform::AmdAndOr => Backend::AmdAndOr,
-            Platform::Native => Backend::Native,
-        };
+        let backend = self.renderer_platform().backend();
         Technique::Stencil {
             backend,
             flush: FlushPolicy::Auto,

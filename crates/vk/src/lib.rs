@@ -69,6 +69,7 @@ pub use renderer::materials::{
     mip_chain, plan_materials, srgb_to_linear, GpuMaterials, MaterialPlan, MaterialRecord, SetPlan,
     TextureKey,
 };
+pub use renderer::platform::Platform;
 pub use renderer::technique::{
     Backend, FrameDesc, MixedTiles, Shading, Technique, TileClassify, TileSide,
 };

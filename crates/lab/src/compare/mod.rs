@@ -133,10 +133,7 @@ fn first_row_modules(
 /// The table's rows: the technique and platform backend of each.
 pub fn table_rows() -> Vec<(&'static str, Technique)> {
     let flush = FlushPolicy::Auto;
-    let x360 = Backend::X360 {
-        zero_preserved: true,
-        save_restore: false,
-    };
+    let x360 = histencil_vk::Platform::X360.backend();
     vec![
         (
             "branching",

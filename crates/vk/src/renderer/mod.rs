@@ -8,6 +8,7 @@ mod create;
 mod frame;
 pub(crate) mod materials;
 mod plan;
+pub(crate) mod platform;
 mod simulator;
 pub(crate) mod technique;
 
