@@ -68,6 +68,7 @@ fn generated_glsl() -> String {
         .chain(LIGHT_FALLOFFS)
         .chain(LIGHT_DRAW_FLAGS)
         .chain(ALPHA_MODES)
+        .chain(HI_STENCIL_MODES)
     {
         writeln!(s, "#define {name} {value}u").unwrap();
     }

@@ -48,9 +48,6 @@ layout(push_constant) uniform Update {
     uint value2;
 } update;
 
-const uint MODE_CONSOLE = 0u;
-const uint MODE_PRETESTS = 1u;
-const uint MODE_AND_OR = 2u;
 
 bool compare_passes(uint op, uint a, uint b) {
     switch (op) {
@@ -142,13 +139,13 @@ void main() {
     }
     bool passes;
     switch (update.mode) {
-    case MODE_PRETESTS:
+    case HI_STENCIL_MODE_PRETESTS:
         passes = (update.tests < 1u
                   || some_pixel_passes(origin, end, 2u, update.read_mask, update.reference))
               && (update.tests < 2u
                   || some_pixel_passes(origin, end, 2u, update.mask2, update.value2));
         break;
-    case MODE_AND_OR:
+    case HI_STENCIL_MODE_AND_OR:
         passes = tile_and_or_may_pass(origin, end);
         break;
     default:

@@ -26,6 +26,23 @@ pub const HI_STENCIL_TILE: u32 = 8;
 #[allow(dead_code)]
 pub const HI_STENCIL_UPDATE_GROUP: u32 = 64;
 
+/// `mode` of the hi-stencil tile update's push constants (GLSL `HI_STENCIL_MODE_*`): what a
+/// tile's flag evaluates: the console's compare, AMD's two pretests, or AMD's AND/OR tiles.
+pub const HI_STENCIL_MODE_CONSOLE: u32 = 0;
+/// See [`HI_STENCIL_MODE_CONSOLE`].
+pub const HI_STENCIL_MODE_PRETESTS: u32 = 1;
+/// See [`HI_STENCIL_MODE_CONSOLE`].
+pub const HI_STENCIL_MODE_AND_OR: u32 = 2;
+
+/// GLSL `HI_STENCIL_MODE_*` (hi_stencil_update.comp). Read by build.rs; the library uses the
+/// constants above.
+#[allow(dead_code)]
+pub const HI_STENCIL_MODES: [(&str, u32); 3] = [
+    ("HI_STENCIL_MODE_CONSOLE", HI_STENCIL_MODE_CONSOLE),
+    ("HI_STENCIL_MODE_PRETESTS", HI_STENCIL_MODE_PRETESTS),
+    ("HI_STENCIL_MODE_AND_OR", HI_STENCIL_MODE_AND_OR),
+];
+
 /// BRDF model ids the tiled classification maps to slots (GLSL `TILED_MODELS`): at least
 /// `histencil_brdf::MODEL_IDS`, the built-ins' and an engine set's (build.rs checks). Its push
 /// constants are then 116 bytes, within the 128 every device has.

@@ -9,8 +9,8 @@ use crate::gpu::teardown::build;
 use ash::vk;
 
 /// What a binding holds: the subset of Vulkan's descriptor types histencil's shaders use
-/// (separate images and samplers, no combined image samplers). The order is that of the
-/// per-kind counts the device limits are checked with (`limits::SetCounts`).
+/// (separate images and samplers, no combined image samplers), and the kinds the device's
+/// per-kind descriptor limits count (`limits::SetCounts`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
     /// A `uniform` block (`UNIFORM_BUFFER`).
@@ -26,6 +26,15 @@ pub enum BindingKind {
 }
 
 impl BindingKind {
+    /// Every kind, in the order of `SetCounts`' counts.
+    pub const ALL: [BindingKind; 5] = [
+        BindingKind::UniformBuffer,
+        BindingKind::StorageBuffer,
+        BindingKind::SampledImage,
+        BindingKind::Sampler,
+        BindingKind::StorageImage,
+    ];
+
     fn descriptor_type(self) -> vk::DescriptorType {
         match self {
             BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
@@ -232,12 +241,9 @@ pub(crate) fn create_set_layout(
     let layout = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }
         .call("vkCreateDescriptorSetLayout")?;
     ctx.name(layout, name);
-    let mut counts = SetCounts {
-        stages,
-        kinds: [0; 5],
-    };
+    let mut counts = SetCounts::new(stages);
     for b in set {
-        counts.kinds[b.kind as usize] += 1;
+        counts.add(b.kind, 1);
     }
     ctx.set_counts
         .lock()

@@ -5,6 +5,7 @@
 //! sees them ([`crate::Context`] records the largest need met), so a device below a need gets an
 //! error that names the limit, never a driver's undefined behaviour.
 
+use crate::gpu::descriptors::BindingKind;
 use ash::vk;
 
 /// A `VkPhysicalDeviceLimits` member histencil's work depends on.
@@ -281,36 +282,54 @@ pub fn describe(needs: &[Need], device: &DeviceLimits) -> String {
 pub(crate) struct SetCounts {
     /// The stages these bindings are visible to.
     pub stages: vk::ShaderStageFlags,
-    /// Uniform buffers, storage buffers, sampled images, samplers, storage images.
-    pub kinds: [u32; 5],
+    /// Descriptors per kind, indexed as [`BindingKind::ALL`].
+    kinds: [u32; BindingKind::ALL.len()],
 }
 
 impl SetCounts {
+    /// No descriptor yet, visible to `stages`.
+    pub fn new(stages: vk::ShaderStageFlags) -> Self {
+        Self {
+            stages,
+            kinds: [0; BindingKind::ALL.len()],
+        }
+    }
+
+    /// Counts `count` more descriptors of `kind`.
+    pub fn add(&mut self, kind: BindingKind, count: u32) {
+        self.kinds[kind as usize] += count;
+    }
+
+    /// The descriptors of `kind`.
+    pub fn of(&self, kind: BindingKind) -> u32 {
+        self.kinds[kind as usize]
+    }
+
     /// The counts of an engine's layout from the bindings it was created with, one entry per
     /// distinct stage mask (descriptor types histencil's limits do not track are not counted).
     pub fn of_bindings(bindings: &[vk::DescriptorSetLayoutBinding]) -> Vec<SetCounts> {
         let mut groups: Vec<SetCounts> = Vec::new();
         for b in bindings {
-            let kind = match b.descriptor_type {
-                vk::DescriptorType::UNIFORM_BUFFER | vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC => {
-                    0
-                }
-                vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::STORAGE_BUFFER_DYNAMIC => {
-                    1
-                }
-                vk::DescriptorType::SAMPLED_IMAGE | vk::DescriptorType::UNIFORM_TEXEL_BUFFER => 2,
-                vk::DescriptorType::SAMPLER => 3,
-                vk::DescriptorType::STORAGE_IMAGE | vk::DescriptorType::STORAGE_TEXEL_BUFFER => 4,
-                vk::DescriptorType::COMBINED_IMAGE_SAMPLER => {
+            let kinds: &[BindingKind] =
+                match b.descriptor_type {
+                    vk::DescriptorType::UNIFORM_BUFFER
+                    | vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC => &[BindingKind::UniformBuffer],
+                    vk::DescriptorType::STORAGE_BUFFER
+                    | vk::DescriptorType::STORAGE_BUFFER_DYNAMIC => &[BindingKind::StorageBuffer],
+                    vk::DescriptorType::SAMPLED_IMAGE
+                    | vk::DescriptorType::UNIFORM_TEXEL_BUFFER => &[BindingKind::SampledImage],
+                    vk::DescriptorType::SAMPLER => &[BindingKind::Sampler],
+                    vk::DescriptorType::STORAGE_IMAGE
+                    | vk::DescriptorType::STORAGE_TEXEL_BUFFER => &[BindingKind::StorageImage],
                     // A sampled image and a sampler, each counted against its limit.
-                    let g = group(&mut groups, b.stage_flags);
-                    g.kinds[2] += b.descriptor_count;
-                    g.kinds[3] += b.descriptor_count;
-                    continue;
-                }
-                _ => continue,
-            };
-            group(&mut groups, b.stage_flags).kinds[kind] += b.descriptor_count;
+                    vk::DescriptorType::COMBINED_IMAGE_SAMPLER => {
+                        &[BindingKind::SampledImage, BindingKind::Sampler]
+                    }
+                    _ => &[],
+                };
+            for kind in kinds {
+                group(&mut groups, b.stage_flags).add(*kind, b.descriptor_count);
+            }
         }
         groups
     }
@@ -321,14 +340,22 @@ fn group(groups: &mut Vec<SetCounts>, stages: vk::ShaderStageFlags) -> &mut SetC
     let at = match groups.iter().position(|g| g.stages == stages) {
         Some(i) => i,
         None => {
-            groups.push(SetCounts {
-                stages,
-                kinds: [0; 5],
-            });
+            groups.push(SetCounts::new(stages));
             groups.len() - 1
         }
     };
     &mut groups[at]
+}
+
+/// The per-stage limit on descriptors of `kind`.
+fn per_stage_limit(kind: BindingKind) -> Limit {
+    match kind {
+        BindingKind::UniformBuffer => Limit::PerStageUniformBuffers,
+        BindingKind::StorageBuffer => Limit::PerStageStorageBuffers,
+        BindingKind::SampledImage => Limit::PerStageSampledImages,
+        BindingKind::Sampler => Limit::PerStageSamplers,
+        BindingKind::StorageImage => Limit::PerStageStorageImages,
+    }
 }
 
 /// The per-stage and per-layout needs of a pipeline layout of `set_count` sets whose bindings
@@ -339,13 +366,6 @@ pub(crate) fn layout_needs(
     set_count: u32,
     push_constant_bytes: u32,
 ) -> Vec<(Limit, u32)> {
-    let per_stage = [
-        Limit::PerStageUniformBuffers,
-        Limit::PerStageStorageBuffers,
-        Limit::PerStageSampledImages,
-        Limit::PerStageSamplers,
-        Limit::PerStageStorageImages,
-    ];
     let mut needs = vec![
         (Limit::BoundDescriptorSets, set_count),
         (Limit::PushConstantsSize, push_constant_bytes),
@@ -355,25 +375,21 @@ pub(crate) fn layout_needs(
         vk::ShaderStageFlags::FRAGMENT,
         vk::ShaderStageFlags::COMPUTE,
     ];
-    let mut most = [0u32; 5];
+    let mut most = [0u32; BindingKind::ALL.len()];
     let mut resources = 0;
     for stage in stages {
-        let mut sum = [0u32; 5];
-        for set in sets.iter().filter(|s| s.stages.contains(stage)) {
-            for (s, k) in sum.iter_mut().zip(set.kinds) {
-                *s += k;
-            }
-        }
+        let visible = || sets.iter().filter(|s| s.stages.contains(stage));
+        let sum = BindingKind::ALL.map(|kind| visible().map(|s| s.of(kind)).sum::<u32>());
         for (m, s) in most.iter_mut().zip(sum) {
             *m = (*m).max(s);
         }
         resources = resources.max(sum.iter().sum::<u32>());
     }
-    needs.extend(per_stage.into_iter().zip(most));
+    needs.extend(BindingKind::ALL.map(per_stage_limit).into_iter().zip(most));
     needs.push((Limit::PerStageResources, resources));
-    let total = |k: usize| sets.iter().map(|s| s.kinds[k]).sum::<u32>();
-    needs.push((Limit::SetStorageBuffers, total(1)));
-    needs.push((Limit::SetSampledImages, total(2)));
+    let total = |kind| sets.iter().map(|s| s.of(kind)).sum::<u32>();
+    needs.push((Limit::SetStorageBuffers, total(BindingKind::StorageBuffer)));
+    needs.push((Limit::SetSampledImages, total(BindingKind::SampledImage)));
     needs
 }
 
@@ -457,18 +473,19 @@ mod tests {
 
     #[test]
     fn a_layout_counts_each_stage_and_the_whole_layout() {
-        let frame = SetCounts {
-            stages: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-            kinds: [1, 1, 0, 0, 0],
+        use BindingKind::{SampledImage, StorageBuffer, StorageImage, UniformBuffer};
+        let counts = |stages, kinds: &[(BindingKind, u32)]| {
+            let mut c = SetCounts::new(stages);
+            for &(kind, n) in kinds {
+                c.add(kind, n);
+            }
+            c
         };
-        let gbuffer = SetCounts {
-            stages: vk::ShaderStageFlags::FRAGMENT,
-            kinds: [0, 0, 3, 0, 0],
-        };
-        let tiled = SetCounts {
-            stages: vk::ShaderStageFlags::COMPUTE,
-            kinds: [0, 4, 0, 0, 1],
-        };
+        let vertex_fragment = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        let frame = counts(vertex_fragment, &[(UniformBuffer, 1), (StorageBuffer, 1)]);
+        let gbuffer = counts(vk::ShaderStageFlags::FRAGMENT, &[(SampledImage, 3)]);
+        let compute = vk::ShaderStageFlags::COMPUTE;
+        let tiled = counts(compute, &[(StorageBuffer, 4), (StorageImage, 1)]);
         let needs = layout_needs(&[frame, gbuffer, tiled], 3, 96);
         let get = |l| needs.iter().find(|(n, _)| *n == l).map(|&(_, v)| v);
         assert_eq!(get(Limit::BoundDescriptorSets), Some(3));

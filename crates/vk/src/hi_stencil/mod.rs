@@ -36,7 +36,10 @@ use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
 use crate::gpu::state::compare_op;
 use crate::gpu::teardown::{build, Destroy};
-use crate::shader_consts::HI_STENCIL_UPDATE_GROUP;
+use crate::shader_consts::{
+    HI_STENCIL_MODE_AND_OR, HI_STENCIL_MODE_CONSOLE, HI_STENCIL_MODE_PRETESTS,
+    HI_STENCIL_UPDATE_GROUP,
+};
 use crate::shaders;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -67,9 +70,9 @@ struct UpdatePush {
     rect_tiles: u32,
     /// The touch image's code of the write's marker; 0: every tile of the rectangle was touched.
     marker: u32,
-    /// What is evaluated: [`TileTest`]'s mode.
+    /// What is evaluated: `HI_STENCIL_MODE_*` (`shader_consts`), by [`TileTest`].
     mode: u32,
-    /// Mode 1: how many pretests, the first in `read_mask` / `reference`, the second here.
+    /// With the pretests: how many, the first in `read_mask` / `reference`, the second here.
     tests: u32,
     mask2: u32,
     value2: u32,
@@ -492,7 +495,7 @@ impl HiStencilSurface {
             rect_width: rect.width,
             rect_tiles: rect.width * rect.height,
             marker: 0,
-            mode: 0,
+            mode: HI_STENCIL_MODE_CONSOLE,
             tests: 0,
             mask2: 0,
             value2: 0,
@@ -556,14 +559,15 @@ impl HiStencilSurface {
             TileTest::Pretests(p) => {
                 let held: Vec<(u8, u8)> = p.into_iter().flatten().collect();
                 let pair = |i: usize| held.get(i).map_or((0, 0), |(m, v)| (*m, v & m));
-                (1, held.len() as u32, pair(0), pair(1), 0)
+                let tests = held.len() as u32;
+                (HI_STENCIL_MODE_PRETESTS, tests, pair(0), pair(1), 0)
             }
             TileTest::AndOr {
                 compare,
                 mask,
                 reference,
             } => (
-                2,
+                HI_STENCIL_MODE_AND_OR,
                 0,
                 (mask, reference),
                 (0, 0),

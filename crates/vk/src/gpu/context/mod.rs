@@ -341,7 +341,10 @@ impl Context {
     ///   nothing else uses that queue (Vulkan requires queues to be externally synchronised);
     /// - while a [`crate::DeferredLighting`] or [`crate::AlphaLightmaps`] that has recorded, or a
     ///   [`crate::LutTables`], is dropped, nothing else uses any queue of the device: dropping
-    ///   waits for the device to go idle. Their `unsafe fn destroy` frees without that wait.
+    ///   waits for the device to go idle. [`crate::DeferredLighting::destroy`] and
+    ///   [`crate::AlphaLightmaps::destroy`] free without that wait once every slot was declared
+    ///   finished (and refuse otherwise), and `unsafe` [`crate::LutTables::destroy`] once its
+    ///   caller promises the GPU is done.
     ///
     /// The engine-facing parts submit nothing themselves: making, recording and reading them
     /// never touches a queue.
