@@ -347,7 +347,8 @@ fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
 fn compare_verdicts_do_not_reverse_under_background_load() {
     use histencil_lab::compare::merge::{DeviceReport, Merged};
     let mut settings = CompareSettings::talk(64, 64, 15);
-    settings.light_sizes = vec![0.01, 1.0];
+    // One light size: the sweep's verdicts pair by round as the table's do (CI's time).
+    settings.light_sizes = vec![1.0];
     // Pairing by round is what this test holds, without the steady clock's retakes (which
     // the busy threads would multiply).
     settings.clock = None;
@@ -476,15 +477,16 @@ fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget()
     settings.until_decided = true;
     settings.predict_budget = true;
     // The cap: a run that cannot decide stops here at the latest (short: the talk's verdicts
-    // are 18 cells, and a pilot on lavapipe predicts more than a test should spend).
-    settings.budget = std::time::Duration::from_secs(30);
+    // are 18 cells, and a pilot on lavapipe predicts more than a test should spend; the pilot
+    // itself takes about 6 s alone, twice that beside another test).
+    settings.budget = std::time::Duration::from_secs(20);
     let report = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
     use histencil_lab::stats::{Stop, MIN_VERDICT_ROUNDS};
     let t = report.sampled;
     let p = t.prediction.expect("a pilot's prediction");
     assert_eq!(p.pilot_rounds, MIN_VERDICT_ROUNDS);
     assert!(t.rounds >= MIN_VERDICT_ROUNDS, "{t:?}");
-    assert!(p.budget_seconds <= 30.0, "{p:?}");
+    assert!(p.budget_seconds <= 20.0, "{p:?}");
     match t.stop {
         Stop::Decided => assert_eq!(t.open, 0, "{t:?}"),
         Stop::Budget | Stop::MaxRounds => assert!(t.open > 0, "{t:?}"),
