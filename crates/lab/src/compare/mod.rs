@@ -748,7 +748,7 @@ impl<'c> SteadyClock<'c> {
             .and_then(|s| s.warm_ups.last())
         {
             progress(&format!(
-                "{name}: steady clock warmed up in {} frames ({:.1} s), canary {:.3} ms{}",
+                "{name}: steady clock warmed up in {} canary times ({:.1} s), canary {:.3} ms{}",
                 w.times_ms.len(),
                 w.seconds,
                 w.reference_ms,
