@@ -100,7 +100,10 @@ pub struct CompareArgs {
     /// all 10 of the talk's verdicts, the steady clock's retakes included): 320x180, light sizes
     /// 1, 10 and 100 %, each of the four measurement sets (the table, three sizes) sampled until
     /// decided within at most 90 s. A default run (1280x720, seven light sizes, up to 1800 s a
-    /// set) takes hours on lavapipe and is meant for a GPU; progress goes to stderr either way.
+    /// set) takes hours on lavapipe and is meant for a GPU: on an NVIDIA H200 (a run before the
+    /// steady clock) its eight sets sampled for 6 s in all, each decided in 10 to 12 rounds,
+    /// the references and pipelines around them taking most of its time. Progress goes to
+    /// stderr either way.
     #[arg(long, conflicts_with_all = ["width", "height", "light_sizes", "budget_cap_s", "budget_s"])]
     quick: bool,
     #[command(subcommand)]
