@@ -24,7 +24,7 @@ use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
-use crate::gpu::state::{apply, FULLSCREEN};
+use crate::gpu::state::FULLSCREEN;
 use crate::gpu::teardown::{DestroyResult, PendingSlots};
 use crate::gpu::timing::{LightmapTimings, SlotTimer};
 use crate::passes::{begin_all_cleared, CLEAR_BLACK};
@@ -537,89 +537,88 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     ) {
         let ctx: &Context = &self.ctx;
         // SAFETY: this fn's # Safety is `Recording::new`'s.
-        let rec = unsafe { Recording::new(ctx, cmd) };
-        let cmd = rec.outside();
-        self.pending.recorded(slot, cmd);
+        let recording = unsafe { Recording::new(ctx, cmd) };
+        let rec = &recording;
+        self.pending.recorded(slot, rec.outside());
         let slot = &mut self.slots[slot as usize];
         // Queries are reset outside rendering, as Vulkan requires.
         let mut timer = slot.timer.active();
         if let Some(t) = timer.as_deref_mut() {
-            t.reset(ctx, cmd);
-            t.start(ctx, cmd);
+            t.reset(rec);
+            t.start(rec);
         }
-        let pipeline = match direction {
-            Some(direction) => {
-                ctx.begin_label(cmd, "alpha-lightmaps-directional");
-                begin_all_cleared(ctx, cmd, &mut [atlas, direction], CLEAR_BLACK);
-                self.directional_pipeline
-            }
-            None => {
-                ctx.begin_label(cmd, "alpha-lightmaps");
-                begin_all_cleared(ctx, cmd, &mut [atlas], CLEAR_BLACK);
-                self.pipeline
-            }
+        let label = match direction {
+            Some(_) => "alpha-lightmaps-directional",
+            None => "alpha-lightmaps",
         };
-        rec.began_rendering();
-        let d = &ctx.device;
-        // SAFETY: `cmd` is recording on this context's device (the # Safety of `record` and
-        // `record_directional`, and `AlphaLighting` records into the renderer's own), inside
-        // the rendering begun above. The pipeline is non-null: the directional one only with a
-        // direction map, which `check_direction` (or `AlphaLighting`'s desc) ties to a direction
-        // format; it and the layout were made by `create` and live as long as `self`. The
-        // slot's sets were written by `write_frame` and match the layout's sets 0 and 1.
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline_layout,
-                0,
-                &[slot.frame_set, slot.alpha_set],
-                &[],
-            );
-        }
-        apply(ctx, cmd, &FULLSCREEN);
-        if let Some(t) = timer.as_deref_mut() {
-            t.mark(ctx, cmd, "clear".to_owned(), None);
-        }
-        for (index, (r, lights)) in layout.regions.iter().zip(&slot.entity_lights).enumerate() {
-            if lights.is_empty() {
-                continue;
+        rec.step(label, |rec| {
+            let pipeline = match direction {
+                Some(direction) => {
+                    begin_all_cleared(rec, &mut [atlas, direction], CLEAR_BLACK);
+                    self.directional_pipeline
+                }
+                None => {
+                    begin_all_cleared(rec, &mut [atlas], CLEAR_BLACK);
+                    self.pipeline
+                }
+            };
+            let (d, cmd) = (rec.device(), rec.inside());
+            // SAFETY: `cmd` is recording on this context's device (the # Safety of `record` and
+            // `record_directional`, and `AlphaLighting` records into the renderer's own), inside
+            // the rendering begun above. The pipeline is non-null: the directional one only with a
+            // direction map, which `check_direction` (or `AlphaLighting`'s desc) ties to a direction
+            // format; it and the layout were made by `create` and live as long as `self`. The
+            // slot's sets were written by `write_frame` and match the layout's sets 0 and 1.
+            unsafe {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.pipeline_layout,
+                    0,
+                    &[slot.frame_set, slot.alpha_set],
+                    &[],
+                );
             }
-            let mut region = r.region;
-            (region.width, region.height) = r.shape.size();
-            set_region(ctx, cmd, region);
-            for &light in lights {
-                let push = AlphaDrawPush {
-                    entity: index as u32,
-                    light,
-                    ..Default::default()
-                };
-                // SAFETY: inside the rendering begun above, with the pipeline and sets bound,
-                // the dynamic state set (`apply`, `set_region`); the push is `AlphaDrawPush` at
-                // offset 0, the layout's graphics-stage range; the full-screen triangle reads
-                // no vertex buffer.
-                unsafe {
-                    d.cmd_push_constants(
-                        cmd,
-                        self.pipeline_layout,
-                        GRAPHICS_STAGES,
-                        0,
-                        bytemuck::bytes_of(&push),
-                    );
-                    d.cmd_draw(cmd, 3, 1, 0, 0);
+            rec.apply(&FULLSCREEN);
+            if let Some(t) = timer.as_deref_mut() {
+                t.mark(rec, "clear".to_owned(), None);
+            }
+            for (index, (r, lights)) in layout.regions.iter().zip(&slot.entity_lights).enumerate() {
+                if lights.is_empty() {
+                    continue;
+                }
+                let mut region = r.region;
+                (region.width, region.height) = r.shape.size();
+                set_region(rec, region);
+                for &light in lights {
+                    let push = AlphaDrawPush {
+                        entity: index as u32,
+                        light,
+                        ..Default::default()
+                    };
+                    // SAFETY: inside the rendering begun above, with the pipeline and sets bound,
+                    // the dynamic state set (`apply`, `set_region`); the push is `AlphaDrawPush` at
+                    // offset 0, the layout's graphics-stage range; the full-screen triangle reads
+                    // no vertex buffer.
+                    unsafe {
+                        d.cmd_push_constants(
+                            cmd,
+                            self.pipeline_layout,
+                            GRAPHICS_STAGES,
+                            0,
+                            bytemuck::bytes_of(&push),
+                        );
+                        d.cmd_draw(cmd, 3, 1, 0, 0);
+                    }
+                }
+                if let Some(t) = timer.as_deref_mut() {
+                    t.mark(rec, "entity".to_owned(), Some(index as u32));
                 }
             }
-            if let Some(t) = timer.as_deref_mut() {
-                t.mark(ctx, cmd, "entity".to_owned(), Some(index as u32));
-            }
-        }
-        // SAFETY: ends the rendering `begin_all_cleared` began on `cmd` above (`inside` checks
-        // it is open).
-        unsafe { d.cmd_end_rendering(rec.inside()) };
-        rec.ended_rendering();
-        ctx.end_label(cmd);
-        rec.finish();
+            rec.end_rendering();
+        });
+        recording.finish();
     }
 
     /// Sets 0 and 1 of the alpha pipelines (frame, alpha), for histencil's own alpha pass.
@@ -685,7 +684,7 @@ fn fit(ctx: &Context, buffer: &mut Buffer, name: &str, slot: u32, bytes: usize) 
 }
 
 /// Viewport and scissor over one atlas region.
-pub(crate) fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: Region) {
+pub(crate) fn set_region(rec: &Recording, r: Region) {
     let viewport = vk::Viewport {
         x: r.x as f32,
         y: r.y as f32,
@@ -708,7 +707,7 @@ pub(crate) fn set_region(ctx: &Context, cmd: vk::CommandBuffer, r: Region) {
     // recording its pass (see there). One viewport and scissor, at 0, of the region's shape:
     // non-zero and inside the atlas, as `check_frame` held every region before the recording.
     unsafe {
-        ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
-        ctx.device.cmd_set_scissor(cmd, 0, &[scissor]);
+        rec.device().cmd_set_viewport(rec.any(), 0, &[viewport]);
+        rec.device().cmd_set_scissor(rec.any(), 0, &[scissor]);
     }
 }

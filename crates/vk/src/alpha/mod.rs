@@ -18,7 +18,7 @@ pub use gpu::AlphaEntityRecord;
 pub use histencil_alpha::{mesh_bounds, AlphaEntity, AlphaEntityKind};
 pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 
-use crate::gpu::access::{transition, Contents, ImageAccess};
+use crate::gpu::access::{Contents, ImageAccess};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, write_sampled_images, ALPHA_LIGHTMAP_SET,
@@ -27,8 +27,9 @@ use crate::gpu::descriptors::{
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::meshes::Meshes;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
-use crate::gpu::state::{apply, oriented, FULLSCREEN};
+use crate::gpu::state::{oriented, FULLSCREEN};
 use crate::gpu::targets::{Targets, HDR_FORMAT};
 use crate::gpu::timing::LightmapTimings;
 use crate::passes::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
@@ -335,11 +336,11 @@ impl<'c> AlphaLighting<'c> {
     }
 
     /// Writes the frame's entity records (every mode reads them) and, in the lightmap modes,
-    /// records the lightmap pass into `cmd`, as an engine would, with timestamps if asked
-    /// ([`Self::lightmap_timings`]).
+    /// records the lightmap pass through `rec`'s command buffer, as an engine would (through
+    /// the lightmaps' own entry points), with timestamps if asked ([`Self::lightmap_timings`]).
     pub fn record_lightmaps(
         &mut self,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         scene: &Scene,
         view: &ViewDesc,
         mode: AlphaMode,
@@ -360,7 +361,8 @@ impl<'c> AlphaLighting<'c> {
         // before it records the next, and records nothing after a wait that failed
         // (`Renderer::begin_commands`): slot 0's last frame has finished.
         unsafe { self.lightmaps.slot_finished(0)? };
-        self.lightmaps.write_frame(cmd, &frame, &self.lightmap)?;
+        self.lightmaps
+            .write_frame(rec.outside(), &frame, &self.lightmap)?;
         let direction = match mode {
             AlphaMode::Lightmap => None,
             AlphaMode::Directional => Some(&mut *self.direction_map),
@@ -368,8 +370,9 @@ impl<'c> AlphaLighting<'c> {
         };
         // SAFETY: the renderer's command buffer is recording on this device, outside rendering
         // between its passes (`Renderer::record_deferred` and the alpha pass after it), and
-        // only this call records into it now.
+        // only this call records into it now (`rec` waits for it, `Recording::new`).
         unsafe {
+            let cmd = rec.outside();
             self.lightmaps
                 .record_pass(cmd, 0, &self.layout, &mut self.lightmap, direction)
         };
@@ -382,13 +385,13 @@ impl<'c> AlphaLighting<'c> {
         self.lightmaps.timings(0)
     }
 
-    fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, push: AlphaDrawPush) {
-        // SAFETY: `record_alpha`, the one caller, pushes inside its HDR rendering on `cmd` (the
-        // renderer's, recording) with a pipeline of this layout bound; the push is
-        // `AlphaDrawPush` at offset 0, the layout's graphics-stage range.
+    fn push(&self, rec: &Recording, push: AlphaDrawPush) {
+        // SAFETY: `record_alpha`, the one caller, pushes inside its HDR rendering with a
+        // pipeline of this layout bound; the push is `AlphaDrawPush` at offset 0, the layout's
+        // graphics-stage range.
         unsafe {
-            ctx.device.cmd_push_constants(
-                cmd,
+            rec.device().cmd_push_constants(
+                rec.inside(),
                 self.pipeline_layout,
                 GRAPHICS_STAGES,
                 0,
@@ -450,8 +453,7 @@ impl<'c> AlphaLighting<'c> {
     /// Pipeline creation errors, the first time a mode is used; nothing is recorded then.
     pub fn record_alpha(
         &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         inputs: &AlphaInputs,
         targets: &mut Targets,
     ) -> Result<()> {
@@ -463,89 +465,85 @@ impl<'c> AlphaLighting<'c> {
             extent,
             depth,
         } = *inputs;
-        let [object_pipeline, particle_pipeline] = self.pipelines(ctx, mode)?;
-        ctx.begin_label(cmd, "alpha");
-        // SAFETY: `cmd` is the renderer's, recording and outside rendering (the passes before
-        // ended theirs). The sets match the layout's sets 0 to 2 (`create` made it from their
-        // layouts): the renderer's frame set, the lightmaps' slot 0 alpha set (written by
-        // `record_lightmaps` this frame) and the lightmap set; all live as long as `self`.
-        unsafe {
-            ctx.device.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline_layout,
-                0,
-                &[frame_set, self.lightmaps.alpha_set(0), self.lightmap_set],
-                &[],
-            );
-        }
-        // Forward and probe frames never write the atlas, nor plain lightmap frames the
-        // direction map; the transition still gives each bound (and unread) image the layout its
-        // descriptor declares. An image no frame has written yet is cleared first, so no
-        // read-only layout is entered from UNDEFINED.
-        for image in [&mut self.lightmap, &mut self.direction_map] {
-            if image.state.layout == vk::ImageLayout::UNDEFINED {
-                begin_cleared(ctx, cmd, image, CLEAR_BLACK);
-                // SAFETY: ends the rendering `begin_cleared` began on `cmd` just above.
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
+        let [object_pipeline, particle_pipeline] = self.pipelines(rec.ctx(), mode)?;
+        rec.step("alpha", |rec| {
+            let (d, cmd) = (rec.device(), rec.any());
+            // SAFETY: `cmd` is the renderer's, recording and outside rendering (the passes before
+            // ended theirs). The sets match the layout's sets 0 to 2 (`create` made it from their
+            // layouts): the renderer's frame set, the lightmaps' slot 0 alpha set (written by
+            // `record_lightmaps` this frame) and the lightmap set; all live as long as `self`.
+            unsafe {
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.pipeline_layout,
+                    0,
+                    &[frame_set, self.lightmaps.alpha_set(0), self.lightmap_set],
+                    &[],
+                );
             }
-            transition(
-                ctx,
-                cmd,
-                image,
-                ImageAccess::FragmentSampled,
-                Contents::Keep,
-            );
-        }
-        let attachments = (&mut *targets.hdr, &mut *targets.depth_stencil);
-        begin_hdr_rendering(ctx, cmd, attachments, extent, Load::Keep, Load::Keep);
-        let d = &ctx.device;
-        let objects = scene.alpha_objects.len();
-        for &entity in &self.order {
-            match entity {
-                EntityKey::Object(i) => {
-                    // SAFETY: inside the HDR rendering begun above, whose attachments' formats
-                    // (HDR_FORMAT, the context's depth-stencil) the pipeline was made for; it
-                    // lives in `self.pipelines` until `destroy`.
-                    unsafe {
-                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, object_pipeline);
-                    }
-                    apply(ctx, cmd, &oriented(ALPHA_OBJECTS, depth));
-                    let push = AlphaDrawPush {
-                        entity: i as u32,
-                        ..Default::default()
-                    };
-                    self.push(ctx, cmd, push);
-                    meshes.shape(scene.alpha_objects[i].shape).draw(ctx, cmd);
+            // Forward and probe frames never write the atlas, nor plain lightmap frames the
+            // direction map; the transition still gives each bound (and unread) image the layout its
+            // descriptor declares. An image no frame has written yet is cleared first, so no
+            // read-only layout is entered from UNDEFINED.
+            for image in [&mut self.lightmap, &mut self.direction_map] {
+                if image.state.layout == vk::ImageLayout::UNDEFINED {
+                    begin_cleared(rec, image, CLEAR_BLACK);
+                    rec.end_rendering();
                 }
-                EntityKey::System(i) => {
-                    let (first, count) = self.sprite_ranges[i];
-                    // SAFETY: as for the object pipeline above; `sprites` is a live vertex
-                    // buffer of this device (`VERTEX_BUFFER` usage, made by `create`).
-                    unsafe {
-                        d.cmd_bind_pipeline(
-                            cmd,
-                            vk::PipelineBindPoint::GRAPHICS,
-                            particle_pipeline,
-                        );
-                        d.cmd_bind_vertex_buffers(cmd, 0, &[self.sprites.handle], &[0]);
+                rec.transition(image, ImageAccess::FragmentSampled, Contents::Keep);
+            }
+            let attachments = (&mut *targets.hdr, &mut *targets.depth_stencil);
+            begin_hdr_rendering(rec, attachments, extent, Load::Keep, Load::Keep);
+            let objects = scene.alpha_objects.len();
+            for &entity in &self.order {
+                match entity {
+                    EntityKey::Object(i) => {
+                        // SAFETY: inside the HDR rendering begun above, whose attachments' formats
+                        // (HDR_FORMAT, the context's depth-stencil) the pipeline was made for; it
+                        // lives in `self.pipelines` until `destroy`.
+                        unsafe {
+                            d.cmd_bind_pipeline(
+                                cmd,
+                                vk::PipelineBindPoint::GRAPHICS,
+                                object_pipeline,
+                            );
+                        }
+                        rec.apply(&oriented(ALPHA_OBJECTS, depth));
+                        let push = AlphaDrawPush {
+                            entity: i as u32,
+                            ..Default::default()
+                        };
+                        self.push(rec, push);
+                        meshes.shape(scene.alpha_objects[i].shape).draw(rec);
                     }
-                    apply(ctx, cmd, &oriented(PARTICLES, depth));
-                    let push = AlphaDrawPush {
-                        entity: (objects + i) as u32,
-                        ..Default::default()
-                    };
-                    self.push(ctx, cmd, push);
-                    // SAFETY: the particle pipeline, sets, sprites and dynamic state are bound
-                    // and set above; `first..first + count` is this system's range of the
-                    // sprite buffer (`sprite_ranges`, from `create`).
-                    unsafe { d.cmd_draw(cmd, count, 1, first, 0) };
+                    EntityKey::System(i) => {
+                        let (first, count) = self.sprite_ranges[i];
+                        // SAFETY: as for the object pipeline above; `sprites` is a live vertex
+                        // buffer of this device (`VERTEX_BUFFER` usage, made by `create`).
+                        unsafe {
+                            d.cmd_bind_pipeline(
+                                cmd,
+                                vk::PipelineBindPoint::GRAPHICS,
+                                particle_pipeline,
+                            );
+                            d.cmd_bind_vertex_buffers(cmd, 0, &[self.sprites.handle], &[0]);
+                        }
+                        rec.apply(&oriented(PARTICLES, depth));
+                        let push = AlphaDrawPush {
+                            entity: (objects + i) as u32,
+                            ..Default::default()
+                        };
+                        self.push(rec, push);
+                        // SAFETY: the particle pipeline, sets, sprites and dynamic state are bound
+                        // and set above; `first..first + count` is this system's range of the
+                        // sprite buffer (`sprite_ranges`, from `create`).
+                        unsafe { d.cmd_draw(cmd, count, 1, first, 0) };
+                    }
                 }
             }
-        }
-        // SAFETY: ends the HDR rendering `begin_hdr_rendering` began on `cmd` above.
-        unsafe { d.cmd_end_rendering(cmd) };
-        ctx.end_label(cmd);
+            rec.end_rendering();
+        });
         Ok(())
     }
 

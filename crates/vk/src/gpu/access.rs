@@ -3,7 +3,7 @@
 //! barrier, whoever owns the image: histencil's own targets and an engine's images handed in as
 //! [`ImageRef`]s go through the same code.
 
-use crate::gpu::context::Context;
+use crate::gpu::recording::Recording;
 use ash::vk;
 
 /// Where an image stands: its layout and the last stages and accesses that touched it (the
@@ -240,85 +240,87 @@ pub(crate) enum Contents {
     Keep,
 }
 
-/// Records the barrier that takes `image` from its current state to `next`.
-pub(crate) fn transition(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    image: &mut ImageRef,
-    next: ImageAccess,
-    contents: Contents,
-) {
-    // The frame checks refuse targets without the usage their recording needs; an access here
-    // that they did not foresee is histencil's bug.
-    debug_assert!(
-        image.usage.contains(next.usage()),
-        "{next:?} on an image with usage {:?}: the frame checks missed it",
-        image.usage
-    );
-    let ImageState {
-        layout: old_layout,
-        stage: src_stage,
-        access: src_access,
-    } = image.state;
-    let (new_layout, dst_stage, dst_access) = access_info(next);
-    let old_layout = match contents {
-        Contents::Discard => vk::ImageLayout::UNDEFINED,
-        Contents::Keep => old_layout,
-    };
-    let barrier = vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(src_stage)
-        .src_access_mask(src_access)
-        .dst_stage_mask(dst_stage)
-        .dst_access_mask(dst_access)
-        .old_layout(old_layout)
-        .new_layout(new_layout)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image.image)
-        .subresource_range(subresource_range(image.aspect()));
-    let barriers = [barrier];
-    let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
-    // SAFETY: `cmd` is the caller's, recording outside rendering (transitions go between
-    // passes; the renderer's frame, `submit_once`'s, or an engine's under `record`'s # Safety).
-    // `image` is live with every aspect of its format named; its `state` is true when `cmd`
-    // runs (histencil's bookkeeping, or the engine's promise for its `ImageRef`s), so the old
-    // layout is right, and `dependency` lives until the call returns.
-    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
-    image.state = ImageState::after(next);
-}
+impl Recording<'_> {
+    /// Records the barrier that takes `image` from its current state to `next`.
+    pub(crate) fn transition(&self, image: &mut ImageRef, next: ImageAccess, contents: Contents) {
+        // The frame checks refuse targets without the usage their recording needs; an access here
+        // that they did not foresee is histencil's bug.
+        debug_assert!(
+            image.usage.contains(next.usage()),
+            "{next:?} on an image with usage {:?}: the frame checks missed it",
+            image.usage
+        );
+        let ImageState {
+            layout: old_layout,
+            stage: src_stage,
+            access: src_access,
+        } = image.state;
+        let (new_layout, dst_stage, dst_access) = access_info(next);
+        let old_layout = match contents {
+            Contents::Discard => vk::ImageLayout::UNDEFINED,
+            Contents::Keep => old_layout,
+        };
+        let barrier = vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(src_stage)
+            .src_access_mask(src_access)
+            .dst_stage_mask(dst_stage)
+            .dst_access_mask(dst_access)
+            .old_layout(old_layout)
+            .new_layout(new_layout)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(image.image)
+            .subresource_range(subresource_range(image.aspect()));
+        let barriers = [barrier];
+        let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+        // SAFETY: the recording's command buffer is recording outside rendering (transitions go between
+        // passes; the renderer's frame, `submit_once`'s, or an engine's under `record`'s # Safety).
+        // `image` is live with every aspect of its format named; its `state` is true when `cmd`
+        // runs (histencil's bookkeeping, or the engine's promise for its `ImageRef`s), so the old
+        // layout is right, and `dependency` lives until the call returns.
+        unsafe {
+            self.device()
+                .cmd_pipeline_barrier2(self.outside(), &dependency)
+        };
+        image.state = ImageState::after(next);
+    }
 
-/// A global memory barrier: every write recorded before is visible to every access after.
-///
-/// Split light passes (draws that share the statistics buffer), the depth-id and tiled passes
-/// hand buffers and attachments between fragment shaders, attachments and compute; one broad
-/// barrier between those phases is simpler to get right than a precise one per hand-over. The
-/// hi-stencil emulation's own bookkeeping (reset, flush, save) uses [`buffer_barrier`] instead:
-/// its hand-overs are few and known, and a full wait there would count against the console.
-///
-/// The stages are the ones histencil records (named rather than `ALL_COMMANDS`, which the
-/// best-practices layer flags); synchronisation validation in every test run would report a
-/// hazard through a stage missing here.
-pub(crate) fn memory_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
-    use vk::PipelineStageFlags2 as S;
-    let stages = S::DRAW_INDIRECT
-        | S::VERTEX_INPUT
-        | S::VERTEX_SHADER
-        | S::EARLY_FRAGMENT_TESTS
-        | S::FRAGMENT_SHADER
-        | S::LATE_FRAGMENT_TESTS
-        | S::COLOR_ATTACHMENT_OUTPUT
-        | S::COMPUTE_SHADER
-        | S::ALL_TRANSFER;
-    let barrier = [vk::MemoryBarrier2::default()
-        .src_stage_mask(stages)
-        .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-        .dst_stage_mask(stages)
-        .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
-    let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
-    // SAFETY: `cmd` is the caller's, recording outside rendering (the callers barrier between
-    // their compute and render phases); the stages are all ones a graphics queue supports,
-    // and `dependency` lives until the call returns.
-    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+    /// A global memory barrier: every write recorded before is visible to every access after.
+    ///
+    /// Split light passes (draws that share the statistics buffer), the depth-id and tiled passes
+    /// hand buffers and attachments between fragment shaders, attachments and compute; one broad
+    /// barrier between those phases is simpler to get right than a precise one per hand-over. The
+    /// hi-stencil emulation's own bookkeeping (reset, flush, save) uses [`Recording::buffer_barrier`] instead:
+    /// its hand-overs are few and known, and a full wait there would count against the console.
+    ///
+    /// The stages are the ones histencil records (named rather than `ALL_COMMANDS`, which the
+    /// best-practices layer flags); synchronisation validation in every test run would report a
+    /// hazard through a stage missing here.
+    pub(crate) fn memory_barrier(&self) {
+        use vk::PipelineStageFlags2 as S;
+        let stages = S::DRAW_INDIRECT
+            | S::VERTEX_INPUT
+            | S::VERTEX_SHADER
+            | S::EARLY_FRAGMENT_TESTS
+            | S::FRAGMENT_SHADER
+            | S::LATE_FRAGMENT_TESTS
+            | S::COLOR_ATTACHMENT_OUTPUT
+            | S::COMPUTE_SHADER
+            | S::ALL_TRANSFER;
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(stages)
+            .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
+            .dst_stage_mask(stages)
+            .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
+        let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
+        // SAFETY: the recording's command buffer is recording outside rendering (the callers barrier between
+        // their compute and render phases); the stages are all ones a graphics queue supports,
+        // and `dependency` lives until the call returns.
+        unsafe {
+            self.device()
+                .cmd_pipeline_barrier2(self.outside(), &dependency)
+        };
+    }
 }
 
 /// How a buffer is used, as [`ImageAccess`] says it of an image: the stages and accesses a
@@ -372,30 +374,35 @@ fn union(
 }
 
 /// One barrier command for every hand-over, each whole buffer from its `from` uses to its `to`
-/// uses: a dependency on those stages alone, not the full wait of [`memory_barrier`]. Only writes
+/// uses: a dependency on those stages alone, not the full wait of [`Recording::memory_barrier`]. Only writes
 /// are made available; a read before needs only the execution dependency.
-pub(crate) fn buffer_barrier(ctx: &Context, cmd: vk::CommandBuffer, hand_overs: &[HandOver]) {
-    let barriers: Vec<vk::BufferMemoryBarrier2> = hand_overs
-        .iter()
-        .map(|&(buffer, from, to)| {
-            let (src_stage, src_access) = union(from, true);
-            let (dst_stage, dst_access) = union(to, false);
-            vk::BufferMemoryBarrier2::default()
-                .src_stage_mask(src_stage)
-                .src_access_mask(src_access)
-                .dst_stage_mask(dst_stage)
-                .dst_access_mask(dst_access)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .buffer(buffer)
-                .offset(0)
-                .size(vk::WHOLE_SIZE)
-        })
-        .collect();
-    let dependency = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);
-    // SAFETY: `cmd` is recording outside rendering (the callers' contract) and the buffers are
-    // alive; the barrier names only stages and accesses those buffers support.
-    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dependency) };
+impl Recording<'_> {
+    pub(crate) fn buffer_barrier(&self, hand_overs: &[HandOver]) {
+        let barriers: Vec<vk::BufferMemoryBarrier2> = hand_overs
+            .iter()
+            .map(|&(buffer, from, to)| {
+                let (src_stage, src_access) = union(from, true);
+                let (dst_stage, dst_access) = union(to, false);
+                vk::BufferMemoryBarrier2::default()
+                    .src_stage_mask(src_stage)
+                    .src_access_mask(src_access)
+                    .dst_stage_mask(dst_stage)
+                    .dst_access_mask(dst_access)
+                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .buffer(buffer)
+                    .offset(0)
+                    .size(vk::WHOLE_SIZE)
+            })
+            .collect();
+        let dependency = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);
+        // SAFETY: the recording is outside rendering (`outside` checks it in debug builds) and the buffers are
+        // alive; the barrier names only stages and accesses those buffers support.
+        unsafe {
+            self.device()
+                .cmd_pipeline_barrier2(self.outside(), &dependency)
+        };
+    }
 }
 
 #[cfg(test)]

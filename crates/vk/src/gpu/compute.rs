@@ -9,7 +9,7 @@ use crate::gpu::descriptors::{
 };
 use crate::gpu::error::Result;
 use crate::gpu::pipelines::create_compute_pipeline;
-use crate::gpu::readback::host_readable;
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::upload::submit_once;
 use ash::vk;
@@ -62,9 +62,9 @@ impl ComputePipeline {
     }
 
     /// Binds the pipeline and `set` as set 0, and pushes `push` at offset 0.
-    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, set: vk::DescriptorSet, push: &[u8]) {
-        let d = &ctx.device;
-        // SAFETY: `cmd` is the caller's, recording on this device (`submit_once`'s, or a
+    pub fn bind(&self, rec: &Recording, set: vk::DescriptorSet, push: &[u8]) {
+        let (d, cmd) = (rec.device(), rec.outside());
+        // SAFETY: the recording's command buffer is recording on this device (`submit_once`'s, or a
         // lighting's under `record`'s # Safety). The pipeline and layout are live (`self`), and
         // `set` is a live set of `set_layout`. Both callers push exactly the layout's
         // `push_bytes` (4 for a case count, `size_of::<UpdatePush>()` for the tile update).
@@ -159,19 +159,19 @@ impl CaseKernel {
     fn dispatch(&self, ctx: &Context, buffers: &[vk::Buffer], count: u32) -> Result<()> {
         let (pool, set) =
             create_storage_buffer_set(ctx, self.name, self.compute.set_layout, buffers)?;
-        let recorded = submit_once(ctx, self.name, |cmd| {
+        let recorded = submit_once(ctx, self.name, |rec| {
             // Host writes to the inputs are visible at submit; only the results need a
             // barrier, towards the host read after the fence.
-            self.compute.bind(ctx, cmd, set, &count.to_le_bytes());
+            self.compute.bind(rec, set, &count.to_le_bytes());
             // SAFETY: `cmd` is `submit_once`'s, recording outside rendering, with the pipeline
             // and its set bound just above. The group count stays within the spec's minimum
             // `maxComputeWorkGroupCount[0]` (65535) up to 65535 * 64 cases; nothing checks a
             // longer list (the evaluators' callers pass test-sized ones).
             unsafe {
-                ctx.device
-                    .cmd_dispatch(cmd, count.div_ceil(WORKGROUP), 1, 1)
+                rec.device()
+                    .cmd_dispatch(rec.outside(), count.div_ceil(WORKGROUP), 1, 1)
             };
-            host_readable(ctx, cmd, vk::PipelineStageFlags2::COMPUTE_SHADER);
+            rec.host_readable(vk::PipelineStageFlags2::COMPUTE_SHADER);
         });
         // SAFETY: the pool (and its set) was made above for this dispatch alone. When
         // `submit_once` succeeded its fence wait left the GPU done with it; when it failed

@@ -3,6 +3,7 @@
 
 use crate::gpu::context::Context;
 use crate::gpu::error::Result;
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::teardown::{build, Owned};
 use crate::gpu::upload::{upload, BufferUpload};
@@ -93,20 +94,18 @@ impl GpuMesh {
     }
 
     /// Binds and draws the whole mesh.
-    pub(crate) fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        // SAFETY: `cmd` is the caller's, recording inside a rendering with a graphics pipeline
+    pub(crate) fn draw(&self, rec: &Recording) {
+        let (d, cmd) = (rec.device(), rec.inside());
+        // SAFETY: the recording's command buffer is recording inside a rendering with a graphics pipeline
         // bound whose vertex input reads binding 0 (the passes' contract). The buffers are
         // live, made with VERTEX_BUFFER / INDEX_BUFFER usage and filled before any draw
         // (uploaded and waited for, or written through their mapping); `index_count` u32
         // indices, each naming a vertex of the mesh (`Scene::validate` checks imported
         // meshes; the built-in shapes are made so).
         unsafe {
-            ctx.device
-                .cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.handle], &[0]);
-            ctx.device
-                .cmd_bind_index_buffer(cmd, self.indices.handle, 0, vk::IndexType::UINT32);
-            ctx.device
-                .cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
+            d.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.handle], &[0]);
+            d.cmd_bind_index_buffer(cmd, self.indices.handle, 0, vk::IndexType::UINT32);
+            d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
         }
     }
 
@@ -169,10 +168,10 @@ impl LightVolumes {
     }
 
     /// Draws the volume of a light of `kind` (the vertex shader places it).
-    pub(crate) fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, kind: &LightKind) {
+    pub(crate) fn draw(&self, rec: &Recording, kind: &LightKind) {
         match kind {
-            LightKind::Spot { .. } => self.cone.draw(ctx, cmd),
-            _ => self.sphere.draw(ctx, cmd),
+            LightKind::Spot { .. } => self.cone.draw(rec),
+            _ => self.sphere.draw(rec),
         }
     }
 

@@ -1,6 +1,6 @@
 //! Graphics pipelines. Everything that changes between the talk's light passes (cull mode, depth
 //! and stencil state) is dynamic state set per draw from the model's pass state
-//! ([`crate::gpu::state::apply`]); pipelines differ only in shaders, attachments, blending and
+//! ([`Recording::apply`](crate::gpu::recording::Recording::apply)); pipelines differ only in shaders, attachments, blending and
 //! colour writes.
 
 use crate::gpu::context::Context;

@@ -1,9 +1,10 @@
 //! Copying the frame's images back to the host: tonemapped colour, HDR colour and the raw stencil.
 
 use crate::gpu::access::ImageRef;
-use crate::gpu::access::{transition, Contents, ImageAccess};
+use crate::gpu::access::{Contents, ImageAccess};
 use crate::gpu::context::Context;
 use crate::gpu::error::Result;
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::targets::Targets;
 use crate::gpu::teardown::build;
@@ -55,62 +56,63 @@ pub struct FrameImages {
 }
 
 /// Copies one aspect of the whole of `image` into `buffer`, tightly packed.
-pub(crate) fn copy_image_to_buffer(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    image: &mut ImageRef,
-    aspect: vk::ImageAspectFlags,
-    buffer: &Buffer,
-) {
-    transition(ctx, cmd, image, ImageAccess::TransferSource, Contents::Keep);
-    let region = vk::BufferImageCopy::default()
-        .image_subresource(
-            vk::ImageSubresourceLayers::default()
-                .aspect_mask(aspect)
-                .layer_count(1),
-        )
-        .image_extent(vk::Extent3D {
-            width: image.extent.width,
-            height: image.extent.height,
-            depth: 1,
-        });
-    // SAFETY: `cmd` is the caller's, recording outside rendering (a renderer's frame or
-    // capture, or an engine's under `record`'s # Safety). The transition just put `image` in
-    // TRANSFER_SRC_OPTIMAL; `aspect` is one aspect of its format, and every caller's `buffer`
-    // has TRANSFER_DST usage and room for the whole extent at that aspect's texel size
-    // (`ReadbackBuffers::new` and the like).
-    unsafe {
-        ctx.device.cmd_copy_image_to_buffer(
-            cmd,
-            image.image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            buffer.handle,
-            &[region],
-        )
-    };
-}
+impl Recording<'_> {
+    pub(crate) fn copy_image_to_buffer(
+        &self,
+        image: &mut ImageRef,
+        aspect: vk::ImageAspectFlags,
+        buffer: &Buffer,
+    ) {
+        self.transition(image, ImageAccess::TransferSource, Contents::Keep);
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(
+                vk::ImageSubresourceLayers::default()
+                    .aspect_mask(aspect)
+                    .layer_count(1),
+            )
+            .image_extent(vk::Extent3D {
+                width: image.extent.width,
+                height: image.extent.height,
+                depth: 1,
+            });
+        // SAFETY: the recording's command buffer is recording outside rendering (a renderer's frame or
+        // capture, or an engine's under `record`'s # Safety). The transition just put `image` in
+        // TRANSFER_SRC_OPTIMAL; `aspect` is one aspect of its format, and every caller's `buffer`
+        // has TRANSFER_DST usage and room for the whole extent at that aspect's texel size
+        // (`ReadbackBuffers::new` and the like).
+        unsafe {
+            self.device().cmd_copy_image_to_buffer(
+                self.outside(),
+                image.image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buffer.handle,
+                &[region],
+            )
+        };
+    }
 
-/// Makes the writes of `stage` so far (copies, or shader storage writes) visible to host reads
-/// after the fence.
-pub(crate) fn host_readable(ctx: &Context, cmd: vk::CommandBuffer, stage: vk::PipelineStageFlags2) {
-    let writes = if stage == vk::PipelineStageFlags2::COPY {
-        vk::AccessFlags2::TRANSFER_WRITE
-    } else {
-        vk::AccessFlags2::SHADER_STORAGE_WRITE
-    };
-    let barrier = [vk::MemoryBarrier2::default()
-        .src_stage_mask(stage)
-        .src_access_mask(writes)
-        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-    // SAFETY: `cmd` is the caller's, recording outside rendering; `barrier` lives until the
-    // call returns and names only stages and accesses the queue family supports.
-    unsafe {
-        ctx.device.cmd_pipeline_barrier2(
-            cmd,
-            &vk::DependencyInfo::default().memory_barriers(&barrier),
-        )
-    };
+    /// Makes the writes of `stage` so far (copies, or shader storage writes) visible to host reads
+    /// after the fence.
+    pub(crate) fn host_readable(&self, stage: vk::PipelineStageFlags2) {
+        let writes = if stage == vk::PipelineStageFlags2::COPY {
+            vk::AccessFlags2::TRANSFER_WRITE
+        } else {
+            vk::AccessFlags2::SHADER_STORAGE_WRITE
+        };
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(stage)
+            .src_access_mask(writes)
+            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+            .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+        // SAFETY: the recording's command buffer is recording outside rendering; `barrier` lives until the
+        // call returns and names only stages and accesses the queue family supports.
+        unsafe {
+            self.device().cmd_pipeline_barrier2(
+                self.outside(),
+                &vk::DependencyInfo::default().memory_barriers(&barrier),
+            )
+        };
+    }
 }
 
 #[derive(Default)]
@@ -136,38 +138,27 @@ impl ReadbackBuffers {
         })
     }
 
-    pub fn record(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        targets: &mut Targets,
-        what: Readback,
-    ) {
+    pub fn record(&self, rec: &Recording, targets: &mut Targets, what: Readback) {
         if what == Readback::NONE {
             return;
         }
-        ctx.begin_label(cmd, "readback");
-        let color = vk::ImageAspectFlags::COLOR;
-        if what.ldr {
-            copy_image_to_buffer(ctx, cmd, &mut targets.ldr, color, &self.ldr);
-        }
-        if what.hdr {
-            copy_image_to_buffer(ctx, cmd, &mut targets.hdr, color, &self.hdr);
-        }
-        if what.stencil {
-            copy_image_to_buffer(
-                ctx,
-                cmd,
-                &mut targets.depth_stencil,
-                vk::ImageAspectFlags::STENCIL,
-                &self.stencil,
-            );
-        }
-        if what.brdf_ids {
-            copy_image_to_buffer(ctx, cmd, &mut targets.gbuffer[2], color, &self.material);
-        }
-        host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
-        ctx.end_label(cmd);
+        rec.step("readback", |rec| {
+            let color = vk::ImageAspectFlags::COLOR;
+            if what.ldr {
+                rec.copy_image_to_buffer(&mut targets.ldr, color, &self.ldr);
+            }
+            if what.hdr {
+                rec.copy_image_to_buffer(&mut targets.hdr, color, &self.hdr);
+            }
+            if what.stencil {
+                let stencil = vk::ImageAspectFlags::STENCIL;
+                rec.copy_image_to_buffer(&mut targets.depth_stencil, stencil, &self.stencil);
+            }
+            if what.brdf_ids {
+                rec.copy_image_to_buffer(&mut targets.gbuffer[2], color, &self.material);
+            }
+            rec.host_readable(vk::PipelineStageFlags2::COPY);
+        });
     }
 
     /// The images `what` asks for; BRDF ids are named by `set`, the renderer's.

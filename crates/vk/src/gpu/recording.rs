@@ -1,10 +1,22 @@
-//! A command buffer histencil records into, and what it knows of its state: the one place the
-//! state a recording needs is promised ([`Recording::new`], unsafe), and where whether dynamic
-//! rendering is open is tracked, so that a function that must record outside rendering (a
-//! barrier, a copy, a fill, a dispatch) or inside it (a draw) says so by asking for the command
-//! buffer that way ([`Recording::outside`], [`Recording::inside`]) and a debug build checks it.
-//! Modelled on wgpu-hal's `CommandEncoder`, whose docs state what each call needs of the
-//! encoder's state.
+//! The encoder: the one way histencil records into a command buffer. A [`Recording`] owns the
+//! state a recording has (whether dynamic rendering is open, which debug labels are open), so
+//! that beginning and ending rendering, opening and closing a label, and asking for the command
+//! buffer inside or outside rendering all go through it and a debug build checks each against
+//! that state; nothing records with a bare `vk::CommandBuffer` but this file (and the public
+//! `unsafe fn record*` entry points, which take an engine's and wrap it here at once).
+//!
+//! Barriers, copies and dynamic state are its methods too, written beside what they serve
+//! (`transition`, `memory_barrier` and `buffer_barrier` in `access.rs`, `apply` in `state.rs`,
+//! `copy_image_to_buffer` and `host_readable` in `readback.rs`). Modelled on wgpu-hal's
+//! `CommandEncoder` and Granite's `CommandBuffer`, which own `begin_render_pass` /
+//! `end_render_pass` so pass state cannot be forgotten, and on kajiya's `record_pass_cb`, which
+//! wraps each pass in its label: [`Recording::step`] does the label. The renderer's timestamp
+//! after each pass (`Timestamps::mark`) is also the GPU-written marker a stalled wait reports
+//! (`timing::progress_words`): the marks the GPU has written name the passes it finished.
+//!
+//! Methods take `&self`: the state is in `Cell`s, which makes a `Recording` `!Sync`, so one
+//! thread records through it, as Vulkan's external synchronisation of a command buffer asks; a
+//! step's body records through the same shared reference it was handed, without reborrowing.
 
 use crate::gpu::context::Context;
 use ash::vk;
@@ -16,22 +28,26 @@ pub(crate) struct Recording<'a> {
     cmd: vk::CommandBuffer,
     /// Dynamic rendering is open (begun through this recording and not yet ended).
     rendering: Cell<bool>,
+    /// Debug labels opened through this recording and not yet closed.
+    labels: Cell<u32>,
 }
 
 impl<'a> Recording<'a> {
-    /// Starts tracking `cmd`, outside rendering.
+    /// Starts recording through `cmd`, outside rendering and labels.
     ///
     /// # Safety
     /// `cmd` is in the recording state, was allocated from `ctx`'s device on a queue family
     /// that supports what its users record (graphics for rendering and draws, compute for
-    /// dispatches), and is outside any render pass or dynamic rendering; until this
-    /// value is dropped only this value's users record into it, and they begin and end
-    /// rendering through [`Recording::began_rendering`] and [`Recording::ended_rendering`].
+    /// dispatches), and is outside any render pass or dynamic rendering; until this value is
+    /// dropped only this value's users record into it. (A recording of `cmd` made earlier, and
+    /// outside rendering, may hand `cmd` to an entry point that makes its own recording, as
+    /// the renderer's frame does with the lighting's: it records nothing until that returns.)
     pub unsafe fn new(ctx: &'a Context, cmd: vk::CommandBuffer) -> Self {
         Self {
             ctx,
             cmd,
             rendering: Cell::new(false),
+            labels: Cell::new(0),
         }
     }
 
@@ -40,21 +56,26 @@ impl<'a> Recording<'a> {
         self.ctx
     }
 
+    /// The device the commands are recorded for.
+    pub fn device(&self) -> &'a ash::Device {
+        &self.ctx.device
+    }
+
     /// The command buffer, for commands Vulkan allows outside rendering only (barriers,
-    /// copies, fills, dispatches, query resets, beginning rendering).
+    /// copies, fills, dispatches, query resets).
     pub fn outside(&self) -> vk::CommandBuffer {
         debug_assert!(!self.rendering.get(), "recorded inside rendering");
         self.cmd
     }
 
-    /// The command buffer, for commands inside rendering (draws, ending rendering).
+    /// The command buffer, for commands inside rendering (draws, clears of attachments).
     pub fn inside(&self) -> vk::CommandBuffer {
         debug_assert!(self.rendering.get(), "recorded outside rendering");
         self.cmd
     }
 
     /// The command buffer, for commands Vulkan allows inside and outside rendering alike
-    /// (debug labels, timestamps, binding pipelines and sets, dynamic state).
+    /// (timestamps, binding pipelines and sets, push constants, dynamic state).
     pub fn any(&self) -> vk::CommandBuffer {
         self.cmd
     }
@@ -64,21 +85,117 @@ impl<'a> Recording<'a> {
         self.rendering.get()
     }
 
-    /// Notes that the caller began rendering on [`Self::outside`]'s command buffer.
-    pub fn began_rendering(&self) {
-        debug_assert!(!self.rendering.get(), "rendering begun twice");
+    /// Begins dynamic rendering as `info` says. Callers transitioned every attachment `info`
+    /// names to the layout it is named with (`transition` on its `ImageRef`) and chose a render
+    /// area inside the attachments.
+    pub fn begin_rendering(&self, info: &vk::RenderingInfo) {
+        let cmd = self.outside();
+        // SAFETY: `cmd` records outside rendering (checked above in debug builds, and every
+        // rendering is begun and ended here, so it is tracked); the attachments' layouts and
+        // the render area are the callers' as said above; `info` outlives the call.
+        unsafe { self.ctx.device.cmd_begin_rendering(cmd, info) };
         self.rendering.set(true);
     }
 
-    /// Notes that the caller ended rendering on [`Self::inside`]'s command buffer.
-    pub fn ended_rendering(&self) {
-        debug_assert!(self.rendering.get(), "rendering ended while not open");
+    /// Begins dynamic rendering over the whole `extent` of the attachments and sets the
+    /// viewport and scissor to it: what every full-screen pass does.
+    pub fn begin_rendering_over(
+        &self,
+        extent: vk::Extent2D,
+        colors: &[vk::RenderingAttachmentInfo],
+        depth_stencil: Option<&vk::RenderingAttachmentInfo>,
+    ) {
+        let area = vk::Rect2D::default().extent(extent);
+        let mut info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(colors);
+        if let Some(ds) = depth_stencil {
+            info = info.depth_attachment(ds).stencil_attachment(ds);
+        }
+        self.begin_rendering(&info);
+        self.set_viewport_and_scissor(area);
+    }
+
+    /// Sets the viewport (depth 0 to 1) and the scissor to `area`.
+    pub fn set_viewport_and_scissor(&self, area: vk::Rect2D) {
+        let viewport = vk::Viewport {
+            x: area.offset.x as f32,
+            y: area.offset.y as f32,
+            width: area.extent.width as f32,
+            height: area.extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: dynamic state the pipelines declare (`pipelines.rs`), allowed in and out of
+        // rendering; the callers' areas lie inside their attachments.
+        unsafe {
+            self.ctx.device.cmd_set_viewport(self.cmd, 0, &[viewport]);
+            self.ctx.device.cmd_set_scissor(self.cmd, 0, &[area]);
+        }
+    }
+
+    /// Ends the rendering begun through this recording.
+    pub fn end_rendering(&self) {
+        let cmd = self.inside();
+        // SAFETY: rendering is open on `cmd` (checked above in debug builds), begun by
+        // `begin_rendering` on this recording.
+        unsafe { self.ctx.device.cmd_end_rendering(cmd) };
         self.rendering.set(false);
     }
 
-    /// Ends the tracking, checking (in debug builds) that rendering was left closed, as every
-    /// caller of histencil's recording functions is promised.
+    /// Binds the graphics `pipeline` and `sets` from set 0 of `layout`: how a pass starts
+    /// drawing.
+    ///
+    /// # Safety
+    /// `pipeline`, `layout` and `sets` are live objects of this recording's device, `pipeline`
+    /// was made with `layout`, and each set is of the layout's set layout at its index.
+    pub unsafe fn bind_graphics(
+        &self,
+        pipeline: vk::Pipeline,
+        layout: vk::PipelineLayout,
+        sets: &[vk::DescriptorSet],
+    ) {
+        let (d, graphics) = (&self.ctx.device, vk::PipelineBindPoint::GRAPHICS);
+        // SAFETY: this fn's # Safety; binding is allowed inside and outside rendering.
+        unsafe {
+            d.cmd_bind_pipeline(self.cmd, graphics, pipeline);
+            if !sets.is_empty() {
+                d.cmd_bind_descriptor_sets(self.cmd, graphics, layout, 0, sets, &[]);
+            }
+        }
+    }
+
+    /// Records `body` inside its own debug label region, `name`: a pass or a step of one. The
+    /// context's step observer sees the label too (a hung worker's last line names it).
+    pub fn step<R>(&self, name: &str, body: impl FnOnce(&Self) -> R) -> R {
+        self.begin_label(name);
+        let out = body(self);
+        self.end_label();
+        out
+    }
+
+    /// Opens a debug label region; [`Self::end_label`] closes it. Prefer [`Self::step`]; this
+    /// pair is for regions that open in one call and close in another (the lighting's lights).
+    pub fn begin_label(&self, name: &str) {
+        self.ctx.begin_label(self.cmd, name);
+        self.labels.set(self.labels.get() + 1);
+    }
+
+    /// Closes the innermost label region opened through this recording.
+    pub fn end_label(&self) {
+        debug_assert!(
+            self.labels.get() > 0,
+            "a label closed that was never opened"
+        );
+        self.ctx.end_label(self.cmd);
+        self.labels.set(self.labels.get().saturating_sub(1));
+    }
+
+    /// Ends the recording, checking (in debug builds) that rendering and every label it opened
+    /// were closed, as every caller of histencil's recording functions is promised.
     pub fn finish(self) {
         debug_assert!(!self.rendering.get(), "a recording left rendering open");
+        debug_assert_eq!(self.labels.get(), 0, "a recording left a label open");
     }
 }

@@ -5,7 +5,7 @@
 //! Hi-stencil state is not Vulkan state: the GPU tile surface that emulates it is recorded by
 //! the lighting pass, not here.
 
-use crate::gpu::context::Context;
+use crate::gpu::recording::Recording;
 use ash::vk;
 use histencil_model::{
     CompareOp, CullMode, DepthConvention, DepthRange, DepthState, FaceStencil, PassState, StencilOp,
@@ -89,66 +89,63 @@ pub fn with_stencil(state: PassState, face: FaceStencil) -> PassState {
     }
 }
 
-/// Records `state` into `cmd` as dynamic state. A face without stencil state passes and keeps
+/// Records `state` as dynamic state. A face without stencil state passes and keeps
 /// (the stencil test is one switch for both faces in Vulkan). Colour writes are pipeline state:
 /// the caller binds a pipeline that matches `state.color_write`.
-/// Without the depth bounds test ([`apply_bounded`] for a light's passes).
-pub(crate) fn apply(ctx: &Context, cmd: vk::CommandBuffer, state: &PassState) {
-    apply_bounded(ctx, cmd, state, None);
-}
+/// Without the depth bounds test ([`Self::apply_bounded`] for a light's passes).
+impl Recording<'_> {
+    pub(crate) fn apply(&self, state: &PassState) {
+        self.apply_bounded(state, None);
+    }
 
-/// [`apply`], where `bounds` is the depth range a pass with `state.depth_bounds` is confined to
-/// (its light's, from the plan) when the device has the depth bounds test enabled; every other
-/// draw runs without the test.
-pub(crate) fn apply_bounded(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    state: &PassState,
-    bounds: Option<DepthRange>,
-) {
-    let d = &ctx.device;
-    let enabled = state.front.is_some() || state.back.is_some();
-    if ctx.depth_bounds {
-        let bounds = bounds.filter(|_| state.depth_bounds);
-        // SAFETY: `cmd` is the caller's, recording on this device. `depthBounds` is enabled
-        // (`ctx.depth_bounds` is set only where `Context::new` enabled it). The bounds must lie
-        // in [0, 1] (no VK_EXT_depth_range_unrestricted): `FramePlan::with_depth_bounds`
-        // clamps its ranges so; a hand-made plan's public `depth_range` is not checked here.
-        unsafe {
-            d.cmd_set_depth_bounds_test_enable(cmd, bounds.is_some());
-            if let Some(b) = bounds {
-                d.cmd_set_depth_bounds(cmd, b.min, b.max);
+    /// [`Self::apply`], where `bounds` is the depth range a pass with `state.depth_bounds` is confined to
+    /// (its light's, from the plan) when the device has the depth bounds test enabled; every other
+    /// draw runs without the test.
+    pub(crate) fn apply_bounded(&self, state: &PassState, bounds: Option<DepthRange>) {
+        let (ctx, d, cmd) = (self.ctx(), self.device(), self.any());
+        let enabled = state.front.is_some() || state.back.is_some();
+        if ctx.depth_bounds {
+            let bounds = bounds.filter(|_| state.depth_bounds);
+            // SAFETY: the recording's command buffer is recording on this device. `depthBounds` is enabled
+            // (`ctx.depth_bounds` is set only where `Context::new` enabled it). The bounds must lie
+            // in [0, 1] (no VK_EXT_depth_range_unrestricted): `FramePlan::with_depth_bounds`
+            // clamps its ranges so; a hand-made plan's public `depth_range` is not checked here.
+            unsafe {
+                d.cmd_set_depth_bounds_test_enable(cmd, bounds.is_some());
+                if let Some(b) = bounds {
+                    d.cmd_set_depth_bounds(cmd, b.min, b.max);
+                }
             }
         }
-    }
-    // SAFETY: `cmd` is the caller's, recording on this device (the renderer's, or an engine's
-    // under `record`'s # Safety). These commands set core Vulkan 1.3 dynamic state and take
-    // only plain values; the masks and reference widen from the model's 8-bit ones.
-    unsafe {
-        d.cmd_set_cull_mode(cmd, cull_mode(state.cull));
-        d.cmd_set_depth_test_enable(cmd, state.depth.compare.is_some());
-        d.cmd_set_depth_compare_op(
-            cmd,
-            compare_op(state.depth.compare.unwrap_or(CompareOp::Always)),
-        );
-        d.cmd_set_depth_write_enable(cmd, state.depth.write);
-        d.cmd_set_stencil_test_enable(cmd, enabled);
-        for (flags, face) in [
-            (vk::StencilFaceFlags::FRONT, state.front),
-            (vk::StencilFaceFlags::BACK, state.back),
-        ] {
-            let s = face.unwrap_or(FaceStencil::DISABLED);
-            d.cmd_set_stencil_op(
+        // SAFETY: the recording's command buffer is recording on this device (the renderer's, or an engine's
+        // under `record`'s # Safety). These commands set core Vulkan 1.3 dynamic state and take
+        // only plain values; the masks and reference widen from the model's 8-bit ones.
+        unsafe {
+            d.cmd_set_cull_mode(cmd, cull_mode(state.cull));
+            d.cmd_set_depth_test_enable(cmd, state.depth.compare.is_some());
+            d.cmd_set_depth_compare_op(
                 cmd,
-                flags,
-                stencil_op(s.fail),
-                stencil_op(s.pass),
-                stencil_op(s.depth_fail),
-                compare_op(s.compare),
+                compare_op(state.depth.compare.unwrap_or(CompareOp::Always)),
             );
-            d.cmd_set_stencil_compare_mask(cmd, flags, u32::from(s.compare_mask));
-            d.cmd_set_stencil_write_mask(cmd, flags, u32::from(s.write_mask));
-            d.cmd_set_stencil_reference(cmd, flags, u32::from(s.reference));
+            d.cmd_set_depth_write_enable(cmd, state.depth.write);
+            d.cmd_set_stencil_test_enable(cmd, enabled);
+            for (flags, face) in [
+                (vk::StencilFaceFlags::FRONT, state.front),
+                (vk::StencilFaceFlags::BACK, state.back),
+            ] {
+                let s = face.unwrap_or(FaceStencil::DISABLED);
+                d.cmd_set_stencil_op(
+                    cmd,
+                    flags,
+                    stencil_op(s.fail),
+                    stencil_op(s.pass),
+                    stencil_op(s.depth_fail),
+                    compare_op(s.compare),
+                );
+                d.cmd_set_stencil_compare_mask(cmd, flags, u32::from(s.compare_mask));
+                d.cmd_set_stencil_write_mask(cmd, flags, u32::from(s.write_mask));
+                d.cmd_set_stencil_reference(cmd, flags, u32::from(s.reference));
+            }
         }
     }
 }

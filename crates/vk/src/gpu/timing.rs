@@ -2,6 +2,7 @@
 
 use crate::gpu::context::Context;
 use crate::gpu::error::{Result, VkCall};
+use crate::gpu::recording::Recording;
 use ash::vk;
 
 const MAX_MARKS: u32 = 16;
@@ -199,25 +200,28 @@ fn timestamp_pool(ctx: &Context, name: &str, marks: u32) -> Result<vk::QueryPool
 }
 
 /// Resets the queries of the first `marks` marks of `pool`.
-fn reset_marks(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, marks: u32) {
-    // SAFETY: `cmd` is the caller's, recording outside rendering (`StepTimer::reset` says so,
+fn reset_marks(rec: &Recording, pool: vk::QueryPool, marks: u32) {
+    // SAFETY: the recording's command buffer is recording outside rendering (`StepTimer::reset` says so,
     // `begin_frame` runs before any pass). Both callers pass `marks` equal to the pool's own
     // count (`MAX_MARKS`, `capacity`), so the range is the pool's queries.
     unsafe {
-        ctx.device
-            .cmd_reset_query_pool(cmd, pool, 0, marks * QUERIES_PER_MARK)
+        rec.device()
+            .cmd_reset_query_pool(rec.outside(), pool, 0, marks * QUERIES_PER_MARK)
     };
 }
 
 /// Mark `index`: a timestamp after all previous work (and its flushing twin).
-fn write_timestamp(ctx: &Context, cmd: vk::CommandBuffer, pool: vk::QueryPool, index: u32) {
+fn write_timestamp(rec: &Recording, pool: vk::QueryPool, index: u32) {
     let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
     for query in index * QUERIES_PER_MARK..(index + 1) * QUERIES_PER_MARK {
-        // SAFETY: `cmd` is the caller's, recording; its queue family has timestamps
+        // SAFETY: the recording's command buffer is recording; its queue family has timestamps
         // (`REQUIREMENTS.timestamps`). `query` is in the pool (the callers assert `index`
         // below its mark count) and was reset earlier in the same recording (`begin_frame`,
         // `StepTimer::reset`), so it is unavailable, as a timestamp write needs.
-        unsafe { ctx.device.cmd_write_timestamp2(cmd, bottom, pool, query) };
+        unsafe {
+            rec.device()
+                .cmd_write_timestamp2(rec.any(), bottom, pool, query)
+        };
     }
 }
 
@@ -256,20 +260,20 @@ impl Timestamps {
         })
     }
 
-    pub fn begin_frame(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+    pub fn begin_frame(&mut self, rec: &Recording) {
         self.names.clear();
-        reset_marks(ctx, cmd, self.pool, MAX_MARKS);
-        self.mark(ctx, cmd, "start");
+        reset_marks(rec, self.pool, MAX_MARKS);
+        self.mark(rec, "start");
     }
 
     /// Timestamp after all previous work: the end of pass `name`.
-    pub fn mark(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &'static str) {
+    pub fn mark(&mut self, rec: &Recording, name: &'static str) {
         let index = self.names.len() as u32;
         assert!(
             index < MAX_MARKS,
             "more timestamp marks than the pool holds"
         );
-        write_timestamp(ctx, cmd, self.pool, index);
+        write_timestamp(rec, self.pool, index);
         self.names.push(name);
     }
 
@@ -363,27 +367,21 @@ impl StepTimer {
     }
 
     /// Resets the queries: outside any rendering, as Vulkan requires.
-    pub fn reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+    pub fn reset(&mut self, rec: &Recording) {
         self.steps.clear();
-        reset_marks(ctx, cmd, self.pool, self.capacity);
+        reset_marks(rec, self.pool, self.capacity);
     }
 
     /// The mark the first step is timed from.
-    pub fn start(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
-        write_timestamp(ctx, cmd, self.pool, 0);
+    pub fn start(&mut self, rec: &Recording) {
+        write_timestamp(rec, self.pool, 0);
     }
 
     /// Marks the end of a step of `group`, drawn for scene light `light`.
-    pub fn mark(
-        &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        group: String,
-        light: Option<u32>,
-    ) {
+    pub fn mark(&mut self, rec: &Recording, group: String, light: Option<u32>) {
         let index = self.steps.len() as u32 + 1;
         assert!(index < self.capacity, "more steps than the timer holds");
-        write_timestamp(ctx, cmd, self.pool, index);
+        write_timestamp(rec, self.pool, index);
         self.steps.push((group, light));
     }
 

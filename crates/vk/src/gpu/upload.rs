@@ -5,6 +5,7 @@
 
 use crate::gpu::context::Context;
 use crate::gpu::error::{Result, VkCall};
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -14,7 +15,7 @@ use gpu_allocator::MemoryLocation;
 pub(crate) fn submit_once(
     ctx: &Context,
     name: &str,
-    record: impl FnOnce(vk::CommandBuffer),
+    record: impl FnOnce(&Recording),
 ) -> Result<()> {
     let d = &ctx.device;
     let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
@@ -41,9 +42,11 @@ pub(crate) fn submit_once(
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: `cmd` was just allocated, so it is in the initial state; `begin` outlives it.
         unsafe { d.begin_command_buffer(cmd, &begin) }.call("vkBeginCommandBuffer")?;
-        ctx.begin_label(cmd, name);
-        record(cmd);
-        ctx.end_label(cmd);
+        // SAFETY: `cmd` was just begun on this context's device, from a pool of its queue
+        // family (graphics and compute), outside rendering; only `record` records into it.
+        let rec = unsafe { Recording::new(ctx, cmd) };
+        rec.step(name, record);
+        rec.finish();
         // SAFETY: `cmd` is recording, outside any rendering (`record` ends what it begins), and
         // its labels are closed. The submit names only `cmd` and the unsignalled, unused
         // `fence`; `cmds` and `submit` live until it returns. `Context::submit` holds the
@@ -136,8 +139,8 @@ pub(crate) fn upload(
         staging.write_at(offset as usize, chunk);
     }
     let src = staging.handle;
-    let done = submit_once(ctx, name, |cmd| {
-        let d = &ctx.device;
+    let done = submit_once(ctx, name, |rec| {
+        let (d, cmd) = (rec.device(), rec.outside());
         let mut offsets = offsets.iter();
         for b in buffers {
             let offset = *offsets.next().expect("one offset per chunk");

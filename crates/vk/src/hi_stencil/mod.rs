@@ -23,15 +23,12 @@
 //! testing draw is preceded by `hi_stencil_count.frag` over the same geometry, and light shaders
 //! count the fragments they shade.
 
-use crate::gpu::access::{
-    access_info, buffer_barrier, transition, BufferAccess, Contents, ImageAccess, ImageRef,
-};
+use crate::gpu::access::{access_info, BufferAccess, Contents, ImageAccess, ImageRef};
 use crate::gpu::attachments::{depth_stencil_attachment, Load};
 use crate::gpu::compute::ComputePipeline;
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{sets_of, write_storage_buffers, HI_STENCIL_UPDATE_SET};
 use crate::gpu::error::{Result, VkCall};
-use crate::gpu::readback::{copy_image_to_buffer, host_readable};
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
 use crate::gpu::state::compare_op;
@@ -328,7 +325,7 @@ impl HiStencilSurface {
         // the surface.
         let fill = [BufferAccess::TransferWrite];
         let before = surface.map(|b| (b, &frame_uses[..], &fill[..]));
-        buffer_barrier(ctx, cmd, &before);
+        rec.buffer_barrier(&before);
         // SAFETY: `cmd` is recording outside rendering (the lighting pass resets before it
         // begins rendering); the buffers are ours, made with TRANSFER_DST, and the barrier above
         // orders the fills after every earlier use.
@@ -339,7 +336,7 @@ impl HiStencilSurface {
             d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
         }
         let after = surface.map(|b| (b, &fill[..], &frame_uses[..]));
-        buffer_barrier(ctx, cmd, &after);
+        rec.buffer_barrier(&after);
         self.unflushed = false;
         // The frame's first touch draw clears the touch image whole, so no frame depends on
         // what an earlier one (recorded, perhaps never submitted) left there.
@@ -353,14 +350,10 @@ impl HiStencilSurface {
         let (pending, active) = (self.pending.handle, self.active.handle);
         // The tile updates wrote the pending tiles; light shaders may still read the active
         // ones.
-        buffer_barrier(
-            ctx,
-            cmd,
-            &[
-                (pending, &[ComputeWrite], &[TransferRead]),
-                (active, &[FragmentRead, TransferWrite], &[TransferWrite]),
-            ],
-        );
+        rec.buffer_barrier(&[
+            (pending, &[ComputeWrite], &[TransferRead]),
+            (active, &[FragmentRead, TransferWrite], &[TransferWrite]),
+        ]);
         let region = [vk::BufferCopy::default().size(self.pending.size)];
         // SAFETY: `cmd` is recording outside rendering (a flush closes rendering first); both
         // buffers are ours and of one size, pending with TRANSFER_SRC and active with
@@ -371,14 +364,10 @@ impl HiStencilSurface {
         };
         // The next tile updates overwrite the pending tiles the copy read; the light shaders
         // read the new active ones.
-        buffer_barrier(
-            ctx,
-            cmd,
-            &[
-                (pending, &[TransferRead], &[ComputeWrite]),
-                (active, &[TransferWrite], &[FragmentRead, TransferWrite]),
-            ],
-        );
+        rec.buffer_barrier(&[
+            (pending, &[TransferRead], &[ComputeWrite]),
+            (active, &[TransferWrite], &[FragmentRead, TransferWrite]),
+        ]);
         self.unflushed = false;
     }
 
@@ -388,7 +377,6 @@ impl HiStencilSurface {
     /// with the touch pipeline (`LightShader::TouchTiles`) and the write's faces, then calls
     /// [`Self::end_touch`].
     pub fn begin_touch(&mut self, rec: &Recording, rect: TileRect) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
         // The image is cleared whole at the frame's first touch draw and when the markers run
         // out, so no pixel outside this draw's area can hold its marker, and the draw renders
         // its rectangle only (a CPU rasteriser pays for a rendering's whole area).
@@ -407,7 +395,7 @@ impl HiStencilSurface {
             (Load::Keep, Contents::Keep, rect.pixels(self.extent))
         };
         let access = ImageAccess::DepthStencilAttachment;
-        transition(ctx, cmd, &mut self.touch, access, contents);
+        rec.transition(&mut self.touch, access, contents);
         let depth = depth_stencil_attachment(&self.touch, load);
         let info = vk::RenderingInfo::default()
             .render_area(area)
@@ -423,23 +411,19 @@ impl HiStencilSurface {
             min_depth: marker,
             max_depth: marker,
         };
-        // SAFETY: `cmd` is recording outside rendering (the write's bookkeeping split it); the
-        // touch image is ours, transitioned to an attachment above, and `info` lives until the
-        // call returns.
+        // Outside rendering (the write's bookkeeping split it); the touch image is ours,
+        // transitioned to an attachment above.
+        rec.begin_rendering(&info);
+        // SAFETY: dynamic state the touch pipeline declares; the area lies in the image.
         unsafe {
-            ctx.device.cmd_begin_rendering(cmd, &info);
-            ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
-            ctx.device.cmd_set_scissor(cmd, 0, &[area]);
+            rec.device().cmd_set_viewport(rec.any(), 0, &[viewport]);
+            rec.device().cmd_set_scissor(rec.any(), 0, &[area]);
         }
-        rec.began_rendering();
     }
 
     /// Ends the touch draw's rendering.
     pub fn end_touch(&self, rec: &Recording) {
-        // SAFETY: `inside` checks (in debug builds) that rendering is open: the rendering
-        // `begin_touch` began, its one caller's pairing.
-        unsafe { rec.ctx().device.cmd_end_rendering(rec.inside()) };
-        rec.ended_rendering();
+        rec.end_rendering();
     }
 
     /// Outside rendering, after a write draw touched `tiles`, in a frame recorded into `slot`
@@ -477,7 +461,7 @@ impl HiStencilSurface {
             marker,
             ..self.update_push(rect)
         };
-        self.dispatch_update(rec.ctx(), rec.outside(), slot, depth_stencil, &push);
+        self.dispatch_update(rec, slot, depth_stencil, &push);
     }
 
     /// The update's settings over the tiles of `rect`, evaluating nothing yet (mode 0, no
@@ -506,14 +490,13 @@ impl HiStencilSurface {
     /// the pending surface; leaves the depth-stencil image attached-ready.
     fn dispatch_update(
         &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         slot: u32,
         depth_stencil: &mut ImageRef,
         push: &UpdatePush,
     ) {
         let stencil_read = ImageAccess::ComputeDepthStencilSampled;
-        transition(ctx, cmd, depth_stencil, stencil_read, Contents::Keep);
+        rec.transition(depth_stencil, stencil_read, Contents::Keep);
         // The update's set holds the touch image whether or not this update looks at it, so it
         // is always in the layout the set names (its contents are kept only after a touch draw).
         let (read_layout, ..) = access_info(stencil_read);
@@ -524,17 +507,17 @@ impl HiStencilSurface {
             } else {
                 Contents::Discard
             };
-            transition(ctx, cmd, &mut self.touch, stencil_read, contents);
+            rec.transition(&mut self.touch, stencil_read, contents);
         }
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
-        update.bind(ctx, cmd, set, bytemuck::bytes_of(push));
+        update.bind(rec, set, bytemuck::bytes_of(push));
         let groups = push.rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
-        // SAFETY: `cmd` is recording outside rendering with the update pipeline and its set
+        // SAFETY: the recording is outside rendering (`outside` checks it) with the update pipeline and its set
         // bound just above; the set's images were transitioned to the layouts it reads.
-        unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
+        unsafe { rec.device().cmd_dispatch(rec.outside(), groups, 1, 1) };
         let attached = ImageAccess::DepthStencilAttachment;
-        transition(ctx, cmd, depth_stencil, attached, Contents::Keep);
+        rec.transition(depth_stencil, attached, Contents::Keep);
     }
 
     /// Outside rendering, before a draw of a frame recorded into `slot` that tests stencil, on
@@ -584,42 +567,29 @@ impl HiStencilSurface {
             value2: u32::from(second.1),
             ..self.update_push(rect)
         };
-        self.dispatch_update(rec.ctx(), rec.outside(), slot, depth_stencil, &push);
+        self.dispatch_update(rec, slot, depth_stencil, &push);
         // The tiles outside `rect` are not the draw's: active there is whatever it was.
         self.record_flush(rec);
     }
 
     /// Outside rendering: copies the stencil aside for a later restore (`restore_preserved.frag`).
     pub fn record_save(&self, rec: &Recording, depth_stencil: &mut ImageRef) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
         use BufferAccess::{FragmentRead, TransferWrite};
         let saved = self.saved.handle;
         // The last restore (an earlier frame's) read what this copy overwrites.
-        buffer_barrier(ctx, cmd, &[(saved, &[FragmentRead], &[TransferWrite])]);
-        copy_image_to_buffer(
-            ctx,
-            cmd,
-            depth_stencil,
-            vk::ImageAspectFlags::STENCIL,
-            &self.saved,
-        );
-        transition(
-            ctx,
-            cmd,
+        rec.buffer_barrier(&[(saved, &[FragmentRead], &[TransferWrite])]);
+        rec.copy_image_to_buffer(depth_stencil, vk::ImageAspectFlags::STENCIL, &self.saved);
+        rec.transition(
             depth_stencil,
             ImageAccess::DepthStencilAttachment,
             Contents::Keep,
         );
-        buffer_barrier(ctx, cmd, &[(saved, &[TransferWrite], &[FragmentRead])]);
+        rec.buffer_barrier(&[(saved, &[TransferWrite], &[FragmentRead])]);
     }
 
     /// Makes the statistics visible to the host; record after the last lighting draw.
     pub fn record_stats_readable(&self, rec: &Recording) {
-        host_readable(
-            rec.ctx(),
-            rec.outside(),
-            vk::PipelineStageFlags2::FRAGMENT_SHADER,
-        );
+        rec.host_readable(vk::PipelineStageFlags2::FRAGMENT_SHADER);
     }
 
     /// The statistics of the last frame that counted; `flushes` is the caller's to fill in.

@@ -443,7 +443,6 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         // into it now.
         let rec = unsafe { Recording::new(ctx, cmd) };
         let pass = LightingPass {
-            ctx,
             rec: &rec,
             plan: frame.plan,
             lights: frame.lights,

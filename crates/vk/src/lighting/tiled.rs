@@ -87,7 +87,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &TiledFrame,
         targets: &mut LightingTargets,
         shade: TiledShade,
-        mut between: impl FnMut(vk::CommandBuffer, &'static str),
+        mut between: impl FnMut(&Recording, &'static str),
     ) -> Result<()> {
         if shade == TiledShade::DepthId && frame.mixed == MixedTiles::Branching {
             return Err(bad(
@@ -148,9 +148,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
         tiled.record_classify(&rec, &sets, targets, depth_sampled, clear, mixed, shape);
-        between(rec.outside(), "tile-classify");
+        between(&rec, "tile-classify");
         tiled.record_light_lists(&rec, frame.lights.len() as u32);
-        between(rec.outside(), "tile-lights");
+        between(&rec, "tile-lights");
         match shade {
             TiledShade::Kernels => tiled.record_shade(&rec, mixed),
             TiledShade::DepthId => {
@@ -176,7 +176,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// last depth-id frame left it, into `buffer` (2 bytes per pixel).
     pub(crate) fn copy_depth_ids(
         &mut self,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         side: TileSide,
         slot: u32,
         buffer: &Buffer,
@@ -184,16 +184,16 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         // A recording of the slot's depth-id image: the slot is in flight until declared
         // finished, as after any recording (its caller, the renderer, declared it first).
         debug_assert!(
-            self.pending.refuse_slot(slot, cmd).is_ok(),
+            self.pending.refuse_slot(slot, rec.any()).is_ok(),
             "slot {slot} copied while in flight"
         );
-        self.pending.recorded(slot, cmd);
+        self.pending.recorded(slot, rec.any());
         let (_, pass) = self
             .depth_id
             .iter_mut()
             .find(|(s, _)| *s == side)
             .expect("a depth-id frame was recorded");
-        pass.copy_ids(&self.ctx, cmd, slot, buffer);
+        pass.copy_ids(rec, slot, buffer);
     }
 
     /// The set layout the decode hook binds at set 1: histencil's G-buffer's, or the engine's.

@@ -17,15 +17,13 @@
 //! what the EQUAL test saves on a GPU is modelled in the simulator
 //! (`histencil_model::depth_id_stats`), not timed here.
 
-use crate::gpu::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::create_pipeline_layout;
 use crate::gpu::error::Result;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::readback::copy_image_to_buffer;
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
-use crate::gpu::state::apply;
 use crate::gpu::teardown::{build, Destroy};
 use crate::passes::light_modules::LightModules;
 use crate::passes::{depth_stencil_attachment, Load};
@@ -174,9 +172,9 @@ impl DepthIdPass {
 
     /// Records a copy of frame-in-flight `slot`'s id image (as its last frame left it) into
     /// `buffer`, 2 bytes per pixel, for [`crate::Renderer`]'s statistics.
-    pub fn copy_ids(&mut self, ctx: &Context, cmd: vk::CommandBuffer, slot: u32, buffer: &Buffer) {
+    pub fn copy_ids(&mut self, rec: &Recording, slot: u32, buffer: &Buffer) {
         let image = &mut self.ids[slot as usize];
-        copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, buffer);
+        rec.copy_image_to_buffer(image, vk::ImageAspectFlags::DEPTH, buffer);
     }
 
     /// The pipelines this pass holds.
@@ -199,112 +197,103 @@ impl DepthIdPass {
         targets: &mut LightingTargets,
         depth_sampled: bool,
     ) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
-        let d = &ctx.device;
-        ctx.begin_label(cmd, "depth-id");
-        // The light lists' masks, from compute to the shade passes (the images by their
-        // transitions below).
-        memory_barrier(ctx, cmd);
-        for image in targets.gbuffer.iter_mut() {
-            transition(
-                ctx,
-                cmd,
-                image,
-                ImageAccess::FragmentSampled,
-                Contents::Keep,
-            );
-        }
-        if depth_sampled {
-            let access = ImageAccess::StencilAttachmentDepthSampled;
-            transition(ctx, cmd, &mut targets.depth_stencil, access, Contents::Keep);
-        }
-        let hdr = ImageAccess::FragmentStorage;
-        transition(ctx, cmd, &mut targets.hdr, hdr, Contents::Keep);
-        let ids = &mut self.ids[slot as usize];
-        let access = ImageAccess::DepthStencilAttachment;
-        transition(ctx, cmd, ids, access, Contents::Discard);
-        let far = vk::ClearValue {
-            depth_stencil: vk::ClearDepthStencilValue {
-                depth: 1.0,
-                stencil: 0,
-            },
-        };
-        let attachment = depth_stencil_attachment(ids, Load::Clear(far));
-        let extent = ids.extent;
-        let area = vk::Rect2D::default().extent(extent);
-        let info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .depth_attachment(&attachment);
-        let graphics = vk::PipelineBindPoint::GRAPHICS;
-        let layout = self.pipeline_layout;
-        let (sets, visibility) = bound;
-        // SAFETY: `cmd` is recording outside rendering (`rec.outside()` above checks it in debug
-        // builds; the tiled passes before record no rendering); the id image was just transitioned
-        // to a depth attachment and `info` names only it, over its extent. The sets match the
-        // layout `new` made from `DepthIdDesc::set_layouts` (sets 0 to 2, and 4 only when the
-        // hooks have a visibility layout); `push` is the tiled technique's `PUSH_BYTES`, the
-        // layout's fragment range.
-        unsafe {
-            d.cmd_begin_rendering(cmd, &info);
-            d.cmd_set_scissor(cmd, 0, &[area]);
-            d.cmd_bind_descriptor_sets(cmd, graphics, layout, 0, &sets, &[]);
-            if let Some(set) = visibility {
-                d.cmd_bind_descriptor_sets(cmd, graphics, layout, 4, &[set], &[]);
+        let d = rec.device();
+        rec.step("depth-id", |rec| {
+            // The light lists' masks, from compute to the shade passes (the images by their
+            // transitions below).
+            rec.memory_barrier();
+            for image in targets.gbuffer.iter_mut() {
+                rec.transition(image, ImageAccess::FragmentSampled, Contents::Keep);
             }
-            d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::FRAGMENT, 0, push);
-        }
-        rec.began_rendering();
-        let viewport = |depth: Option<f32>| vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: extent.width as f32,
-            height: extent.height as f32,
-            min_depth: depth.unwrap_or(0.0),
-            max_depth: depth.unwrap_or(1.0),
-        };
-        let state = |compare, write| PassState {
-            cull: CullMode::None,
-            depth: DepthState {
-                compare: Some(compare),
-                write,
-            },
-            front: None,
-            back: None,
-            color_write: false,
-            hi_stencil: None,
-            depth_bounds: false,
-        };
-        // The copy: every surface pixel's slot as its depth (the shader writes the depth).
-        ctx.begin_label(cmd, "depth-id-copy");
-        apply(ctx, cmd, &state(CompareOp::Always, true));
-        // SAFETY: inside the rendering begun above, with sets, push constants, scissor and the
-        // pass state bound or set; the copy pipeline was made by `new` for a depth-only
-        // `ID_FORMAT` attachment, this one; the full-screen triangle reads no vertex buffer.
-        unsafe {
-            d.cmd_set_viewport(cmd, 0, &[viewport(None)]);
-            d.cmd_bind_pipeline(cmd, graphics, self.copy);
-            d.cmd_draw(cmd, 3, 1, 0, 0);
-        }
-        ctx.end_label(cmd);
-        // Each slot's pass at its depth: a viewport of no depth range pins every fragment
-        // there. Depth attachment accesses are ordered within the rendering, so the passes
-        // see the copy's depths without a barrier.
-        apply(ctx, cmd, &state(CompareOp::Equal, false));
-        for (s, pipeline) in self.shade.iter().enumerate() {
-            ctx.begin_label(cmd, &format!("depth-id-shade-{s}"));
-            // SAFETY: as for the copy above; the viewport's depth is one in [0, 1].
+            if depth_sampled {
+                let access = ImageAccess::StencilAttachmentDepthSampled;
+                rec.transition(&mut targets.depth_stencil, access, Contents::Keep);
+            }
+            let hdr = ImageAccess::FragmentStorage;
+            rec.transition(&mut targets.hdr, hdr, Contents::Keep);
+            let ids = &mut self.ids[slot as usize];
+            let access = ImageAccess::DepthStencilAttachment;
+            rec.transition(ids, access, Contents::Discard);
+            let far = vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: 1.0,
+                    stencil: 0,
+                },
+            };
+            let attachment = depth_stencil_attachment(ids, Load::Clear(far));
+            let extent = ids.extent;
+            let area = vk::Rect2D::default().extent(extent);
+            let info = vk::RenderingInfo::default()
+                .render_area(area)
+                .layer_count(1)
+                .depth_attachment(&attachment);
+            let graphics = vk::PipelineBindPoint::GRAPHICS;
+            let layout = self.pipeline_layout;
+            let (sets, visibility) = bound;
+            // The id image was just transitioned to a depth attachment and `info` names only it,
+            // over its extent.
+            rec.begin_rendering(&info);
+            let cmd = rec.inside();
+            // SAFETY: `cmd` records inside the rendering begun just now. The sets match the
+            // layout `new` made from `DepthIdDesc::set_layouts` (sets 0 to 2, and 4 only when the
+            // hooks have a visibility layout); `push` is the tiled technique's `PUSH_BYTES`, the
+            // layout's fragment range.
             unsafe {
-                d.cmd_set_viewport(cmd, 0, &[viewport(Some(depth_of(s)))]);
-                d.cmd_bind_pipeline(cmd, graphics, *pipeline);
-                d.cmd_draw(cmd, 3, 1, 0, 0);
+                d.cmd_set_scissor(cmd, 0, &[area]);
+                d.cmd_bind_descriptor_sets(cmd, graphics, layout, 0, &sets, &[]);
+                if let Some(set) = visibility {
+                    d.cmd_bind_descriptor_sets(cmd, graphics, layout, 4, &[set], &[]);
+                }
+                d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::FRAGMENT, 0, push);
             }
-            ctx.end_label(cmd);
-        }
-        // SAFETY: ends the rendering begun on `cmd` above (`inside` checks it is open).
-        unsafe { d.cmd_end_rendering(rec.inside()) };
-        rec.ended_rendering();
-        ctx.end_label(cmd);
+            let viewport = |depth: Option<f32>| vk::Viewport {
+                x: 0.0,
+                y: 0.0,
+                width: extent.width as f32,
+                height: extent.height as f32,
+                min_depth: depth.unwrap_or(0.0),
+                max_depth: depth.unwrap_or(1.0),
+            };
+            let state = |compare, write| PassState {
+                cull: CullMode::None,
+                depth: DepthState {
+                    compare: Some(compare),
+                    write,
+                },
+                front: None,
+                back: None,
+                color_write: false,
+                hi_stencil: None,
+                depth_bounds: false,
+            };
+            // The copy: every surface pixel's slot as its depth (the shader writes the depth).
+            rec.step("depth-id-copy", |rec| {
+                rec.apply(&state(CompareOp::Always, true));
+                // SAFETY: inside the rendering begun above, with sets, push constants, scissor and the
+                // pass state bound or set; the copy pipeline was made by `new` for a depth-only
+                // `ID_FORMAT` attachment, this one; the full-screen triangle reads no vertex buffer.
+                unsafe {
+                    d.cmd_set_viewport(cmd, 0, &[viewport(None)]);
+                    d.cmd_bind_pipeline(cmd, graphics, self.copy);
+                    d.cmd_draw(cmd, 3, 1, 0, 0);
+                }
+            });
+            // Each slot's pass at its depth: a viewport of no depth range pins every fragment
+            // there. Depth attachment accesses are ordered within the rendering, so the passes
+            // see the copy's depths without a barrier.
+            rec.apply(&state(CompareOp::Equal, false));
+            for (s, pipeline) in self.shade.iter().enumerate() {
+                rec.step(&format!("depth-id-shade-{s}"), |_| {
+                    // SAFETY: as for the copy above; the viewport's depth is one in [0, 1].
+                    unsafe {
+                        d.cmd_set_viewport(cmd, 0, &[viewport(Some(depth_of(s)))]);
+                        d.cmd_bind_pipeline(cmd, graphics, *pipeline);
+                        d.cmd_draw(cmd, 3, 1, 0, 0);
+                    }
+                });
+            }
+            rec.end_rendering();
+        });
     }
 }
 

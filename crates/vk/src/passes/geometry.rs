@@ -3,17 +3,18 @@
 //! the G-buffer pass. [`MeshPasses`] owns their pipelines; each frame they draw [`MeshInputs`].
 
 use super::{
-    begin_hdr_rendering, begin_rendering, clear_depth_stencil, color_attachment,
-    depth_stencil_attachment, Load, CLEAR_BLACK,
+    begin_hdr_rendering, clear_depth_stencil, color_attachment, depth_stencil_attachment, Load,
+    CLEAR_BLACK,
 };
-use crate::gpu::access::{transition, Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{pass_layouts, MATERIAL_SET};
 use crate::gpu::error::Result;
 use crate::gpu::gpu_types::DrawPush;
 use crate::gpu::meshes::Meshes;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::state::{apply, oriented, with_stencil, OPAQUE};
+use crate::gpu::recording::Recording;
+use crate::gpu::state::{oriented, with_stencil, OPAQUE};
 use crate::gpu::teardown::build;
 use crate::shaders;
 use ash::vk;
@@ -151,14 +152,12 @@ impl MeshPasses {
 
     fn draw<'a>(
         &self,
-        ctx: &'a Context,
-        cmd: vk::CommandBuffer,
+        rec: &'a Recording<'a>,
         pipeline: vk::Pipeline,
         inputs: &'a MeshInputs<'a>,
     ) -> Draw<'a> {
         Draw {
-            ctx,
-            cmd,
+            rec,
             pipeline,
             pipeline_layout: self.pipeline_layout,
             inputs,
@@ -166,75 +165,61 @@ impl MeshPasses {
     }
 
     /// Writes the G-buffer and each draw's BRDF slot into the stencil BRDF bits.
-    pub fn record_gbuffer(
+    pub(crate) fn record_gbuffer(
         &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         inputs: &MeshInputs,
         stencil: &GbufferStencil,
         targets: &mut LightingTargets,
     ) {
-        ctx.begin_label(cmd, "gbuffer");
-        for image in targets.gbuffer.iter_mut() {
-            transition(
-                ctx,
-                cmd,
-                image,
-                ImageAccess::ColorAttachment,
-                Contents::Discard,
-            );
-        }
-        transition(
-            ctx,
-            cmd,
-            &mut targets.depth_stencil,
-            ImageAccess::DepthStencilAttachment,
-            Contents::Discard,
-        );
-        // The material target's w (BRDF id) is cleared to -1: "no geometry here".
-        let no_brdf = vk::ClearValue {
-            color: vk::ClearColorValue {
-                float32: [0.0, 0.0, 0.0, -1.0],
-            },
-        };
-        let clears = [CLEAR_BLACK, CLEAR_BLACK, no_brdf];
-        let colors: Vec<_> = targets
-            .gbuffer
-            .iter()
-            .zip(clears)
-            .map(|(i, clear)| color_attachment(i, Load::Clear(clear)))
-            .collect();
-        let depth = inputs.depth;
-        let clear = Load::Clear(clear_depth_stencil(depth));
-        let ds = depth_stencil_attachment(&targets.depth_stencil, clear);
-        begin_rendering(ctx, cmd, inputs.extent, &colors, Some(&ds));
-        let GbufferStencil {
-            layout,
-            slots,
-            preserved_pattern,
-        } = *stencil;
-        self.draw(ctx, cmd, self.gbuffer, inputs).objects(|i| {
-            Some(match gbuffer_stencil(layout, slots[i], preserved_pattern) {
-                Some(s) => with_stencil(oriented(OPAQUE, depth), s),
-                None => oriented(OPAQUE, depth),
-            })
+        rec.step("gbuffer", |rec| {
+            for image in targets.gbuffer.iter_mut() {
+                rec.transition(image, ImageAccess::ColorAttachment, Contents::Discard);
+            }
+            let ds = ImageAccess::DepthStencilAttachment;
+            rec.transition(&mut targets.depth_stencil, ds, Contents::Discard);
+            // The material target's w (BRDF id) is cleared to -1: "no geometry here".
+            let no_brdf = vk::ClearValue {
+                color: vk::ClearColorValue {
+                    float32: [0.0, 0.0, 0.0, -1.0],
+                },
+            };
+            let clears = [CLEAR_BLACK, CLEAR_BLACK, no_brdf];
+            let colors: Vec<_> = targets
+                .gbuffer
+                .iter()
+                .zip(clears)
+                .map(|(i, clear)| color_attachment(i, Load::Clear(clear)))
+                .collect();
+            let depth = inputs.depth;
+            let clear = Load::Clear(clear_depth_stencil(depth));
+            let ds = depth_stencil_attachment(&targets.depth_stencil, clear);
+            rec.begin_rendering_over(inputs.extent, &colors, Some(&ds));
+            let GbufferStencil {
+                layout,
+                slots,
+                preserved_pattern,
+            } = *stencil;
+            self.draw(rec, self.gbuffer, inputs).objects(|i| {
+                Some(match gbuffer_stencil(layout, slots[i], preserved_pattern) {
+                    Some(s) => with_stencil(oriented(OPAQUE, depth), s),
+                    None => oriented(OPAQUE, depth),
+                })
+            });
+            rec.end_rendering();
         });
-        // SAFETY: ends the rendering `begin_rendering` began on `cmd` above.
-        unsafe { ctx.device.cmd_end_rendering(cmd) };
-        ctx.end_label(cmd);
     }
 
     /// The forward reference: lit HDR colour straight from the meshes.
-    pub fn record_forward(
+    pub(crate) fn record_forward(
         &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         inputs: &MeshInputs,
         targets: &mut LightingTargets,
     ) {
         let depth = Load::Clear(clear_depth_stencil(inputs.depth));
         let opaque = oriented(OPAQUE, inputs.depth);
-        self.draw(ctx, cmd, self.forward, inputs)
+        self.draw(rec, self.forward, inputs)
             .hdr_pass(targets, "forward", depth, |_| Some(opaque));
     }
 
@@ -243,16 +228,15 @@ impl MeshPasses {
     /// in front of the stored one: the same vertex stage computes it again, and no driver
     /// decorates `gl_Position` invariant without complaint; nothing written but colour), so
     /// the light passes add onto it and emission counts once.
-    pub fn record_emissive(
+    pub(crate) fn record_emissive(
         &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         inputs: &MeshInputs,
         targets: &mut LightingTargets,
     ) {
         let visible = oriented(VISIBLE_AGAIN, inputs.depth);
         let objects = &inputs.scene.objects;
-        self.draw(ctx, cmd, self.emissive, inputs)
+        self.draw(rec, self.emissive, inputs)
             .hdr_pass(targets, "emissive", Load::Keep, |i| {
                 objects[i].material.emits().then_some(visible)
             });
@@ -281,8 +265,7 @@ crate::gpu::teardown::destroy_by_method!(MeshPasses);
 
 /// One mesh pass being recorded: a pipeline and the frame's inputs.
 struct Draw<'a> {
-    ctx: &'a Context,
-    cmd: vk::CommandBuffer,
+    rec: &'a Recording<'a>,
     pipeline: vk::Pipeline,
     pipeline_layout: vk::PipelineLayout,
     inputs: &'a MeshInputs<'a>,
@@ -292,22 +275,13 @@ impl Draw<'_> {
     /// Draws the objects `state_of` gives a state, each with its material set and push
     /// constants.
     fn objects(&self, state_of: impl Fn(usize) -> Option<PassState>) {
-        let (d, cmd, inputs) = (&self.ctx.device, self.cmd, self.inputs);
+        let (rec, inputs) = (self.rec, self.inputs);
+        let (d, cmd) = (rec.device(), rec.inside());
         // SAFETY: `cmd` is recording inside the rendering the pass began (`record_gbuffer`,
         // `hdr_pass`) into attachments of the formats the pipeline was made for (`MeshFormats`;
         // `Renderer::record_gbuffer` checks an engine's images). The pipeline and layout were
         // made by `new` and live as long as `self`; the frame set is of set 0's layout.
-        unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline_layout,
-                0,
-                &[inputs.frame_set],
-                &[],
-            );
-        }
+        unsafe { rec.bind_graphics(self.pipeline, self.pipeline_layout, &[inputs.frame_set]) };
         let mut bound = None;
         for (i, object) in inputs.scene.objects.iter().enumerate() {
             let Some(mut state) = state_of(i) else {
@@ -316,7 +290,7 @@ impl Draw<'_> {
             if object.material.double_sided {
                 state.cull = CullMode::None;
             }
-            apply(self.ctx, cmd, &state);
+            rec.apply(&state);
             let set = inputs.material_sets[i];
             if bound != Some(set) {
                 bound = Some(set);
@@ -349,7 +323,7 @@ impl Draw<'_> {
                     bytemuck::bytes_of(&push),
                 );
             }
-            inputs.meshes.shape(object.shape).draw(self.ctx, cmd);
+            inputs.meshes.shape(object.shape).draw(rec);
         }
     }
 
@@ -362,20 +336,13 @@ impl Draw<'_> {
         depth: Load,
         state_of: impl Fn(usize) -> Option<PassState>,
     ) {
-        let (ctx, cmd) = (self.ctx, self.cmd);
-        ctx.begin_label(cmd, label);
-        begin_hdr_rendering(
-            ctx,
-            cmd,
-            (&mut targets.hdr, &mut targets.depth_stencil),
-            self.inputs.extent,
-            Load::Clear(CLEAR_BLACK),
-            depth,
-        );
-        self.objects(state_of);
-        // SAFETY: ends the rendering `begin_hdr_rendering` began on `cmd` above.
-        unsafe { ctx.device.cmd_end_rendering(cmd) };
-        ctx.end_label(cmd);
+        self.rec.step(label, |rec| {
+            let attachments = (&mut targets.hdr, &mut targets.depth_stencil);
+            let (extent, hdr) = (self.inputs.extent, Load::Clear(CLEAR_BLACK));
+            begin_hdr_rendering(rec, attachments, extent, hdr, depth);
+            self.objects(state_of);
+            rec.end_rendering();
+        });
     }
 }
 

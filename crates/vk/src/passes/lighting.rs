@@ -13,13 +13,12 @@ use super::light_pipelines::{
     pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
 };
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
-use crate::gpu::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
-use crate::gpu::context::Context;
+use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::error::Result;
 use crate::gpu::gpu_types::LightDrawPush;
 use crate::gpu::meshes::LightVolumes;
 use crate::gpu::recording::Recording;
-use crate::gpu::state::{apply_bounded, FULLSCREEN};
+use crate::gpu::state::FULLSCREEN;
 use crate::gpu::timing::StepTimer;
 use crate::hi_stencil::{
     plan_touches, tile_rect, GpuHierarchy, HiStencilSurface, TouchedTiles, WriteTiles,
@@ -53,9 +52,7 @@ pub fn pass_group(kind: PassKind, brdfs: &[BrdfId], source: BrdfSource) -> Strin
 /// One frame's lighting as `DeferredLighting::record` hands it to the recorder: the plan and
 /// everything its steps bind, borrowed for the recording only.
 pub struct LightingPass<'a> {
-    /// The device the commands are recorded for.
-    pub ctx: &'a Context,
-    /// The command buffer being recorded, and whether rendering is open in it.
+    /// The recording the commands go through (its device, and whether rendering is open).
     pub(crate) rec: &'a Recording<'a>,
     /// The model's steps for this frame, in order.
     pub plan: &'a FramePlan,
@@ -117,24 +114,15 @@ impl Rendering {
         } else {
             ImageAccess::DepthStencilAttachment
         };
-        begin_hdr_rendering_as(
-            pass.ctx,
-            pass.rec.outside(),
-            attachments,
-            pass.extent,
-            (hdr, Load::Keep),
-            depth,
-        );
-        pass.rec.began_rendering();
+        let loads = (hdr, Load::Keep);
+        begin_hdr_rendering_as(pass.rec, attachments, pass.extent, loads, depth);
         self.cleared = true;
     }
 
     fn close(&mut self, pass: &LightingPass) {
         if pass.rec.is_rendering() {
-            // SAFETY: the recording says the command buffer is inside rendering, the one
-            // `Rendering::open` began (the touch draw ends its own).
-            unsafe { pass.ctx.device.cmd_end_rendering(pass.rec.inside()) };
-            pass.rec.ended_rendering();
+            // The rendering `Rendering::open` began (the touch draw ends its own).
+            pass.rec.end_rendering();
         }
     }
 
@@ -142,7 +130,7 @@ impl Rendering {
     /// buffer cannot be ordered inside one dynamic rendering instance.
     fn split(&mut self, pass: &LightingPass) {
         self.close(pass);
-        memory_barrier(pass.ctx, pass.rec.outside());
+        pass.rec.memory_barrier();
     }
 }
 
@@ -199,12 +187,10 @@ impl Timers<'_> {
         group: impl FnOnce() -> (String, Option<u32>),
         body: impl FnOnce(&mut Self) -> R,
     ) -> R {
-        pass.ctx.begin_label(pass.rec.any(), label);
-        let result = body(self);
-        pass.ctx.end_label(pass.rec.any());
+        let result = pass.rec.step(label, |_| body(self));
         if let Some(t) = self.steps.as_deref_mut() {
             let (group, light) = group();
-            t.mark(pass.ctx, pass.rec.any(), group, light);
+            t.mark(pass.rec, group, light);
         }
         result
     }
@@ -220,7 +206,7 @@ impl Timers<'_> {
     /// Ends the emulation timer's span before it: `group` names what it timed.
     fn mark(&mut self, pass: &LightingPass, group: &str) {
         if let Some(t) = self.emulation.as_deref_mut() {
-            t.mark(pass.ctx, pass.rec.any(), group.into(), None);
+            t.mark(pass.rec, group.into(), None);
         }
     }
 }
@@ -240,29 +226,22 @@ impl LightingPass<'_> {
         timer: Option<&mut StepTimer>,
         emulation: Option<&mut StepTimer>,
     ) -> Result<()> {
-        // Labels and timestamps, which Vulkan allows inside and outside rendering.
-        let (ctx, cmd) = (self.ctx, self.rec.any());
+        let rec = self.rec;
         let mut timers = Timers {
             steps: timer,
             emulation,
         };
-        ctx.begin_label(cmd, "lighting");
+        rec.begin_label("lighting");
         for image in targets.gbuffer.iter_mut() {
-            transition(
-                ctx,
-                self.rec.outside(),
-                image,
-                ImageAccess::FragmentSampled,
-                Contents::Keep,
-            );
+            rec.transition(image, ImageAccess::FragmentSampled, Contents::Keep);
         }
         // Query resets are outside rendering.
         if let Some(t) = timers.steps.as_deref_mut() {
-            t.reset(ctx, self.rec.outside());
+            t.reset(rec);
         }
         if let Some(t) = timers.emulation.as_deref_mut() {
-            t.reset(ctx, self.rec.outside());
-            t.start(ctx, cmd);
+            t.reset(rec);
+            t.start(rec);
         }
         hi_stencil.record_reset(self.rec);
         timers.mark(self, Emulation::BOOKKEEPING);
@@ -272,7 +251,7 @@ impl LightingPass<'_> {
         };
         rendering.open(self, targets);
         if let Some(t) = timers.steps.as_deref_mut() {
-            t.start(ctx, cmd);
+            t.start(rec);
         }
         // Each planned light's passes sit inside one label of its own.
         let mut current_light = None;
@@ -281,12 +260,12 @@ impl LightingPass<'_> {
                 return;
             }
             if current_light.is_some() {
-                ctx.end_label(cmd);
+                rec.end_label();
             }
             current_light = light;
             if let Some(light) = light {
                 let input = self.plan.lights[light].input;
-                ctx.begin_label(cmd, &format!("light-{input}"));
+                rec.begin_label(&format!("light-{input}"));
             }
         };
         let touches = plan_touches(self.plan);
@@ -361,13 +340,13 @@ impl LightingPass<'_> {
         if self.count_stats {
             hi_stencil.record_stats_readable(self.rec);
         }
-        ctx.end_label(cmd);
+        rec.end_label();
         Ok(())
     }
 
     /// Binds the frame's sets, and the engine's visibility set where it has one.
     fn bind_sets(&self) {
-        let (d, cmd, layout) = (&self.ctx.device, self.rec.any(), self.pipeline_layout);
+        let (d, cmd, layout) = (self.rec.device(), self.rec.any(), self.pipeline_layout);
         let graphics = vk::PipelineBindPoint::GRAPHICS;
         // SAFETY: `cmd` is recording (LightingPass's contract); the sets and the layout were
         // made from this context's device by the lighting, and the sets match the layout's set
@@ -528,8 +507,8 @@ impl LightingPass<'_> {
         (geometry, bounds): (Geometry, Option<DepthRange>),
         push: LightDrawPush,
     ) {
-        let (ctx, cmd) = (self.ctx, self.rec.inside());
-        let d = &ctx.device;
+        let rec = self.rec;
+        let (d, cmd) = (rec.device(), rec.inside());
         // SAFETY: `cmd` is inside the lighting's rendering (`record_pass` opens it before each
         // draw); the pipeline was made for this plan's pass state (`prepare_pipelines`) with
         // `pipeline_layout`, whose push range holds a `LightDrawPush`.
@@ -547,14 +526,14 @@ impl LightingPass<'_> {
                 bytemuck::bytes_of(&push),
             );
         }
-        apply_bounded(ctx, cmd, state, bounds);
+        rec.apply_bounded(state, bounds);
         match geometry {
             // SAFETY: inside rendering with a full-screen pipeline bound just above, which draws
             // its triangle from the vertex index alone.
             Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
             Geometry::Volume => {
                 let kind = &self.lights[push.light_index as usize].kind;
-                self.volumes.draw(ctx, cmd, kind);
+                self.volumes.draw(rec, kind);
             }
         }
     }

@@ -10,7 +10,7 @@
 //! into the tiles of its screen rectangle whose depth range its range sphere reaches.
 //! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
-use crate::gpu::access::{memory_barrier, transition, Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers, TILED_SET,
@@ -477,92 +477,79 @@ impl TiledLighting {
         let (ctx, cmd) = (rec.ctx(), rec.outside());
         let d = &ctx.device;
         let push = self.push(clear, mixed);
-        ctx.begin_label(cmd, "tiled-classify");
-        for image in targets.gbuffer.iter_mut() {
-            transition(ctx, cmd, image, ImageAccess::ComputeSampled, Contents::Keep);
-        }
-        if depth_sampled {
-            let ds = &mut targets.depth_stencil;
-            transition(
-                ctx,
-                cmd,
-                ds,
-                ImageAccess::ComputeDepthSampled,
-                Contents::Keep,
-            );
-        }
-        let hdr_contents = if clear {
-            Contents::Discard
-        } else {
-            Contents::Keep
-        };
-        transition(
-            ctx,
-            cmd,
-            &mut targets.hdr,
-            ImageAccess::ComputeStorage,
-            hdr_contents,
-        );
-        // Each slot's dispatch starts at zero tiles.
-        let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
-        // SAFETY: `cmd` is recording outside rendering (`rec.outside()` checks it in debug
-        // builds; `Recording::new`'s # Safety). `reset` is the dispatch buffer's exact size, `(MIXED_SLOT + 1) * 16` bytes,
-        // a multiple of 4 under 64 KiB; both buffers are live with `TRANSFER_DST` usage.
-        unsafe {
-            d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
-            // Every tile's light mask starts empty; the light lists set bits.
-            d.cmd_fill_buffer(cmd, self.masks.handle, 0, vk::WHOLE_SIZE, 0);
-        }
-        buffer_barrier(
-            ctx,
-            cmd,
-            (
-                vk::PipelineStageFlags2::ALL_TRANSFER,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            ),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            ),
-        );
-        // SAFETY: as above for `cmd`. The sets match the layout made in `new`: the lighting's
-        // frame and decode sets (sets 0 and 1), this slot's tiled set (2) and the visibility
-        // hook's (4, its layout there when it has a set); the push is `TiledPush`, the layout's
-        // compute range.
-        unsafe {
-            let bound = [sets.frame, sets.decode, self.sets[sets.slot as usize]];
-            let compute = vk::PipelineBindPoint::COMPUTE;
-            d.cmd_bind_descriptor_sets(cmd, compute, self.pipeline_layout, 0, &bound, &[]);
-            if let Some(set) = sets.visibility {
-                let layout = self.pipeline_layout;
-                d.cmd_bind_descriptor_sets(cmd, compute, layout, 4, &[set], &[]);
+        rec.step("tiled-classify", |rec| {
+            for image in targets.gbuffer.iter_mut() {
+                rec.transition(image, ImageAccess::ComputeSampled, Contents::Keep);
             }
-            d.cmd_push_constants(
-                cmd,
-                self.pipeline_layout,
-                vk::ShaderStageFlags::COMPUTE,
-                0,
-                bytemuck::bytes_of(&push),
-            );
-        }
-        // SAFETY: as above for `cmd`; both classification pipelines were made by `new` with
-        // this layout, whose sets and push constants are bound just above.
-        unsafe {
-            let (x, y) = self.tiles_xy;
-            let (pipeline, groups) = match shape {
-                TileClassify::Workgroup => (self.classify, (x, y)),
-                // A workgroup of `tile` x `tile` invocations covers as many tiles.
-                TileClassify::PerInvocation => {
-                    let tile = self.side.pixels();
-                    (self.classify_alone, (x.div_ceil(tile), y.div_ceil(tile)))
-                }
+            if depth_sampled {
+                let ds = &mut targets.depth_stencil;
+                rec.transition(ds, ImageAccess::ComputeDepthSampled, Contents::Keep);
+            }
+            let hdr_contents = if clear {
+                Contents::Discard
+            } else {
+                Contents::Keep
             };
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
-            d.cmd_dispatch(cmd, groups.0, groups.1, 1);
-        }
-        // The lists and depth ranges for what follows, the counts for the indirect dispatches.
-        after_compute(ctx, cmd);
-        ctx.end_label(cmd);
+            rec.transition(&mut targets.hdr, ImageAccess::ComputeStorage, hdr_contents);
+            // Each slot's dispatch starts at zero tiles.
+            let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
+            // SAFETY: `cmd` is recording outside rendering (`rec.outside()` checks it in debug
+            // builds; `Recording::new`'s # Safety). `reset` is the dispatch buffer's exact size, `(MIXED_SLOT + 1) * 16` bytes,
+            // a multiple of 4 under 64 KiB; both buffers are live with `TRANSFER_DST` usage.
+            unsafe {
+                d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
+                // Every tile's light mask starts empty; the light lists set bits.
+                d.cmd_fill_buffer(cmd, self.masks.handle, 0, vk::WHOLE_SIZE, 0);
+            }
+            tile_barrier(
+                rec,
+                (
+                    vk::PipelineStageFlags2::ALL_TRANSFER,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                ),
+            );
+            // SAFETY: as above for `cmd`. The sets match the layout made in `new`: the lighting's
+            // frame and decode sets (sets 0 and 1), this slot's tiled set (2) and the visibility
+            // hook's (4, its layout there when it has a set); the push is `TiledPush`, the layout's
+            // compute range.
+            unsafe {
+                let bound = [sets.frame, sets.decode, self.sets[sets.slot as usize]];
+                let compute = vk::PipelineBindPoint::COMPUTE;
+                d.cmd_bind_descriptor_sets(cmd, compute, self.pipeline_layout, 0, &bound, &[]);
+                if let Some(set) = sets.visibility {
+                    let layout = self.pipeline_layout;
+                    d.cmd_bind_descriptor_sets(cmd, compute, layout, 4, &[set], &[]);
+                }
+                d.cmd_push_constants(
+                    cmd,
+                    self.pipeline_layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+            }
+            // SAFETY: as above for `cmd`; both classification pipelines were made by `new` with
+            // this layout, whose sets and push constants are bound just above.
+            unsafe {
+                let (x, y) = self.tiles_xy;
+                let (pipeline, groups) = match shape {
+                    TileClassify::Workgroup => (self.classify, (x, y)),
+                    // A workgroup of `tile` x `tile` invocations covers as many tiles.
+                    TileClassify::PerInvocation => {
+                        let tile = self.side.pixels();
+                        (self.classify_alone, (x.div_ceil(tile), y.div_ceil(tile)))
+                    }
+                };
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+            }
+            // The lists and depth ranges for what follows, the counts for the indirect dispatches.
+            after_compute(rec);
+        });
     }
 
     /// Records the light lists of `lights` lights, after [`TiledLighting::record_classify`] in
@@ -570,20 +557,20 @@ impl TiledLighting {
     /// the masks of the tiles it can reach, for [`TiledLighting::record_shade`].
     pub fn record_light_lists(&self, rec: &Recording, lights: u32) {
         let (ctx, cmd) = (rec.ctx(), rec.outside());
-        ctx.begin_label(cmd, "tiled-light-lists");
-        // A workgroup per light, in rows of at most the guaranteed workgroup count.
-        const ROW: u32 = 65535;
-        let groups = (lights.min(ROW), lights.div_ceil(ROW));
-        // SAFETY: `cmd` is recording outside rendering, after `record_classify` bound this
-        // layout's sets and push constants (`record_tiled_with`, the one caller); the pipeline
-        // was made by `new` with that layout; at most 65535 groups along each axis.
-        unsafe {
-            let d = &ctx.device;
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.light_lists);
-            d.cmd_dispatch(cmd, groups.0, groups.1, 1);
-        }
-        after_compute(ctx, cmd);
-        ctx.end_label(cmd);
+        rec.step("tiled-light-lists", |rec| {
+            // A workgroup per light, in rows of at most the guaranteed workgroup count.
+            const ROW: u32 = 65535;
+            let groups = (lights.min(ROW), lights.div_ceil(ROW));
+            // SAFETY: `cmd` is recording outside rendering, after `record_classify` bound this
+            // layout's sets and push constants (`record_tiled_with`, the one caller); the pipeline
+            // was made by `new` with that layout; at most 65535 groups along each axis.
+            unsafe {
+                let d = &ctx.device;
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.light_lists);
+                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+            }
+            after_compute(rec);
+        });
     }
 
     /// Records one indirect dispatch per BRDF slot over its tiles, and with
@@ -593,31 +580,31 @@ impl TiledLighting {
     pub fn record_shade(&self, rec: &Recording, mixed: MixedTiles) {
         let (ctx, cmd) = (rec.ctx(), rec.outside());
         let d = &ctx.device;
-        ctx.begin_label(cmd, "tiled-shade");
-        let branching = (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
-        for (slot, pipeline) in self.shade.iter().enumerate().chain(branching) {
-            ctx.begin_label(cmd, &format!("tiled-shade-{slot}"));
-            // SAFETY: as in `record_light_lists`; `slot <= MIXED_SLOT` (at most `MAX_SLOTS`
-            // kernels, checked in `new`), so the arguments at `slot * 16` lie inside the
-            // dispatch buffer, which has `INDIRECT_BUFFER` usage.
-            unsafe {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);
-                d.cmd_dispatch_indirect(cmd, self.dispatch.handle, (slot * 16) as u64);
+        rec.step("tiled-shade", |rec| {
+            let branching =
+                (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
+            for (slot, pipeline) in self.shade.iter().enumerate().chain(branching) {
+                rec.step(&format!("tiled-shade-{slot}"), |_| {
+                    // SAFETY: as in `record_light_lists`; `slot <= MIXED_SLOT` (at most `MAX_SLOTS`
+                    // kernels, checked in `new`), so the arguments at `slot * 16` lie inside the
+                    // dispatch buffer, which has `INDIRECT_BUFFER` usage.
+                    unsafe {
+                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);
+                        d.cmd_dispatch_indirect(cmd, self.dispatch.handle, (slot * 16) as u64);
+                    }
+                });
+                // The next BRDF's kernel adds onto the same image (other pixels, but one image).
+                rec.memory_barrier();
             }
-            ctx.end_label(cmd);
-            // The next BRDF's kernel adds onto the same image (other pixels, but one image).
-            memory_barrier(ctx, cmd);
-        }
-        ctx.end_label(cmd);
+        });
     }
 }
 
 /// Compute writes of the tile buffers made visible to the next compute pass and to the indirect
 /// dispatches.
-fn after_compute(ctx: &Context, cmd: vk::CommandBuffer) {
-    buffer_barrier(
-        ctx,
-        cmd,
+fn after_compute(rec: &Recording) {
+    tile_barrier(
+        rec,
         (
             vk::PipelineStageFlags2::COMPUTE_SHADER,
             vk::AccessFlags2::SHADER_STORAGE_WRITE,
@@ -632,9 +619,8 @@ fn after_compute(ctx: &Context, cmd: vk::CommandBuffer) {
 }
 
 /// A global barrier between `src` and `dst` (stage, access) for the tile buffers.
-fn buffer_barrier(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
+fn tile_barrier(
+    rec: &Recording,
     src: (vk::PipelineStageFlags2, vk::AccessFlags2),
     dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
 ) {
@@ -647,5 +633,5 @@ fn buffer_barrier(
     // SAFETY: `cmd` is recording outside rendering (the record fns above, inside
     // `record_tiled_with`), from a graphics and compute queue family, which supports the
     // transfer, compute and indirect stages named.
-    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &info) };
+    unsafe { rec.device().cmd_pipeline_barrier2(rec.outside(), &info) };
 }

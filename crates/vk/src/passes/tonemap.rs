@@ -1,13 +1,14 @@
 //! HDR -> 8-bit display colour. [`Tonemap`] owns its pipeline and the set that samples the
 //! renderer's HDR target; each frame it reads [`TonemapInputs`].
 
-use super::{begin_rendering, color_attachment, Load, CLEAR_BLACK};
-use crate::gpu::access::{transition, Contents, ImageAccess};
+use super::{color_attachment, Load, CLEAR_BLACK};
+use crate::gpu::access::{Contents, ImageAccess};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{one_set, pass_layouts, write_sampled_images, TONEMAP_SET};
 use crate::gpu::error::Result;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::state::{apply, FULLSCREEN};
+use crate::gpu::recording::Recording;
+use crate::gpu::state::FULLSCREEN;
 use crate::gpu::targets::Targets;
 use crate::gpu::teardown::build;
 use crate::shaders;
@@ -69,55 +70,28 @@ impl Tonemap {
     }
 
     /// Tonemaps `targets.hdr` into `targets.ldr`.
-    pub fn record(
-        &self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
-        inputs: &TonemapInputs,
-        targets: &mut Targets,
-    ) {
-        ctx.begin_label(cmd, "tonemap");
-        transition(
-            ctx,
-            cmd,
-            &mut targets.hdr,
-            ImageAccess::FragmentSampled,
-            Contents::Keep,
-        );
-        transition(
-            ctx,
-            cmd,
-            &mut targets.ldr,
-            ImageAccess::ColorAttachment,
-            Contents::Discard,
-        );
-        begin_rendering(
-            ctx,
-            cmd,
-            inputs.extent,
-            &[color_attachment(&targets.ldr, Load::Clear(CLEAR_BLACK))],
-            None,
-        );
-        // SAFETY: `cmd` is the renderer's, recording, inside the rendering begun above into
-        // the LDR target, of the format the pipeline was made for. The pipeline, layout and set
-        // were made by `new` and live as long as `self`; the frame set is of set 0's layout and
-        // `self.set` samples the HDR target, transitioned above for fragment reads.
-        unsafe {
-            ctx.device
-                .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-            ctx.device.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipeline_layout,
-                0,
-                &[inputs.frame_set, self.set],
-                &[],
-            );
-            apply(ctx, cmd, &FULLSCREEN);
-            ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
-            ctx.device.cmd_end_rendering(cmd);
-        }
-        ctx.end_label(cmd);
+    pub(crate) fn record(&self, rec: &Recording, inputs: &TonemapInputs, targets: &mut Targets) {
+        rec.step("tonemap", |rec| {
+            let hdr = (ImageAccess::FragmentSampled, Contents::Keep);
+            rec.transition(&mut targets.hdr, hdr.0, hdr.1);
+            let ldr = (ImageAccess::ColorAttachment, Contents::Discard);
+            rec.transition(&mut targets.ldr, ldr.0, ldr.1);
+            let colors = [color_attachment(&targets.ldr, Load::Clear(CLEAR_BLACK))];
+            rec.begin_rendering_over(inputs.extent, &colors, None);
+            // SAFETY: the pipeline, layout and set were made by `new` from this device and live
+            // as long as `self`, the pipeline with that layout (for the LDR target's format, the
+            // rendering's); the frame set is of set 0's layout and `self.set` of set 1's,
+            // sampling the HDR target, transitioned above for fragment reads.
+            unsafe {
+                let sets = [inputs.frame_set, self.set];
+                rec.bind_graphics(self.pipeline, self.pipeline_layout, &sets);
+            }
+            rec.apply(&FULLSCREEN);
+            // SAFETY: inside the rendering begun above, with the pipeline, its sets and the
+            // dynamic state it reads bound and set; the triangle reads no vertex buffer.
+            unsafe { rec.device().cmd_draw(rec.inside(), 3, 1, 0, 0) };
+            rec.end_rendering();
+        });
     }
 
     /// Frees the pipeline, the set's pool and the layouts; a second call does nothing.

@@ -9,9 +9,8 @@ use crate::gpu::error::{Error, Result};
 use crate::gpu::gpu_types::LightDrawPush;
 use crate::gpu::meshes::LightVolumes;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::readback::{copy_image_to_buffer, host_readable};
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
-use crate::gpu::state::apply;
 use crate::passes::begin_cleared;
 use crate::shaders;
 use ash::vk;
@@ -173,44 +172,40 @@ impl FootprintCapture {
     /// frame descriptor set must be bound.
     pub fn record(
         &mut self,
-        ctx: &Context,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         pipeline_layout: vk::PipelineLayout,
         volumes: &LightVolumes,
         light: (u32, &Light),
     ) {
-        ctx.begin_label(cmd, &format!("capture-footprint-{}", light.0));
-        for (face, cull) in [CullMode::Back, CullMode::Front].into_iter().enumerate() {
-            let clear = vk::ClearValue {
-                color: vk::ClearColorValue {
-                    float32: [NO_FACE; 4],
-                },
-            };
-            let image = &mut self.faces[face];
-            begin_cleared(ctx, cmd, image, clear);
-            let push = LightDrawPush {
-                light_index: light.0,
-                ..Default::default()
-            };
-            // SAFETY: `cmd` is recording (the caller, `Renderer::simulator_inputs`, began it)
-            // and inside the rendering `begin_cleared` began above; the pipeline was made by
-            // `new` with `pipeline_layout`, from this device, and lives until `destroy`; the
-            // push is `LightDrawPush` at offset 0, within the layout's graphics-stage range.
-            unsafe {
-                ctx.device
-                    .cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-                ctx.device.cmd_push_constants(
-                    cmd,
-                    pipeline_layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    bytemuck::bytes_of(&push),
-                );
-            }
-            apply(
-                ctx,
-                cmd,
-                &PassState {
+        rec.step(&format!("capture-footprint-{}", light.0), |rec| {
+            for (face, cull) in [CullMode::Back, CullMode::Front].into_iter().enumerate() {
+                let clear = vk::ClearValue {
+                    color: vk::ClearColorValue {
+                        float32: [NO_FACE; 4],
+                    },
+                };
+                let image = &mut self.faces[face];
+                begin_cleared(rec, image, clear);
+                let push = LightDrawPush {
+                    light_index: light.0,
+                    ..Default::default()
+                };
+                let (d, cmd) = (rec.device(), rec.inside());
+                // SAFETY: `cmd` is recording (the caller, `Renderer::simulator_inputs`, began it)
+                // and inside the rendering `begin_cleared` began above; the pipeline was made by
+                // `new` with `pipeline_layout`, from this device, and lives until `destroy`; the
+                // push is `LightDrawPush` at offset 0, within the layout's graphics-stage range.
+                unsafe {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+                    d.cmd_push_constants(
+                        cmd,
+                        pipeline_layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&push),
+                    );
+                }
+                rec.apply(&PassState {
                     cull,
                     depth: DepthState::OFF,
                     front: None,
@@ -218,21 +213,13 @@ impl FootprintCapture {
                     color_write: true,
                     hi_stencil: None,
                     depth_bounds: false,
-                },
-            );
-            volumes.draw(ctx, cmd, &light.1.kind);
-            // SAFETY: ends the rendering `begin_cleared` began on `cmd` in this iteration.
-            unsafe { ctx.device.cmd_end_rendering(cmd) };
-            copy_image_to_buffer(
-                ctx,
-                cmd,
-                image,
-                vk::ImageAspectFlags::COLOR,
-                &self.readback[face],
-            );
-        }
-        host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
-        ctx.end_label(cmd);
+                });
+                volumes.draw(rec, &light.1.kind);
+                rec.end_rendering();
+                rec.copy_image_to_buffer(image, vk::ImageAspectFlags::COLOR, &self.readback[face]);
+            }
+            rec.host_readable(vk::PipelineStageFlags2::COPY);
+        });
     }
 
     /// The footprint of the last recorded light, once the commands have completed, its depths

@@ -7,6 +7,7 @@ use crate::alpha::AlphaInputs;
 use crate::gpu::access::LightingTargets;
 use crate::gpu::error::{Error, Result, VkCall};
 use crate::gpu::readback::Readback;
+use crate::gpu::recording::Recording;
 use crate::gpu::targets::GBUFFER_FORMATS;
 use crate::gpu::timing::{progress_words, FrameTimings};
 use crate::hi_stencil::GpuHierarchy;
@@ -20,7 +21,7 @@ use crate::renderer::technique::{FrameDesc, MixedTiles, Shading, Technique, Tile
 use ash::vk;
 use histencil_model::{DepthConvention, FramePlan, ViewDesc};
 
-impl Renderer<'_> {
+impl<'c> Renderer<'c> {
     /// Renders one frame and waits for it: the forward reference ([`Shading::Forward`]) or a
     /// [`Technique`]'s deferred frame. `readback` says which images to copy back.
     pub fn render(&mut self, shading: impl Into<Shading>, readback: Readback) -> Result<Frame> {
@@ -46,20 +47,21 @@ impl Renderer<'_> {
             Some((technique, _)) => self.gpu_hierarchy(desc, *technique)?,
             None => None,
         };
-        let cmd = self.begin_commands()?;
-        self.timestamps.begin_frame(ctx, cmd);
+        let recording = self.begin_commands()?;
+        let rec = &recording;
+        self.timestamps.begin_frame(rec);
         match &deferred {
-            None => self.record_forward_pass(desc),
+            None => self.record_forward_pass(rec, desc),
             Some((technique, plan)) => {
                 let lit = (*technique, hierarchy);
-                self.record_deferred(desc, lit, &view, plan)?
+                self.record_deferred(rec, desc, lit, &view, plan)?
             }
         }
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            alpha.record_lightmaps(cmd, scene, &view, desc.alpha, desc.pass_timing)?;
-            self.timestamps.mark(ctx, cmd, "alpha-lightmaps");
+            alpha.record_lightmaps(rec, scene, &view, desc.alpha, desc.pass_timing)?;
+            self.timestamps.mark(rec, "alpha-lightmaps");
             let inputs = AlphaInputs {
                 scene,
                 meshes,
@@ -68,22 +70,22 @@ impl Renderer<'_> {
                 extent: self.extent,
                 depth: desc.depth,
             };
-            alpha.record_alpha(ctx, cmd, &inputs, &mut self.targets)?;
-            self.timestamps.mark(ctx, cmd, "alpha");
+            alpha.record_alpha(rec, &inputs, &mut self.targets)?;
+            self.timestamps.mark(rec, "alpha");
         }
         let inputs = TonemapInputs {
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
         };
-        self.tonemap.record(ctx, cmd, &inputs, &mut self.targets);
-        self.timestamps.mark(ctx, cmd, "tonemap");
+        self.tonemap.record(rec, &inputs, &mut self.targets);
+        self.timestamps.mark(rec, "tonemap");
         // Only the deferred frame has a G-buffer to read BRDF ids from.
         let readback = Readback {
             brdf_ids: desc.readback.brdf_ids && deferred.is_some(),
             ..desc.readback
         };
-        self.readback.record(ctx, cmd, &mut self.targets, readback);
-        self.submit_and_wait()?;
+        self.readback.record(rec, &mut self.targets, readback);
+        self.submit_and_wait(recording)?;
         let mut timings = self.timestamps.read(ctx)?;
         let planned = deferred.as_ref().filter(|(t, _)| t.records_plan());
         if desc.pass_timing && planned.is_some() {
@@ -113,15 +115,12 @@ impl Renderer<'_> {
     }
 
     /// The forward frame's one pass: every object lit by every light into the HDR target.
-    fn record_forward_pass(&mut self, desc: &FrameDesc) {
-        let (ctx, cmd) = (self.ctx, self.cmd);
+    fn record_forward_pass(&mut self, rec: &Recording, desc: &FrameDesc) {
         let mut targets = self.targets.lighting();
         let inputs = self.mesh_inputs(desc.depth);
-        self.mesh_passes
-            .record_forward(ctx, cmd, &inputs, &mut targets);
+        self.mesh_passes.record_forward(rec, &inputs, &mut targets);
         self.targets.lit(&targets);
-        self.timestamps
-            .mark(ctx, cmd, Shading::Forward.lighting_pass());
+        self.timestamps.mark(rec, Shading::Forward.lighting_pass());
     }
 
     /// The deferred frame's passes: the G-buffer, emission into the HDR target, and the
@@ -129,23 +128,23 @@ impl Renderer<'_> {
     /// platform emulating `hierarchy`.
     fn record_deferred(
         &mut self,
+        rec: &Recording,
         desc: &FrameDesc,
         (technique, hierarchy): (Technique, Option<GpuHierarchy>),
         view: &ViewDesc,
         plan: &FramePlan,
     ) -> Result<()> {
-        let (ctx, cmd) = (self.ctx, self.cmd);
-        self.record_gbuffer_pass(desc);
+        let ctx = self.ctx;
+        self.record_gbuffer_pass(rec, desc);
         // Emitted light goes into the HDR target once; the lighting adds onto it.
         let emits = self.scene.objects.iter().any(|o| o.material.emits());
         if emits {
             let mut targets = self.targets.lighting();
             let inputs = self.mesh_inputs(desc.depth);
-            self.mesh_passes
-                .record_emissive(ctx, cmd, &inputs, &mut targets);
+            self.mesh_passes.record_emissive(rec, &inputs, &mut targets);
             self.targets.lit(&targets);
         }
-        self.timestamps.mark(ctx, cmd, "gbuffer");
+        self.timestamps.mark(rec, "gbuffer");
         let tiled = match technique {
             Technique::Tiled { mixed, side } => Some((mixed, side, TiledShade::Kernels)),
             Technique::DepthId { side } => Some((MixedTiles::PerBrdf, side, TiledShade::DepthId)),
@@ -164,15 +163,20 @@ impl Renderer<'_> {
             };
             let mut targets = self.targets.lighting();
             let timestamps = &mut self.timestamps;
-            let classified = |cmd, pass| timestamps.mark(ctx, cmd, pass);
+            let classified = |rec: &Recording, pass| timestamps.mark(rec, pass);
             // SAFETY: as for `record_emulating` below; and the HDR target has `STORAGE` usage
             // (`Targets::new`), and the built-in hooks bind no engine resources.
             unsafe {
-                self.lighting
-                    .record_tiled_with(cmd, &frame, &mut targets, shade, classified)?
+                self.lighting.record_tiled_with(
+                    rec.outside(),
+                    &frame,
+                    &mut targets,
+                    shade,
+                    classified,
+                )?
             };
             self.targets.lit(&targets);
-            self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
+            self.timestamps.mark(rec, desc.shading.lighting_pass());
             return Ok(());
         }
         let frame = LightingFrame {
@@ -187,22 +191,24 @@ impl Renderer<'_> {
             hook_sets: HookSets::default(),
         };
         let mut targets = self.targets.lighting();
-        // SAFETY: `cmd` was begun by `begin_commands` on this context's device, the one the
-        // lighting was made with, and every pass before this one ended its rendering; the
+        // SAFETY: `rec` was begun by `begin_commands` on this context's device, the one the
+        // lighting was made with, and every pass before this one ended its rendering (`rec`
+        // records nothing until the lighting's own recording returns); the
         // targets are the renderer's own, with the states it tracks (`Targets::lit` after each
         // pass); `begin_commands` declared slot 0 finished after the last frame's wait.
         unsafe {
             self.lighting
-                .record_emulating(cmd, &frame, &mut targets, hierarchy)?
+                .record_emulating(rec.outside(), &frame, &mut targets, hierarchy)?
         };
         self.targets.lit(&targets);
-        self.timestamps.mark(ctx, cmd, desc.shading.lighting_pass());
+        self.timestamps.mark(rec, desc.shading.lighting_pass());
         Ok(())
     }
 
     /// Resets the frame's command pool (its one command buffer; resetting pools, not single
-    /// buffers, is what the best-practices layer asks for) and begins the command buffer.
-    pub(super) fn begin_commands(&mut self) -> Result<vk::CommandBuffer> {
+    /// buffers, is what the best-practices layer asks for), begins the command buffer and
+    /// returns the recording the frame's passes record through.
+    pub(super) fn begin_commands(&mut self) -> Result<Recording<'c>> {
         // The renderer's last frame was submitted and waiting for it failed (a timeout or a
         // lost device): it records nothing more, and says why as the wait did (a device error).
         if let Some(result) = self.unfinished.get() {
@@ -226,12 +232,16 @@ impl Renderer<'_> {
             d.begin_command_buffer(cmd, &begin)
                 .call("vkBeginCommandBuffer")?;
         }
-        Ok(cmd)
+        // SAFETY: `cmd` was begun just now, outside rendering, on the context's queue family
+        // (graphics and compute); the renderer records into it through this recording alone.
+        Ok(unsafe { Recording::new(self.ctx, cmd) })
     }
 
-    /// Ends, submits and waits for the frame's command buffer.
-    pub(super) fn submit_and_wait(&self) -> Result<()> {
-        let (ctx, cmd) = (self.ctx, self.cmd);
+    /// Ends, submits and waits for the frame's command buffer, recorded through `rec`
+    /// ([`Self::begin_commands`]'s).
+    pub(super) fn submit_and_wait(&self, rec: Recording) -> Result<()> {
+        let (ctx, cmd) = (self.ctx, rec.outside());
+        rec.finish();
         // SAFETY: `cmd` is recording (`begin_commands`) and outside rendering: every pass ends
         // its own. The fence is this renderer's, unsignalled (reset after each wait, created
         // unsignalled) and not in use by another submit. `Context::submit` holds the queue's
@@ -302,11 +312,10 @@ impl Renderer<'_> {
     }
 
     /// Records the G-buffer pass into the renderer's targets.
-    pub(super) fn record_gbuffer_pass(&mut self, desc: &FrameDesc) {
-        let cmd = self.cmd;
+    pub(super) fn record_gbuffer_pass(&mut self, rec: &Recording, desc: &FrameDesc) {
         let mut targets = self.targets.lighting();
         let (depth, pattern) = (desc.depth, desc.preserved_pattern);
-        self.record_gbuffer_into(cmd, &mut targets, depth, pattern);
+        self.record_gbuffer_into(rec, &mut targets, depth, pattern);
         self.targets.lit(&targets);
     }
 
@@ -325,7 +334,7 @@ impl Renderer<'_> {
 
     fn record_gbuffer_into(
         &self,
-        cmd: vk::CommandBuffer,
+        rec: &Recording,
         targets: &mut LightingTargets,
         depth: DepthConvention,
         preserved_pattern: u8,
@@ -337,7 +346,7 @@ impl Renderer<'_> {
         };
         let inputs = self.mesh_inputs(depth);
         self.mesh_passes
-            .record_gbuffer(self.ctx, cmd, &inputs, &stencil, targets);
+            .record_gbuffer(rec, &inputs, &stencil, targets);
     }
 
     /// Records histencil's G-buffer pass of the scene (its camera, its objects) into another
@@ -372,7 +381,11 @@ impl Renderer<'_> {
                 )));
             }
         }
-        self.record_gbuffer_into(cmd, targets, DepthConvention::Standard, 0);
+        // SAFETY: this fn's # Safety is `Recording::new`'s, and the renderer's device is its
+        // context's.
+        let rec = unsafe { Recording::new(self.ctx, cmd) };
+        self.record_gbuffer_into(&rec, targets, DepthConvention::Standard, 0);
+        rec.finish();
         Ok(())
     }
 

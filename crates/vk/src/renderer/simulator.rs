@@ -2,7 +2,6 @@
 
 use super::Renderer;
 use crate::gpu::error::Result;
-use crate::gpu::readback::{copy_image_to_buffer, host_readable};
 use crate::gpu::resources::Buffer;
 use crate::hi_stencil::GpuHierarchy;
 use crate::renderer::capture::{FootprintCapture, SimulatorInputs};
@@ -46,13 +45,13 @@ impl Renderer<'_> {
         let mut depth = Buffer::readback(ctx, "depth-readback", pixels * 4)?;
         let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
         let result = (|| {
-            let cmd = self.begin_commands()?;
-            self.record_gbuffer_pass(desc);
+            let rec = self.begin_commands()?;
+            self.record_gbuffer_pass(&rec, desc);
             let image = &mut self.targets.depth_stencil;
-            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::DEPTH, &depth);
-            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
-            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
-            self.submit_and_wait()?;
+            rec.copy_image_to_buffer(image, vk::ImageAspectFlags::DEPTH, &depth);
+            rec.copy_image_to_buffer(image, vk::ImageAspectFlags::STENCIL, &stencil);
+            rec.host_readable(vk::PipelineStageFlags2::COPY);
+            self.submit_and_wait(rec)?;
             let target = SoftTarget {
                 width: self.extent.width,
                 height: self.extent.height,
@@ -67,13 +66,13 @@ impl Renderer<'_> {
                     footprints.push(full.in_convention(desc.depth));
                     continue;
                 }
-                let cmd = self.begin_commands()?;
-                // SAFETY: `cmd` was just begun by `begin_commands`, outside rendering; the
+                let rec = self.begin_commands()?;
+                // SAFETY: `rec` was just begun by `begin_commands`, outside rendering; the
                 // frame set's layout is made identical to the lighting's frame set layout, set 0
                 // of `layout` (`Descriptors::new`), and both live as long as the renderer.
                 unsafe {
                     ctx.device.cmd_bind_descriptor_sets(
-                        cmd,
+                        rec.outside(),
                         vk::PipelineBindPoint::GRAPHICS,
                         layout,
                         0,
@@ -82,8 +81,8 @@ impl Renderer<'_> {
                     );
                 }
                 let light = &self.scene.lights[index as usize];
-                capture.record(ctx, cmd, layout, self.lighting.volumes(), (index, light));
-                self.submit_and_wait()?;
+                capture.record(&rec, layout, self.lighting.volumes(), (index, light));
+                self.submit_and_wait(rec)?;
                 footprints.push(capture.footprint(desc.depth)?);
             }
             Ok(SimulatorInputs {
@@ -114,10 +113,10 @@ impl Renderer<'_> {
         let pixels = u64::from(width) * u64::from(height);
         let mut ids = Buffer::readback(ctx, "depth-id-readback", pixels * 2)?;
         let result = (|| {
-            let cmd = self.begin_commands()?;
-            self.lighting.copy_depth_ids(cmd, side, 0, &ids);
-            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
-            self.submit_and_wait()?;
+            let rec = self.begin_commands()?;
+            self.lighting.copy_depth_ids(&rec, side, 0, &ids);
+            rec.host_readable(vk::PipelineStageFlags2::COPY);
+            self.submit_and_wait(rec)?;
             let ids: &[u16] = bytemuck::cast_slice(ids.read());
             let tiles = TileSurface::new(width, height, HI_STENCIL_TILE);
             let passes: Vec<u16> = (0..self.brdfs.len() as u32).map(slot_id).collect();
@@ -158,12 +157,12 @@ impl Renderer<'_> {
         let pixels = u64::from(width) * u64::from(height);
         let mut stencil = Buffer::readback(ctx, "pretest-stencil-readback", pixels)?;
         let result = (|| {
-            let cmd = self.begin_commands()?;
-            self.record_gbuffer_pass(desc);
+            let rec = self.begin_commands()?;
+            self.record_gbuffer_pass(&rec, desc);
             let image = &mut self.targets.depth_stencil;
-            copy_image_to_buffer(ctx, cmd, image, vk::ImageAspectFlags::STENCIL, &stencil);
-            host_readable(ctx, cmd, vk::PipelineStageFlags2::COPY);
-            self.submit_and_wait()?;
+            rec.copy_image_to_buffer(image, vk::ImageAspectFlags::STENCIL, &stencil);
+            rec.host_readable(vk::PipelineStageFlags2::COPY);
+            self.submit_and_wait(rec)?;
             let layout = &self.stencil_layout;
             let tiles = TileSurface::new(width, height, HI_STENCIL_TILE);
             let counts = slot_tile_counts(layout, stencil.read(), width, &tiles);

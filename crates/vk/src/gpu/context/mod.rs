@@ -598,7 +598,9 @@ impl Context {
         }
     }
 
-    /// Opens a debug label region on a command buffer; pair with [`Context::end_label`].
+    /// Opens a debug label region on a command buffer and tells the step observer; pair with
+    /// [`Context::end_label`]. Only the encoder calls it (`Recording::step`, which tracks the
+    /// labels it opened and checks they are closed).
     pub(crate) fn begin_label(&self, cmd: vk::CommandBuffer, label: &str) {
         let observed = {
             let mut steps = self.steps.lock().unwrap_or_else(|e| e.into_inner());
