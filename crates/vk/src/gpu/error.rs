@@ -6,6 +6,7 @@ use ash::vk;
 /// failed: choose another configuration or device), the data (a scene, layout or plan the
 /// renderer cannot take: fix the content), or the output (a file that could not be written).
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// The Vulkan loader, or the validation layer that was asked for, is not installed.
     #[error("cannot load the Vulkan library: {0}")]

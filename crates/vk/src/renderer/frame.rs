@@ -301,8 +301,7 @@ impl<'c> Renderer<'c> {
             }
             if let Some(step) = step {
                 let written = self.timestamps.written(ctx);
-                if written.is_some() && written != told {
-                    let n = written.unwrap_or_default();
+                if let Some(n) = written.filter(|n| told != Some(*n)) {
                     ctx.step_progress(step, &progress_words(self.timestamps.names(), n));
                     told = written;
                 }
