@@ -22,6 +22,7 @@ mod lighting;
 pub mod passes;
 mod renderer;
 mod shader_consts;
+pub mod shader_layouts;
 mod tools;
 
 // The device layer's public modules, where engines and tests have always found them.

@@ -1,7 +1,8 @@
 //! Every descriptor binding reflected from the SPIR-V (by naga) matches the Rust-side layout the
 //! module is used with: same set, binding, kind, and GLSL name.
 
-use histencil_vk::descriptors::{BindingKind, SHADER_LAYOUTS};
+use histencil_vk::descriptors::BindingKind;
+use histencil_vk::shader_layouts::SHADER_LAYOUTS;
 use histencil_vk::shaders;
 
 fn reflected_bindings(name: &str, spirv: &[u8]) -> Vec<(u32, u32, BindingKind, String)> {

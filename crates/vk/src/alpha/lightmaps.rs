@@ -14,10 +14,12 @@
 use super::gpu::{frame_records, AlphaDrawPush, FrameRecords};
 use super::lightmap_checks::{bad, check_direction, check_frame};
 use crate::gpu::access::ImageRef;
+use crate::gpu::attachments::{begin_all_cleared, CLEAR_BLACK};
 use crate::gpu::context::Context;
+use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::descriptors::{
-    create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers, ALPHA_SET,
-    FRAME_SET, GRAPHICS_STAGES,
+    create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers, FRAME_SET,
+    GRAPHICS_STAGES,
 };
 use crate::gpu::error::{Error, Result, VkCall};
 use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
@@ -27,7 +29,6 @@ use crate::gpu::resources::Buffer;
 use crate::gpu::state::FULLSCREEN;
 use crate::gpu::teardown::{DestroyResult, PendingSlots};
 use crate::gpu::timing::{LightmapTimings, SlotTimer};
-use crate::passes::{begin_all_cleared, CLEAR_BLACK};
 use crate::shaders;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -36,6 +37,15 @@ use histencil_alpha::{LightmapLayout, Region, Viewer};
 use histencil_model::ViewDesc;
 use histencil_scene::Light;
 use std::ops::Deref;
+
+/// Set 1 of the alpha pipelines (include/alpha.glsl): entity records, dust and ribbon points,
+/// each entity's light list, and the objects' baked probes.
+pub(crate) const ALPHA_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, ""),
+    binding(3, BindingKind::StorageBuffer, ""),
+];
 
 /// What an [`AlphaLightmaps`] is made for: fixed for its lifetime.
 #[derive(Clone, Copy, Debug)]

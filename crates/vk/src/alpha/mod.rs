@@ -12,17 +12,18 @@
 
 mod gpu;
 mod lightmap_checks;
-mod lightmaps;
+pub(crate) mod lightmaps;
 
 pub use gpu::AlphaEntityRecord;
 pub use histencil_alpha::{mesh_bounds, AlphaEntity, AlphaEntityKind};
 pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 
 use crate::gpu::access::{Contents, ImageAccess};
+use crate::gpu::attachments::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
 use crate::gpu::context::Context;
+use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::descriptors::{
-    create_pipeline_layout, create_set_layout, write_sampled_images, ALPHA_LIGHTMAP_SET,
-    GRAPHICS_STAGES,
+    create_pipeline_layout, create_set_layout, write_sampled_images, GRAPHICS_STAGES,
 };
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::meshes::Meshes;
@@ -32,7 +33,6 @@ use crate::gpu::resources::{Buffer, Image};
 use crate::gpu::state::{oriented, FULLSCREEN};
 use crate::gpu::targets::{Targets, HDR_FORMAT};
 use crate::gpu::timing::LightmapTimings;
-use crate::passes::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
 use crate::shader_consts::ALPHA_MODES;
 use crate::shaders;
 use ash::vk;
@@ -43,6 +43,14 @@ use histencil_alpha::{
 };
 use histencil_model::{CompareOp, CullMode, DepthConvention, DepthState, PassState, ViewDesc};
 use histencil_scene::Scene;
+
+/// Set 2 of the alpha pass (include/alpha_lightmap.glsl): the lightmap atlas. A set of its own
+/// because the lightmap pass renders into it.
+pub(crate) const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::SampledImage, "lightmap"),
+    binding(1, BindingKind::SampledImage, "direction_map"),
+    binding(2, BindingKind::Sampler, "lightmap_sampler"),
+];
 
 /// How the alpha pass lights translucent objects and particles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -1,5 +1,6 @@
 //! Descriptor set layouts as data, the pipeline layouts built from them, and the sets of a frame.
-//! The tables here are what the reflection test holds every shader module against.
+//! The sets every pass shares (the frame's, the G-buffer's) are here; each pass keeps its own
+//! set's table, and `crate::shader_layouts` gathers them for the reflection test.
 
 use crate::gpu::context::Context;
 use crate::gpu::error::{Result, VkCall};
@@ -58,7 +59,11 @@ pub struct BindingDesc {
     pub glsl_name: &'static str,
 }
 
-const fn binding(binding: u32, kind: BindingKind, glsl_name: &'static str) -> BindingDesc {
+pub(crate) const fn binding(
+    binding: u32,
+    kind: BindingKind,
+    glsl_name: &'static str,
+) -> BindingDesc {
     BindingDesc {
         binding,
         kind,
@@ -71,139 +76,11 @@ pub const FRAME_SET: &[BindingDesc] = &[
     binding(0, BindingKind::UniformBuffer, "frame"),
     binding(1, BindingKind::StorageBuffer, "lights"),
 ];
-/// Set 1 of the mesh pipelines (include/material.glsl): a material's map record, its three
-/// maps and their samplers.
-pub const MATERIAL_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::UniformBuffer, "material_maps"),
-    binding(1, BindingKind::SampledImage, "map_base_color"),
-    binding(2, BindingKind::SampledImage, "map_normal"),
-    binding(3, BindingKind::SampledImage, "map_metallic_roughness"),
-    binding(4, BindingKind::SampledImage, "map_emissive"),
-    binding(5, BindingKind::Sampler, "sampler_base_color"),
-    binding(6, BindingKind::Sampler, "sampler_normal"),
-    binding(7, BindingKind::Sampler, "sampler_metallic_roughness"),
-    binding(8, BindingKind::Sampler, "sampler_emissive"),
-];
 /// Set 1 of the deferred light pipelines (include/gbuffer.glsl).
 pub const GBUFFER_SET: &[BindingDesc] = &[
     binding(0, BindingKind::SampledImage, "gbuffer_albedo"),
     binding(1, BindingKind::SampledImage, "gbuffer_normal_depth"),
     binding(2, BindingKind::SampledImage, "gbuffer_material"),
-];
-/// Set 2 of the light pipelines: the hi-stencil emulation (include/hi_stencil.glsl).
-pub const HI_STENCIL_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, ""),
-    binding(1, BindingKind::StorageBuffer, ""),
-    binding(2, BindingKind::StorageBuffer, "hi_stats"),
-    binding(3, BindingKind::StorageBuffer, ""),
-];
-/// The tile update's pending surface (written), touch image (read) and stencil (a
-/// stencil-aspect view, read); see `hi_stencil.rs`.
-pub const HI_STENCIL_UPDATE_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, ""),
-    binding(1, BindingKind::SampledImage, "touch_depth"),
-    binding(2, BindingKind::SampledImage, "stencil_image"),
-];
-/// Set 1 of the tonemap pipeline (tonemap.frag).
-pub const TONEMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "hdr")];
-/// The BRDF evaluator's cases (read) and results (written); see `brdf_eval.rs`.
-pub const BRDF_EVAL_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, "cases"),
-    binding(1, BindingKind::StorageBuffer, "results"),
-];
-
-/// Set 3 of the light pipelines: the LUT technique's tables (include/lut.glsl), bound only by
-/// the LUT light shader.
-pub const LUT_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, ""),
-    binding(1, BindingKind::StorageBuffer, ""),
-];
-/// The table lookup evaluator's cases, results and tables; see `lut.rs`.
-pub const LUT_EVAL_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, ""),
-    binding(1, BindingKind::StorageBuffer, ""),
-    binding(2, BindingKind::StorageBuffer, ""),
-    binding(3, BindingKind::StorageBuffer, ""),
-];
-
-/// Set 1 of the alpha pipelines (include/alpha.glsl): entity records, dust and ribbon points,
-/// each entity's light list, and the objects' baked probes.
-pub const ALPHA_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, ""),
-    binding(1, BindingKind::StorageBuffer, ""),
-    binding(2, BindingKind::StorageBuffer, ""),
-    binding(3, BindingKind::StorageBuffer, ""),
-];
-/// Set 2 of the alpha pass (include/alpha_lightmap.glsl): the lightmap atlas. A set of its own
-/// because the lightmap pass renders into it.
-pub const ALPHA_LIGHTMAP_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::SampledImage, "lightmap"),
-    binding(1, BindingKind::SampledImage, "direction_map"),
-    binding(2, BindingKind::Sampler, "lightmap_sampler"),
-];
-
-/// Set 2 of the tiled technique's compute passes (include/tiled.glsl): dispatch arguments, tile
-/// lists and light masks, and the HDR target as a storage image.
-pub const TILED_SET: &[BindingDesc] = &[
-    binding(0, BindingKind::StorageBuffer, ""),
-    binding(1, BindingKind::StorageBuffer, ""),
-    binding(2, BindingKind::StorageBuffer, ""),
-    binding(3, BindingKind::StorageBuffer, ""),
-    binding(4, BindingKind::StorageImage, "tiled_hdr"),
-];
-
-// The pipeline layouts: which sets, in order (set N is element N), as `SHADER_LAYOUTS` holds
-// each module to them.
-
-/// The mesh pipelines: G-buffer, forward reference and emissive.
-pub const MESH_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, MATERIAL_SET];
-/// The light pipelines: deferred and LUT lights, hi-stencil count, stencil restore, footprint.
-pub const LIGHTING_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, HI_STENCIL_SET, LUT_SET];
-/// The tonemap pass.
-pub const TONEMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, TONEMAP_SET];
-/// The BRDF evaluator's compute pipeline.
-pub const BRDF_EVAL_LAYOUT: &[&[BindingDesc]] = &[BRDF_EVAL_SET];
-/// The hi-stencil tile update's compute pipeline.
-pub const HI_STENCIL_UPDATE_LAYOUT: &[&[BindingDesc]] = &[HI_STENCIL_UPDATE_SET];
-/// The table lookup evaluator's compute pipeline.
-pub const LUT_EVAL_LAYOUT: &[&[BindingDesc]] = &[LUT_EVAL_SET];
-/// The alpha pass: translucent objects and particles.
-pub const ALPHA_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET, ALPHA_LIGHTMAP_SET];
-/// The lightmap pass renders into the atlas, so it does not bind it.
-pub const LIGHTMAP_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, ALPHA_SET];
-/// The tiled technique's compute passes and the depth-id technique's copy and shade.
-pub const TILED_LAYOUT: &[&[BindingDesc]] = &[FRAME_SET, GBUFFER_SET, TILED_SET];
-
-/// Every shader module and the pipeline layout it is used with.
-pub const SHADER_LAYOUTS: &[(&str, &[&[BindingDesc]])] = &[
-    ("mesh.vert", MESH_LAYOUT),
-    ("gbuffer.frag", MESH_LAYOUT),
-    ("forward.frag", MESH_LAYOUT),
-    ("emissive.frag", MESH_LAYOUT),
-    ("light_volume.vert", LIGHTING_LAYOUT),
-    ("deferred_light.frag", LIGHTING_LAYOUT),
-    ("lut_light.frag", LIGHTING_LAYOUT),
-    ("hi_stencil_count.frag", LIGHTING_LAYOUT),
-    ("restore_preserved.frag", LIGHTING_LAYOUT),
-    ("footprint.frag", LIGHTING_LAYOUT),
-    ("hi_stencil_update.comp", HI_STENCIL_UPDATE_LAYOUT),
-    ("fullscreen.vert", LIGHTING_LAYOUT),
-    ("tonemap.frag", TONEMAP_LAYOUT),
-    ("brdf_eval.comp", BRDF_EVAL_LAYOUT),
-    ("lut_eval.comp", LUT_EVAL_LAYOUT),
-    ("lightmap.frag", LIGHTMAP_LAYOUT),
-    ("lightmap_directional.frag", LIGHTMAP_LAYOUT),
-    ("alpha_object.vert", ALPHA_LAYOUT),
-    ("alpha_object.frag", ALPHA_LAYOUT),
-    ("particle.vert", ALPHA_LAYOUT),
-    ("particle.frag", ALPHA_LAYOUT),
-    ("tile_classify.comp", TILED_LAYOUT),
-    ("tile_lights.comp", TILED_LAYOUT),
-    ("tile_shade.comp", TILED_LAYOUT),
-    ("tile_classify_8.comp", TILED_LAYOUT),
-    ("tile_shade_8.comp", TILED_LAYOUT),
-    ("depth_id_copy.frag", TILED_LAYOUT),
-    ("depth_id_shade.frag", TILED_LAYOUT),
 ];
 
 /// The stages of the graphics passes: every binding and push constant is visible to both.

@@ -5,7 +5,7 @@ use crate::shader_consts::LIGHT_KINDS;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use histencil_model::ViewDesc;
-use histencil_scene::{Camera, Light, LightKind, Material};
+use histencil_scene::{Camera, Light, LightKind};
 
 /// `Frame` in frame.glsl (std140).
 #[repr(C)]
@@ -167,52 +167,10 @@ impl GpuLight {
     }
 }
 
-/// `Draw` push constants in draw.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-pub struct DrawPush {
-    /// Object to world.
-    pub model: [[f32; 4]; 4],
-    /// rgb: the material's tint; w: its material index (the LUT technique's table).
-    pub tint: [f32; 4],
-    /// xyz: the BRDF's packed parameters; w: its model index.
-    pub params: [f32; 4],
-}
-
-impl DrawPush {
-    /// `material_index` is the material's LUT table (the G-buffer stores it for the LUT
-    /// technique).
-    pub fn new(model: Mat4, material: &Material, material_index: u32) -> Self {
-        let p = material.brdf.packed_params();
-        Self {
-            model: model.to_cols_array_2d(),
-            tint: material.tint.extend(material_index as f32).to_array(),
-            params: [
-                p[0] as f32,
-                p[1] as f32,
-                p[2] as f32,
-                material.brdf.model_index() as f32,
-            ],
-        }
-    }
-}
-
-/// Push constants of the light passes (include/light_draw.glsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct LightDrawPush {
-    /// The light's index in the frame's light buffer.
-    pub light_index: u32,
-    /// Unique per draw of a frame: the hi-stencil emulation marks covered tiles with it.
-    pub stamp: u32,
-    /// `LIGHT_DRAW_*` bits (`shader_consts::LIGHT_DRAW_FLAGS`).
-    pub flags: u32,
-    /// The stencil bit a restore draw writes.
-    pub bit: u32,
-}
-
-/// Bytes of push-constant space every pipeline layout declares (the largest block, `Draw`).
-pub const PUSH_CONSTANT_BYTES: u32 = std::mem::size_of::<DrawPush>() as u32;
+/// Bytes of push-constant space every pipeline layout declares: the largest block, the mesh
+/// passes' `Draw` (`passes::geometry::DrawPush`, which asserts it is this size; every other
+/// pass's block is smaller, and a layout's range must cover it).
+pub const PUSH_CONSTANT_BYTES: u32 = 96;
 
 // 128 bytes is the push-constant space every Vulkan device guarantees.
 const _: () = assert!(PUSH_CONSTANT_BYTES <= 128);
@@ -306,6 +264,5 @@ mod tests {
     fn block_sizes_match_the_glsl() {
         assert_eq!(std::mem::size_of::<FrameUniforms>(), 4 * 64 + 5 * 16);
         assert_eq!(std::mem::size_of::<GpuLight>(), 64);
-        assert_eq!(PUSH_CONSTANT_BYTES, 96);
     }
 }

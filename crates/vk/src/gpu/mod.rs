@@ -1,8 +1,11 @@
 //! The device layer: the device histencil borrows or owns, memory and images, barriers derived
 //! from declared accesses, descriptors, pipelines, readback and upload, timing, names and
 //! validation messages, and teardown that survives a creation failing half way. Everything
-//! above it (the passes, the emulation, the engine API, the renderer) records through it; it
-//! knows nothing of lighting.
+//! above it (the passes, the emulation, the engine API, the renderer) records through it
+//! (`recording::Recording`, the encoder) and it imports nothing from above. Of the passes it
+//! holds only what they all share: the frame set (`FRAME_SET`, `FrameUniforms`, `GpuLight`),
+//! the G-buffer's contract (`GBUFFER_SET`, `access::LightingTargets`) and the timings' types;
+//! each pass keeps its own sets' tables and push blocks (`crate::shader_layouts` gathers them).
 
 pub mod access;
 pub(crate) mod attachments;

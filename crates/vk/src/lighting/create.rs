@@ -5,16 +5,18 @@ use super::{DeferredLighting, Slot};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers, FRAME_SET,
-    GBUFFER_SET, GRAPHICS_STAGES, HI_STENCIL_SET, LUT_SET,
+    GBUFFER_SET, GRAPHICS_STAGES,
 };
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::gpu_types::{FrameUniforms, GpuLight, PUSH_CONSTANT_BYTES};
-use crate::gpu::meshes::LightVolumes;
 use crate::gpu::resources::Buffer;
 use crate::gpu::timing::SlotTimer;
 use crate::hi_stencil::HiStencilSurface;
+use crate::hi_stencil::HI_STENCIL_SET;
 use crate::lighting::hooks::LightHooks;
+use crate::lighting::lut::LUT_SET;
 use crate::passes::light_pipelines::LightPipelines;
+use crate::passes::light_volumes::LightVolumes;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::ops::Deref;

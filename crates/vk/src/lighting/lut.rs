@@ -5,7 +5,7 @@
 
 use crate::gpu::compute::{pad, CaseKernel};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::LUT_EVAL_SET;
+use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::error::{Error, Result};
 use crate::gpu::resources::Buffer;
 use crate::gpu::teardown::InFlight;
@@ -15,6 +15,20 @@ use ash::vk;
 use histencil_brdf::lut::{Lut, LutAxes};
 use histencil_brdf::{Brdf, V3};
 use std::ops::Deref;
+
+/// Set 3 of the light pipelines: the LUT technique's tables (include/lut.glsl), bound only by
+/// the LUT light shader.
+pub(crate) const LUT_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+];
+/// The table lookup evaluator's cases, results and tables; see `lut.rs`.
+pub(crate) const LUT_EVAL_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, ""),
+    binding(3, BindingKind::StorageBuffer, ""),
+];
 
 /// std430 mirror of `LutTable` in `crates/vk/shaders/include/lut.glsl`.
 #[repr(C)]

@@ -8,9 +8,10 @@ use super::{
 };
 use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::{pass_layouts, MATERIAL_SET};
+use crate::gpu::descriptors::pass_layouts;
+use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::error::Result;
-use crate::gpu::gpu_types::DrawPush;
+use crate::gpu::gpu_types::PUSH_CONSTANT_BYTES;
 use crate::gpu::meshes::Meshes;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::recording::Recording;
@@ -18,11 +19,61 @@ use crate::gpu::state::{oriented, with_stencil, OPAQUE};
 use crate::gpu::teardown::build;
 use crate::shaders;
 use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use glam::Mat4;
 use histencil_model::{
     CompareOp, CullMode, DepthConvention, DepthState, FaceStencil, PassState, StencilLayout,
     StencilOp,
 };
+use histencil_scene::Material;
 use histencil_scene::Scene;
+
+/// `Draw` push constants in draw.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct DrawPush {
+    /// Object to world.
+    pub model: [[f32; 4]; 4],
+    /// rgb: the material's tint; w: its material index (the LUT technique's table).
+    pub tint: [f32; 4],
+    /// xyz: the BRDF's packed parameters; w: its model index.
+    pub params: [f32; 4],
+}
+
+impl DrawPush {
+    /// `material_index` is the material's LUT table (the G-buffer stores it for the LUT
+    /// technique).
+    pub fn new(model: Mat4, material: &Material, material_index: u32) -> Self {
+        let p = material.brdf.packed_params();
+        Self {
+            model: model.to_cols_array_2d(),
+            tint: material.tint.extend(material_index as f32).to_array(),
+            params: [
+                p[0] as f32,
+                p[1] as f32,
+                p[2] as f32,
+                material.brdf.model_index() as f32,
+            ],
+        }
+    }
+}
+
+// Every pipeline layout's push range is `Draw`'s size.
+const _: () = assert!(std::mem::size_of::<DrawPush>() as u32 == PUSH_CONSTANT_BYTES);
+
+/// Set 1 of the mesh pipelines (include/material.glsl): a material's map record, its three
+/// maps and their samplers.
+pub(crate) const MATERIAL_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::UniformBuffer, "material_maps"),
+    binding(1, BindingKind::SampledImage, "map_base_color"),
+    binding(2, BindingKind::SampledImage, "map_normal"),
+    binding(3, BindingKind::SampledImage, "map_metallic_roughness"),
+    binding(4, BindingKind::SampledImage, "map_emissive"),
+    binding(5, BindingKind::Sampler, "sampler_base_color"),
+    binding(6, BindingKind::Sampler, "sampler_normal"),
+    binding(7, BindingKind::Sampler, "sampler_metallic_roughness"),
+    binding(8, BindingKind::Sampler, "sampler_emissive"),
+];
 
 /// The mesh passes, made once: the G-buffer, forward and emission pipelines, their pipeline
 /// layout (set 0 the frame, set 1 an object's material) and the material set layout.

@@ -15,14 +15,13 @@ use super::light_pipelines::{
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
 use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::error::Result;
-use crate::gpu::gpu_types::LightDrawPush;
-use crate::gpu::meshes::LightVolumes;
 use crate::gpu::recording::Recording;
 use crate::gpu::state::FULLSCREEN;
 use crate::gpu::timing::StepTimer;
 use crate::hi_stencil::{
     plan_touches, tile_rect, GpuHierarchy, HiStencilSurface, TouchedTiles, WriteTiles,
 };
+use crate::passes::light_volumes::LightVolumes;
 use crate::shader_consts::{LIGHT_DRAW_COUNT, LIGHT_DRAW_HI_STENCIL_TEST};
 use ash::vk;
 use histencil_brdf::BrdfId;
@@ -31,6 +30,20 @@ use histencil_model::{
     PassKind, PassState, Shader, StencilOp, Step,
 };
 use histencil_scene::Light;
+
+/// Push constants of the light passes (include/light_draw.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightDrawPush {
+    /// The light's index in the frame's light buffer.
+    pub light_index: u32,
+    /// Unique per draw of a frame: the hi-stencil emulation marks covered tiles with it.
+    pub stamp: u32,
+    /// `LIGHT_DRAW_*` bits (`shader_consts::LIGHT_DRAW_FLAGS`).
+    pub flags: u32,
+    /// The stencil bit a restore draw writes.
+    pub bit: u32,
+}
 
 /// The talk's pass group of a planned pass, for timings: `setup`, `mask-<brdf>`, `shade-<brdf>`
 /// (`-branching` for the uber shader, `-lut` for the table shader), `cleanup`, `zero-preserved`.

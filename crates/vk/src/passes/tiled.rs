@@ -12,8 +12,9 @@
 
 use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
+use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::descriptors::{
-    create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers, TILED_SET,
+    create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers,
 };
 use crate::gpu::error::{Error, Result};
 use crate::gpu::limits::Limit;
@@ -28,6 +29,16 @@ use crate::shaders;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_brdf::BrdfId;
+
+/// Set 2 of the tiled technique's compute passes (include/tiled.glsl): dispatch arguments, tile
+/// lists and light masks, and the HDR target as a storage image.
+pub(crate) const TILED_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, ""),
+    binding(1, BindingKind::StorageBuffer, ""),
+    binding(2, BindingKind::StorageBuffer, ""),
+    binding(3, BindingKind::StorageBuffer, ""),
+    binding(4, BindingKind::StorageImage, "tiled_hdr"),
+];
 
 /// `Tiled` in include/tiled.glsl.
 #[repr(C)]

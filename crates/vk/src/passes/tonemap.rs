@@ -4,7 +4,8 @@
 use super::{color_attachment, Load, CLEAR_BLACK};
 use crate::gpu::access::{Contents, ImageAccess};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::{one_set, pass_layouts, write_sampled_images, TONEMAP_SET};
+use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
+use crate::gpu::descriptors::{one_set, pass_layouts, write_sampled_images};
 use crate::gpu::error::Result;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::recording::Recording;
@@ -13,6 +14,9 @@ use crate::gpu::targets::Targets;
 use crate::gpu::teardown::build;
 use crate::shaders;
 use ash::vk;
+
+/// Set 1 of the tonemap pipeline (tonemap.frag).
+pub(crate) const TONEMAP_SET: &[BindingDesc] = &[binding(0, BindingKind::SampledImage, "hdr")];
 
 /// The tonemap pass, made once for one HDR target.
 #[derive(Default)]

@@ -4,14 +4,14 @@
 //! clamp). Running `histencil_model::Simulator` on them predicts the GPU frame exactly: its
 //! final stencil and its hi-stencil statistics (`tests/tests/hi_stencil.rs` holds it to that).
 
+use crate::gpu::attachments::begin_cleared;
 use crate::gpu::context::Context;
 use crate::gpu::error::{Error, Result};
-use crate::gpu::gpu_types::LightDrawPush;
-use crate::gpu::meshes::LightVolumes;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
-use crate::passes::begin_cleared;
+use crate::passes::light_volumes::LightVolumes;
+use crate::passes::lighting::LightDrawPush;
 use crate::shaders;
 use ash::vk;
 use histencil_model::{

@@ -3,10 +3,16 @@
 
 use crate::gpu::compute::{pad, CaseKernel};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::BRDF_EVAL_SET;
+use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::error::Result;
 use crate::shaders;
 use histencil_brdf::{Brdf, Parts, V3};
+
+/// The BRDF evaluator's cases (read) and results (written); see `brdf_eval.rs`.
+pub(crate) const BRDF_EVAL_SET: &[BindingDesc] = &[
+    binding(0, BindingKind::StorageBuffer, "cases"),
+    binding(1, BindingKind::StorageBuffer, "results"),
+];
 
 /// std430 mirror of `BrdfCase` in `crates/vk/shaders/brdf_eval.comp`.
 #[repr(C)]
