@@ -37,7 +37,8 @@ pub struct DriverInfo {
     pub id: vk::DriverId,
     /// `VkPhysicalDeviceProperties::driverVersion`, in the driver's own encoding.
     pub version: u32,
-    /// The quirks in force on the device, as [`crate::Quirks::describe`] names them.
+    /// The quirks in force on the device with their reasons, as [`crate::Quirks::describe`]
+    /// writes them.
     pub quirks: String,
     /// The device limits histencil needs above the spec's minimum, with the device's values, as
     /// [`crate::describe_limits`] writes them.

@@ -1,7 +1,7 @@
 //! Driver quirks as data: where histencil shapes its work differently for one driver, the rule
 //! lives in one table keyed by the driver Vulkan names (`VkDriverId`) and its version, each with
 //! its reason, instead of branches on the device's type scattered through the passes. A report
-//! prints the quirks in force ([`Quirks::describe`]), and [`crate::ContextDesc::general_path`]
+//! prints the quirks in force with their reasons ([`Quirks::describe`], in every driver line), and [`crate::ContextDesc::general_path`]
 //! turns them all off, so any device can run the path every other device takes.
 //!
 //! None of these changes an image: each shapes work whose result is the same bit for bit
@@ -113,13 +113,29 @@ impl Quirks {
         self.rules.iter().any(|r| r.quirk == quirk)
     }
 
-    /// `small-tiles, classify-per-invocation`, or `none`: what a report's driver line says.
-    pub fn describe(&self) -> String {
+    /// `small-tiles, classify-per-invocation`, or `none`: the quirks' names.
+    pub fn names(&self) -> String {
         if self.rules.is_empty() {
             return "none".into();
         }
         let names: Vec<_> = self.rules.iter().map(|r| r.quirk.name()).collect();
         names.join(", ")
+    }
+
+    /// What a report's driver line says: each quirk in force with its reason,
+    /// `small-tiles (why: ...), classify-per-invocation (why: ...)`, or `none`. A reader of a
+    /// report from a device whose work was shaped differently learns how, and on what evidence,
+    /// without the source.
+    pub fn describe(&self) -> String {
+        if self.rules.is_empty() {
+            return "none".into();
+        }
+        let rules: Vec<_> = self
+            .rules
+            .iter()
+            .map(|r| format!("{} (why: {})", r.quirk.name(), r.reason))
+            .collect();
+        rules.join(", ")
     }
 
     /// The rules in force, with their reasons.
@@ -140,7 +156,11 @@ mod tests {
         ] {
             let q = Quirks::of(QUIRKS, driver, 0);
             assert!(q.has(Quirk::SmallTiles) && q.has(Quirk::ClassifyPerInvocation));
-            assert_eq!(q.describe(), "small-tiles, classify-per-invocation");
+            assert_eq!(q.names(), "small-tiles, classify-per-invocation");
+            let line = q.describe();
+            assert!(line.starts_with("small-tiles (why: "), "{line}");
+            assert!(line.contains("), classify-per-invocation (why: "), "{line}");
+            assert!(q.rules().iter().all(|r| line.contains(r.reason)), "{line}");
         }
         for driver in [
             vk::DriverId::NVIDIA_PROPRIETARY,
@@ -149,7 +169,7 @@ mod tests {
         ] {
             let q = Quirks::of(QUIRKS, driver, 7);
             assert_eq!(q, Quirks::none());
-            assert_eq!(q.describe(), "none");
+            assert_eq!((q.names(), q.describe()), ("none".into(), "none".into()));
         }
     }
 

@@ -454,6 +454,11 @@ impl HiStencilSurface {
         hi: &HiStencilState,
         tiles: WriteTiles,
     ) {
+        // Not a flush the plan left out: the hardware's own retiring of an update, at the latest
+        // point it could happen (the next write starts), which the model defines and the
+        // simulator runs (`histencil_model::TileSurface::begin_write`); the plan's flushes are
+        // the ones an engine records. The same rule in both is what lets the simulator be the
+        // oracle for `FlushPolicy::Never`, where a test sees the write before the last.
         if self.unflushed {
             self.record_flush(rec);
         }
