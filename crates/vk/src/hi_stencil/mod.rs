@@ -608,6 +608,12 @@ impl HiStencilSurface {
         rec.buffer_barrier(&[(saved, &[TransferWrite], &[FragmentRead])]);
     }
 
+    /// The buffers light shaders write, with atomics: the touched marks and the statistics. A
+    /// split of the lighting's rendering hands them from the draws before to those after.
+    pub fn fragment_written(&self) -> [vk::Buffer; 2] {
+        [self.touched.handle, self.stats.handle]
+    }
+
     /// Makes the statistics visible to the host; record after the last lighting draw.
     pub fn record_stats_readable(&self, rec: &Recording) {
         rec.host_readable(vk::PipelineStageFlags2::FRAGMENT_SHADER);

@@ -13,7 +13,7 @@ use super::light_pipelines::{
     pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
 };
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
-use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{BufferAccess, Contents, ImageAccess, LightingTargets};
 use crate::gpu::error::Result;
 use crate::gpu::recording::Recording;
 use crate::gpu::state::FULLSCREEN;
@@ -109,6 +109,9 @@ pub struct LightingPass<'a> {
 struct Rendering {
     /// The HDR target needs no clear (done by the first opening, or not asked for).
     cleared: bool,
+    /// The buffers light shaders write (the hi-stencil surface's touched marks and
+    /// statistics, [`HiStencilSurface::fragment_written`]): what a split hands over.
+    counted: [vk::Buffer; 2],
 }
 
 impl Rendering {
@@ -139,11 +142,19 @@ impl Rendering {
         }
     }
 
-    /// Ends rendering and makes every write so far visible: draws that share the statistics
-    /// buffer cannot be ordered inside one dynamic rendering instance.
+    /// Ends rendering and hands the buffers light shaders write over to the draws after:
+    /// draws that share the statistics buffer cannot be ordered inside one dynamic rendering
+    /// instance. Exact, not a full memory barrier (as it was until 2026-11-29): the attachments
+    /// are handed over by `open`'s transitions, the stencil to the tile update by its own, and
+    /// the tile surface's other buffers by the hi-stencil's reset, flush and save barriers; an
+    /// engine's hooks only read. That list is held by reading, not by a test: synchronisation
+    /// validation does not see these buffers' hazards (with no barrier here at all every test
+    /// passed on lavapipe, which runs draws in order, 2026-11-29).
     fn split(&mut self, pass: &LightingPass) {
         self.close(pass);
-        pass.rec.memory_barrier();
+        let rw = [BufferAccess::FragmentReadWrite];
+        let hand_overs = self.counted.map(|buffer| (buffer, &rw[..], &rw[..]));
+        pass.rec.buffer_barrier(&hand_overs);
     }
 }
 
@@ -261,6 +272,7 @@ impl LightingPass<'_> {
         self.bind_sets();
         let mut rendering = Rendering {
             cleared: !self.clear_hdr,
+            counted: hi_stencil.fragment_written(),
         };
         rendering.open(self, targets);
         if let Some(t) = timers.steps.as_deref_mut() {
