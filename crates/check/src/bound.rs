@@ -109,8 +109,6 @@
 //! - **A3**: on one device the same conversion of the same value gives the same result (alpha
 //!   entities' sources and opacities are rounded alike in both frames).
 
-use crate::judge::Tolerance;
-
 /// The relative error of one f16 rounding in f16's normal range: either neighbour of `x >=
 /// 2^-14` is within a factor `(1 - 2^-10, 1 + 2^-10)` of it.
 pub const F16_RELATIVE: f64 = 1.0 / 1024.0;
@@ -208,6 +206,17 @@ pub fn display_difference(roundings: u32) -> f64 {
 /// apart, when each may return either neighbour: `ceil(d) + 1`, at most 255.
 pub fn quantised_max(d: f64) -> u8 {
     (d.ceil() + 1.0).min(255.0) as u8
+}
+
+/// A bound on the 8-bit error per channel: the largest difference and the mean over every
+/// channel of the pixels judged. Exact techniques' bounds are derived per scene and technique
+/// ([`crate::matrix::SceneNeeds::exact_tolerance`]); the approximate ones'
+/// are `judge`'s constants. Here, beside the derivation, so the matrix and
+/// the judge both take it from below them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    pub max: u8,
+    pub mean: f64,
 }
 
 /// The bound an exact case's image is held to: max `ceil(d) + 1` and mean `d`, for

@@ -6,15 +6,7 @@ use crate::matrix::{Expect, Platform};
 use histencil_model::StencilLayout;
 use image::RgbaImage;
 
-/// A bound on the 8-bit error per channel: the largest difference and the mean over every
-/// channel of the pixels judged. Exact techniques' bounds are derived per scene and technique
-/// ([`crate::bound`], [`crate::matrix::SceneNeeds::exact_tolerance`]); the approximate ones'
-/// are the constants below.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tolerance {
-    pub max: u8,
-    pub mean: f64,
-}
+pub use crate::bound::Tolerance;
 
 /// The LUT technique at its default resolution (32): the bound `tests/tests/techniques.rs`
 /// holds it to and the README documents (23/255 at most where Blinn-Phong 256 highlights fall

@@ -10,8 +10,9 @@
 //! the known-wrong configurations run on the one depth format whose depths the CPU simulator
 //! reads (it decides whether their failure must show).
 
-use crate::bound::{alpha_layers, exact_bound, lights_at_a_point, Accumulation, PixelPath};
-use crate::judge::Tolerance;
+use crate::bound::{
+    alpha_layers, exact_bound, lights_at_a_point, Accumulation, PixelPath, Tolerance,
+};
 use histencil_model::FlushPolicy;
 use histencil_vk::{AlphaMode, DepthStencilFormat, MixedTiles, Technique, TileSide};
 use std::fmt;

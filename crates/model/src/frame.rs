@@ -67,7 +67,7 @@ pub struct PlannedLight {
     pub screen_rect: Option<NdcRect>,
     /// The depth-buffer values its volume can reach, where its shade passes are confined to
     /// them by the depth bounds test ([`FramePlan::with_depth_bounds`]); `None` otherwise.
-    pub depth_range: Option<crate::depth_bounds::DepthRange>,
+    pub depth_range: Option<crate::view::DepthRange>,
     /// Its case, the BRDF slots it touches and the technique chosen for it.
     pub request: LightRequest,
 }
@@ -102,7 +102,7 @@ pub struct FramePlan {
     /// The view, lights and layout [`crate::plan_frame`] made this plan for, which the lighting
     /// holds every frame against; `None` for a plan built by hand from requests, which names no
     /// view.
-    pub made_for: Option<Box<crate::planner::PlannedFor>>,
+    pub made_for: Option<Box<crate::light_shape::PlannedFor>>,
 }
 
 impl FramePlan {

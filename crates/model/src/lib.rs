@@ -57,6 +57,7 @@ pub mod depth_id;
 mod footprint;
 mod frame;
 mod layout;
+mod light_shape;
 mod plan;
 mod planner;
 mod sim;

@@ -348,6 +348,23 @@ pub struct NdcRect {
     pub max: [f64; 2],
 }
 
+/// Depth-buffer values `[min, max]` (in `[0, 1]`, the frame's convention) that hold every point
+/// of a light's bounding sphere the view can see.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthRange {
+    /// The smallest depth value, whichever end of depth is near.
+    pub min: f32,
+    /// The largest.
+    pub max: f32,
+}
+
+impl DepthRange {
+    /// Whether a stored depth passes the test (`min <= d <= max`, as Vulkan's test keeps it).
+    pub fn contains(&self, depth: f32) -> bool {
+        self.min <= depth && depth <= self.max
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
