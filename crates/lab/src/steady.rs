@@ -14,6 +14,7 @@
 //! The decisions are pure functions ([`settled`], [`strays`]) and [`Clock`] is generic over the
 //! canary and the round's work, so the whole policy is unit-tested without a GPU.
 
+use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Shading, Technique};
 use std::time::{Duration, Instant};
 
 /// How steady a clock must be, and how long to wait for it.
@@ -241,6 +242,14 @@ impl Stability {
     }
 }
 
+/// What a clock did that its user may want to say as it happens: a round thrown away, or the
+/// canary warmed up (at a set's start, or again where conditions changed).
+#[derive(Clone, Debug, PartialEq)]
+pub enum News {
+    Retaken(Retake),
+    WarmedUp(WarmUp),
+}
+
 /// The steady clock of a run: the reference in force and the record so far.
 pub struct Clock {
     settings: ClockSettings,
@@ -248,6 +257,8 @@ pub struct Clock {
     /// The last canary time, if it did not stray: the next round's "before".
     last_steady: Option<f64>,
     record: Stability,
+    /// What happened since the last [`Clock::take_news`].
+    news: Vec<News>,
 }
 
 impl Clock {
@@ -261,7 +272,13 @@ impl Clock {
                 settings,
                 sets: Vec::new(),
             },
+            news: Vec::new(),
         }
+    }
+
+    /// The retakes and warm-ups since the last call, in order: what a progress line says.
+    pub fn take_news(&mut self) -> Vec<News> {
+        std::mem::take(&mut self.news)
     }
 
     /// The record so far.
@@ -336,6 +353,7 @@ impl Clock {
             settled: reference.is_some(),
             reference_ms,
         };
+        self.news.push(News::WarmedUp(warm_up.clone()));
         self.set().warm_ups.push(warm_up);
         Ok(())
     }
@@ -387,16 +405,142 @@ impl Clock {
                     after
                 }
             };
-            let reference_ms = self.reference_ms.unwrap_or(0.0);
-            self.set().retaken.push(Retake {
+            let retake = Retake {
                 round: index,
                 canary_ms: strayed,
-                reference_ms,
-            });
+                reference_ms: self.reference_ms.unwrap_or(0.0),
+            };
+            self.news.push(News::Retaken(retake));
+            self.set().retaken.push(retake);
             strays_in_a_row += 1;
             if strays_in_a_row % rewarm == 0 {
                 self.warm_up(index, Vec::new(), Some(deadline), canary)?;
             }
+        }
+    }
+}
+
+/// The steady clock with its canary on a device: branching's lighting (native backend), the
+/// median of [`CANARY_FRAMES`] frames, on a renderer of its own (the measured renderers keep
+/// their state). Off, it keeps every round as taken.
+pub(crate) struct SteadyClock<'c> {
+    clock: Option<Clock>,
+    renderer: Option<Renderer<'c>>,
+}
+
+/// The canary's technique.
+const CANARY: Technique = Technique::Branching {
+    backend: Backend::Native,
+    flush: FlushPolicy::Auto,
+};
+
+/// Frames one canary time is the median of: a single frame's hiccup (a scheduler's time
+/// slice on llvmpipe's cores) is not a change of conditions; a clock that moved moves all three.
+const CANARY_FRAMES: usize = 3;
+
+/// One canary time: the median lighting time of [`CANARY_FRAMES`] frames.
+fn canary_ms(renderer: &mut Renderer) -> crate::Result<f64> {
+    let mut times = (0..CANARY_FRAMES)
+        .map(|_| {
+            let timings = renderer.render(CANARY, Readback::NONE)?.timings;
+            Ok(timings.technique_ms(Shading::Deferred(CANARY).lighting_passes()))
+        })
+        .collect::<crate::Result<Vec<f64>>>()?;
+    times.sort_by(f64::total_cmp);
+    Ok(histencil_vk::median_of_sorted(&times))
+}
+
+impl<'c> SteadyClock<'c> {
+    /// No clock: every round kept as taken.
+    pub(crate) fn off() -> Self {
+        Self {
+            clock: None,
+            renderer: None,
+        }
+    }
+
+    /// A clock whose canary lights `renderer`'s scene (`scene` says which, for the report),
+    /// its pipelines built before the first timed frame.
+    pub(crate) fn new(
+        mut renderer: Renderer<'c>,
+        scene: &str,
+        settings: ClockSettings,
+    ) -> crate::Result<Self> {
+        renderer.render(CANARY, Readback::NONE)?;
+        let workload =
+            format!("the median of {CANARY_FRAMES} frames of branching's lighting on {scene}");
+        Ok(Self {
+            clock: Some(Clock::new(workload, settings)),
+            renderer: Some(renderer),
+        })
+    }
+
+    /// The record, if the clock ran.
+    pub(crate) fn into_stability(self) -> Option<Stability> {
+        self.clock.map(Clock::into_stability)
+    }
+
+    /// Starts the set `name` (a warm-up where the canary strays).
+    pub(crate) fn begin_set(
+        &mut self,
+        name: &str,
+        progress: &mut dyn FnMut(&str),
+    ) -> crate::Result<()> {
+        let (Some(clock), Some(renderer)) = (self.clock.as_mut(), self.renderer.as_mut()) else {
+            return Ok(());
+        };
+        clock.begin_set(name, &mut || canary_ms(renderer))?;
+        Self::tell(clock, name, progress);
+        Ok(())
+    }
+
+    /// The round `start` says: `work`'s kept try ([`Clock::round`]), retaken only while the
+    /// set's budget lasts; or `work` once without a clock.
+    pub(crate) fn round<T>(
+        &mut self,
+        start: &crate::stats::RoundStart,
+        progress: &mut dyn FnMut(&str),
+        work: &mut dyn FnMut() -> crate::Result<T>,
+    ) -> crate::Result<T> {
+        let (Some(clock), Some(renderer)) = (self.clock.as_mut(), self.renderer.as_mut()) else {
+            return work();
+        };
+        // A fixed number of rounds has no budget (`Duration::MAX`): a year stands for it.
+        let left = (start.budget_seconds - start.seconds).clamp(0.0, 3.2e7);
+        let deadline = Instant::now() + Duration::from_secs_f64(left);
+        let kept = clock.round(start.index, deadline, &mut || canary_ms(renderer), work)?;
+        let set = clock
+            .stability()
+            .sets
+            .last()
+            .map(|s| s.set.clone())
+            .unwrap_or_default();
+        Self::tell(clock, &set, progress);
+        Ok(kept)
+    }
+
+    /// Says what the clock did since it was last asked, a line each.
+    fn tell(clock: &mut Clock, set: &str, progress: &mut dyn FnMut(&str)) {
+        for news in clock.take_news() {
+            progress(&match news {
+                News::Retaken(r) => format!(
+                    "{set}: round {} retaken, canary {:.3} ms against {:.3} ms",
+                    r.round + 1,
+                    r.canary_ms,
+                    r.reference_ms
+                ),
+                News::WarmedUp(w) if w.before_round == 0 => format!(
+                    "{set}: steady clock warmed up in {} canary times ({:.1} s), canary {:.3} ms{}",
+                    w.times_ms.len(),
+                    w.seconds,
+                    w.reference_ms,
+                    if w.settled { "" } else { " (not settled)" }
+                ),
+                News::WarmedUp(w) => format!(
+                    "{set}: conditions changed, canary warmed up again: {:.3} ms",
+                    w.reference_ms
+                ),
+            });
         }
     }
 }
@@ -495,6 +639,11 @@ mod tests {
         assert!(set.unsteady.is_empty());
         assert_eq!(set.canary_range(), Some((1.0, 1.0)));
         assert_eq!(set.canary[2].reference_ms, 2.0);
+        let news = clock.take_news();
+        assert!(
+            matches!(news[..], [News::WarmedUp(_), News::Retaken(_), News::Retaken(_), News::Retaken(_), News::WarmedUp(ref w)] if w.before_round == 1)
+        );
+        assert!(clock.take_news().is_empty(), "news is told once");
         // A one-round hiccup is retaken once, nothing else.
         let mut clock = Clock::new("test", settings());
         let mut canary = replay(vec![1.0, 1.0, 1.0, 1.0, 1.5, 1.0, 1.0, 1.0]);

@@ -9,7 +9,7 @@ use crate::measure::{frame, Timing};
 use crate::stats::{
     median_interval, ratio_interval, sample_deciding, Interval, Sampled, Sampling, Verdict,
 };
-use crate::steady::{Clock, ClockSettings, Stability};
+use crate::steady::{ClockSettings, Stability, SteadyClock};
 use crate::variants::{brdf_palette, light_size_scene, with_brdf_count, with_one_brdf};
 use crate::Result;
 use histencil_brdf::BrdfId;
@@ -615,7 +615,15 @@ pub fn run_compare(
     } else {
         settings.beside_load
     });
-    let mut steady = SteadyClock::new(ctx, settings)?;
+    let mut steady = match settings.clock {
+        Some(clock) => {
+            let scene = with_brdf_count(&settings.scene, 1);
+            let renderer = renderer_for(ctx, settings, scene)?;
+            let (name, w, h) = (&settings.scene.name, settings.width, settings.height);
+            SteadyClock::new(renderer, &format!("`{name}` at 1 BRDF, {w}x{h}"), clock)?
+        }
+        None => SteadyClock::off(),
+    };
     let sampling = Sampling {
         min_rounds: settings.frames.max(1),
         target: settings.target_ci,
@@ -678,126 +686,11 @@ pub fn run_compare(
         costs: table.costs,
         costs_calibrated: settings.costs.is_some(),
         depth_id: table.depth_id,
-        stability: steady.clock.map(Clock::into_stability),
+        stability: steady.into_stability(),
         load_from_round: settings
             .load_from_round
             .filter(|_| settings.beside_load > 0),
     })
-}
-
-/// The steady clock and its canary: branching's lighting on the settings' scene folded onto one
-/// BRDF, at the settings' size, a renderer of its own (the cells' renderers keep their state).
-struct SteadyClock<'c> {
-    clock: Option<Clock>,
-    renderer: Option<Renderer<'c>>,
-}
-
-/// The canary's technique.
-const CANARY: Technique = Technique::Branching {
-    backend: Backend::Native,
-    flush: FlushPolicy::Auto,
-};
-
-/// Frames one canary time is the median of: a single frame's hiccup (a scheduler's time
-/// slice on llvmpipe's cores) is not a change of conditions; a clock that moved moves all three.
-const CANARY_FRAMES: usize = 3;
-
-/// One canary time: the median lighting time of [`CANARY_FRAMES`] frames.
-fn canary_ms(renderer: &mut Renderer) -> Result<f64> {
-    let mut times = (0..CANARY_FRAMES)
-        .map(|_| lighting_ms(renderer, CANARY).map(|(ms, _)| ms))
-        .collect::<Result<Vec<f64>>>()?;
-    times.sort_by(f64::total_cmp);
-    Ok(histencil_vk::median_of_sorted(&times))
-}
-
-impl<'c> SteadyClock<'c> {
-    fn new(ctx: &'c Context, settings: &CompareSettings) -> Result<Self> {
-        let Some(clock_settings) = settings.clock else {
-            return Ok(Self {
-                clock: None,
-                renderer: None,
-            });
-        };
-        let scene = with_brdf_count(&settings.scene, 1);
-        let mut renderer = renderer_for(ctx, settings, scene)?;
-        // Its pipelines built before the first timed frame.
-        lighting_ms(&mut renderer, CANARY)?;
-        let workload = format!(
-            "the median of {CANARY_FRAMES} frames of branching's lighting on `{}` at 1 BRDF, \
-             {}x{}",
-            settings.scene.name, settings.width, settings.height
-        );
-        Ok(Self {
-            clock: Some(Clock::new(workload, clock_settings)),
-            renderer: Some(renderer),
-        })
-    }
-
-    /// Starts the set `name` (a warm-up where the canary strays).
-    fn begin_set(&mut self, name: &str, progress: &mut dyn FnMut(&str)) -> Result<()> {
-        let (Some(clock), Some(renderer)) = (self.clock.as_mut(), self.renderer.as_mut()) else {
-            return Ok(());
-        };
-        let mut canary = || canary_ms(renderer);
-        clock.begin_set(name, &mut canary)?;
-        if let Some(w) = clock
-            .stability()
-            .sets
-            .last()
-            .and_then(|s| s.warm_ups.last())
-        {
-            progress(&format!(
-                "{name}: steady clock warmed up in {} canary times ({:.1} s), canary {:.3} ms{}",
-                w.times_ms.len(),
-                w.seconds,
-                w.reference_ms,
-                if w.settled { "" } else { " (not settled)" }
-            ));
-        }
-        Ok(())
-    }
-
-    /// The round `start` says: `work`'s kept try ([`Clock::round`]), retaken only while the
-    /// set's budget lasts; or `work` once without a clock.
-    fn round<T>(
-        &mut self,
-        start: &crate::stats::RoundStart,
-        progress: &mut dyn FnMut(&str),
-        work: &mut dyn FnMut() -> Result<T>,
-    ) -> Result<T> {
-        let (Some(clock), Some(renderer)) = (self.clock.as_mut(), self.renderer.as_mut()) else {
-            return work();
-        };
-        // A fixed number of rounds has no budget (`Duration::MAX`): a year stands for it.
-        let left = (start.budget_seconds - start.seconds).clamp(0.0, 3.2e7);
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs_f64(left);
-        let index = start.index;
-        let counts = |c: &Clock| {
-            let set = c.stability().sets.last();
-            set.map_or((0, 0), |s| (s.retaken.len(), s.warm_ups.len()))
-        };
-        let (retaken, warm_ups) = counts(clock);
-        let mut canary = || canary_ms(renderer);
-        let kept = clock.round(index, deadline, &mut canary, work)?;
-        let set = clock.stability().sets.last().expect("a set begun");
-        for r in &set.retaken[retaken..] {
-            progress(&format!(
-                "{}: round {} retaken, canary {:.3} ms against {:.3} ms",
-                set.set,
-                r.round + 1,
-                r.canary_ms,
-                r.reference_ms
-            ));
-        }
-        if let Some(w) = set.warm_ups.get(warm_ups..).and_then(<[_]>::last) {
-            progress(&format!(
-                "{}: conditions changed, canary warmed up again: {:.3} ms",
-                set.set, w.reference_ms
-            ));
-        }
-        Ok(kept)
-    }
 }
 
 /// A renderer of `scene` at the settings' size, with their costs.
