@@ -348,7 +348,8 @@ impl Shard {
     /// Whether the case named `full` (`scene/case`), at `position` (from 0) of the run's
     /// order, is this part's. A hash shard reads the name alone, so adding, removing or
     /// filtering other cases moves no case between shards; an interleaved part reads the
-    /// position, as deqp-runner's `--fraction` does.
+    /// position, as deqp-runner's `--fraction` does (deqp-runner after a seeded shuffle of its
+    /// list, so its parts are other cases).
     pub fn holds(&self, position: usize, full: &str) -> bool {
         if self.interleaved {
             position % self.count as usize == (self.index - 1) as usize

@@ -25,7 +25,7 @@ mod shader_consts;
 pub mod shader_layouts;
 mod tools;
 
-// The device layer's public modules, where engines and tests have always found them.
+// The device layer's public modules, at the crate's root where engines and tests find them.
 pub use gpu::{access, descriptors, gpu_types, state};
 
 /// The compiled SPIR-V of every shader module (built by build.rs, never checked in).

@@ -1,5 +1,5 @@
 // Per-draw push constants of the mesh passes (G-buffer, forward).
-// Rust mirror: crates/vk/src/gpu/gpu_types.rs (DrawPush).
+// Rust mirror: crates/vk/src/passes/geometry.rs (DrawPush).
 #ifndef DRAW_GLSL
 #define DRAW_GLSL
 

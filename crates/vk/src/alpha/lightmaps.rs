@@ -16,10 +16,9 @@ use super::lightmap_checks::{bad, check_direction, check_frame};
 use crate::gpu::access::ImageRef;
 use crate::gpu::attachments::{begin_all_cleared, CLEAR_BLACK};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::descriptors::{
-    create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers, FRAME_SET,
-    GRAPHICS_STAGES,
+    binding, create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers,
+    BindingDesc, BindingKind, FRAME_SET, GRAPHICS_STAGES,
 };
 use crate::gpu::error::{Error, Result, VkCall};
 use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
@@ -713,8 +712,8 @@ pub(crate) fn set_region(rec: &Recording, r: Region) {
             height: r.height,
         },
     };
-    // SAFETY: `cmd` is recording on this context's device: `record_pass`, the one caller, is
-    // recording its pass (see there). One viewport and scissor, at 0, of the region's shape:
+    // SAFETY: `rec` records on this context's device: `record_pass`, the one caller, is
+    // recording its pass (see there); dynamic state, allowed in and out of rendering. One viewport and scissor, at 0, of the region's shape:
     // non-zero and inside the atlas, as `check_frame` held every region before the recording.
     unsafe {
         rec.device().cmd_set_viewport(rec.any(), 0, &[viewport]);

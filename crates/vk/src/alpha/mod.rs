@@ -21,9 +21,9 @@ pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 use crate::gpu::access::{Contents, ImageAccess};
 use crate::gpu::attachments::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::descriptors::{
-    create_pipeline_layout, create_set_layout, write_sampled_images, GRAPHICS_STAGES,
+    binding, create_pipeline_layout, create_set_layout, write_sampled_images, BindingDesc,
+    BindingKind, GRAPHICS_STAGES,
 };
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::meshes::Meshes;
@@ -475,14 +475,14 @@ impl<'c> AlphaLighting<'c> {
         } = *inputs;
         let [object_pipeline, particle_pipeline] = self.pipelines(rec.ctx(), mode)?;
         rec.step("alpha", |rec| {
-            let (d, cmd) = (rec.device(), rec.any());
-            // SAFETY: `cmd` is the renderer's, recording and outside rendering (the passes before
-            // ended theirs). The sets match the layout's sets 0 to 2 (`create` made it from their
+            let d = rec.device();
+            // SAFETY: the recording is the renderer's, outside rendering (the passes before
+            // ended theirs; `outside` checks it). The sets match the layout's sets 0 to 2 (`create` made it from their
             // layouts): the renderer's frame set, the lightmaps' slot 0 alpha set (written by
             // `record_lightmaps` this frame) and the lightmap set; all live as long as `self`.
             unsafe {
                 d.cmd_bind_descriptor_sets(
-                    cmd,
+                    rec.outside(),
                     vk::PipelineBindPoint::GRAPHICS,
                     self.pipeline_layout,
                     0,
@@ -503,6 +503,7 @@ impl<'c> AlphaLighting<'c> {
             }
             let attachments = (&mut *targets.hdr, &mut *targets.depth_stencil);
             begin_hdr_rendering(rec, attachments, extent, Load::Keep, Load::Keep);
+            let cmd = rec.inside();
             let objects = scene.alpha_objects.len();
             for &entity in &self.order {
                 match entity {

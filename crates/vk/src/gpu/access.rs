@@ -273,10 +273,10 @@ impl Recording<'_> {
             .subresource_range(subresource_range(image.aspect()));
         let barriers = [barrier];
         let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
-        // SAFETY: the recording's command buffer is recording outside rendering (transitions go between
-        // passes; the renderer's frame, `submit_once`'s, or an engine's under `record`'s # Safety).
-        // `image` is live with every aspect of its format named; its `state` is true when `cmd`
-        // runs (histencil's bookkeeping, or the engine's promise for its `ImageRef`s), so the old
+        // SAFETY: the recording is outside rendering (`outside` checks it in debug builds;
+        // transitions go between passes: the renderer's frame, `submit_once`'s, or an engine's
+        // under `record`'s # Safety). `image` is live with every aspect of its format named; its
+        // `state` is true when the commands run (histencil's bookkeeping, or the engine's promise for its `ImageRef`s), so the old
         // layout is right, and `dependency` lives until the call returns.
         unsafe {
             self.device()
@@ -287,11 +287,13 @@ impl Recording<'_> {
 
     /// A global memory barrier: every write recorded before is visible to every access after.
     ///
-    /// Split light passes (draws that share the statistics buffer), the depth-id and tiled passes
-    /// hand buffers and attachments between fragment shaders, attachments and compute; one broad
-    /// barrier between those phases is simpler to get right than a precise one per hand-over. The
-    /// hi-stencil emulation's own bookkeeping (reset, flush, save) uses [`Recording::buffer_barrier`] instead:
-    /// its hand-overs are few and known, and a full wait there would count against the console.
+    /// The depth-id and tiled passes hand buffers and attachments between fragment shaders,
+    /// attachments and compute; one broad barrier between those phases is simpler to get right
+    /// than a precise one per hand-over (and the light passes' split uses it where an engine's
+    /// hooks bind resources histencil cannot see). The hi-stencil emulation's bookkeeping
+    /// (reset, flush, save) and the light passes' own split use
+    /// [`Recording::buffer_barrier`] instead: their hand-overs are few and known, and a full
+    /// wait there would count against the console.
     ///
     /// The stages are the ones histencil records (named rather than `ALL_COMMANDS`, which the
     /// best-practices layer flags); synchronisation validation in every test run would report a
@@ -373,10 +375,11 @@ fn union(
     )
 }
 
-/// One barrier command for every hand-over, each whole buffer from its `from` uses to its `to`
-/// uses: a dependency on those stages alone, not the full wait of [`Recording::memory_barrier`]. Only writes
-/// are made available; a read before needs only the execution dependency.
 impl Recording<'_> {
+    /// One barrier command for every hand-over, each whole buffer from its `from` uses to its
+    /// `to` uses: a dependency on those stages alone, not the full wait of
+    /// [`Recording::memory_barrier`]. Only writes are made available; a read before needs only
+    /// the execution dependency.
     pub(crate) fn buffer_barrier(&self, hand_overs: &[HandOver]) {
         let barriers: Vec<vk::BufferMemoryBarrier2> = hand_overs
             .iter()

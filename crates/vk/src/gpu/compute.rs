@@ -163,7 +163,7 @@ impl CaseKernel {
             // Host writes to the inputs are visible at submit; only the results need a
             // barrier, towards the host read after the fence.
             self.compute.bind(rec, set, &count.to_le_bytes());
-            // SAFETY: `cmd` is `submit_once`'s, recording outside rendering, with the pipeline
+            // SAFETY: `rec` is `submit_once`'s, recording outside rendering, with the pipeline
             // and its set bound just above. The group count stays within the spec's minimum
             // `maxComputeWorkGroupCount[0]` (65535) up to 65535 * 64 cases; nothing checks a
             // longer list (the evaluators' callers pass test-sized ones).

@@ -2,10 +2,12 @@
 //! from declared accesses, descriptors, pipelines, readback and upload, timing, names and
 //! validation messages, and teardown that survives a creation failing half way. Everything
 //! above it (the passes, the emulation, the engine API, the renderer) records through it
-//! (`recording::Recording`, the encoder) and it imports nothing from above. Of the passes it
-//! holds only what they all share: the frame set (`FRAME_SET`, `FrameUniforms`, `GpuLight`),
-//! the G-buffer's contract (`GBUFFER_SET`, `access::LightingTargets`) and the timings' types;
-//! each pass keeps its own sets' tables and push blocks (`crate::shader_layouts` gathers them).
+//! (`recording::Recording`, the encoder) and it imports nothing from above. Of the passes'
+//! data it keeps what they share: the frame set (`FRAME_SET`, `FrameUniforms`, `GpuLight`),
+//! the G-buffer's contract (`GBUFFER_SET`, `access::LightingTargets`, the renderer's
+//! `targets`), the ways a pass begins rendering (`attachments`), the common pass states and
+//! push range, and the timings' types; each pass keeps its own sets' tables and push blocks
+//! (`crate::shader_layouts` gathers them).
 
 pub mod access;
 pub(crate) mod attachments;

@@ -283,7 +283,7 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     let blend_attachments = vec![blend_attachment; desc.color_formats.len()];
     let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
     // With the depth bounds test enabled, every pipeline takes it as dynamic state, so one
-    // pipeline serves a light's passes with and without it (`state::apply` sets it per draw).
+    // pipeline serves a light's passes with and without it (`Recording::apply_bounded` sets it per draw).
     let mut dynamic_states = DYNAMIC_STATES.to_vec();
     if ctx.depth_bounds {
         dynamic_states.extend([

@@ -55,8 +55,8 @@ pub struct FrameImages {
     pub brdf_ids: Option<Vec<Option<BrdfId>>>,
 }
 
-/// Copies one aspect of the whole of `image` into `buffer`, tightly packed.
 impl Recording<'_> {
+    /// Copies one aspect of the whole of `image` into `buffer`, tightly packed.
     pub(crate) fn copy_image_to_buffer(
         &self,
         image: &mut ImageRef,

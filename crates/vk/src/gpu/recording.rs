@@ -2,8 +2,11 @@
 //! state a recording has (whether dynamic rendering is open, which debug labels are open), so
 //! that beginning and ending rendering, opening and closing a label, and asking for the command
 //! buffer inside or outside rendering all go through it and a debug build checks each against
-//! that state; nothing records with a bare `vk::CommandBuffer` but this file (and the public
-//! `unsafe fn record*` entry points, which take an engine's and wrap it here at once).
+//! that state. No pass takes a bare `vk::CommandBuffer`: only the entry points do (an engine's
+//! `unsafe fn record*` and the crate-private bodies they share with the renderer, which hands
+//! them its recording's buffer), each wrapping it in a `Recording` at once. The commands
+//! themselves (draws, binds, pushes, dispatches) are ash's, on the buffer the recording hands
+//! out as [`Recording::inside`], [`Recording::outside`] or [`Recording::any`].
 //!
 //! Barriers, copies and dynamic state are its methods too, written beside what they serve
 //! (`transition`, `memory_barrier` and `buffer_barrier` in `access.rs`, `apply` in `state.rs`,
@@ -85,7 +88,9 @@ impl<'a> Recording<'a> {
         self.rendering.get()
     }
 
-    /// Begins dynamic rendering as `info` says. Callers transitioned every attachment `info`
+    /// Begins dynamic rendering as `info` says. Safe, as `transition` is: what it relies on is
+    /// histencil's own bookkeeping (the `ImageRef` states), not a caller's promise about
+    /// handles, which is what makes [`Self::bind_graphics`] unsafe. Callers transitioned every attachment `info`
     /// names to the layout it is named with (`transition` on its `ImageRef`) and chose a render
     /// area inside the attachments.
     pub fn begin_rendering(&self, info: &vk::RenderingInfo) {
@@ -176,7 +181,8 @@ impl<'a> Recording<'a> {
     }
 
     /// Opens a debug label region; [`Self::end_label`] closes it. Prefer [`Self::step`]; this
-    /// pair is for regions that open in one call and close in another (the lighting's lights).
+    /// pair is for regions that open and close as a loop goes (the lighting's, around its
+    /// per-light labels, which open and close as the plan's steps change light).
     pub fn begin_label(&self, name: &str) {
         self.ctx.begin_label(self.cmd, name);
         self.labels.set(self.labels.get() + 1);

@@ -89,11 +89,11 @@ pub fn with_stencil(state: PassState, face: FaceStencil) -> PassState {
     }
 }
 
-/// Records `state` as dynamic state. A face without stencil state passes and keeps
-/// (the stencil test is one switch for both faces in Vulkan). Colour writes are pipeline state:
-/// the caller binds a pipeline that matches `state.color_write`.
-/// Without the depth bounds test ([`Self::apply_bounded`] for a light's passes).
 impl Recording<'_> {
+    /// Records `state` as dynamic state. A face without stencil state passes and keeps (the
+    /// stencil test is one switch for both faces in Vulkan). Colour writes are pipeline state:
+    /// the caller binds a pipeline that matches `state.color_write`. Without the depth bounds
+    /// test ([`Self::apply_bounded`] for a light's passes).
     pub(crate) fn apply(&self, state: &PassState) {
         self.apply_bounded(state, None);
     }

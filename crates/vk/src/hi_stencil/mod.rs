@@ -27,7 +27,7 @@ use crate::gpu::access::{access_info, BufferAccess, Contents, ImageAccess, Image
 use crate::gpu::attachments::{depth_stencil_attachment, Load};
 use crate::gpu::compute::ComputePipeline;
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::{sets_of, write_storage_buffers};
+use crate::gpu::descriptors::{binding, sets_of, write_storage_buffers, BindingDesc, BindingKind};
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::{Buffer, Image};
@@ -47,7 +47,6 @@ mod touch;
 
 pub use amd::{GpuHierarchy, TileTest};
 
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use touch::next_marker;
 
 /// Set 2 of the light pipelines: the hi-stencil emulation (include/hi_stencil.glsl).
@@ -58,7 +57,7 @@ pub(crate) const HI_STENCIL_SET: &[BindingDesc] = &[
     binding(3, BindingKind::StorageBuffer, ""),
 ];
 /// The tile update's pending surface (written), touch image (read) and stencil (a
-/// stencil-aspect view, read); see `hi_stencil.rs`.
+/// stencil-aspect view, read): the update's set (`hi_stencil_update.comp`).
 pub(crate) const HI_STENCIL_UPDATE_SET: &[BindingDesc] = &[
     binding(0, BindingKind::StorageBuffer, ""),
     binding(1, BindingKind::SampledImage, "touch_depth"),

@@ -458,6 +458,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             clear_hdr: frame.clear_hdr,
             depth_sampled: self.desc.hooks.samples_depth(),
             slot: frame.slot,
+            engine_hooks: !self.desc.hooks.is_builtin_decode(),
             hierarchy,
         };
         let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");

@@ -8,8 +8,7 @@ use super::{
 };
 use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::pass_layouts;
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
+use crate::gpu::descriptors::{binding, pass_layouts, BindingDesc, BindingKind};
 use crate::gpu::error::Result;
 use crate::gpu::gpu_types::PUSH_CONSTANT_BYTES;
 use crate::gpu::meshes::Meshes;

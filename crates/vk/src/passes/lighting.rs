@@ -1,6 +1,6 @@
 //! The deferred lighting pass, driven by histencil-model's frame plan: every light's passes
 //! (setup, per-BRDF mask and shade, cleanup, as `plan_light` derives them for the platform
-//! backend), with the state of each draw translated by `state::apply`.
+//! backend), with the state of each draw translated by `Recording::apply` (`gpu/state.rs`).
 //!
 //! This module only decides how each light is classified and which BRDFs it touches, and records
 //! the plan; the stencil logic lives in the model, where the CPU simulator checks it.
@@ -97,6 +97,9 @@ pub struct LightingPass<'a> {
     pub depth_sampled: bool,
     /// The frame-in-flight slot, whose hi-stencil update set reads this frame's stencil.
     pub slot: u32,
+    /// An engine's hooks bind their own resources (`LightHooks::Engine`), which their shaders
+    /// may write: a split then orders every write, not only histencil's own buffers.
+    pub(crate) engine_hooks: bool,
     /// On the AMD platforms, the GPU's own hierarchy the emulation follows
     /// (`crate::hi_stencil::amd`): evaluated before every pass it tests, which then rejects
     /// the tiles it rules out.
@@ -146,12 +149,17 @@ impl Rendering {
     /// draws that share the statistics buffer cannot be ordered inside one dynamic rendering
     /// instance. Exact, not a full memory barrier (as it was until 2026-11-29): the attachments
     /// are handed over by `open`'s transitions, the stencil to the tile update by its own, and
-    /// the tile surface's other buffers by the hi-stencil's reset, flush and save barriers; an
-    /// engine's hooks only read. That list is held by reading, not by a test: synchronisation
-    /// validation does not see these buffers' hazards (with no barrier here at all every test
-    /// passed on lavapipe, which runs draws in order, 2026-11-29).
+    /// the tile surface's other buffers by the hi-stencil's reset, flush and save barriers.
+    /// That list is held by reading, not by a test: synchronisation validation does not see
+    /// these buffers' hazards (with no barrier here at all every test passed on lavapipe, which
+    /// runs draws in order, 2026-11-29). An engine's hooks bind resources histencil cannot see,
+    /// which their shaders may write: with them, the full barrier as before.
     fn split(&mut self, pass: &LightingPass) {
         self.close(pass);
+        if pass.engine_hooks {
+            pass.rec.memory_barrier();
+            return;
+        }
         let rw = [BufferAccess::FragmentReadWrite];
         let hand_overs = self.counted.map(|buffer| (buffer, &rw[..], &rw[..]));
         pass.rec.buffer_barrier(&hand_overs);
@@ -534,8 +542,9 @@ impl LightingPass<'_> {
     ) {
         let rec = self.rec;
         let (d, cmd) = (rec.device(), rec.inside());
-        // SAFETY: `cmd` is inside the lighting's rendering (`record_pass` opens it before each
-        // draw); the pipeline was made for this plan's pass state (`prepare_pipelines`) with
+        // SAFETY: `cmd` is inside rendering (`inside` checks it: `record_pass` opens the
+        // lighting's before a pass's draws, `begin_touch` the touch image's, `Rendering::open`
+        // before a restore); the pipeline was made for this plan's pass state (`prepare_pipelines`) with
         // `pipeline_layout`, whose push range holds a `LightDrawPush`.
         unsafe {
             d.cmd_bind_pipeline(

@@ -4,8 +4,8 @@
 //! `destroy` (a creation that fails half way frees what it made); each frame it records from
 //! one inputs struct (`MeshInputs`, `TonemapInputs`, `LightingFrame`, `LightmapFrame`,
 //! `AlphaInputs`) through the caller's `Recording` (the encoder: it begins and ends the
-//! pass's rendering and opens its label, `Recording::step`), never a bare command buffer; the
-//! public entry points an engine calls with its own command buffer wrap it in one at once.
+//! pass's rendering and opens its label, `Recording::step`); no pass takes a bare command
+//! buffer, and the entry points an engine calls with its own wrap it in one at once.
 //! The lighting's
 //! per-frame recording (`lighting.rs`) and the light pipelines it creates per plan
 //! (`light_pipelines.rs`) live here and belong to `DeferredLighting`.

@@ -12,9 +12,9 @@
 
 use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::descriptors::{
-    create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers,
+    binding, create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers,
+    BindingDesc, BindingKind,
 };
 use crate::gpu::error::{Error, Result};
 use crate::gpu::limits::Limit;
@@ -641,7 +641,7 @@ fn tile_barrier(
         .dst_stage_mask(dst.0)
         .dst_access_mask(dst.1)];
     let info = vk::DependencyInfo::default().memory_barriers(&barrier);
-    // SAFETY: `cmd` is recording outside rendering (the record fns above, inside
+    // SAFETY: `rec` is outside rendering (`outside` checks it; the record fns above, inside
     // `record_tiled_with`), from a graphics and compute queue family, which supports the
     // transfer, compute and indirect stages named.
     unsafe { rec.device().cmd_pipeline_barrier2(rec.outside(), &info) };

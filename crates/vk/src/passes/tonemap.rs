@@ -4,8 +4,9 @@
 use super::{color_attachment, Load, CLEAR_BLACK};
 use crate::gpu::access::{Contents, ImageAccess};
 use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
-use crate::gpu::descriptors::{one_set, pass_layouts, write_sampled_images};
+use crate::gpu::descriptors::{
+    binding, one_set, pass_layouts, write_sampled_images, BindingDesc, BindingKind,
+};
 use crate::gpu::error::Result;
 use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::recording::Recording;
