@@ -280,7 +280,8 @@ fn the_lab_measures_the_engine_brdfs() {
     let sampling = histencil_lab::stats::Sampling::rounds(2);
     with_validated_context(|ctx| {
         let calibration =
-            histencil_lab::calibrate_with(ctx, (64, 36), modules, &sampling, &mut |_| {}).unwrap();
+            histencil_lab::calibrate_with(ctx, (64, 36), modules, &sampling, None, &mut |_| {})
+                .unwrap();
         let c = calibration.costs;
         assert!(c.shade_ms > 0.0 && c.pass_overhead_ms.is_finite(), "{c:?}");
         // Each engine BRDF weighed on its own (and the wall's padding), relative to their mean;

@@ -294,6 +294,20 @@ fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
     }
     assert!(c.shade_ms > 0.0, "{c:?}");
     assert_eq!(calibration.sampled.rounds, 2);
+    // `calibrate` keeps its rounds by the steady clock: one set, warmed up, a canary time after
+    // each of the two kept rounds, and the record in the costs file.
+    let stability = calibration
+        .stability
+        .as_ref()
+        .expect("the steady clock ran");
+    let set = &stability.sets[0];
+    assert_eq!(set.set, "the calibration");
+    assert!(
+        !set.warm_ups.is_empty(),
+        "the first canary sets no reference: {set:?}"
+    );
+    assert_eq!(set.canary.len(), 2, "{set:?}");
+    assert!(calibration.json()["stability"]["sets"].is_array());
     let costs = [
         c.pass_overhead_ms,
         c.stencil_per_brdf_ms,

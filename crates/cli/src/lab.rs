@@ -88,14 +88,8 @@ pub struct CompareArgs {
     /// retaken and its canary warmed up again there, in the report's "Steady clock").
     #[arg(long, value_name = "N", requires = "beside_load", value_parser = clap::value_parser!(u32).range(1..))]
     beside_load_from_round: Option<u32>,
-    /// The steady clock's tolerance in percent: a canary frame (branching's lighting at 1 BRDF,
-    /// timed between every two rounds after a warm-up until it settles) further than this from
-    /// its reference has its round thrown away and retaken.
-    #[arg(long, value_name = "PERCENT", default_value_t = 10.0)]
-    clock_tolerance: f64,
-    /// No steady clock: no canary, no warm-up until it settles, every round kept as taken.
-    #[arg(long, conflicts_with = "clock_tolerance")]
-    no_steady_clock: bool,
+    #[command(flatten)]
+    clock: ClockArgs,
     /// A first answer in minutes (3 min 9 s on lavapipe with 2 cores, where its table decided
     /// all 10 of the talk's verdicts, the steady clock's retakes included): 320x180, light sizes
     /// 1, 10 and 100 %, each of the four measurement sets (the table, three sizes) sampled until
@@ -162,6 +156,35 @@ fn compare_merge(args: &CompareMergeArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The steady clock under a measurement's rounds (compare, calibrate).
+#[derive(clap::Args)]
+pub struct ClockArgs {
+    /// The steady clock's tolerance in percent: a canary frame (branching's lighting at 1 BRDF,
+    /// timed between every two rounds after a warm-up until it settles) further than this from
+    /// its reference has its round thrown away and retaken.
+    #[arg(long, value_name = "PERCENT", default_value_t = 10.0)]
+    clock_tolerance: f64,
+    /// No steady clock: no canary, no warm-up until it settles, every round kept as taken.
+    #[arg(long, conflicts_with = "clock_tolerance")]
+    no_steady_clock: bool,
+}
+
+impl ClockArgs {
+    /// The clock's settings, `None` without one.
+    fn settings(&self) -> Result<Option<histencil_lab::steady::ClockSettings>> {
+        let tolerance = self.clock_tolerance;
+        if !(tolerance > 0.0 && tolerance < 100.0) {
+            bail!("--clock-tolerance: {tolerance} is not a percentage in (0, 100)");
+        }
+        Ok(
+            (!self.no_steady_clock).then_some(histencil_lab::steady::ClockSettings {
+                tolerance: tolerance / 100.0,
+                ..Default::default()
+            }),
+        )
+    }
 }
 
 /// How long a measurement samples (compare, calibrate).
@@ -251,6 +274,8 @@ pub struct CalibrateArgs {
     out: PathBuf,
     #[command(flatten)]
     sampling: SamplingArgs,
+    #[command(flatten)]
+    clock: ClockArgs,
 }
 
 #[derive(clap::Args)]
@@ -450,14 +475,7 @@ pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
         read_costs_arg(args.costs.as_deref(), &settings.brdfs.set)?;
     settings.beside_load = usize::from(args.beside_load);
     settings.load_from_round = args.beside_load_from_round.map(|r| r as usize - 1);
-    let tolerance = args.clock_tolerance;
-    if !(tolerance > 0.0 && tolerance < 100.0) {
-        bail!("--clock-tolerance: {tolerance} is not a percentage in (0, 100)");
-    }
-    settings.clock = (!args.no_steady_clock).then_some(histencil_lab::steady::ClockSettings {
-        tolerance: tolerance / 100.0,
-        ..Default::default()
-    });
+    settings.clock = args.clock.settings()?;
     settings.first_row = true;
     let report = on_device(args.run.device(), |ctx| {
         Ok(with_spinner(|step| {
@@ -516,11 +534,12 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     steady_llvmpipe();
     histencil_vk::check_output_file(&args.out)?;
     let sampling = args.sampling.sampling(args.run.frames)?;
+    let clock = args.clock.settings()?;
     let modules = args.brdfs.modules()?;
     let calibration = on_device(args.run.device(), |ctx| {
         let c = with_spinner(|step| {
             let size = (args.run.width, args.run.height);
-            histencil_lab::calibrate_with(ctx, size, modules, &sampling, step)
+            histencil_lab::calibrate_with(ctx, size, modules, &sampling, clock, step)
         });
         Ok(c?)
     })?;

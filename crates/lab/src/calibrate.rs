@@ -26,6 +26,7 @@
 
 use crate::measure::{Timing, WARM_UP_FRAMES};
 use crate::stats::{median_interval, sample, Interval, Sampled, Sampling};
+use crate::steady::{ClockSettings, Stability, SteadyClock};
 use crate::variants::{brdf_palette, light_size_scene, with_brdf_count, with_one_brdf};
 use crate::{LabError, Result};
 use histencil_model::{DepthIdCosts, TiledCosts, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
@@ -60,6 +61,10 @@ pub struct Calibration {
     pub sampled: Sampled,
     /// `(what, lighting time)` of every measured frame kind.
     pub measurements: Vec<(String, Timing)>,
+    /// The steady clock's record: its canary's warm-ups and times, and the rounds it retook
+    /// (`None` without the clock). A cost fitted from rounds whose clock moved would steer the
+    /// adaptive technique wrong on every frame after.
+    pub stability: Option<Stability>,
 }
 
 /// One measured frame kind: the wall at a coverage, a BRDF count, a technique.
@@ -88,18 +93,16 @@ pub fn calibrate(
     sampling: &Sampling,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Calibration> {
-    calibrate_with(
-        ctx,
-        (width, height),
-        BrdfModules::builtin(),
-        sampling,
-        progress,
-    )
+    let clock = Some(ClockSettings::default());
+    let modules = BrdfModules::builtin();
+    calibrate_with(ctx, (width, height), modules, sampling, clock, progress)
 }
 
 /// [`calibrate`] with the wall striped in `brdfs`' engine BRDFs, when it has any (`calibrate
 /// --brdfs`): the costs are then those of the engine's shading models, averaged over them, which
-/// the adaptive technique takes through `--costs`.
+/// the adaptive technique takes through `--costs`; with `clock`, every round kept by the steady
+/// clock ([`crate::steady`]: branching's lighting on the full-screen wall at 1 BRDF its canary),
+/// without it every round kept as taken.
 ///
 /// # Errors
 /// As [`calibrate`].
@@ -108,6 +111,7 @@ pub fn calibrate_with(
     (width, height): (u32, u32),
     modules: &'static BrdfModules,
     sampling: &Sampling,
+    clock: Option<ClockSettings>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Calibration> {
     // Before the wall is built: its shape follows the aspect ratio.
@@ -196,6 +200,21 @@ pub fn calibrate_with(
         });
         renderers.push((renderer, lights));
     }
+    let mut steady = match clock {
+        Some(settings) => {
+            let mut wall = light_size_scene(1.0, aspect);
+            histencil_scene::retarget_brdfs(&mut wall, &modules.set);
+            let desc = RendererDesc {
+                brdfs: modules,
+                ..RendererDesc::new(width, height)
+            };
+            let canary = Renderer::with_desc(ctx, with_brdf_count(&wall, 1), &desc)?;
+            let scene = format!("the full-screen wall at 1 BRDF, {width}x{height}");
+            SteadyClock::new(canary, &scene, settings)?
+        }
+        None => SteadyClock::off(),
+    };
+    steady.begin_set("the calibration", progress)?;
     // Kinds in push order: full 1 BRDF (branching, stencil, depth-id), full 3 (branching,
     // stencil, tiled, depth-id), small 1 (stencil), small 3 (stencil), then each weighed BRDF.
     let full_lights = renderers[0].1;
@@ -236,17 +255,26 @@ pub fn calibrate_with(
             progress(&start.line());
             let round = start.index;
             let mut k = kinds.borrow_mut();
-            for kind in k.iter_mut() {
-                let (renderer, lights) = &mut renderers[kind.renderer];
-                let timings = renderer.render(kind.technique, histencil_vk::Readback::NONE)?;
-                // A tiled frame's light lists cost per light, as its shading does.
-                let t = &timings.timings;
-                let ms =
-                    t.pass_ms("lighting").unwrap_or(0.0) + t.pass_ms("tile-lights").unwrap_or(0.0);
-                kind.per_light_ms.push(ms / *lights);
-                if let Some(classify) = t.pass_ms("tile-classify") {
-                    kind.classify_ms.push(classify);
-                }
+            // One try of the round: every kind's per-light time and classification, committed
+            // only once the steady clock keeps the try.
+            let mut one_try = || -> Result<Vec<(f64, Option<f64>)>> {
+                k.iter()
+                    .map(|kind| {
+                        let (renderer, lights) = &mut renderers[kind.renderer];
+                        let t = renderer
+                            .render(kind.technique, histencil_vk::Readback::NONE)?
+                            .timings;
+                        // A tiled frame's light lists cost per light, as its shading does.
+                        let ms = t.pass_ms("lighting").unwrap_or(0.0)
+                            + t.pass_ms("tile-lights").unwrap_or(0.0);
+                        Ok((ms / *lights, t.pass_ms("tile-classify")))
+                    })
+                    .collect()
+            };
+            let kept = steady.round(start, progress, &mut one_try)?;
+            for (kind, (per_light, classify)) in k.iter_mut().zip(kept) {
+                kind.per_light_ms.push(per_light);
+                kind.classify_ms.extend(classify);
             }
             fits.borrow_mut().push(fit(&k, round));
             Ok(())
@@ -309,6 +337,7 @@ pub fn calibrate_with(
         brdf_weights,
         sampled,
         measurements,
+        stability: steady.into_stability(),
     })
 }
 
@@ -345,6 +374,9 @@ impl Calibration {
             "sampling": {"rounds": self.sampled.rounds, "stopped": self.sampled.stop.word(),
                          "seconds": self.sampled.seconds},
         });
+        if let Some(stability) = &self.stability {
+            out["stability"] = stability.json();
+        }
         // The costs as `CostModel::from_json` reads them back: each group's costs by name, with
         // their intervals beside them.
         for (name, value) in costs_object(&COST_FIELDS, &self.costs.fields(), self.costs.interval) {
@@ -493,6 +525,7 @@ mod tests {
                 prediction: None,
             },
             measurements: vec![],
+            stability: None,
         };
         let path = dir.join("costs.json");
         calibration.write(&path).unwrap();
