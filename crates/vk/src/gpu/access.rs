@@ -240,49 +240,81 @@ pub(crate) enum Contents {
     Keep,
 }
 
+/// An image a step uses and how: the step's barriers are derived from these
+/// ([`Recording::declare`]), and the image's state follows.
+pub(crate) type Use<'i> = (&'i mut ImageRef, ImageAccess, Contents);
+
+/// The barrier that takes `image` from its current state to `next`, and the state it leaves.
+fn image_barrier(
+    image: &ImageRef,
+    next: ImageAccess,
+    contents: Contents,
+) -> vk::ImageMemoryBarrier2<'static> {
+    // The frame checks refuse targets without the usage their recording needs; an access here
+    // that they did not foresee is histencil's bug.
+    debug_assert!(
+        image.usage.contains(next.usage()),
+        "{next:?} on an image with usage {:?}: the frame checks missed it",
+        image.usage
+    );
+    let ImageState {
+        layout: old_layout,
+        stage: src_stage,
+        access: src_access,
+    } = image.state;
+    let (new_layout, dst_stage, dst_access) = access_info(next);
+    let old_layout = match contents {
+        Contents::Discard => vk::ImageLayout::UNDEFINED,
+        Contents::Keep => old_layout,
+    };
+    vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)
+        .old_layout(old_layout)
+        .new_layout(new_layout)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image.image)
+        .subresource_range(subresource_range(image.aspect()))
+}
+
 impl Recording<'_> {
-    /// Records the barrier that takes `image` from its current state to `next`.
-    pub(crate) fn transition(&self, image: &mut ImageRef, next: ImageAccess, contents: Contents) {
-        // The frame checks refuse targets without the usage their recording needs; an access here
-        // that they did not foresee is histencil's bug.
+    /// Declares how a step uses `uses`' images next and records the one barrier command that
+    /// takes each from its current state there: a pass declares its accesses, then draws.
+    pub(crate) fn declare(&self, uses: &mut [Use<'_>]) {
+        if uses.is_empty() {
+            return;
+        }
         debug_assert!(
-            image.usage.contains(next.usage()),
-            "{next:?} on an image with usage {:?}: the frame checks missed it",
-            image.usage
+            (1..uses.len()).all(|i| uses[..i].iter().all(|u| u.0.image != uses[i].0.image)),
+            "an image declared twice in one step's accesses"
         );
-        let ImageState {
-            layout: old_layout,
-            stage: src_stage,
-            access: src_access,
-        } = image.state;
-        let (new_layout, dst_stage, dst_access) = access_info(next);
-        let old_layout = match contents {
-            Contents::Discard => vk::ImageLayout::UNDEFINED,
-            Contents::Keep => old_layout,
-        };
-        let barrier = vk::ImageMemoryBarrier2::default()
-            .src_stage_mask(src_stage)
-            .src_access_mask(src_access)
-            .dst_stage_mask(dst_stage)
-            .dst_access_mask(dst_access)
-            .old_layout(old_layout)
-            .new_layout(new_layout)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(image.image)
-            .subresource_range(subresource_range(image.aspect()));
-        let barriers = [barrier];
+        let barriers: Vec<_> = uses
+            .iter()
+            .map(|(image, next, contents)| image_barrier(image, *next, *contents))
+            .collect();
         let dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
         // SAFETY: the recording is outside rendering (`outside` checks it in debug builds;
-        // transitions go between passes: the renderer's frame, `submit_once`'s, or an engine's
-        // under `record`'s # Safety). `image` is live with every aspect of its format named; its
-        // `state` is true when the commands run (histencil's bookkeeping, or the engine's promise for its `ImageRef`s), so the old
-        // layout is right, and `dependency` lives until the call returns.
+        // accesses are declared between passes: the renderer's frame, `submit_once`'s, or an
+        // engine's under `record`'s # Safety). Each image is live with every aspect of its format
+        // named; its `state` is true when the commands run (histencil's bookkeeping, or the
+        // engine's promise for its `ImageRef`s), so each old layout is right; an image declared
+        // twice in one call would take its second barrier from a state the first replaced, which
+        // no caller does. `dependency` lives until the call returns.
         unsafe {
             self.device()
                 .cmd_pipeline_barrier2(self.outside(), &dependency)
         };
-        image.state = ImageState::after(next);
+        for (image, next, _) in uses.iter_mut() {
+            image.state = ImageState::after(*next);
+        }
+    }
+
+    /// [`Self::declare`] for one image.
+    pub(crate) fn transition(&self, image: &mut ImageRef, next: ImageAccess, contents: Contents) {
+        self.declare(&mut [(image, next, contents)]);
     }
 
     /// A global memory barrier: every write recorded before is visible to every access after.

@@ -3,7 +3,7 @@
 //! begin rendering into their targets through the encoder. Below the passes, so the hi-stencil
 //! emulation's touch draw and the alpha passes use them as the passes do.
 
-use crate::gpu::access::{Contents, ImageAccess, ImageRef};
+use crate::gpu::access::{Contents, ImageAccess, ImageRef, Use};
 use crate::gpu::recording::Recording;
 use ash::vk;
 use histencil_model::DepthConvention;
@@ -80,9 +80,17 @@ pub(crate) fn begin_all_cleared(
     images: &mut [&mut ImageRef],
     clear: vk::ClearValue,
 ) {
-    for image in images.iter_mut() {
-        rec.transition(image, ImageAccess::ColorAttachment, Contents::Discard);
-    }
+    let mut uses: Vec<Use> = images
+        .iter_mut()
+        .map(|image| {
+            (
+                &mut **image,
+                ImageAccess::ColorAttachment,
+                Contents::Discard,
+            )
+        })
+        .collect();
+    rec.declare(&mut uses);
     let colors: Vec<_> = images
         .iter()
         .map(|image| color_attachment(image, Load::Clear(clear)))
@@ -118,8 +126,10 @@ pub(crate) fn begin_hdr_rendering_as(
         Load::Clear(_) => Contents::Discard,
         Load::Keep => Contents::Keep,
     };
-    rec.transition(hdr_image, ImageAccess::ColorAttachment, contents(hdr));
-    rec.transition(depth_stencil, depth_access, contents(depth));
+    rec.declare(&mut [
+        (&mut *hdr_image, ImageAccess::ColorAttachment, contents(hdr)),
+        (&mut *depth_stencil, depth_access, contents(depth)),
+    ]);
     let colors = [color_attachment(hdr_image, hdr)];
     let ds = attachment(depth_stencil, depth_stencil.state.layout, depth);
     rec.begin_rendering_over(extent, &colors, Some(&ds));

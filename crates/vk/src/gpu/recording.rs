@@ -9,7 +9,9 @@
 //! out as [`Recording::inside`], [`Recording::outside`] or [`Recording::any`].
 //!
 //! Barriers, copies and dynamic state are its methods too, written beside what they serve
-//! (`transition`, `memory_barrier` and `buffer_barrier` in `access.rs`, `apply` in `state.rs`,
+//! (`declare`, `transition`, `memory_barrier` and `buffer_barrier` in `access.rs`: a step
+//! declares how it uses its images next, `rec.declare(&mut [(image, access, contents), ..])`,
+//! and one barrier command takes them all there; `apply` in `state.rs`,
 //! `copy_image_to_buffer` and `host_readable` in `readback.rs`). Modelled on wgpu-hal's
 //! `CommandEncoder` and Granite's `CommandBuffer`, which own `begin_render_pass` /
 //! `end_render_pass` so pass state cannot be forgotten, and on kajiya's `record_pass_cb`, which

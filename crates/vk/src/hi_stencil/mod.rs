@@ -23,7 +23,7 @@
 //! testing draw is preceded by `hi_stencil_count.frag` over the same geometry, and light shaders
 //! count the fragments they shade.
 
-use crate::gpu::access::{access_info, BufferAccess, Contents, ImageAccess, ImageRef};
+use crate::gpu::access::{access_info, BufferAccess, Contents, ImageAccess, ImageRef, Use};
 use crate::gpu::attachments::{depth_stencil_attachment, Load};
 use crate::gpu::compute::ComputePipeline;
 use crate::gpu::context::Context;
@@ -516,7 +516,7 @@ impl HiStencilSurface {
         push: &UpdatePush,
     ) {
         let stencil_read = ImageAccess::ComputeDepthStencilSampled;
-        rec.transition(depth_stencil, stencil_read, Contents::Keep);
+        let mut uses: Vec<Use> = vec![(depth_stencil, stencil_read, Contents::Keep)];
         // The update's set holds the touch image whether or not this update looks at it, so it
         // is always in the layout the set names (its contents are kept only after a touch draw).
         let (read_layout, ..) = access_info(stencil_read);
@@ -527,14 +527,19 @@ impl HiStencilSurface {
             } else {
                 Contents::Discard
             };
-            rec.transition(&mut self.touch, stencil_read, contents);
+            uses.push((&mut self.touch, stencil_read, contents));
         }
+        rec.declare(&mut uses);
+        // The stencil back from the declared uses, for its transition after the dispatch.
+        let depth_stencil = uses.swap_remove(0).0;
+        drop(uses);
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(rec, set, bytemuck::bytes_of(push));
         let groups = push.rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
-        // SAFETY: the recording is outside rendering (`outside` checks it) with the update pipeline and its set
-        // bound just above; the set's images were transitioned to the layouts it reads.
+        // SAFETY: the recording is outside rendering (`outside` checks it) with the update
+        // pipeline and its set bound just above; the set's images were declared in the layouts
+        // it reads.
         unsafe { rec.device().cmd_dispatch(rec.outside(), groups, 1, 1) };
         let attached = ImageAccess::DepthStencilAttachment;
         rec.transition(depth_stencil, attached, Contents::Keep);

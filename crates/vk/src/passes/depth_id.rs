@@ -17,7 +17,7 @@
 //! what the EQUAL test saves on a GPU is modelled in the simulator
 //! (`histencil_model::depth_id_stats`), not timed here.
 
-use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{Contents, ImageAccess, LightingTargets, Use};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::create_pipeline_layout;
 use crate::gpu::error::Result;
@@ -202,18 +202,22 @@ impl DepthIdPass {
             // The light lists' masks, from compute to the shade passes (the images by their
             // transitions below).
             rec.memory_barrier();
-            for image in targets.gbuffer.iter_mut() {
-                rec.transition(image, ImageAccess::FragmentSampled, Contents::Keep);
-            }
+            let keep = Contents::Keep;
+            let sampled = ImageAccess::FragmentSampled;
+            let mut uses: Vec<Use> = targets
+                .gbuffer
+                .iter_mut()
+                .map(|i| (i, sampled, keep))
+                .collect();
             if depth_sampled {
                 let access = ImageAccess::StencilAttachmentDepthSampled;
-                rec.transition(&mut targets.depth_stencil, access, Contents::Keep);
+                uses.push((&mut targets.depth_stencil, access, keep));
             }
-            let hdr = ImageAccess::FragmentStorage;
-            rec.transition(&mut targets.hdr, hdr, Contents::Keep);
+            uses.push((&mut targets.hdr, ImageAccess::FragmentStorage, keep));
             let ids = &mut self.ids[slot as usize];
-            let access = ImageAccess::DepthStencilAttachment;
-            rec.transition(ids, access, Contents::Discard);
+            uses.push((ids, ImageAccess::DepthStencilAttachment, Contents::Discard));
+            rec.declare(&mut uses);
+            let ids = &self.ids[slot as usize];
             let far = vk::ClearValue {
                 depth_stencil: vk::ClearDepthStencilValue {
                     depth: 1.0,

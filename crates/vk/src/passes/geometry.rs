@@ -6,7 +6,7 @@ use super::{
     begin_hdr_rendering, clear_depth_stencil, color_attachment, depth_stencil_attachment, Load,
     CLEAR_BLACK,
 };
-use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{Contents, ImageAccess, LightingTargets, Use};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{binding, pass_layouts, BindingDesc, BindingKind};
 use crate::gpu::error::Result;
@@ -223,11 +223,15 @@ impl MeshPasses {
         targets: &mut LightingTargets,
     ) {
         rec.step("gbuffer", |rec| {
-            for image in targets.gbuffer.iter_mut() {
-                rec.transition(image, ImageAccess::ColorAttachment, Contents::Discard);
-            }
+            let (color, discard) = (ImageAccess::ColorAttachment, Contents::Discard);
+            let mut uses: Vec<Use> = targets
+                .gbuffer
+                .iter_mut()
+                .map(|i| (i, color, discard))
+                .collect();
             let ds = ImageAccess::DepthStencilAttachment;
-            rec.transition(&mut targets.depth_stencil, ds, Contents::Discard);
+            uses.push((&mut targets.depth_stencil, ds, discard));
+            rec.declare(&mut uses);
             // The material target's w (BRDF id) is cleared to -1: "no geometry here".
             let no_brdf = vk::ClearValue {
                 color: vk::ClearColorValue {

@@ -13,7 +13,7 @@ use super::light_pipelines::{
     pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
 };
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
-use crate::gpu::access::{BufferAccess, Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{BufferAccess, Contents, ImageAccess, LightingTargets, Use};
 use crate::gpu::error::Result;
 use crate::gpu::recording::Recording;
 use crate::gpu::state::FULLSCREEN;
@@ -264,9 +264,13 @@ impl LightingPass<'_> {
             emulation,
         };
         rec.begin_label("lighting");
-        for image in targets.gbuffer.iter_mut() {
-            rec.transition(image, ImageAccess::FragmentSampled, Contents::Keep);
-        }
+        let (sampled, keep) = (ImageAccess::FragmentSampled, Contents::Keep);
+        let mut uses: Vec<Use> = targets
+            .gbuffer
+            .iter_mut()
+            .map(|i| (i, sampled, keep))
+            .collect();
+        rec.declare(&mut uses);
         // Query resets are outside rendering.
         if let Some(t) = timers.steps.as_deref_mut() {
             t.reset(rec);

@@ -10,7 +10,7 @@
 //! into the tiles of its screen rectangle whose depth range its range sphere reaches.
 //! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
-use crate::gpu::access::{Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{Contents, ImageAccess, LightingTargets, Use};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
     binding, create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers,
@@ -489,19 +489,23 @@ impl TiledLighting {
         let d = &ctx.device;
         let push = self.push(clear, mixed);
         rec.step("tiled-classify", |rec| {
-            for image in targets.gbuffer.iter_mut() {
-                rec.transition(image, ImageAccess::ComputeSampled, Contents::Keep);
-            }
+            let (sampled, keep) = (ImageAccess::ComputeSampled, Contents::Keep);
+            let mut uses: Vec<Use> = targets
+                .gbuffer
+                .iter_mut()
+                .map(|i| (i, sampled, keep))
+                .collect();
             if depth_sampled {
                 let ds = &mut targets.depth_stencil;
-                rec.transition(ds, ImageAccess::ComputeDepthSampled, Contents::Keep);
+                uses.push((ds, ImageAccess::ComputeDepthSampled, keep));
             }
             let hdr_contents = if clear {
                 Contents::Discard
             } else {
                 Contents::Keep
             };
-            rec.transition(&mut targets.hdr, ImageAccess::ComputeStorage, hdr_contents);
+            uses.push((&mut targets.hdr, ImageAccess::ComputeStorage, hdr_contents));
+            rec.declare(&mut uses);
             // Each slot's dispatch starts at zero tiles.
             let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
             // SAFETY: `cmd` is recording outside rendering (`rec.outside()` checks it in debug

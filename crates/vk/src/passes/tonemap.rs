@@ -77,10 +77,18 @@ impl Tonemap {
     /// Tonemaps `targets.hdr` into `targets.ldr`.
     pub(crate) fn record(&self, rec: &Recording, inputs: &TonemapInputs, targets: &mut Targets) {
         rec.step("tonemap", |rec| {
-            let hdr = (ImageAccess::FragmentSampled, Contents::Keep);
-            rec.transition(&mut targets.hdr, hdr.0, hdr.1);
-            let ldr = (ImageAccess::ColorAttachment, Contents::Discard);
-            rec.transition(&mut targets.ldr, ldr.0, ldr.1);
+            rec.declare(&mut [
+                (
+                    &mut targets.hdr,
+                    ImageAccess::FragmentSampled,
+                    Contents::Keep,
+                ),
+                (
+                    &mut targets.ldr,
+                    ImageAccess::ColorAttachment,
+                    Contents::Discard,
+                ),
+            ]);
             let colors = [color_attachment(&targets.ldr, Load::Clear(CLEAR_BLACK))];
             rec.begin_rendering_over(inputs.extent, &colors, None);
             // SAFETY: the pipeline, layout and set were made by `new` from this device and live
