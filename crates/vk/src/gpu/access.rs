@@ -244,6 +244,16 @@ pub(crate) enum Contents {
 /// ([`Recording::declare`]), and the image's state follows.
 pub(crate) type Use<'i> = (&'i mut ImageRef, ImageAccess, Contents);
 
+/// Every image of `images` used as `access` with `contents`: a step's uses of a group of images
+/// (the G-buffer's targets), to which it may add others before declaring them.
+pub(crate) fn uses_of(
+    images: &mut [ImageRef],
+    access: ImageAccess,
+    contents: Contents,
+) -> Vec<Use<'_>> {
+    images.iter_mut().map(|i| (i, access, contents)).collect()
+}
+
 /// The barrier that takes `image` from its current state to `next`, and the state it leaves.
 fn image_barrier(
     image: &ImageRef,

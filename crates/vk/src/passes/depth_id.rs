@@ -17,7 +17,7 @@
 //! what the EQUAL test saves on a GPU is modelled in the simulator
 //! (`histencil_model::depth_id_stats`), not timed here.
 
-use crate::gpu::access::{Contents, ImageAccess, LightingTargets, Use};
+use crate::gpu::access::{uses_of, Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::create_pipeline_layout;
 use crate::gpu::error::Result;
@@ -204,11 +204,7 @@ impl DepthIdPass {
             rec.memory_barrier();
             let keep = Contents::Keep;
             let sampled = ImageAccess::FragmentSampled;
-            let mut uses: Vec<Use> = targets
-                .gbuffer
-                .iter_mut()
-                .map(|i| (i, sampled, keep))
-                .collect();
+            let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
             if depth_sampled {
                 let access = ImageAccess::StencilAttachmentDepthSampled;
                 uses.push((&mut targets.depth_stencil, access, keep));

@@ -6,7 +6,7 @@ use super::{
     begin_hdr_rendering, clear_depth_stencil, color_attachment, depth_stencil_attachment, Load,
     CLEAR_BLACK,
 };
-use crate::gpu::access::{Contents, ImageAccess, LightingTargets, Use};
+use crate::gpu::access::{uses_of, Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{binding, pass_layouts, BindingDesc, BindingKind};
 use crate::gpu::error::Result;
@@ -224,11 +224,7 @@ impl MeshPasses {
     ) {
         rec.step("gbuffer", |rec| {
             let (color, discard) = (ImageAccess::ColorAttachment, Contents::Discard);
-            let mut uses: Vec<Use> = targets
-                .gbuffer
-                .iter_mut()
-                .map(|i| (i, color, discard))
-                .collect();
+            let mut uses = uses_of(&mut targets.gbuffer, color, discard);
             let ds = ImageAccess::DepthStencilAttachment;
             uses.push((&mut targets.depth_stencil, ds, discard));
             rec.declare(&mut uses);

@@ -13,7 +13,7 @@ use super::light_pipelines::{
     pipeline_key, BrdfSource, LightPipelineKey, LightPipelines, LightShader,
 };
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
-use crate::gpu::access::{BufferAccess, Contents, ImageAccess, LightingTargets, Use};
+use crate::gpu::access::{uses_of, BufferAccess, Contents, ImageAccess, LightingTargets};
 use crate::gpu::error::Result;
 use crate::gpu::recording::Recording;
 use crate::gpu::state::FULLSCREEN;
@@ -265,11 +265,7 @@ impl LightingPass<'_> {
         };
         rec.begin_label("lighting");
         let (sampled, keep) = (ImageAccess::FragmentSampled, Contents::Keep);
-        let mut uses: Vec<Use> = targets
-            .gbuffer
-            .iter_mut()
-            .map(|i| (i, sampled, keep))
-            .collect();
+        let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
         rec.declare(&mut uses);
         // Query resets are outside rendering.
         if let Some(t) = timers.steps.as_deref_mut() {

@@ -10,7 +10,7 @@
 //! into the tiles of its screen rectangle whose depth range its range sphere reaches.
 //! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
-use crate::gpu::access::{Contents, ImageAccess, LightingTargets, Use};
+use crate::gpu::access::{uses_of, Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
     binding, create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers,
@@ -490,11 +490,7 @@ impl TiledLighting {
         let push = self.push(clear, mixed);
         rec.step("tiled-classify", |rec| {
             let (sampled, keep) = (ImageAccess::ComputeSampled, Contents::Keep);
-            let mut uses: Vec<Use> = targets
-                .gbuffer
-                .iter_mut()
-                .map(|i| (i, sampled, keep))
-                .collect();
+            let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
             if depth_sampled {
                 let ds = &mut targets.depth_stencil;
                 uses.push((ds, ImageAccess::ComputeDepthSampled, keep));
