@@ -158,7 +158,7 @@ fn compare_merge(args: &CompareMergeArgs) -> Result<()> {
     Ok(())
 }
 
-/// The steady clock under a measurement's rounds (compare, calibrate).
+/// The steady clock under a measurement's rounds (compare, calibrate, sweep).
 #[derive(clap::Args)]
 pub struct ClockArgs {
     /// The steady clock's tolerance in percent: a canary frame (branching's lighting at 1 BRDF,
@@ -259,6 +259,8 @@ pub struct SweepArgs {
     /// Output directory: sweep.csv, sweep.json, pareto.png.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
+    #[command(flatten)]
+    clock: ClockArgs,
 }
 
 #[derive(clap::Args)]
@@ -507,19 +509,18 @@ pub fn sweep(args: &SweepArgs, lights: DefaultLights) -> Result<()> {
         args.scene.as_deref().unwrap_or(param.default_scene()),
         lights,
     )?;
+    let clock = args.clock.settings()?;
     let report = on_device(args.run.device(), |ctx| {
-        let what = format!("{} on {}", param.name(), scene.name);
-        let total = values.len();
         let report = with_spinner(|step| {
             histencil_lab::run_sweep(
                 ctx,
                 scene,
                 param,
                 &values,
-                args.run.width,
-                args.run.height,
+                (args.run.width, args.run.height),
                 args.run.frames as usize,
-                &mut |done, _| step(&format!("{what}: {done} of {total} values measured")),
+                clock,
+                step,
             )
         });
         Ok(report?)

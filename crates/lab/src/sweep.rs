@@ -21,6 +21,9 @@
 use crate::image_error::{image_error, ImageError};
 use crate::measure::{frame, time_lighting, time_passes, Timing, WARM_UP_FRAMES};
 use crate::plot::{self, Axis};
+use crate::stats::RoundStart;
+use crate::steady::{ClockSettings, Stability, SteadyClock};
+use crate::variants::with_brdf_count;
 use crate::{write_file, AlphaReference, LabError, Result};
 use histencil_scene::{ParticleLayout, ParticleSystem, Scene, MAX_SLICES};
 use histencil_vk::{Backend, Context, FlushPolicy, Renderer, RendererDesc, Shading, Technique};
@@ -103,6 +106,9 @@ pub struct SweepReport {
     pub height: u32,
     pub frames: usize,
     pub points: Vec<SweepPoint>,
+    /// The steady clock's record (`None` without the clock, and for tile sizes, which are
+    /// simulated, not timed): each value's timing is a round, retaken where the canary strayed.
+    pub stability: Option<Stability>,
 }
 
 /// Every value of `values` in `param`'s range, so that a sweep refuses a bad value before it
@@ -135,17 +141,19 @@ pub fn check_values(param: SweepParam, values: &[u32], width: u32, height: u32) 
     Ok(())
 }
 
-/// Measures `scene` at every value; `progress(done, total)` after each.
+/// Measures `scene` at every value, each value's timing a round of the steady clock where
+/// `clock` asks for one (its canary branching's lighting on `scene` at 1 BRDF); `progress` is
+/// told each value measured and each retake.
 #[allow(clippy::too_many_arguments)]
 pub fn run_sweep(
     ctx: &Context,
     scene: Scene,
     param: SweepParam,
     values: &[u32],
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
     frames: usize,
-    progress: &mut dyn FnMut(usize, usize),
+    clock: Option<ClockSettings>,
+    progress: &mut dyn FnMut(&str),
 ) -> Result<SweepReport> {
     histencil_vk::check_extent(ctx, width, height).map(drop)?;
     if values.is_empty() {
@@ -166,6 +174,29 @@ pub fn run_sweep(
     check_values(param, values, width, height)?;
     let name = scene.name.clone();
     let original = scene.clone();
+    let mut steady = match clock.filter(|_| param != SweepParam::TileSize) {
+        Some(settings) => {
+            let canary = Renderer::new(ctx, with_brdf_count(&scene, 1), width, height)?;
+            let what = format!("`{name}` at 1 BRDF, {width}x{height}");
+            SteadyClock::new(canary, &what, settings)?
+        }
+        None => SteadyClock::off(),
+    };
+    let set = format!("{} on {name}", param.name());
+    steady.begin_set(&set, progress)?;
+    let start = std::time::Instant::now();
+    // Value `i`'s round: its place in the set, for the clock and the progress lines.
+    let round = |i: usize| RoundStart {
+        index: i,
+        seconds: start.elapsed().as_secs_f64(),
+        budget_seconds: f64::INFINITY,
+        pilot: None,
+        predicted_rounds: None,
+        fixed_rounds: Some(values.len()),
+        open: None,
+    };
+    let total = values.len();
+    let measured = |i: usize| format!("{set}: {} of {total} values measured", i + 1);
     let mut renderer = Renderer::new(ctx, scene, width, height)?;
     let mut points = Vec::new();
     match param {
@@ -183,7 +214,8 @@ pub fn run_sweep(
                     ..RendererDesc::new(width, height)
                 };
                 let mut renderer = Renderer::with_desc(ctx, original.clone(), &desc)?;
-                let speed = time_lighting(&mut renderer, lut, frames)?;
+                let mut timed = || time_lighting(&mut renderer, lut, frames);
+                let speed = steady.round(&round(i), progress, &mut timed)?;
                 let error = image_error(&frame(&mut renderer, lut)?, &reference);
                 let bytes = renderer.lut_tables()?.size_bytes();
                 points.push(SweepPoint {
@@ -192,7 +224,7 @@ pub fn run_sweep(
                     error,
                     extra: vec![("table_bytes", bytes as f64)],
                 });
-                progress(i + 1, values.len());
+                progress(&measured(i));
             }
         }
         SweepParam::LightmapRes => {
@@ -205,17 +237,14 @@ pub fn run_sweep(
                     ..RendererDesc::new(width, height)
                 };
                 let mut renderer = Renderer::with_desc(ctx, original.clone(), &desc)?;
-                let speed = time_passes(
-                    &mut renderer,
-                    technique,
-                    &["alpha-lightmaps", "alpha"],
-                    frames,
-                )?;
+                let passes = ["alpha-lightmaps", "alpha"];
+                let mut timed = || time_passes(&mut renderer, technique, &passes, frames);
+                let speed = steady.round(&round(i), progress, &mut timed)?;
                 let lit = frame(&mut renderer, technique)?;
                 let masked = reference.error(&lit);
                 let whole = image_error(&lit, &reference.forward);
                 points.push(alpha_point(&mut renderer, side, speed, &masked, &whole)?);
-                progress(i + 1, values.len());
+                progress(&measured(i));
             }
         }
         SweepParam::Slices => {
@@ -232,12 +261,13 @@ pub fn run_sweep(
                 }
                 let mut renderer = Renderer::new(ctx, scene, width, height)?;
                 let passes = ["alpha-lightmaps", "alpha"];
-                let speed = time_passes(&mut renderer, technique, &passes, frames)?;
+                let mut timed = || time_passes(&mut renderer, technique, &passes, frames);
+                let speed = steady.round(&round(i), progress, &mut timed)?;
                 let lit = frame(&mut renderer, technique)?;
                 let masked = reference.error(&lit);
                 let whole = image_error(&lit, &reference.forward);
                 points.push(alpha_point(&mut renderer, count, speed, &masked, &whole)?);
-                progress(i + 1, values.len());
+                progress(&measured(i));
             }
         }
         SweepParam::TileSize => {
@@ -272,7 +302,7 @@ pub fn run_sweep(
                         ("flushes", stats.flushes as f64),
                     ],
                 });
-                progress(i + 1, values.len());
+                progress(&measured(i));
             }
         }
     }
@@ -285,6 +315,7 @@ pub fn run_sweep(
         height,
         frames,
         points,
+        stability: steady.into_stability(),
     })
 }
 
@@ -434,14 +465,18 @@ impl SweepReport {
                 v
             })
             .collect();
-        json!({
+        let mut out = json!({
             "device": self.device,
             "driver": self.driver,
             "param": self.param.name(),
             "settings": {"scene": self.scene, "width": self.width, "height": self.height,
                          "frames": self.frames, "warm_up_frames": WARM_UP_FRAMES},
             "points": points,
-        })
+        });
+        if let Some(stability) = &self.stability {
+            out["stability"] = stability.json();
+        }
+        out
     }
 }
 
