@@ -133,13 +133,23 @@ pub fn calibrate_with(
         (1.0, vec![branching, stencil, tiled, depth_id]),
         (SMALL_COVERAGE, vec![stencil]),
     ];
+    // Every renderer of the calibration: at its size, in the modules' BRDFs, lighting the wall
+    // at a coverage in those BRDFs.
+    let desc = RendererDesc {
+        brdfs: modules,
+        ..RendererDesc::new(width, height)
+    };
+    let wall_at = |coverage: f64| {
+        let mut wall = light_size_scene(coverage, aspect);
+        histencil_scene::retarget_brdfs(&mut wall, &modules.set);
+        wall
+    };
     let mut renderers = Vec::new();
     let mut kinds = Vec::new();
     // Extra BRDFs each light touches, on average (small lights at the wall's edge miss one).
     let mut extra_brdfs = Vec::new();
     for (coverage, techniques) in &walls {
-        let mut wall = light_size_scene(*coverage, aspect);
-        histencil_scene::retarget_brdfs(&mut wall, &modules.set);
+        let wall = wall_at(*coverage);
         crate::variants::check_palette(&wall, 3, &modules.set)?;
         let lights = wall.lights.len() as f64;
         let touched = wall
@@ -150,10 +160,6 @@ pub fn calibrate_with(
         extra_brdfs.push((touched / lights - 1.0).max(1e-6));
         for brdfs in [1, 3] {
             progress(&format!("coverage {coverage}, {brdfs} BRDF(s): building"));
-            let desc = RendererDesc {
-                brdfs: modules,
-                ..RendererDesc::new(width, height)
-            };
             let mut renderer = Renderer::with_desc(ctx, with_brdf_count(&wall, brdfs), &desc)?;
             // Tiled is fitted from the 3-BRDF wall only.
             let measured = techniques
@@ -180,13 +186,8 @@ pub fn calibrate_with(
     for brdf in &weighed {
         let name = brdf.id().name();
         progress(&format!("{name} alone: building"));
-        let mut wall = light_size_scene(1.0, aspect);
-        histencil_scene::retarget_brdfs(&mut wall, &modules.set);
+        let wall = wall_at(1.0);
         let lights = wall.lights.len() as f64;
-        let desc = RendererDesc {
-            brdfs: modules,
-            ..RendererDesc::new(width, height)
-        };
         let mut renderer = Renderer::with_desc(ctx, with_one_brdf(&wall, *brdf), &desc)?;
         for _ in 0..WARM_UP_FRAMES {
             renderer.render(stencil, histencil_vk::Readback::NONE)?;
@@ -202,13 +203,7 @@ pub fn calibrate_with(
     }
     let mut steady = match clock {
         Some(settings) => {
-            let mut wall = light_size_scene(1.0, aspect);
-            histencil_scene::retarget_brdfs(&mut wall, &modules.set);
-            let desc = RendererDesc {
-                brdfs: modules,
-                ..RendererDesc::new(width, height)
-            };
-            let canary = Renderer::with_desc(ctx, with_brdf_count(&wall, 1), &desc)?;
+            let canary = Renderer::with_desc(ctx, with_brdf_count(&wall_at(1.0), 1), &desc)?;
             let scene = format!("the full-screen wall at 1 BRDF, {width}x{height}");
             SteadyClock::new(canary, &scene, settings)?
         }

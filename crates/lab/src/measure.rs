@@ -1,7 +1,7 @@
 //! Timing a technique over frames, and the frame it renders.
 
 use crate::Result;
-use histencil_vk::{median_of_sorted, FrameDesc, Readback, Renderer, Technique};
+use histencil_vk::{median_of_sorted, FrameDesc, Readback, Renderer, Shading, Technique};
 use image::RgbaImage;
 
 /// Milliseconds of one measured quantity over frames: the median and the spread.
@@ -86,6 +86,18 @@ pub fn time_lighting(
     frames: usize,
 ) -> Result<Timing> {
     time_passes(renderer, technique, &["lighting"], frames)
+}
+
+/// The lighting's time in one frame: the technique's (the lighting pass without the
+/// hi-stencil emulator's bookkeeping, and the tiled technique's classification before it), and
+/// on an emulated backend the bookkeeping's.
+pub(crate) fn lighting_ms(
+    renderer: &mut Renderer,
+    technique: Technique,
+) -> Result<(f64, Option<f64>)> {
+    let timings = renderer.render(technique, Readback::NONE)?.timings;
+    let own = timings.technique_ms(Shading::Deferred(technique).lighting_passes());
+    Ok((own, timings.bookkeeping_ms))
 }
 
 /// The tonemapped frame.

@@ -14,7 +14,7 @@
 //! The decisions are pure functions ([`settled`], [`strays`]) and [`Clock`] is generic over the
 //! canary and the round's work, so the whole policy is unit-tested without a GPU.
 
-use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Shading, Technique};
+use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
 use std::time::{Duration, Instant};
 
 /// How steady a clock must be, and how long to wait for it.
@@ -441,10 +441,7 @@ const CANARY_FRAMES: usize = 3;
 /// One canary time: the median lighting time of [`CANARY_FRAMES`] frames.
 fn canary_ms(renderer: &mut Renderer) -> crate::Result<f64> {
     let mut times = (0..CANARY_FRAMES)
-        .map(|_| {
-            let timings = renderer.render(CANARY, Readback::NONE)?.timings;
-            Ok(timings.technique_ms(Shading::Deferred(CANARY).lighting_passes()))
-        })
+        .map(|_| crate::measure::lighting_ms(renderer, CANARY).map(|(ms, _)| ms))
         .collect::<crate::Result<Vec<f64>>>()?;
     times.sort_by(f64::total_cmp);
     Ok(histencil_vk::median_of_sorted(&times))

@@ -5,7 +5,7 @@ pub mod merge;
 mod report;
 
 use crate::image_error::{image_error, ImageError};
-use crate::measure::{frame, Timing};
+use crate::measure::{frame, lighting_ms, Timing};
 use crate::stats::{
     median_interval, ratio_interval, sample_deciding, Interval, Sampled, Sampling, Verdict,
 };
@@ -1109,15 +1109,6 @@ fn depth_id_stats(renderer: &mut Renderer) -> Result<TileStats> {
 
 /// The most rounds one measurement set takes, whatever its target and budget.
 pub const MAX_ROUNDS: usize = 400;
-
-/// The lighting's time in one frame: the technique's (the lighting pass without the
-/// hi-stencil emulator's bookkeeping, and the tiled technique's classification before it), and
-/// on an emulated backend the bookkeeping's.
-fn lighting_ms(renderer: &mut Renderer, technique: Technique) -> Result<(f64, Option<f64>)> {
-    let timings = renderer.render(technique, Readback::NONE)?.timings;
-    let own = timings.technique_ms(Shading::Deferred(technique).lighting_passes());
-    Ok((own, timings.bookkeeping_ms))
-}
 
 /// Each of `palette`'s share of the surface pixels `renderer`'s G-buffer holds (zero for a
 /// BRDF it does not use; pixels of BRDFs outside the palette are not counted).
