@@ -502,14 +502,14 @@ fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget()
     // The cap: a run that cannot decide stops here at the latest (short: the talk's verdicts
     // are 18 cells, and a pilot on lavapipe predicts more than a test should spend; the pilot
     // itself takes about 6 s alone, twice that beside another test).
-    settings.budget = std::time::Duration::from_secs(20);
+    settings.budget = std::time::Duration::from_secs(14);
     let report = with_validated_context(|ctx| run_compare(ctx, &settings, &mut |_| {}).unwrap());
     use histencil_lab::stats::{Stop, MIN_VERDICT_ROUNDS};
     let t = report.sampled;
     let p = t.prediction.expect("a pilot's prediction");
     assert_eq!(p.pilot_rounds, MIN_VERDICT_ROUNDS);
     assert!(t.rounds >= MIN_VERDICT_ROUNDS, "{t:?}");
-    assert!(p.budget_seconds <= 20.0, "{p:?}");
+    assert!(p.budget_seconds <= 14.0, "{p:?}");
     match t.stop {
         Stop::Decided => assert_eq!(t.open, 0, "{t:?}"),
         Stop::Budget | Stop::MaxRounds => assert!(t.open > 0, "{t:?}"),

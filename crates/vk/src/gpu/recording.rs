@@ -15,9 +15,12 @@
 //! `copy_image_to_buffer` and `host_readable` in `readback.rs`). Modelled on wgpu-hal's
 //! `CommandEncoder` and Granite's `CommandBuffer`, which own `begin_render_pass` /
 //! `end_render_pass` so pass state cannot be forgotten, and on kajiya's `record_pass_cb`, which
-//! wraps each pass in its label: [`Recording::step`] does the label. The renderer's timestamp
-//! after each pass (`Timestamps::mark`) is also the GPU-written marker a stalled wait reports
-//! (`timing::progress_words`): the marks the GPU has written name the passes it finished.
+//! wraps each pass in its label: [`Recording::step`] does the label. A recording may also carry
+//! a clock (`start_clock`, in `timing.rs`; the renderer's frame has one): then
+//! `rec.timed(name, body)` writes a timestamp after the pass's commands, which is both the
+//! frame's per-pass GPU time and the GPU-written marker a stalled wait reports
+//! (`timing::progress_words`: the marks the GPU has written name the passes it finished). A
+//! recording without one (an engine's command buffer) records the same commands, untimed.
 //!
 //! Methods take `&self`: the state is in `Cell`s, which makes a `Recording` `!Sync`, so one
 //! thread records through it, as Vulkan's external synchronisation of a command buffer asks; a
@@ -25,7 +28,18 @@
 
 use crate::gpu::context::Context;
 use ash::vk;
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
+use std::rc::Rc;
+
+/// Where a recording's timed passes write their end timestamps (`Recording::timed`): a
+/// timestamp pool, how many marks it holds, and the names of the marks written so far (`start`
+/// first). Shared by the recordings of one command buffer: the renderer's frame and the
+/// lighting's own recording of the same buffer, whose tiled passes are timed too.
+pub(crate) struct PassClock {
+    pub(super) pool: vk::QueryPool,
+    pub(super) capacity: u32,
+    pub(super) names: RefCell<Vec<&'static str>>,
+}
 
 /// A command buffer being recorded on one context's device.
 pub(crate) struct Recording<'a> {
@@ -35,6 +49,8 @@ pub(crate) struct Recording<'a> {
     rendering: Cell<bool>,
     /// Debug labels opened through this recording and not yet closed.
     labels: Cell<u32>,
+    /// The clock its timed passes write to, when it has one.
+    pub(super) clock: Option<Rc<PassClock>>,
 }
 
 impl<'a> Recording<'a> {
@@ -53,6 +69,7 @@ impl<'a> Recording<'a> {
             cmd,
             rendering: Cell::new(false),
             labels: Cell::new(0),
+            clock: None,
         }
     }
 
@@ -201,9 +218,13 @@ impl<'a> Recording<'a> {
     }
 
     /// Ends the recording, checking (in debug builds) that rendering and every label it opened
-    /// were closed, as every caller of histencil's recording functions is promised.
-    pub fn finish(self) {
+    /// were closed, as every caller of histencil's recording functions is promised. Returns
+    /// the names of the marks its clock holds (`start`, then each timed pass), none without one.
+    pub fn finish(self) -> Vec<&'static str> {
         debug_assert!(!self.rendering.get(), "a recording left rendering open");
         debug_assert_eq!(self.labels.get(), 0, "a recording left a label open");
+        self.clock
+            .map(|clock| clock.names.borrow().clone())
+            .unwrap_or_default()
     }
 }

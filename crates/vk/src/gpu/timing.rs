@@ -2,8 +2,10 @@
 
 use crate::gpu::context::Context;
 use crate::gpu::error::{Result, VkCall};
-use crate::gpu::recording::Recording;
+use crate::gpu::recording::{PassClock, Recording};
 use ash::vk;
+use std::cell::RefCell;
+use std::rc::Rc;
 
 const MAX_MARKS: u32 = 16;
 
@@ -202,7 +204,7 @@ fn timestamp_pool(ctx: &Context, name: &str, marks: u32) -> Result<vk::QueryPool
 /// Resets the queries of the first `marks` marks of `pool`.
 fn reset_marks(rec: &Recording, pool: vk::QueryPool, marks: u32) {
     // SAFETY: the recording's command buffer is recording outside rendering (`StepTimer::reset` says so,
-    // `begin_frame` runs before any pass). Both callers pass `marks` equal to the pool's own
+    // `start_clock` runs before any pass). Both callers pass `marks` equal to the pool's own
     // count (`MAX_MARKS`, `capacity`), so the range is the pool's queries.
     unsafe {
         rec.device()
@@ -216,7 +218,7 @@ fn write_timestamp(rec: &Recording, pool: vk::QueryPool, index: u32) {
     for query in index * QUERIES_PER_MARK..(index + 1) * QUERIES_PER_MARK {
         // SAFETY: the recording's command buffer is recording; its queue family has timestamps
         // (`REQUIREMENTS.timestamps`). `query` is in the pool (the callers assert `index`
-        // below its mark count) and was reset earlier in the same recording (`begin_frame`,
+        // below its mark count) and was reset earlier in the same recording (`start_clock`,
         // `StepTimer::reset`), so it is unavailable, as a timestamp write needs.
         unsafe {
             rec.device()
@@ -246,6 +248,7 @@ fn read_ticks(ctx: &Context, pool: vk::QueryPool, count: usize) -> Result<Vec<u6
     Ok(ticks.into_iter().step_by(per_mark).collect())
 }
 
+/// The frame's timestamp pool, and the names of the marks the last submission wrote.
 pub(crate) struct Timestamps {
     pool: vk::QueryPool,
     names: Vec<&'static str>,
@@ -260,21 +263,16 @@ impl Timestamps {
         })
     }
 
-    pub fn begin_frame(&mut self, rec: &Recording) {
-        self.names.clear();
-        reset_marks(rec, self.pool, MAX_MARKS);
-        self.mark(rec, "start");
+    /// Gives `rec` this pool as its clock: its timed passes are the frame's.
+    pub fn time(&self, rec: &mut Recording) {
+        rec.start_clock(self.pool, MAX_MARKS);
     }
 
-    /// Timestamp after all previous work: the end of pass `name`.
-    pub fn mark(&mut self, rec: &Recording, name: &'static str) {
-        let index = self.names.len() as u32;
-        assert!(
-            index < MAX_MARKS,
-            "more timestamp marks than the pool holds"
-        );
-        write_timestamp(rec, self.pool, index);
-        self.names.push(name);
+    /// Keeps the names of the marks the recording just submitted wrote (its `finish`'s): none
+    /// for a submission without a clock, whose stall then says so instead of reading the last
+    /// frame's marks as its own.
+    pub fn submitted(&mut self, names: Vec<&'static str>) {
+        self.names = names;
     }
 
     /// How many of the last recorded frame's marks the GPU has written, without waiting: a
@@ -309,6 +307,9 @@ impl Timestamps {
     }
 
     pub fn read(&self, ctx: &Context) -> Result<FrameTimings> {
+        if self.names.is_empty() {
+            return Ok(FrameTimings::default());
+        }
         let ticks = read_ticks(ctx, self.pool, self.names.len())?;
         let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * ctx.timestamp_period_ns * 1e-6;
         let passes = (1..ticks.len())
@@ -331,6 +332,10 @@ impl Timestamps {
 /// What `written` of a frame's marks `names` (`start` first, then each pass's end) say of the
 /// GPU's progress: `the GPU has finished gbuffer, lighting, not tonemap`.
 pub(crate) fn progress_words(names: &[&str], written: usize) -> String {
+    if names.is_empty() {
+        return "the submission times no passes (not a frame), so how far the GPU got is unknown"
+            .to_owned();
+    }
     match (written, names.get(written)) {
         (0, _) => "the GPU has not begun the frame (its start timestamp is unwritten)".to_owned(),
         (1, Some(next)) => format!("the GPU has begun the frame, not finished {next}"),
@@ -339,6 +344,55 @@ pub(crate) fn progress_words(names: &[&str], written: usize) -> String {
             names[1..n].join(", ")
         ),
         (_, None) => "the GPU has finished every pass of the frame".to_owned(),
+    }
+}
+
+impl Recording<'_> {
+    /// Times this recording's passes ([`Self::timed`]) with the first `capacity` marks of
+    /// `pool`: resets them and writes the `start` mark. Outside rendering. Private: `capacity`
+    /// is the pool's own count (`Timestamps::time`'s), which the queries' validity relies on.
+    fn start_clock(&mut self, pool: vk::QueryPool, capacity: u32) {
+        reset_marks(self, pool, capacity);
+        self.clock = Some(Rc::new(PassClock {
+            pool,
+            capacity,
+            names: RefCell::new(Vec::new()),
+        }));
+        self.mark("start");
+    }
+
+    /// The clock this recording's timed passes write to, for a recording of the same command
+    /// buffer made inside this one's (an entry point the renderer shares with engines).
+    pub fn clock(&self) -> Option<Rc<PassClock>> {
+        self.clock.clone()
+    }
+
+    /// Times this recording's passes by `clock`, another recording's of the same command buffer
+    /// (its [`Self::clock`]); `None` leaves them untimed.
+    pub fn time_by(&mut self, clock: Option<Rc<PassClock>>) {
+        self.clock = clock;
+    }
+
+    /// Records `body`, then, where this recording has a clock, a timestamp that ends the pass
+    /// `name`: written by the GPU once every command before it has finished, so the pass's GPU
+    /// time is the distance from the mark before, and a stalled wait names the passes whose
+    /// marks were written. Without a clock, `body` alone.
+    pub fn timed<R>(&self, name: &'static str, body: impl FnOnce(&Self) -> R) -> R {
+        let out = body(self);
+        self.mark(name);
+        out
+    }
+
+    fn mark(&self, name: &'static str) {
+        let Some(clock) = &self.clock else { return };
+        let mut names = clock.names.borrow_mut();
+        let index = names.len() as u32;
+        assert!(
+            index < clock.capacity,
+            "more timed passes than the clock's pool holds"
+        );
+        write_timestamp(self, clock.pool, index);
+        names.push(name);
     }
 }
 
@@ -490,6 +544,9 @@ mod tests {
             "the GPU has finished gbuffer, lighting, not tonemap"
         );
         assert_eq!(words(4), "the GPU has finished every pass of the frame");
+        // A submission without a clock (the simulator's captures) once read the last frame's
+        // marks as its own: "every pass finished" of a submission that had stalled.
+        assert!(progress_words(&[], 0).contains("times no passes (not a frame)"));
     }
 
     #[test]

@@ -7,7 +7,7 @@ use super::{DeferredLighting, TiledFrame};
 use crate::gpu::access::LightingTargets;
 use crate::gpu::context::Context;
 use crate::gpu::error::Result;
-use crate::gpu::recording::Recording;
+use crate::gpu::recording::{PassClock, Recording};
 use crate::gpu::resources::Buffer;
 use crate::lighting::hooks::LightHooks;
 use crate::passes::depth_id::{DepthIdDesc, DepthIdPass};
@@ -15,6 +15,7 @@ use crate::passes::tiled::{MixedTiles, TileSide};
 use crate::passes::tiled::{TiledDesc, TiledLighting, TiledSets, TiledShade};
 use ash::vk;
 use std::ops::Deref;
+use std::rc::Rc;
 
 impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// Records `frame` lit by the tiled technique into `cmd` against `targets`, as engines
@@ -43,7 +44,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         targets: &mut LightingTargets,
     ) -> Result<()> {
         // SAFETY: the caller upholds this fn's # Safety, which is `record_tiled_with`'s.
-        unsafe { self.record_tiled_with(cmd, frame, targets, TiledShade::Kernels, |_, _| {}) }
+        unsafe { self.record_tiled_with(cmd, frame, targets, TiledShade::Kernels, None) }
     }
 
     /// Records `frame` lit by the depth-id technique, as Bevy's deferred renderer lights its
@@ -72,12 +73,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ) -> Result<()> {
         // SAFETY: the caller upholds this fn's # Safety: `record_tiled_with`'s, and the hook
         // resources readable by the fragment shaders the depth-id passes shade with.
-        unsafe { self.record_tiled_with(cmd, frame, targets, TiledShade::DepthId, |_, _| {}) }
+        unsafe { self.record_tiled_with(cmd, frame, targets, TiledShade::DepthId, None) }
     }
 
-    /// [`DeferredLighting::record_tiled`], calling `between` with the pass's name after the
-    /// classification (`tile-classify`) and after the light lists (`tile-lights`), before the
-    /// shade kernels (the renderer's timestamps between them).
+    /// [`DeferredLighting::record_tiled`], timing the classification (`tile-classify`) and the
+    /// light lists (`tile-lights`) as passes of their own by `clock` (the renderer's frame's:
+    /// `Recording::timed`), when given one.
     ///
     /// # Safety
     /// As [`DeferredLighting::record_tiled`].
@@ -87,7 +88,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &TiledFrame,
         targets: &mut LightingTargets,
         shade: TiledShade,
-        mut between: impl FnMut(&Recording, &'static str),
+        clock: Option<Rc<PassClock>>,
     ) -> Result<()> {
         if shade == TiledShade::DepthId && frame.mixed == MixedTiles::Branching {
             return Err(bad(
@@ -142,15 +143,18 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         self.pending.recorded(frame.slot, cmd);
         // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
         // family with graphics and compute, outside any render pass; this call alone records
-        // into it now (`between` records through `rec`).
-        let rec = unsafe { Recording::new(ctx, cmd) };
+        // into it now (the clock, if any, is the caller's recording's of `cmd`, which records
+        // nothing until this returns).
+        let mut rec = unsafe { Recording::new(ctx, cmd) };
+        rec.time_by(clock);
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
-        tiled.record_classify(&rec, &sets, targets, depth_sampled, clear, mixed, shape);
-        between(&rec, "tile-classify");
-        tiled.record_light_lists(&rec, frame.lights.len() as u32);
-        between(&rec, "tile-lights");
+        rec.timed("tile-classify", |rec| {
+            tiled.record_classify(rec, &sets, targets, depth_sampled, clear, mixed, shape)
+        });
+        let lights = frame.lights.len() as u32;
+        rec.timed("tile-lights", |rec| tiled.record_light_lists(rec, lights));
         match shade {
             TiledShade::Kernels => tiled.record_shade(&rec, mixed),
             TiledShade::DepthId => {

@@ -47,9 +47,9 @@ impl<'c> Renderer<'c> {
             Some((technique, _)) => self.gpu_hierarchy(desc, *technique)?,
             None => None,
         };
-        let recording = self.begin_commands()?;
+        let mut recording = self.begin_commands()?;
+        self.timestamps.time(&mut recording);
         let rec = &recording;
-        self.timestamps.begin_frame(rec);
         match &deferred {
             None => self.record_forward_pass(rec, desc),
             Some((technique, plan)) => {
@@ -60,8 +60,9 @@ impl<'c> Renderer<'c> {
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            alpha.record_lightmaps(rec, scene, &view, desc.alpha, desc.pass_timing)?;
-            self.timestamps.mark(rec, "alpha-lightmaps");
+            rec.timed("alpha-lightmaps", |rec| {
+                alpha.record_lightmaps(rec, scene, &view, desc.alpha, desc.pass_timing)
+            })?;
             let inputs = AlphaInputs {
                 scene,
                 meshes,
@@ -70,15 +71,16 @@ impl<'c> Renderer<'c> {
                 extent: self.extent,
                 depth: desc.depth,
             };
-            alpha.record_alpha(rec, &inputs, &mut self.targets)?;
-            self.timestamps.mark(rec, "alpha");
+            let targets = &mut self.targets;
+            rec.timed("alpha", |rec| alpha.record_alpha(rec, &inputs, targets))?;
         }
         let inputs = TonemapInputs {
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
         };
-        self.tonemap.record(rec, &inputs, &mut self.targets);
-        self.timestamps.mark(rec, "tonemap");
+        rec.timed("tonemap", |rec| {
+            self.tonemap.record(rec, &inputs, &mut self.targets)
+        });
         // Only the deferred frame has a G-buffer to read BRDF ids from.
         let readback = Readback {
             brdf_ids: desc.readback.brdf_ids && deferred.is_some(),
@@ -116,11 +118,12 @@ impl<'c> Renderer<'c> {
 
     /// The forward frame's one pass: every object lit by every light into the HDR target.
     fn record_forward_pass(&mut self, rec: &Recording, desc: &FrameDesc) {
-        let mut targets = self.targets.lighting();
-        let inputs = self.mesh_inputs(desc.depth);
-        self.mesh_passes.record_forward(rec, &inputs, &mut targets);
-        self.targets.lit(&targets);
-        self.timestamps.mark(rec, Shading::Forward.lighting_pass());
+        rec.timed(Shading::Forward.lighting_pass(), |rec| {
+            let mut targets = self.targets.lighting();
+            let inputs = self.mesh_inputs(desc.depth);
+            self.mesh_passes.record_forward(rec, &inputs, &mut targets);
+            self.targets.lit(&targets);
+        });
     }
 
     /// The deferred frame's passes: the G-buffer, emission into the HDR target, and the
@@ -135,16 +138,18 @@ impl<'c> Renderer<'c> {
         plan: &FramePlan,
     ) -> Result<()> {
         let ctx = self.ctx;
-        self.record_gbuffer_pass(rec, desc);
         // Emitted light goes into the HDR target once; the lighting adds onto it.
         let emits = self.scene.objects.iter().any(|o| o.material.emits());
-        if emits {
-            let mut targets = self.targets.lighting();
-            let inputs = self.mesh_inputs(desc.depth);
-            self.mesh_passes.record_emissive(rec, &inputs, &mut targets);
-            self.targets.lit(&targets);
-        }
-        self.timestamps.mark(rec, "gbuffer");
+        rec.timed("gbuffer", |rec| {
+            self.record_gbuffer_pass(rec, desc);
+            if emits {
+                let mut targets = self.targets.lighting();
+                let inputs = self.mesh_inputs(desc.depth);
+                self.mesh_passes.record_emissive(rec, &inputs, &mut targets);
+                self.targets.lit(&targets);
+            }
+        });
+        let lighting_pass = desc.shading.lighting_pass();
         let tiled = match technique {
             Technique::Tiled { mixed, side } => Some((mixed, side, TiledShade::Kernels)),
             Technique::DepthId { side } => Some((MixedTiles::PerBrdf, side, TiledShade::DepthId)),
@@ -162,21 +167,16 @@ impl<'c> Renderer<'c> {
                 hook_sets: HookSets::default(),
             };
             let mut targets = self.targets.lighting();
-            let timestamps = &mut self.timestamps;
-            let classified = |rec: &Recording, pass| timestamps.mark(rec, pass);
+            // The classification and light lists are timed passes of their own, by this
+            // recording's clock.
+            let clock = rec.clock();
             // SAFETY: as for `record_emulating` below; and the HDR target has `STORAGE` usage
             // (`Targets::new`), and the built-in hooks bind no engine resources.
-            unsafe {
-                self.lighting.record_tiled_with(
-                    rec.outside(),
-                    &frame,
-                    &mut targets,
-                    shade,
-                    classified,
-                )?
-            };
+            rec.timed(lighting_pass, |rec| unsafe {
+                let (cmd, lighting) = (rec.outside(), &mut self.lighting);
+                lighting.record_tiled_with(cmd, &frame, &mut targets, shade, clock)
+            })?;
             self.targets.lit(&targets);
-            self.timestamps.mark(rec, desc.shading.lighting_pass());
             return Ok(());
         }
         let frame = LightingFrame {
@@ -196,12 +196,11 @@ impl<'c> Renderer<'c> {
         // records nothing until the lighting's own recording returns); the
         // targets are the renderer's own, with the states it tracks (`Targets::lit` after each
         // pass); `begin_commands` declared slot 0 finished after the last frame's wait.
-        unsafe {
+        rec.timed(lighting_pass, |rec| unsafe {
             self.lighting
-                .record_emulating(rec.outside(), &frame, &mut targets, hierarchy)?
-        };
+                .record_emulating(rec.outside(), &frame, &mut targets, hierarchy)
+        })?;
         self.targets.lit(&targets);
-        self.timestamps.mark(rec, desc.shading.lighting_pass());
         Ok(())
     }
 
@@ -239,9 +238,9 @@ impl<'c> Renderer<'c> {
 
     /// Ends, submits and waits for the frame's command buffer, recorded through `rec`
     /// ([`Self::begin_commands`]'s).
-    pub(super) fn submit_and_wait(&self, rec: Recording) -> Result<()> {
+    pub(super) fn submit_and_wait(&mut self, rec: Recording) -> Result<()> {
         let (ctx, cmd) = (self.ctx, rec.outside());
-        rec.finish();
+        self.timestamps.submitted(rec.finish());
         // SAFETY: `cmd` is recording (`begin_commands`) and outside rendering: every pass ends
         // its own. The fence is this renderer's, unsignalled (reset after each wait, created
         // unsignalled) and not in use by another submit. `Context::submit` holds the queue's
