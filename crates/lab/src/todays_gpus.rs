@@ -22,46 +22,52 @@ use std::path::{Path, PathBuf};
 /// The engine's bits, as in the talk's 360 story (and `demo`, `check`).
 pub const ENGINE_BITS: u8 = 0xA0;
 
-/// One platform as the table describes it: the renderer's platforms ([`histencil_vk::Platform`])
-/// the talk's questions are asked of, and NVIDIA's ZCull criterion, a row of its own that runs
-/// as the PS3's.
+/// One row of the table: one of the renderer's platforms ([`histencil_vk::Platform`]), the
+/// one vocabulary of platforms, or NVIDIA's ZCull criterion, a row of its own that runs as the
+/// PS3's (a model of a GPU's hierarchy, not a platform the renderer plans for).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Platform {
-    X360NoZeroing,
-    X360,
-    Ps3,
+pub enum Row {
+    Of(histencil_vk::Platform),
     /// NVIDIA's ZCull stencil criterion, assumed to cull as the PS3's (the documented fields
     /// are the RSX's; what a region stores and when is not public).
     NvidiaZcull,
-    AmdPretest,
-    AmdAndOr,
-    Native,
 }
 
-impl Platform {
-    pub const ALL: [Platform; 7] = [
-        Platform::X360NoZeroing,
-        Platform::X360,
-        Platform::Ps3,
-        Platform::NvidiaZcull,
-        Platform::AmdPretest,
-        Platform::AmdAndOr,
-        Platform::Native,
+use histencil_vk::Platform as P;
+
+impl Row {
+    /// The table's rows, in its order: the talk's consoles, NVIDIA's criterion, AMD's two
+    /// hierarchies and native Vulkan.
+    pub const ALL: [Row; 7] = [
+        Row::Of(P::X360NoZeroing),
+        Row::Of(P::X360),
+        Row::Of(P::Ps3),
+        Row::NvidiaZcull,
+        Row::Of(P::AmdPretest),
+        Row::Of(P::AmdAndOr),
+        Row::Of(P::Native),
     ];
+
+    /// The native row, which every correct platform shades as.
+    pub const NATIVE: Row = Row::Of(P::Native);
 
     pub fn name(self) -> &'static str {
         match self {
-            Platform::X360NoZeroing => "360-like, engine bits kept (the talk's failure)",
-            Platform::X360 => "360-like, zeroing (the talk's fix)",
-            Platform::Ps3 => "PS3-like",
-            Platform::NvidiaZcull => {
+            Row::Of(P::X360NoZeroing) => "360-like, engine bits kept (the talk's failure)",
+            Row::Of(P::X360) => "360-like, zeroing (the talk's fix)",
+            Row::Of(P::X360SaveRestore) => {
+                "360-like, zeroing, the engine's bits saved and restored"
+            }
+            Row::Of(P::Ps3) => "PS3-like",
+            Row::NvidiaZcull => {
                 "NVIDIA ZCull's stencil criterion (Turing to Blackwell), assumed to cull as the \
                  PS3's: its fields are the RSX's; what a region holds, and whether the driver \
                  programs it, is not public"
             }
-            Platform::AmdPretest => "amd-pretest (GFX9-11 with pretests, as PAL allows)",
-            Platform::AmdAndOr => "amd-andor (GFX12)",
-            Platform::Native => {
+            Row::Of(P::AmdPretest) => "amd-pretest (GFX9-11 with pretests, as PAL allows)",
+            Row::Of(P::AmdAndOr) => "amd-andor (GFX12)",
+            Row::Of(P::AmdAndOrUnmasked) => "amd-andor-unmasked (GFX12's tiles, read mask ignored)",
+            Row::Of(P::Native) => {
                 "native: no hierarchical stencil through Vulkan (AMD GFX9-11, Intel, Adreno, Mali, \
                  Apple, PowerVR; NVK)"
             }
@@ -71,57 +77,52 @@ impl Platform {
     /// What the platform needs between a hierarchy write and a test, and what a change costs.
     pub fn flush_or_reset(self) -> &'static str {
         match self {
-            Platform::X360NoZeroing | Platform::X360 | Platform::Ps3 => {
+            Row::Of(P::X360NoZeroing | P::X360 | P::X360SaveRestore | P::Ps3) => {
                 "a flush between each mask pass's hi-stencil write and the shade passes testing it"
             }
-            Platform::NvidiaZcull => {
+            Row::NvidiaZcull => {
                 "as the PS3 (assumed); a criterion change invalidates unless told not to \
                  (`NO_INVALIDATE`), at a cost not public"
             }
-            Platform::AmdPretest => {
+            Row::Of(P::AmdPretest) => {
                 "none within the frame (pretests bound before the G-buffer); changing one needs an \
                  initialisation barrier and a rewrite of the whole stencil"
             }
-            Platform::AmdAndOr => {
+            Row::Of(P::AmdAndOr | P::AmdAndOrUnmasked) => {
                 "none (updated as stencil is written); reset to the full range after any layout \
                  that does not keep it, which this frame never uses"
             }
-            Platform::Native => "none",
+            Row::Of(P::Native) => "none",
         }
     }
 
     /// How many BRDFs the hierarchy can cull by their id.
     pub fn brdfs_culled(self) -> &'static str {
         match self {
-            Platform::X360NoZeroing | Platform::X360 | Platform::Ps3 | Platform::NvidiaZcull => {
-                "every BRDF a light touches (a mask pass and a flush each)"
-            }
-            Platform::AmdPretest => {
+            Row::Of(P::X360NoZeroing | P::X360 | P::X360SaveRestore | P::Ps3)
+            | Row::NvidiaZcull => "every BRDF a light touches (a mask pass and a flush each)",
+            Row::Of(P::AmdPretest) => {
                 "2 by their id (the two pretests, on the two rarest BRDFs); the others per pixel \
                  only"
             }
-            Platform::AmdAndOr => "any, wherever a tile's known bits contradict the BRDF's id",
-            Platform::Native => "0 (per pixel only)",
+            Row::Of(P::AmdAndOr | P::AmdAndOrUnmasked) => {
+                "any, wherever a tile's known bits contradict the BRDF's id"
+            }
+            Row::Of(P::Native) => "0 (per pixel only)",
         }
     }
 
     /// The renderer's platform this row runs as (NVIDIA's ZCull criterion as the PS3's).
-    fn renderer_platform(self) -> histencil_vk::Platform {
-        use histencil_vk::Platform as P;
+    fn platform(self) -> P {
         match self {
-            Platform::X360NoZeroing => P::X360NoZeroing,
-            Platform::X360 => P::X360,
-            Platform::Ps3 | Platform::NvidiaZcull => P::Ps3,
-            Platform::AmdPretest => P::AmdPretest,
-            Platform::AmdAndOr => P::AmdAndOr,
-            Platform::Native => P::Native,
+            Row::Of(platform) => platform,
+            Row::NvidiaZcull => P::Ps3,
         }
     }
 
     fn technique(self) -> Technique {
-        let backend = self.renderer_platform().backend();
         Technique::Stencil {
-            backend,
+            backend: self.platform().backend(),
             flush: FlushPolicy::Auto,
         }
     }
@@ -164,8 +165,8 @@ pub struct TodaysGpusReport {
     pub height: u32,
     pub tile_size: u32,
     pub scenes: Vec<String>,
-    /// Per platform ([`Platform::ALL`] order), per scene.
-    pub counts: Vec<(Platform, Vec<SceneCounts>)>,
+    /// Per row ([`Row::ALL`] order), per scene.
+    pub counts: Vec<(Row, Vec<SceneCounts>)>,
     /// Per scene: the depth-id technique's passes (BRDFs in the frame) and what a hierarchical
     /// depth would cull of them (`histencil_model::depth_id`), with the engine's bits, from the
     /// G-buffer; then the same model on the id image the GPU wrote.
@@ -235,8 +236,8 @@ impl TodaysGpusReport {
 }
 
 /// The simulator's counts of `platform` on `inputs` (captured with some engine bits).
-fn counts_of(inputs: &SimulatorInputs, platform: Platform, plan: &FramePlan) -> TileStats {
-    let backend = platform.technique().backend();
+fn counts_of(inputs: &SimulatorInputs, row: Row, plan: &FramePlan) -> TileStats {
+    let backend = row.platform().backend();
     inputs.predict_on(plan, backend).0.stats
 }
 
@@ -262,8 +263,8 @@ pub fn run_todays_gpus(
     height: u32,
     progress: &mut dyn FnMut(&str),
 ) -> Result<TodaysGpusReport> {
-    let mut counts: Vec<(Platform, Vec<SceneCounts>)> =
-        Platform::ALL.iter().map(|p| (*p, Vec::new())).collect();
+    let mut counts: Vec<(Row, Vec<SceneCounts>)> =
+        Row::ALL.iter().map(|p| (*p, Vec::new())).collect();
     let mut tile_size = 0;
     let mut depth_id = Vec::new();
     let mut lrz = Vec::new();
@@ -273,7 +274,7 @@ pub fn run_todays_gpus(
         let capture = |renderer: &mut Renderer, bits: u8| {
             let desc = FrameDesc {
                 preserved_pattern: bits,
-                ..FrameDesc::from(Platform::Native.technique())
+                ..FrameDesc::from(Row::NATIVE.technique())
             };
             renderer.simulator_inputs(desc)
         };
@@ -285,13 +286,13 @@ pub fn run_todays_gpus(
         let gpu_ids = gpu_counts(renderer, Technique::DepthId { side })?;
         depth_id.push((passes, with_bits.predict_depth_id(), gpu_ids));
         // The plans follow the lights and the view, not the engine's bits: one per platform.
-        let plans = Platform::ALL
+        let plans = Row::ALL
             .iter()
             .map(|p| renderer.plan(p.technique()))
             .collect::<histencil_vk::Result<Vec<FramePlan>>>()?;
-        let native_at = Platform::ALL.iter().position(|p| *p == Platform::Native);
-        let native_plan = &plans[native_at.expect("native is a platform")];
-        let native = counts_of(&with_bits, Platform::Native, native_plan);
+        let native_at = Row::ALL.iter().position(|p| *p == Row::NATIVE);
+        let native_plan = &plans[native_at.expect("native is a row")];
+        let native = counts_of(&with_bits, Row::NATIVE, native_plan);
         lrz.push(LrzCost::of(native_plan));
         for ((platform, per_scene), plan) in counts.iter_mut().zip(&plans) {
             per_scene.push(SceneCounts {
