@@ -571,23 +571,15 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                     self.pipeline
                 }
             };
-            let (d, cmd) = (rec.device(), rec.inside());
-            // SAFETY: `cmd` is recording on this context's device (the # Safety of `record` and
+            // SAFETY: the recording is on this context's device (the # Safety of `record` and
             // `record_directional`, and `AlphaLighting` records into the renderer's own), inside
             // the rendering begun above. The pipeline is non-null: the directional one only with a
             // direction map, which `check_direction` (or `AlphaLighting`'s desc) ties to a direction
             // format; it and the layout were made by `create` and live as long as `self`. The
             // slot's sets were written by `write_frame` and match the layout's sets 0 and 1.
             unsafe {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.pipeline_layout,
-                    0,
-                    &[slot.frame_set, slot.alpha_set],
-                    &[],
-                );
+                let sets = [slot.frame_set, slot.alpha_set];
+                rec.bind_graphics(pipeline, self.pipeline_layout, &sets);
             }
             rec.apply(&FULLSCREEN);
             if let Some(t) = timer.as_deref_mut() {
@@ -611,14 +603,9 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
                     // offset 0, the layout's graphics-stage range; the full-screen triangle reads
                     // no vertex buffer.
                     unsafe {
-                        d.cmd_push_constants(
-                            cmd,
-                            self.pipeline_layout,
-                            GRAPHICS_STAGES,
-                            0,
-                            bytemuck::bytes_of(&push),
-                        );
-                        d.cmd_draw(cmd, 3, 1, 0, 0);
+                        let bytes = bytemuck::bytes_of(&push);
+                        rec.push(self.pipeline_layout, GRAPHICS_STAGES, 0, bytes);
+                        rec.draw(3, 0);
                     }
                 }
                 if let Some(t) = timer.as_deref_mut() {
@@ -712,11 +699,8 @@ pub(crate) fn set_region(rec: &Recording, r: Region) {
             height: r.height,
         },
     };
-    // SAFETY: `rec` records on this context's device: `record_pass`, the one caller, is
-    // recording its pass (see there); dynamic state, allowed in and out of rendering. One viewport and scissor, at 0, of the region's shape:
-    // non-zero and inside the atlas, as `check_frame` held every region before the recording.
-    unsafe {
-        rec.device().cmd_set_viewport(rec.any(), 0, &[viewport]);
-        rec.device().cmd_set_scissor(rec.any(), 0, &[scissor]);
-    }
+    // The region's shape: non-zero and inside the atlas, as `check_frame` held every region
+    // before the recording.
+    rec.set_viewport(viewport);
+    rec.set_scissor(scissor);
 }

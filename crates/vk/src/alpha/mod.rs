@@ -398,14 +398,13 @@ impl<'c> AlphaLighting<'c> {
         // pipeline of this layout bound; the push is `AlphaDrawPush` at offset 0, the layout's
         // graphics-stage range.
         unsafe {
-            rec.device().cmd_push_constants(
-                rec.inside(),
+            rec.push(
                 self.pipeline_layout,
                 GRAPHICS_STAGES,
                 0,
                 bytemuck::bytes_of(&push),
-            );
-        }
+            )
+        };
     }
 
     /// The object and particle pipelines of `mode`, made on first use.
@@ -475,20 +474,13 @@ impl<'c> AlphaLighting<'c> {
         } = *inputs;
         let [object_pipeline, particle_pipeline] = self.pipelines(rec.ctx(), mode)?;
         rec.step("alpha", |rec| {
-            let d = rec.device();
-            // SAFETY: the recording is the renderer's, outside rendering (the passes before
-            // ended theirs; `outside` checks it). The sets match the layout's sets 0 to 2 (`create` made it from their
+            // SAFETY: the sets match the layout's sets 0 to 2 (`create` made it from their
             // layouts): the renderer's frame set, the lightmaps' slot 0 alpha set (written by
             // `record_lightmaps` this frame) and the lightmap set; all live as long as `self`.
             unsafe {
-                d.cmd_bind_descriptor_sets(
-                    rec.outside(),
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.pipeline_layout,
-                    0,
-                    &[frame_set, self.lightmaps.alpha_set(0), self.lightmap_set],
-                    &[],
-                );
+                let sets = [frame_set, self.lightmaps.alpha_set(0), self.lightmap_set];
+                let graphics = vk::PipelineBindPoint::GRAPHICS;
+                rec.bind_sets(graphics, self.pipeline_layout, 0, &sets);
             }
             // Forward and probe frames never write the atlas, nor plain lightmap frames the
             // direction map; the transition still gives each bound (and unread) image the layout its
@@ -503,7 +495,7 @@ impl<'c> AlphaLighting<'c> {
             }
             let attachments = (&mut *targets.hdr, &mut *targets.depth_stencil);
             begin_hdr_rendering(rec, attachments, extent, Load::Keep, Load::Keep);
-            let cmd = rec.inside();
+            let graphics = vk::PipelineBindPoint::GRAPHICS;
             let objects = scene.alpha_objects.len();
             for &entity in &self.order {
                 match entity {
@@ -511,13 +503,7 @@ impl<'c> AlphaLighting<'c> {
                         // SAFETY: inside the HDR rendering begun above, whose attachments' formats
                         // (HDR_FORMAT, the context's depth-stencil) the pipeline was made for; it
                         // lives in `self.pipelines` until `destroy`.
-                        unsafe {
-                            d.cmd_bind_pipeline(
-                                cmd,
-                                vk::PipelineBindPoint::GRAPHICS,
-                                object_pipeline,
-                            );
-                        }
+                        unsafe { rec.bind_pipeline(graphics, object_pipeline) };
                         rec.apply(&oriented(ALPHA_OBJECTS, depth));
                         let push = AlphaDrawPush {
                             entity: i as u32,
@@ -531,12 +517,8 @@ impl<'c> AlphaLighting<'c> {
                         // SAFETY: as for the object pipeline above; `sprites` is a live vertex
                         // buffer of this device (`VERTEX_BUFFER` usage, made by `create`).
                         unsafe {
-                            d.cmd_bind_pipeline(
-                                cmd,
-                                vk::PipelineBindPoint::GRAPHICS,
-                                particle_pipeline,
-                            );
-                            d.cmd_bind_vertex_buffers(cmd, 0, &[self.sprites.handle], &[0]);
+                            rec.bind_pipeline(graphics, particle_pipeline);
+                            rec.bind_vertex_buffer(self.sprites.handle);
                         }
                         rec.apply(&oriented(PARTICLES, depth));
                         let push = AlphaDrawPush {
@@ -547,7 +529,7 @@ impl<'c> AlphaLighting<'c> {
                         // SAFETY: the particle pipeline, sets, sprites and dynamic state are bound
                         // and set above; `first..first + count` is this system's range of the
                         // sprite buffer (`sprite_ranges`, from `create`).
-                        unsafe { d.cmd_draw(cmd, count, 1, first, 0) };
+                        unsafe { rec.draw(count, first) };
                     }
                 }
             }

@@ -351,15 +351,28 @@ impl Recording<'_> {
             | S::COLOR_ATTACHMENT_OUTPUT
             | S::COMPUTE_SHADER
             | S::ALL_TRANSFER;
+        let write = vk::AccessFlags2::MEMORY_WRITE;
+        let read_write = vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE;
+        self.memory_dependency((stages, write), (stages, read_write));
+    }
+
+    /// A global memory barrier from `src`'s writes to `dst`'s accesses, each a (stages,
+    /// accesses) pair of the graphics, compute and transfer stages (which the recording's queue
+    /// family supports: `Recording::new`'s # Safety), each access one its stages perform.
+    pub(crate) fn memory_dependency(
+        &self,
+        src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+        dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    ) {
         let barrier = [vk::MemoryBarrier2::default()
-            .src_stage_mask(stages)
-            .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-            .dst_stage_mask(stages)
-            .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)];
+            .src_stage_mask(src.0)
+            .src_access_mask(src.1)
+            .dst_stage_mask(dst.0)
+            .dst_access_mask(dst.1)];
         let dependency = vk::DependencyInfo::default().memory_barriers(&barrier);
-        // SAFETY: the recording's command buffer is recording outside rendering (the callers barrier between
-        // their compute and render phases); the stages are all ones a graphics queue supports,
-        // and `dependency` lives until the call returns.
+        // SAFETY: outside rendering (`outside` checks it in debug builds; the callers barrier
+        // between their compute, transfer and render phases); the stages are ones the queue
+        // family supports, as said above, and `dependency` lives until the call returns.
         unsafe {
             self.device()
                 .cmd_pipeline_barrier2(self.outside(), &dependency)

@@ -63,22 +63,13 @@ impl ComputePipeline {
 
     /// Binds the pipeline and `set` as set 0, and pushes `push` at offset 0.
     pub fn bind(&self, rec: &Recording, set: vk::DescriptorSet, push: &[u8]) {
-        let (d, cmd) = (rec.device(), rec.outside());
         // SAFETY: the recording's command buffer is recording on this device (`submit_once`'s, or a
         // lighting's under `record`'s # Safety). The pipeline and layout are live (`self`), and
         // `set` is a live set of `set_layout`. Both callers push exactly the layout's
         // `push_bytes` (4 for a case count, `size_of::<UpdatePush>()` for the tile update).
         unsafe {
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            d.cmd_bind_descriptor_sets(
-                cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                self.layout,
-                0,
-                &[set],
-                &[],
-            );
-            d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+            rec.bind_compute(self.pipeline, self.layout, &[set]);
+            rec.push(self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
         }
     }
 
@@ -167,10 +158,7 @@ impl CaseKernel {
             // and its set bound just above. The group count stays within the spec's minimum
             // `maxComputeWorkGroupCount[0]` (65535) up to 65535 * 64 cases; nothing checks a
             // longer list (the evaluators' callers pass test-sized ones).
-            unsafe {
-                rec.device()
-                    .cmd_dispatch(rec.outside(), count.div_ceil(WORKGROUP), 1, 1)
-            };
+            unsafe { rec.dispatch([count.div_ceil(WORKGROUP), 1, 1]) };
             rec.host_readable(vk::PipelineStageFlags2::COMPUTE_SHADER);
         });
         // SAFETY: the pool (and its set) was made above for this dispatch alone. When

@@ -93,18 +93,14 @@ impl GpuMesh {
 
     /// Binds and draws the whole mesh.
     pub(crate) fn draw(&self, rec: &Recording) {
-        let (d, cmd) = (rec.device(), rec.inside());
-        // SAFETY: the recording's command buffer is recording inside a rendering with a graphics pipeline
-        // bound whose vertex input reads binding 0 (the passes' contract). The buffers are
-        // live, made with VERTEX_BUFFER / INDEX_BUFFER usage and filled before any draw
-        // (uploaded and waited for, or written through their mapping); `index_count` u32
-        // indices, each naming a vertex of the mesh (`Scene::validate` checks imported
+        let (vertices, indices) = (self.vertices.handle, self.indices.handle);
+        // SAFETY: the passes draw a mesh inside a rendering with a graphics pipeline bound
+        // whose vertex input reads binding 0, with its sets and state (the passes' contract).
+        // The buffers are live, made with VERTEX_BUFFER / INDEX_BUFFER usage and filled before
+        // any draw (uploaded and waited for, or written through their mapping); `index_count`
+        // u32 indices, each naming a vertex of the mesh (`Scene::validate` checks imported
         // meshes; the built-in shapes are made so).
-        unsafe {
-            d.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices.handle], &[0]);
-            d.cmd_bind_index_buffer(cmd, self.indices.handle, 0, vk::IndexType::UINT32);
-            d.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, 0);
-        }
+        unsafe { rec.draw_mesh(vertices, indices, self.index_count) };
     }
 
     pub(crate) fn destroy(&mut self, ctx: &Context) {

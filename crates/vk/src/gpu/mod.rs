@@ -11,6 +11,7 @@
 
 pub mod access;
 pub(crate) mod attachments;
+pub(crate) mod commands;
 pub(crate) mod compute;
 pub(crate) mod context;
 pub(crate) mod debug;

@@ -5,8 +5,8 @@
 //! that state. No pass takes a bare `vk::CommandBuffer`: only the entry points do (an engine's
 //! `unsafe fn record*` and the crate-private bodies they share with the renderer, which hands
 //! them its recording's buffer), each wrapping it in a `Recording` at once. The commands
-//! themselves (draws, binds, pushes, dispatches) are ash's, on the buffer the recording hands
-//! out as [`Recording::inside`], [`Recording::outside`] or [`Recording::any`].
+//! themselves (binds, pushes, draws, dispatches, fills, copies) are its methods in
+//! `commands.rs`, each checked against the rendering state.
 //!
 //! Barriers, copies and dynamic state are its methods too, written beside what they serve
 //! (`declare`, `transition`, `memory_barrier` and `buffer_barrier` in `access.rs`: a step
@@ -109,7 +109,7 @@ impl<'a> Recording<'a> {
 
     /// Begins dynamic rendering as `info` says. Safe, as `transition` is: what it relies on is
     /// histencil's own bookkeeping (the `ImageRef` states), not a caller's promise about
-    /// handles, which is what makes [`Self::bind_graphics`] unsafe. Callers transitioned every attachment `info`
+    /// handles, which is what makes `bind_graphics` unsafe. Callers transitioned every attachment `info`
     /// names to the layout it is named with (`transition` on its `ImageRef`) and chose a render
     /// area inside the attachments.
     pub fn begin_rendering(&self, info: &vk::RenderingInfo) {
@@ -143,20 +143,30 @@ impl<'a> Recording<'a> {
 
     /// Sets the viewport (depth 0 to 1) and the scissor to `area`.
     pub fn set_viewport_and_scissor(&self, area: vk::Rect2D) {
-        let viewport = vk::Viewport {
+        self.set_viewport(vk::Viewport {
             x: area.offset.x as f32,
             y: area.offset.y as f32,
             width: area.extent.width as f32,
             height: area.extent.height as f32,
             min_depth: 0.0,
             max_depth: 1.0,
-        };
-        // SAFETY: dynamic state the pipelines declare (`pipelines.rs`), allowed in and out of
-        // rendering; the callers' areas lie inside their attachments.
-        unsafe {
-            self.ctx.device.cmd_set_viewport(self.cmd, 0, &[viewport]);
-            self.ctx.device.cmd_set_scissor(self.cmd, 0, &[area]);
-        }
+        });
+        self.set_scissor(area);
+    }
+
+    /// Sets the viewport. Safe: every pipeline histencil makes declares the viewport dynamic
+    /// (`pipelines.rs`), and Vulkan allows it inside and outside rendering; callers keep it
+    /// inside their attachments and its depths in 0 to 1.
+    pub fn set_viewport(&self, viewport: vk::Viewport) {
+        // SAFETY: as said above; `viewport` outlives the call.
+        unsafe { self.ctx.device.cmd_set_viewport(self.cmd, 0, &[viewport]) };
+    }
+
+    /// Sets the scissor, dynamic in every pipeline histencil makes; callers keep it inside
+    /// their attachments.
+    pub fn set_scissor(&self, area: vk::Rect2D) {
+        // SAFETY: as for `set_viewport`.
+        unsafe { self.ctx.device.cmd_set_scissor(self.cmd, 0, &[area]) };
     }
 
     /// Ends the rendering begun through this recording.
@@ -166,28 +176,6 @@ impl<'a> Recording<'a> {
         // `begin_rendering` on this recording.
         unsafe { self.ctx.device.cmd_end_rendering(cmd) };
         self.rendering.set(false);
-    }
-
-    /// Binds the graphics `pipeline` and `sets` from set 0 of `layout`: how a pass starts
-    /// drawing.
-    ///
-    /// # Safety
-    /// `pipeline`, `layout` and `sets` are live objects of this recording's device, `pipeline`
-    /// was made with `layout`, and each set is of the layout's set layout at its index.
-    pub unsafe fn bind_graphics(
-        &self,
-        pipeline: vk::Pipeline,
-        layout: vk::PipelineLayout,
-        sets: &[vk::DescriptorSet],
-    ) {
-        let (d, graphics) = (&self.ctx.device, vk::PipelineBindPoint::GRAPHICS);
-        // SAFETY: this fn's # Safety; binding is allowed inside and outside rendering.
-        unsafe {
-            d.cmd_bind_pipeline(self.cmd, graphics, pipeline);
-            if !sets.is_empty() {
-                d.cmd_bind_descriptor_sets(self.cmd, graphics, layout, 0, sets, &[]);
-            }
-        }
     }
 
     /// Records `body` inside its own debug label region, `name`: a pass or a step of one. The

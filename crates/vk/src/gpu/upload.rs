@@ -140,7 +140,6 @@ pub(crate) fn upload(
     }
     let src = staging.handle;
     let done = submit_once(ctx, name, |rec| {
-        let (d, cmd) = (rec.device(), rec.outside());
         let mut offsets = offsets.iter();
         for b in buffers {
             let offset = *offsets.next().expect("one offset per chunk");
@@ -148,10 +147,11 @@ pub(crate) fn upload(
                 let region = vk::BufferCopy::default()
                     .src_offset(offset)
                     .size(b.bytes.len() as u64);
-                // SAFETY: `cmd` is `submit_once`'s, recording outside rendering. `src` (the
+                // SAFETY: `rec` is `submit_once`'s, recording outside rendering. `src` (the
                 // staging buffer, TRANSFER_SRC) holds this chunk at `offset`, and `b.dst` is a
-                // live buffer the caller made with TRANSFER_DST of at least `bytes.len()`.
-                unsafe { d.cmd_copy_buffer(cmd, src, b.dst, &[region]) };
+                // live buffer the caller made with TRANSFER_DST of at least `bytes.len()`, not
+                // yet used (the upload comes before anything reads it).
+                unsafe { rec.copy_buffer(src, b.dst, &[region]) };
             }
         }
         let whole = |levels: u32| {
@@ -172,14 +172,9 @@ pub(crate) fn upload(
                     .subresource_range(whole(i.levels.len() as u32))
             })
             .collect();
-        // SAFETY: `cmd` is recording outside rendering; `to_transfer` lives until the call
-        // returns and names live colour images the caller made, every level of each.
-        unsafe {
-            d.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default().image_memory_barriers(&to_transfer),
-            )
-        };
+        // SAFETY: `to_transfer` lives until the call returns and names live colour images the
+        // caller made, every level of each, from UNDEFINED (nothing in them yet) to the copy.
+        unsafe { rec.barrier(&vk::DependencyInfo::default().image_memory_barriers(&to_transfer)) };
         for image in images {
             let regions: Vec<_> = image
                 .levels
@@ -202,19 +197,11 @@ pub(crate) fn upload(
                         })
                 })
                 .collect();
-            // SAFETY: `cmd` is recording outside rendering; the image (the caller's, with
-            // TRANSFER_DST usage and these levels) is in TRANSFER_DST_OPTIMAL (the barrier
-            // above), and the staging buffer holds each level's tightly packed RGBA8 texels at
-            // its `offset`, 16-byte aligned and so a multiple of the texel size.
-            unsafe {
-                d.cmd_copy_buffer_to_image(
-                    cmd,
-                    src,
-                    image.dst,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &regions,
-                )
-            };
+            // SAFETY: the image (the caller's, with TRANSFER_DST usage and these levels) is in
+            // TRANSFER_DST_OPTIMAL (the barrier above), and the staging buffer holds each
+            // level's tightly packed RGBA8 texels at its `offset`, 16-byte aligned and so a
+            // multiple of the texel size.
+            unsafe { rec.copy_buffer_to_image(src, image.dst, &regions) };
         }
         let to_shader: Vec<_> = images
             .iter()
@@ -247,16 +234,12 @@ pub(crate) fn upload(
                     | vk::AccessFlags2::UNIFORM_READ
                     | vk::AccessFlags2::SHADER_STORAGE_READ,
             )];
-        // SAFETY: `cmd` is recording outside rendering; the barrier structs live until the
-        // call returns and name the images just copied to, in TRANSFER_DST_OPTIMAL.
-        unsafe {
-            d.cmd_pipeline_barrier2(
-                cmd,
-                &vk::DependencyInfo::default()
-                    .memory_barriers(&buffer_reads)
-                    .image_memory_barriers(&to_shader),
-            )
-        };
+        let dependency = vk::DependencyInfo::default()
+            .memory_barriers(&buffer_reads)
+            .image_memory_barriers(&to_shader);
+        // SAFETY: the barrier structs live until the call returns and name the images just
+        // copied to, in TRANSFER_DST_OPTIMAL; the stages are a graphics and compute queue's.
+        unsafe { rec.barrier(&dependency) };
     });
     staging.destroy(ctx);
     done

@@ -318,8 +318,6 @@ impl HiStencilSurface {
 
     /// Outside rendering, before lighting: every tile passes, no tile is marked, statistics zero.
     pub fn record_reset(&mut self, rec: &Recording) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
-        let d = &ctx.device;
         let surface = [
             self.active.handle,
             self.pending.handle,
@@ -341,14 +339,14 @@ impl HiStencilSurface {
         let fill = [BufferAccess::TransferWrite];
         let before = surface.map(|b| (b, &frame_uses[..], &fill[..]));
         rec.buffer_barrier(&before);
-        // SAFETY: `cmd` is recording outside rendering (the lighting pass resets before it
-        // begins rendering); the buffers are ours, made with TRANSFER_DST, and the barrier above
-        // orders the fills after every earlier use.
+        // SAFETY: outside rendering (the lighting pass resets before it begins rendering;
+        // `fill` checks it); the buffers are ours, made with TRANSFER_DST, and the barrier
+        // above orders the fills after every earlier use.
         unsafe {
-            d.cmd_fill_buffer(cmd, self.active.handle, 0, vk::WHOLE_SIZE, 1);
-            d.cmd_fill_buffer(cmd, self.pending.handle, 0, vk::WHOLE_SIZE, 1);
-            d.cmd_fill_buffer(cmd, self.touched.handle, 0, vk::WHOLE_SIZE, 0);
-            d.cmd_fill_buffer(cmd, self.stats.handle, 0, vk::WHOLE_SIZE, 0);
+            rec.fill(self.active.handle, 1);
+            rec.fill(self.pending.handle, 1);
+            rec.fill(self.touched.handle, 0);
+            rec.fill(self.stats.handle, 0);
         }
         let after = surface.map(|b| (b, &fill[..], &frame_uses[..]));
         rec.buffer_barrier(&after);
@@ -360,7 +358,6 @@ impl HiStencilSurface {
 
     /// Outside rendering: pending state becomes active.
     pub fn record_flush(&mut self, rec: &Recording) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
         use BufferAccess::{ComputeWrite, FragmentRead, TransferRead, TransferWrite};
         let (pending, active) = (self.pending.handle, self.active.handle);
         // The tile updates wrote the pending tiles; light shaders may still read the active
@@ -370,13 +367,10 @@ impl HiStencilSurface {
             (active, &[FragmentRead, TransferWrite], &[TransferWrite]),
         ]);
         let region = [vk::BufferCopy::default().size(self.pending.size)];
-        // SAFETY: `cmd` is recording outside rendering (a flush closes rendering first); both
-        // buffers are ours and of one size, pending with TRANSFER_SRC and active with
+        // SAFETY: outside rendering (a flush closes rendering first; `copy_buffer` checks it);
+        // both buffers are ours and of one size, pending with TRANSFER_SRC and active with
         // TRANSFER_DST, and the barrier above orders the copy after their earlier uses.
-        unsafe {
-            ctx.device
-                .cmd_copy_buffer(cmd, self.pending.handle, self.active.handle, &region)
-        };
+        unsafe { rec.copy_buffer(pending, active, &region) };
         // The next tile updates overwrite the pending tiles the copy read; the light shaders
         // read the new active ones.
         rec.buffer_barrier(&[
@@ -429,11 +423,8 @@ impl HiStencilSurface {
         // Outside rendering (the write's bookkeeping split it); the touch image is ours,
         // transitioned to an attachment above.
         rec.begin_rendering(&info);
-        // SAFETY: dynamic state the touch pipeline declares; the area lies in the image.
-        unsafe {
-            rec.device().cmd_set_viewport(rec.any(), 0, &[viewport]);
-            rec.device().cmd_set_scissor(rec.any(), 0, &[area]);
-        }
+        rec.set_viewport(viewport);
+        rec.set_scissor(area);
     }
 
     /// Ends the touch draw's rendering.
@@ -537,10 +528,9 @@ impl HiStencilSurface {
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(rec, set, bytemuck::bytes_of(push));
         let groups = push.rect_tiles.div_ceil(HI_STENCIL_UPDATE_GROUP);
-        // SAFETY: the recording is outside rendering (`outside` checks it) with the update
-        // pipeline and its set bound just above; the set's images were declared in the layouts
-        // it reads.
-        unsafe { rec.device().cmd_dispatch(rec.outside(), groups, 1, 1) };
+        // SAFETY: outside rendering (`dispatch` checks it), with the update pipeline, its set
+        // and push bound just above; the set's images were declared in the layouts it reads.
+        unsafe { rec.dispatch([groups, 1, 1]) };
         let attached = ImageAccess::DepthStencilAttachment;
         rec.transition(depth_stencil, attached, Contents::Keep);
     }

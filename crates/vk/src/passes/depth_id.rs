@@ -197,7 +197,6 @@ impl DepthIdPass {
         targets: &mut LightingTargets,
         depth_sampled: bool,
     ) {
-        let d = rec.device();
         rec.step("depth-id", |rec| {
             // The light lists' masks, from compute to the shade passes (the images by their
             // transitions below).
@@ -233,18 +232,16 @@ impl DepthIdPass {
             // The id image was just transitioned to a depth attachment and `info` names only it,
             // over its extent.
             rec.begin_rendering(&info);
-            let cmd = rec.inside();
-            // SAFETY: `cmd` records inside the rendering begun just now. The sets match the
-            // layout `new` made from `DepthIdDesc::set_layouts` (sets 0 to 2, and 4 only when the
-            // hooks have a visibility layout); `push` is the tiled technique's `PUSH_BYTES`, the
-            // layout's fragment range.
+            rec.set_scissor(area);
+            // SAFETY: the sets match the layout `new` made from `DepthIdDesc::set_layouts` (sets
+            // 0 to 2, and 4 only when the hooks have a visibility layout); `push` is the tiled
+            // technique's `PUSH_BYTES`, the layout's fragment range.
             unsafe {
-                d.cmd_set_scissor(cmd, 0, &[area]);
-                d.cmd_bind_descriptor_sets(cmd, graphics, layout, 0, &sets, &[]);
+                rec.bind_sets(graphics, layout, 0, &sets);
                 if let Some(set) = visibility {
-                    d.cmd_bind_descriptor_sets(cmd, graphics, layout, 4, &[set], &[]);
+                    rec.bind_sets(graphics, layout, 4, &[set]);
                 }
-                d.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::FRAGMENT, 0, push);
+                rec.push(layout, vk::ShaderStageFlags::FRAGMENT, 0, push);
             }
             let viewport = |depth: Option<f32>| vk::Viewport {
                 x: 0.0,
@@ -269,13 +266,14 @@ impl DepthIdPass {
             // The copy: every surface pixel's slot as its depth (the shader writes the depth).
             rec.step("depth-id-copy", |rec| {
                 rec.apply(&state(CompareOp::Always, true));
-                // SAFETY: inside the rendering begun above, with sets, push constants, scissor and the
-                // pass state bound or set; the copy pipeline was made by `new` for a depth-only
-                // `ID_FORMAT` attachment, this one; the full-screen triangle reads no vertex buffer.
+                rec.set_viewport(viewport(None));
+                // SAFETY: inside the rendering begun above, with sets, push constants, scissor,
+                // viewport and the pass state bound or set; the copy pipeline was made by `new`
+                // for a depth-only `ID_FORMAT` attachment, this one; the full-screen triangle
+                // reads no vertex buffer.
                 unsafe {
-                    d.cmd_set_viewport(cmd, 0, &[viewport(None)]);
-                    d.cmd_bind_pipeline(cmd, graphics, self.copy);
-                    d.cmd_draw(cmd, 3, 1, 0, 0);
+                    rec.bind_pipeline(graphics, self.copy);
+                    rec.draw(3, 0);
                 }
             });
             // Each slot's pass at its depth: a viewport of no depth range pins every fragment
@@ -283,12 +281,13 @@ impl DepthIdPass {
             // see the copy's depths without a barrier.
             rec.apply(&state(CompareOp::Equal, false));
             for (s, pipeline) in self.shade.iter().enumerate() {
-                rec.step(&format!("depth-id-shade-{s}"), |_| {
-                    // SAFETY: as for the copy above; the viewport's depth is one in [0, 1].
+                rec.step(&format!("depth-id-shade-{s}"), |rec| {
+                    // The viewport's depth is one in [0, 1].
+                    rec.set_viewport(viewport(Some(depth_of(s))));
+                    // SAFETY: as for the copy above.
                     unsafe {
-                        d.cmd_set_viewport(cmd, 0, &[viewport(Some(depth_of(s)))]);
-                        d.cmd_bind_pipeline(cmd, graphics, *pipeline);
-                        d.cmd_draw(cmd, 3, 1, 0, 0);
+                        rec.bind_pipeline(graphics, *pipeline);
+                        rec.draw(3, 0);
                     }
                 });
             }

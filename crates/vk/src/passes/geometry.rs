@@ -326,8 +326,7 @@ impl Draw<'_> {
     /// constants.
     fn objects(&self, state_of: impl Fn(usize) -> Option<PassState>) {
         let (rec, inputs) = (self.rec, self.inputs);
-        let (d, cmd) = (rec.device(), rec.inside());
-        // SAFETY: `cmd` is recording inside the rendering the pass began (`record_gbuffer`,
+        // SAFETY: the recording is inside the rendering the pass began (`record_gbuffer`,
         // `hdr_pass`) into attachments of the formats the pipeline was made for (`MeshFormats`;
         // `Renderer::record_gbuffer` checks an engine's images). The pipeline and layout were
         // made by `new` and live as long as `self`; the frame set is of set 0's layout.
@@ -347,14 +346,8 @@ impl Draw<'_> {
                 // SAFETY: as above; `set` is the object's material set, allocated from
                 // `material_layout`, set 1 of this layout (`GpuMaterials::new`).
                 unsafe {
-                    d.cmd_bind_descriptor_sets(
-                        cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        self.pipeline_layout,
-                        1,
-                        &[set],
-                        &[],
-                    );
+                    let graphics = vk::PipelineBindPoint::GRAPHICS;
+                    rec.bind_sets(graphics, self.pipeline_layout, 1, &[set]);
                 }
             }
             let push = DrawPush::new(
@@ -365,13 +358,8 @@ impl Draw<'_> {
             // SAFETY: as above; the push is `DrawPush` at offset 0, the layout's graphics-stage
             // range (`PUSH_CONSTANT_BYTES` is its size).
             unsafe {
-                d.cmd_push_constants(
-                    cmd,
-                    self.pipeline_layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    bytemuck::bytes_of(&push),
-                );
+                let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                rec.push(self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
             }
             inputs.meshes.shape(object.shape).draw(rec);
         }

@@ -379,16 +379,16 @@ impl LightingPass<'_> {
 
     /// Binds the frame's sets, and the engine's visibility set where it has one.
     fn bind_sets(&self) {
-        let (d, cmd, layout) = (self.rec.device(), self.rec.any(), self.pipeline_layout);
+        let (rec, layout) = (self.rec, self.pipeline_layout);
         let graphics = vk::PipelineBindPoint::GRAPHICS;
-        // SAFETY: `cmd` is recording (LightingPass's contract); the sets and the layout were
-        // made from this context's device by the lighting, and the sets match the layout's set
-        // layouts from set 0 (and the visibility layout at VISIBILITY_SET).
+        // SAFETY: the sets and the layout were made from this context's device by the
+        // lighting, and the sets match the layout's set layouts from set 0 (and the visibility
+        // layout at VISIBILITY_SET).
         unsafe {
-            d.cmd_bind_descriptor_sets(cmd, graphics, layout, 0, self.sets, &[]);
+            rec.bind_sets(graphics, layout, 0, self.sets);
             if let Some(set) = self.visibility_set {
                 let first = crate::lighting::hooks::VISIBILITY_SET;
-                d.cmd_bind_descriptor_sets(cmd, graphics, layout, first, &[set], &[]);
+                rec.bind_sets(graphics, layout, first, &[set]);
             }
         }
     }
@@ -541,30 +541,21 @@ impl LightingPass<'_> {
         push: LightDrawPush,
     ) {
         let rec = self.rec;
-        let (d, cmd) = (rec.device(), rec.inside());
-        // SAFETY: `cmd` is inside rendering (`inside` checks it: `record_pass` opens the
-        // lighting's before a pass's draws, `begin_touch` the touch image's, `Rendering::open`
-        // before a restore); the pipeline was made for this plan's pass state (`prepare_pipelines`) with
-        // `pipeline_layout`, whose push range holds a `LightDrawPush`.
+        // SAFETY: inside rendering (`record_pass` opens the lighting's before a pass's draws,
+        // `begin_touch` the touch image's, `Rendering::open` before a restore); the pipeline
+        // was made for this plan's pass state (`prepare_pipelines`) with `pipeline_layout`,
+        // whose push range holds a `LightDrawPush` for both stages.
         unsafe {
-            d.cmd_bind_pipeline(
-                cmd,
-                vk::PipelineBindPoint::GRAPHICS,
-                self.pipelines.get(key),
-            );
-            d.cmd_push_constants(
-                cmd,
-                self.pipeline_layout,
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(&push),
-            );
+            let graphics = vk::PipelineBindPoint::GRAPHICS;
+            rec.bind_pipeline(graphics, self.pipelines.get(key));
+            let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+            rec.push(self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
         }
         rec.apply_bounded(state, bounds);
         match geometry {
-            // SAFETY: inside rendering with a full-screen pipeline bound just above, which draws
-            // its triangle from the vertex index alone.
-            Geometry::FullScreen => unsafe { d.cmd_draw(cmd, 3, 1, 0, 0) },
+            // SAFETY: inside rendering (`draw` checks it) with a full-screen pipeline bound just
+            // above, its sets and state, which draws its triangle from the vertex index alone.
+            Geometry::FullScreen => unsafe { rec.draw(3, 0) },
             Geometry::Volume => {
                 let kind = &self.lights[push.light_index as usize].kind;
                 self.volumes.draw(rec, kind);

@@ -485,8 +485,6 @@ impl TiledLighting {
         mixed: MixedTiles,
         shape: TileClassify,
     ) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
-        let d = &ctx.device;
         let push = self.push(clear, mixed);
         rec.step("tiled-classify", |rec| {
             let (sampled, keep) = (ImageAccess::ComputeSampled, Contents::Keep);
@@ -504,16 +502,17 @@ impl TiledLighting {
             rec.declare(&mut uses);
             // Each slot's dispatch starts at zero tiles.
             let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
-            // SAFETY: `cmd` is recording outside rendering (`rec.outside()` checks it in debug
-            // builds; `Recording::new`'s # Safety). `reset` is the dispatch buffer's exact size, `(MIXED_SLOT + 1) * 16` bytes,
-            // a multiple of 4 under 64 KiB; both buffers are live with `TRANSFER_DST` usage.
+            // SAFETY: outside rendering (`update` and `fill` check it in debug builds;
+            // `Recording::new`'s # Safety). `reset` is the dispatch buffer's exact size,
+            // `(MIXED_SLOT + 1) * 16` bytes, a multiple of 4 under 64 KiB; both buffers are live
+            // with `TRANSFER_DST` usage, and the slot's last frame using them has finished
+            // (`record_tiled_with` refused a pending slot).
             unsafe {
-                d.cmd_update_buffer(cmd, self.dispatch.handle, 0, bytemuck::cast_slice(&reset));
+                rec.update(self.dispatch.handle, bytemuck::cast_slice(&reset));
                 // Every tile's light mask starts empty; the light lists set bits.
-                d.cmd_fill_buffer(cmd, self.masks.handle, 0, vk::WHOLE_SIZE, 0);
+                rec.fill(self.masks.handle, 0);
             }
-            tile_barrier(
-                rec,
+            rec.memory_dependency(
                 (
                     vk::PipelineStageFlags2::ALL_TRANSFER,
                     vk::AccessFlags2::TRANSFER_WRITE,
@@ -523,28 +522,24 @@ impl TiledLighting {
                     vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
                 ),
             );
-            // SAFETY: as above for `cmd`. The sets match the layout made in `new`: the lighting's
-            // frame and decode sets (sets 0 and 1), this slot's tiled set (2) and the visibility
-            // hook's (4, its layout there when it has a set); the push is `TiledPush`, the layout's
-            // compute range.
+            // SAFETY: the sets match the layout made in `new`: the lighting's frame and decode
+            // sets (sets 0 and 1), this slot's tiled set (2) and the visibility hook's (4, its
+            // layout there when it has a set); the push is `TiledPush`, the layout's compute
+            // range.
             unsafe {
                 let bound = [sets.frame, sets.decode, self.sets[sets.slot as usize]];
-                let compute = vk::PipelineBindPoint::COMPUTE;
-                d.cmd_bind_descriptor_sets(cmd, compute, self.pipeline_layout, 0, &bound, &[]);
+                let (compute, layout) = (vk::PipelineBindPoint::COMPUTE, self.pipeline_layout);
+                rec.bind_sets(compute, layout, 0, &bound);
                 if let Some(set) = sets.visibility {
-                    let layout = self.pipeline_layout;
-                    d.cmd_bind_descriptor_sets(cmd, compute, layout, 4, &[set], &[]);
+                    rec.bind_sets(compute, layout, 4, &[set]);
                 }
-                d.cmd_push_constants(
-                    cmd,
-                    self.pipeline_layout,
-                    vk::ShaderStageFlags::COMPUTE,
-                    0,
-                    bytemuck::bytes_of(&push),
-                );
+                let stages = vk::ShaderStageFlags::COMPUTE;
+                rec.push(layout, stages, 0, bytemuck::bytes_of(&push));
             }
-            // SAFETY: as above for `cmd`; both classification pipelines were made by `new` with
-            // this layout, whose sets and push constants are bound just above.
+            // SAFETY: outside rendering (`dispatch` checks it); both classification pipelines
+            // were made by `new` with this layout, whose sets and push constants are bound just
+            // above; a group per tile (or per `tile` x `tile` tiles), far below 65535 a side for
+            // any image a device allows.
             unsafe {
                 let (x, y) = self.tiles_xy;
                 let (pipeline, groups) = match shape {
@@ -555,8 +550,8 @@ impl TiledLighting {
                         (self.classify_alone, (x.div_ceil(tile), y.div_ceil(tile)))
                     }
                 };
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
-                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+                rec.bind_pipeline(vk::PipelineBindPoint::COMPUTE, pipeline);
+                rec.dispatch([groups.0, groups.1, 1]);
             }
             // The lists and depth ranges for what follows, the counts for the indirect dispatches.
             after_compute(rec);
@@ -567,18 +562,16 @@ impl TiledLighting {
     /// the same command buffer (whose sets and push constants stay bound): each light's bit in
     /// the masks of the tiles it can reach, for [`TiledLighting::record_shade`].
     pub fn record_light_lists(&self, rec: &Recording, lights: u32) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
         rec.step("tiled-light-lists", |rec| {
             // A workgroup per light, in rows of at most the guaranteed workgroup count.
             const ROW: u32 = 65535;
             let groups = (lights.min(ROW), lights.div_ceil(ROW));
-            // SAFETY: `cmd` is recording outside rendering, after `record_classify` bound this
-            // layout's sets and push constants (`record_tiled_with`, the one caller); the pipeline
-            // was made by `new` with that layout; at most 65535 groups along each axis.
+            // SAFETY: outside rendering (`dispatch` checks it), after `record_classify` bound
+            // this layout's sets and push constants (`record_tiled_with`, the one caller); the
+            // pipeline was made by `new` with that layout; at most 65535 groups along each axis.
             unsafe {
-                let d = &ctx.device;
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.light_lists);
-                d.cmd_dispatch(cmd, groups.0, groups.1, 1);
+                rec.bind_pipeline(vk::PipelineBindPoint::COMPUTE, self.light_lists);
+                rec.dispatch([groups.0, groups.1, 1]);
             }
             after_compute(rec);
         });
@@ -589,19 +582,18 @@ impl TiledLighting {
     /// [`TiledLighting::record_classify`] with the same `mixed` in the same command buffer
     /// (whose sets and push constants stay bound); the HDR target stays in `GENERAL`.
     pub fn record_shade(&self, rec: &Recording, mixed: MixedTiles) {
-        let (ctx, cmd) = (rec.ctx(), rec.outside());
-        let d = &ctx.device;
         rec.step("tiled-shade", |rec| {
             let branching =
                 (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
             for (slot, pipeline) in self.shade.iter().enumerate().chain(branching) {
-                rec.step(&format!("tiled-shade-{slot}"), |_| {
+                rec.step(&format!("tiled-shade-{slot}"), |rec| {
                     // SAFETY: as in `record_light_lists`; `slot <= MIXED_SLOT` (at most `MAX_SLOTS`
                     // kernels, checked in `new`), so the arguments at `slot * 16` lie inside the
-                    // dispatch buffer, which has `INDIRECT_BUFFER` usage.
+                    // dispatch buffer, which has `INDIRECT_BUFFER` usage, written by the
+                    // classification and made visible to the indirect read (`after_compute`).
                     unsafe {
-                        d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);
-                        d.cmd_dispatch_indirect(cmd, self.dispatch.handle, (slot * 16) as u64);
+                        rec.bind_pipeline(vk::PipelineBindPoint::COMPUTE, *pipeline);
+                        rec.dispatch_indirect(self.dispatch.handle, (slot * 16) as u64);
                     }
                 });
                 // The next BRDF's kernel adds onto the same image (other pixels, but one image).
@@ -614,8 +606,7 @@ impl TiledLighting {
 /// Compute writes of the tile buffers made visible to the next compute pass and to the indirect
 /// dispatches.
 fn after_compute(rec: &Recording) {
-    tile_barrier(
-        rec,
+    rec.memory_dependency(
         (
             vk::PipelineStageFlags2::COMPUTE_SHADER,
             vk::AccessFlags2::SHADER_STORAGE_WRITE,
@@ -627,22 +618,4 @@ fn after_compute(rec: &Recording) {
                 | vk::AccessFlags2::INDIRECT_COMMAND_READ,
         ),
     );
-}
-
-/// A global barrier between `src` and `dst` (stage, access) for the tile buffers.
-fn tile_barrier(
-    rec: &Recording,
-    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
-) {
-    let barrier = [vk::MemoryBarrier2::default()
-        .src_stage_mask(src.0)
-        .src_access_mask(src.1)
-        .dst_stage_mask(dst.0)
-        .dst_access_mask(dst.1)];
-    let info = vk::DependencyInfo::default().memory_barriers(&barrier);
-    // SAFETY: `rec` is outside rendering (`outside` checks it; the record fns above, inside
-    // `record_tiled_with`), from a graphics and compute queue family, which supports the
-    // transfer, compute and indirect stages named.
-    unsafe { rec.device().cmd_pipeline_barrier2(rec.outside(), &info) };
 }

@@ -102,7 +102,7 @@ impl Tonemap {
             rec.apply(&FULLSCREEN);
             // SAFETY: inside the rendering begun above, with the pipeline, its sets and the
             // dynamic state it reads bound and set; the triangle reads no vertex buffer.
-            unsafe { rec.device().cmd_draw(rec.inside(), 3, 1, 0, 0) };
+            unsafe { rec.draw(3, 0) };
             rec.end_rendering();
         });
     }

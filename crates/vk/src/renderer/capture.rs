@@ -190,20 +190,14 @@ impl FootprintCapture {
                     light_index: light.0,
                     ..Default::default()
                 };
-                let (d, cmd) = (rec.device(), rec.inside());
-                // SAFETY: `cmd` is recording (the caller, `Renderer::simulator_inputs`, began it)
-                // and inside the rendering `begin_cleared` began above; the pipeline was made by
+                // SAFETY: the recording is the caller's (`Renderer::simulator_inputs` began it),
+                // inside the rendering `begin_cleared` began above; the pipeline was made by
                 // `new` with `pipeline_layout`, from this device, and lives until `destroy`; the
                 // push is `LightDrawPush` at offset 0, within the layout's graphics-stage range.
                 unsafe {
-                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-                    d.cmd_push_constants(
-                        cmd,
-                        pipeline_layout,
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
-                        bytemuck::bytes_of(&push),
-                    );
+                    rec.bind_pipeline(vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+                    let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                    rec.push(pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
                 }
                 rec.apply(&PassState {
                     cull,

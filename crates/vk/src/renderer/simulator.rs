@@ -71,14 +71,8 @@ impl Renderer<'_> {
                 // frame set's layout is made identical to the lighting's frame set layout, set 0
                 // of `layout` (`Descriptors::new`), and both live as long as the renderer.
                 unsafe {
-                    ctx.device.cmd_bind_descriptor_sets(
-                        rec.outside(),
-                        vk::PipelineBindPoint::GRAPHICS,
-                        layout,
-                        0,
-                        &[self.descriptors.frame_set],
-                        &[],
-                    );
+                    let graphics = vk::PipelineBindPoint::GRAPHICS;
+                    rec.bind_sets(graphics, layout, 0, &[self.descriptors.frame_set]);
                 }
                 let light = &self.scene.lights[index as usize];
                 capture.record(&rec, layout, self.lighting.volumes(), (index, light));
