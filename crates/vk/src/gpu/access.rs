@@ -364,6 +364,20 @@ impl Recording<'_> {
         src: (vk::PipelineStageFlags2, vk::AccessFlags2),
         dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
     ) {
+        use vk::PipelineStageFlags2 as S;
+        let supported = S::DRAW_INDIRECT
+            | S::VERTEX_INPUT
+            | S::VERTEX_SHADER
+            | S::EARLY_FRAGMENT_TESTS
+            | S::FRAGMENT_SHADER
+            | S::LATE_FRAGMENT_TESTS
+            | S::COLOR_ATTACHMENT_OUTPUT
+            | S::COMPUTE_SHADER
+            | S::ALL_TRANSFER;
+        debug_assert!(
+            supported.contains(src.0) && supported.contains(dst.0),
+            "a memory dependency on stages histencil does not record in"
+        );
         let barrier = [vk::MemoryBarrier2::default()
             .src_stage_mask(src.0)
             .src_access_mask(src.1)

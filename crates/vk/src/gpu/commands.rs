@@ -103,6 +103,7 @@ impl Recording<'_> {
         offset: u32,
         bytes: &[u8],
     ) {
+        debug_assert!(!bytes.is_empty() && (bytes.len() | offset as usize) & 3 == 0);
         // SAFETY: this fn's # Safety; allowed inside and outside rendering.
         unsafe {
             self.device()
@@ -122,13 +123,13 @@ impl Recording<'_> {
         unsafe { self.device().cmd_draw(self.inside(), vertices, 1, first, 0) }
     }
 
-    /// Binds the vertex buffer (binding 0) and the u32 index buffer of a mesh and draws its
-    /// `indices` indices, inside rendering.
+    /// Binds the vertex buffer (binding 0) and the u32 index buffer of a mesh and draws `count`
+    /// indices, inside rendering.
     ///
     /// # Safety
     /// As [`Self::draw`]; `vertices` and `indices` are live buffers of this device made with
     /// `VERTEX_BUFFER` and `INDEX_BUFFER` usage and filled before the draw runs, and each of the
-    /// `indices` u32 indices names a vertex of `vertices`.
+    /// first `count` u32 indices of `indices` names a vertex of `vertices`.
     pub unsafe fn draw_mesh(&self, vertices: vk::Buffer, indices: vk::Buffer, count: u32) {
         let (d, cmd) = (self.device(), self.inside());
         // SAFETY: inside rendering (checked in debug builds); the rest is this fn's # Safety.
@@ -192,8 +193,9 @@ impl Recording<'_> {
     /// Writes `bytes` into `buffer` from offset 0, outside rendering.
     ///
     /// # Safety
-    /// As [`Self::fill`]; `bytes` is at most 65536 bytes, a multiple of 4, and fits the buffer.
+    /// As [`Self::fill`]; `bytes` is 4 to 65536 bytes, a multiple of 4, and fits the buffer.
     pub unsafe fn update(&self, buffer: vk::Buffer, bytes: &[u8]) {
+        debug_assert!(!bytes.is_empty() && bytes.len() <= 65536 && bytes.len() & 3 == 0);
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
             self.device()

@@ -36,6 +36,8 @@ use std::rc::Rc;
 /// first). Shared by the recordings of one command buffer: the renderer's frame and the
 /// lighting's own recording of the same buffer, whose tiled passes are timed too.
 pub(crate) struct PassClock {
+    /// The command buffer whose recordings write the marks (reset there, by `start_clock`).
+    pub(super) cmd: vk::CommandBuffer,
     pub(super) pool: vk::QueryPool,
     pub(super) capacity: u32,
     pub(super) names: RefCell<Vec<&'static str>>,
@@ -158,6 +160,13 @@ impl<'a> Recording<'a> {
     /// (`pipelines.rs`), and Vulkan allows it inside and outside rendering; callers keep it
     /// inside their attachments and its depths in 0 to 1.
     pub fn set_viewport(&self, viewport: vk::Viewport) {
+        debug_assert!(
+            viewport.width > 0.0
+                && viewport.height > 0.0
+                && (0.0..=1.0).contains(&viewport.min_depth)
+                && (0.0..=1.0).contains(&viewport.max_depth),
+            "an invalid viewport {viewport:?}"
+        );
         // SAFETY: as said above; `viewport` outlives the call.
         unsafe { self.ctx.device.cmd_set_viewport(self.cmd, 0, &[viewport]) };
     }

@@ -275,17 +275,21 @@ impl Timestamps {
         self.names = names;
     }
 
-    /// How many of the last recorded frame's marks the GPU has written, without waiting: a
+    /// How many of the last submission's marks the GPU has written, without waiting: a
     /// bottom-of-pipe timestamp is written once every command before it has finished, so the
     /// marks written name the passes the GPU has finished. `None` where the results cannot be
-    /// read (a lost device).
+    /// read (a lost device); 0 for a submission without a clock, which has no marks to read
+    /// (and a read of no queries is invalid usage).
     pub fn written(&self, ctx: &Context) -> Option<usize> {
+        if self.names.is_empty() {
+            return Some(0);
+        }
         let queries = self.names.len() * QUERIES_PER_MARK as usize;
         // Per query its value and its availability (`WITH_AVAILABILITY`, 64-bit each).
         let mut results = vec![[0u64; 2]; queries];
         let flags = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY;
-        // SAFETY: the pool is live and holds the marks the last recording wrote (`mark` asserts
-        // they fit); `results` has a value and an availability word per query, the stride
+        // SAFETY: the pool is live and holds the marks the last submission wrote (`mark`
+        // asserts they fit), at least one (checked above); `results` has a value and an availability word per query, the stride
         // `[u64; 2]` gives. Without WAIT the call returns at once: NOT_READY where some query
         // is unwritten, which writes the availability of every query and the values of the
         // available ones only.
@@ -301,7 +305,7 @@ impl Timestamps {
         Some(marks.take_while(|m| m.iter().all(|q| q[1] != 0)).count())
     }
 
-    /// The names of the last recorded frame's marks, `start` first.
+    /// The names of the last submission's marks, `start` first; none without a clock.
     pub fn names(&self) -> &[&'static str] {
         &self.names
     }
@@ -354,6 +358,7 @@ impl Recording<'_> {
     fn start_clock(&mut self, pool: vk::QueryPool, capacity: u32) {
         reset_marks(self, pool, capacity);
         self.clock = Some(Rc::new(PassClock {
+            cmd: self.any(),
             pool,
             capacity,
             names: RefCell::new(Vec::new()),
@@ -370,6 +375,11 @@ impl Recording<'_> {
     /// Times this recording's passes by `clock`, another recording's of the same command buffer
     /// (its [`Self::clock`]); `None` leaves them untimed.
     pub fn time_by(&mut self, clock: Option<Rc<PassClock>>) {
+        debug_assert!(
+            clock.as_ref().is_none_or(|c| c.cmd == self.any()),
+            "a clock lent to a recording of another command buffer, where its queries were \
+             never reset"
+        );
         self.clock = clock;
     }
 

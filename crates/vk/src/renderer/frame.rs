@@ -298,7 +298,9 @@ impl<'c> Renderer<'c> {
                 Err(vk::Result::TIMEOUT) if left > slice => {}
                 other => return other,
             }
-            if let Some(step) = step {
+            // A submission without a clock has no progress to tell.
+            let timed = !self.timestamps.names().is_empty();
+            if let Some(step) = step.filter(|_| timed) {
                 let written = self.timestamps.written(ctx);
                 if let Some(n) = written.filter(|n| told != Some(*n)) {
                     ctx.step_progress(step, &progress_words(self.timestamps.names(), n));
