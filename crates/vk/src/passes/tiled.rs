@@ -500,30 +500,21 @@ impl TiledLighting {
             };
             uses.push((&mut targets.hdr, ImageAccess::ComputeStorage, hdr_contents));
             rec.declare(&mut uses);
-            // Every slot shares the dispatch and mask buffers: an earlier frame still in flight
-            // (an engine's, another slot) may be reading them, by the tiled shade's indirect
-            // dispatches and kernels (which its closing full barrier orders before these
-            // writes) or by the depth-id passes' fragment shaders (which nothing of histencil's
-            // did: a write-after-read race with two depth-id frames in flight, until this).
-            rec.memory_dependency(
-                (
-                    vk::PipelineStageFlags2::DRAW_INDIRECT
-                        | vk::PipelineStageFlags2::COMPUTE_SHADER
-                        | vk::PipelineStageFlags2::FRAGMENT_SHADER,
-                    vk::AccessFlags2::NONE,
-                ),
-                (
-                    vk::PipelineStageFlags2::ALL_TRANSFER,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
-            );
+            // Every slot shares the tile buffers: an earlier frame still in flight (an engine's,
+            // another slot) may be using them, by the tiled shade's indirect dispatches and
+            // kernels or by the depth-id passes' fragment shaders (which nothing of histencil's
+            // ordered before this rewrite, until this barrier). It waits for every earlier use
+            // at every stage histencil records in, not a list of today's readers: the next
+            // reader added needs no change here. Synchronisation validation does not see this
+            // hand-over across submissions (nor the light passes' split): held by reading.
+            rec.memory_barrier();
             // Each slot's dispatch starts at zero tiles.
             let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
             // SAFETY: outside rendering (`update` and `fill` check it in debug builds;
             // `Recording::new`'s # Safety). `reset` is the dispatch buffer's exact size,
             // `(MIXED_SLOT + 1) * 16` bytes, a multiple of 4 under 64 KiB; both buffers are live
-            // with `TRANSFER_DST` usage, and the dependency above orders these writes after
-            // every earlier read of them.
+            // with `TRANSFER_DST` usage, and the barrier above orders these writes after every
+            // earlier use of them.
             unsafe {
                 rec.update(self.dispatch.handle, bytemuck::cast_slice(&reset));
                 // Every tile's light mask starts empty; the light lists set bits.
