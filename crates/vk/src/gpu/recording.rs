@@ -22,8 +22,9 @@
 //! (`timing::progress_words`: the marks the GPU has written name the passes it finished). A
 //! recording without one (an engine's command buffer) records the same commands, untimed.
 //!
-//! Methods take `&self`: the state is in `Cell`s, which makes a `Recording` `!Sync`, so one
-//! thread records through it, as Vulkan's external synchronisation of a command buffer asks; a
+//! Methods take `&self`: the state is in `Cell`s, which makes a `Recording` `!Sync` (and the
+//! clock's `Rc` `!Send`), so one thread records through it, as Vulkan's external
+//! synchronisation of a command buffer asks; a
 //! step's body records through the same shared reference it was handed, without reborrowing.
 
 use crate::gpu::context::Context;
