@@ -14,7 +14,7 @@
 use crate::{write_file, Result};
 use histencil_model::{FlushPolicy, FramePlan, TileStats};
 use histencil_scene::Scene;
-use histencil_vk::{Context, FrameDesc, Renderer, SimulatorInputs, Technique};
+use histencil_vk::{Context, FrameDesc, Platform as P, Renderer, SimulatorInputs, Technique};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -32,8 +32,6 @@ pub enum Row {
     /// are the RSX's; what a region stores and when is not public).
     NvidiaZcull,
 }
-
-use histencil_vk::Platform as P;
 
 impl Row {
     /// The table's rows, in its order: the talk's consoles, NVIDIA's criterion, AMD's two

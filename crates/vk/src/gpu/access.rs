@@ -341,16 +341,7 @@ impl Recording<'_> {
     /// best-practices layer flags); synchronisation validation in every test run would report a
     /// hazard through a stage missing here.
     pub(crate) fn memory_barrier(&self) {
-        use vk::PipelineStageFlags2 as S;
-        let stages = S::DRAW_INDIRECT
-            | S::VERTEX_INPUT
-            | S::VERTEX_SHADER
-            | S::EARLY_FRAGMENT_TESTS
-            | S::FRAGMENT_SHADER
-            | S::LATE_FRAGMENT_TESTS
-            | S::COLOR_ATTACHMENT_OUTPUT
-            | S::COMPUTE_SHADER
-            | S::ALL_TRANSFER;
+        let stages = recorded_stages();
         let write = vk::AccessFlags2::MEMORY_WRITE;
         let read_write = vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE;
         self.memory_dependency((stages, write), (stages, read_write));
@@ -364,16 +355,7 @@ impl Recording<'_> {
         src: (vk::PipelineStageFlags2, vk::AccessFlags2),
         dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
     ) {
-        use vk::PipelineStageFlags2 as S;
-        let supported = S::DRAW_INDIRECT
-            | S::VERTEX_INPUT
-            | S::VERTEX_SHADER
-            | S::EARLY_FRAGMENT_TESTS
-            | S::FRAGMENT_SHADER
-            | S::LATE_FRAGMENT_TESTS
-            | S::COLOR_ATTACHMENT_OUTPUT
-            | S::COMPUTE_SHADER
-            | S::ALL_TRANSFER;
+        let supported = recorded_stages();
         debug_assert!(
             supported.contains(src.0) && supported.contains(dst.0),
             "a memory dependency on stages histencil does not record in"
@@ -392,6 +374,22 @@ impl Recording<'_> {
                 .cmd_pipeline_barrier2(self.outside(), &dependency)
         };
     }
+}
+
+/// The stages histencil records work in (named rather than `ALL_COMMANDS`, which the
+/// best-practices layer flags), all supported by the graphics and compute queue family it
+/// records on: what a full barrier waits for, and what a memory dependency may name.
+fn recorded_stages() -> vk::PipelineStageFlags2 {
+    use vk::PipelineStageFlags2 as S;
+    S::DRAW_INDIRECT
+        | S::VERTEX_INPUT
+        | S::VERTEX_SHADER
+        | S::EARLY_FRAGMENT_TESTS
+        | S::FRAGMENT_SHADER
+        | S::LATE_FRAGMENT_TESTS
+        | S::COLOR_ATTACHMENT_OUTPUT
+        | S::COMPUTE_SHADER
+        | S::ALL_TRANSFER
 }
 
 /// How a buffer is used, as [`ImageAccess`] says it of an image: the stages and accesses a

@@ -47,20 +47,6 @@ impl Recording<'_> {
         unsafe { self.bind(vk::PipelineBindPoint::GRAPHICS, pipeline, layout, sets) }
     }
 
-    /// Binds the compute `pipeline` and `sets` from set 0 of `layout`.
-    ///
-    /// # Safety
-    /// As [`Self::bind`], for a compute pipeline.
-    pub unsafe fn bind_compute(
-        &self,
-        pipeline: vk::Pipeline,
-        layout: vk::PipelineLayout,
-        sets: &[vk::DescriptorSet],
-    ) {
-        // SAFETY: this fn's # Safety.
-        unsafe { self.bind(vk::PipelineBindPoint::COMPUTE, pipeline, layout, sets) }
-    }
-
     /// Binds `pipeline` at `point` alone, keeping the sets bound (a pipeline of the same layout).
     ///
     /// # Safety

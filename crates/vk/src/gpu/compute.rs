@@ -68,7 +68,12 @@ impl ComputePipeline {
         // `set` is a live set of `set_layout`. Both callers push exactly the layout's
         // `push_bytes` (4 for a case count, `size_of::<UpdatePush>()` for the tile update).
         unsafe {
-            rec.bind_compute(self.pipeline, self.layout, &[set]);
+            rec.bind(
+                vk::PipelineBindPoint::COMPUTE,
+                self.pipeline,
+                self.layout,
+                &[set],
+            );
             rec.push(self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
         }
     }

@@ -289,10 +289,10 @@ impl Timestamps {
         let mut results = vec![[0u64; 2]; queries];
         let flags = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY;
         // SAFETY: the pool is live and holds the marks the last submission wrote (`mark`
-        // asserts they fit), at least one (checked above); `results` has a value and an availability word per query, the stride
-        // `[u64; 2]` gives. Without WAIT the call returns at once: NOT_READY where some query
-        // is unwritten, which writes the availability of every query and the values of the
-        // available ones only.
+        // asserts they fit), at least one (checked above); `results` has a value and an
+        // availability word per query, the stride `[u64; 2]` gives. Without WAIT the call
+        // returns at once: NOT_READY where some query is unwritten, which writes the
+        // availability of every query and the values of the available ones only.
         let read = unsafe {
             ctx.device
                 .get_query_pool_results(self.pool, 0, &mut results, flags)
