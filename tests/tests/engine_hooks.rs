@@ -378,3 +378,68 @@ fn an_engine_names_brdfs_and_the_lighting_gives_their_stencil_slots() {
         );
     });
 }
+
+/// An outside viewer's decode hook read its per-BRDF parameter rows for ids 0 to 7, as the book
+/// sized them, while its own BRDFs took ids 8 and up: its toon wall came out unlit with no error
+/// and no validation message. The lighting now holds what the hook says of its rows
+/// (`EngineHooks::with_brdf_params`) against the ids it shades, at creation, naming both; a hook
+/// that says nothing is taken to have the built-ins' 8 rows.
+#[test]
+fn a_decode_hook_without_rows_for_the_ids_the_lighting_shades_is_refused_at_creation() {
+    use histencil_brdf::{BrdfId, EngineBrdf};
+    use histencil_vk::BrdfParams;
+    let toon = BrdfId::Engine(EngineBrdf::new(0, "toon"));
+    let mut ids: Vec<u32> = BrdfId::ALL.iter().map(|b| b.index()).collect();
+    ids.push(toon.index());
+    let mut names: Vec<&'static str> = BrdfId::ALL.iter().map(|b| b.name()).collect();
+    names.push("toon");
+    // The modules' list of ids is what `DeferredLighting::new` holds a description to first;
+    // every refusal below comes before any module or layout is used.
+    let modules = LightModules {
+        brdfs: Vec::leak(ids),
+        brdf_names: Vec::leak(names),
+        ..LightModules::BUILTIN
+    };
+    let engine = Engine::start();
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let brdfs = vec![BrdfId::Lambert, toon];
+        let layout = histencil_model::StencilLayout::new(2, 0).unwrap();
+        let extent = vk::Extent2D {
+            width: 16,
+            height: 16,
+        };
+        let ds = ctx.depth_stencil_format().vk();
+        let bindings = gbuffer_bindings(ALL_LIGHT_STAGES);
+        let with = |params: Option<BrdfParams>| {
+            let hooks = hooks(modules, &bindings).unwrap();
+            let hooks = match params {
+                Some(p) => hooks.with_brdf_params(p),
+                None => hooks,
+            };
+            LightingDesc {
+                hooks: LightHooks::Engine(hooks),
+                ..lighting_desc(layout, brdfs.clone(), extent, ds, 1)
+            }
+        };
+        let cases = [
+            (None, "taken to have the built-ins' 8 rows"),
+            (Some(BrdfParams::Rows(8)), "reads 8 BRDF rows"),
+        ];
+        for (params, words) in cases {
+            match DeferredLighting::new(&ctx, &with(params)) {
+                Err(e @ Error::BadSetup(_)) => {
+                    let m = e.to_string();
+                    assert!(
+                        m.contains(words) && m.contains("`toon` (id 8)") && m.contains("unlit"),
+                        "{m}"
+                    );
+                }
+                Err(other) => panic!("{params:?}: {other}"),
+                Ok(_) => panic!("{params:?}: a hook without toon's row was accepted"),
+            }
+        }
+    }
+    engine.destroy().assert_clean();
+}

@@ -24,6 +24,7 @@ const SIZE: vk::Extent2D = vk::Extent2D {
 /// validation log empty.
 struct Case<'a> {
     engine: &'a Engine,
+    ctx: &'a Context,
     renderer: &'a Renderer<'a>,
     lighting: DeferredLighting<&'a Context>,
     frame: LightingFrame<'a>,
@@ -57,6 +58,7 @@ fn on_a_lighting_with(frames: u32, case: impl FnOnce(Case)) {
         let images = engine.lighting_targets(SIZE, ds_format);
         case(Case {
             engine: &engine,
+            ctx: &ctx,
             renderer: &renderer,
             lighting,
             frame: plain_frame(&view, &scene.lights, &plan, HookSets::default()),
@@ -113,6 +115,7 @@ fn a_slot_in_flight_is_not_recorded_resized_or_destroyed_until_declared_finished
             frame,
             tiled,
             images,
+            ..
         } = case;
         let mut targets = images.refs();
         let d = &engine.device;
@@ -191,6 +194,7 @@ fn a_slot_recorded_into_another_pending_slots_command_buffer_is_refused() {
             frame,
             tiled,
             images,
+            ..
         } = case;
         let mut targets = images.refs();
         let d = &engine.device;
@@ -369,6 +373,160 @@ fn a_resize_past_the_devices_limits_is_refused_before_anything_is_made() {
         };
         lighting.resize(bigger).unwrap();
         assert_eq!(lighting.desc().extent, bigger);
+        lighting.destroy().unwrap();
+    });
+}
+
+/// Records the G-buffer and `lighting`'s frame into the engine's command buffer of `slot`, ended
+/// and not submitted.
+fn record_unsubmitted(
+    case: &mut Case,
+    (cmd, fence): (vk::CommandBuffer, vk::Fence),
+    targets: &mut histencil_vk::LightingTargets,
+) {
+    let d = &case.engine.device;
+    let begin =
+        vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+    // SAFETY: the engine's device, command buffer and fence, none in use.
+    unsafe {
+        d.reset_fences(&[fence]).unwrap();
+        d.begin_command_buffer(cmd, &begin).unwrap();
+        case.renderer.record_gbuffer(cmd, targets).unwrap();
+        case.lighting.record(cmd, &case.frame, targets).unwrap();
+        d.end_command_buffer(cmd).unwrap();
+    }
+}
+
+/// Submits the recorded `cmd` with `fence` and waits for it.
+fn submit_recorded(engine: &Engine, (cmd, fence): (vk::CommandBuffer, vk::Fence)) {
+    let d = &engine.device;
+    // SAFETY: the engine's queue, an ended command buffer and an unsignalled fence.
+    unsafe {
+        let queue = d.get_device_queue(engine.queue_family, 0);
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
+        d.queue_submit2(queue, &[submit], fence).unwrap();
+        d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+    }
+}
+
+/// An outside engine recorded a frame, replaced its lighting before submitting (its `destroy`
+/// refused, it dropped the value handed back, as the docs allow), then submitted: the frame read
+/// freed objects (21 validation messages, then SIGSEGV on lavapipe). Dropped with a slot in
+/// flight, the lighting now leaves its objects to the context: the frame runs clean, and
+/// `free_retired` frees them once the engine's fence says it is done.
+#[test]
+fn a_lighting_dropped_between_recording_and_submitting_keeps_what_its_frame_reads() {
+    on_a_lighting(|mut case| {
+        let slots = case.engine.frame_slots(1);
+        let (_, cmd, fence) = slots[0];
+        let mut targets = case.images.refs();
+        record_unsubmitted(&mut case, (cmd, fence), &mut targets);
+        let Case {
+            engine,
+            ctx,
+            lighting,
+            ..
+        } = case;
+        let refused = lighting.destroy().expect_err("a destroy in flight");
+        assert!(matches!(refused.error, Error::InFlight(_)), "{refused}");
+        drop(refused);
+        assert_eq!(ctx.retired_count(), 1, "the dropped lighting's objects");
+        submit_recorded(engine, (cmd, fence));
+        // SAFETY: the one frame recorded through the dropped lighting finished (its fence).
+        unsafe { ctx.free_retired() };
+        assert_eq!(ctx.retired_count(), 0);
+        engine.free_frame_slots(&slots);
+    });
+}
+
+/// As above, with the frame's objects left to the context's own drop (after the device is
+/// idle), and a second lighting made and recorded meanwhile: nothing is freed early or twice.
+#[test]
+fn a_lighting_dropped_in_flight_is_freed_with_its_context() {
+    on_a_lighting(|mut case| {
+        let slots = case.engine.frame_slots(2);
+        let mut targets = case.images.refs();
+        record_unsubmitted(&mut case, (slots[0].1, slots[0].2), &mut targets);
+        let desc = case.lighting.desc().clone();
+        let replaced = DeferredLighting::new(case.ctx, &desc).unwrap();
+        drop(std::mem::replace(&mut case.lighting, replaced));
+        assert_eq!(case.ctx.retired_count(), 1);
+        // The second frame takes the images as the first leaves them.
+        record_unsubmitted(&mut case, (slots[1].1, slots[1].2), &mut targets);
+        submit_recorded(case.engine, (slots[0].1, slots[0].2));
+        submit_recorded(case.engine, (slots[1].1, slots[1].2));
+        // SAFETY: both frames finished (their fences).
+        unsafe { case.lighting.slot_finished(0).unwrap() };
+        case.lighting.destroy().unwrap();
+        case.engine.free_frame_slots(&slots);
+        // The context, dropped by the helper, frees the first lighting's objects.
+        assert_eq!(case.ctx.retired_count(), 1);
+    });
+}
+
+/// A description with fewer BRDFs than its stencil layout has slots panicked at the first frame
+/// ("index out of bounds: the len is 5 but the index is 5"); a plan edited by hand (its fields
+/// are public) could index past the lighting's BRDFs or its own lights the same way. Each is
+/// refused naming what it indexes, before anything is made or recorded.
+#[test]
+fn descriptions_and_plans_that_index_past_their_lists_are_refused_not_panicked_on() {
+    use histencil_model::{PassKind, Shader, Step};
+    on_a_lighting(|case| {
+        let Case {
+            engine,
+            ctx,
+            mut lighting,
+            frame,
+            images,
+            ..
+        } = case;
+        let desc = lighting.desc().clone();
+        let fewer = histencil_vk::LightingDesc {
+            brdfs: desc.brdfs[..desc.brdfs.len() - 1].to_vec(),
+            ..desc.clone()
+        };
+        match DeferredLighting::new(ctx, &fewer) {
+            Err(Error::BadSetup(m)) => assert!(m.contains("BRDF slots"), "{m}"),
+            Err(other) => panic!("fewer BRDFs than slots: {other}"),
+            Ok(_) => panic!("fewer BRDFs than slots: accepted"),
+        }
+        let slots = desc.brdfs.len() as u32;
+        let mut past_slot = frame.plan.clone();
+        let shade = (past_slot.steps.iter_mut())
+            .find_map(|s| match s {
+                Step::Pass { pass, .. } if matches!(pass.kind, PassKind::Shade(_)) => Some(pass),
+                _ => None,
+            })
+            .expect("the plan shades");
+        shade.kind = PassKind::Shade(Shader::Brdf(slots));
+        let mut past_light = frame.plan.clone();
+        for step in &mut past_light.steps {
+            if let Step::Pass { light, .. } = step {
+                *light = 99;
+            }
+        }
+        let (pool, cmd) = engine.command_buffer();
+        let d = &engine.device;
+        let cases = [(&past_slot, "BRDF slot"), (&past_light, "light 99")];
+        // SAFETY: the engine's command buffer, recording; every case is refused before anything
+        // is recorded.
+        unsafe {
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            for (plan, words) in cases {
+                let bad = LightingFrame { plan, ..frame };
+                match lighting.record(cmd, &bad, &mut images.refs()) {
+                    Err(e @ Error::BadFrame(_)) => {
+                        assert!(e.to_string().contains(words), "{e}")
+                    }
+                    other => panic!("a plan past its lists: {other:?}"),
+                }
+            }
+            d.end_command_buffer(cmd).unwrap();
+            d.destroy_command_pool(pool, None);
+        }
+        assert!(!lighting.in_flight());
         lighting.destroy().unwrap();
     });
 }

@@ -513,7 +513,13 @@ impl BrdfSet {
                 }
             }
         }
-        ids += "#endif\n";
+        // Every id of the set, built-in or the engine's, is below this: what an engine's decode
+        // hook sizes its per-id parameter rows with (`BrdfParams::Rows` in histencil-vk).
+        let count = (self.engine().map(|(id, _)| id.index() + 1))
+            .max()
+            .unwrap_or(0)
+            .max(BrdfId::ALL.len() as u32);
+        ids += &format!("#define BRDF_ID_COUNT {count}u\n#endif\n");
         [
             ("brdf_set/ids.glsl", ids),
             ("brdf_set/functions.glsl", functions),

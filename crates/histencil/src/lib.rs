@@ -120,12 +120,12 @@ pub mod prelude {
 
     // The device, the lighting, the hooks.
     pub use histencil_vk::{
-        aspect_of, gbuffer_stencil_reference, Backend, BorrowedDevice, BrdfSource, Cause, Context,
-        DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks, Error,
-        HookSetLayout, HookSets, ImageRef, ImageState, LightHooks, LightModules, LightingBreakdown,
-        LightingDesc, LightingFrame, LightingTargets, LutTables, MixedTiles, StillInFlight,
-        TileClassify, TileSide, TileStats, TiledFrame, ValidationLog, ValidationMessage,
-        GBUFFER_FORMATS, REQUIREMENTS,
+        aspect_of, gbuffer_stencil_reference, Backend, BorrowedDevice, BrdfParams, BrdfSource,
+        Cause, Context, DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks,
+        Error, HookSetLayout, HookSets, ImageRef, ImageState, LightHooks, LightModules,
+        LightingBreakdown, LightingDesc, LightingFrame, LightingTargets, LutTables, MixedTiles,
+        StillInFlight, TileClassify, TileSide, TileStats, TiledFrame, ValidationLog,
+        ValidationMessage, GBUFFER_FORMATS, REQUIREMENTS,
     };
 
     // Lightmaps for translucent entities.

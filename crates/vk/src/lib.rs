@@ -58,7 +58,8 @@ pub use histencil_model::{
     CostModel, DepthIdCosts, FlushPolicy, FrameChoice, SlotWeights, TileStats, TiledCosts,
 };
 pub use lighting::hooks::{
-    EngineHooks, HookSetLayout, HookSets, LightHooks, LightModules, DECODE_SET, VISIBILITY_SET,
+    BrdfParams, EngineHooks, HookSetLayout, HookSets, LightHooks, LightModules, DECODE_SET,
+    VISIBILITY_SET,
 };
 pub use lighting::lut::{LutEvaluator, LutTables};
 pub use lighting::{

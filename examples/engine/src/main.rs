@@ -27,7 +27,7 @@ use gpu_allocator::MemoryLocation;
 use histencil::vk::gpu_types::FrameUniforms;
 use histencil::{
     mesh_bounds, plan_entities, plan_frame, AlphaEntity, AlphaEntityKind, AlphaLightmaps,
-    AlphaLightmapsDesc, Backend, BrdfModules, BrdfSource, ChoiceSettings, Context,
+    AlphaLightmapsDesc, Backend, BrdfModules, BrdfParams, BrdfSource, ChoiceSettings, Context,
     DeferredLighting, DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSetLayout, HookSets,
     ImageState, LightHooks, LightModules, LightingDesc, LightingFrame, LightingTargets,
     LightmapFrame, MixedTiles, Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout,
@@ -233,8 +233,11 @@ fn main() {
     // SAFETY: the decode set layout is the engine's, made from those bindings on the lent
     // device, and is destroyed after the lighting; LIGHT_MODULES come from histencil_build of
     // this histencil-vk.
+    // The compact G-buffer carries each pixel's BRDF parameters (surface_decode.glsl): every
+    // id of the set reads its own.
     let hooks = unsafe { EngineHooks::new(LIGHT_MODULES, decode_layout, None, surface_formats) }
-        .expect("the engine's light shaders");
+        .expect("the engine's light shaders")
+        .with_brdf_params(BrdfParams::PerPixel);
     let mut lighting = DeferredLighting::new(
         &ctx,
         &LightingDesc {

@@ -28,9 +28,11 @@
 layout(set = 1, binding = 0) uniform texture2D two_target_normal;
 layout(set = 1, binding = 1) uniform texture2D two_target_tint_brdf;
 layout(set = 1, binding = 2) uniform texture2D two_target_depth;
-// One row per BRDF id (BrdfId::index), each Brdf::packed_params as four floats: a 128-byte
-// buffer. 8: histencil_brdf::BrdfId::ALL.len().
-#define TWO_TARGET_BRDF_ROWS 8u
+// One row per BRDF id (BrdfId::index), each Brdf::packed_params as four floats: BRDF_ID_COUNT
+// rows, every id of the set the light shaders are compiled for (8 for histencil's own, more
+// with engine BRDFs), said to histencil as BrdfParams::Rows(BRDF_ID_COUNT).
+#include "brdf_set/ids.glsl"
+#define TWO_TARGET_BRDF_ROWS BRDF_ID_COUNT
 layout(set = 1, binding = 3, std140) uniform TwoTargetBrdfs {
     vec4 packed_params[TWO_TARGET_BRDF_ROWS];
 } two_target_brdfs;

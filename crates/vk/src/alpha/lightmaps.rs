@@ -26,7 +26,7 @@ use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::gpu::state::FULLSCREEN;
-use crate::gpu::teardown::{DestroyResult, PendingSlots};
+use crate::gpu::teardown::{free_or_retire, DestroyResult, PendingSlots};
 use crate::gpu::timing::{LightmapTimings, SlotTimer};
 use crate::shaders;
 use ash::vk;
@@ -339,7 +339,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     ///
     /// # Errors
     /// [`crate::StillInFlight`] while a slot is not declared finished: it holds the lightmaps, whole,
-    /// and the error naming the slots (dropping it waits for the device).
+    /// and the error naming the slots (dropping it leaves its objects to the context until
+    /// the GPU is known to be done: `Context::free_retired`).
     pub fn destroy(self) -> DestroyResult<Self> {
         PendingSlots::destroy(self, |l| &l.pending)
     }
@@ -629,34 +630,41 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
 }
 
 impl<C: Deref<Target = Context>> Drop for AlphaLightmaps<C> {
-    /// Once these have recorded, waits for the device to go idle (so nothing else may use any
-    /// of its queues meanwhile; [`AlphaLightmaps::destroy`] does not wait), then frees
-    /// everything, also after a creation that failed half way.
+    /// Frees everything, also after a creation that failed half way; while a slot is in flight,
+    /// leaves it to the context until the GPU is known to be done (as
+    /// [`crate::DeferredLighting`]'s drop does).
     fn drop(&mut self) {
-        let ctx: &Context = &self.ctx;
-        let d = &ctx.device;
-        self.pending.wait(ctx);
-        for slot in &mut self.slots {
-            slot.uniforms.destroy(ctx);
-            slot.lights.destroy(ctx);
-            for b in &mut slot.storage {
-                b.destroy(ctx);
+        let mut slots = std::mem::take(&mut self.slots);
+        let pipelines = [self.pipeline, self.directional_pipeline];
+        let (pool, pipeline_layout, set_layouts) =
+            (self.pool, self.pipeline_layout, self.set_layouts);
+        let free = move |ctx: &Context| {
+            for slot in &mut slots {
+                slot.uniforms.destroy(ctx);
+                slot.lights.destroy(ctx);
+                for b in &mut slot.storage {
+                    b.destroy(ctx);
+                }
+                slot.timer.destroy(ctx);
             }
-            slot.timer.destroy(ctx);
-        }
-        // SAFETY: the GPU is done with these: the device went idle above once they had
-        // recorded, or `destroy`'s caller promised so (its # Safety). Each was made by `create`
-        // from `ctx.device`, or is null (no direction format, or a creation that failed half
-        // way), which destroying ignores.
-        unsafe {
-            d.destroy_pipeline(self.pipeline, None);
-            d.destroy_pipeline(self.directional_pipeline, None);
-            d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_pipeline_layout(self.pipeline_layout, None);
-            for l in self.set_layouts {
-                d.destroy_descriptor_set_layout(l, None);
+            let d = &ctx.device;
+            // SAFETY: the GPU is done with these: no slot is pending (`slot_finished`'s
+            // # Safety), or this runs from the context's retired list once the device is idle
+            // or `free_retired`'s caller says so. Each was made by `create` from `ctx.device`,
+            // or is null (no direction format, or a creation that failed half way), which
+            // destroying ignores.
+            unsafe {
+                for p in pipelines {
+                    d.destroy_pipeline(p, None);
+                }
+                d.destroy_descriptor_pool(pool, None);
+                d.destroy_pipeline_layout(pipeline_layout, None);
+                for l in set_layouts {
+                    d.destroy_descriptor_set_layout(l, None);
+                }
             }
-        }
+        };
+        free_or_retire(&self.ctx, self.pending.any(), free);
     }
 }
 

@@ -2,7 +2,8 @@
 //!
 //! Resources are destroyed explicitly with the context (`destroy`), never by `Drop`, so
 //! teardown order stays in the owner's hands; only the objects an engine holds (which keep
-//! their context) free theirs on `Drop`, waiting first as [`InFlight`] says. Two helpers keep a failed creation from leaking
+//! their context) free theirs on `Drop`, or leave them to the context while a frame they
+//! recorded may still run ([`free_or_retire`]). Two helpers keep a failed creation from leaking
 //! what its earlier steps made:
 //! - [`build`] fills a value in place from its empty state, one step at a time, and destroys it
 //!   when a step fails. It works because every `destroy` accepts a value only partly made:
@@ -93,14 +94,9 @@ macro_rules! destroy_by_method {
 }
 pub(crate) use destroy_by_method;
 
-/// Whether an engine-facing object ([`crate::DeferredLighting`], [`crate::AlphaLightmaps`],
-/// [`crate::LutTables`]) may still be in use by the GPU when it is dropped: from its first
-/// recording (tables: from their making, as any lighting may bind them) until its owner frees
-/// it through its `unsafe fn destroy`, which promises the GPU is done.
-///
-/// Dropping an object in use waits for the device to go idle first. Vulkan counts that wait
-/// as a use of every queue of the device, which an engine submitting from other threads cannot
-/// allow; an object never recorded, or freed through `destroy`, does not wait.
+/// Whether an engine-facing object ([`crate::LutTables`]) may still be in use by the GPU when
+/// it is dropped: from its making (any lighting may bind the tables) until its owner frees it
+/// through its `unsafe fn destroy`, which promises the GPU is done.
 #[derive(Default)]
 pub(crate) struct InFlight(bool);
 
@@ -113,16 +109,26 @@ impl InFlight {
         self.0 = false;
     }
 
-    /// Waits for the device to go idle if the object may still be in use.
-    pub fn wait(&self, ctx: &Context) {
-        if self.0 {
-            // `vkDeviceWaitIdle` needs every queue of the device externally synchronised:
-            // histencil's own submits (`submit_once`, a renderer's frame) wait for the queue's
-            // lock (`Context::wait_idle`), and on a lent device the engine's are kept off by
-            // `Context::from_raw`'s # Safety (nothing else uses a queue while one that recorded
-            // is dropped).
-            let _ = ctx.wait_idle();
-        }
+    pub fn any(&self) -> bool {
+        self.0
+    }
+}
+
+/// An engine-facing object's drop: runs `free` now, or, while the GPU may still use what it
+/// frees (`in_use`), leaves it to the context ([`Context::retire`]), which frees it once the GPU
+/// is known to be done. Histencil sees no fence and cannot know whether a command buffer it
+/// recorded into was submitted, will be, or was dropped: a wait at the drop would not cover a
+/// frame submitted after it (an engine that replaces its lighting between recording a frame and
+/// submitting it), so nothing used by a frame in flight is freed before the context goes.
+pub(crate) fn free_or_retire(
+    ctx: &Context,
+    in_use: bool,
+    free: impl FnOnce(&Context) + Send + 'static,
+) {
+    if in_use {
+        ctx.retire(Box::new(free));
+    } else {
+        free(ctx);
     }
 }
 
@@ -169,12 +175,6 @@ impl PendingSlots {
     /// Whether a slot is pending.
     pub fn any(&self) -> bool {
         self.pending.iter().any(Option::is_some)
-    }
-
-    /// The owner's drop: waits for the device to go idle while a slot is pending (as
-    /// [`InFlight`] does), not otherwise.
-    pub fn wait(&self, ctx: &Context) {
-        InFlight(self.any()).wait(ctx);
     }
 
     /// Refuses `what` (a resize, a destroy) while a slot is pending, naming the slots.
@@ -232,7 +232,8 @@ pub(crate) type DestroyResult<T> = std::result::Result<(), Box<StillInFlight<T>>
 /// What a refused `destroy` (of a [`crate::DeferredLighting`] or [`crate::AlphaLightmaps`])
 /// gives back: the value, whole, and why.
 pub struct StillInFlight<T> {
-    /// What was not destroyed; dropping it waits for the device, then frees it.
+    /// What was not destroyed; dropping it leaves its objects to the context until the GPU is
+    /// known to be done ([`Context::free_retired`], or the context's drop).
     pub value: T,
     /// [`Error::InFlight`], naming the slots.
     pub error: Error,

@@ -7,7 +7,7 @@ use crate::gpu::error::{Error, Result};
 use crate::gpu::targets::GBUFFER_FORMATS;
 use crate::lighting::hooks::{HookSets, LightHooks};
 use ash::vk;
-use histencil_model::{FramePlan, Step};
+use histencil_model::{FramePlan, PassKind, Shader, Step};
 
 pub(super) fn bad(message: String) -> Error {
     Error::BadFrame(message)
@@ -62,12 +62,55 @@ pub(super) fn check_desc(desc: &LightingDesc) -> Result<()> {
             known.join(", ")
         )));
     }
+    // Each of the layout's BRDF slots is shaded with the BRDF at its index: a slot with none
+    // would have nothing to shade with (a plan's passes name slots, not BRDFs).
     let slots = desc.layout.brdfs_in_use() as usize;
-    if desc.brdfs.len() > slots {
+    if desc.brdfs.len() != slots {
         return Err(bad_setup(format!(
-            "{} BRDFs for a stencil layout with {slots} BRDF slots",
+            "{} BRDFs for a stencil layout with {slots} BRDF slots: give one BRDF per slot \
+             (StencilLayout::new with the number of BRDFs)",
             desc.brdfs.len()
         )));
+    }
+    Ok(())
+}
+
+/// Checks that every index a plan holds points into what it indexes: a step's light into the
+/// plan's lights, each planned light into the frame's, each pass's BRDF slot into the
+/// lighting's BRDFs. A plan is plain data an engine may build or edit by hand, so the recording
+/// holds it to these before indexing with them (an index past the end would panic).
+pub(super) fn check_plan_indices(
+    desc: &LightingDesc,
+    plan: &FramePlan,
+    lights: usize,
+) -> Result<()> {
+    if let Some(l) = plan.lights.iter().find(|l| l.input >= lights) {
+        return Err(bad(format!(
+            "the plan lights input {} of {lights} lights",
+            l.input
+        )));
+    }
+    let slots = desc.brdfs.len();
+    for (index, step) in plan.steps.iter().enumerate() {
+        let Step::Pass { light, pass } = step else {
+            continue;
+        };
+        if *light >= plan.lights.len() {
+            return Err(bad(format!(
+                "step {index} of the plan draws light {light} of its {} planned lights",
+                plan.lights.len()
+            )));
+        }
+        if let PassKind::Mask(Shader::Brdf(slot)) | PassKind::Shade(Shader::Brdf(slot)) = pass.kind
+        {
+            if slot as usize >= slots {
+                return Err(bad(format!(
+                    "step {index} of the plan shades BRDF slot {slot}, and this lighting has \
+                     {slots} BRDF slots (LightingDesc::brdfs): was the plan made for another \
+                     stencil layout?"
+                )));
+            }
+        }
     }
     Ok(())
 }
@@ -94,18 +137,7 @@ pub(super) fn check_frame(
     targets: &LightingTargets,
 ) -> Result<()> {
     check_slot_and_lights(desc, frame.slot, frame.lights)?;
-    if let Some(l) = frame
-        .plan
-        .lights
-        .iter()
-        .find(|l| l.input >= frame.lights.len())
-    {
-        return Err(bad(format!(
-            "the plan lights input {} of {} lights",
-            l.input,
-            frame.lights.len()
-        )));
-    }
+    check_plan_indices(desc, frame.plan, frame.lights.len())?;
     if !desc.hi_stencil && needs_hi_stencil(frame.plan) {
         return Err(bad(
             "the plan uses hi-stencil (a PS3-like or 360-like backend), and this lighting was \

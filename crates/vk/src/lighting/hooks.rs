@@ -15,6 +15,7 @@ use crate::gpu::error::{Error, Result};
 use crate::gpu::spirv_bindings::{reflect_bindings, Resource};
 pub use crate::passes::light_modules::LightModules;
 use ash::vk;
+use histencil_brdf::BrdfId;
 use std::io::Cursor;
 
 /// Where a lighting's shaders get surfaces and visibility from (fixed for its life).
@@ -59,6 +60,21 @@ pub struct EngineHooks {
     /// layouts made with them are checked against the device's limits with.
     /// (Shared: the hooks are cloned into every lighting, and kept small.)
     pub(crate) layout_counts: LayoutCounts,
+    /// How the decode hook reads each BRDF's parameters ([`EngineHooks::with_brdf_params`]).
+    pub(crate) brdf_params: Option<BrdfParams>,
+}
+
+/// How an engine's decode hook reads each pixel's BRDF parameters (`Surface::params`), which a
+/// lighting holds against the BRDF ids it shades: a hook with rows for ids 0 to 7 reads nothing
+/// for an engine BRDF's id 8, and its surfaces come out unlit with no error anywhere.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BrdfParams {
+    /// From the pixel itself (the G-buffer carries them, as `examples/engine`'s compact
+    /// G-buffer does): every id.
+    PerPixel,
+    /// From rows indexed by the BRDF id (`BrdfId::index`), each a `Brdf::packed_params`: ids 0
+    /// to `rows - 1`. Size them from the set: `BRDF_ID_COUNT` in `brdf_set/ids.glsl`.
+    Rows(u32),
 }
 
 /// What each of an engine's layouts holds ([`EngineHooks::register_layouts`]).
@@ -127,7 +143,17 @@ impl EngineHooks {
             surface_formats: surface_formats.into(),
             tiled_refusal,
             layout_counts: std::sync::Arc::new(layout_counts),
+            brdf_params: None,
         })
+    }
+
+    /// Says how the decode hook reads each BRDF's parameters, so that a lighting shading an id
+    /// the hook has no row for is refused at creation, naming the ids and the rows. Hooks that do
+    /// not say are taken to have a row for each built-in id (0 to 7, the book's first hooks)
+    /// and are refused for an engine BRDF's.
+    pub fn with_brdf_params(mut self, params: BrdfParams) -> Self {
+        self.brdf_params = Some(params);
+        self
     }
 }
 
@@ -365,6 +391,41 @@ impl LightHooks {
             )));
         }
         Ok(())
+    }
+
+    /// Refuses BRDF ids the decode hook reads no parameters for ([`BrdfParams`]).
+    pub(crate) fn check_ids(&self, brdfs: &[BrdfId]) -> Result<()> {
+        let LightHooks::Engine(e) = self else {
+            return Ok(());
+        };
+        let builtins = BrdfId::ALL.len() as u32;
+        let (rows, said) = match e.brdf_params {
+            Some(BrdfParams::PerPixel) => return Ok(()),
+            Some(BrdfParams::Rows(rows)) => (rows, true),
+            None => (builtins, false),
+        };
+        let past: Vec<String> = (brdfs.iter())
+            .filter(|b| b.index() >= rows)
+            .map(|b| format!("`{b}` (id {})", b.index()))
+            .collect();
+        if past.is_empty() {
+            return Ok(());
+        }
+        let declared = if said {
+            format!("the decode hook reads {rows} BRDF rows (EngineHooks::with_brdf_params)")
+        } else {
+            format!(
+                "the decode hook did not say how it reads BRDF parameters, so it is taken to \
+                 have the built-ins' {builtins} rows (EngineHooks::with_brdf_params)"
+            )
+        };
+        Err(Error::BadSetup(format!(
+            "{declared}, and the lighting shades {}: those pixels would read no parameters \
+             and come out unlit. Size the hook's rows from the set (BRDF_ID_COUNT in \
+             brdf_set/ids.glsl) and say BrdfParams::Rows(BRDF_ID_COUNT), or BrdfParams::PerPixel \
+             when the G-buffer carries them",
+            past.join(", ")
+        )))
     }
 
     /// Why the tiled technique cannot be recorded with these hooks, if it cannot.

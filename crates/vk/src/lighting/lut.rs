@@ -8,7 +8,7 @@ use crate::gpu::context::Context;
 use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
 use crate::gpu::error::{Error, Result};
 use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::InFlight;
+use crate::gpu::teardown::{free_or_retire, InFlight};
 use crate::shaders;
 use crate::{BrdfEvaluator, BrdfModules};
 use ash::vk;
@@ -169,12 +169,16 @@ impl<C: Deref<Target = Context>> LutTables<C> {
 }
 
 impl<C: Deref<Target = Context>> Drop for LutTables<C> {
-    /// Waits for the device to go idle (so nothing else may use any of its queues meanwhile;
-    /// [`LutTables::destroy`] does not wait), then frees the tables.
+    /// Frees the tables, or, unless [`LutTables::destroy`] promised the GPU is done, leaves them
+    /// to the context until it is ([`Context::free_retired`], or the context's drop).
     fn drop(&mut self) {
-        self.in_flight.wait(&self.ctx);
-        self.headers.destroy(&self.ctx);
-        self.values.destroy(&self.ctx);
+        let mut headers = std::mem::take(&mut self.headers);
+        let mut values = std::mem::take(&mut self.values);
+        let free = move |ctx: &Context| {
+            headers.destroy(ctx);
+            values.destroy(ctx);
+        };
+        free_or_retire(&self.ctx, self.in_flight.any(), free);
     }
 }
 

@@ -36,7 +36,7 @@ use crate::gpu::error::{Error, Result};
 use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
 use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::{Destroy, DestroyResult, PendingSlots};
+use crate::gpu::teardown::{free_or_retire, Destroy, DestroyResult, PendingSlots};
 use crate::gpu::timing::{LightingBreakdown, SlotTimer};
 use crate::hi_stencil::{GpuHierarchy, HiStencilSurface};
 use crate::lighting::hooks::HookSets;
@@ -167,6 +167,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     pub fn new(ctx: C, desc: &LightingDesc) -> Result<Self> {
         check_desc(desc)?;
         desc.hooks.check(&ctx)?;
+        desc.hooks.check_ids(&desc.brdfs)?;
         if ctx.depth_stencil_named && desc.depth_stencil_format != ctx.depth_stencil_format {
             return Err(bad_setup(format!(
                 "depth-stencil format {:?}, but the context was lent {:?} \
@@ -371,6 +372,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ///   touched it (`ImageState::UNDEFINED` discards contents, so not for the G-buffer or
     ///   depth-stencil).
     /// - What [`DeferredLighting::slot_finished`] was told is true (the slot itself is checked).
+    /// - The context outlives `cmd`'s execution. The lighting need not: dropped while `slot` is
+    ///   in flight, it leaves what the frame reads to the context ([`Context::free_retired`]).
     pub unsafe fn record(
         &mut self,
         cmd: vk::CommandBuffer,
@@ -559,7 +562,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ///
     /// # Errors
     /// [`crate::StillInFlight`] while a slot is not declared finished: it holds the lighting, whole
-    /// and unchanged, and the error naming the slots (dropping it waits for the device).
+    /// and unchanged, and the error naming the slots (dropping it leaves its objects to the context until
+    /// the GPU is known to be done: `Context::free_retired`).
     pub fn destroy(self) -> DestroyResult<Self> {
         PendingSlots::destroy(self, |l| &l.pending)
     }
@@ -590,43 +594,61 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
 }
 
 impl<C: Deref<Target = Context>> Drop for DeferredLighting<C> {
-    /// While a slot is in flight (recorded, not declared finished), waits for the device to
-    /// go idle (so nothing else may use any of its queues meanwhile); then frees everything,
-    /// also after a creation that failed half way.
+    /// Frees everything, also after a creation that failed half way. While a slot is in flight
+    /// (recorded, not declared finished: its command buffer may not even be submitted yet) the
+    /// objects go to the context instead, freed once the GPU is known to be done
+    /// ([`Context::free_retired`], or the context's drop): dropping never waits, and a frame
+    /// recorded before the drop reads live objects when it runs.
     fn drop(&mut self) {
-        let ctx: &Context = &self.ctx;
-        let d = &ctx.device;
-        self.pending.wait(ctx);
-        self.pipelines.destroy(ctx);
-        for (_, t) in &mut self.tiled {
-            t.destroy(ctx);
-        }
-        for (_, p) in &mut self.depth_id {
-            p.destroy(ctx);
-        }
-        for slot in &mut self.slots {
-            slot.uniforms.destroy(ctx);
-            slot.lights.destroy(ctx);
-            slot.timer.destroy(ctx);
-            slot.emulation.destroy(ctx);
-        }
-        if let Some(h) = self.hi_stencil.as_mut() {
-            h.destroy(ctx);
-        }
-        if let Some(v) = self.volumes.as_mut() {
-            v.destroy(ctx);
-        }
-        // SAFETY: the GPU is done with the pool, the layouts and the sets: no slot is pending
-        // (`slot_finished`'s # Safety) or the device went idle above, and the pipelines made
-        // with the layout are destroyed. Each handle was made from `ctx.device` by `create`,
-        // or is still null after a creation that failed half way (a no-op).
-        unsafe {
-            d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_pipeline_layout(self.pipeline_layout, None);
-            // The null ones (set 1 with an engine's decode hook) are no-ops.
-            for l in self.set_layouts {
-                d.destroy_descriptor_set_layout(l, None);
+        let null_pipelines = LightPipelines::new(
+            vk::PipelineLayout::null(),
+            self.desc.hooks.modules(),
+            self.desc.hdr_format,
+            self.desc.depth_stencil_format,
+        );
+        let mut pipelines = std::mem::replace(&mut self.pipelines, null_pipelines);
+        let mut tiled = std::mem::take(&mut self.tiled);
+        let mut depth_id = std::mem::take(&mut self.depth_id);
+        let mut slots = std::mem::take(&mut self.slots);
+        let mut hi_stencil = self.hi_stencil.take();
+        let mut volumes = self.volumes.take();
+        let (pool, pipeline_layout, set_layouts) =
+            (self.pool, self.pipeline_layout, self.set_layouts);
+        let free = move |ctx: &Context| {
+            pipelines.destroy(ctx);
+            for (_, t) in &mut tiled {
+                t.destroy(ctx);
             }
-        }
+            for (_, p) in &mut depth_id {
+                p.destroy(ctx);
+            }
+            for slot in &mut slots {
+                slot.uniforms.destroy(ctx);
+                slot.lights.destroy(ctx);
+                slot.timer.destroy(ctx);
+                slot.emulation.destroy(ctx);
+            }
+            if let Some(h) = hi_stencil.as_mut() {
+                h.destroy(ctx);
+            }
+            if let Some(v) = volumes.as_mut() {
+                v.destroy(ctx);
+            }
+            let d = &ctx.device;
+            // SAFETY: the GPU is done with the pool, the layouts and the sets: no slot is
+            // pending (`slot_finished`'s # Safety), or this runs from the context's retired
+            // list once the device is idle or `free_retired`'s caller says so; the pipelines
+            // made with the layout are destroyed. Each handle was made from `ctx.device` by
+            // `create`, or is still null after a creation that failed half way (a no-op).
+            unsafe {
+                d.destroy_descriptor_pool(pool, None);
+                d.destroy_pipeline_layout(pipeline_layout, None);
+                // The null ones (set 1 with an engine's decode hook) are no-ops.
+                for l in set_layouts {
+                    d.destroy_descriptor_set_layout(l, None);
+                }
+            }
+        };
+        free_or_retire(&self.ctx, self.pending.any(), free);
     }
 }

@@ -193,7 +193,13 @@ pub struct Context {
     pub(crate) memory: MemoryAccount,
     /// The step observer and the labelled regions open ([`Context::observe_steps`]).
     steps: Mutex<Steps>,
+    /// What engine-facing objects left behind when dropped while the GPU might still use it
+    /// ([`Context::retire`]): freed at [`Context::free_retired`] or when the context drops.
+    retired: Mutex<Vec<Retired>>,
 }
+
+/// How to free what a dropped object left to its context ([`Context::retire`]).
+pub(crate) type Retired = Box<dyn FnOnce(&Context) + Send>;
 
 /// What [`Context::observe_steps`] calls with each step.
 pub type StepObserver = Box<dyn Fn(&str) + Send + Sync>;
@@ -339,12 +345,12 @@ impl Context {
     /// - `debug_utils` is true only if `VK_EXT_debug_utils` is enabled on `instance`;
     /// - while histencil's owned-device tools ([`crate::Renderer`]) submit to `queue` and wait,
     ///   nothing else uses that queue (Vulkan requires queues to be externally synchronised);
-    /// - while a [`crate::DeferredLighting`] or [`crate::AlphaLightmaps`] that has recorded, or a
-    ///   [`crate::LutTables`], is dropped, nothing else uses any queue of the device: dropping
-    ///   waits for the device to go idle. [`crate::DeferredLighting::destroy`] and
-    ///   [`crate::AlphaLightmaps::destroy`] free without that wait once every slot was declared
-    ///   finished (and refuse otherwise), and `unsafe` [`crate::LutTables::destroy`] once its
-    ///   caller promises the GPU is done.
+    /// - while this context is dropped holding retired objects ([`Context::retired_count`]:
+    ///   a [`crate::DeferredLighting`] or [`crate::AlphaLightmaps`] dropped with a slot not
+    ///   declared finished, or [`crate::LutTables`] dropped without their `destroy`), nothing
+    ///   else uses any queue of the device: the drop waits for the device to go idle before it
+    ///   frees them, and every command buffer recorded through them has been submitted or never
+    ///   will be. [`Context::free_retired`] frees them earlier, without that wait.
     ///
     /// The engine-facing parts submit nothing themselves: making, recording and reading them
     /// never touches a queue.
@@ -436,6 +442,7 @@ impl Context {
             depth_bounds: false,
             quirks,
             memory: MemoryAccount::new(memory_budget),
+            retired: Mutex::default(),
         })
     }
 
@@ -643,8 +650,59 @@ impl Context {
     }
 }
 
+impl Context {
+    /// Keeps what `free` frees until the GPU is known to be done with it: an engine-facing
+    /// object ([`crate::DeferredLighting`], [`crate::AlphaLightmaps`], [`crate::LutTables`])
+    /// dropped while a frame it recorded may not have run yet (recorded and not declared
+    /// finished: the engine may still submit it, after the drop) hands its objects here instead
+    /// of freeing them under that frame. Dropping never waits for the GPU, so an engine that
+    /// replaces its lighting with a frame recorded and not yet submitted gets no crash when it
+    /// submits: the old lighting's objects live on with the context.
+    pub(crate) fn retire(&self, free: Retired) {
+        let mut retired = self.retired.lock().unwrap_or_else(|p| p.into_inner());
+        retired.push(free);
+    }
+
+    /// How many dropped objects' parts this context still keeps for frames that may not have
+    /// run ([`Context::free_retired`]).
+    pub fn retired_count(&self) -> usize {
+        self.retired.lock().unwrap_or_else(|p| p.into_inner()).len()
+    }
+
+    /// Frees what lightings, lightmaps and tables dropped while in flight left to this context
+    /// (they keep their Vulkan objects here, so that a command buffer recorded before the drop
+    /// and submitted after it reads live objects). Dropping the context frees them too, after
+    /// waiting for the device to go idle; an engine that replaces lightings often calls this
+    /// once its fences say those frames are done.
+    ///
+    /// # Safety
+    /// Every command buffer recorded through an object dropped before this call has finished
+    /// executing on the GPU, or will never be submitted.
+    pub unsafe fn free_retired(&self) {
+        let retired = std::mem::take(&mut *self.retired.lock().unwrap_or_else(|p| p.into_inner()));
+        for free in retired {
+            free(self);
+        }
+    }
+
+    /// The context's drop: waits for the device when anything is retired (a retired object's
+    /// frame may have been submitted after its drop), then frees it.
+    fn free_retired_at_drop(&mut self) {
+        let retired = std::mem::take(self.retired.get_mut().unwrap_or_else(|p| p.into_inner()));
+        if retired.is_empty() {
+            return;
+        }
+        let _ = self.wait_idle();
+        for free in retired {
+            free(self);
+        }
+    }
+}
+
 impl Drop for Context {
     fn drop(&mut self) {
+        // What dropped objects retired holds allocations of the allocator: freed before it.
+        self.free_retired_at_drop();
         if !self.owned {
             // The engine's allocator, device and instance stay; only our reference goes. A
             // private allocator (the engine lent none) goes with it, freeing its blocks while

@@ -375,6 +375,7 @@ impl Context {
             depth_bounds,
             quirks,
             memory: MemoryAccount::new(desc.memory_budget),
+            retired: Mutex::default(),
         };
         ctx.name(ctx.device.handle(), "histencil-device");
         if ctx.pipeline_cache != vk::PipelineCache::null() {
