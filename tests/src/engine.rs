@@ -9,7 +9,8 @@ use std::sync::{Arc, Mutex};
 
 /// The engine's side: what it created, in creation order.
 pub struct Engine {
-    _entry: ash::Entry,
+    /// The loader, whose `vkGetInstanceProcAddr` a C engine lends histencil.
+    pub entry: ash::Entry,
     pub instance: ash::Instance,
     pub debug: ash::ext::debug_utils::Instance,
     pub messenger: vk::DebugUtilsMessengerEXT,
@@ -91,7 +92,7 @@ impl Engine {
         })
         .expect("allocator");
         Self {
-            _entry: entry,
+            entry,
             instance,
             debug,
             messenger,

@@ -1,0 +1,470 @@
+//! The lighting: made once from a description, planned and recorded into the engine's command
+//! buffer each frame, told when a slot's frame has finished, resized and destroyed.
+
+use crate::frame::{
+    HistencilFrame, HistencilTargets, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
+    HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
+    HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
+};
+use crate::handles::{self, Kind};
+use crate::{call, check_size, required, slice, Failure, HistencilResult, Outcome};
+use ash::vk;
+use histencil::{
+    plan_frame, Backend, BrdfId, BrdfSource, Context, DeferredLighting, FlushPolicy, HookSets,
+    LightHooks, LightingDesc, LightingFrame, MixedTiles, PlanInputs, PlanSettings, StencilLayout,
+    TechniqueChoice, TileClassify, TileSide, TiledFrame, View,
+};
+use std::ffi::{c_char, CStr};
+use std::sync::Arc;
+
+/// What `histencil_lighting_create` makes a lighting for.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct HistencilLightingDesc {
+    /// `sizeof(HistencilLightingDesc)`.
+    pub size: u32,
+    /// How many BRDFs: each takes one stencil slot, in this order.
+    pub brdf_count: u32,
+    /// The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...).
+    pub brdf_names: *const *const c_char,
+    /// Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
+    pub engine_stencil_bits: u32,
+    /// The targets' width.
+    pub width: u32,
+    /// The targets' height.
+    pub height: u32,
+    /// The depth-stencil image's format (with stencil).
+    pub depth_stencil_format: vk::Format,
+    /// The HDR image's format (`VK_FORMAT_R16G16B16A16_SFLOAT` for every technique).
+    pub hdr_format: vk::Format,
+    /// How many frames the engine has in flight: slots 0 to `frames_in_flight - 1`.
+    pub frames_in_flight: u32,
+    /// The most lights a frame passes.
+    pub max_lights: u32,
+    /// Non-zero to emulate the consoles' hi-stencil (the PS3-like and 360-like platforms).
+    pub hi_stencil: u32,
+}
+
+/// A lighting made on a context, with the names it was made with.
+pub struct HistencilLighting {
+    lighting: DeferredLighting<Arc<Context>>,
+    /// How the tiled techniques classify on this context's driver (the quirk table).
+    classify: TileClassify,
+}
+
+/// The most BRDFs a description names: histencil's eight and an engine's sixteen.
+const MAX_BRDFS: u32 = 24;
+/// The most frames in flight a description asks for.
+const MAX_FRAMES_IN_FLIGHT: u32 = 16;
+
+/// `name` as a BRDF id histencil lights, or the error listing those it knows.
+fn brdf_named(name: &str) -> Outcome<BrdfId> {
+    BrdfId::ALL
+        .into_iter()
+        .find(|b| b.name() == name)
+        .ok_or_else(|| {
+            let known: Vec<&str> = BrdfId::ALL.iter().map(|b| b.name()).collect();
+            Failure {
+                result: HistencilResult::BadSetup,
+                message: format!(
+                    "no BRDF named `{name}` (histencil's own: {}; an engine's own BRDFs come \
+                 through a BRDF set, not yet in the C API)",
+                    known.join(", ")
+                ),
+            }
+        })
+}
+
+/// `count` NUL-terminated names at `names`, as UTF-8.
+///
+/// # Safety
+/// `names` is null or points at `count` pointers, each null or a NUL-terminated string.
+unsafe fn names<'a>(names: *const *const c_char, count: u32, what: &str) -> Outcome<Vec<&'a str>> {
+    // SAFETY: this fn's # Safety.
+    let pointers = unsafe { slice(names, count, what) }?;
+    let mut out = Vec::with_capacity(pointers.len());
+    for (i, &p) in pointers.iter().enumerate() {
+        if p.is_null() {
+            return Err(Failure::invalid(format!("{what}[{i}] is null")));
+        }
+        // SAFETY: this fn's # Safety: a non-null entry is a NUL-terminated string.
+        let name = unsafe { CStr::from_ptr(p) }.to_str();
+        out.push(name.map_err(|_| Failure::invalid(format!("{what}[{i}] is not UTF-8")))?);
+    }
+    Ok(out)
+}
+
+fn lighting_desc(desc: &HistencilLightingDesc) -> Outcome<LightingDesc> {
+    check_size::<HistencilLightingDesc>("HistencilLightingDesc", desc.size)?;
+    let ranges = [
+        ("brdf_count", desc.brdf_count, 1, MAX_BRDFS),
+        (
+            "frames_in_flight",
+            desc.frames_in_flight,
+            1,
+            MAX_FRAMES_IN_FLIGHT,
+        ),
+    ];
+    for (name, value, min, max) in ranges {
+        if !(min..=max).contains(&value) {
+            return Err(Failure::invalid(format!(
+                "HistencilLightingDesc.{name} is {value}, outside {min} to {max}"
+            )));
+        }
+    }
+    // SAFETY: the header's contract: `brdf_count` names at `brdf_names`.
+    let names = unsafe { names(desc.brdf_names, desc.brdf_count, "brdf_names") }?;
+    let brdfs = names
+        .into_iter()
+        .map(brdf_named)
+        .collect::<Outcome<Vec<_>>>()?;
+    let layout = StencilLayout::new(desc.brdf_count, desc.engine_stencil_bits)
+        .map_err(histencil::Error::from)?;
+    Ok(LightingDesc {
+        layout,
+        brdfs,
+        extent: vk::Extent2D {
+            width: desc.width,
+            height: desc.height,
+        },
+        depth_stencil_format: desc.depth_stencil_format,
+        hdr_format: desc.hdr_format,
+        frames_in_flight: desc.frames_in_flight,
+        max_lights: desc.max_lights,
+        hi_stencil: desc.hi_stencil != 0,
+        hooks: LightHooks::Builtin,
+    })
+}
+
+/// Makes a lighting on `context`: its pipeline layout, light volumes, per-slot buffers and sets
+/// (light pipelines are made at the first frame that needs them). Nothing is submitted.
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, a wrong `size` or a
+/// count out of range; `BAD_SETUP` for a BRDF name histencil does not know, more engine stencil
+/// bits than the stencil has beside the BRDFs, a zero extent or a depth format without stencil;
+/// `DEVICE_LIMIT`, `VULKAN` as the device says.
+///
+/// Thread safety: not at the same time as another call on `context`.
+///
+/// # Safety
+/// `desc` is null or points at a live description whose pointers hold what it says; `lighting`
+/// is null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_create(
+    context: *mut crate::HistencilContext,
+    desc: *const HistencilLightingDesc,
+    lighting: *mut *mut HistencilLighting,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule: no other call uses `context` now.
+        let context = unsafe { handles::get(context, Kind::Context, "context") }?;
+        // SAFETY: this fn's # Safety.
+        let desc = unsafe { required(desc, "desc") }?;
+        if lighting.is_null() {
+            return Err(Failure::invalid("lighting (the out pointer) is null"));
+        }
+        let desc = lighting_desc(desc)?;
+        let classify = TileClassify::for_context(&context.ctx);
+        let made = DeferredLighting::new(context.ctx.clone(), &desc)?;
+        let handle = handles::make(
+            HistencilLighting {
+                lighting: made,
+                classify,
+            },
+            Kind::Lighting,
+        );
+        // SAFETY: checked non-null above; writable by this fn's # Safety.
+        unsafe { lighting.write(handle) };
+        Ok(())
+    })
+}
+
+/// The stencil reference and write mask the engine's G-buffer pass draws a surface of BRDF
+/// `brdf_name` with (its slot's bits; the engine's own bits are outside the mask).
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer; `BAD_SETUP` for a BRDF the
+/// lighting was not made with.
+///
+/// Thread safety: not at the same time as another call on `lighting`.
+///
+/// # Safety
+/// `brdf_name` is null or NUL-terminated; `reference` and `write_mask` are null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_stencil_reference(
+    lighting: *mut HistencilLighting,
+    brdf_name: *const c_char,
+    reference: *mut u8,
+    write_mask: *mut u8,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
+        // SAFETY: this fn's # Safety: one NUL-terminated name, or null.
+        let name = unsafe { names(&brdf_name, 1, "brdf_name") }?[0];
+        if reference.is_null() || write_mask.is_null() {
+            return Err(Failure::invalid("reference or write_mask is null"));
+        }
+        let brdf = brdf_named(name)?;
+        let (r, m) = held
+            .lighting
+            .desc()
+            .stencil_reference(brdf)
+            .ok_or_else(|| Failure {
+                result: HistencilResult::BadSetup,
+                message: format!("the lighting was not made with BRDF `{name}`"),
+            })?;
+        // SAFETY: checked non-null; writable by this fn's # Safety.
+        unsafe {
+            reference.write(r);
+            write_mask.write(m);
+        }
+        Ok(())
+    })
+}
+
+/// Plans `frame` (which lights to draw, per BRDF, on the platform asked) and records its
+/// lighting into `command_buffer`, against `targets`, whose image states it then updates to
+/// where the commands leave them. Nothing is submitted; on an error nothing is recorded.
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, a wrong `size`, an
+/// unknown technique, platform, light kind or falloff, or counts that do not match;
+/// `BAD_FRAME` for a slot past `frames_in_flight`, more lights than `max_lights`, a light or
+/// view histencil cannot light with, targets of another extent or format or without the usages
+/// the technique needs; `IN_FLIGHT` for a slot recorded and not declared finished;
+/// `UNSUPPORTED` for a hi-stencil platform on a lighting made without `hi_stencil`.
+///
+/// Cannot be checked (the engine's to keep): that `command_buffer` is recording, outside a
+/// render pass, on a graphics and compute queue family of the context's device; that the images
+/// are live, of the extent, format and usages they say, and in the states they say when the
+/// commands run; that the context outlives the command buffer's execution.
+///
+/// Thread safety: not at the same time as another call on `lighting`; other lightings may record
+/// on other threads.
+///
+/// # Safety
+/// `frame` and `targets` are null or point at live structs whose pointers hold what they say.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_record(
+    lighting: *mut HistencilLighting,
+    command_buffer: vk::CommandBuffer,
+    frame: *const HistencilFrame,
+    targets: *mut HistencilTargets,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
+        // SAFETY: this fn's # Safety.
+        let frame = unsafe { required(frame, "frame") }?;
+        // SAFETY: this fn's # Safety: null or a live, writable struct.
+        let c_targets =
+            unsafe { targets.as_mut() }.ok_or_else(|| Failure::invalid("targets is null"))?;
+        if command_buffer == vk::CommandBuffer::null() {
+            return Err(Failure::invalid("command_buffer is VK_NULL_HANDLE"));
+        }
+        check_size::<HistencilFrame>("HistencilFrame", frame.size)?;
+        let mut targets = c_targets.to_targets()?;
+        let lights = frame.lights()?;
+        let view = frame.view.to_view();
+        let slot = frame.slot;
+        let clear_hdr = frame.clear_hdr != 0;
+        let technique = match frame.technique {
+            HISTENCIL_TECHNIQUE_STENCIL => Some(TechniqueChoice::Stencil),
+            HISTENCIL_TECHNIQUE_BRANCHING => Some(TechniqueChoice::Branching),
+            HISTENCIL_TECHNIQUE_TILED | HISTENCIL_TECHNIQUE_DEPTH_ID => None,
+            t => {
+                return Err(Failure::invalid(format!(
+                    "HistencilFrame.technique is {t}, not a HISTENCIL_TECHNIQUE_* value"
+                )))
+            }
+        };
+        let depth_id = frame.technique == HISTENCIL_TECHNIQUE_DEPTH_ID;
+        let lighting = &mut held.lighting;
+        match technique {
+            Some(technique) => {
+                let backend = match frame.platform {
+                    HISTENCIL_PLATFORM_NATIVE => Backend::Native,
+                    HISTENCIL_PLATFORM_PS3 => Backend::Ps3,
+                    HISTENCIL_PLATFORM_X360 => Backend::X360 {
+                        zero_preserved: true,
+                        save_restore: false,
+                    },
+                    p => {
+                        return Err(Failure::invalid(format!(
+                            "HistencilFrame.platform is {p}, not a HISTENCIL_PLATFORM_* value"
+                        )))
+                    }
+                };
+                let bounds = frame.bounds(lighting.desc().brdfs.len())?;
+                let shapes: Vec<_> = lights.iter().map(|l| l.shape()).collect();
+                let planned_view = View::new(&view).map_err(|e| Failure {
+                    result: HistencilResult::BadFrame,
+                    message: format!("the view: {e}"),
+                })?;
+                let inputs = PlanInputs {
+                    lights: &shapes,
+                    brdf_bounds: &bounds,
+                    view: &planned_view,
+                };
+                let settings = PlanSettings {
+                    technique,
+                    caps: backend.platform().caps(),
+                    flush: FlushPolicy::Auto,
+                };
+                let layout = lighting.desc().layout;
+                let plan =
+                    plan_frame(&layout, &inputs, &settings).map_err(histencil::Error::from)?;
+                let frame = LightingFrame {
+                    slot,
+                    view: &view,
+                    lights: &lights,
+                    plan: &plan,
+                    clear_hdr,
+                    timestamps: false,
+                    brdf_source: BrdfSource::Formula,
+                    tile_stats: false,
+                    hook_sets: HookSets::default(),
+                };
+                // SAFETY: the header's contract for this call, which is `record`'s # Safety:
+                // a recording command buffer of the context's device, outside a render pass,
+                // true image states, a context outliving the execution.
+                unsafe { lighting.record(command_buffer, &frame, &mut targets) }?;
+            }
+            None => {
+                let frame = TiledFrame {
+                    slot,
+                    view: &view,
+                    lights: &lights,
+                    clear_hdr,
+                    side: TileSide::Sixteen,
+                    mixed: MixedTiles::PerBrdf,
+                    classify: held.classify,
+                    hook_sets: HookSets::default(),
+                };
+                // SAFETY: as above: `record_tiled`'s and `record_depth_id`'s # Safety are
+                // `record`'s.
+                unsafe {
+                    if depth_id {
+                        lighting.record_depth_id(command_buffer, &frame, &mut targets)
+                    } else {
+                        lighting.record_tiled(command_buffer, &frame, &mut targets)
+                    }
+                }?;
+            }
+        }
+        c_targets.left_as(&targets);
+        Ok(())
+    })
+}
+
+/// Says the GPU has finished the frame last recorded into `slot` (the engine waited for its
+/// fence), so the slot may be recorded again and the lighting resized or destroyed once every
+/// slot is finished. A slot never recorded, or declared twice, is harmless.
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle; `BAD_FRAME` for a slot past
+/// `frames_in_flight`.
+///
+/// Cannot be checked: that the GPU has finished (histencil sees no fence; the engine's word is
+/// taken, and a lie frees or rewrites what the GPU still reads).
+///
+/// Thread safety: not at the same time as another call on `lighting`.
+///
+/// # Safety
+/// Every command buffer that recorded `slot` through this lighting has finished executing, or
+/// will never be submitted.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_slot_finished(
+    lighting: *mut HistencilLighting,
+    slot: u32,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
+        // SAFETY: this fn's # Safety is `slot_finished`'s.
+        unsafe { held.lighting.slot_finished(slot) }?;
+        Ok(())
+    })
+}
+
+/// Writes 1 to `in_flight` while a slot is recorded and not declared finished, else 0.
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle or a null `in_flight`.
+///
+/// Thread safety: not at the same time as another call on `lighting`.
+///
+/// # Safety
+/// `in_flight` is null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_in_flight(
+    lighting: *mut HistencilLighting,
+    in_flight: *mut u32,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
+        if in_flight.is_null() {
+            return Err(Failure::invalid("in_flight is null"));
+        }
+        // SAFETY: checked non-null; writable by this fn's # Safety.
+        unsafe { in_flight.write(u32::from(held.lighting.in_flight())) };
+        Ok(())
+    })
+}
+
+/// Makes the lighting fit targets of `width` x `height`, all or nothing.
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle; `BAD_SETUP` for a zero extent;
+/// `DEVICE_LIMIT` past the device's image or buffer limits; `IN_FLIGHT` while a slot is not
+/// declared finished (the lighting is unchanged).
+///
+/// Thread safety: not at the same time as another call on `lighting`.
+///
+/// # Safety
+/// `lighting` is null or a handle from `histencil_lighting_create` (a freed one is refused).
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_resize(
+    lighting: *mut HistencilLighting,
+    width: u32,
+    height: u32,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
+        held.lighting.resize(vk::Extent2D { width, height })?;
+        Ok(())
+    })
+}
+
+/// Frees the lighting. Refused with `IN_FLIGHT` while a slot is not declared finished: the
+/// lighting stays whole and usable (wait for those frames, declare them, destroy again).
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle; `IN_FLIGHT` as above.
+///
+/// Thread safety: not at the same time as another call on `lighting`.
+///
+/// # Safety
+/// `lighting` is null or a handle from `histencil_lighting_create` (a freed one is refused).
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_destroy(
+    lighting: *mut HistencilLighting,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
+        if held.lighting.in_flight() {
+            // Refused here, before the handle is taken, so the lighting stays whole.
+            return Err(Failure {
+                result: HistencilResult::InFlight,
+                message: "frames in flight: destroy while a slot may still be read by the GPU: \
+                          wait for those frames, and say so with \
+                          histencil_lighting_slot_finished, first"
+                    .into(),
+            });
+        }
+        // SAFETY: as above.
+        let held = unsafe { handles::take(lighting, Kind::Lighting, "lighting") }?;
+        held.lighting
+            .destroy()
+            .map_err(|refused| Failure::from(refused.error))?;
+        Ok(())
+    })
+}

@@ -1,0 +1,76 @@
+/* Every function of histencil.h, called from C99 as an engine's C code would call it, each
+ * with what it must refuse without a device: null handles and pointers, a wrong struct size, a
+ * handle of the wrong kind. Built by tests/c_header.rs with -std=c99 -pedantic -Wall -Wextra
+ * -Werror (and the sanitizers), linked against the static library; exit 0 when every call
+ * returned its code and said why. */
+#include "histencil.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static int failures = 0;
+static int calls = 0;
+
+static void expect(HistencilResult got, HistencilResult want, const char *words, const char *what) {
+    const char *message = histencil_last_error();
+    calls += 1;
+    if (got != want || message == NULL || strstr(message, words) == NULL) {
+        fprintf(stderr, "%s: got %d (%s), want %d saying `%s`\n", what, (int)got,
+                message ? message : "(null)", (int)want, words);
+        failures += 1;
+    }
+}
+
+int main(void) {
+    HistencilDeviceDesc device;
+    HistencilLightingDesc desc;
+    HistencilFrame frame;
+    HistencilTargets targets;
+    HistencilContext *context = NULL;
+    HistencilLighting *lighting = NULL;
+    uint8_t reference = 0, write_mask = 0;
+    uint32_t in_flight = 0;
+    uint32_t version = histencil_version();
+
+    if ((version >> 22) != HISTENCIL_VERSION_MAJOR) {
+        fprintf(stderr, "library major version %u, header %d\n", version >> 22, HISTENCIL_VERSION_MAJOR);
+        return 1;
+    }
+    if (strcmp(histencil_last_error(), "") != 0) {
+        fprintf(stderr, "a last error before any call\n");
+        return 1;
+    }
+    memset(&device, 0, sizeof device);
+    memset(&desc, 0, sizeof desc);
+    memset(&frame, 0, sizeof frame);
+    memset(&targets, 0, sizeof targets);
+
+    expect(histencil_context_create(NULL, &context), HISTENCIL_RESULT_INVALID_ARGUMENT, "desc is null", "context_create(NULL)");
+    expect(histencil_context_create(&device, &context), HISTENCIL_RESULT_INVALID_ARGUMENT, "HistencilDeviceDesc.size is 0", "context_create(size 0)");
+    device.size = sizeof device;
+    expect(histencil_context_create(&device, NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "out pointer", "context_create(out NULL)");
+    expect(histencil_context_create(&device, &context), HISTENCIL_RESULT_INVALID_ARGUMENT, "instance is VK_NULL_HANDLE", "context_create(null handles)");
+    expect(histencil_context_destroy(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "context_destroy(NULL)");
+
+    desc.size = sizeof desc;
+    expect(histencil_lighting_create(NULL, &desc, &lighting), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "lighting_create(NULL)");
+    /* A pointer that is no handle of histencil's is refused, never dereferenced. */
+    context = (HistencilContext *)&device;
+    expect(histencil_lighting_create(context, &desc, &lighting), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "lighting_create(foreign)");
+    expect(histencil_context_destroy(context), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "context_destroy(foreign)");
+    lighting = (HistencilLighting *)&desc;
+    expect(histencil_lighting_stencil_reference(lighting, "lambert", &reference, &write_mask), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "stencil_reference");
+    expect(histencil_lighting_record(lighting, VK_NULL_HANDLE, &frame, &targets), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "record");
+    expect(histencil_lighting_slot_finished(lighting, 0), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "slot_finished");
+    expect(histencil_lighting_in_flight(lighting, &in_flight), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "in_flight");
+    expect(histencil_lighting_resize(lighting, 64, 64), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "resize");
+    expect(histencil_lighting_destroy(lighting), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "lighting_destroy(foreign)");
+    expect(histencil_lighting_destroy(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "lighting is null", "lighting_destroy(NULL)");
+
+    if (failures > 0) {
+        fprintf(stderr, "c99: %d of %d calls not as the header says\n", failures, calls);
+        return 1;
+    }
+    printf("c99: %d calls, every one refused as the header says\n", calls);
+    return 0;
+}

@@ -1,0 +1,659 @@
+//! The C API end to end, on lavapipe under the validation layer, called as a C engine calls it
+//! (the `extern "C"` functions, handles and sized structs): its frames are the Rust API's, bit
+//! for bit, on the talk's stencil technique (PS3-like, native) and the tiled one; and every
+//! misuse a C engine can make returns its error code and a message naming the problem, with
+//! the process going on and the layer silent.
+
+use ash::vk;
+use histencil::{Backend, Context, DeferredLighting, HookSets};
+use histencil_capi::*;
+use histencil_tests::engine::{
+    copy_to_buffer, hdr_floats, lighting_desc, plain_frame, stencil_plan, Engine, EngineTargets,
+};
+use std::ffi::{c_char, CStr, CString};
+use std::ptr::{null, null_mut};
+
+const SIZE: vk::Extent2D = vk::Extent2D {
+    width: 48,
+    height: 32,
+};
+
+fn last_error() -> String {
+    // SAFETY: never null, valid until the next call on this thread.
+    unsafe { CStr::from_ptr(histencil_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// Holds a call's result to `expected` and its message to contain `words`.
+#[track_caller]
+fn expect(result: HistencilResult, expected: HistencilResult, words: &str) {
+    let message = last_error();
+    assert_eq!(result, expected, "{message}");
+    assert!(message.contains(words), "`{message}` should say `{words}`");
+}
+
+fn device_desc(engine: &Engine) -> HistencilDeviceDesc {
+    HistencilDeviceDesc {
+        size: size_of::<HistencilDeviceDesc>() as u32,
+        queue_family: engine.queue_family,
+        get_instance_proc_addr: Some(engine.entry.static_fn().get_instance_proc_addr),
+        instance: engine.instance.handle(),
+        physical_device: engine.physical_device,
+        device: engine.device.handle(),
+        // SAFETY: the engine's live device and a queue it created.
+        queue: unsafe { engine.device.get_device_queue(engine.queue_family, 0) },
+        depth_stencil_format: vk::Format::UNDEFINED,
+        debug_utils: 1,
+        memory_budget: 0,
+    }
+}
+
+fn c_image(image: &histencil::ImageRef) -> HistencilImage {
+    HistencilImage {
+        image: image.image,
+        view: image.view,
+        format: image.format,
+        width: image.extent.width,
+        height: image.extent.height,
+        usage: image.usage,
+        layout: image.state.layout,
+        stage: image.state.stage,
+        access: image.state.access,
+    }
+}
+
+/// `targets` as the C side passes them, its G-buffer images kept in `gbuffer`.
+fn c_targets_of(
+    targets: &histencil::LightingTargets,
+    gbuffer: &mut Vec<HistencilImage>,
+) -> HistencilTargets {
+    *gbuffer = targets.gbuffer.iter().map(c_image).collect();
+    HistencilTargets {
+        size: size_of::<HistencilTargets>() as u32,
+        gbuffer_count: gbuffer.len() as u32,
+        gbuffer: gbuffer.as_mut_ptr(),
+        depth_stencil: c_image(&targets.depth_stencil),
+        hdr: c_image(&targets.hdr),
+    }
+}
+
+/// The scene, view and G-buffer every frame here lights: `brdfs-3` through histencil's
+/// renderer's G-buffer pass, on the engine's images.
+struct World {
+    scene: histencil::scene::Scene,
+    view: histencil::ViewDesc,
+    names: Vec<CString>,
+}
+
+impl World {
+    fn c_view(&self) -> HistencilView {
+        let flat = |m: [[f32; 4]; 4]| {
+            let mut out = [0.0; 16];
+            for (c, column) in m.iter().enumerate() {
+                out[c * 4..c * 4 + 4].copy_from_slice(column);
+            }
+            out
+        };
+        HistencilView {
+            world_to_view: flat(self.view.world_to_view),
+            view_to_clip: flat(self.view.view_to_clip),
+            reversed_depth: u32::from(self.view.depth == histencil::DepthConvention::Reversed),
+        }
+    }
+
+    fn c_lights(&self) -> Vec<HistencilLight> {
+        use histencil::{Falloff, LightKind};
+        (self.scene.lights.iter())
+            .map(|l| {
+                let (kind, direction, inner, outer) = match l.kind {
+                    LightKind::Point => (HISTENCIL_LIGHT_POINT, [0.0; 3], 0.0, 0.0),
+                    LightKind::Spot {
+                        direction,
+                        inner_angle,
+                        outer_angle,
+                    } => (
+                        HISTENCIL_LIGHT_SPOT,
+                        direction.into(),
+                        inner_angle,
+                        outer_angle,
+                    ),
+                    LightKind::Directional { direction } => {
+                        (HISTENCIL_LIGHT_DIRECTIONAL, direction.into(), 0.0, 0.0)
+                    }
+                };
+                HistencilLight {
+                    kind,
+                    falloff: match l.falloff {
+                        Falloff::SquaredWindow => HISTENCIL_FALLOFF_SQUARED_WINDOW,
+                        Falloff::Gltf => HISTENCIL_FALLOFF_GLTF,
+                        Falloff::InverseSquare => HISTENCIL_FALLOFF_INVERSE_SQUARE,
+                    },
+                    position: l.position.into(),
+                    radius: l.radius,
+                    color: l.color.into(),
+                    inner_angle: inner,
+                    direction,
+                    outer_angle: outer,
+                }
+            })
+            .collect()
+    }
+}
+
+/// Runs `body` with the engine, a Rust context on its device (for histencil's renderer, which
+/// writes the G-buffer, and the Rust lighting compared against), a C context on the same
+/// device, the engine's targets and the world; then frees all and holds the layer silent.
+fn with_c_context(
+    body: impl FnOnce(&Engine, &histencil::vk::Renderer, *mut HistencilContext, &EngineTargets, &World),
+) {
+    let mut scene = histencil::scene::embedded("brdfs-3").unwrap();
+    scene.normalise_lights();
+    let engine = Engine::start();
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.unwrap();
+        let renderer =
+            histencil::vk::Renderer::new(&ctx, scene.clone(), SIZE.width, SIZE.height).unwrap();
+        let names = (renderer.brdfs().iter())
+            .map(|b| CString::new(b.name()).unwrap())
+            .collect();
+        let world = World {
+            view: scene.camera.view_desc(1.5),
+            scene,
+            names,
+        };
+        let images = engine.lighting_targets(SIZE, ctx.depth_stencil_format().vk());
+        let mut c_ctx = null_mut();
+        // SAFETY: a live desc of the engine's live handles; a writable out pointer.
+        let made = unsafe { histencil_context_create(&device_desc(&engine), &mut c_ctx) };
+        assert_eq!(made, HistencilResult::Success, "{}", last_error());
+        body(&engine, &renderer, c_ctx, &images, &world);
+        // SAFETY: a live context with no lighting left.
+        let freed = unsafe { histencil_context_destroy(c_ctx) };
+        assert_eq!(freed, HistencilResult::Success, "{}", last_error());
+        images.free(&engine);
+        drop(renderer);
+    }
+    engine.destroy().assert_clean();
+}
+
+fn c_lighting_desc(world: &World, names: &[*const c_char]) -> HistencilLightingDesc {
+    HistencilLightingDesc {
+        size: size_of::<HistencilLightingDesc>() as u32,
+        brdf_count: names.len() as u32,
+        brdf_names: names.as_ptr(),
+        engine_stencil_bits: 0,
+        width: SIZE.width,
+        height: SIZE.height,
+        depth_stencil_format: vk::Format::D32_SFLOAT_S8_UINT,
+        hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+        frames_in_flight: 1,
+        max_lights: world.scene.lights.len() as u32,
+        hi_stencil: 1,
+    }
+}
+
+#[test]
+fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
+    with_c_context(|engine, renderer, c_ctx, images, world| {
+        let d = &engine.device;
+        let ds = images.refs().depth_stencil.format;
+        let names: Vec<*const c_char> = world.names.iter().map(|n| n.as_ptr()).collect();
+        let desc = HistencilLightingDesc {
+            depth_stencil_format: ds,
+            ..c_lighting_desc(world, &names)
+        };
+        let mut c_lighting = null_mut();
+        // SAFETY: a live context, a live desc whose names outlive the call.
+        let made = unsafe { histencil_lighting_create(c_ctx, &desc, &mut c_lighting) };
+        assert_eq!(made, HistencilResult::Success, "{}", last_error());
+        // The Rust lighting, on the renderer's own context, made alike.
+        let layout = *renderer.stencil_layout();
+        let brdfs = renderer.brdfs().to_vec();
+        let rust_desc = lighting_desc(layout, brdfs.clone(), SIZE, ds, world.scene.lights.len());
+        let mut rust = DeferredLighting::new(renderer.context(), &rust_desc).unwrap();
+        let readback = engine.readback_buffer(u64::from(SIZE.width * SIZE.height) * 8);
+        let lights = world.c_lights();
+        let bounds_lists = world.scene.brdf_bounds(&brdfs);
+        let boxes: Vec<Vec<[f32; 6]>> = (bounds_lists.iter())
+            .map(|b| {
+                b.iter()
+                    .map(|a| [a.min[0], a.min[1], a.min[2], a.max[0], a.max[1], a.max[2]])
+                    .collect()
+            })
+            .collect();
+        let bounds: Vec<HistencilBrdfBounds> = (boxes.iter())
+            .map(|b| HistencilBrdfBounds {
+                boxes: b.as_ptr(),
+                box_count: b.len() as u32,
+            })
+            .collect();
+        let cases = [
+            (
+                HISTENCIL_TECHNIQUE_STENCIL,
+                HISTENCIL_PLATFORM_PS3,
+                Some(Backend::Ps3),
+            ),
+            (
+                HISTENCIL_TECHNIQUE_STENCIL,
+                HISTENCIL_PLATFORM_NATIVE,
+                Some(Backend::Native),
+            ),
+            (HISTENCIL_TECHNIQUE_TILED, HISTENCIL_PLATFORM_NATIVE, None),
+        ];
+        for (technique, platform, backend) in cases {
+            // One frame through `record`, read back.
+            let lit =
+                |record: &mut dyn FnMut(vk::CommandBuffer, &mut histencil::LightingTargets)| {
+                    let mut targets = images.refs();
+                    let (pool, cmd) = engine.command_buffer();
+                    // SAFETY: the engine's command buffer, recorded here and waited for.
+                    unsafe {
+                        d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                            .unwrap();
+                        renderer.record_gbuffer(cmd, &mut targets).unwrap();
+                        record(cmd, &mut targets);
+                        copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
+                        engine.submit_and_wait(pool, cmd);
+                    }
+                    hdr_floats(readback.bytes())
+                };
+            let through_c = lit(&mut |cmd, targets| {
+                let mut gbuffer = Vec::new();
+                let mut c_targets = c_targets_of(targets, &mut gbuffer);
+                let frame = HistencilFrame {
+                    size: size_of::<HistencilFrame>() as u32,
+                    slot: 0,
+                    technique,
+                    platform,
+                    view: world.c_view(),
+                    light_count: lights.len() as u32,
+                    lights: lights.as_ptr(),
+                    brdf_bounds_count: bounds.len() as u32,
+                    brdf_bounds: bounds.as_ptr(),
+                    clear_hdr: 1,
+                };
+                // SAFETY: a recording command buffer of the lent device; live structs.
+                let r =
+                    unsafe { histencil_lighting_record(c_lighting, cmd, &frame, &mut c_targets) };
+                assert_eq!(r, HistencilResult::Success, "{}", last_error());
+                // The states the C side was handed back are where the commands left the HDR.
+                targets.hdr.state.layout = c_targets.hdr.layout;
+                targets.hdr.state.stage = c_targets.hdr.stage;
+                targets.hdr.state.access = c_targets.hdr.access;
+            });
+            // SAFETY: the frame was waited for.
+            let r = unsafe { histencil_lighting_slot_finished(c_lighting, 0) };
+            assert_eq!(r, HistencilResult::Success, "{}", last_error());
+            let through_rust = lit(&mut |cmd, targets| {
+                let tiled = histencil::TiledFrame {
+                    slot: 0,
+                    view: &world.view,
+                    lights: &world.scene.lights,
+                    clear_hdr: true,
+                    side: histencil::TileSide::Sixteen,
+                    mixed: histencil::MixedTiles::PerBrdf,
+                    classify: histencil::TileClassify::for_context(renderer.context()),
+                    hook_sets: HookSets::default(),
+                };
+                // SAFETY: as above.
+                unsafe {
+                    match backend {
+                        Some(backend) => {
+                            let plan =
+                                stencil_plan(&world.scene, &layout, &brdfs, &world.view, backend);
+                            let frame = plain_frame(
+                                &world.view,
+                                &world.scene.lights,
+                                &plan,
+                                HookSets::default(),
+                            );
+                            rust.record(cmd, &frame, targets).unwrap();
+                        }
+                        None => rust.record_tiled(cmd, &tiled, targets).unwrap(),
+                    }
+                }
+            });
+            // SAFETY: the frame was waited for.
+            unsafe { rust.slot_finished(0) }.unwrap();
+            let lit_pixels = through_rust
+                .chunks(4)
+                .filter(|p| p[..3].iter().any(|v| *v > 0.0))
+                .count();
+            assert!(
+                lit_pixels > through_rust.len() / 16,
+                "the frame is lit ({lit_pixels} pixels)"
+            );
+            assert!(
+                through_c
+                    .iter()
+                    .zip(&through_rust)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "technique {technique}, platform {platform}: the C API's frame differs from Rust's"
+            );
+        }
+        rust.destroy().unwrap();
+        // SAFETY: every frame was waited for and declared finished.
+        let r = unsafe { histencil_lighting_destroy(c_lighting) };
+        assert_eq!(r, HistencilResult::Success, "{}", last_error());
+        engine.free_buffer(readback);
+    });
+}
+
+#[test]
+fn misuse_through_c_returns_its_error_and_names_the_problem() {
+    use HistencilResult as R;
+    with_c_context(|engine, renderer, c_ctx, images, world| {
+        let names: Vec<*const c_char> = world.names.iter().map(|n| n.as_ptr()).collect();
+        let ds = images.refs().depth_stencil.format;
+        let good = HistencilLightingDesc {
+            depth_stencil_format: ds,
+            ..c_lighting_desc(world, &names)
+        };
+        let mut out = null_mut();
+        // SAFETY: every call below passes null, a live struct or a live or freed handle, which
+        // the C API refuses or uses; nothing is left dangling.
+        unsafe {
+            // Null pointers and handles.
+            expect(
+                histencil_context_create(null(), &mut null_mut()),
+                R::InvalidArgument,
+                "desc is null",
+            );
+            expect(
+                histencil_lighting_create(null_mut(), &good, &mut out),
+                R::InvalidArgument,
+                "context is null",
+            );
+            expect(
+                histencil_lighting_create(c_ctx, null(), &mut out),
+                R::InvalidArgument,
+                "desc is null",
+            );
+            expect(
+                histencil_lighting_create(c_ctx, &good, null_mut()),
+                R::InvalidArgument,
+                "out pointer",
+            );
+            let mut desc = device_desc(engine);
+            desc.device = vk::Device::null();
+            expect(
+                histencil_context_create(&desc, &mut null_mut()),
+                R::InvalidArgument,
+                "device is VK_NULL_HANDLE",
+            );
+            desc = device_desc(engine);
+            desc.get_instance_proc_addr = None;
+            expect(
+                histencil_context_create(&desc, &mut null_mut()),
+                R::InvalidArgument,
+                "get_instance_proc_addr is null",
+            );
+            // A wrong struct size, counts out of range, a null array with a count, a BRDF
+            // histencil lacks.
+            let unknown = CString::new("velvet").unwrap();
+            let mut wrong = names.clone();
+            wrong[0] = unknown.as_ptr();
+            let bad_descs = [
+                (
+                    HistencilLightingDesc { size: 12, ..good },
+                    R::InvalidArgument,
+                    "HistencilLightingDesc.size is 12",
+                ),
+                (
+                    HistencilLightingDesc {
+                        brdf_count: 0,
+                        ..good
+                    },
+                    R::InvalidArgument,
+                    "brdf_count is 0",
+                ),
+                (
+                    HistencilLightingDesc {
+                        brdf_names: null(),
+                        ..good
+                    },
+                    R::InvalidArgument,
+                    "brdf_names is null",
+                ),
+                (
+                    HistencilLightingDesc {
+                        brdf_names: wrong.as_ptr(),
+                        ..good
+                    },
+                    R::BadSetup,
+                    "no BRDF named `velvet`",
+                ),
+                (
+                    HistencilLightingDesc {
+                        frames_in_flight: 99,
+                        ..good
+                    },
+                    R::InvalidArgument,
+                    "frames_in_flight is 99",
+                ),
+                (
+                    HistencilLightingDesc {
+                        engine_stencil_bits: 7,
+                        ..good
+                    },
+                    R::BadSetup,
+                    "bits",
+                ),
+            ];
+            for (desc, code, words) in bad_descs {
+                expect(
+                    histencil_lighting_create(c_ctx, &desc, &mut out),
+                    code,
+                    words,
+                );
+            }
+            // A lighting, then a frame with each thing wrong.
+            let mut lighting = null_mut();
+            assert_eq!(
+                histencil_lighting_create(c_ctx, &good, &mut lighting),
+                R::Success,
+                "{}",
+                last_error()
+            );
+            let (mut r, mut m) = (0u8, 0u8);
+            expect(
+                histencil_lighting_stencil_reference(lighting, unknown.as_ptr(), &mut r, &mut m),
+                R::BadSetup,
+                "velvet",
+            );
+            let mut targets = images.refs();
+            let mut gbuffer = Vec::new();
+            let mut c_targets = c_targets_of(&targets, &mut gbuffer);
+            let lights = world.c_lights();
+            let empty: Vec<HistencilBrdfBounds> = names
+                .iter()
+                .map(|_| HistencilBrdfBounds {
+                    boxes: null(),
+                    box_count: 0,
+                })
+                .collect();
+            let frame = HistencilFrame {
+                size: size_of::<HistencilFrame>() as u32,
+                slot: 0,
+                technique: HISTENCIL_TECHNIQUE_STENCIL,
+                platform: HISTENCIL_PLATFORM_PS3,
+                view: world.c_view(),
+                light_count: lights.len() as u32,
+                lights: lights.as_ptr(),
+                brdf_bounds_count: empty.len() as u32,
+                brdf_bounds: empty.as_ptr(),
+                clear_hdr: 1,
+            };
+            let (pool, cmd) = engine.command_buffer();
+            let d = &engine.device;
+            d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+                .unwrap();
+            let bad_frames: [(HistencilFrame, R, &str); 7] = [
+                (
+                    HistencilFrame { size: 4, ..frame },
+                    R::InvalidArgument,
+                    "HistencilFrame.size is 4",
+                ),
+                (
+                    HistencilFrame {
+                        technique: 77,
+                        ..frame
+                    },
+                    R::InvalidArgument,
+                    "technique is 77",
+                ),
+                (
+                    HistencilFrame {
+                        platform: 9,
+                        ..frame
+                    },
+                    R::InvalidArgument,
+                    "platform is 9",
+                ),
+                (
+                    HistencilFrame { slot: 3, ..frame },
+                    R::BadFrame,
+                    "slot 3 of 1 frames in flight",
+                ),
+                (
+                    HistencilFrame {
+                        lights: null(),
+                        ..frame
+                    },
+                    R::InvalidArgument,
+                    "lights is null",
+                ),
+                (
+                    HistencilFrame {
+                        brdf_bounds_count: 1,
+                        ..frame
+                    },
+                    R::InvalidArgument,
+                    "brdf_bounds_count is 1",
+                ),
+                (
+                    HistencilFrame {
+                        light_count: u32::MAX,
+                        ..frame
+                    },
+                    R::InvalidArgument,
+                    "light_count is 4294967295",
+                ),
+            ];
+            for (bad, code, words) in bad_frames {
+                expect(
+                    histencil_lighting_record(lighting, cmd, &bad, &mut c_targets),
+                    code,
+                    words,
+                );
+            }
+            let mut spot = lights.clone();
+            spot[0].kind = 5;
+            let bad_light = HistencilFrame {
+                lights: spot.as_ptr(),
+                ..frame
+            };
+            expect(
+                histencil_lighting_record(lighting, cmd, &bad_light, &mut c_targets),
+                R::InvalidArgument,
+                "lights[0].kind is 5",
+            );
+            expect(
+                histencil_lighting_record(
+                    lighting,
+                    vk::CommandBuffer::null(),
+                    &frame,
+                    &mut c_targets,
+                ),
+                R::InvalidArgument,
+                "command_buffer",
+            );
+            expect(
+                histencil_lighting_record(lighting, cmd, &frame, null_mut()),
+                R::InvalidArgument,
+                "targets is null",
+            );
+            // A frame recorded: the slot is in flight until declared finished.
+            renderer.record_gbuffer(cmd, &mut targets).unwrap();
+            c_targets = c_targets_of(&targets, &mut gbuffer);
+            assert_eq!(
+                histencil_lighting_record(lighting, cmd, &frame, &mut c_targets),
+                R::Success,
+                "{}",
+                last_error()
+            );
+            let mut in_flight = 0;
+            assert_eq!(
+                histencil_lighting_in_flight(lighting, &mut in_flight),
+                R::Success
+            );
+            assert_eq!(in_flight, 1);
+            expect(
+                histencil_lighting_record(lighting, cmd, &frame, &mut c_targets),
+                R::InFlight,
+                "slot_finished(0)",
+            );
+            expect(
+                histencil_lighting_resize(lighting, 64, 64),
+                R::InFlight,
+                "resize while slot 0",
+            );
+            expect(
+                histencil_lighting_destroy(lighting),
+                R::InFlight,
+                "histencil_lighting_slot_finished",
+            );
+            expect(
+                histencil_context_destroy(c_ctx),
+                R::InFlight,
+                "1 lighting(s)",
+            );
+            engine.submit_and_wait(pool, cmd);
+            assert_eq!(histencil_lighting_slot_finished(lighting, 0), R::Success);
+            expect(
+                histencil_lighting_slot_finished(lighting, 1),
+                R::BadFrame,
+                "slot_finished(1) of 1",
+            );
+            expect(
+                histencil_lighting_resize(lighting, 1 << 20, 8),
+                R::DeviceLimit,
+                "maxImageDimension2D",
+            );
+            expect(
+                histencil_lighting_resize(lighting, 0, 8),
+                R::BadSetup,
+                "0x8",
+            );
+            assert_eq!(
+                histencil_lighting_destroy(lighting),
+                R::Success,
+                "{}",
+                last_error()
+            );
+            // The freed handle, and a handle of the wrong kind, are refused, not used.
+            expect(
+                histencil_lighting_destroy(lighting),
+                R::InvalidArgument,
+                "not a live Lighting handle",
+            );
+            expect(
+                histencil_lighting_resize(c_ctx.cast(), 8, 8),
+                R::InvalidArgument,
+                "not a live Lighting handle",
+            );
+            expect(
+                histencil_lighting_in_flight(lighting, &mut in_flight),
+                R::InvalidArgument,
+                "not a live",
+            );
+        }
+        // The message of a success-only call leaves the last error as it was; a fresh thread
+        // has none.
+        let fresh = std::thread::spawn(last_error).join().unwrap();
+        assert_eq!(fresh, "");
+        assert!(histencil_version() >> 22 == HISTENCIL_VERSION_MAJOR);
+    });
+}
