@@ -68,6 +68,20 @@
 // draw), emulated; needs a lighting made with `hi_stencil`.
 #define HISTENCIL_PLATFORM_X360 2
 
+// The Vulkan version an engine's instance must be created for: `VK_API_VERSION_1_3`, spelt
+// out for the header (`api_version_is_vulkans` holds the two equal).
+#define HISTENCIL_API_VERSION ((1 << 22) | (3 << 12))
+
+// How many images histencil's G-buffer has (`histencil_gbuffer_formats`).
+#define HISTENCIL_GBUFFER_IMAGES 3
+
+// The bytes of histencil's frame block (`frame.glsl`'s `Frame`, set 0 binding 0, std140).
+#define HISTENCIL_FRAME_UNIFORMS_BYTES 336
+
+// The bytes of one light in histencil's light buffer (`frame.glsl`'s `Light`, set 0 binding 1,
+// std430).
+#define HISTENCIL_GPU_LIGHT_BYTES 64
+
 // What every call returns. On anything but `HISTENCIL_RESULT_SUCCESS`,
 // `histencil_last_error()` says what, on the calling thread.
 typedef enum HistencilResult {
@@ -131,31 +145,13 @@ typedef struct HistencilDeviceDesc {
   uint64_t memory_budget;
 } HistencilDeviceDesc;
 
-// What `histencil_lighting_create` makes a lighting for.
-typedef struct HistencilLightingDesc {
-  // `sizeof(HistencilLightingDesc)`.
-  uint32_t size;
-  // How many BRDFs: each takes one stencil slot, in this order.
-  uint32_t brdf_count;
-  // The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...).
-  const char *const *brdf_names;
-  // Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
-  uint32_t engine_stencil_bits;
-  // The targets' width.
-  uint32_t width;
-  // The targets' height.
-  uint32_t height;
-  // The depth-stencil image's format (with stencil).
-  VkFormat depth_stencil_format;
-  // The HDR image's format (`VK_FORMAT_R16G16B16A16_SFLOAT` for every technique).
-  VkFormat hdr_format;
-  // How many frames the engine has in flight: slots 0 to `frames_in_flight - 1`.
-  uint32_t frames_in_flight;
-  // The most lights a frame passes.
-  uint32_t max_lights;
-  // Non-zero to emulate the consoles' hi-stencil (the PS3-like and 360-like platforms).
-  uint32_t hi_stencil;
-} HistencilLightingDesc;
+// One named parameter of a BRDF (`ggx`'s `perceptual_roughness`, ...).
+typedef struct HistencilBrdfParam {
+  // The parameter's name, NUL-terminated.
+  const char *name;
+  // Its value.
+  double value;
+} HistencilBrdfParam;
 
 // The camera: column-major matrices, as GLSL and most C math libraries store them.
 typedef struct HistencilView {
@@ -186,6 +182,32 @@ typedef struct HistencilLight {
   // Spot lights: the angle from the axis where the light ends, in radians.
   float outer_angle;
 } HistencilLight;
+
+// What `histencil_lighting_create` makes a lighting for.
+typedef struct HistencilLightingDesc {
+  // `sizeof(HistencilLightingDesc)`.
+  uint32_t size;
+  // How many BRDFs: each takes one stencil slot, in this order.
+  uint32_t brdf_count;
+  // The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...).
+  const char *const *brdf_names;
+  // Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
+  uint32_t engine_stencil_bits;
+  // The targets' width.
+  uint32_t width;
+  // The targets' height.
+  uint32_t height;
+  // The depth-stencil image's format (with stencil).
+  VkFormat depth_stencil_format;
+  // The HDR image's format (`VK_FORMAT_R16G16B16A16_SFLOAT` for every technique).
+  VkFormat hdr_format;
+  // How many frames the engine has in flight: slots 0 to `frames_in_flight - 1`.
+  uint32_t frames_in_flight;
+  // The most lights a frame passes.
+  uint32_t max_lights;
+  // Non-zero to emulate the consoles' hi-stencil (the PS3-like and 360-like platforms).
+  uint32_t hi_stencil;
+} HistencilLightingDesc;
 
 // The world boxes of what one BRDF draws: the lights that reach none of them are not drawn
 // for that BRDF.
@@ -303,6 +325,75 @@ enum HistencilResult histencil_context_create(const struct HistencilDeviceDesc *
 // # Safety
 // `context` is null, or a handle from `histencil_context_create` (a freed one is refused).
 enum HistencilResult histencil_context_destroy(struct HistencilContext *context);
+
+// Writes histencil's G-buffer formats, in binding order (albedo, normal-depth, material:
+// `share/histencil/shaders/include/gbuffer_write.glsl` says what each channel holds), into
+// `formats`, which holds `HISTENCIL_GBUFFER_IMAGES`.
+//
+// Errors: `INVALID_ARGUMENT` for a null `formats`.
+//
+// Thread safety: any thread.
+//
+// # Safety
+// `formats` is null or points at `HISTENCIL_GBUFFER_IMAGES` writable formats.
+enum HistencilResult histencil_gbuffer_formats(VkFormat *formats);
+
+// The G-buffer's values for a surface of BRDF `name` with `params` (each parameter the BRDF
+// takes, by name): its packed parameters (`gbuffer_encode`'s `brdf_params`, the first three)
+// and its model id (`brdf_model`). Every parameter is held to its range, as the Rust API holds
+// it.
+//
+// Errors: `INVALID_ARGUMENT` for a null pointer or a name that is not UTF-8; `BAD_SETUP` for a
+// BRDF histencil does not know, a parameter it does not take, one left out, or one out of its
+// range (the message names it).
+//
+// Thread safety: any thread.
+//
+// # Safety
+// `name` is null or NUL-terminated; `params` is null or points at `param_count` parameters
+// whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `model_index` is
+// null or writable.
+enum HistencilResult histencil_brdf_encode(const char *name,
+                                           const struct HistencilBrdfParam *params,
+                                           uint32_t param_count,
+                                           float *packed,
+                                           uint32_t *model_index);
+
+// Adds the features histencil needs to an engine's own, before it creates its device: sets
+// them in `features` (chained as `VkDeviceCreateInfo::pEnabledFeatures` or in
+// `VkPhysicalDeviceFeatures2`) and `features13` (chained into `pNext`), leaving every other
+// member, `sType` and `pNext` as they are.
+//
+// Errors: `INVALID_ARGUMENT` for a null pointer.
+//
+// Thread safety: any thread.
+//
+// # Safety
+// Each pointer is null or points at a live, writable struct.
+enum HistencilResult histencil_device_features(VkPhysicalDeviceFeatures *features,
+                                               VkPhysicalDeviceVulkan13Features *features13);
+
+// Writes histencil's frame block for `view` at `width` x `height` with `light_count` lights,
+// `HISTENCIL_FRAME_UNIFORMS_BYTES` bytes, and each of `lights` as histencil's light buffer
+// holds it, `HISTENCIL_GPU_LIGHT_BYTES` bytes each: what an engine's own shaders that include
+// histencil's `light.glsl` (a forward reference shading as histencil shades, say) read in set 0.
+//
+// Errors: `INVALID_ARGUMENT` for a null pointer, an unknown light kind or falloff;
+// `BAD_FRAME` for a view whose projection cannot be inverted per pixel.
+//
+// Thread safety: any thread.
+//
+// # Safety
+// `view` is null or live; `lights` is null or points at `light_count` lights; `frame_block` is
+// null or holds `HISTENCIL_FRAME_UNIFORMS_BYTES` writable bytes, `gpu_lights` null or
+// `light_count * HISTENCIL_GPU_LIGHT_BYTES`.
+enum HistencilResult histencil_shading_inputs(const struct HistencilView *view,
+                                              uint32_t width,
+                                              uint32_t height,
+                                              const struct HistencilLight *lights,
+                                              uint32_t light_count,
+                                              uint8_t *frame_block,
+                                              uint8_t *gpu_lights);
 
 // Makes a lighting on `context`: its pipeline layout, light volumes, per-slot buffers and sets
 // (light pipelines are made at the first frame that needs them). Nothing is submitted.

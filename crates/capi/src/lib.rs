@@ -17,6 +17,7 @@
 
 mod device;
 mod frame;
+mod gbuffer;
 mod handles;
 mod lighting;
 
@@ -30,6 +31,11 @@ pub use frame::{
     HISTENCIL_LIGHT_SPOT, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
     HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
     HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
+};
+pub use gbuffer::{
+    histencil_brdf_encode, histencil_device_features, histencil_gbuffer_formats,
+    histencil_shading_inputs, HistencilBrdfParam, HISTENCIL_API_VERSION,
+    HISTENCIL_FRAME_UNIFORMS_BYTES, HISTENCIL_GBUFFER_IMAGES, HISTENCIL_GPU_LIGHT_BYTES,
 };
 pub use lighting::{
     histencil_lighting_create, histencil_lighting_destroy, histencil_lighting_in_flight,

@@ -1,0 +1,230 @@
+//! What a C engine needs to write histencil's G-buffer and make its device: the images' formats,
+//! each BRDF's values as the G-buffer stores them, and the device features histencil needs.
+
+use crate::{call, slice, Failure, HistencilResult};
+use ash::vk;
+use histencil::brdf::Brdf;
+use std::ffi::{c_char, CStr};
+
+/// The Vulkan version an engine's instance must be created for: `VK_API_VERSION_1_3`, spelt
+/// out for the header (`api_version_is_vulkans` holds the two equal).
+pub const HISTENCIL_API_VERSION: u32 = (1 << 22) | (3 << 12);
+/// How many images histencil's G-buffer has (`histencil_gbuffer_formats`).
+pub const HISTENCIL_GBUFFER_IMAGES: u32 = 3;
+
+/// One named parameter of a BRDF (`ggx`'s `perceptual_roughness`, ...).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct HistencilBrdfParam {
+    /// The parameter's name, NUL-terminated.
+    pub name: *const c_char,
+    /// Its value.
+    pub value: f64,
+}
+
+/// Writes histencil's G-buffer formats, in binding order (albedo, normal-depth, material:
+/// `share/histencil/shaders/include/gbuffer_write.glsl` says what each channel holds), into
+/// `formats`, which holds `HISTENCIL_GBUFFER_IMAGES`.
+///
+/// Errors: `INVALID_ARGUMENT` for a null `formats`.
+///
+/// Thread safety: any thread.
+///
+/// # Safety
+/// `formats` is null or points at `HISTENCIL_GBUFFER_IMAGES` writable formats.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_gbuffer_formats(formats: *mut vk::Format) -> HistencilResult {
+    call(|| {
+        if formats.is_null() {
+            return Err(Failure::invalid("formats is null"));
+        }
+        for (i, f) in histencil::GBUFFER_FORMATS.iter().enumerate() {
+            // SAFETY: this fn's # Safety: room for every G-buffer format.
+            unsafe { formats.add(i).write(*f) };
+        }
+        Ok(())
+    })
+}
+
+/// The G-buffer's values for a surface of BRDF `name` with `params` (each parameter the BRDF
+/// takes, by name): its packed parameters (`gbuffer_encode`'s `brdf_params`, the first three)
+/// and its model id (`brdf_model`). Every parameter is held to its range, as the Rust API holds
+/// it.
+///
+/// Errors: `INVALID_ARGUMENT` for a null pointer or a name that is not UTF-8; `BAD_SETUP` for a
+/// BRDF histencil does not know, a parameter it does not take, one left out, or one out of its
+/// range (the message names it).
+///
+/// Thread safety: any thread.
+///
+/// # Safety
+/// `name` is null or NUL-terminated; `params` is null or points at `param_count` parameters
+/// whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `model_index` is
+/// null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_brdf_encode(
+    name: *const c_char,
+    params: *const HistencilBrdfParam,
+    param_count: u32,
+    packed: *mut f32,
+    model_index: *mut u32,
+) -> HistencilResult {
+    call(|| {
+        if name.is_null() || packed.is_null() || model_index.is_null() {
+            return Err(Failure::invalid("name, packed or model_index is null"));
+        }
+        let utf8 = |p: *const c_char, what: &str| {
+            // SAFETY: this fn's # Safety: a non-null name is NUL-terminated.
+            unsafe { CStr::from_ptr(p) }
+                .to_str()
+                .map_err(|_| Failure::invalid(format!("{what} is not UTF-8")))
+        };
+        let name = utf8(name, "name")?;
+        // SAFETY: this fn's # Safety: `param_count` parameters at `params`.
+        let params = unsafe { slice(params, param_count, "params") }?;
+        let mut map = serde_json::Map::new();
+        for (i, p) in params.iter().enumerate() {
+            if p.name.is_null() {
+                return Err(Failure::invalid(format!("params[{i}].name is null")));
+            }
+            let number = serde_json::Number::from_f64(p.value).ok_or_else(|| Failure {
+                result: HistencilResult::BadSetup,
+                message: format!("params[{i}] is {}, not a finite number", p.value),
+            })?;
+            map.insert(
+                utf8(p.name, "a parameter's name")?.to_owned(),
+                number.into(),
+            );
+        }
+        let brdf = Brdf::parse(name, &map).map_err(|e| Failure {
+            result: HistencilResult::BadSetup,
+            message: format!("BRDF `{name}`: {e}"),
+        })?;
+        let values = brdf.packed_params();
+        for (i, v) in values.iter().enumerate() {
+            // SAFETY: this fn's # Safety: 4 writable floats.
+            unsafe { packed.add(i).write(*v as f32) };
+        }
+        // SAFETY: checked non-null; writable by this fn's # Safety.
+        unsafe { model_index.write(brdf.model_index()) };
+        Ok(())
+    })
+}
+
+/// Adds the features histencil needs to an engine's own, before it creates its device: sets
+/// them in `features` (chained as `VkDeviceCreateInfo::pEnabledFeatures` or in
+/// `VkPhysicalDeviceFeatures2`) and `features13` (chained into `pNext`), leaving every other
+/// member, `sType` and `pNext` as they are.
+///
+/// Errors: `INVALID_ARGUMENT` for a null pointer.
+///
+/// Thread safety: any thread.
+///
+/// # Safety
+/// Each pointer is null or points at a live, writable struct.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_device_features(
+    features: *mut vk::PhysicalDeviceFeatures,
+    features13: *mut vk::PhysicalDeviceVulkan13Features,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: this fn's # Safety: null or live and writable.
+        let (Some(features), Some(features13)) =
+            (unsafe { features.as_mut() }, unsafe { features13.as_mut() })
+        else {
+            return Err(Failure::invalid("features or features13 is null"));
+        };
+        let needed = histencil::REQUIREMENTS.features();
+        features.depth_clamp |= needed.depth_clamp;
+        features.fragment_stores_and_atomics |= needed.fragment_stores_and_atomics;
+        let needed13 = histencil::REQUIREMENTS.features13();
+        features13.dynamic_rendering |= needed13.dynamic_rendering;
+        features13.synchronization2 |= needed13.synchronization2;
+        Ok(())
+    })
+}
+
+/// The bytes of histencil's frame block (`frame.glsl`'s `Frame`, set 0 binding 0, std140).
+pub const HISTENCIL_FRAME_UNIFORMS_BYTES: u32 = 336;
+/// The bytes of one light in histencil's light buffer (`frame.glsl`'s `Light`, set 0 binding 1,
+/// std430).
+pub const HISTENCIL_GPU_LIGHT_BYTES: u32 = 64;
+
+/// Writes histencil's frame block for `view` at `width` x `height` with `light_count` lights,
+/// `HISTENCIL_FRAME_UNIFORMS_BYTES` bytes, and each of `lights` as histencil's light buffer
+/// holds it, `HISTENCIL_GPU_LIGHT_BYTES` bytes each: what an engine's own shaders that include
+/// histencil's `light.glsl` (a forward reference shading as histencil shades, say) read in set 0.
+///
+/// Errors: `INVALID_ARGUMENT` for a null pointer, an unknown light kind or falloff;
+/// `BAD_FRAME` for a view whose projection cannot be inverted per pixel.
+///
+/// Thread safety: any thread.
+///
+/// # Safety
+/// `view` is null or live; `lights` is null or points at `light_count` lights; `frame_block` is
+/// null or holds `HISTENCIL_FRAME_UNIFORMS_BYTES` writable bytes, `gpu_lights` null or
+/// `light_count * HISTENCIL_GPU_LIGHT_BYTES`.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_shading_inputs(
+    view: *const crate::HistencilView,
+    width: u32,
+    height: u32,
+    lights: *const crate::HistencilLight,
+    light_count: u32,
+    frame_block: *mut u8,
+    gpu_lights: *mut u8,
+) -> HistencilResult {
+    use histencil::vk::gpu_types::{FrameUniforms, GpuLight};
+    call(|| {
+        // SAFETY: this fn's # Safety.
+        let view = unsafe { crate::required(view, "view") }?.to_view();
+        // SAFETY: this fn's # Safety.
+        let lights = unsafe { slice(lights, light_count, "lights") }?;
+        if frame_block.is_null() || (light_count > 0 && gpu_lights.is_null()) {
+            return Err(Failure::invalid("frame_block or gpu_lights is null"));
+        }
+        let uniforms =
+            FrameUniforms::from_view(&view, width, height, light_count).map_err(|e| Failure {
+                result: HistencilResult::BadFrame,
+                message: format!("the view: {e}"),
+            })?;
+        let gpu: Vec<GpuLight> = (lights.iter().enumerate())
+            .map(|(i, l)| l.to_light(i).map(|l| GpuLight::new(&l)))
+            .collect::<crate::Outcome<_>>()?;
+        let block = bytemuck::bytes_of(&uniforms);
+        let light_bytes: &[u8] = bytemuck::cast_slice(&gpu);
+        // SAFETY: this fn's # Safety: room for the block and every light; the sources are
+        // this function's own values, so nothing overlaps.
+        unsafe {
+            std::ptr::copy_nonoverlapping(block.as_ptr(), frame_block, block.len());
+            if !light_bytes.is_empty() {
+                std::ptr::copy_nonoverlapping(light_bytes.as_ptr(), gpu_lights, light_bytes.len());
+            }
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn shading_input_sizes_are_histencils() {
+        use histencil::vk::gpu_types::{FrameUniforms, GpuLight};
+        assert_eq!(
+            super::HISTENCIL_FRAME_UNIFORMS_BYTES as usize,
+            size_of::<FrameUniforms>()
+        );
+        assert_eq!(
+            super::HISTENCIL_GPU_LIGHT_BYTES as usize,
+            size_of::<GpuLight>()
+        );
+    }
+
+    #[test]
+    fn api_version_is_vulkans() {
+        assert_eq!(
+            super::HISTENCIL_API_VERSION,
+            histencil::REQUIREMENTS.api_version
+        );
+    }
+}
