@@ -155,10 +155,9 @@ impl<C: Deref<Target = Context>> LutTables<C> {
         [self.headers.handle, self.values.handle]
     }
 
-    /// Frees the tables now, without the device-wide wait that dropping does
-    /// (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the device): an
-    /// engine that submits from other threads frees through this, once its own fences say the
-    /// GPU is done.
+    /// Frees the tables now, once the engine's fences say the GPU is done (dropping them
+    /// instead leaves them to the context, freed with it or at `Context::free_retired`, since
+    /// any lighting may have bound them).
     ///
     /// # Safety
     /// The GPU has finished every command buffer recorded with a lighting pointed at these

@@ -555,10 +555,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         })
     }
 
-    /// Frees everything now, without the device-wide wait that dropping does while a slot is
-    /// in flight (`vkDeviceWaitIdle`, which Vulkan counts as a use of every queue of the
-    /// device): an engine that submits from other threads frees through this, once its own
-    /// fences say the GPU is done and [`DeferredLighting::slot_finished`] was told so.
+    /// Frees everything now, once the engine's fences say the GPU is done and
+    /// [`DeferredLighting::slot_finished`] was told so (dropping it while a slot is in flight
+    /// leaves its objects to the context instead, freed with it or at
+    /// [`Context::free_retired`]).
     ///
     /// # Errors
     /// [`crate::StillInFlight`] while a slot is not declared finished: it holds the lighting, whole
