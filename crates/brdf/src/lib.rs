@@ -37,6 +37,8 @@ pub mod encoding;
 pub mod eval_csv;
 pub mod half_float;
 mod id;
+#[cfg(feature = "manifest")]
+mod includes;
 pub mod lut;
 #[cfg(feature = "manifest")]
 mod manifest;

@@ -288,6 +288,9 @@ impl BrdfSet {
                 };
                 return Err(t.error(t.line_of_key("glsl"), e.to_string()));
             }
+            // What the file includes is confined too, before anything reaches glslc.
+            let real = glsl.canonicalize().map_err(io(&glsl))?;
+            crate::includes::check_includes(&folder, &real, &mut Vec::new())?;
             specs.push(spec);
         }
         BrdfSet::new(&builtins, specs)
