@@ -28,6 +28,7 @@ use checks::{
     UsageNeeds,
 };
 pub use frames::{gbuffer_stencil_reference, LightingDesc, LightingFrame, TiledFrame};
+pub use tiled::TILED_HDR_FORMATS;
 
 use crate::gpu::access::LightingTargets;
 use crate::gpu::context::Context;

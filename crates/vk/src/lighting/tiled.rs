@@ -17,6 +17,11 @@ use ash::vk;
 use std::ops::Deref;
 use std::rc::Rc;
 
+/// The HDR formats the tiled and depth-id techniques take (their kernels write the HDR image
+/// as a storage image declared `rgba16f`); the light-volume techniques take any colour format
+/// the engine renders to. An engine asks before making a lighting it will record them with.
+pub const TILED_HDR_FORMATS: &[vk::Format] = &[vk::Format::R16G16B16A16_SFLOAT];
+
 impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// Records `frame` lit by the tiled technique into `cmd` against `targets`, as engines
     /// today light many BRDFs: a compute pass classifies each tile of the surfaces (the BRDFs
@@ -108,9 +113,16 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 "the tiled technique's kernels cannot bind the hooks: {why}"
             )));
         }
-        if self.desc.hdr_format != vk::Format::R16G16B16A16_SFLOAT {
+        if !TILED_HDR_FORMATS.contains(&self.desc.hdr_format) {
+            let technique = match shade {
+                TiledShade::DepthId => "the depth-id technique (its tile classification binds \
+                                        the HDR image as the tiled kernels do)",
+                _ => "the tiled technique",
+            };
             return Err(bad(format!(
-                "the tiled technique stores light as rgba16f, and the HDR target is {:?}",
+                "{technique} stores light as rgba16f, and the lighting's HDR format is {:?}: \
+                 make the lighting with one of TILED_HDR_FORMATS ({TILED_HDR_FORMATS:?}) to \
+                 record it",
                 self.desc.hdr_format
             )));
         }
