@@ -228,6 +228,36 @@ fn a_material_the_set_does_not_hold_and_a_non_finite_brdf_are_refused_before_rec
         assert!(text.contains("engine BRDF `spiky` returns"), "{text}");
         assert_eq!(err.cause(), histencil_vk::Cause::Data);
     });
+    // Negative light (an outside engine's BRDF read another's parameter row and gave it) is
+    // refused as a NaN is, by the probe an engine runs itself (`probe_brdfs`).
+    let dir = folder(
+        "engine-brdfs-negative",
+        &[(
+            "negative.glsl",
+            "vec3 negative(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(max(dot(N, L), 0.0) - 0.25);\n}\n",
+        )],
+    );
+    let spec = EngineBrdfSpec {
+        name: "negative".into(),
+        glsl: "negative.glsl".into(),
+        function: "negative".into(),
+        white: None,
+        params: vec![],
+        tangent: false,
+    };
+    let set = BrdfSet::new(&[], vec![spec])
+        .unwrap()
+        .with_folder(dir.canonicalize().unwrap());
+    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    with_validated_context(|ctx| {
+        let text = histencil_vk::probe_brdfs(ctx, modules)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            text.contains("engine BRDF `negative` returns -") && text.contains("not negative"),
+            "{text}"
+        );
+    });
 }
 
 #[test]

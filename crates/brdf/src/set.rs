@@ -530,16 +530,17 @@ impl BrdfSet {
     }
 
     /// A Rust expression that makes this set again (without its folder), for `include!` in an
-    /// engine whose build script compiled it (histencil-build): with `BrdfSet`, `BrdfId`,
-    /// `EngineBrdfSpec`, `EngineParam` and `Range` in scope (`use histencil::brdf::*`).
+    /// engine whose build script compiled it (histencil-build). Every name is spelt by its full
+    /// path through the `histencil` crate an engine depends on, so the file compiles whatever
+    /// the engine has in scope (a `Range` of its own, say).
     pub fn rust_expression(&self) -> String {
         let builtins: Vec<String> = self
             .builtins
             .iter()
-            .map(|b| format!("BrdfId::{b:?}"))
+            .map(|b| format!("::histencil::brdf::BrdfId::{b:?}"))
             .collect();
         let mut out = format!(
-            "BrdfSet::new(\n    &[{}],\n    vec![\n",
+            "::histencil::brdf::BrdfSet::new(\n    &[{}],\n    vec![\n",
             builtins.join(", ")
         );
         for (_, spec) in &self.engine {
@@ -548,13 +549,13 @@ impl BrdfSet {
                 .iter()
                 .map(|p| {
                     format!(
-                        "EngineParam {{ name: {:?}.into(), range: Range::new({:?}, {:?}), default: {:?} }}",
+                        "::histencil::brdf::EngineParam {{ name: {:?}.into(), range: ::histencil::brdf::Range::new({:?}, {:?}), default: {:?} }}",
                         p.name, p.range.min, p.range.max, p.default
                     )
                 })
                 .collect();
             out += &format!(
-                "        EngineBrdfSpec {{\n            name: {:?}.into(),\n            glsl: {:?}.into(),\n            function: {:?}.into(),\n            white: {},\n            params: vec![{}],\n            tangent: {},\n        }},\n",
+                "        ::histencil::brdf::EngineBrdfSpec {{\n            name: {:?}.into(),\n            glsl: {:?}.into(),\n            function: {:?}.into(),\n            white: {},\n            params: vec![{}],\n            tangent: {},\n        }},\n",
                 spec.name,
                 spec.glsl,
                 spec.function,
@@ -701,7 +702,9 @@ mod tests {
         // The Rust spelling makes the same set.
         let rust = set.rust_expression();
         assert!(
-            rust.starts_with("BrdfSet::new(\n    &[BrdfId::Ggx],"),
+            rust.starts_with(
+                "::histencil::brdf::BrdfSet::new(\n    &[::histencil::brdf::BrdfId::Ggx],"
+            ),
             "{rust}"
         );
         assert!(
@@ -709,7 +712,7 @@ mod tests {
             "{rust}"
         );
         assert!(
-            rust.contains("Range::new(1.0, 8.0), default: 3.0"),
+            rust.contains("::histencil::brdf::Range::new(1.0, 8.0), default: 3.0"),
             "{rust}"
         );
     }

@@ -393,7 +393,7 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
     }
     let (ids, names) = ids_and_names(set);
     let expression = format!(
-        "BrdfModules {{\n    set: {set},\n    light: LightModules {{\n        deferred_light: {},\n        lut_light: {},\n        tile_shade: {},\n        tile_shade_8: {},\n        depth_id_shade: {},\n        brdfs: &[{ids}],\n        brdf_names: &[{names}],\n        ..LightModules::BUILTIN\n    }},\n    forward: {},\n    lightmap: {},\n    lightmap_directional: {},\n    alpha_object: {},\n    particle: {},\n    brdf_eval: {},\n}}\n",
+        "::histencil::BrdfModules {{\n    set: {set},\n    light: ::histencil::LightModules {{\n        deferred_light: {},\n        lut_light: {},\n        tile_shade: {},\n        tile_shade_8: {},\n        depth_id_shade: {},\n        brdfs: &[{ids}],\n        brdf_names: &[{names}],\n        ..::histencil::LightModules::BUILTIN\n    }},\n    forward: {},\n    lightmap: {},\n    lightmap_directional: {},\n    alpha_object: {},\n    particle: {},\n    brdf_eval: {},\n}}\n",
         spirv[0],
         spirv[1],
         spirv[2],

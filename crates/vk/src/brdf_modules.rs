@@ -232,9 +232,9 @@ fn probe_directions() -> Vec<[V3<f32>; 4]> {
     out
 }
 
-/// Refuses an engine BRDF that returns NaN or an infinity anywhere it is probed (its parameters
-/// at their defaults, each at its ends, all at their ends, at [`probe_directions`]), naming the
-/// BRDF and the point: such a value is written into every technique's frame and the forward
+/// Refuses an engine BRDF that returns NaN, an infinity or a negative value anywhere it is
+/// probed (its parameters at their defaults, each at its ends, all at their ends, at
+/// `probe_directions`), naming the BRDF and the point: such a value is written into every technique's frame and the forward
 /// reference's alike, where no comparison between them can see it. Histencil's own BRDFs are
 /// held to their f64 reference instead, and pass at once.
 ///
@@ -285,12 +285,17 @@ pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> 
     let values = evaluator.evaluate(ctx, &cases);
     evaluator.destroy(ctx);
     for ((brdf, [n, _, v, l]), parts) in cases.iter().zip(values?) {
-        let bad = parts.channels().into_iter().find(|x| !x.is_finite());
+        // Negative light (a BRDF reading another's parameters, say) is refused as a NaN is:
+        // every technique and the forward reference would subtract it alike.
+        let bad = parts
+            .channels()
+            .into_iter()
+            .find(|x| !x.is_finite() || *x < 0.0);
         if let Some(x) = bad {
             return Err(Error::BrdfSet(format!(
                 "engine BRDF `{}` returns {x} with parameters {:?} at N {n:?}, V {v:?}, L {l:?}: \
-                 it must be finite wherever it is evaluated (the forward reference would hold \
-                 the same non-number, so no comparison could see it)",
+                 it must be finite and not negative wherever it is evaluated (the forward \
+                 reference would hold the same value, so no comparison could see it)",
                 brdf.name(),
                 &brdf.packed_params()[..3],
             )));

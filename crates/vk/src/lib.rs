@@ -38,7 +38,7 @@ pub use alpha::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord, AlphaLightmaps,
     AlphaLightmapsDesc, AlphaMode, LightmapFrame,
 };
-pub use brdf_modules::{compile as compile_brdf_set, BrdfModules};
+pub use brdf_modules::{compile as compile_brdf_set, probe_finite as probe_brdfs, BrdfModules};
 pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};
 pub use gpu::debug::{ValidationLog, ValidationMessage};
 pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};

@@ -54,10 +54,9 @@ const LIGHT_MODULES: LightModules =
 /// The engine's own BRDFs (`../brdfs`) and every module that evaluates them with histencil's
 /// own G-buffer (build.rs): the lighting the compact layout is timed against, the lightmaps and
 /// histencil's Renderer of the same state.
-static BRDF_MODULES: std::sync::LazyLock<BrdfModules> = std::sync::LazyLock::new(|| {
-    use histencil::brdf::{BrdfId, BrdfSet, EngineBrdfSpec, EngineParam, Range};
-    include!(concat!(env!("OUT_DIR"), "/histencil_brdf_modules.rs"))
-});
+/// The generated file names everything by its full path, so it needs nothing in scope.
+static BRDF_MODULES: std::sync::LazyLock<BrdfModules> =
+    std::sync::LazyLock::new(|| include!(concat!(env!("OUT_DIR"), "/histencil_brdf_modules.rs")));
 /// The engine's lightmap atlas: what its alpha entities need at this size fits easily.
 const ATLAS_SIDE: u32 = 256;
 

@@ -115,8 +115,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         }
         if !TILED_HDR_FORMATS.contains(&self.desc.hdr_format) {
             let technique = match shade {
-                TiledShade::DepthId => "the depth-id technique (its tile classification binds \
-                                        the HDR image as the tiled kernels do)",
+                TiledShade::DepthId => {
+                    "the depth-id technique (its tile classification binds \
+                                        the HDR image as the tiled kernels do)"
+                }
                 _ => "the tiled technique",
             };
             return Err(bad(format!(
