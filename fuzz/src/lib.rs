@@ -1,6 +1,7 @@
 //! Coverage-guided fuzz targets for every file histencil reads: glTF and GLB scenes (JSON and
 //! binary chunks, buffers, images, accessors, extensions), material extras with `Brdf::parse`,
-//! the `brdf-eval` case CSV and the costs JSON.
+//! the `brdf-eval` case CSV and the costs JSON; and the plain data an engine plans its frames
+//! from (`engine_plan`).
 //!
 //! Each target takes arbitrary bytes and must return, whatever they are: an error is an answer,
 //! a panic, a hang or an abort is a defect. Where the input is accepted, the target also checks
@@ -13,6 +14,9 @@
 //! corpus seeds (`fuzz/corpus/TARGET`) and every crash found (`fuzz/regressions/TARGET`, each
 //! fixed at its root) are replayed by this crate's test in every `cargo test`.
 
+mod engine_plan;
+pub use engine_plan::engine_plan;
+
 use histencil_brdf::{cases, eval_csv, Brdf, V3};
 use histencil_model::{CostModel, COST_FIELDS};
 use std::path::{Path, PathBuf};
@@ -22,11 +26,12 @@ use std::sync::OnceLock;
 pub type Target = fn(&[u8]);
 
 /// The targets by name: the name is their corpus folder's and, prefixed `fuzz-`, their binary's.
-pub const TARGETS: [(&str, Target); 4] = [
+pub const TARGETS: [(&str, Target); 5] = [
     ("gltf", gltf),
     ("material", material),
     ("brdf_csv", brdf_csv),
     ("costs", costs),
+    ("engine_plan", engine_plan),
 ];
 
 /// Runs `target` under AFL++ with the `afl` feature; otherwise once on each file named on the
