@@ -109,6 +109,9 @@ typedef enum HistencilResult {
   HISTENCIL_RESULT_INTERNAL = 8,
 } HistencilResult;
 
+// A BRDF set and the shaders compiled for it.
+typedef struct HistencilBrdfSet HistencilBrdfSet;
+
 // A device lent to histencil, and what hangs off it (its private allocator).
 typedef struct HistencilContext HistencilContext;
 
@@ -189,8 +192,11 @@ typedef struct HistencilLightingDesc {
   uint32_t size;
   // How many BRDFs: each takes one stencil slot, in this order.
   uint32_t brdf_count;
-  // The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...).
+  // The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...) and
+  // those of `brdf_set`.
   const char *const *brdf_names;
+  // The engine's BRDF set (`histencil_brdf_set_load`), or null for histencil's own BRDFs.
+  const struct HistencilBrdfSet *brdf_set;
   // Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
   uint32_t engine_stencil_bits;
   // The targets' width.
@@ -298,6 +304,34 @@ const char *histencil_last_error(void);
 // Thread safety: any thread.
 uint32_t histencil_version(void);
 
+// Reads the BRDF folder `folder` (its `brdfs.toml` and the GLSL files it names, each confined
+// to the folder), compiles histencil's shaders for the set (glslc, as `histencil render
+// --brdfs` does; compiled once per set in a process) and probes each engine BRDF on the
+// context's device: one that returns NaN, an infinity or negative light anywhere is refused.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer, a folder that is not UTF-8;
+// `BAD_SETUP` for a manifest or GLSL file histencil refuses (the message gives the file and
+// line), a GLSL compile error (glslc's words, with the engine's file and line), a probe that
+// fails; `UNSUPPORTED` when glslc cannot be run.
+//
+// Thread safety: not at the same time as another call on `context`.
+//
+// # Safety
+// `folder` is null or NUL-terminated; `set` is null or writable.
+enum HistencilResult histencil_brdf_set_load(struct HistencilContext *context,
+                                             const char *folder,
+                                             struct HistencilBrdfSet **set);
+
+// Frees the handle. Lightings made with the set keep what they need: it may go at once.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle.
+//
+// Thread safety: not at the same time as another call naming `set`.
+//
+// # Safety
+// `set` is null or a handle from `histencil_brdf_set_load` (a freed one is refused).
+enum HistencilResult histencil_brdf_set_destroy(struct HistencilBrdfSet *set);
+
 // Makes a context on the engine's device. Creates nothing of Vulkan's but histencil's private
 // memory allocator; checks that the physical device and queue family have what histencil needs.
 //
@@ -339,25 +373,28 @@ enum HistencilResult histencil_context_destroy(struct HistencilContext *context)
 enum HistencilResult histencil_gbuffer_formats(VkFormat *formats);
 
 // The G-buffer's values for a surface of BRDF `name` with `params` (each parameter the BRDF
-// takes, by name): its packed parameters (`gbuffer_encode`'s `brdf_params`, the first three)
-// and its model id (`brdf_model`). Every parameter is held to its range, as the Rust API holds
-// it.
+// takes, by name; an engine BRDF's left out take their defaults): its packed parameters
+// (`gbuffer_encode`'s `brdf_params`, the first three; `packed` holds 4) and its id
+// (`brdf_model`, the BRDF's `BrdfId::index`). `set` is the engine's BRDF set that holds `name`
+// (`histencil_brdf_set_load`), or null for histencil's own BRDFs. Every parameter is held to
+// its range, as the Rust API holds it.
 //
-// Errors: `INVALID_ARGUMENT` for a null pointer or a name that is not UTF-8; `BAD_SETUP` for a
-// BRDF histencil does not know, a parameter it does not take, one left out, or one out of its
-// range (the message names it).
+// Errors: `INVALID_ARGUMENT` for a null pointer, a freed `set` or a name that is not UTF-8;
+// `BAD_SETUP` for a BRDF neither histencil nor `set` holds, a parameter it does not take, one
+// left out that has no default, or one out of its range (the message names it).
 //
 // Thread safety: any thread.
 //
 // # Safety
 // `name` is null or NUL-terminated; `params` is null or points at `param_count` parameters
-// whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `model_index` is
-// null or writable.
-enum HistencilResult histencil_brdf_encode(const char *name,
+// whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `brdf_id` is
+// null or writable; `set` is null or a handle from `histencil_brdf_set_load`.
+enum HistencilResult histencil_brdf_encode(const struct HistencilBrdfSet *set,
+                                           const char *name,
                                            const struct HistencilBrdfParam *params,
                                            uint32_t param_count,
                                            float *packed,
-                                           uint32_t *model_index);
+                                           uint32_t *brdf_id);
 
 // Adds the features histencil needs to an engine's own, before it creates its device: sets
 // them in `features` (chained as `VkDeviceCreateInfo::pEnabledFeatures` or in
@@ -399,7 +436,7 @@ enum HistencilResult histencil_shading_inputs(const struct HistencilView *view,
 // (light pipelines are made at the first frame that needs them). Nothing is submitted.
 //
 // Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, a wrong `size` or a
-// count out of range; `BAD_SETUP` for a BRDF name histencil does not know, more engine stencil
+// count out of range; `BAD_SETUP` for a BRDF name neither histencil nor `brdf_set` holds, more engine stencil
 // bits than the stencil has beside the BRDFs, a zero extent or a depth format without stencil;
 // `DEVICE_LIMIT`, `VULKAN` as the device says.
 //

@@ -1,10 +1,11 @@
 //! What a C engine needs to write histencil's G-buffer and make its device: the images' formats,
 //! each BRDF's values as the G-buffer stores them, and the device features histencil needs.
 
+use crate::brdf_set::utf8;
 use crate::{call, slice, Failure, HistencilResult};
 use ash::vk;
 use histencil::brdf::Brdf;
-use std::ffi::{c_char, CStr};
+use std::ffi::c_char;
 
 /// The Vulkan version an engine's instance must be created for: `VK_API_VERSION_1_3`, spelt
 /// out for the header (`api_version_is_vulkans` holds the two equal).
@@ -47,68 +48,85 @@ pub unsafe extern "C" fn histencil_gbuffer_formats(formats: *mut vk::Format) -> 
 }
 
 /// The G-buffer's values for a surface of BRDF `name` with `params` (each parameter the BRDF
-/// takes, by name): its packed parameters (`gbuffer_encode`'s `brdf_params`, the first three)
-/// and its model id (`brdf_model`). Every parameter is held to its range, as the Rust API holds
-/// it.
+/// takes, by name; an engine BRDF's left out take their defaults): its packed parameters
+/// (`gbuffer_encode`'s `brdf_params`, the first three; `packed` holds 4) and its id
+/// (`brdf_model`, the BRDF's `BrdfId::index`). `set` is the engine's BRDF set that holds `name`
+/// (`histencil_brdf_set_load`), or null for histencil's own BRDFs. Every parameter is held to
+/// its range, as the Rust API holds it.
 ///
-/// Errors: `INVALID_ARGUMENT` for a null pointer or a name that is not UTF-8; `BAD_SETUP` for a
-/// BRDF histencil does not know, a parameter it does not take, one left out, or one out of its
-/// range (the message names it).
+/// Errors: `INVALID_ARGUMENT` for a null pointer, a freed `set` or a name that is not UTF-8;
+/// `BAD_SETUP` for a BRDF neither histencil nor `set` holds, a parameter it does not take, one
+/// left out that has no default, or one out of its range (the message names it).
 ///
 /// Thread safety: any thread.
 ///
 /// # Safety
 /// `name` is null or NUL-terminated; `params` is null or points at `param_count` parameters
-/// whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `model_index` is
-/// null or writable.
+/// whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `brdf_id` is
+/// null or writable; `set` is null or a handle from `histencil_brdf_set_load`.
 #[no_mangle]
 pub unsafe extern "C" fn histencil_brdf_encode(
+    set: *const crate::HistencilBrdfSet,
     name: *const c_char,
     params: *const HistencilBrdfParam,
     param_count: u32,
     packed: *mut f32,
-    model_index: *mut u32,
+    brdf_id: *mut u32,
 ) -> HistencilResult {
     call(|| {
-        if name.is_null() || packed.is_null() || model_index.is_null() {
-            return Err(Failure::invalid("name, packed or model_index is null"));
+        if packed.is_null() || brdf_id.is_null() {
+            return Err(Failure::invalid("packed or brdf_id is null"));
         }
-        let utf8 = |p: *const c_char, what: &str| {
-            // SAFETY: this fn's # Safety: a non-null name is NUL-terminated.
-            unsafe { CStr::from_ptr(p) }
-                .to_str()
-                .map_err(|_| Failure::invalid(format!("{what} is not UTF-8")))
-        };
-        let name = utf8(name, "name")?;
+        // SAFETY: this fn's # Safety.
+        let modules = unsafe { crate::brdf_set::modules_of(set) }?;
+        // SAFETY: this fn's # Safety: null or NUL-terminated.
+        let name = unsafe { utf8(name, "name") }?;
         // SAFETY: this fn's # Safety: `param_count` parameters at `params`.
         let params = unsafe { slice(params, param_count, "params") }?;
-        let mut map = serde_json::Map::new();
+        let mut given = Vec::with_capacity(params.len());
         for (i, p) in params.iter().enumerate() {
-            if p.name.is_null() {
-                return Err(Failure::invalid(format!("params[{i}].name is null")));
+            // SAFETY: this fn's # Safety: each name null or NUL-terminated.
+            let key = unsafe { utf8(p.name, &format!("params[{i}].name")) }?;
+            if !p.value.is_finite() {
+                return Err(setup(format!(
+                    "params[{i}] (`{key}`) is {}, not finite",
+                    p.value
+                )));
             }
-            let number = serde_json::Number::from_f64(p.value).ok_or_else(|| Failure {
-                result: HistencilResult::BadSetup,
-                message: format!("params[{i}] is {}, not a finite number", p.value),
-            })?;
-            map.insert(
-                utf8(p.name, "a parameter's name")?.to_owned(),
-                number.into(),
-            );
+            given.push((key, p.value));
         }
-        let brdf = Brdf::parse(name, &map).map_err(|e| Failure {
-            result: HistencilResult::BadSetup,
-            message: format!("BRDF `{name}`: {e}"),
-        })?;
-        let values = brdf.packed_params();
-        for (i, v) in values.iter().enumerate() {
+        let engine = modules.set.engine().any(|(_, spec)| spec.name == name);
+        let brdf = if engine {
+            modules.set.engine_brdf(name, &given)
+        } else {
+            let map: serde_json::Map<String, serde_json::Value> = (given.iter())
+                .filter_map(|(k, v)| {
+                    Some(((*k).to_owned(), serde_json::Number::from_f64(*v)?.into()))
+                })
+                .collect();
+            Brdf::parse(name, &map)
+        }
+        .map_err(|e| setup(format!("BRDF `{name}`: {e}")))?;
+        if !modules.set.ids().contains(&brdf.id()) {
+            return Err(setup(format!(
+                "BRDF `{name}` is not in the set (its manifest's builtins leave it out)"
+            )));
+        }
+        for (i, v) in brdf.packed_params().iter().enumerate() {
             // SAFETY: this fn's # Safety: 4 writable floats.
             unsafe { packed.add(i).write(*v as f32) };
         }
         // SAFETY: checked non-null; writable by this fn's # Safety.
-        unsafe { model_index.write(brdf.model_index()) };
+        unsafe { brdf_id.write(brdf.id().index()) };
         Ok(())
     })
+}
+
+fn setup(message: String) -> Failure {
+    Failure {
+        result: HistencilResult::BadSetup,
+        message,
+    }
 }
 
 /// Adds the features histencil needs to an engine's own, before it creates its device: sets

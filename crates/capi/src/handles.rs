@@ -10,6 +10,7 @@ use std::sync::Mutex;
 pub(crate) enum Kind {
     Context,
     Lighting,
+    BrdfSet,
 }
 
 static LIVE: Mutex<Option<HashSet<(usize, Kind)>>> = Mutex::new(None);

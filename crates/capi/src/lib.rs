@@ -15,12 +15,14 @@
 //!   [`HistencilResult::Internal`], its message kept.
 //! - **Enums travel as `uint32_t`** and are checked, so an unknown value is an error.
 
+mod brdf_set;
 mod device;
 mod frame;
 mod gbuffer;
 mod handles;
 mod lighting;
 
+pub use brdf_set::{histencil_brdf_set_destroy, histencil_brdf_set_load, HistencilBrdfSet};
 pub use device::{
     histencil_context_create, histencil_context_destroy, HistencilContext, HistencilDeviceDesc,
 };

@@ -1,6 +1,7 @@
 //! The lighting: made once from a description, planned and recorded into the engine's command
 //! buffer each frame, told when a slot's frame has finished, resized and destroyed.
 
+use crate::brdf_set::{brdf_named, modules_of, HistencilBrdfSet};
 use crate::frame::{
     HistencilFrame, HistencilTargets, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
     HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
@@ -10,7 +11,7 @@ use crate::handles::{self, Kind};
 use crate::{call, check_size, required, slice, Failure, HistencilResult, Outcome};
 use ash::vk;
 use histencil::{
-    plan_frame, Backend, BrdfId, BrdfSource, Context, DeferredLighting, FlushPolicy, HookSets,
+    plan_frame, Backend, BrdfModules, BrdfSource, Context, DeferredLighting, FlushPolicy, HookSets,
     LightHooks, LightingDesc, LightingFrame, MixedTiles, PlanInputs, PlanSettings, StencilLayout,
     TechniqueChoice, TileClassify, TileSide, TiledFrame, View,
 };
@@ -25,8 +26,11 @@ pub struct HistencilLightingDesc {
     pub size: u32,
     /// How many BRDFs: each takes one stencil slot, in this order.
     pub brdf_count: u32,
-    /// The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...).
+    /// The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...) and
+    /// those of `brdf_set`.
     pub brdf_names: *const *const c_char,
+    /// The engine's BRDF set (`histencil_brdf_set_load`), or null for histencil's own BRDFs.
+    pub brdf_set: *const HistencilBrdfSet,
     /// Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
     pub engine_stencil_bits: u32,
     /// The targets' width.
@@ -48,6 +52,8 @@ pub struct HistencilLightingDesc {
 /// A lighting made on a context, with the names it was made with.
 pub struct HistencilLighting {
     lighting: DeferredLighting<Arc<Context>>,
+    /// The shaders it lights with, whose set names its BRDFs.
+    modules: &'static BrdfModules,
     /// How the tiled techniques classify on this context's driver (the quirk table).
     classify: TileClassify,
 }
@@ -56,24 +62,6 @@ pub struct HistencilLighting {
 const MAX_BRDFS: u32 = 24;
 /// The most frames in flight a description asks for.
 const MAX_FRAMES_IN_FLIGHT: u32 = 16;
-
-/// `name` as a BRDF id histencil lights, or the error listing those it knows.
-fn brdf_named(name: &str) -> Outcome<BrdfId> {
-    BrdfId::ALL
-        .into_iter()
-        .find(|b| b.name() == name)
-        .ok_or_else(|| {
-            let known: Vec<&str> = BrdfId::ALL.iter().map(|b| b.name()).collect();
-            Failure {
-                result: HistencilResult::BadSetup,
-                message: format!(
-                    "no BRDF named `{name}` (histencil's own: {}; an engine's own BRDFs come \
-                 through a BRDF set, not yet in the C API)",
-                    known.join(", ")
-                ),
-            }
-        })
-}
 
 /// `count` NUL-terminated names at `names`, as UTF-8.
 ///
@@ -94,7 +82,7 @@ unsafe fn names<'a>(names: *const *const c_char, count: u32, what: &str) -> Outc
     Ok(out)
 }
 
-fn lighting_desc(desc: &HistencilLightingDesc) -> Outcome<LightingDesc> {
+fn lighting_desc(desc: &HistencilLightingDesc) -> Outcome<(LightingDesc, &'static BrdfModules)> {
     check_size::<HistencilLightingDesc>("HistencilLightingDesc", desc.size)?;
     let ranges = [
         ("brdf_count", desc.brdf_count, 1, MAX_BRDFS),
@@ -114,13 +102,15 @@ fn lighting_desc(desc: &HistencilLightingDesc) -> Outcome<LightingDesc> {
     }
     // SAFETY: the header's contract: `brdf_count` names at `brdf_names`.
     let names = unsafe { names(desc.brdf_names, desc.brdf_count, "brdf_names") }?;
+    // SAFETY: the header's contract: null or a handle from histencil_brdf_set_load.
+    let modules = unsafe { modules_of(desc.brdf_set) }?;
     let brdfs = names
         .into_iter()
-        .map(brdf_named)
+        .map(|n| brdf_named(modules, n))
         .collect::<Outcome<Vec<_>>>()?;
     let layout = StencilLayout::new(desc.brdf_count, desc.engine_stencil_bits)
         .map_err(histencil::Error::from)?;
-    Ok(LightingDesc {
+    let desc = LightingDesc {
         layout,
         brdfs,
         extent: vk::Extent2D {
@@ -132,15 +122,20 @@ fn lighting_desc(desc: &HistencilLightingDesc) -> Outcome<LightingDesc> {
         frames_in_flight: desc.frames_in_flight,
         max_lights: desc.max_lights,
         hi_stencil: desc.hi_stencil != 0,
-        hooks: LightHooks::Builtin,
-    })
+        hooks: if std::ptr::eq(modules, BrdfModules::builtin()) {
+            LightHooks::Builtin
+        } else {
+            LightHooks::BuiltinWithBrdfs(modules.light)
+        },
+    };
+    Ok((desc, modules))
 }
 
 /// Makes a lighting on `context`: its pipeline layout, light volumes, per-slot buffers and sets
 /// (light pipelines are made at the first frame that needs them). Nothing is submitted.
 ///
 /// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, a wrong `size` or a
-/// count out of range; `BAD_SETUP` for a BRDF name histencil does not know, more engine stencil
+/// count out of range; `BAD_SETUP` for a BRDF name neither histencil nor `brdf_set` holds, more engine stencil
 /// bits than the stencil has beside the BRDFs, a zero extent or a depth format without stencil;
 /// `DEVICE_LIMIT`, `VULKAN` as the device says.
 ///
@@ -163,12 +158,13 @@ pub unsafe extern "C" fn histencil_lighting_create(
         if lighting.is_null() {
             return Err(Failure::invalid("lighting (the out pointer) is null"));
         }
-        let desc = lighting_desc(desc)?;
+        let (desc, modules) = lighting_desc(desc)?;
         let classify = TileClassify::for_context(&context.ctx);
         let made = DeferredLighting::new(context.ctx.clone(), &desc)?;
         let handle = handles::make(
             HistencilLighting {
                 lighting: made,
+                modules,
                 classify,
             },
             Kind::Lighting,
@@ -204,7 +200,7 @@ pub unsafe extern "C" fn histencil_lighting_stencil_reference(
         if reference.is_null() || write_mask.is_null() {
             return Err(Failure::invalid("reference or write_mask is null"));
         }
-        let brdf = brdf_named(name)?;
+        let brdf = brdf_named(held.modules, name)?;
         let (r, m) = held
             .lighting
             .desc()

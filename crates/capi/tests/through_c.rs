@@ -183,6 +183,7 @@ fn c_lighting_desc(world: &World, names: &[*const c_char]) -> HistencilLightingD
         size: size_of::<HistencilLightingDesc>() as u32,
         brdf_count: names.len() as u32,
         brdf_names: names.as_ptr(),
+        brdf_set: null(),
         engine_stencil_bits: 0,
         width: SIZE.width,
         height: SIZE.height,
@@ -655,5 +656,119 @@ fn misuse_through_c_returns_its_error_and_names_the_problem() {
         let fresh = std::thread::spawn(last_error).join().unwrap();
         assert_eq!(fresh, "");
         assert!(histencil_version() >> 22 == HISTENCIL_VERSION_MAJOR);
+    });
+}
+
+/// An engine's own BRDFs through C: `examples/brdfs` (a toon ramp, glTF's Charlie sheen) loaded,
+/// compiled and probed on the context's device; a lighting made with them beside histencil's
+/// own, their stencil references given; their G-buffer values as the Rust API's; and a folder or
+/// name histencil refuses says why.
+#[test]
+fn an_engines_own_brdfs_come_through_c_from_its_folder() {
+    use HistencilResult as R;
+    with_c_context(|_, _, c_ctx, images, world| {
+        let folder = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/brdfs\0");
+        let mut set = null_mut();
+        // SAFETY: a live context, a NUL-terminated folder, a writable out pointer; every call
+        // below passes live structs and handles, or ones the C API refuses.
+        unsafe {
+            let loaded = histencil_brdf_set_load(c_ctx, folder.as_ptr().cast(), &mut set);
+            assert_eq!(loaded, R::Success, "{}", last_error());
+            let missing = c"/nonexistent/brdfs";
+            expect(
+                histencil_brdf_set_load(c_ctx, missing.as_ptr(), &mut null_mut()),
+                R::BadSetup,
+                "/nonexistent/brdfs",
+            );
+            let names = [c"lambert", c"toon", c"charlie_sheen"];
+            let pointers: Vec<*const c_char> = names.iter().map(|n| n.as_ptr()).collect();
+            let desc = HistencilLightingDesc {
+                brdf_set: set,
+                depth_stencil_format: images.refs().depth_stencil.format,
+                ..c_lighting_desc(world, &pointers)
+            };
+            let mut lighting = null_mut();
+            let made = histencil_lighting_create(c_ctx, &desc, &mut lighting);
+            assert_eq!(made, R::Success, "{}", last_error());
+            let (mut reference, mut mask) = (0u8, 0u8);
+            let r = histencil_lighting_stencil_reference(
+                lighting,
+                c"toon".as_ptr(),
+                &mut reference,
+                &mut mask,
+            );
+            assert_eq!(r, R::Success, "{}", last_error());
+            assert_ne!(mask, 0);
+            // Without the set, histencil does not know `toon`.
+            let own = HistencilLightingDesc {
+                brdf_set: null(),
+                ..desc
+            };
+            expect(
+                histencil_lighting_create(c_ctx, &own, &mut null_mut()),
+                R::BadSetup,
+                "no BRDF named `toon`",
+            );
+            // The G-buffer's values, as the Rust set gives them.
+            let rust_set =
+                histencil::brdf::BrdfSet::load(folder.trim_end_matches('\0').as_ref()).unwrap();
+            let expected = rust_set.engine_brdf("toon", &[("bands", 4.0)]).unwrap();
+            let bands = HistencilBrdfParam {
+                name: c"bands".as_ptr(),
+                value: 4.0,
+            };
+            let (mut packed, mut id) = ([0.0f32; 4], 0u32);
+            let r = histencil_brdf_encode(
+                set,
+                c"toon".as_ptr(),
+                &bands,
+                1,
+                packed.as_mut_ptr(),
+                &mut id,
+            );
+            assert_eq!(r, R::Success, "{}", last_error());
+            assert_eq!(id, expected.id().index());
+            assert_eq!(packed, expected.packed_params().map(|p| p as f32));
+            expect(
+                histencil_brdf_encode(
+                    null(),
+                    c"toon".as_ptr(),
+                    &bands,
+                    1,
+                    packed.as_mut_ptr(),
+                    &mut id,
+                ),
+                R::BadSetup,
+                "toon",
+            );
+            let huge = HistencilBrdfParam {
+                name: c"bands".as_ptr(),
+                value: 1e9,
+            };
+            expect(
+                histencil_brdf_encode(
+                    set,
+                    c"toon".as_ptr(),
+                    &huge,
+                    1,
+                    packed.as_mut_ptr(),
+                    &mut id,
+                ),
+                R::BadSetup,
+                "bands",
+            );
+            assert_eq!(
+                histencil_lighting_destroy(lighting),
+                R::Success,
+                "{}",
+                last_error()
+            );
+            assert_eq!(histencil_brdf_set_destroy(set), R::Success);
+            expect(
+                histencil_brdf_set_destroy(set),
+                R::InvalidArgument,
+                "not a live BrdfSet handle",
+            );
+        }
     });
 }

@@ -74,6 +74,11 @@ int main(void) {
     expect(histencil_lighting_resize(lighting, 64, 64), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "resize");
     expect(histencil_lighting_destroy(lighting), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "lighting_destroy(foreign)");
     expect(histencil_lighting_destroy(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "lighting is null", "lighting_destroy(NULL)");
+    {
+        HistencilBrdfSet *set = NULL;
+        expect(histencil_brdf_set_load(NULL, "examples/brdfs", &set), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "brdf_set_load(NULL)");
+        expect(histencil_brdf_set_destroy((HistencilBrdfSet *)&device), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live BrdfSet handle", "brdf_set_destroy(foreign)");
+    }
 
     /* What an engine writes its G-buffer and device with. */
     {
@@ -89,14 +94,14 @@ int main(void) {
             fprintf(stderr, "G-buffer image 0 is format %d\n", (int)formats[0]);
             failures += 1;
         }
-        expect(histencil_brdf_encode("ggx", NULL, 0, packed, &model), HISTENCIL_RESULT_BAD_SETUP, "ggx", "brdf_encode(ggx, no params)");
-        expect(histencil_brdf_encode("velvet", NULL, 0, packed, &model), HISTENCIL_RESULT_BAD_SETUP, "velvet", "brdf_encode(velvet)");
-        expect(histencil_brdf_encode("lambert", NULL, 1, packed, &model), HISTENCIL_RESULT_INVALID_ARGUMENT, "params is null", "brdf_encode(NULL params)");
+        expect(histencil_brdf_encode(NULL, "ggx", NULL, 0, packed, &model), HISTENCIL_RESULT_BAD_SETUP, "ggx", "brdf_encode(ggx, no params)");
+        expect(histencil_brdf_encode(NULL, "velvet", NULL, 0, packed, &model), HISTENCIL_RESULT_BAD_SETUP, "velvet", "brdf_encode(velvet)");
+        expect(histencil_brdf_encode(NULL, "lambert", NULL, 1, packed, &model), HISTENCIL_RESULT_INVALID_ARGUMENT, "params is null", "brdf_encode(NULL params)");
         rho.name = "rho";
         rho.value = 0.8;
-        expect_ok(histencil_brdf_encode("lambert", &rho, 1, packed, &model), "brdf_encode(lambert)");
+        expect_ok(histencil_brdf_encode(NULL, "lambert", &rho, 1, packed, &model), "brdf_encode(lambert)");
         if (model != 0 || packed[0] != 0.8f) {
-            fprintf(stderr, "lambert encodes as model %u, %f\n", model, (double)packed[0]);
+            fprintf(stderr, "lambert encodes as id %u, %f\n", model, (double)packed[0]);
             failures += 1;
         }
         memset(&features, 0, sizeof features);
