@@ -25,29 +25,48 @@ pub struct Engine {
 }
 
 impl Engine {
-    /// Creates the instance, messenger, device and allocator.
+    /// Creates the instance (with the validation layer, synchronisation validation on),
+    /// messenger, device and allocator.
     pub fn start() -> Self {
+        Self::start_with(true)
+    }
+
+    /// [`Engine::start`] without the validation layer: for benchmarks of the CPU's work, which
+    /// the layer's own would swamp.
+    pub fn start_unvalidated() -> Self {
+        Self::start_with(false)
+    }
+
+    fn start_with(validated: bool) -> Self {
         let turn = crate::instance_turn();
         let entry = unsafe { ash::Entry::load() }.expect("Vulkan loader");
         let log = Arc::new(ValidationLog::default());
         let app = vk::ApplicationInfo::default().api_version(REQUIREMENTS.api_version);
-        let layers = [c"VK_LAYER_KHRONOS_validation".as_ptr()];
-        let extensions = [
+        let all_layers = [c"VK_LAYER_KHRONOS_validation".as_ptr()];
+        let layers = if validated { &all_layers[..] } else { &[] };
+        let all_extensions = [
             ash::ext::debug_utils::NAME.as_ptr(),
             ash::ext::validation_features::NAME.as_ptr(),
         ];
+        let extensions = if validated {
+            &all_extensions[..]
+        } else {
+            &all_extensions[..1]
+        };
         let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
         let mut features =
             vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
         // SAFETY: `log` lives in the engine until after the messenger is destroyed.
         let messenger_info = unsafe { ValidationLog::messenger_create_info(&log) };
         let mut on_create = messenger_info;
-        let info = vk::InstanceCreateInfo::default()
+        let mut info = vk::InstanceCreateInfo::default()
             .application_info(&app)
-            .enabled_layer_names(&layers)
-            .enabled_extension_names(&extensions)
-            .push_next(&mut features)
+            .enabled_layer_names(layers)
+            .enabled_extension_names(extensions)
             .push_next(&mut on_create);
+        if validated {
+            info = info.push_next(&mut features);
+        }
         let instance = unsafe { entry.create_instance(&info, None) }.expect("instance");
         let debug = ash::ext::debug_utils::Instance::new(&entry, &instance);
         let messenger = unsafe { debug.create_debug_utils_messenger(&messenger_info, None) }
