@@ -207,10 +207,8 @@ fn main() {
             // SAFETY: the pool's buffer was never submitted.
             unsafe { d.destroy_command_pool(pool, None) };
             // SAFETY: no slot in flight.
-            assert_eq!(
-                unsafe { histencil_lighting_destroy(c_lighting) },
-                HistencilResult::Success
-            );
+            let freed = unsafe { histencil_lighting_destroy(c_lighting) };
+            assert_eq!(freed, HistencilResult::Success);
             rust.destroy().unwrap();
         }
         images.free(&engine);
