@@ -12,7 +12,7 @@
 mod common;
 
 use ash::vk;
-use common::{c_targets_of, device_desc, World};
+use common::{c_boxes, c_targets_of, device_desc, World};
 use histencil::{Backend, Context, DeferredLighting, HookSets, Light};
 use histencil_capi::*;
 use histencil_tests::engine::{lighting_desc, plain_frame, stencil_plan, Engine};
@@ -114,13 +114,7 @@ fn main() {
             let made = unsafe { histencil_lighting_create(c_ctx, &c_desc, &mut c_lighting) };
             assert_eq!(made, HistencilResult::Success);
             let c_lights = world.c_lights();
-            let boxes: Vec<Vec<[f32; 6]>> = (world.scene.brdf_bounds(&brdfs).iter())
-                .map(|b| {
-                    b.iter()
-                        .map(|a| [a.min[0], a.min[1], a.min[2], a.max[0], a.max[1], a.max[2]])
-                        .collect()
-                })
-                .collect();
+            let boxes = c_boxes(&world.scene.brdf_bounds(&brdfs));
             let bounds: Vec<HistencilBrdfBounds> = (boxes.iter())
                 .map(|b| HistencilBrdfBounds {
                     boxes: b.as_ptr(),

@@ -127,7 +127,7 @@ typedef struct HistencilDeviceDesc {
   uint32_t queue_family;
   // The loader's (or the engine's) `vkGetInstanceProcAddr`, through which histencil loads
   // every instance and device function it calls.
-  PFN_vkVoidFunction (*get_instance_proc_addr)(VkInstance, const char*);
+  PFN_vkGetInstanceProcAddr get_instance_proc_addr;
   // The engine's instance, created for Vulkan 1.3 or later.
   VkInstance instance;
   // The physical device behind `device`.
@@ -215,11 +215,19 @@ typedef struct HistencilLightingDesc {
   uint32_t hi_stencil;
 } HistencilLightingDesc;
 
+// An axis-aligned box in world space.
+typedef struct HistencilBox {
+  // The corner with the smallest coordinates.
+  float min[3];
+  // The corner with the largest; no coordinate below `min`'s.
+  float max[3];
+} HistencilBox;
+
 // The world boxes of what one BRDF draws: the lights that reach none of them are not drawn
 // for that BRDF.
 typedef struct HistencilBrdfBounds {
-  // `box_count` boxes, each `{min x, min y, min z, max x, max y, max z}`.
-  const float (*boxes)[6];
+  // `box_count` boxes.
+  const struct HistencilBox *boxes;
   // How many.
   uint32_t box_count;
 } HistencilBrdfBounds;
@@ -272,9 +280,18 @@ typedef struct HistencilImage {
   VkAccessFlags2 access;
 } HistencilImage;
 
-// The images a lighting records against: the G-buffer (histencil's `GBUFFER_FORMATS`, in
-// order), the depth-stencil holding each pixel's BRDF slot, and the HDR image light is added
-// to. Each image's state is read before and written after the recording.
+// The images a lighting records against, each the engine's own `HistencilImage`, read before
+// the recording and written after it with the state the commands leave it in (so the engine's
+// next barrier starts from there):
+// - `gbuffer`: histencil's G-buffer (`histencil_gbuffer_formats`, in that order), made with
+//   `SAMPLED` usage; its stencil-carrying depth image written by the engine's G-buffer pass
+//   with each surface's BRDF slot (`histencil_lighting_stencil_reference`), the BRDF bits
+//   cleared to 0 everywhere else first.
+// - `depth_stencil`: `DEPTH_STENCIL_ATTACHMENT`, and `SAMPLED` for the PS3-like and 360-like
+//   platforms (the hi-stencil emulation reads it), `TRANSFER_SRC` for a 360-like save.
+// - `hdr`: `COLOR_ATTACHMENT`, and `STORAGE` for the tiled and depth-id techniques (which take
+//   `VK_FORMAT_R16G16B16A16_SFLOAT` only).
+// A usage a frame needs and an image lacks is refused with `BAD_FRAME`, naming it.
 typedef struct HistencilTargets {
   // `sizeof(HistencilTargets)`.
   uint32_t size;
@@ -283,9 +300,9 @@ typedef struct HistencilTargets {
   // The G-buffer images.
   struct HistencilImage *gbuffer;
   // The depth-stencil image.
-  struct HistencilImage depth_stencil;
+  struct HistencilImage *depth_stencil;
   // The HDR image.
-  struct HistencilImage hdr;
+  struct HistencilImage *hdr;
 } HistencilTargets;
 
 #ifdef __cplusplus
@@ -332,6 +349,21 @@ enum HistencilResult histencil_brdf_set_load(struct HistencilContext *context,
 // `set` is null or a handle from `histencil_brdf_set_load` (a freed one is refused).
 enum HistencilResult histencil_brdf_set_destroy(struct HistencilBrdfSet *set);
 
+// Writes what histencil's shaders include to evaluate the set into `folder` (`brdf_set/*.glsl`
+// and the engine's GLSL files under their own folder): put `folder` before the installed
+// `share/histencil/shaders/include` on glslc's include path, and an engine's own shader that
+// includes `light.glsl` (a forward reference) evaluates the set's BRDFs as histencil does.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer; `VULKAN` never;
+// `BAD_SETUP` when the folder cannot be written (the message names the file).
+//
+// Thread safety: any thread, not at the same time as `histencil_brdf_set_destroy(set)`.
+//
+// # Safety
+// `folder` is null or NUL-terminated.
+enum HistencilResult histencil_brdf_set_write_includes(struct HistencilBrdfSet *set,
+                                                       const char *folder);
+
 // Makes a context on the engine's device. Creates nothing of Vulkan's but histencil's private
 // memory allocator; checks that the physical device and queue family have what histencil needs.
 //
@@ -359,6 +391,24 @@ enum HistencilResult histencil_context_create(const struct HistencilDeviceDesc *
 // # Safety
 // `context` is null, or a handle from `histencil_context_create` (a freed one is refused).
 enum HistencilResult histencil_context_destroy(struct HistencilContext *context);
+
+// Whether histencil can light on `physical_device` of `instance` with `queue_family`, asked
+// before the engine creates its device: writes 1 to `suits` if so, else 0 with the reason in
+// `histencil_last_error()` (the features or limits the device lacks, or what the family
+// cannot do), which `histencil_context_create` would refuse with.
+//
+// Errors: `INVALID_ARGUMENT` for a null pointer or handle.
+//
+// Thread safety: any thread.
+//
+// # Safety
+// `instance` is live, created for Vulkan 1.3 with `get_instance_proc_addr`'s loader, and
+// `physical_device` enumerated from it; `suits` is null or writable.
+enum HistencilResult histencil_device_suits(PFN_vkGetInstanceProcAddr get_instance_proc_addr,
+                                            VkInstance instance,
+                                            VkPhysicalDevice physical_device,
+                                            uint32_t queue_family,
+                                            uint32_t *suits);
 
 // Writes histencil's G-buffer formats, in binding order (albedo, normal-depth, material:
 // `share/histencil/shaders/include/gbuffer_write.glsl` says what each channel holds), into

@@ -85,6 +85,34 @@ pub unsafe extern "C" fn histencil_brdf_set_destroy(set: *mut HistencilBrdfSet) 
     })
 }
 
+/// Writes what histencil's shaders include to evaluate the set into `folder` (`brdf_set/*.glsl`
+/// and the engine's GLSL files under their own folder): put `folder` before the installed
+/// `share/histencil/shaders/include` on glslc's include path, and an engine's own shader that
+/// includes `light.glsl` (a forward reference) evaluates the set's BRDFs as histencil does.
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer; `VULKAN` never;
+/// `BAD_SETUP` when the folder cannot be written (the message names the file).
+///
+/// Thread safety: any thread, not at the same time as `histencil_brdf_set_destroy(set)`.
+///
+/// # Safety
+/// `folder` is null or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_brdf_set_write_includes(
+    set: *mut HistencilBrdfSet,
+    folder: *const c_char,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(set, Kind::BrdfSet, "set") }?;
+        // SAFETY: this fn's # Safety.
+        let folder = unsafe { utf8(folder, "folder") }?;
+        histencil_build::stage_brdf_set(&held.modules.set, folder.as_ref())
+            .map_err(|e| setup(e.to_string()))?;
+        Ok(())
+    })
+}
+
 /// The set's shaders: `set`'s, or histencil's own for a null `set`.
 ///
 /// # Safety

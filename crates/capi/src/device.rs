@@ -8,6 +8,12 @@ use histencil::{BorrowedDevice, Context, DepthStencilFormat};
 use std::ffi::c_char;
 use std::sync::Arc;
 
+/// `<vulkan/vulkan.h>`'s `PFN_vkGetInstanceProcAddr`, nullable (the header uses Vulkan's own
+/// typedef: cbindgen is told not to define it).
+#[allow(non_camel_case_types)]
+pub type PFN_vkGetInstanceProcAddr =
+    Option<unsafe extern "system" fn(vk::Instance, *const c_char) -> vk::PFN_vkVoidFunction>;
+
 /// The engine's device, as `histencil_context_create` borrows it. The engine keeps every handle
 /// and destroys them itself, after the context.
 #[repr(C)]
@@ -18,8 +24,7 @@ pub struct HistencilDeviceDesc {
     pub queue_family: u32,
     /// The loader's (or the engine's) `vkGetInstanceProcAddr`, through which histencil loads
     /// every instance and device function it calls.
-    pub get_instance_proc_addr:
-        Option<unsafe extern "system" fn(vk::Instance, *const c_char) -> vk::PFN_vkVoidFunction>,
+    pub get_instance_proc_addr: PFN_vkGetInstanceProcAddr,
     /// The engine's instance, created for Vulkan 1.3 or later.
     pub instance: vk::Instance,
     /// The physical device behind `device`.
@@ -165,6 +170,68 @@ pub unsafe extern "C" fn histencil_context_destroy(
         }
         // SAFETY: as above.
         drop(unsafe { handles::take(context, Kind::Context, "context") }?);
+        Ok(())
+    })
+}
+
+/// Whether histencil can light on `physical_device` of `instance` with `queue_family`, asked
+/// before the engine creates its device: writes 1 to `suits` if so, else 0 with the reason in
+/// `histencil_last_error()` (the features or limits the device lacks, or what the family
+/// cannot do), which `histencil_context_create` would refuse with.
+///
+/// Errors: `INVALID_ARGUMENT` for a null pointer or handle.
+///
+/// Thread safety: any thread.
+///
+/// # Safety
+/// `instance` is live, created for Vulkan 1.3 with `get_instance_proc_addr`'s loader, and
+/// `physical_device` enumerated from it; `suits` is null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_device_suits(
+    get_instance_proc_addr: PFN_vkGetInstanceProcAddr,
+    instance: vk::Instance,
+    physical_device: vk::PhysicalDevice,
+    queue_family: u32,
+    suits: *mut u32,
+) -> HistencilResult {
+    call(|| {
+        let get_instance_proc_addr = get_instance_proc_addr
+            .ok_or_else(|| Failure::invalid("get_instance_proc_addr is null"))?;
+        if instance == vk::Instance::null() || physical_device == vk::PhysicalDevice::null() {
+            return Err(Failure::invalid(
+                "instance or physical_device is VK_NULL_HANDLE",
+            ));
+        }
+        if suits.is_null() {
+            return Err(Failure::invalid("suits is null"));
+        }
+        let loader = ash::StaticFn {
+            get_instance_proc_addr,
+        };
+        // SAFETY: this fn's # Safety: a live instance of that loader.
+        let instance = unsafe { ash::Instance::load(&loader, instance) };
+        let requirements = histencil::REQUIREMENTS;
+        // SAFETY: this fn's # Safety: the physical device belongs to the live instance, made
+        // for Vulkan 1.3.
+        let missing = unsafe { requirements.missing(&instance, physical_device) };
+        // SAFETY: as above.
+        let family =
+            unsafe { requirements.queue_family_fits(&instance, physical_device, queue_family) };
+        let why = if !missing.is_empty() {
+            Some(format!("the device lacks {}", missing.join(", ")))
+        } else if !family {
+            Some(format!(
+                "queue family {queue_family} of the device cannot draw, compute and write \
+                 timestamps"
+            ))
+        } else {
+            None
+        };
+        // SAFETY: checked non-null; writable by this fn's # Safety.
+        unsafe { suits.write(u32::from(why.is_none())) };
+        if let Some(why) = why {
+            crate::set_last_error(&why);
+        }
         Ok(())
     })
 }

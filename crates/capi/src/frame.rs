@@ -1,7 +1,7 @@
 //! What an engine passes per frame, as C structs, and their checked conversion to histencil's
 //! own: lights, the view, each BRDF's bounds, the technique and platform, and the images.
 
-use crate::{check_size, slice, Failure, Outcome};
+use crate::{check_size, required, slice, Failure, Outcome};
 use ash::vk;
 use glam::Vec3;
 use histencil::{Aabb, DepthConvention, Falloff, ImageRef, ImageState, Light, LightKind, ViewDesc};
@@ -138,13 +138,23 @@ impl HistencilView {
     }
 }
 
+/// An axis-aligned box in world space.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct HistencilBox {
+    /// The corner with the smallest coordinates.
+    pub min: [f32; 3],
+    /// The corner with the largest; no coordinate below `min`'s.
+    pub max: [f32; 3],
+}
+
 /// The world boxes of what one BRDF draws: the lights that reach none of them are not drawn
 /// for that BRDF.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct HistencilBrdfBounds {
-    /// `box_count` boxes, each `{min x, min y, min z, max x, max y, max z}`.
-    pub boxes: *const [f32; 6],
+    /// `box_count` boxes.
+    pub boxes: *const HistencilBox,
     /// How many.
     pub box_count: u32,
 }
@@ -205,9 +215,18 @@ impl HistencilImage {
     }
 }
 
-/// The images a lighting records against: the G-buffer (histencil's `GBUFFER_FORMATS`, in
-/// order), the depth-stencil holding each pixel's BRDF slot, and the HDR image light is added
-/// to. Each image's state is read before and written after the recording.
+/// The images a lighting records against, each the engine's own `HistencilImage`, read before
+/// the recording and written after it with the state the commands leave it in (so the engine's
+/// next barrier starts from there):
+/// - `gbuffer`: histencil's G-buffer (`histencil_gbuffer_formats`, in that order), made with
+///   `SAMPLED` usage; its stencil-carrying depth image written by the engine's G-buffer pass
+///   with each surface's BRDF slot (`histencil_lighting_stencil_reference`), the BRDF bits
+///   cleared to 0 everywhere else first.
+/// - `depth_stencil`: `DEPTH_STENCIL_ATTACHMENT`, and `SAMPLED` for the PS3-like and 360-like
+///   platforms (the hi-stencil emulation reads it), `TRANSFER_SRC` for a 360-like save.
+/// - `hdr`: `COLOR_ATTACHMENT`, and `STORAGE` for the tiled and depth-id techniques (which take
+///   `VK_FORMAT_R16G16B16A16_SFLOAT` only).
+/// A usage a frame needs and an image lacks is refused with `BAD_FRAME`, naming it.
 #[repr(C)]
 #[derive(Debug)]
 pub struct HistencilTargets {
@@ -218,12 +237,12 @@ pub struct HistencilTargets {
     /// The G-buffer images.
     pub gbuffer: *mut HistencilImage,
     /// The depth-stencil image.
-    pub depth_stencil: HistencilImage,
+    pub depth_stencil: *mut HistencilImage,
     /// The HDR image.
-    pub hdr: HistencilImage,
+    pub hdr: *mut HistencilImage,
 }
 
-/// The G-buffer's most images: histencil's own has four.
+/// The G-buffer's most images: histencil's own has three.
 const MAX_GBUFFER_IMAGES: u32 = 8;
 
 impl HistencilTargets {
@@ -241,26 +260,35 @@ impl HistencilTargets {
         let gbuffer = (gbuffer.iter().enumerate())
             .map(|(i, g)| g.to_ref(&format!("gbuffer[{i}]")))
             .collect::<Outcome<Vec<_>>>()?;
+        // SAFETY: the header's contract: null or a live image each.
+        let (depth_stencil, hdr) = unsafe {
+            (
+                required(self.depth_stencil, "HistencilTargets.depth_stencil")?,
+                required(self.hdr, "HistencilTargets.hdr")?,
+            )
+        };
         Ok(histencil::LightingTargets {
             gbuffer,
-            depth_stencil: self.depth_stencil.to_ref("depth_stencil")?,
-            hdr: self.hdr.to_ref("hdr")?,
+            depth_stencil: depth_stencil.to_ref("depth_stencil")?,
+            hdr: hdr.to_ref("hdr")?,
         })
     }
 
     /// Writes back the states a recording left the images in.
     pub(crate) fn left_as(&mut self, targets: &histencil::LightingTargets) {
-        if self.gbuffer_count > 0 && !self.gbuffer.is_null() {
-            // SAFETY: checked by `to_targets` before the recording: `gbuffer_count` images.
-            let gbuffer = unsafe {
-                std::slice::from_raw_parts_mut(self.gbuffer, self.gbuffer_count as usize)
-            };
-            for (g, t) in gbuffer.iter_mut().zip(&targets.gbuffer) {
-                g.left_as(t);
+        // SAFETY: checked by `to_targets` before the recording: `gbuffer_count` images at
+        // `gbuffer` (none when the count is 0), and live `depth_stencil` and `hdr`.
+        unsafe {
+            if self.gbuffer_count > 0 {
+                let count = self.gbuffer_count as usize;
+                let gbuffer = std::slice::from_raw_parts_mut(self.gbuffer, count);
+                for (g, t) in gbuffer.iter_mut().zip(&targets.gbuffer) {
+                    g.left_as(t);
+                }
             }
+            (*self.depth_stencil).left_as(&targets.depth_stencil);
+            (*self.hdr).left_as(&targets.hdr);
         }
-        self.depth_stencil.left_as(&targets.depth_stencil);
-        self.hdr.left_as(&targets.hdr);
     }
 }
 
@@ -327,9 +355,9 @@ impl HistencilFrame {
             out.push(
                 boxes
                     .iter()
-                    .map(|v| Aabb {
-                        min: [v[0], v[1], v[2]],
-                        max: [v[3], v[4], v[5]],
+                    .map(|b| Aabb {
+                        min: b.min,
+                        max: b.max,
                     })
                     .collect(),
             );

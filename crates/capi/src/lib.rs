@@ -22,13 +22,17 @@ mod gbuffer;
 mod handles;
 mod lighting;
 
-pub use brdf_set::{histencil_brdf_set_destroy, histencil_brdf_set_load, HistencilBrdfSet};
+pub use brdf_set::{
+    histencil_brdf_set_destroy, histencil_brdf_set_load, histencil_brdf_set_write_includes,
+    HistencilBrdfSet,
+};
 pub use device::{
-    histencil_context_create, histencil_context_destroy, HistencilContext, HistencilDeviceDesc,
+    histencil_context_create, histencil_context_destroy, histencil_device_suits, HistencilContext,
+    HistencilDeviceDesc, PFN_vkGetInstanceProcAddr,
 };
 pub use frame::{
-    HistencilBrdfBounds, HistencilFrame, HistencilImage, HistencilLight, HistencilTargets,
-    HistencilView, HISTENCIL_FALLOFF_GLTF, HISTENCIL_FALLOFF_INVERSE_SQUARE,
+    HistencilBox, HistencilBrdfBounds, HistencilFrame, HistencilImage, HistencilLight,
+    HistencilTargets, HistencilView, HISTENCIL_FALLOFF_GLTF, HISTENCIL_FALLOFF_INVERSE_SQUARE,
     HISTENCIL_FALLOFF_SQUARED_WINDOW, HISTENCIL_LIGHT_DIRECTIONAL, HISTENCIL_LIGHT_POINT,
     HISTENCIL_LIGHT_SPOT, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
     HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
@@ -127,7 +131,7 @@ thread_local! {
     static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
 }
 
-fn set_last_error(message: &str) {
+pub(crate) fn set_last_error(message: &str) {
     // A message with a NUL in it (from a name the engine passed) is cut there.
     let message = message.split('\0').next().unwrap_or_default();
     let message = CString::new(message).unwrap_or_default();

@@ -12,7 +12,7 @@ use histencil_tests::engine::{
 };
 mod common;
 
-use common::{c_targets_of, device_desc, World};
+use common::{c_boxes, c_targets_of, device_desc, World};
 use std::ffi::{c_char, CStr, CString};
 use std::ptr::{null, null_mut};
 
@@ -112,13 +112,7 @@ fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
         let readback = engine.readback_buffer(u64::from(SIZE.width * SIZE.height) * 8);
         let lights = world.c_lights();
         let bounds_lists = world.scene.brdf_bounds(&brdfs);
-        let boxes: Vec<Vec<[f32; 6]>> = (bounds_lists.iter())
-            .map(|b| {
-                b.iter()
-                    .map(|a| [a.min[0], a.min[1], a.min[2], a.max[0], a.max[1], a.max[2]])
-                    .collect()
-            })
-            .collect();
+        let boxes = c_boxes(&bounds_lists);
         let bounds: Vec<HistencilBrdfBounds> = (boxes.iter())
             .map(|b| HistencilBrdfBounds {
                 boxes: b.as_ptr(),
@@ -175,9 +169,10 @@ fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
                     unsafe { histencil_lighting_record(c_lighting, cmd, &frame, &mut c_targets) };
                 assert_eq!(r, HistencilResult::Success, "{}", last_error());
                 // The states the C side was handed back are where the commands left the HDR.
-                targets.hdr.state.layout = c_targets.hdr.layout;
-                targets.hdr.state.stage = c_targets.hdr.stage;
-                targets.hdr.state.access = c_targets.hdr.access;
+                let hdr = gbuffer[gbuffer.len() - 1];
+                targets.hdr.state.layout = hdr.layout;
+                targets.hdr.state.stage = hdr.stage;
+                targets.hdr.state.access = hdr.access;
             });
             // SAFETY: the frame was waited for.
             let r = unsafe { histencil_lighting_slot_finished(c_lighting, 0) };
@@ -251,6 +246,17 @@ fn misuse_through_c_returns_its_error_and_names_the_problem() {
         // SAFETY: every call below passes null, a live struct or a live or freed handle, which
         // the C API refuses or uses; nothing is left dangling.
         unsafe {
+            // Asked before the device is made: the engine's fits; a queue family it lacks does
+            // not, and says why.
+            let mut suits = 7;
+            let gipa = Some(engine.entry.static_fn().get_instance_proc_addr);
+            let (instance, physical) = (engine.instance.handle(), engine.physical_device);
+            let r =
+                histencil_device_suits(gipa, instance, physical, engine.queue_family, &mut suits);
+            assert_eq!((r, suits), (R::Success, 1), "{}", last_error());
+            let r = histencil_device_suits(gipa, instance, physical, 99, &mut suits);
+            assert_eq!((r, suits), (R::Success, 0));
+            assert!(last_error().contains("queue family 99"), "{}", last_error());
             // Null pointers and handles.
             expect(
                 histencil_context_create(null(), &mut null_mut()),
@@ -652,12 +658,15 @@ fn an_engines_own_brdfs_come_through_c_from_its_folder() {
                 R::BadSetup,
                 "bands",
             );
-            assert_eq!(
-                histencil_lighting_destroy(lighting),
-                R::Success,
-                "{}",
-                last_error()
-            );
+            // The set's GLSL for the engine's own shaders (a forward reference).
+            let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("c-set-includes");
+            let out_c = CString::new(out.to_str().unwrap()).unwrap();
+            let r = histencil_brdf_set_write_includes(set, out_c.as_ptr());
+            assert_eq!(r, R::Success, "{}", last_error());
+            let ids = std::fs::read_to_string(out.join("brdf_set/ids.glsl")).unwrap();
+            assert!(ids.contains("#define BRDF_ENGINE_TOON 8u"), "{ids}");
+            let r = histencil_lighting_destroy(lighting);
+            assert_eq!(r, R::Success, "{}", last_error());
             assert_eq!(histencil_brdf_set_destroy(set), R::Success);
             expect(
                 histencil_brdf_set_destroy(set),

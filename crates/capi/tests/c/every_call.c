@@ -78,6 +78,8 @@ int main(void) {
         HistencilBrdfSet *set = NULL;
         expect(histencil_brdf_set_load(NULL, "examples/brdfs", &set), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "brdf_set_load(NULL)");
         expect(histencil_brdf_set_destroy((HistencilBrdfSet *)&device), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live BrdfSet handle", "brdf_set_destroy(foreign)");
+        expect(histencil_brdf_set_write_includes(NULL, "out"), HISTENCIL_RESULT_INVALID_ARGUMENT, "set is null", "brdf_set_write_includes(NULL)");
+        expect(histencil_device_suits(NULL, VK_NULL_HANDLE, VK_NULL_HANDLE, 0, &in_flight), HISTENCIL_RESULT_INVALID_ARGUMENT, "get_instance_proc_addr is null", "device_suits(NULL)");
     }
 
     /* What an engine writes its G-buffer and device with. */

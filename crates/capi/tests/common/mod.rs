@@ -38,19 +38,41 @@ pub fn c_image(image: &histencil::ImageRef) -> HistencilImage {
     }
 }
 
-/// `targets` as the C side passes them, its G-buffer images kept in `gbuffer`.
+/// `targets` as the C side passes them, its images kept in `images`: the G-buffer's, then the
+/// depth-stencil, then the HDR image (`images[images.len() - 1]` after a recording holds the
+/// state the HDR image was left in).
 pub fn c_targets_of(
     targets: &histencil::LightingTargets,
-    gbuffer: &mut Vec<HistencilImage>,
+    images: &mut Vec<HistencilImage>,
 ) -> HistencilTargets {
-    *gbuffer = targets.gbuffer.iter().map(c_image).collect();
+    *images = targets.gbuffer.iter().map(c_image).collect();
+    images.push(c_image(&targets.depth_stencil));
+    images.push(c_image(&targets.hdr));
+    let gbuffer = targets.gbuffer.len();
+    let base = images.as_mut_ptr();
     HistencilTargets {
         size: size_of::<HistencilTargets>() as u32,
-        gbuffer_count: gbuffer.len() as u32,
-        gbuffer: gbuffer.as_mut_ptr(),
-        depth_stencil: c_image(&targets.depth_stencil),
-        hdr: c_image(&targets.hdr),
+        gbuffer_count: gbuffer as u32,
+        gbuffer: base,
+        // SAFETY: both within `images`, which holds the G-buffer's images and these two.
+        depth_stencil: unsafe { base.add(gbuffer) },
+        // SAFETY: as above.
+        hdr: unsafe { base.add(gbuffer + 1) },
     }
+}
+
+/// Each BRDF's boxes as the C side passes them (`HistencilBrdfBounds` point into the result).
+pub fn c_boxes(bounds: &[Vec<histencil::Aabb>]) -> Vec<Vec<HistencilBox>> {
+    (bounds.iter())
+        .map(|b| {
+            b.iter()
+                .map(|a| HistencilBox {
+                    min: a.min,
+                    max: a.max,
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// The scene, view and G-buffer every frame here lights: `brdfs-3` through histencil's

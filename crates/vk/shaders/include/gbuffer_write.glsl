@@ -14,9 +14,10 @@
 //                                                      (histencil_brdf::Brdf::model_index)
 //
 // Clear values: 0 for albedo and normal_depth, (0, 0, 0, -1) for material. The stencil gets the
-// draw's BRDF slot in the layout's BRDF field with the culling bit 0
-// (histencil_vk::gbuffer_stencil_reference gives reference and write mask); the depth buffer
-// is the engine's, in the depth convention its ViewDesc names.
+// draw's BRDF slot in the layout's BRDF field with the culling bit 0, the BRDF bits cleared to 0
+// first (LightingDesc::stencil_reference in Rust, histencil_lighting_stencil_reference in C give
+// reference and write mask); the depth buffer is the engine's, in the depth convention its view
+// names.
 //
 // Self-contained on purpose: an engine's shader needs nothing else from histencil to write it.
 #ifndef GBUFFER_WRITE_GLSL
