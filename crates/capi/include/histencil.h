@@ -291,6 +291,7 @@ typedef struct HistencilImage {
 //   platforms (the hi-stencil emulation reads it), `TRANSFER_SRC` for a 360-like save.
 // - `hdr`: `COLOR_ATTACHMENT`, and `STORAGE` for the tiled and depth-id techniques (which take
 //   `VK_FORMAT_R16G16B16A16_SFLOAT` only).
+//
 // A usage a frame needs and an image lacks is refused with `BAD_FRAME`, naming it.
 typedef struct HistencilTargets {
   // `sizeof(HistencilTargets)`.
