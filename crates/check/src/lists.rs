@@ -112,10 +112,43 @@ fn read(path: &Path) -> Result<String, ListError> {
     })
 }
 
-/// Expected results: the case's full name and the status it is known to end with.
+/// Expected results: the case's full name and the status it is known to end with, and why.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Baseline {
     pub expected: BTreeMap<String, Status>,
+    /// Each line's reason, where the file gives one: the comment at the end of the line, else
+    /// the comment lines directly above it (no blank line between). What a driver team's
+    /// `*-fails.txt` carries beside each line, which `--print-gtest-baseline` keeps.
+    pub reasons: BTreeMap<String, String>,
+}
+
+/// The comment each `name,Status` line of `text` carries, by line number (1-based): its own
+/// trailing comment, else the comment lines directly above it, joined by a space.
+fn line_reasons(text: &str) -> BTreeMap<usize, String> {
+    let mut reasons = BTreeMap::new();
+    let mut above: Vec<&str> = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let (content, comment) = match line.split_once('#') {
+            Some((c, comment)) => (c.trim(), Some(comment.trim())),
+            None => (line.trim(), None),
+        };
+        if content.is_empty() {
+            match comment {
+                Some(c) if !c.is_empty() => above.push(c),
+                _ => above.clear(),
+            }
+            continue;
+        }
+        let reason = match comment.filter(|c| !c.is_empty()) {
+            Some(own) => own.to_owned(),
+            None => above.join(" "),
+        };
+        if !reason.is_empty() {
+            reasons.insert(i + 1, reason);
+        }
+        above.clear();
+    }
+    reasons
 }
 
 impl Baseline {
@@ -123,6 +156,8 @@ impl Baseline {
     /// case needs no line), and a muted validation layer can never be expected.
     pub fn parse(text: &str, path: &str) -> Result<Baseline, ListError> {
         let mut expected = BTreeMap::new();
+        let mut reasons = BTreeMap::new();
+        let mut line_reasons = line_reasons(text);
         for (line, content) in lines(text) {
             let err = |message: String| ListError {
                 path: path.to_owned(),
@@ -149,11 +184,14 @@ impl Baseline {
                 )));
             }
             let name = name.trim().to_owned();
+            if let Some(reason) = line_reasons.remove(&line) {
+                reasons.insert(name.clone(), reason);
+            }
             if expected.insert(name.clone(), status).is_some() {
                 return Err(err(format!("`{name}` is listed twice")));
             }
         }
-        Ok(Baseline { expected })
+        Ok(Baseline { expected, reasons })
     }
 
     pub fn load(path: &Path) -> Result<Baseline, ListError> {
@@ -386,6 +424,19 @@ mod tests {
         .unwrap();
         assert_eq!(b.expected["scene/a"], Status::Fail);
         assert_eq!(b.expected["scene/b"], Status::Crash);
+        // Each line's reason: its own comment, else the comment lines right above it.
+        assert_eq!(b.reasons["scene/a"], "known on lavapipe 22.3");
+        assert_eq!(b.reasons["scene/b"], "comment");
+        let b = Baseline::parse("# header
+
+# why
+# and more
+scene/c,Fail
+scene/d,Fail
+", "b")
+            .unwrap();
+        assert_eq!(b.reasons["scene/c"], "why and more");
+        assert!(!b.reasons.contains_key("scene/d"), "{:?}", b.reasons);
         for bad in [
             "scene/a",
             "scene/a,Pass",

@@ -64,9 +64,9 @@ pub struct CheckArgs {
     /// and `?` wildcards), as deqp-runner's `gtest-runner` runs a group.
     #[arg(long = "gtest_filter")]
     gtest_filter: Option<String>,
-    /// Print --baseline in googletest spelling (`Group.name,Status`, comments dropped), the
-    /// form deqp-runner's gtest-runner reads, and exit: one baseline file kept in
-    /// `scene/case` spelling serves both runners.
+    /// Print --baseline in googletest spelling (`Group.name,Status`, each line's reason kept as
+    /// a `#` comment above it), the form deqp-runner's gtest-runner reads, and exit: one
+    /// baseline file kept in `scene/case` spelling serves both runners.
     #[arg(long, requires = "baseline")]
     print_gtest_baseline: bool,
     /// The prefix a deqp-runner suite entry gives histencil's cases (`histencil-`, as in
@@ -505,26 +505,31 @@ fn load_baseline(
 ) -> Result<Baseline, histencil_check::lists::ListError> {
     let mut baseline = Baseline::load(path)?;
     let mut outside = Vec::new();
+    let mut reasons = std::mem::take(&mut baseline.reasons);
+    let mut renamed_reasons = std::collections::BTreeMap::new();
     baseline.expected = std::mem::take(&mut baseline.expected)
         .into_iter()
         .filter_map(|(name, status)| match prefix {
-            Some(p) => name.strip_prefix(p).map(|n| (n.to_owned(), status)),
-            None => Some((name, status)),
+            Some(p) => name.strip_prefix(p).map(|n| (name.clone(), n.to_owned(), status)),
+            None => Some((name.clone(), name, status)),
         })
-        .map(|(name, status)| {
+        .map(|(written, name, status)| {
             let full = names
                 .full_name(&name)
                 .map(str::to_owned)
                 .or_else(|| names.gtest_name(&name).map(|_| name.clone()));
-            match full {
-                Some(full) => (full, status),
-                None => {
-                    outside.push(name.clone());
-                    (name, status)
-                }
+            let name = full.unwrap_or_else(|| {
+                outside.push(name.clone());
+                name
+            });
+            // A line's reason follows it under its new name.
+            if let Some(reason) = reasons.remove(&written) {
+                renamed_reasons.insert(name.clone(), reason);
             }
+            (name, status)
         })
         .collect();
+    baseline.reasons = renamed_reasons;
     note_outside(path, &outside);
     Ok(baseline)
 }
@@ -564,6 +569,11 @@ fn print_gtest_baseline(
             (None, Some((scene, case))) => histencil_check::gtest::test_name(scene, case),
             (None, None) => name.clone(),
         };
+        // The reason goes with the line into the driver's fails file (deqp-runner skips `#`
+        // lines), so its team reads why beside what.
+        if let Some(reason) = baseline.reasons.get(name) {
+            out.push_str(&format!("# {reason}\n"));
+        }
         out.push_str(&format!("{}{gtest},{status}\n", prefix.unwrap_or("")));
     }
     print!("{out}");
