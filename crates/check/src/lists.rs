@@ -427,14 +427,17 @@ mod tests {
         // Each line's reason: its own comment, else the comment lines right above it.
         assert_eq!(b.reasons["scene/a"], "known on lavapipe 22.3");
         assert_eq!(b.reasons["scene/b"], "comment");
-        let b = Baseline::parse("# header
+        let b = Baseline::parse(
+            "# header
 
 # why
 # and more
 scene/c,Fail
 scene/d,Fail
-", "b")
-            .unwrap();
+",
+            "b",
+        )
+        .unwrap();
         assert_eq!(b.reasons["scene/c"], "why and more");
         assert!(!b.reasons.contains_key("scene/d"), "{:?}", b.reasons);
         for bad in [

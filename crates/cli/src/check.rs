@@ -510,7 +510,9 @@ fn load_baseline(
     baseline.expected = std::mem::take(&mut baseline.expected)
         .into_iter()
         .filter_map(|(name, status)| match prefix {
-            Some(p) => name.strip_prefix(p).map(|n| (name.clone(), n.to_owned(), status)),
+            Some(p) => name
+                .strip_prefix(p)
+                .map(|n| (name.clone(), n.to_owned(), status)),
             None => Some((name.clone(), name, status)),
         })
         .map(|(written, name, status)| {
