@@ -61,8 +61,14 @@ fn main() {
     let engine = Engine::start_unvalidated();
     let d = &engine.device;
     {
+        // Lent as the C API lends it (histencil's private allocator), so both ways record on
+        // the same kind of context.
+        let lent = histencil::BorrowedDevice {
+            allocator: None,
+            ..engine.lend(engine.queue_family)
+        };
         // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
-        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.unwrap();
+        let ctx = unsafe { Context::from_raw(lent) }.unwrap();
         let driver = ctx.driver();
         println!(
             "device: {}; driver {} {}",

@@ -185,10 +185,11 @@ pub struct HistencilImage {
 }
 
 impl HistencilImage {
-    fn to_ref(self, what: &str) -> Outcome<ImageRef> {
+    fn to_ref(self, what: impl Fn() -> String) -> Outcome<ImageRef> {
         if self.image == vk::Image::null() || self.view == vk::ImageView::null() {
             return Err(Failure::invalid(format!(
-                "{what}: its image or view is VK_NULL_HANDLE"
+                "{}: its image or view is VK_NULL_HANDLE",
+                what()
             )));
         }
         Ok(ImageRef {
@@ -259,7 +260,7 @@ impl HistencilTargets {
         let gbuffer =
             unsafe { slice(self.gbuffer, self.gbuffer_count, "HistencilTargets.gbuffer") }?;
         let gbuffer = (gbuffer.iter().enumerate())
-            .map(|(i, g)| g.to_ref(&format!("gbuffer[{i}]")))
+            .map(|(i, g)| g.to_ref(|| format!("gbuffer[{i}]")))
             .collect::<Outcome<Vec<_>>>()?;
         // SAFETY: the header's contract: null or a live image each.
         let (depth_stencil, hdr) = unsafe {
@@ -270,8 +271,8 @@ impl HistencilTargets {
         };
         Ok(histencil::LightingTargets {
             gbuffer,
-            depth_stencil: depth_stencil.to_ref("depth_stencil")?,
-            hdr: hdr.to_ref("hdr")?,
+            depth_stencil: depth_stencil.to_ref(|| "depth_stencil".into())?,
+            hdr: hdr.to_ref(|| "hdr".into())?,
         })
     }
 
@@ -324,7 +325,9 @@ pub struct HistencilFrame {
 const MAX_LIGHTS: u32 = 1 << 20;
 
 impl HistencilFrame {
-    pub(crate) fn lights(&self) -> Outcome<Vec<Light>> {
+    /// The frame's lights, converted into `out` (a lighting's own, reused frame after frame so
+    /// that a frame through C allocates nothing the Rust API's does not).
+    pub(crate) fn lights_into(&self, out: &mut Vec<Light>) -> Outcome {
         if self.light_count > MAX_LIGHTS {
             return Err(Failure::invalid(format!(
                 "HistencilFrame.light_count is {}, past {MAX_LIGHTS}",
@@ -333,12 +336,15 @@ impl HistencilFrame {
         }
         // SAFETY: the header's contract: `light_count` lights at `lights`.
         let lights = unsafe { slice(self.lights, self.light_count, "HistencilFrame.lights") }?;
-        (lights.iter().enumerate())
-            .map(|(i, l)| l.to_light(i))
-            .collect()
+        out.clear();
+        for (i, l) in lights.iter().enumerate() {
+            out.push(l.to_light(i)?);
+        }
+        Ok(())
     }
 
-    pub(crate) fn bounds(&self, brdfs: usize) -> Outcome<Vec<Vec<Aabb>>> {
+    /// Each BRDF's boxes, converted into `out` (reused as `lights_into`'s).
+    pub(crate) fn bounds_into(&self, brdfs: usize, out: &mut Vec<Vec<Aabb>>) -> Outcome {
         if self.brdf_bounds_count as usize != brdfs {
             return Err(Failure::invalid(format!(
                 "HistencilFrame.brdf_bounds_count is {}, and the lighting has {brdfs} BRDFs: one \
@@ -348,21 +354,22 @@ impl HistencilFrame {
         }
         // SAFETY: the header's contract: `brdf_bounds_count` entries at `brdf_bounds`.
         let all = unsafe { slice(self.brdf_bounds, self.brdf_bounds_count, "brdf_bounds") }?;
-        let mut out = Vec::with_capacity(all.len());
-        for (b, bounds) in all.iter().enumerate() {
-            let what = format!("brdf_bounds[{b}].boxes");
-            // SAFETY: the header's contract: `box_count` boxes at `boxes`.
-            let boxes = unsafe { slice(bounds.boxes, bounds.box_count, &what) }?;
-            out.push(
-                boxes
-                    .iter()
-                    .map(|b| Aabb {
-                        min: b.min,
-                        max: b.max,
-                    })
-                    .collect(),
-            );
+        out.resize_with(all.len(), Vec::new);
+        for (b, (bounds, boxes_out)) in all.iter().zip(out.iter_mut()).enumerate() {
+            if bounds.boxes.is_null() && bounds.box_count > 0 {
+                return Err(Failure::invalid(format!(
+                    "brdf_bounds[{b}].boxes is null with a count of {}",
+                    bounds.box_count
+                )));
+            }
+            // SAFETY: the header's contract: `box_count` boxes at a non-null `boxes`.
+            let boxes = unsafe { slice(bounds.boxes, bounds.box_count, "boxes") }?;
+            boxes_out.clear();
+            boxes_out.extend(boxes.iter().map(|b| Aabb {
+                min: b.min,
+                max: b.max,
+            }));
         }
-        Ok(out)
+        Ok(())
     }
 }

@@ -52,6 +52,11 @@ pub struct HistencilLightingDesc {
 /// A lighting made on a context, with the names it was made with.
 pub struct HistencilLighting {
     lighting: DeferredLighting<Arc<Context>>,
+    /// Each frame's lights, shapes and boxes, converted from the C structs into these, kept
+    /// from frame to frame: a frame through C allocates nothing the Rust API's does not.
+    lights: Vec<histencil::Light>,
+    shapes: Vec<histencil::LightShape>,
+    bounds: Vec<Vec<histencil::Aabb>>,
     /// The shaders it lights with, whose set names its BRDFs.
     modules: &'static BrdfModules,
     /// How the tiled techniques classify on this context's driver (the quirk table).
@@ -164,6 +169,9 @@ pub unsafe extern "C" fn histencil_lighting_create(
         let handle = handles::make(
             HistencilLighting {
                 lighting: made,
+                lights: Vec::new(),
+                shapes: Vec::new(),
+                bounds: Vec::new(),
                 modules,
                 classify,
             },
@@ -259,7 +267,8 @@ pub unsafe extern "C" fn histencil_lighting_record(
         }
         check_size::<HistencilFrame>("HistencilFrame", frame.size)?;
         let mut targets = c_targets.to_targets()?;
-        let lights = frame.lights()?;
+        frame.lights_into(&mut held.lights)?;
+        let lights = &held.lights;
         let view = frame.view.to_view();
         let slot = frame.slot;
         let clear_hdr = frame.clear_hdr != 0;
@@ -290,15 +299,16 @@ pub unsafe extern "C" fn histencil_lighting_record(
                         )))
                     }
                 };
-                let bounds = frame.bounds(lighting.desc().brdfs.len())?;
-                let shapes: Vec<_> = lights.iter().map(|l| l.shape()).collect();
+                frame.bounds_into(lighting.desc().brdfs.len(), &mut held.bounds)?;
+                held.shapes.clear();
+                held.shapes.extend(lights.iter().map(|l| l.shape()));
                 let planned_view = View::new(&view).map_err(|e| Failure {
                     result: HistencilResult::BadFrame,
                     message: format!("the view: {e}"),
                 })?;
                 let inputs = PlanInputs {
-                    lights: &shapes,
-                    brdf_bounds: &bounds,
+                    lights: &held.shapes,
+                    brdf_bounds: &held.bounds,
                     view: &planned_view,
                 };
                 let settings = PlanSettings {
@@ -312,7 +322,7 @@ pub unsafe extern "C" fn histencil_lighting_record(
                 let frame = LightingFrame {
                     slot,
                     view: &view,
-                    lights: &lights,
+                    lights,
                     plan: &plan,
                     clear_hdr,
                     timestamps: false,
@@ -329,7 +339,7 @@ pub unsafe extern "C" fn histencil_lighting_record(
                 let frame = TiledFrame {
                     slot,
                     view: &view,
-                    lights: &lights,
+                    lights,
                     clear_hdr,
                     side: TileSide::Sixteen,
                     mixed: MixedTiles::PerBrdf,

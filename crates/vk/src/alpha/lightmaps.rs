@@ -243,6 +243,15 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         self.pending.finished(slot)
     }
 
+    /// Every slot finished at once, for histencil's own renderer after its device-wide wait.
+    ///
+    /// # Safety
+    /// The GPU has finished every command buffer recorded through this object, or none of
+    /// them will be submitted.
+    pub(crate) unsafe fn all_finished(&mut self) {
+        self.pending.clear();
+    }
+
     /// Whether a slot is recorded into and not yet declared finished.
     pub fn in_flight(&self) -> bool {
         self.pending.any()

@@ -539,6 +539,15 @@ impl<'c> AlphaLighting<'c> {
     }
 
     /// Frees the alpha pass's own objects; the lightmaps free theirs when dropped.
+    /// Every slot of its lightmaps finished (the renderer's drop, after its wait).
+    ///
+    /// # Safety
+    /// As [`AlphaLightmaps::all_finished`]'s.
+    pub(crate) unsafe fn all_finished(&mut self) {
+        // SAFETY: this fn's # Safety.
+        unsafe { self.lightmaps.all_finished() };
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         let mut parts = Parts {
             images: vec![],

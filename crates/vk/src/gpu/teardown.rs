@@ -172,6 +172,12 @@ impl PendingSlots {
         Ok(())
     }
 
+    /// Every slot finished: the owner's owner knows the GPU is done (histencil's renderer,
+    /// after its device-wide wait).
+    pub fn clear(&mut self) {
+        self.pending.iter_mut().for_each(|p| *p = None);
+    }
+
     /// Whether a slot is pending.
     pub fn any(&self) -> bool {
         self.pending.iter().any(Option::is_some)

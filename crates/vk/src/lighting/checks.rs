@@ -64,8 +64,10 @@ pub(super) fn check_desc(desc: &LightingDesc) -> Result<()> {
     }
     // Each of the layout's BRDF slots is shaded with the BRDF at its index: a slot with none
     // would have nothing to shade with (a plan's passes name slots, not BRDFs).
+    // (A layout has at least one slot: a lighting of no BRDFs, a scene of translucent objects
+    // alone, shades nothing, and its plans' indices are held at every frame.)
     let slots = desc.layout.brdfs_in_use() as usize;
-    if desc.brdfs.len() != slots {
+    if !desc.brdfs.is_empty() && desc.brdfs.len() != slots {
         return Err(bad_setup(format!(
             "{} BRDFs for a stencil layout with {slots} BRDF slots: give one BRDF per slot \
              (StencilLayout::new with the number of BRDFs)",

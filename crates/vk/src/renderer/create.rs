@@ -286,6 +286,14 @@ impl Drop for Renderer<'_> {
             ctx.device.destroy_fence(self.fence, None);
             ctx.device.destroy_command_pool(self.command_pool, None);
         }
+        // SAFETY: the wait above left the GPU done with every frame the renderer recorded,
+        // also one whose submission failed part way (a memory budget reached): the lighting
+        // frees its objects now instead of leaving them to the context.
+        unsafe { self.lighting.all_finished() };
+        if let Some(a) = self.alpha.as_mut() {
+            // SAFETY: as above.
+            unsafe { a.all_finished() };
+        }
         self.timestamps.destroy(ctx);
         self.readback.destroy(ctx);
         self.tonemap.destroy(ctx);

@@ -1,8 +1,8 @@
 /* Every function of histencil.h, called from C99 as an engine's C code would call it, each
  * with what it must refuse without a device: null handles and pointers, a wrong struct size, a
- * handle of the wrong kind. Built by tests/c_header.rs with -std=c99 -pedantic -Wall -Wextra
- * -Werror (and the sanitizers), linked against the static library; exit 0 when every call
- * returned its code and said why. */
+ * handle of the wrong kind; and the calls that need none. Built by this folder's CMake with
+ * -std=c99 -pedantic -Wall -Wextra -Werror against the installed static library (the proof that
+ * the header is C); exit 0 when every call returned its code and said why. */
 #include "histencil.h"
 
 #include <stdio.h>
