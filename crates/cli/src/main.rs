@@ -40,8 +40,9 @@ struct Cli {
 enum Command {
     /// Render a scene to PNG (and optionally EXR and a stencil dump).
     Render(RenderArgs),
-    /// A short tour of the talk: stencil on the 360-like, PS3-like and native backends next to
-    /// branching and forward, with times, errors and hi-stencil statistics, and a contact sheet.
+    /// A short tour of the talk: the stencil technique on each platform (the consoles, native and
+    /// AMD's two) next to branching, tiled, depth-id and forward, with times, errors against
+    /// forward, hi-stencil statistics and the engine's bits, and a contact sheet.
     Demo(lab::DemoArgs),
     /// List the embedded scenes, then any glTF files given: name, BRDFs in use, lights, alpha
     /// entities, description (which says when the default rig lights a scene).
