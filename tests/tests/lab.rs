@@ -16,6 +16,20 @@ use histencil_vk::{
 };
 use serde_json::Value;
 use std::path::Path;
+use std::sync::{Mutex, MutexGuard};
+
+/// Every test here times the device, and two of them make load on purpose (busy threads beside
+/// the rounds, from a chosen round on): one test's rounds beside another's rendering or busy
+/// threads move its clock, which can throw a canary off its reference or turn a verdict
+/// undecided. CI once failed in both of the tests that load on purpose, run two at a time, where
+/// each passes alone. So the tests hold this lock and run one at a
+/// time under any runner; on two cores that costs nothing (113 s alone against 117 s two at a
+/// time, measured on lavapipe), since each test keeps the cores busy by itself.
+fn one_at_a_time() -> MutexGuard<'static, ()> {
+    static TIMING: Mutex<()> = Mutex::new(());
+    // A test that failed holding the lock poisons it; the next test still runs alone.
+    TIMING.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 /// Every number under `value` is finite; returns how many there are. Nulls are refused too.
 fn count_finite_numbers(value: &Value, at: &str) -> usize {
@@ -60,6 +74,7 @@ fn read_json(path: &Path) -> Value {
 /// The tiled technique lights it as forward does with both tile sides.
 #[test]
 fn the_light_size_wall_is_lit_and_tiled_lights_it_as_forward() {
+    let _alone = one_at_a_time();
     with_validated_context(|ctx| {
         for (coverage, at_least) in [(0.001, 0.2), (0.1, 0.4), (1.0, 0.6)] {
             let scene = light_size_scene(coverage, 16.0 / 9.0);
@@ -84,6 +99,7 @@ fn the_light_size_wall_is_lit_and_tiled_lights_it_as_forward() {
 
 #[test]
 fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
+    let _alone = one_at_a_time();
     let mut settings = CompareSettings::talk(64, 64, 2);
     // The lab's tests run beside each other on CI's two cores: a steady clock would retake
     // most rounds. Its own test is `the_steady_clock_sees_a_load_...`.
@@ -246,6 +262,7 @@ fn compare_writes_a_finite_report_with_the_talks_columns_and_plots() {
 
 #[test]
 fn sweeps_write_csv_json_and_a_pareto_plot_and_error_falls() {
+    let _alone = one_at_a_time();
     let cases = [
         (SweepParam::LutRes, "default", vec![8, 32]),
         (SweepParam::LightmapRes, "alpha", vec![8, 64]),
@@ -289,6 +306,7 @@ fn sweeps_write_csv_json_and_a_pareto_plot_and_error_falls() {
 
 #[test]
 fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
+    let _alone = one_at_a_time();
     let calibration = with_validated_context(|ctx| {
         calibrate(ctx, 96, 64, &Sampling::rounds(2), &mut |_| {}).unwrap()
     });
@@ -368,6 +386,7 @@ fn calibrated_costs_are_finite_and_feed_the_adaptive_technique() {
 /// run it: the merge finds no reversal between two runs of one device.
 #[test]
 fn compare_verdicts_do_not_reverse_under_background_load() {
+    let _alone = one_at_a_time();
     use histencil_lab::compare::merge::{DeviceReport, Merged};
     let mut settings = CompareSettings::talk(64, 64, 15);
     // One light size: the sweep's verdicts pair by round as the table's do (CI's time).
@@ -443,6 +462,7 @@ fn compare_verdicts_do_not_reverse_under_background_load() {
 /// With histencil's BRDFs, and with an engine's (`demo --brdfs examples/brdfs`).
 #[test]
 fn the_demo_shows_each_failure_next_to_a_fix_that_matches_forward() {
+    let _alone = one_at_a_time();
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/brdfs");
     let set = histencil_brdf::BrdfSet::load(&dir).unwrap();
     let engine = histencil_vk::compile_brdf_set(&set).unwrap();
@@ -494,6 +514,7 @@ fn demo_holds(settings: histencil_lab::DemoSettings) {
 /// the predicted budget is spent, never before the pilot, and the report carries both.
 #[test]
 fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget() {
+    let _alone = one_at_a_time();
     let mut settings = CompareSettings::talk(48, 27, 2);
     settings.light_sizes = vec![1.0];
     settings.clock = None;
@@ -531,6 +552,7 @@ fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget()
 /// the CPU's share, which the busy threads take; on a GPU it is the GPU's clock.)
 #[test]
 fn the_steady_clock_sees_a_load_that_starts_part_way_and_retakes_the_round() {
+    let _alone = one_at_a_time();
     let mut settings = CompareSettings::talk(160, 90, 6);
     settings.brdf_counts = vec![1];
     settings.light_sizes = Vec::new();
