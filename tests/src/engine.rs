@@ -465,6 +465,94 @@ impl Engine {
     }
 }
 
+/// An engine's decode set for histencil's own decode read through a layout of the engine's: its
+/// three G-buffer images as sampled images, visible to `stages`.
+pub struct DecodeSet {
+    pub bindings: Vec<vk::DescriptorSetLayoutBinding<'static>>,
+    pub layout: vk::DescriptorSetLayout,
+    pub pool: vk::DescriptorPool,
+    pub set: vk::DescriptorSet,
+}
+
+impl Engine {
+    /// The decode set of `images`' G-buffer (see [`DecodeSet`]); freed by [`DecodeSet::free`]
+    /// after every lighting made with its layout.
+    pub fn decode_set(&self, images: &EngineTargets, stages: vk::ShaderStageFlags) -> DecodeSet {
+        let d = &self.device;
+        let bindings = gbuffer_bindings(stages);
+        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+        // SAFETY: the engine's device; the caller frees them after their users.
+        let layout = unsafe { d.create_descriptor_set_layout(&info, None) }.unwrap();
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::SAMPLED_IMAGE)
+            .descriptor_count(3)];
+        let pool_info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(1)
+            .pool_sizes(&sizes);
+        // SAFETY: as above.
+        let pool = unsafe { d.create_descriptor_pool(&pool_info, None) }.unwrap();
+        let layouts = [layout];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(pool)
+            .set_layouts(&layouts);
+        // SAFETY: as above.
+        let set = unsafe { d.allocate_descriptor_sets(&alloc) }.unwrap()[0];
+        let infos: Vec<[vk::DescriptorImageInfo; 1]> = (images.gbuffer.iter())
+            .map(|g| {
+                [vk::DescriptorImageInfo::default()
+                    .image_view(g.view)
+                    .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
+            })
+            .collect();
+        let writes: Vec<_> = (infos.iter().enumerate())
+            .map(|(i, info)| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(i as u32)
+                    .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                    .image_info(info)
+            })
+            .collect();
+        // SAFETY: a set of the engine's pool; the views are live.
+        unsafe { d.update_descriptor_sets(&writes, &[]) };
+        DecodeSet {
+            bindings,
+            layout,
+            pool,
+            set,
+        }
+    }
+}
+
+/// The bindings of histencil's own decode (`include/gbuffer.glsl`: three sampled images), as an
+/// engine that binds that decode's resources itself declares them, visible to `stages`.
+pub fn gbuffer_bindings(
+    stages: vk::ShaderStageFlags,
+) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+    (0..3)
+        .map(|binding| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(binding)
+                .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                .descriptor_count(1)
+                .stage_flags(stages)
+        })
+        .collect()
+}
+
+impl DecodeSet {
+    /// Frees the pool and layout: after every lighting made with the layout is gone.
+    pub fn free(self, engine: &Engine) {
+        // SAFETY: the caller's word: nothing uses them any more.
+        unsafe {
+            engine.device.destroy_descriptor_pool(self.pool, None);
+            engine
+                .device
+                .destroy_descriptor_set_layout(self.layout, None);
+        }
+    }
+}
+
 impl EngineTargets {
     /// As histencil sees them, before anything touched them.
     pub fn refs(&self) -> histencil_vk::LightingTargets {

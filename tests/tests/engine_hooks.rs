@@ -7,26 +7,12 @@
 
 use ash::vk;
 use histencil_tests::engine::{
-    copy_to_buffer, hdr_floats, lighting_desc, plain_frame, stencil_plan, Engine,
+    copy_to_buffer, gbuffer_bindings, hdr_floats, lighting_desc, plain_frame, stencil_plan, Engine,
 };
 use histencil_vk::{
     Backend, Context, DeferredLighting, EngineHooks, Error, HookSetLayout, HookSets, LightHooks,
     LightModules, LightingDesc, MixedTiles, Renderer, TileClassify, TileSide, TiledFrame,
 };
-
-/// The bindings of histencil's own decode (`include/gbuffer.glsl`: three sampled images), as an
-/// engine that binds that decode's resources itself declares them, visible to `stages`.
-fn gbuffer_bindings(stages: vk::ShaderStageFlags) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
-    (0..3)
-        .map(|binding| {
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(binding)
-                .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-                .descriptor_count(1)
-                .stage_flags(stages)
-        })
-        .collect()
-}
 
 const ALL_LIGHT_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
     vk::ShaderStageFlags::FRAGMENT.as_raw() | vk::ShaderStageFlags::COMPUTE.as_raw(),
@@ -157,10 +143,11 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         let renderer = Renderer::new(&ctx, scene.clone(), width, height).unwrap();
         let layout = *renderer.stencil_layout();
         let brdfs = renderer.brdfs().to_vec();
-        // The engine's decode layout: histencil's decode, fragment stage only (no tiled).
-        let bindings = gbuffer_bindings(vk::ShaderStageFlags::FRAGMENT);
-        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
-        let set_layout = unsafe { d.create_descriptor_set_layout(&info, None) }.unwrap();
+        // The engine's decode set: its three G-buffer images, through a layout of its own for
+        // histencil's decode, fragment stage only (no tiled).
+        let images = engine.lighting_targets(extent, ds_format);
+        let decode_set = engine.decode_set(&images, vk::ShaderStageFlags::FRAGMENT);
+        let (set_layout, bindings) = (decode_set.layout, decode_set.bindings.clone());
         let decode = HookSetLayout {
             layout: set_layout,
             bindings: &bindings,
@@ -185,42 +172,6 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         let view = scene.camera.view_desc(width as f32 / height as f32);
         let plan = stencil_plan(&scene, &layout, &brdfs, &view, Backend::Ps3);
 
-        // The engine's decode set: its three G-buffer images.
-        let images = engine.lighting_targets(extent, ds_format);
-        let sizes = [vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::SAMPLED_IMAGE)
-            .descriptor_count(3)];
-        let pool_info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(1)
-            .pool_sizes(&sizes);
-        let set_pool = unsafe { d.create_descriptor_pool(&pool_info, None) }.unwrap();
-        let layouts = [set_layout];
-        let alloc = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(set_pool)
-            .set_layouts(&layouts);
-        let decode_set = unsafe { d.allocate_descriptor_sets(&alloc) }.unwrap()[0];
-        let infos: Vec<[vk::DescriptorImageInfo; 1]> = images
-            .gbuffer
-            .iter()
-            .map(|g| {
-                [vk::DescriptorImageInfo::default()
-                    .image_view(g.view)
-                    .image_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)]
-            })
-            .collect();
-        let writes: Vec<_> = infos
-            .iter()
-            .enumerate()
-            .map(|(i, info)| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(decode_set)
-                    .dst_binding(i as u32)
-                    .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
-                    .image_info(info)
-            })
-            .collect();
-        unsafe { d.update_descriptor_sets(&writes, &[]) };
-
         // One frame: the G-buffer, then `lighting` with `hook_sets`, the HDR image read back.
         let readback = engine.readback_buffer(u64::from(width * height) * 8);
         let lit = |lighting: &mut DeferredLighting<&Context>, hook_sets: HookSets| {
@@ -242,7 +193,7 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         let theirs = lit(
             &mut engines,
             HookSets {
-                decode: Some(decode_set),
+                decode: Some(decode_set.set),
                 visibility: None,
             },
         );
@@ -259,7 +210,7 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
         let (pool, cmd) = engine.command_buffer();
         unsafe { d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()) }.unwrap();
         let hook_sets = HookSets {
-            decode: Some(decode_set),
+            decode: Some(decode_set.set),
             visibility: None,
         };
         let frame = plain_frame(&view, &scene.lights, &plan, hook_sets);
@@ -319,9 +270,8 @@ fn an_engine_decode_set_lights_as_histencil_does_and_its_images_are_checked() {
             // Every frame was waited for and declared finished.
             engines.destroy().unwrap();
             histencils.destroy().unwrap();
-            d.destroy_descriptor_pool(set_pool, None);
-            d.destroy_descriptor_set_layout(set_layout, None);
         }
+        decode_set.free(&engine);
         images.free(&engine);
         engine.free_buffer(readback);
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");

@@ -207,7 +207,7 @@ pub fn brdf_folder(dir: &Path) -> Result<BrdfSet, BuildError> {
 
 /// The engine's GLSL files in `folder` (any depth, `/`-separated paths, links followed only
 /// inside it), which its BRDFs' files may include from one another.
-fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
+pub fn engine_files(folder: &Path) -> Result<Vec<(String, PathBuf)>, BuildError> {
     fn walk(
         folder: &Path,
         dir: &Path,

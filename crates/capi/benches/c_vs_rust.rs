@@ -105,7 +105,7 @@ fn main() {
                 size: size_of::<HistencilLightingDesc>() as u32,
                 brdf_count: names.len() as u32,
                 brdf_names: names.as_ptr(),
-                brdf_set: std::ptr::null(),
+                shaders: std::ptr::null(),
                 engine_stencil_bits: 0,
                 width: SIZE.width,
                 height: SIZE.height,
@@ -114,6 +114,7 @@ fn main() {
                 frames_in_flight: 1,
                 max_lights: count as u32,
                 hi_stencil: 1,
+                hooks: std::ptr::null(),
             };
             let mut c_lighting = null_mut();
             // SAFETY: a live context and description.
@@ -138,6 +139,8 @@ fn main() {
                 brdf_bounds_count: bounds.len() as u32,
                 brdf_bounds: bounds.as_ptr(),
                 clear_hdr: 1,
+                decode_set: vk::DescriptorSet::null(),
+                visibility_set: vk::DescriptorSet::null(),
             };
             let (pool, cmd) = engine.command_buffer();
             // One frame recorded one way, timed; the command buffer reset after, untimed.

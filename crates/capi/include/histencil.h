@@ -109,14 +109,14 @@ typedef enum HistencilResult {
   HISTENCIL_RESULT_INTERNAL = 8,
 } HistencilResult;
 
-// A BRDF set and the shaders compiled for it.
-typedef struct HistencilBrdfSet HistencilBrdfSet;
-
 // A device lent to histencil, and what hangs off it (its private allocator).
 typedef struct HistencilContext HistencilContext;
 
 // A lighting made on a context, with the names it was made with.
 typedef struct HistencilLighting HistencilLighting;
+
+// histencil's shaders compiled for a BRDF set and, if the engine gave them, its hooks.
+typedef struct HistencilShaders HistencilShaders;
 
 // The engine's device, as `histencil_context_create` borrows it. The engine keeps every handle
 // and destroys them itself, after the context.
@@ -186,6 +186,39 @@ typedef struct HistencilLight {
   float outer_angle;
 } HistencilLight;
 
+// The descriptor set layouts an engine binds its hooks' resources with, and the images its
+// decode hook reads. Vulkan cannot be asked what a layout holds, so the engine says: every
+// resource the hooks' shaders declare in sets 1 and 4 is held to these bindings when the
+// lighting is made (the binding exists, its type serves the shader, its count covers the
+// array, it is visible to the stage), and a mismatch is refused naming module, set, binding
+// and types, not left to the driver.
+typedef struct HistencilHooks {
+  // `sizeof(HistencilHooks)`.
+  uint32_t size;
+  // The decode hook's layout (set 1), made by the engine from `decode_bindings`.
+  VkDescriptorSetLayout decode_layout;
+  // How many bindings `decode_layout` was made with.
+  uint32_t decode_binding_count;
+  // The `pBindings` `decode_layout` was made with.
+  const VkDescriptorSetLayoutBinding *decode_bindings;
+  // The visibility hook's layout (set 4), or `VK_NULL_HANDLE` when it reads no resource of
+  // its own (or reads them in set 1, beside the decode's).
+  VkDescriptorSetLayout visibility_layout;
+  // How many bindings `visibility_layout` was made with (0 without one).
+  uint32_t visibility_binding_count;
+  // The `pBindings` `visibility_layout` was made with (null without one).
+  const VkDescriptorSetLayoutBinding *visibility_bindings;
+  // How many images the decode reads: `HistencilTargets.gbuffer_count` each frame.
+  uint32_t surface_format_count;
+  // Their formats, in `HistencilTargets.gbuffer` order.
+  const VkFormat *surface_formats;
+  // How the decode reads each BRDF's parameters: 0 from the pixel itself (the G-buffer
+  // carries them), else from rows indexed by BRDF id, ids 0 to `brdf_param_rows - 1`
+  // (`BRDF_ID_COUNT` in `brdf_set/ids.glsl` sizes them). A lighting shading an id without a
+  // row is refused: its surfaces would be unlit with no error anywhere.
+  uint32_t brdf_param_rows;
+} HistencilHooks;
+
 // What `histencil_lighting_create` makes a lighting for.
 typedef struct HistencilLightingDesc {
   // `sizeof(HistencilLightingDesc)`.
@@ -193,10 +226,11 @@ typedef struct HistencilLightingDesc {
   // How many BRDFs: each takes one stencil slot, in this order.
   uint32_t brdf_count;
   // The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...) and
-  // those of `brdf_set`.
+  // those of `shaders`.
   const char *const *brdf_names;
-  // The engine's BRDF set (`histencil_brdf_set_load`), or null for histencil's own BRDFs.
-  const struct HistencilBrdfSet *brdf_set;
+  // histencil's shaders compiled for the engine's BRDFs and hooks (`histencil_shaders_compile`
+  // or `histencil_shaders_load`), or null for histencil's own BRDFs, G-buffer and no shadows.
+  const struct HistencilShaders *shaders;
   // Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
   uint32_t engine_stencil_bits;
   // The targets' width.
@@ -213,6 +247,10 @@ typedef struct HistencilLightingDesc {
   uint32_t max_lights;
   // Non-zero to emulate the consoles' hi-stencil (the PS3-like and 360-like platforms).
   uint32_t hi_stencil;
+  // The layouts the engine binds its hooks' resources with: required when `shaders` were
+  // compiled with hooks, else null (or given, to bind histencil's own decode's G-buffer
+  // images in a set of the engine's).
+  const struct HistencilHooks *hooks;
 } HistencilLightingDesc;
 
 // An axis-aligned box in world space.
@@ -255,6 +293,12 @@ typedef struct HistencilFrame {
   const struct HistencilBrdfBounds *brdf_bounds;
   // Non-zero to clear the HDR image first; zero to add to what it holds.
   uint32_t clear_hdr;
+  // The engine's descriptor set for its decode hook (set 1): required when the lighting was
+  // made with `HistencilLightingDesc.hooks`, else `VK_NULL_HANDLE`.
+  VkDescriptorSet decode_set;
+  // The engine's descriptor set for its visibility hook (set 4): required exactly when
+  // `HistencilHooks.visibility_layout` was given, else `VK_NULL_HANDLE`.
+  VkDescriptorSet visibility_set;
 } HistencilFrame;
 
 // One of the engine's images, and the state it is in: what histencil's barriers start from.
@@ -322,49 +366,6 @@ const char *histencil_last_error(void);
 // Thread safety: any thread.
 uint32_t histencil_version(void);
 
-// Reads the BRDF folder `folder` (its `brdfs.toml` and the GLSL files it names, each confined
-// to the folder), compiles histencil's shaders for the set (glslc, as `histencil render
-// --brdfs` does; compiled once per set in a process) and probes each engine BRDF on the
-// context's device: one that returns NaN, an infinity or negative light anywhere is refused.
-//
-// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer, a folder that is not UTF-8;
-// `BAD_SETUP` for a manifest or GLSL file histencil refuses (the message gives the file and
-// line), a GLSL compile error (glslc's words, with the engine's file and line), a probe that
-// fails; `UNSUPPORTED` when glslc cannot be run.
-//
-// Thread safety: not at the same time as another call on `context`.
-//
-// # Safety
-// `folder` is null or NUL-terminated; `set` is null or writable.
-enum HistencilResult histencil_brdf_set_load(struct HistencilContext *context,
-                                             const char *folder,
-                                             struct HistencilBrdfSet **set);
-
-// Frees the handle. Lightings made with the set keep what they need: it may go at once.
-//
-// Errors: `INVALID_ARGUMENT` for a null or freed handle.
-//
-// Thread safety: not at the same time as another call naming `set`.
-//
-// # Safety
-// `set` is null or a handle from `histencil_brdf_set_load` (a freed one is refused).
-enum HistencilResult histencil_brdf_set_destroy(struct HistencilBrdfSet *set);
-
-// Writes what histencil's shaders include to evaluate the set into `folder` (`brdf_set/*.glsl`
-// and the engine's GLSL files under their own folder): put `folder` before the installed
-// `share/histencil/shaders/include` on glslc's include path, and an engine's own shader that
-// includes `light.glsl` (a forward reference) evaluates the set's BRDFs as histencil does.
-//
-// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer; `VULKAN` never;
-// `BAD_SETUP` when the folder cannot be written (the message names the file).
-//
-// Thread safety: any thread, not at the same time as `histencil_brdf_set_destroy(set)`.
-//
-// # Safety
-// `folder` is null or NUL-terminated.
-enum HistencilResult histencil_brdf_set_write_includes(struct HistencilBrdfSet *set,
-                                                       const char *folder);
-
 // Makes a context on the engine's device. Creates nothing of Vulkan's but histencil's private
 // memory allocator; checks that the physical device and queue family have what histencil needs.
 //
@@ -426,12 +427,12 @@ enum HistencilResult histencil_gbuffer_formats(VkFormat *formats);
 // The G-buffer's values for a surface of BRDF `name` with `params` (each parameter the BRDF
 // takes, by name; an engine BRDF's left out take their defaults): its packed parameters
 // (`gbuffer_encode`'s `brdf_params`, the first three; `packed` holds 4) and its id
-// (`brdf_model`, the BRDF's `BrdfId::index`). `set` is the engine's BRDF set that holds `name`
-// (`histencil_brdf_set_load`), or null for histencil's own BRDFs. Every parameter is held to
+// (`brdf_model`, the BRDF's `BrdfId::index`). `shaders` are those compiled for the engine's BRDF
+// set that holds `name` (`histencil_shaders_compile` or `_load`), or null for histencil's own BRDFs. Every parameter is held to
 // its range, as the Rust API holds it.
 //
-// Errors: `INVALID_ARGUMENT` for a null pointer, a freed `set` or a name that is not UTF-8;
-// `BAD_SETUP` for a BRDF neither histencil nor `set` holds, a parameter it does not take, one
+// Errors: `INVALID_ARGUMENT` for a null pointer, freed `shaders` or a name that is not UTF-8;
+// `BAD_SETUP` for a BRDF neither histencil nor `shaders`' set holds, a parameter it does not take, one
 // left out that has no default, or one out of its range (the message names it).
 //
 // Thread safety: any thread.
@@ -439,8 +440,8 @@ enum HistencilResult histencil_gbuffer_formats(VkFormat *formats);
 // # Safety
 // `name` is null or NUL-terminated; `params` is null or points at `param_count` parameters
 // whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `brdf_id` is
-// null or writable; `set` is null or a handle from `histencil_brdf_set_load`.
-enum HistencilResult histencil_brdf_encode(const struct HistencilBrdfSet *set,
+// null or writable; `shaders` is null or a live handle.
+enum HistencilResult histencil_brdf_encode(const struct HistencilShaders *shaders,
                                            const char *name,
                                            const struct HistencilBrdfParam *params,
                                            uint32_t param_count,
@@ -594,6 +595,72 @@ enum HistencilResult histencil_lighting_resize(struct HistencilLighting *lightin
 // # Safety
 // `lighting` is null or a handle from `histencil_lighting_create` (a freed one is refused).
 enum HistencilResult histencil_lighting_destroy(struct HistencilLighting *lighting);
+
+// Compiles histencil's shaders (glslc, as `histencil render --brdfs` does; compiled once per
+// set and hooks in a process) for the BRDF folder `brdf_folder` (its `brdfs.toml` and the GLSL
+// files it names, each confined to the folder; null for histencil's own BRDFs) and the hook
+// folder `hooks_folder` (`surface_decode.glsl` and/or `light_visibility.glsl`; null for
+// histencil's G-buffer and no shadows), and probes each engine BRDF on the context's device:
+// one that returns NaN, an infinity or negative light anywhere is refused. With hooks, a
+// lighting made with these shaders takes `HistencilLightingDesc.hooks`.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null `shaders`, a folder that is not
+// UTF-8; `BAD_SETUP` for a manifest or GLSL file histencil refuses (the message gives the file
+// and line), a hook folder with neither hook file, a GLSL compile error (glslc's words, with
+// the engine's file and line), a probe that fails; `UNSUPPORTED` when glslc cannot be run.
+//
+// Thread safety: not at the same time as another call on `context`.
+//
+// # Safety
+// `brdf_folder` and `hooks_folder` are null or NUL-terminated; `shaders` is null or writable.
+enum HistencilResult histencil_shaders_compile(struct HistencilContext *context,
+                                               const char *brdf_folder,
+                                               const char *hooks_folder,
+                                               struct HistencilShaders **shaders);
+
+// Reads the shader file `path` that `histencil shaders --brdfs DIR --hooks DIR --out FILE`
+// wrote at the engine's build, with this version of histencil, and probes its engine BRDFs on
+// the context's device as `histencil_shaders_compile` does. Needs no glslc.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer, a path that is not UTF-8;
+// `BAD_SETUP` for a file that cannot be read, is not a shader file, was written by another
+// version, is damaged or cut (its checksum), lacks a module or holds one of the wrong stage,
+// or whose BRDF folder histencil refuses, each naming the file; a probe that fails.
+//
+// Thread safety: not at the same time as another call on `context`.
+//
+// # Safety
+// `path` is null or NUL-terminated; `shaders` is null or writable.
+enum HistencilResult histencil_shaders_load(struct HistencilContext *context,
+                                            const char *path,
+                                            struct HistencilShaders **shaders);
+
+// Frees the handle. Lightings made with the shaders keep what they need: it may go at once.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle.
+//
+// Thread safety: not at the same time as another call naming `shaders`.
+//
+// # Safety
+// `shaders` is null or a handle from `histencil_shaders_compile` or `histencil_shaders_load`
+// (a freed one is refused).
+enum HistencilResult histencil_shaders_destroy(struct HistencilShaders *shaders);
+
+// Writes what histencil's shaders include to evaluate the shaders' BRDF set into `folder`
+// (`brdf_set/*.glsl` and the engine's GLSL files under their own folder): put `folder` before
+// the installed `share/histencil/shaders/include` on glslc's include path, and an engine's own
+// shader that includes `light.glsl` (a forward reference) evaluates the set's BRDFs as
+// histencil does; a G-buffer shader includes `brdf_set/ids.glsl` for the ids.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer; `BAD_SETUP` when the folder
+// cannot be written (the message names the file).
+//
+// Thread safety: any thread, not at the same time as `histencil_shaders_destroy(shaders)`.
+//
+// # Safety
+// `folder` is null or NUL-terminated.
+enum HistencilResult histencil_shaders_write_includes(struct HistencilShaders *shaders,
+                                                      const char *folder);
 
 #ifdef __cplusplus
 }  // extern "C"

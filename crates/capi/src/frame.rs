@@ -319,6 +319,12 @@ pub struct HistencilFrame {
     pub brdf_bounds: *const HistencilBrdfBounds,
     /// Non-zero to clear the HDR image first; zero to add to what it holds.
     pub clear_hdr: u32,
+    /// The engine's descriptor set for its decode hook (set 1): required when the lighting was
+    /// made with `HistencilLightingDesc.hooks`, else `VK_NULL_HANDLE`.
+    pub decode_set: vk::DescriptorSet,
+    /// The engine's descriptor set for its visibility hook (set 4): required exactly when
+    /// `HistencilHooks.visibility_layout` was given, else `VK_NULL_HANDLE`.
+    pub visibility_set: vk::DescriptorSet,
 }
 
 /// Most lights a frame may pass: far past any lighting's `max_lights`, a bound on what is read.

@@ -1,7 +1,7 @@
 //! What a C engine needs to write histencil's G-buffer and make its device: the images' formats,
 //! each BRDF's values as the G-buffer stores them, and the device features histencil needs.
 
-use crate::brdf_set::utf8;
+use crate::shaders::utf8;
 use crate::{call, slice, Failure, HistencilResult};
 use ash::vk;
 use histencil::brdf::Brdf;
@@ -50,12 +50,12 @@ pub unsafe extern "C" fn histencil_gbuffer_formats(formats: *mut vk::Format) -> 
 /// The G-buffer's values for a surface of BRDF `name` with `params` (each parameter the BRDF
 /// takes, by name; an engine BRDF's left out take their defaults): its packed parameters
 /// (`gbuffer_encode`'s `brdf_params`, the first three; `packed` holds 4) and its id
-/// (`brdf_model`, the BRDF's `BrdfId::index`). `set` is the engine's BRDF set that holds `name`
-/// (`histencil_brdf_set_load`), or null for histencil's own BRDFs. Every parameter is held to
+/// (`brdf_model`, the BRDF's `BrdfId::index`). `shaders` are those compiled for the engine's BRDF
+/// set that holds `name` (`histencil_shaders_compile` or `_load`), or null for histencil's own BRDFs. Every parameter is held to
 /// its range, as the Rust API holds it.
 ///
-/// Errors: `INVALID_ARGUMENT` for a null pointer, a freed `set` or a name that is not UTF-8;
-/// `BAD_SETUP` for a BRDF neither histencil nor `set` holds, a parameter it does not take, one
+/// Errors: `INVALID_ARGUMENT` for a null pointer, freed `shaders` or a name that is not UTF-8;
+/// `BAD_SETUP` for a BRDF neither histencil nor `shaders`' set holds, a parameter it does not take, one
 /// left out that has no default, or one out of its range (the message names it).
 ///
 /// Thread safety: any thread.
@@ -63,10 +63,10 @@ pub unsafe extern "C" fn histencil_gbuffer_formats(formats: *mut vk::Format) -> 
 /// # Safety
 /// `name` is null or NUL-terminated; `params` is null or points at `param_count` parameters
 /// whose names are NUL-terminated; `packed` is null or holds 4 writable floats; `brdf_id` is
-/// null or writable; `set` is null or a handle from `histencil_brdf_set_load`.
+/// null or writable; `shaders` is null or a live handle.
 #[no_mangle]
 pub unsafe extern "C" fn histencil_brdf_encode(
-    set: *const crate::HistencilBrdfSet,
+    shaders: *const crate::HistencilShaders,
     name: *const c_char,
     params: *const HistencilBrdfParam,
     param_count: u32,
@@ -78,7 +78,7 @@ pub unsafe extern "C" fn histencil_brdf_encode(
             return Err(Failure::invalid("packed or brdf_id is null"));
         }
         // SAFETY: this fn's # Safety.
-        let modules = unsafe { crate::brdf_set::modules_of(set) }?;
+        let modules = unsafe { crate::shaders::modules_of(shaders) }?;
         // SAFETY: this fn's # Safety: null or NUL-terminated.
         let name = unsafe { utf8(name, "name") }?;
         // SAFETY: this fn's # Safety: `param_count` parameters at `params`.

@@ -10,7 +10,7 @@ use std::sync::Mutex;
 pub(crate) enum Kind {
     Context,
     Lighting,
-    BrdfSet,
+    Shaders,
 }
 
 static LIVE: Mutex<Option<HashSet<(usize, Kind)>>> = Mutex::new(None);

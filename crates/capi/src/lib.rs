@@ -15,17 +15,13 @@
 //!   [`HistencilResult::Internal`], its message kept.
 //! - **Enums travel as `uint32_t`** and are checked, so an unknown value is an error.
 
-mod brdf_set;
 mod device;
 mod frame;
 mod gbuffer;
 mod handles;
 mod lighting;
+mod shaders;
 
-pub use brdf_set::{
-    histencil_brdf_set_destroy, histencil_brdf_set_load, histencil_brdf_set_write_includes,
-    HistencilBrdfSet,
-};
 pub use device::{
     histencil_context_create, histencil_context_destroy, histencil_device_suits, HistencilContext,
     HistencilDeviceDesc, PFN_vkGetInstanceProcAddr,
@@ -46,7 +42,11 @@ pub use gbuffer::{
 pub use lighting::{
     histencil_lighting_create, histencil_lighting_destroy, histencil_lighting_in_flight,
     histencil_lighting_record, histencil_lighting_resize, histencil_lighting_slot_finished,
-    histencil_lighting_stencil_reference, HistencilLighting, HistencilLightingDesc,
+    histencil_lighting_stencil_reference, HistencilHooks, HistencilLighting, HistencilLightingDesc,
+};
+pub use shaders::{
+    histencil_shaders_compile, histencil_shaders_destroy, histencil_shaders_load,
+    histencil_shaders_write_includes, HistencilShaders,
 };
 
 use std::cell::RefCell;

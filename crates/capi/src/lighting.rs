@@ -1,19 +1,20 @@
 //! The lighting: made once from a description, planned and recorded into the engine's command
 //! buffer each frame, told when a slot's frame has finished, resized and destroyed.
 
-use crate::brdf_set::{brdf_named, modules_of, HistencilBrdfSet};
 use crate::frame::{
     HistencilFrame, HistencilTargets, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
     HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
     HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
 };
 use crate::handles::{self, Kind};
+use crate::shaders::{brdf_named, shaders_of, HistencilShaders};
 use crate::{call, check_size, required, slice, Failure, HistencilResult, Outcome};
 use ash::vk;
 use histencil::{
-    plan_frame, Backend, BrdfModules, BrdfSource, Context, DeferredLighting, FlushPolicy, HookSets,
-    LightHooks, LightingDesc, LightingFrame, MixedTiles, PlanInputs, PlanSettings, StencilLayout,
-    TechniqueChoice, TileClassify, TileSide, TiledFrame, View,
+    plan_frame, Backend, BrdfModules, BrdfParams, BrdfSource, Context, DeferredLighting,
+    EngineHooks, FlushPolicy, HookSetLayout, HookSets, LightHooks, LightingDesc, LightingFrame,
+    MixedTiles, PlanInputs, PlanSettings, StencilLayout, TechniqueChoice, TileClassify, TileSide,
+    TiledFrame, View,
 };
 use std::ffi::{c_char, CStr};
 use std::sync::Arc;
@@ -27,10 +28,11 @@ pub struct HistencilLightingDesc {
     /// How many BRDFs: each takes one stencil slot, in this order.
     pub brdf_count: u32,
     /// The BRDFs' names, NUL-terminated UTF-8: histencil's own (`lambert`, `ggx`, ...) and
-    /// those of `brdf_set`.
+    /// those of `shaders`.
     pub brdf_names: *const *const c_char,
-    /// The engine's BRDF set (`histencil_brdf_set_load`), or null for histencil's own BRDFs.
-    pub brdf_set: *const HistencilBrdfSet,
+    /// histencil's shaders compiled for the engine's BRDFs and hooks (`histencil_shaders_compile`
+    /// or `histencil_shaders_load`), or null for histencil's own BRDFs, G-buffer and no shadows.
+    pub shaders: *const HistencilShaders,
     /// Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
     pub engine_stencil_bits: u32,
     /// The targets' width.
@@ -47,6 +49,45 @@ pub struct HistencilLightingDesc {
     pub max_lights: u32,
     /// Non-zero to emulate the consoles' hi-stencil (the PS3-like and 360-like platforms).
     pub hi_stencil: u32,
+    /// The layouts the engine binds its hooks' resources with: required when `shaders` were
+    /// compiled with hooks, else null (or given, to bind histencil's own decode's G-buffer
+    /// images in a set of the engine's).
+    pub hooks: *const HistencilHooks,
+}
+
+/// The descriptor set layouts an engine binds its hooks' resources with, and the images its
+/// decode hook reads. Vulkan cannot be asked what a layout holds, so the engine says: every
+/// resource the hooks' shaders declare in sets 1 and 4 is held to these bindings when the
+/// lighting is made (the binding exists, its type serves the shader, its count covers the
+/// array, it is visible to the stage), and a mismatch is refused naming module, set, binding
+/// and types, not left to the driver.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct HistencilHooks {
+    /// `sizeof(HistencilHooks)`.
+    pub size: u32,
+    /// The decode hook's layout (set 1), made by the engine from `decode_bindings`.
+    pub decode_layout: vk::DescriptorSetLayout,
+    /// How many bindings `decode_layout` was made with.
+    pub decode_binding_count: u32,
+    /// The `pBindings` `decode_layout` was made with.
+    pub decode_bindings: *const vk::DescriptorSetLayoutBinding<'static>,
+    /// The visibility hook's layout (set 4), or `VK_NULL_HANDLE` when it reads no resource of
+    /// its own (or reads them in set 1, beside the decode's).
+    pub visibility_layout: vk::DescriptorSetLayout,
+    /// How many bindings `visibility_layout` was made with (0 without one).
+    pub visibility_binding_count: u32,
+    /// The `pBindings` `visibility_layout` was made with (null without one).
+    pub visibility_bindings: *const vk::DescriptorSetLayoutBinding<'static>,
+    /// How many images the decode reads: `HistencilTargets.gbuffer_count` each frame.
+    pub surface_format_count: u32,
+    /// Their formats, in `HistencilTargets.gbuffer` order.
+    pub surface_formats: *const vk::Format,
+    /// How the decode reads each BRDF's parameters: 0 from the pixel itself (the G-buffer
+    /// carries them), else from rows indexed by BRDF id, ids 0 to `brdf_param_rows - 1`
+    /// (`BRDF_ID_COUNT` in `brdf_set/ids.glsl` sizes them). A lighting shading an id without a
+    /// row is refused: its surfaces would be unlit with no error anywhere.
+    pub brdf_param_rows: u32,
 }
 
 /// A lighting made on a context, with the names it was made with.
@@ -107,8 +148,9 @@ fn lighting_desc(desc: &HistencilLightingDesc) -> Outcome<(LightingDesc, &'stati
     }
     // SAFETY: the header's contract: `brdf_count` names at `brdf_names`.
     let names = unsafe { names(desc.brdf_names, desc.brdf_count, "brdf_names") }?;
-    // SAFETY: the header's contract: null or a handle from histencil_brdf_set_load.
-    let modules = unsafe { modules_of(desc.brdf_set) }?;
+    // SAFETY: the header's contract: null or a live handle.
+    let shaders = unsafe { shaders_of(desc.shaders) }?;
+    let modules = shaders.map_or(BrdfModules::builtin(), |s| s.modules);
     let brdfs = names
         .into_iter()
         .map(|n| brdf_named(modules, n))
@@ -127,13 +169,88 @@ fn lighting_desc(desc: &HistencilLightingDesc) -> Outcome<(LightingDesc, &'stati
         frames_in_flight: desc.frames_in_flight,
         max_lights: desc.max_lights,
         hi_stencil: desc.hi_stencil != 0,
-        hooks: if std::ptr::eq(modules, BrdfModules::builtin()) {
-            LightHooks::Builtin
-        } else {
-            LightHooks::BuiltinWithBrdfs(modules.light)
+        // SAFETY: the header's contract: null or a live struct whose pointers hold what it says.
+        hooks: match unsafe { desc.hooks.as_ref() } {
+            Some(hooks) => LightHooks::Engine(engine_hooks(hooks, modules)?),
+            None if shaders.is_some_and(|s| s.engine_hooks) => {
+                return Err(Failure {
+                    result: HistencilResult::BadSetup,
+                    message: "the shaders call the engine's hooks: HistencilLightingDesc.hooks \
+                              gives the layouts their resources are bound with"
+                        .into(),
+                })
+            }
+            None if std::ptr::eq(modules, BrdfModules::builtin()) => LightHooks::Builtin,
+            None => LightHooks::BuiltinWithBrdfs(modules.light),
         },
     };
     Ok((desc, modules))
+}
+
+/// The most bindings a hook layout may list, and images a decode may read.
+const MAX_HOOK_BINDINGS: u32 = 64;
+
+/// `hooks` as the Rust API takes them, every pointer and count checked.
+fn engine_hooks(hooks: &HistencilHooks, modules: &BrdfModules) -> Outcome<EngineHooks> {
+    check_size::<HistencilHooks>("HistencilHooks", hooks.size)?;
+    let counts = [
+        ("decode_binding_count", hooks.decode_binding_count),
+        ("visibility_binding_count", hooks.visibility_binding_count),
+        ("surface_format_count", hooks.surface_format_count),
+    ];
+    for (name, value) in counts {
+        if value > MAX_HOOK_BINDINGS {
+            return Err(Failure::invalid(format!(
+                "HistencilHooks.{name} is {value}, past {MAX_HOOK_BINDINGS}"
+            )));
+        }
+    }
+    if hooks.decode_layout == vk::DescriptorSetLayout::null() {
+        return Err(Failure::invalid(
+            "HistencilHooks.decode_layout is VK_NULL_HANDLE",
+        ));
+    }
+    // SAFETY: the header's contract: each count of entries at its pointer.
+    let (decode, visibility, formats) = unsafe {
+        (
+            slice(
+                hooks.decode_bindings,
+                hooks.decode_binding_count,
+                "decode_bindings",
+            )?,
+            slice(
+                hooks.visibility_bindings,
+                hooks.visibility_binding_count,
+                "visibility_bindings",
+            )?,
+            slice(
+                hooks.surface_formats,
+                hooks.surface_format_count,
+                "surface_formats",
+            )?,
+        )
+    };
+    let has_visibility = hooks.visibility_layout != vk::DescriptorSetLayout::null();
+    if !has_visibility && !visibility.is_empty() {
+        return Err(Failure::invalid(
+            "HistencilHooks.visibility_bindings are given without a visibility_layout",
+        ));
+    }
+    let decode = HookSetLayout {
+        layout: hooks.decode_layout,
+        bindings: decode,
+    };
+    let visibility = has_visibility.then_some(HookSetLayout {
+        layout: hooks.visibility_layout,
+        bindings: visibility,
+    });
+    // SAFETY: the header's contract for the layouts (live, made from these bindings on the
+    // context's device, outliving the lighting); the modules are this version's shaders.
+    let made = unsafe { EngineHooks::new(modules.light, decode, visibility, formats) }?;
+    Ok(made.with_brdf_params(match hooks.brdf_param_rows {
+        0 => BrdfParams::PerPixel,
+        rows => BrdfParams::Rows(rows),
+    }))
 }
 
 /// Makes a lighting on `context`: its pipeline layout, light volumes, per-slot buffers and sets
@@ -283,6 +400,11 @@ pub unsafe extern "C" fn histencil_lighting_record(
             }
         };
         let depth_id = frame.technique == HISTENCIL_TECHNIQUE_DEPTH_ID;
+        let set = |s: vk::DescriptorSet| (s != vk::DescriptorSet::null()).then_some(s);
+        let hook_sets = HookSets {
+            decode: set(frame.decode_set),
+            visibility: set(frame.visibility_set),
+        };
         let lighting = &mut held.lighting;
         match technique {
             Some(technique) => {
@@ -328,7 +450,7 @@ pub unsafe extern "C" fn histencil_lighting_record(
                     timestamps: false,
                     brdf_source: BrdfSource::Formula,
                     tile_stats: false,
-                    hook_sets: HookSets::default(),
+                    hook_sets,
                 };
                 // SAFETY: the header's contract for this call, which is `record`'s # Safety:
                 // a recording command buffer of the context's device, outside a render pass,
@@ -344,7 +466,7 @@ pub unsafe extern "C" fn histencil_lighting_record(
                     side: TileSide::Sixteen,
                     mixed: MixedTiles::PerBrdf,
                     classify: held.classify,
-                    hook_sets: HookSets::default(),
+                    hook_sets,
                 };
                 // SAFETY: as above: `record_tiled`'s and `record_depth_id`'s # Safety are
                 // `record`'s.

@@ -5,95 +5,21 @@
 //! the process going on and the layer silent.
 
 use ash::vk;
-use histencil::{Backend, Context, DeferredLighting, HookSets};
+use histencil::{Backend, DeferredLighting, HookSets};
 use histencil_capi::*;
-use histencil_tests::engine::{
-    copy_to_buffer, hdr_floats, lighting_desc, plain_frame, stencil_plan, Engine, EngineTargets,
-};
+use histencil_tests::engine::{lighting_desc, plain_frame, stencil_plan};
 mod common;
 
-use common::{c_boxes, c_targets_of, device_desc, World};
-use std::ffi::{c_char, CStr, CString};
-use std::ptr::{null, null_mut};
-
-const SIZE: vk::Extent2D = vk::Extent2D {
-    width: 48,
-    height: 32,
+use common::{
+    c_boxes, c_lighting_desc, c_targets_of, device_desc, expect, last_error, lit_frame,
+    record_through_c, with_c_context, SIZE,
 };
-
-fn last_error() -> String {
-    // SAFETY: never null, valid until the next call on this thread.
-    unsafe { CStr::from_ptr(histencil_last_error()) }
-        .to_string_lossy()
-        .into_owned()
-}
-
-/// Holds a call's result to `expected` and its message to contain `words`.
-#[track_caller]
-fn expect(result: HistencilResult, expected: HistencilResult, words: &str) {
-    let message = last_error();
-    assert_eq!(result, expected, "{message}");
-    assert!(message.contains(words), "`{message}` should say `{words}`");
-}
-
-/// Runs `body` with the engine, a Rust context on its device (for histencil's renderer, which
-/// writes the G-buffer, and the Rust lighting compared against), a C context on the same
-/// device, the engine's targets and the world; then frees all and holds the layer silent.
-fn with_c_context(
-    body: impl FnOnce(&Engine, &histencil::vk::Renderer, *mut HistencilContext, &EngineTargets, &World),
-) {
-    let mut scene = histencil::scene::embedded("brdfs-3").unwrap();
-    scene.normalise_lights();
-    let engine = Engine::start();
-    {
-        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
-        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.unwrap();
-        let renderer =
-            histencil::vk::Renderer::new(&ctx, scene.clone(), SIZE.width, SIZE.height).unwrap();
-        let names = (renderer.brdfs().iter())
-            .map(|b| CString::new(b.name()).unwrap())
-            .collect();
-        let world = World {
-            view: scene.camera.view_desc(1.5),
-            scene,
-            names,
-        };
-        let images = engine.lighting_targets(SIZE, ctx.depth_stencil_format().vk());
-        let mut c_ctx = null_mut();
-        // SAFETY: a live desc of the engine's live handles; a writable out pointer.
-        let made = unsafe { histencil_context_create(&device_desc(&engine), &mut c_ctx) };
-        assert_eq!(made, HistencilResult::Success, "{}", last_error());
-        body(&engine, &renderer, c_ctx, &images, &world);
-        // SAFETY: a live context with no lighting left.
-        let freed = unsafe { histencil_context_destroy(c_ctx) };
-        assert_eq!(freed, HistencilResult::Success, "{}", last_error());
-        images.free(&engine);
-        drop(renderer);
-    }
-    engine.destroy().assert_clean();
-}
-
-fn c_lighting_desc(world: &World, names: &[*const c_char]) -> HistencilLightingDesc {
-    HistencilLightingDesc {
-        size: size_of::<HistencilLightingDesc>() as u32,
-        brdf_count: names.len() as u32,
-        brdf_names: names.as_ptr(),
-        brdf_set: null(),
-        engine_stencil_bits: 0,
-        width: SIZE.width,
-        height: SIZE.height,
-        depth_stencil_format: vk::Format::D32_SFLOAT_S8_UINT,
-        hdr_format: vk::Format::R16G16B16A16_SFLOAT,
-        frames_in_flight: 1,
-        max_lights: world.scene.lights.len() as u32,
-        hi_stencil: 1,
-    }
-}
+use std::ffi::{c_char, CString};
+use std::ptr::{null, null_mut};
 
 #[test]
 fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
     with_c_context(|engine, renderer, c_ctx, images, world| {
-        let d = &engine.device;
         let ds = images.refs().depth_stencil.format;
         let names: Vec<*const c_char> = world.names.iter().map(|n| n.as_ptr()).collect();
         let desc = HistencilLightingDesc {
@@ -133,47 +59,26 @@ fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
             (HISTENCIL_TECHNIQUE_TILED, HISTENCIL_PLATFORM_NATIVE, None),
         ];
         for (technique, platform, backend) in cases {
-            // One frame through `record`, read back.
             let lit =
                 |record: &mut dyn FnMut(vk::CommandBuffer, &mut histencil::LightingTargets)| {
-                    let mut targets = images.refs();
-                    let (pool, cmd) = engine.command_buffer();
-                    // SAFETY: the engine's command buffer, recorded here and waited for.
-                    unsafe {
-                        d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
-                            .unwrap();
-                        renderer.record_gbuffer(cmd, &mut targets).unwrap();
-                        record(cmd, &mut targets);
-                        copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
-                        engine.submit_and_wait(pool, cmd);
-                    }
-                    hdr_floats(readback.bytes())
+                    lit_frame(engine, renderer, images, &readback, record)
                 };
-            let through_c = lit(&mut |cmd, targets| {
-                let mut gbuffer = Vec::new();
-                let mut c_targets = c_targets_of(targets, &mut gbuffer);
-                let frame = HistencilFrame {
-                    size: size_of::<HistencilFrame>() as u32,
-                    slot: 0,
-                    technique,
-                    platform,
-                    view: world.c_view(),
-                    light_count: lights.len() as u32,
-                    lights: lights.as_ptr(),
-                    brdf_bounds_count: bounds.len() as u32,
-                    brdf_bounds: bounds.as_ptr(),
-                    clear_hdr: 1,
-                };
-                // SAFETY: a recording command buffer of the lent device; live structs.
-                let r =
-                    unsafe { histencil_lighting_record(c_lighting, cmd, &frame, &mut c_targets) };
-                assert_eq!(r, HistencilResult::Success, "{}", last_error());
-                // The states the C side was handed back are where the commands left the HDR.
-                let hdr = gbuffer[gbuffer.len() - 1];
-                targets.hdr.state.layout = hdr.layout;
-                targets.hdr.state.stage = hdr.stage;
-                targets.hdr.state.access = hdr.access;
-            });
+            let frame = HistencilFrame {
+                size: size_of::<HistencilFrame>() as u32,
+                slot: 0,
+                technique,
+                platform,
+                view: world.c_view(),
+                light_count: lights.len() as u32,
+                lights: lights.as_ptr(),
+                brdf_bounds_count: bounds.len() as u32,
+                brdf_bounds: bounds.as_ptr(),
+                clear_hdr: 1,
+                decode_set: vk::DescriptorSet::null(),
+                visibility_set: vk::DescriptorSet::null(),
+            };
+            let through_c =
+                lit(&mut |cmd, targets| record_through_c(c_lighting, cmd, &frame, targets));
             // SAFETY: the frame was waited for.
             let r = unsafe { histencil_lighting_slot_finished(c_lighting, 0) };
             assert_eq!(r, HistencilResult::Success, "{}", last_error());
@@ -387,6 +292,8 @@ fn misuse_through_c_returns_its_error_and_names_the_problem() {
                 brdf_bounds_count: empty.len() as u32,
                 brdf_bounds: empty.as_ptr(),
                 clear_hdr: 1,
+                decode_set: vk::DescriptorSet::null(),
+                visibility_set: vk::DescriptorSet::null(),
             };
             let (pool, cmd) = engine.command_buffer();
             let d = &engine.device;
@@ -573,18 +480,18 @@ fn an_engines_own_brdfs_come_through_c_from_its_folder() {
         // SAFETY: a live context, a NUL-terminated folder, a writable out pointer; every call
         // below passes live structs and handles, or ones the C API refuses.
         unsafe {
-            let loaded = histencil_brdf_set_load(c_ctx, folder.as_ptr().cast(), &mut set);
+            let loaded = histencil_shaders_compile(c_ctx, folder.as_ptr().cast(), null(), &mut set);
             assert_eq!(loaded, R::Success, "{}", last_error());
             let missing = c"/nonexistent/brdfs";
             expect(
-                histencil_brdf_set_load(c_ctx, missing.as_ptr(), &mut null_mut()),
+                histencil_shaders_compile(c_ctx, missing.as_ptr(), null(), &mut null_mut()),
                 R::BadSetup,
                 "/nonexistent/brdfs",
             );
             let names = [c"lambert", c"toon", c"charlie_sheen"];
             let pointers: Vec<*const c_char> = names.iter().map(|n| n.as_ptr()).collect();
             let desc = HistencilLightingDesc {
-                brdf_set: set,
+                shaders: set,
                 depth_stencil_format: images.refs().depth_stencil.format,
                 ..c_lighting_desc(world, &pointers)
             };
@@ -602,7 +509,7 @@ fn an_engines_own_brdfs_come_through_c_from_its_folder() {
             assert_ne!(mask, 0);
             // Without the set, histencil does not know `toon`.
             let own = HistencilLightingDesc {
-                brdf_set: null(),
+                shaders: null(),
                 ..desc
             };
             expect(
@@ -661,17 +568,17 @@ fn an_engines_own_brdfs_come_through_c_from_its_folder() {
             // The set's GLSL for the engine's own shaders (a forward reference).
             let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("c-set-includes");
             let out_c = CString::new(out.to_str().unwrap()).unwrap();
-            let r = histencil_brdf_set_write_includes(set, out_c.as_ptr());
+            let r = histencil_shaders_write_includes(set, out_c.as_ptr());
             assert_eq!(r, R::Success, "{}", last_error());
             let ids = std::fs::read_to_string(out.join("brdf_set/ids.glsl")).unwrap();
             assert!(ids.contains("#define BRDF_ENGINE_TOON 8u"), "{ids}");
             let r = histencil_lighting_destroy(lighting);
             assert_eq!(r, R::Success, "{}", last_error());
-            assert_eq!(histencil_brdf_set_destroy(set), R::Success);
+            assert_eq!(histencil_shaders_destroy(set), R::Success);
             expect(
-                histencil_brdf_set_destroy(set),
+                histencil_shaders_destroy(set),
                 R::InvalidArgument,
-                "not a live BrdfSet handle",
+                "not a live Shaders handle",
             );
         }
     });

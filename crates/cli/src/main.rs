@@ -79,6 +79,30 @@ enum Command {
     /// Print the error of the BRDF look-up tables against resolution and the error the G-buffer
     /// encodings add (markdown), both against the f64 reference.
     BrdfReport(BrdfReportArgs),
+    /// Compile histencil's shaders for an engine's BRDFs and hooks into one file, at the
+    /// engine's build: the C API reads it (`histencil_shaders_load`), so the engine's build
+    /// needs no cargo and its users no glslc. Prints how many modules it holds.
+    Shaders(ShadersArgs),
+}
+
+#[derive(clap::Args)]
+struct ShadersArgs {
+    /// The engine's BRDF folder (`brdfs.toml` and its GLSL); histencil's eight without it.
+    #[arg(long)]
+    brdfs: Option<PathBuf>,
+    /// The engine's hook folder (`surface_decode.glsl`, `light_visibility.glsl`); histencil's
+    /// G-buffer and no shadows without it.
+    #[arg(long)]
+    hooks: Option<PathBuf>,
+    /// The file to write (whole or not at all).
+    #[arg(long)]
+    out: PathBuf,
+    /// Also write what the engine's own shaders include to evaluate the set (`brdf_set/*.glsl`
+    /// and the engine's GLSL under `engine/`) into this folder: put it before histencil's
+    /// installed includes on glslc's path, and a forward reference that includes `light.glsl`
+    /// shades the engine's BRDFs as histencil does.
+    #[arg(long)]
+    includes: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -692,6 +716,22 @@ fn on_device<T>(
     Ok(value)
 }
 
+fn shaders(args: &ShadersArgs) -> Result<()> {
+    histencil_vk::check_output_file(&args.out)?;
+    let modules =
+        histencil_vk::write_shader_file(args.brdfs.as_deref(), args.hooks.as_deref(), &args.out)
+            .map_err(anyhow::Error::msg)?;
+    if let Some(folder) = &args.includes {
+        let set = match &args.brdfs {
+            Some(dir) => histencil_brdf::BrdfSet::load(dir)?,
+            None => histencil_brdf::BrdfSet::default(),
+        };
+        histencil_build::stage_brdf_set(&set, folder).map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    println!("{}: {modules} modules", args.out.display());
+    Ok(())
+}
+
 fn brdf_eval(args: &BrdfEvalArgs) -> Result<()> {
     histencil_vk::check_output_file(&args.out)?;
     let input = std::fs::File::open(&args.cases)
@@ -821,6 +861,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => lab::calibrate(args),
         Command::BrdfEval(args) => brdf_eval(args),
         Command::BrdfReport(args) => brdf_report(args),
+        Command::Shaders(args) => shaders(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -80,10 +80,11 @@ impl BrdfModules {
 
 /// A folder under the system's temporary one, removed with everything in it on drop (also when
 /// a compile fails half way).
-struct Scratch(PathBuf);
+#[derive(Debug)]
+pub(crate) struct Scratch(pub(crate) PathBuf);
 
 impl Scratch {
-    fn new() -> std::io::Result<Self> {
+    pub(crate) fn new() -> std::io::Result<Self> {
         use std::sync::atomic::{AtomicUsize, Ordering};
         static N: AtomicUsize = AtomicUsize::new(0);
         let path = std::env::temp_dir().join(format!(
@@ -95,7 +96,7 @@ impl Scratch {
         Ok(Self(path))
     }
 
-    fn write(&self, relative: &str, text: &[u8]) -> Result<(), String> {
+    pub(crate) fn write(&self, relative: &str, text: &[u8]) -> Result<(), String> {
         let path = self.0.join(relative);
         let dir = path.parent().expect("a file in the scratch folder");
         std::fs::create_dir_all(dir)
@@ -118,15 +119,48 @@ impl Drop for Scratch {
 /// A message: the set's files could not be read or written, `glslc` could not be run, or it
 /// refused a stage (its message, naming the engine's own file and line).
 pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
-    if set == &BrdfSet::default() {
+    compile_with_hooks(set, None)
+}
+
+/// As [`compile`], with an engine's hook files (`surface_decode.glsl`, `light_visibility.glsl`:
+/// histencil-build's `HOOK_FILES`) from `hooks` searched before histencil's own, as
+/// `histencil_build::compile_light_shaders_for` does at an engine's build: the run-time path
+/// for an engine that cannot run cargo at its build (the C API's `histencil_shaders_compile`)
+/// or ships a file of them (`histencil shaders`). Every hooked stage is compiled then, the
+/// classification and id copy too, since they decode surfaces.
+///
+/// # Errors
+/// As [`compile`], and a hook folder holding neither hook file.
+pub fn compile_with_hooks(
+    set: &BrdfSet,
+    hooks: Option<&Path>,
+) -> Result<&'static BrdfModules, String> {
+    if set == &BrdfSet::default() && hooks.is_none() {
         return Ok(BrdfModules::builtin());
+    }
+    let mut hook_files = Vec::new();
+    if let Some(folder) = hooks {
+        for file in histencil_build::HOOK_FILES {
+            let path = folder.join(file);
+            if path.is_file() {
+                let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+                hook_files.push((file, text));
+            }
+        }
+        if hook_files.is_empty() {
+            return Err(format!(
+                "the hook folder {} holds neither {}",
+                folder.display(),
+                histencil_build::HOOK_FILES.join(" nor ")
+            ));
+        }
     }
     let scratch = Scratch::new().map_err(|e| format!("a scratch folder for glslc: {e}"))?;
     let staged = scratch.0.join("set");
     let copied = histencil_build::stage_brdf_set(set, &staged).map_err(|e| e.to_string())?;
-    // What the modules are a function of: the generated GLSL and every engine file's bytes.
-    // The declarations too: parameters' ranges and defaults are checked and probed from the
-    // set the modules carry.
+    // What the modules are a function of: the generated GLSL, every engine file's bytes and
+    // the hook files'. The declarations too: parameters' ranges and defaults are checked and
+    // probed from the set the modules carry.
     let mut key: Vec<u8> = format!("{set:?}").into_bytes();
     for (name, text) in set.glsl_files("engine") {
         key.extend(name.bytes().chain(text.bytes()).chain([0]));
@@ -134,6 +168,15 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
     for path in &copied {
         let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
         key.extend(path.display().to_string().bytes().chain(bytes).chain([0]));
+    }
+    for (name, text) in &hook_files {
+        key.extend(
+            b"hook "
+                .iter()
+                .chain(name.as_bytes())
+                .chain(text)
+                .chain(&[0]),
+        );
     }
     static COMPILED: OnceLock<Mutex<HashMap<Vec<u8>, &'static BrdfModules>>> = OnceLock::new();
     let cache = COMPILED.get_or_init(Default::default);
@@ -145,15 +188,26 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
         scratch.write(path, text.as_bytes())?;
     }
     let root = &scratch.0;
-    let includes = [
+    // The engine's hooks first: `#include "surface_decode.glsl"` in a stage resolves there
+    // before histencil's defaults (the build's order).
+    let mut includes: Vec<PathBuf> = hooks.into_iter().map(Path::to_owned).collect();
+    includes.extend([
         staged.clone(),
         root.join("include"),
         root.join("generated"),
         root.join("hooks"),
-    ];
+    ]);
     let includes: Vec<&Path> = includes.iter().map(PathBuf::as_path).collect();
-    let mut spirv = Vec::new();
-    for stage in histencil_build::BRDF_STAGES {
+    let mut stages: Vec<&str> = histencil_build::BRDF_STAGES.to_vec();
+    if hooks.is_some() {
+        for stage in histencil_build::HOOKED_STAGES {
+            if !stages.contains(&stage) {
+                stages.push(stage);
+            }
+        }
+    }
+    let mut spirv = HashMap::new();
+    for stage in stages {
         let out = root.join(format!("{stage}.spv"));
         let command =
             histencil_build::glslc_command(&root.join("stages").join(stage), &includes, &out);
@@ -169,37 +223,53 @@ pub fn compile(set: &BrdfSet) -> Result<&'static BrdfModules, String> {
                 .replace(&root.display().to_string(), "histencil-vk/shaders")
         })?;
         let bytes = std::fs::read(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-        spirv.push(&*Box::leak(bytes.into_boxed_slice()));
+        let field = stage.split('.').next().unwrap_or(stage);
+        spirv.insert(field.to_owned(), &*Box::leak(bytes.into_boxed_slice()));
     }
-    let [deferred_light, lut_light, tile_shade, tile_shade_8, depth_id_shade, forward, lightmap, lightmap_directional, alpha_object, particle, brdf_eval] =
-        spirv[..]
-    else {
-        unreachable!("one module per stage");
-    };
-    let modules: &'static BrdfModules = Box::leak(Box::new(BrdfModules {
-        set: set.clone(),
-        light: LightModules {
-            deferred_light,
-            lut_light,
-            tile_shade,
-            tile_shade_8,
-            depth_id_shade,
-            brdfs: Box::leak(set.ids().iter().map(|b| b.index()).collect()),
-            brdf_names: Box::leak(set.ids().iter().map(|b| b.name()).collect()),
-            ..LightModules::BUILTIN
-        },
-        forward,
-        lightmap,
-        lightmap_directional,
-        alpha_object,
-        particle,
-        brdf_eval,
-    }));
+    let modules: &'static BrdfModules = Box::leak(Box::new(
+        modules_of(set, |field| spirv.get(field).copied()).expect("every BRDF stage compiled"),
+    ));
     cache
         .lock()
         .unwrap_or_else(|p| p.into_inner())
         .insert(key, modules);
     Ok(modules)
+}
+
+/// The modules of `set` from its stages' SPIR-V by field name (`deferred_light`, `forward`,
+/// ...): `None` when a BRDF stage is missing; a hooked stage that evaluates no BRDF
+/// (`tile_classify`, `depth_id_copy`) missing is histencil's own.
+pub(crate) fn modules_of(
+    set: &BrdfSet,
+    stage: impl Fn(&str) -> Option<&'static [u8]>,
+) -> Option<BrdfModules> {
+    let mut light = LightModules {
+        brdfs: Box::leak(set.ids().iter().map(|b| b.index()).collect()),
+        brdf_names: Box::leak(set.ids().iter().map(|b| b.name()).collect()),
+        ..LightModules::BUILTIN
+    };
+    let evaluates = |field: &str| {
+        histencil_build::BRDF_STAGES
+            .iter()
+            .any(|s| s.split('.').next() == Some(field))
+    };
+    for (field, module) in light.named_mut() {
+        match stage(field) {
+            Some(spirv) => *module = spirv,
+            None if evaluates(field) => return None,
+            None => {}
+        }
+    }
+    Some(BrdfModules {
+        set: set.clone(),
+        light,
+        forward: stage("forward")?,
+        lightmap: stage("lightmap")?,
+        lightmap_directional: stage("lightmap_directional")?,
+        alpha_object: stage("alpha_object")?,
+        particle: stage("particle")?,
+        brdf_eval: stage("brdf_eval")?,
+    })
 }
 
 /// Unit vector at `elevation` degrees above the plane z = 0, `azimuth` degrees around +z.

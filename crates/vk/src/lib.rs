@@ -22,6 +22,8 @@ mod lighting;
 pub mod passes;
 mod renderer;
 mod shader_consts;
+#[cfg(feature = "files")]
+mod shader_file;
 pub mod shader_layouts;
 mod tools;
 
@@ -38,7 +40,10 @@ pub use alpha::{
     mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord, AlphaLightmaps,
     AlphaLightmapsDesc, AlphaMode, LightmapFrame,
 };
-pub use brdf_modules::{compile as compile_brdf_set, probe_finite as probe_brdfs, BrdfModules};
+pub use brdf_modules::{
+    compile as compile_brdf_set, compile_with_hooks as compile_brdf_set_with_hooks,
+    probe_finite as probe_brdfs, BrdfModules,
+};
 pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};
 pub use gpu::debug::{ValidationLog, ValidationMessage};
 pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
@@ -77,6 +82,8 @@ pub use renderer::technique::{
     Backend, FrameDesc, MixedTiles, Shading, Technique, TileClassify, TileSide,
 };
 pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
+#[cfg(feature = "files")]
+pub use shader_file::{read_shader_file, write_shader_file, ShaderFile};
 pub use tools::brdf_eval::BrdfEvaluator;
 #[cfg(feature = "tools")]
 pub use tools::image_error::{difference_image, masked_error, MaskedError};

@@ -75,10 +75,11 @@ int main(void) {
     expect(histencil_lighting_destroy(lighting), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "lighting_destroy(foreign)");
     expect(histencil_lighting_destroy(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "lighting is null", "lighting_destroy(NULL)");
     {
-        HistencilBrdfSet *set = NULL;
-        expect(histencil_brdf_set_load(NULL, "examples/brdfs", &set), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "brdf_set_load(NULL)");
-        expect(histencil_brdf_set_destroy((HistencilBrdfSet *)&device), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live BrdfSet handle", "brdf_set_destroy(foreign)");
-        expect(histencil_brdf_set_write_includes(NULL, "out"), HISTENCIL_RESULT_INVALID_ARGUMENT, "set is null", "brdf_set_write_includes(NULL)");
+        HistencilShaders *shaders = NULL;
+        expect(histencil_shaders_compile(NULL, "examples/brdfs", NULL, &shaders), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "shaders_compile(NULL)");
+        expect(histencil_shaders_load(NULL, "shaders.bin", &shaders), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "shaders_load(NULL)");
+        expect(histencil_shaders_destroy((HistencilShaders *)&device), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Shaders handle", "shaders_destroy(foreign)");
+        expect(histencil_shaders_write_includes(NULL, "out"), HISTENCIL_RESULT_INVALID_ARGUMENT, "shaders is null", "shaders_write_includes(NULL)");
         expect(histencil_device_suits(NULL, VK_NULL_HANDLE, VK_NULL_HANDLE, 0, &in_flight), HISTENCIL_RESULT_INVALID_ARGUMENT, "get_instance_proc_addr is null", "device_suits(NULL)");
     }
 

@@ -122,6 +122,21 @@ public:
     HistencilContext *handle = nullptr;
 };
 
+// histencil's shaders for the engine's BRDF set, from the file this engine's build wrote with
+// `histencil shaders` (CMakeLists.txt): no glslc needed here.
+class Shaders {
+public:
+    Shaders(Context &context, const char *file) {
+        hcheck(histencil_shaders_load(context.handle, file, &handle), "histencil_shaders_load");
+    }
+    ~Shaders() {
+        if (handle) hreport(histencil_shaders_destroy(handle), "histencil_shaders_destroy");
+    }
+    Shaders(const Shaders &) = delete;
+    Shaders &operator=(const Shaders &) = delete;
+    HistencilShaders *handle = nullptr;
+};
+
 // The lighting. Its destructor waits for the device and declares every slot finished first,
 // so that it frees on the error paths too (histencil refuses to free a lighting in flight).
 class Lighting {
@@ -259,7 +274,10 @@ void run(Results &results) {
     if ((version >> 22) != HISTENCIL_VERSION_MAJOR || ((version >> 12) & 0x3ff) != HISTENCIL_VERSION_MINOR) {
         throw std::runtime_error("the histencil library is not the version of the header");
     }
-    const World world(kWidth, kHeight);
+    // histencil: the context on the engine's device, and its shaders for the engine's BRDFs.
+    Context context(gpu);
+    const Shaders shaders(context, CPP_ENGINE_HISTENCIL_SHADERS);
+    const World world(kWidth, kHeight, shaders.handle);
 
     // The targets histencil lights, in its G-buffer formats.
     VkFormat gbuffer_formats[HISTENCIL_GBUFFER_IMAGES];
@@ -311,14 +329,14 @@ void run(Results &results) {
         s.readback = gpu.buffer(2 * image_bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     }
 
-    // histencil: the context on the engine's device, one lighting for the world's BRDFs (made
-    // with hi-stencil, which the PS3-like platform needs; the native and tiled frames ignore it).
-    Context context(gpu);
+    // One lighting for the world's BRDFs (made with hi-stencil, which the PS3-like platform
+    // needs; the native and tiled frames ignore it).
     HistencilLightingDesc desc{};
     desc.size = sizeof desc;
     desc.brdf_count = static_cast<uint32_t>(world.brdf_names.size());
     desc.brdf_names = world.brdf_names.data();
-    desc.brdf_set = nullptr;  // histencil's own BRDFs only
+    desc.shaders = shaders.handle;  // the engine's BRDF set; histencil's G-buffer, no shadows
+    desc.hooks = nullptr;
     desc.engine_stencil_bits = 0;
     desc.width = kWidth;
     desc.height = kHeight;
@@ -399,8 +417,8 @@ void run(Results &results) {
         s.technique = technique;
     }
     for (uint32_t i = 0; i < kSlots; ++i) finish(slots[(kFrames + i) % kSlots], (kFrames + i) % kSlots);
-    // Leaving the scope frees, in order: the lighting, the context, then the engine's own
-    // objects, the device and the instance.
+    // Leaving the scope frees, in order: the lighting, the engine's own objects, histencil's shaders
+    // and context, then the device and the instance.
 }
 
 }  // namespace

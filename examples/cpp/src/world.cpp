@@ -90,8 +90,9 @@ Mesh unit_box() {
     return mesh;
 }
 
-World::World(uint32_t width, uint32_t height) {
-    brdf_names = {"lambert", "ggx", "oren_nayar_full"};
+World::World(uint32_t width, uint32_t height, const HistencilShaders *shaders) {
+    // histencil's three and the engine's own (brdfs/brdfs.toml).
+    brdf_names = {"lambert", "ggx", "oren_nayar_full", "wrap_diffuse"};
     // Each material's BRDF values, as histencil encodes them for the G-buffer.
     struct Spec {
         uint32_t slot;
@@ -105,13 +106,14 @@ World::World(uint32_t width, uint32_t height) {
         {1, {{"alpha", 0.09}, {"f0", 0.04}}, {0.5f, 0.625f, 0.875f}},          // glossy plastic
         {0, {{"rho", 1.0}}, {0.25f, 0.875f, 0.5f}},                            // white paint
         {2, {{"rho", 0.7}, {"sigma", 1.2}}, {0.875f, 0.875f, 0.5f}},           // clay
+        {3, {{"wrap", 0.6}, {"rho", 0.85}}, {0.875f, 0.625f, 0.5f}},           // skin-like wrap
     };
     for (const Spec &spec : specs) {
         Material m{};
         m.brdf_slot = spec.slot;
         const char *name = brdf_names[spec.slot];
-        // No BRDF set: these are histencil's own BRDFs.
-        if (histencil_brdf_encode(nullptr, name, spec.params.data(),
+        // The engine's set holds histencil's built-ins it keeps and its own.
+        if (histencil_brdf_encode(shaders, name, spec.params.data(),
                                   static_cast<uint32_t>(spec.params.size()), m.packed,
                                   &m.model) != HISTENCIL_RESULT_SUCCESS) {
             throw std::runtime_error(std::string("histencil_brdf_encode(") + name +
@@ -130,6 +132,7 @@ World::World(uint32_t width, uint32_t height) {
     add({1.2f, 0.75f, 0.5f}, -0.3f, {0.8f, 1.5f, 0.8f}, 3);
     add({0.2f, 0.3f, 1.8f}, 0.8f, {0.6f, 0.6f, 0.6f}, 4);
     add({-0.3f, 0.4f, -1.6f}, 0.2f, {1.4f, 0.8f, 0.6f}, 5);
+    add({-1.6f, 0.45f, 1.9f}, 0.4f, {0.7f, 0.9f, 0.7f}, 6);  // the engine's own BRDF
 
     const Mat4 world_to_view = look_at({0, 3, 6.5f}, {0, 0.6f, 0}, {0, 1, 0});
     const Mat4 view_to_clip = perspective(1.0f, float(width) / float(height), 0.1f, 50.0f);

@@ -42,9 +42,10 @@ struct Object {
 };
 
 struct World {
-    // Seen on a `width` x `height` target. Throws with histencil_last_error() when histencil
-    // refuses a BRDF's parameters.
-    World(uint32_t width, uint32_t height);
+    // Seen on a `width` x `height` target, its materials encoded for histencil's shaders of
+    // the engine's BRDF set (`shaders`, which hold its own `wrap_diffuse`). Throws with
+    // histencil_last_error() when histencil refuses a BRDF's parameters.
+    World(uint32_t width, uint32_t height, const HistencilShaders *shaders);
 
     // The lighting's BRDFs, one stencil slot each, in this order.
     std::vector<const char *> brdf_names;

@@ -4,9 +4,11 @@
 #![allow(dead_code)]
 
 use ash::vk;
+use histencil::Context;
 use histencil_capi::*;
-use histencil_tests::engine::Engine;
-use std::ffi::CString;
+use histencil_tests::engine::{Engine, EngineTargets};
+use std::ffi::{c_char, CStr, CString};
+use std::ptr::{null, null_mut};
 
 pub fn device_desc(engine: &Engine) -> HistencilDeviceDesc {
     HistencilDeviceDesc {
@@ -136,4 +138,122 @@ impl World {
             })
             .collect()
     }
+}
+
+pub const SIZE: vk::Extent2D = vk::Extent2D {
+    width: 48,
+    height: 32,
+};
+
+pub fn last_error() -> String {
+    // SAFETY: never null, valid until the next call on this thread.
+    unsafe { CStr::from_ptr(histencil_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// Holds a call's result to `expected` and its message to contain `words`.
+#[track_caller]
+pub fn expect(result: HistencilResult, expected: HistencilResult, words: &str) {
+    let message = last_error();
+    assert_eq!(result, expected, "{message}");
+    assert!(message.contains(words), "`{message}` should say `{words}`");
+}
+
+/// Runs `body` with the engine, a Rust context on its device (for histencil's renderer, which
+/// writes the G-buffer, and the Rust lighting compared against), a C context on the same
+/// device, the engine's targets and the world; then frees all and holds the layer silent.
+pub fn with_c_context(
+    body: impl FnOnce(&Engine, &histencil::vk::Renderer, *mut HistencilContext, &EngineTargets, &World),
+) {
+    let mut scene = histencil::scene::embedded("brdfs-3").unwrap();
+    scene.normalise_lights();
+    let engine = Engine::start();
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.unwrap();
+        let renderer =
+            histencil::vk::Renderer::new(&ctx, scene.clone(), SIZE.width, SIZE.height).unwrap();
+        let names = (renderer.brdfs().iter())
+            .map(|b| CString::new(b.name()).unwrap())
+            .collect();
+        let world = World {
+            view: scene.camera.view_desc(1.5),
+            scene,
+            names,
+        };
+        let images = engine.lighting_targets(SIZE, ctx.depth_stencil_format().vk());
+        let mut c_ctx = null_mut();
+        // SAFETY: a live desc of the engine's live handles; a writable out pointer.
+        let made = unsafe { histencil_context_create(&device_desc(&engine), &mut c_ctx) };
+        assert_eq!(made, HistencilResult::Success, "{}", last_error());
+        body(&engine, &renderer, c_ctx, &images, &world);
+        // SAFETY: a live context with no lighting left.
+        let freed = unsafe { histencil_context_destroy(c_ctx) };
+        assert_eq!(freed, HistencilResult::Success, "{}", last_error());
+        images.free(&engine);
+        drop(renderer);
+    }
+    engine.destroy().assert_clean();
+}
+
+pub fn c_lighting_desc(world: &World, names: &[*const c_char]) -> HistencilLightingDesc {
+    HistencilLightingDesc {
+        size: size_of::<HistencilLightingDesc>() as u32,
+        brdf_count: names.len() as u32,
+        brdf_names: names.as_ptr(),
+        shaders: null(),
+        engine_stencil_bits: 0,
+        width: SIZE.width,
+        height: SIZE.height,
+        depth_stencil_format: vk::Format::D32_SFLOAT_S8_UINT,
+        hdr_format: vk::Format::R16G16B16A16_SFLOAT,
+        frames_in_flight: 1,
+        max_lights: world.scene.lights.len() as u32,
+        hi_stencil: 1,
+        hooks: null(),
+    }
+}
+
+/// One frame on the engine's queue, waited for: histencil's G-buffer through `renderer`, then
+/// `record`, the HDR image copied into `readback` and returned as floats.
+pub fn lit_frame(
+    engine: &Engine,
+    renderer: &histencil::vk::Renderer,
+    images: &EngineTargets,
+    readback: &histencil_tests::engine::EngineBuffer,
+    record: &mut dyn FnMut(vk::CommandBuffer, &mut histencil::LightingTargets),
+) -> Vec<f32> {
+    let d = &engine.device;
+    let mut targets = images.refs();
+    let (pool, cmd) = engine.command_buffer();
+    // SAFETY: the engine's command buffer, recorded here and waited for.
+    unsafe {
+        d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
+            .unwrap();
+        renderer.record_gbuffer(cmd, &mut targets).unwrap();
+        record(cmd, &mut targets);
+        histencil_tests::engine::copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
+        engine.submit_and_wait(pool, cmd);
+    }
+    histencil_tests::engine::hdr_floats(readback.bytes())
+}
+
+/// Records `frame` through the C API into `cmd` against `targets`, and takes the HDR image's
+/// state back from what the C side was handed, as a C engine does for its next barrier.
+pub fn record_through_c(
+    lighting: *mut HistencilLighting,
+    cmd: vk::CommandBuffer,
+    frame: &HistencilFrame,
+    targets: &mut histencil::LightingTargets,
+) {
+    let mut gbuffer = Vec::new();
+    let mut c_targets = c_targets_of(targets, &mut gbuffer);
+    // SAFETY: a recording command buffer of the lent device; live structs.
+    let r = unsafe { histencil_lighting_record(lighting, cmd, frame, &mut c_targets) };
+    assert_eq!(r, HistencilResult::Success, "{}", last_error());
+    let hdr = gbuffer[gbuffer.len() - 1];
+    targets.hdr.state.layout = hdr.layout;
+    targets.hdr.state.stage = hdr.stage;
+    targets.hdr.state.access = hdr.access;
 }

@@ -75,4 +75,18 @@ impl LightModules {
             ("depth_id_shade", self.depth_id_shade),
         ]
     }
+
+    /// Each module by its name, to be set (a run-time compile, a shader file read back).
+    pub(crate) fn named_mut(&mut self) -> [(&'static str, &mut &'static [u8]); 8] {
+        [
+            ("deferred_light", &mut self.deferred_light),
+            ("lut_light", &mut self.lut_light),
+            ("tile_classify", &mut self.tile_classify),
+            ("tile_shade", &mut self.tile_shade),
+            ("tile_classify_8", &mut self.tile_classify_8),
+            ("tile_shade_8", &mut self.tile_shade_8),
+            ("depth_id_copy", &mut self.depth_id_copy),
+            ("depth_id_shade", &mut self.depth_id_shade),
+        ]
+    }
 }
