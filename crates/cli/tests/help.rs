@@ -23,6 +23,7 @@ const HELP: &[(&str, &[&str])] = &[
     ("check-merge", &["check", "merge", "--help"]),
     ("brdf-eval", &["brdf-eval", "--help"]),
     ("brdf-report", &["brdf-report", "--help"]),
+    ("shaders", &["shaders", "--help"]),
 ];
 
 /// Usage errors: one line each, and the exit code clap's errors take (2).
