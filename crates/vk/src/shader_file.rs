@@ -405,4 +405,60 @@ mod tests {
             refused(&file(ours, bad, fnv1a(bad)), words);
         }
     }
+
+    /// A file of histencil's own modules, its body mutated at random (bytes flipped, cut,
+    /// repeated) and its checksum made to match again, so that every mutation reaches the
+    /// parser and the SPIR-V checks behind the checksum: each is refused or read, never a panic.
+    #[test]
+    fn mutated_files_past_the_checksum_are_refused_or_read_never_a_panic() {
+        let mut body = b"hooks -\n".to_vec();
+        for (name, spirv) in named_modules(BrdfModules::builtin()) {
+            body.extend(format!("spirv {name} {}\n", spirv.len()).bytes());
+            body.extend(spirv);
+            body.push(b'\n');
+        }
+        body.extend(b"end\n");
+        let file = |body: &[u8]| {
+            let head = format!(
+                "{HEAD}histencil {}\nchecksum {:016x}\n",
+                env!("CARGO_PKG_VERSION"),
+                fnv1a(body)
+            );
+            [head.as_bytes(), body].concat()
+        };
+        let unmutated = file(&body);
+        let whole = parse(&unmutated).expect("the unmutated file reads");
+        check_stages(&whole.spirv).expect("histencil's own modules");
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = |below: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % below as u64) as usize
+        };
+        let (mut refused, mut read) = (0, 0);
+        for _ in 0..1500 {
+            let mut mutated = body.clone();
+            for _ in 0..1 + next(4) {
+                let at = next(mutated.len());
+                match next(4) {
+                    0 => mutated[at] ^= 1 << next(8),
+                    1 => mutated[at] = b"0123456789 \nx"[next(13)],
+                    2 => mutated.truncate(at),
+                    _ => {
+                        let piece = mutated[at..(at + 1 + next(64)).min(mutated.len())].to_vec();
+                        mutated.splice(at..at, piece);
+                    }
+                }
+                if mutated.is_empty() {
+                    break;
+                }
+            }
+            match parse(&file(&mutated)).and_then(|b| check_stages(&b.spirv)) {
+                Ok(()) => read += 1,
+                Err(_) => refused += 1,
+            }
+        }
+        assert!(refused > 500 && read > 0, "{refused} refused, {read} read");
+    }
 }
