@@ -82,6 +82,27 @@
 // std430).
 #define HISTENCIL_GPU_LIGHT_BYTES 64
 
+// A translucent object: `mesh`, `transform`, `local_min`, `local_max`.
+#define HISTENCIL_ENTITY_OBJECT 0
+
+// A particle system: `particles`, `particle_layout` (and `slices`).
+#define HISTENCIL_ENTITY_PARTICLES 1
+
+// One camera-facing quad around the system.
+#define HISTENCIL_PARTICLES_BILLBOARD 0
+
+// `slices` such quads stacked through the system's depth (2 to 8).
+#define HISTENCIL_PARTICLES_SLICES 1
+
+// As many quads as the lighting needs, chosen from the error estimate.
+#define HISTENCIL_PARTICLES_AUTO 2
+
+// One texel per mote.
+#define HISTENCIL_PARTICLES_DUST 3
+
+// The particles are a ribbon's control points, in order.
+#define HISTENCIL_PARTICLES_RIBBON 4
+
 // What every call returns. On anything but `HISTENCIL_RESULT_SUCCESS`,
 // `histencil_last_error()` says what, on the calling thread.
 typedef enum HistencilResult {
@@ -114,6 +135,9 @@ typedef struct HistencilContext HistencilContext;
 
 // A lighting made on a context, with the names it was made with.
 typedef struct HistencilLighting HistencilLighting;
+
+// Lightmaps made on a context.
+typedef struct HistencilLightmaps HistencilLightmaps;
 
 // histencil's shaders compiled for a BRDF set and, if the engine gave them, its hooks.
 typedef struct HistencilShaders HistencilShaders;
@@ -349,6 +373,105 @@ typedef struct HistencilTargets {
   // The HDR image.
   struct HistencilImage *hdr;
 } HistencilTargets;
+
+// What `histencil_lightmaps_create` makes lightmaps for: fixed for their life.
+typedef struct HistencilLightmapsDesc {
+  // `sizeof(HistencilLightmapsDesc)`.
+  uint32_t size;
+  // The shaders whose BRDF set the entities' materials name (`histencil_shaders_compile` or
+  // `_load`), or null for histencil's own BRDFs.
+  const struct HistencilShaders *shaders;
+  // The atlas's format: a colour format the device blends into
+  // (`VK_FORMAT_R16G16B16A16_SFLOAT` as histencil's own).
+  VkFormat atlas_format;
+  // How many frames the engine has in flight: slots 0 to `frames_in_flight - 1`.
+  uint32_t frames_in_flight;
+  // The direction map's format for `histencil_lightmaps_record` with a `direction` image, or
+  // `VK_FORMAT_UNDEFINED` for plain lightmaps only.
+  VkFormat direction_format;
+} HistencilLightmapsDesc;
+
+// A vertex of a translucent object's probe mesh, in object space.
+typedef struct HistencilVertex {
+  // Its position.
+  float position[3];
+  // Its unit normal.
+  float normal[3];
+  // Its lightmap coordinate in `[0, 1]^2`: the layout the alpha shader samples with.
+  float uv[2];
+} HistencilVertex;
+
+// A translucent object's mesh in its lightmap UV layout: one probe per texel it covers.
+typedef struct HistencilMesh {
+  // How many vertices.
+  uint32_t vertex_count;
+  // The vertices.
+  const struct HistencilVertex *vertices;
+  // How many indices: three per triangle, counter-clockwise seen from outside.
+  uint32_t index_count;
+  // The indices, each below `vertex_count`.
+  const uint32_t *indices;
+} HistencilMesh;
+
+// One sprite of a particle system, in world space.
+typedef struct HistencilParticle {
+  // Its centre (for a ribbon, a control point).
+  float position[3];
+  // Its half-width, positive.
+  float size;
+} HistencilParticle;
+
+// One translucent object or particle system, as lit this frame.
+typedef struct HistencilAlphaEntity {
+  // `HISTENCIL_ENTITY_*`.
+  uint32_t kind;
+  // An object's probe mesh (null for a particle system).
+  const struct HistencilMesh *mesh;
+  // An object's object-to-world matrix, column-major, finite and invertible.
+  float transform[16];
+  // The object-space box of what the object draws: its lights are those reaching it.
+  float local_min[3];
+  // Its other corner.
+  float local_max[3];
+  // A particle system's `HISTENCIL_PARTICLES_*`.
+  uint32_t particle_layout;
+  // With `HISTENCIL_PARTICLES_SLICES`, how many slices.
+  uint32_t slices;
+  // How many particles.
+  uint32_t particle_count;
+  // The particles (null for an object).
+  const struct HistencilParticle *particles;
+  // The BRDF its probes are lit with, by name, NUL-terminated.
+  const char *brdf_name;
+  // How many BRDF parameters.
+  uint32_t param_count;
+  // The BRDF's parameters by name (an engine BRDF's left out take their defaults).
+  const struct HistencilBrdfParam *params;
+  // Its colour, linear RGB in `[0, 1]`.
+  float tint[3];
+  // Its coverage in `[0, 1]`, carried to its record for the alpha shader.
+  float opacity;
+} HistencilAlphaEntity;
+
+// One frame's lightmaps.
+typedef struct HistencilLightmapFrame {
+  // `sizeof(HistencilLightmapFrame)`.
+  uint32_t size;
+  // The frame-in-flight slot, below `frames_in_flight`.
+  uint32_t slot;
+  // The camera: particle quads face it, probes are lit towards it.
+  struct HistencilView view;
+  // How many lights.
+  uint32_t light_count;
+  // The frame's lights; each entity is lit by those whose range reaches it.
+  const struct HistencilLight *lights;
+  // How many entities.
+  uint32_t entity_count;
+  // The entities, in the order their records are written (`histencil_lightmaps_entity_buffer`).
+  const struct HistencilAlphaEntity *entities;
+  // The viewport's height in pixels, which the texel choice estimates the error against.
+  uint32_t viewport_height;
+} HistencilLightmapFrame;
 
 #ifdef __cplusplus
 extern "C" {
@@ -595,6 +718,89 @@ enum HistencilResult histencil_lighting_resize(struct HistencilLighting *lightin
 // # Safety
 // `lighting` is null or a handle from `histencil_lighting_create` (a freed one is refused).
 enum HistencilResult histencil_lighting_destroy(struct HistencilLighting *lighting);
+
+// Makes lightmaps on `context`: their pipelines, per-slot buffers and sets. Nothing is
+// submitted.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer, a wrong `size`,
+// `frames_in_flight` outside 1 to 16; `BAD_SETUP` for an atlas or direction format the device
+// cannot blend into; `DEVICE_LIMIT`, `VULKAN` as the device says.
+//
+// Thread safety: not at the same time as another call on `context`.
+//
+// # Safety
+// `desc` is null or points at a live description; `lightmaps` is null or writable.
+enum HistencilResult histencil_lightmaps_create(struct HistencilContext *context,
+                                                const struct HistencilLightmapsDesc *desc,
+                                                struct HistencilLightmaps **lightmaps);
+
+// Plans the frame's entities' regions of `atlas` (each entity's slices and texels from the CPU
+// error estimate at `viewport_height`, halved where the atlas is full) and lights them into
+// it, after clearing it to black; with a non-null `direction`, also the direction map (the
+// lightmaps were made with its format). Leaves each image's state in it for the engine's next
+// barrier. The entity records the alpha shader reads are in `histencil_lightmaps_entity_buffer`.
+// Nothing is submitted; on an error nothing is recorded.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, a wrong `size`, an
+// unknown entity kind or particle layout, a mesh index past its vertices; `BAD_FRAME` for a
+// slot past `frames_in_flight`, an entity, light or view histencil cannot light (the message
+// names it), an atlas of another format, too small for the regions even halved, or without
+// `COLOR_ATTACHMENT`; `BAD_SETUP` for a BRDF the shaders' set lacks or parameters out of range;
+// `IN_FLIGHT` for a slot recorded and not declared finished.
+//
+// Cannot be checked: as `histencil_lighting_record` (a recording command buffer outside a
+// render pass, images that are what they say, in the states they say).
+//
+// Thread safety: not at the same time as another call on `lightmaps`.
+//
+// # Safety
+// `frame` and `atlas` are null or point at live structs whose pointers hold what they say;
+// `direction` is null or points at a live image.
+enum HistencilResult histencil_lightmaps_record(struct HistencilLightmaps *lightmaps,
+                                                VkCommandBuffer command_buffer,
+                                                const struct HistencilLightmapFrame *frame,
+                                                struct HistencilImage *atlas,
+                                                struct HistencilImage *direction);
+
+// Writes the storage buffer of `slot`'s entity records (what the last frame recorded through
+// `slot` wrote, one `AlphaEntityRecord` per entity in the frame's order: the alpha shader's
+// `lightmap_sample.glsl` reads it) into `buffer`.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or a null `buffer`; `BAD_FRAME` for a
+// slot past `frames_in_flight`.
+//
+// Thread safety: not at the same time as another call on `lightmaps`.
+//
+// # Safety
+// `buffer` is null or writable.
+enum HistencilResult histencil_lightmaps_entity_buffer(struct HistencilLightmaps *lightmaps,
+                                                       uint32_t slot,
+                                                       VkBuffer *buffer);
+
+// Says the GPU has finished the frame last recorded into `slot`, as
+// `histencil_lighting_slot_finished` does for a lighting.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle; `BAD_FRAME` for a slot past
+// `frames_in_flight`.
+//
+// Thread safety: not at the same time as another call on `lightmaps`.
+//
+// # Safety
+// Every command buffer that recorded `slot` through these lightmaps has finished executing, or
+// will never be submitted.
+enum HistencilResult histencil_lightmaps_slot_finished(struct HistencilLightmaps *lightmaps,
+                                                       uint32_t slot);
+
+// Frees the lightmaps. Refused with `IN_FLIGHT` while a slot is not declared finished: they
+// stay whole and usable.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle; `IN_FLIGHT` as above.
+//
+// Thread safety: not at the same time as another call on `lightmaps`.
+//
+// # Safety
+// `lightmaps` is null or a handle from `histencil_lightmaps_create` (a freed one is refused).
+enum HistencilResult histencil_lightmaps_destroy(struct HistencilLightmaps *lightmaps);
 
 // Compiles histencil's shaders (glslc, as `histencil render --brdfs` does; compiled once per
 // set and hooks in a process) for the BRDF folder `brdf_folder` (its `brdfs.toml` and the GLSL

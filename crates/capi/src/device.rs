@@ -164,7 +164,7 @@ pub unsafe extern "C" fn histencil_context_destroy(
             return Err(Failure {
                 result: HistencilResult::InFlight,
                 message: format!(
-                    "the context still has {lightings} lighting(s) made on it: destroy them first"
+                    "the context still has {lightings} lighting(s) or lightmaps made on it: destroy them first"
                 ),
             });
         }

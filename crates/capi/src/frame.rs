@@ -185,7 +185,7 @@ pub struct HistencilImage {
 }
 
 impl HistencilImage {
-    fn to_ref(self, what: impl Fn() -> String) -> Outcome<ImageRef> {
+    pub(crate) fn to_ref(self, what: impl Fn() -> String) -> Outcome<ImageRef> {
         if self.image == vk::Image::null() || self.view == vk::ImageView::null() {
             return Err(Failure::invalid(format!(
                 "{}: its image or view is VK_NULL_HANDLE",
@@ -209,7 +209,7 @@ impl HistencilImage {
         })
     }
 
-    fn left_as(&mut self, image: &ImageRef) {
+    pub(crate) fn left_as(&mut self, image: &ImageRef) {
         self.layout = image.state.layout;
         self.stage = image.state.stage;
         self.access = image.state.access;
@@ -330,23 +330,36 @@ pub struct HistencilFrame {
 /// Most lights a frame may pass: far past any lighting's `max_lights`, a bound on what is read.
 const MAX_LIGHTS: u32 = 1 << 20;
 
+/// `count` lights at `lights`, converted into `out`; `what` names the struct in messages.
+///
+/// # Safety
+/// `lights` is null or points at `count` lights.
+pub(crate) unsafe fn lights_into(
+    lights: *const HistencilLight,
+    count: u32,
+    what: &str,
+    out: &mut Vec<Light>,
+) -> Outcome {
+    if count > MAX_LIGHTS {
+        return Err(Failure::invalid(format!(
+            "{what}.light_count is {count}, past {MAX_LIGHTS}"
+        )));
+    }
+    // SAFETY: this fn's # Safety.
+    let lights = unsafe { slice(lights, count, &format!("{what}.lights")) }?;
+    out.clear();
+    for (i, l) in lights.iter().enumerate() {
+        out.push(l.to_light(i)?);
+    }
+    Ok(())
+}
+
 impl HistencilFrame {
     /// The frame's lights, converted into `out` (a lighting's own, reused frame after frame so
     /// that a frame through C allocates nothing the Rust API's does not).
     pub(crate) fn lights_into(&self, out: &mut Vec<Light>) -> Outcome {
-        if self.light_count > MAX_LIGHTS {
-            return Err(Failure::invalid(format!(
-                "HistencilFrame.light_count is {}, past {MAX_LIGHTS}",
-                self.light_count
-            )));
-        }
         // SAFETY: the header's contract: `light_count` lights at `lights`.
-        let lights = unsafe { slice(self.lights, self.light_count, "HistencilFrame.lights") }?;
-        out.clear();
-        for (i, l) in lights.iter().enumerate() {
-            out.push(l.to_light(i)?);
-        }
-        Ok(())
+        unsafe { lights_into(self.lights, self.light_count, "HistencilFrame", out) }
     }
 
     /// Each BRDF's boxes, converted into `out` (reused as `lights_into`'s).

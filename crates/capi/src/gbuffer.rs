@@ -2,6 +2,7 @@
 //! each BRDF's values as the G-buffer stores them, and the device features histencil needs.
 
 use crate::shaders::utf8;
+use crate::Outcome;
 use crate::{call, slice, Failure, HistencilResult};
 use ash::vk;
 use histencil::brdf::Brdf;
@@ -83,35 +84,7 @@ pub unsafe extern "C" fn histencil_brdf_encode(
         let name = unsafe { utf8(name, "name") }?;
         // SAFETY: this fn's # Safety: `param_count` parameters at `params`.
         let params = unsafe { slice(params, param_count, "params") }?;
-        let mut given = Vec::with_capacity(params.len());
-        for (i, p) in params.iter().enumerate() {
-            // SAFETY: this fn's # Safety: each name null or NUL-terminated.
-            let key = unsafe { utf8(p.name, &format!("params[{i}].name")) }?;
-            if !p.value.is_finite() {
-                return Err(setup(format!(
-                    "params[{i}] (`{key}`) is {}, not finite",
-                    p.value
-                )));
-            }
-            given.push((key, p.value));
-        }
-        let engine = modules.set.engine().any(|(_, spec)| spec.name == name);
-        let brdf = if engine {
-            modules.set.engine_brdf(name, &given)
-        } else {
-            let map: serde_json::Map<String, serde_json::Value> = (given.iter())
-                .filter_map(|(k, v)| {
-                    Some(((*k).to_owned(), serde_json::Number::from_f64(*v)?.into()))
-                })
-                .collect();
-            Brdf::parse(name, &map)
-        }
-        .map_err(|e| setup(format!("BRDF `{name}`: {e}")))?;
-        if !modules.set.ids().contains(&brdf.id()) {
-            return Err(setup(format!(
-                "BRDF `{name}` is not in the set (its manifest's builtins leave it out)"
-            )));
-        }
+        let brdf = brdf_of(modules, name, params)?;
         for (i, v) in brdf.packed_params().iter().enumerate() {
             // SAFETY: this fn's # Safety: 4 writable floats.
             unsafe { packed.add(i).write(*v as f32) };
@@ -120,6 +93,43 @@ pub unsafe extern "C" fn histencil_brdf_encode(
         unsafe { brdf_id.write(brdf.id().index()) };
         Ok(())
     })
+}
+
+/// BRDF `name` of `modules`' set with `params` (by name; an engine BRDF's left out take their
+/// defaults), each held to its range.
+pub(crate) fn brdf_of(
+    modules: &histencil::BrdfModules,
+    name: &str,
+    params: &[HistencilBrdfParam],
+) -> Outcome<histencil::brdf::Brdf> {
+    let mut given = Vec::with_capacity(params.len());
+    for (i, p) in params.iter().enumerate() {
+        // SAFETY: the caller's contract: each name null or NUL-terminated.
+        let key = unsafe { utf8(p.name, &format!("params[{i}].name")) }?;
+        if !p.value.is_finite() {
+            return Err(setup(format!(
+                "params[{i}] (`{key}`) is {}, not finite",
+                p.value
+            )));
+        }
+        given.push((key, p.value));
+    }
+    let engine = modules.set.engine().any(|(_, spec)| spec.name == name);
+    let brdf = if engine {
+        modules.set.engine_brdf(name, &given)
+    } else {
+        let map: serde_json::Map<String, serde_json::Value> = (given.iter())
+            .filter_map(|(k, v)| Some(((*k).to_owned(), serde_json::Number::from_f64(*v)?.into())))
+            .collect();
+        Brdf::parse(name, &map)
+    }
+    .map_err(|e| setup(format!("BRDF `{name}`: {e}")))?;
+    if !modules.set.ids().contains(&brdf.id()) {
+        return Err(setup(format!(
+            "BRDF `{name}` is not in the set (its manifest's builtins leave it out)"
+        )));
+    }
+    Ok(brdf)
 }
 
 fn setup(message: String) -> Failure {

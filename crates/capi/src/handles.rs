@@ -11,6 +11,7 @@ pub(crate) enum Kind {
     Context,
     Lighting,
     Shaders,
+    Lightmaps,
 }
 
 static LIVE: Mutex<Option<HashSet<(usize, Kind)>>> = Mutex::new(None);

@@ -20,6 +20,7 @@ mod frame;
 mod gbuffer;
 mod handles;
 mod lighting;
+mod lightmaps;
 mod shaders;
 
 pub use device::{
@@ -43,6 +44,14 @@ pub use lighting::{
     histencil_lighting_create, histencil_lighting_destroy, histencil_lighting_in_flight,
     histencil_lighting_record, histencil_lighting_resize, histencil_lighting_slot_finished,
     histencil_lighting_stencil_reference, HistencilHooks, HistencilLighting, HistencilLightingDesc,
+};
+pub use lightmaps::{
+    histencil_lightmaps_create, histencil_lightmaps_destroy, histencil_lightmaps_entity_buffer,
+    histencil_lightmaps_record, histencil_lightmaps_slot_finished, HistencilAlphaEntity,
+    HistencilLightmapFrame, HistencilLightmaps, HistencilLightmapsDesc, HistencilMesh,
+    HistencilParticle, HistencilVertex, HISTENCIL_ENTITY_OBJECT, HISTENCIL_ENTITY_PARTICLES,
+    HISTENCIL_PARTICLES_AUTO, HISTENCIL_PARTICLES_BILLBOARD, HISTENCIL_PARTICLES_DUST,
+    HISTENCIL_PARTICLES_RIBBON, HISTENCIL_PARTICLES_SLICES,
 };
 pub use shaders::{
     histencil_shaders_compile, histencil_shaders_destroy, histencil_shaders_load,

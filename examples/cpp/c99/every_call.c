@@ -80,6 +80,22 @@ int main(void) {
         expect(histencil_shaders_load(NULL, "shaders.bin", &shaders), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "shaders_load(NULL)");
         expect(histencil_shaders_destroy((HistencilShaders *)&device), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Shaders handle", "shaders_destroy(foreign)");
         expect(histencil_shaders_write_includes(NULL, "out"), HISTENCIL_RESULT_INVALID_ARGUMENT, "shaders is null", "shaders_write_includes(NULL)");
+        {
+            HistencilLightmaps *lightmaps = NULL;
+            HistencilLightmapsDesc lightmaps_desc;
+            HistencilLightmapFrame lightmap_frame;
+            HistencilImage atlas;
+            VkBuffer entities = VK_NULL_HANDLE;
+            memset(&lightmaps_desc, 0, sizeof lightmaps_desc);
+            memset(&lightmap_frame, 0, sizeof lightmap_frame);
+            memset(&atlas, 0, sizeof atlas);
+            expect(histencil_lightmaps_create(NULL, &lightmaps_desc, &lightmaps), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "lightmaps_create(NULL)");
+            lightmaps = (HistencilLightmaps *)&device;
+            expect(histencil_lightmaps_record(lightmaps, VK_NULL_HANDLE, &lightmap_frame, &atlas, NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lightmaps handle", "lightmaps_record(foreign)");
+            expect(histencil_lightmaps_entity_buffer(lightmaps, 0, &entities), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lightmaps handle", "lightmaps_entity_buffer(foreign)");
+            expect(histencil_lightmaps_slot_finished(lightmaps, 0), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lightmaps handle", "lightmaps_slot_finished(foreign)");
+            expect(histencil_lightmaps_destroy(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "lightmaps is null", "lightmaps_destroy(NULL)");
+        }
         expect(histencil_device_suits(NULL, VK_NULL_HANDLE, VK_NULL_HANDLE, 0, &in_flight), HISTENCIL_RESULT_INVALID_ARGUMENT, "get_instance_proc_addr is null", "device_suits(NULL)");
     }
 
