@@ -636,7 +636,26 @@ pub fn stencil_plan(
     view: &histencil_model::ViewDesc,
     backend: histencil_vk::Backend,
 ) -> histencil_model::FramePlan {
-    use histencil_model::{FlushPolicy, PlanInputs, PlanSettings, TechniqueChoice, View};
+    plan(
+        scene,
+        layout,
+        brdfs,
+        view,
+        backend,
+        histencil_model::TechniqueChoice::Stencil,
+    )
+}
+
+/// As [`stencil_plan`], for `technique` (branching's plan, which the LUT technique shades).
+pub fn plan(
+    scene: &histencil_scene::Scene,
+    layout: &histencil_model::StencilLayout,
+    brdfs: &[histencil_brdf::BrdfId],
+    view: &histencil_model::ViewDesc,
+    backend: histencil_vk::Backend,
+    technique: histencil_model::TechniqueChoice,
+) -> histencil_model::FramePlan {
+    use histencil_model::{FlushPolicy, PlanInputs, PlanSettings, View};
     let shapes: Vec<_> = scene.lights.iter().map(|l| l.shape()).collect();
     let bounds = scene.brdf_bounds(brdfs);
     let inputs = PlanInputs {
@@ -645,7 +664,7 @@ pub fn stencil_plan(
         view: &View::new(view).expect("a valid view"),
     };
     let settings = PlanSettings {
-        technique: TechniqueChoice::Stencil,
+        technique,
         caps: backend.platform().caps(),
         flush: FlushPolicy::Auto,
     };

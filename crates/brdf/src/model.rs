@@ -404,6 +404,16 @@ impl Brdf {
 }
 
 impl Brdf {
+    /// Each parameter with its name, as `Brdf::parse` takes them (an engine BRDF's as `p.x`,
+    /// `p.y`, `p.z`: its set has their names): what a C engine passes to name the material
+    /// again, or a report prints.
+    pub fn params(&self) -> Vec<(&'static str, f64)> {
+        self.named_params()
+            .into_iter()
+            .map(|(name, x, _)| (name, x))
+            .collect()
+    }
+
     /// Each parameter with its name and range.
     fn named_params(&self) -> Vec<(&'static str, f64, Range)> {
         use ranges::*;

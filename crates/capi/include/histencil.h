@@ -57,6 +57,11 @@
 // `HistencilFrame.technique`: the BRDF id in a depth copy, one pass per BRDF.
 #define HISTENCIL_TECHNIQUE_DEPTH_ID 3
 
+// `HistencilFrame.technique`: branching's one light shader, each BRDF read from its material's
+// look-up table (`histencil_lighting_set_lut_tables` first; the G-buffer's material index
+// names the table).
+#define HISTENCIL_TECHNIQUE_LUT 4
+
 // `HistencilFrame.platform`: plain Vulkan, no hi-stencil emulated.
 #define HISTENCIL_PLATFORM_NATIVE 0
 
@@ -138,6 +143,10 @@ typedef struct HistencilLighting HistencilLighting;
 
 // Lightmaps made on a context.
 typedef struct HistencilLightmaps HistencilLightmaps;
+
+// The LUT technique's tables, one per material in the order the G-buffer's material index
+// names them.
+typedef struct HistencilLutTables HistencilLutTables;
 
 // histencil's shaders compiled for a BRDF set and, if the engine gave them, its hooks.
 typedef struct HistencilShaders HistencilShaders;
@@ -473,6 +482,17 @@ typedef struct HistencilLightmapFrame {
   uint32_t viewport_height;
 } HistencilLightmapFrame;
 
+// A material: a BRDF by name with its parameters (an engine BRDF's left out take their
+// defaults).
+typedef struct HistencilMaterial {
+  // The BRDF's name, NUL-terminated.
+  const char *brdf_name;
+  // How many parameters.
+  uint32_t param_count;
+  // The parameters by name.
+  const struct HistencilBrdfParam *params;
+} HistencilMaterial;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -801,6 +821,50 @@ enum HistencilResult histencil_lightmaps_slot_finished(struct HistencilLightmaps
 // # Safety
 // `lightmaps` is null or a handle from `histencil_lightmaps_create` (a freed one is refused).
 enum HistencilResult histencil_lightmaps_destroy(struct HistencilLightmaps *lightmaps);
+
+// Bakes one table per material at `resolution` grid points per axis (a built-in's from its f64
+// reference on the CPU, an engine BRDF's by its own GLSL on the GPU, waited for) and uploads
+// them.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer, too many materials;
+// `BAD_SETUP` for a BRDF the shaders' set lacks, parameters out of range, a resolution
+// histencil-brdf refuses or a BRDF no table can hold (the message says why: a white part, the
+// tangent read); `DEVICE_LIMIT` when the values pass the device's storage-buffer range.
+//
+// Thread safety: not at the same time as another call on `context`.
+//
+// # Safety
+// `materials` is null or points at `material_count` materials whose pointers hold what they
+// say; `shaders` is null or a live handle; `tables` is null or writable.
+enum HistencilResult histencil_lut_tables_create(struct HistencilContext *context,
+                                                 const struct HistencilShaders *shaders,
+                                                 const struct HistencilMaterial *materials,
+                                                 uint32_t material_count,
+                                                 uint32_t resolution,
+                                                 struct HistencilLutTables **tables);
+
+// Points `lighting`'s `HISTENCIL_TECHNIQUE_LUT` frames at `tables`. Refused with `IN_FLIGHT`
+// while a slot of the lighting is not declared finished (the binding is rewritten in place).
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle; `IN_FLIGHT` as above.
+//
+// Thread safety: not at the same time as another call on `lighting` or `tables`.
+//
+// # Safety
+// `lighting` and `tables` are null or handles (freed ones are refused).
+enum HistencilResult histencil_lighting_set_lut_tables(struct HistencilLighting *lighting,
+                                                       struct HistencilLutTables *tables);
+
+// Frees the handle. Any lighting may have bound the tables and histencil sees no fence, so
+// their GPU buffers stay with the context until `histencil_context_destroy`.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle.
+//
+// Thread safety: not at the same time as another call naming `tables`.
+//
+// # Safety
+// `tables` is null or a handle from `histencil_lut_tables_create` (a freed one is refused).
+enum HistencilResult histencil_lut_tables_destroy(struct HistencilLutTables *tables);
 
 // Compiles histencil's shaders (glslc, as `histencil render --brdfs` does; compiled once per
 // set and hooks in a process) for the BRDF folder `brdf_folder` (its `brdfs.toml` and the GLSL

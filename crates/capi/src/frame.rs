@@ -34,6 +34,10 @@ pub const HISTENCIL_TECHNIQUE_BRANCHING: u32 = 1;
 pub const HISTENCIL_TECHNIQUE_TILED: u32 = 2;
 /// `HistencilFrame.technique`: the BRDF id in a depth copy, one pass per BRDF.
 pub const HISTENCIL_TECHNIQUE_DEPTH_ID: u32 = 3;
+/// `HistencilFrame.technique`: branching's one light shader, each BRDF read from its material's
+/// look-up table (`histencil_lighting_set_lut_tables` first; the G-buffer's material index
+/// names the table).
+pub const HISTENCIL_TECHNIQUE_LUT: u32 = 4;
 
 /// `HistencilFrame.platform`: plain Vulkan, no hi-stencil emulated.
 pub const HISTENCIL_PLATFORM_NATIVE: u32 = 0;

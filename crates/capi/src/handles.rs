@@ -12,6 +12,7 @@ pub(crate) enum Kind {
     Lighting,
     Shaders,
     Lightmaps,
+    LutTables,
 }
 
 static LIVE: Mutex<Option<HashSet<(usize, Kind)>>> = Mutex::new(None);

@@ -21,6 +21,7 @@ mod gbuffer;
 mod handles;
 mod lighting;
 mod lightmaps;
+mod lut;
 mod shaders;
 
 pub use device::{
@@ -33,7 +34,7 @@ pub use frame::{
     HISTENCIL_FALLOFF_SQUARED_WINDOW, HISTENCIL_LIGHT_DIRECTIONAL, HISTENCIL_LIGHT_POINT,
     HISTENCIL_LIGHT_SPOT, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
     HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
-    HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
+    HISTENCIL_TECHNIQUE_LUT, HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
 };
 pub use gbuffer::{
     histencil_brdf_encode, histencil_device_features, histencil_gbuffer_formats,
@@ -52,6 +53,10 @@ pub use lightmaps::{
     HistencilParticle, HistencilVertex, HISTENCIL_ENTITY_OBJECT, HISTENCIL_ENTITY_PARTICLES,
     HISTENCIL_PARTICLES_AUTO, HISTENCIL_PARTICLES_BILLBOARD, HISTENCIL_PARTICLES_DUST,
     HISTENCIL_PARTICLES_RIBBON, HISTENCIL_PARTICLES_SLICES,
+};
+pub use lut::{
+    histencil_lighting_set_lut_tables, histencil_lut_tables_create, histencil_lut_tables_destroy,
+    HistencilLutTables, HistencilMaterial,
 };
 pub use shaders::{
     histencil_shaders_compile, histencil_shaders_destroy, histencil_shaders_load,
@@ -117,13 +122,24 @@ impl From<histencil::Error> for Failure {
     fn from(e: histencil::Error) -> Self {
         use histencil::Error as E;
         let result = match &e {
-            E::BadSetup(_) | E::Layout(_) | E::BrdfSet(_) | E::MissingFormat(_) => {
-                HistencilResult::BadSetup
-            }
-            E::BadFrame(_) | E::Plan(_) | E::Scene(_) => HistencilResult::BadFrame,
+            E::BadSetup(_)
+            | E::Layout(_)
+            | E::BrdfSet(_)
+            | E::MissingFormat(_)
+            | E::Lut(_)
+            | E::LutUntabulable { .. }
+            | E::LutTexturedParameters { .. }
+            | E::TooManyMaterials { .. }
+            | E::BadResolution { width: 0, .. }
+            | E::BadResolution { height: 0, .. } => HistencilResult::BadSetup,
+            E::BadFrame(_) | E::Plan(_) | E::Scene(_) | E::Lightmap(_) => HistencilResult::BadFrame,
             E::InFlight(_) => HistencilResult::InFlight,
-            E::DeviceLimit(_) => HistencilResult::DeviceLimit,
+            E::DeviceLimit(_) | E::LutTooLarge { .. } | E::BadResolution { .. } => {
+                HistencilResult::DeviceLimit
+            }
             E::Unsupported(_) | E::NoDevice(_) | E::Loading(_) => HistencilResult::Unsupported,
+            // A Vulkan call or allocation that failed, a stalled GPU; and what a later version
+            // adds (the enum is non-exhaustive), until it is sorted here.
             _ => HistencilResult::Vulkan,
         };
         Failure {

@@ -4,7 +4,7 @@
 use crate::frame::{
     HistencilFrame, HistencilTargets, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
     HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
-    HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
+    HISTENCIL_TECHNIQUE_LUT, HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
 };
 use crate::handles::{self, Kind};
 use crate::shaders::{brdf_named, shaders_of, HistencilShaders};
@@ -92,14 +92,14 @@ pub struct HistencilHooks {
 
 /// A lighting made on a context, with the names it was made with.
 pub struct HistencilLighting {
-    lighting: DeferredLighting<Arc<Context>>,
+    pub(crate) lighting: DeferredLighting<Arc<Context>>,
     /// Each frame's lights, shapes and boxes, converted from the C structs into these, kept
     /// from frame to frame: a frame through C allocates nothing the Rust API's does not.
     lights: Vec<histencil::Light>,
     shapes: Vec<histencil::LightShape>,
     bounds: Vec<Vec<histencil::Aabb>>,
     /// The shaders it lights with, whose set names its BRDFs.
-    modules: &'static BrdfModules,
+    pub(crate) modules: &'static BrdfModules,
     /// How the tiled techniques classify on this context's driver (the quirk table).
     classify: TileClassify,
 }
@@ -391,7 +391,9 @@ pub unsafe extern "C" fn histencil_lighting_record(
         let clear_hdr = frame.clear_hdr != 0;
         let technique = match frame.technique {
             HISTENCIL_TECHNIQUE_STENCIL => Some(TechniqueChoice::Stencil),
-            HISTENCIL_TECHNIQUE_BRANCHING => Some(TechniqueChoice::Branching),
+            HISTENCIL_TECHNIQUE_BRANCHING | HISTENCIL_TECHNIQUE_LUT => {
+                Some(TechniqueChoice::Branching)
+            }
             HISTENCIL_TECHNIQUE_TILED | HISTENCIL_TECHNIQUE_DEPTH_ID => None,
             t => {
                 return Err(Failure::invalid(format!(
@@ -400,6 +402,7 @@ pub unsafe extern "C" fn histencil_lighting_record(
             }
         };
         let depth_id = frame.technique == HISTENCIL_TECHNIQUE_DEPTH_ID;
+        let lut = frame.technique == HISTENCIL_TECHNIQUE_LUT;
         let set = |s: vk::DescriptorSet| (s != vk::DescriptorSet::null()).then_some(s);
         let hook_sets = HookSets {
             decode: set(frame.decode_set),
@@ -448,7 +451,11 @@ pub unsafe extern "C" fn histencil_lighting_record(
                     plan: &plan,
                     clear_hdr,
                     timestamps: false,
-                    brdf_source: BrdfSource::Formula,
+                    brdf_source: if lut {
+                        BrdfSource::Table
+                    } else {
+                        BrdfSource::Formula
+                    },
                     tile_stats: false,
                     hook_sets,
                 };

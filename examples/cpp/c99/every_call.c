@@ -96,6 +96,14 @@ int main(void) {
             expect(histencil_lightmaps_slot_finished(lightmaps, 0), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lightmaps handle", "lightmaps_slot_finished(foreign)");
             expect(histencil_lightmaps_destroy(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "lightmaps is null", "lightmaps_destroy(NULL)");
         }
+        {
+            HistencilLutTables *tables = NULL;
+            HistencilMaterial material;
+            memset(&material, 0, sizeof material);
+            expect(histencil_lut_tables_create(NULL, NULL, &material, 1, 16, &tables), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "lut_tables_create(NULL)");
+            expect(histencil_lighting_set_lut_tables(NULL, tables), HISTENCIL_RESULT_INVALID_ARGUMENT, "lighting is null", "lighting_set_lut_tables(NULL)");
+            expect(histencil_lut_tables_destroy((HistencilLutTables *)&device), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live LutTables handle", "lut_tables_destroy(foreign)");
+        }
         expect(histencil_device_suits(NULL, VK_NULL_HANDLE, VK_NULL_HANDLE, 0, &in_flight), HISTENCIL_RESULT_INVALID_ARGUMENT, "get_instance_proc_addr is null", "device_suits(NULL)");
     }
 

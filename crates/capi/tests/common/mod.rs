@@ -164,7 +164,13 @@ pub fn expect(result: HistencilResult, expected: HistencilResult, words: &str) {
 /// writes the G-buffer, and the Rust lighting compared against), a C context on the same
 /// device, the engine's targets and the world; then frees all and holds the layer silent.
 pub fn with_c_context(
-    body: impl FnOnce(&Engine, &histencil::vk::Renderer, *mut HistencilContext, &EngineTargets, &World),
+    body: impl FnOnce(
+        &Engine,
+        &mut histencil::vk::Renderer,
+        *mut HistencilContext,
+        &EngineTargets,
+        &World,
+    ),
 ) {
     let mut scene = histencil::scene::embedded("brdfs-3").unwrap();
     scene.normalise_lights();
@@ -172,7 +178,7 @@ pub fn with_c_context(
     {
         // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
         let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.unwrap();
-        let renderer =
+        let mut renderer =
             histencil::vk::Renderer::new(&ctx, scene.clone(), SIZE.width, SIZE.height).unwrap();
         let names = (renderer.brdfs().iter())
             .map(|b| CString::new(b.name()).unwrap())
@@ -187,7 +193,7 @@ pub fn with_c_context(
         // SAFETY: a live desc of the engine's live handles; a writable out pointer.
         let made = unsafe { histencil_context_create(&device_desc(&engine), &mut c_ctx) };
         assert_eq!(made, HistencilResult::Success, "{}", last_error());
-        body(&engine, &renderer, c_ctx, &images, &world);
+        body(&engine, &mut renderer, c_ctx, &images, &world);
         // SAFETY: a live context with no lighting left.
         let freed = unsafe { histencil_context_destroy(c_ctx) };
         assert_eq!(freed, HistencilResult::Success, "{}", last_error());
