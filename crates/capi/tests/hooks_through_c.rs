@@ -13,8 +13,8 @@ use histencil_tests::engine::{lighting_desc, plain_frame, stencil_plan};
 mod common;
 
 use common::{
-    c_boxes, c_lighting_desc, c_targets_of, expect, last_error, lit_frame, record_through_c,
-    with_c_context, SIZE,
+    c_lighting_desc, c_targets_of, expect, last_error, lit_frame, record_through_c, with_c_context,
+    FrameInputs, SIZE,
 };
 use std::ffi::{c_char, CString};
 use std::path::{Path, PathBuf};
@@ -89,29 +89,11 @@ fn hooks_compiled_at_run_time_or_read_from_a_file_light_as_histencil_does() {
         };
 
         let readback = engine.readback_buffer(u64::from(SIZE.width * SIZE.height) * 8);
-        let lights = world.c_lights();
         let brdfs = renderer.brdfs().to_vec();
-        let bounds_lists = world.scene.brdf_bounds(&brdfs);
-        let boxes = c_boxes(&bounds_lists);
-        let bounds: Vec<HistencilBrdfBounds> = (boxes.iter())
-            .map(|b| HistencilBrdfBounds {
-                boxes: b.as_ptr(),
-                box_count: b.len() as u32,
-            })
-            .collect();
+        let inputs = FrameInputs::new(world, &brdfs);
         let frame = |technique, decode_set| HistencilFrame {
-            size: size_of::<HistencilFrame>() as u32,
-            slot: 0,
-            technique,
-            platform: HISTENCIL_PLATFORM_PS3,
-            view: world.c_view(),
-            light_count: lights.len() as u32,
-            lights: lights.as_ptr(),
-            brdf_bounds_count: bounds.len() as u32,
-            brdf_bounds: bounds.as_ptr(),
-            clear_hdr: 1,
             decode_set,
-            visibility_set: vk::DescriptorSet::null(),
+            ..inputs.frame(technique, HISTENCIL_PLATFORM_PS3)
         };
         let lit = |record: &mut dyn FnMut(vk::CommandBuffer, &mut histencil::LightingTargets)| {
             lit_frame(engine, renderer, images, &readback, record)

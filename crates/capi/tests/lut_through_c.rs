@@ -11,7 +11,8 @@ use histencil_tests::engine::{lighting_desc, plan};
 mod common;
 
 use common::{
-    c_boxes, c_lighting_desc, expect, last_error, lit_frame, record_through_c, with_c_context, SIZE,
+    c_lighting_desc, expect, last_error, lit_frame, record_through_c, with_c_context, FrameInputs,
+    SIZE,
 };
 use std::ffi::{c_char, CString};
 use std::ptr::{null, null_mut};
@@ -52,29 +53,8 @@ fn lut_frames_through_c_are_the_rust_apis_bit_for_bit() {
 
         let brdfs = renderer.brdfs().to_vec();
         let layout = *renderer.stencil_layout();
-        let lights = world.c_lights();
-        let bounds_lists = world.scene.brdf_bounds(&brdfs);
-        let boxes = c_boxes(&bounds_lists);
-        let bounds: Vec<HistencilBrdfBounds> = (boxes.iter())
-            .map(|b| HistencilBrdfBounds {
-                boxes: b.as_ptr(),
-                box_count: b.len() as u32,
-            })
-            .collect();
-        let frame = HistencilFrame {
-            size: size_of::<HistencilFrame>() as u32,
-            slot: 0,
-            technique: HISTENCIL_TECHNIQUE_LUT,
-            platform: HISTENCIL_PLATFORM_PS3,
-            view: world.c_view(),
-            light_count: lights.len() as u32,
-            lights: lights.as_ptr(),
-            brdf_bounds_count: bounds.len() as u32,
-            brdf_bounds: bounds.as_ptr(),
-            clear_hdr: 1,
-            decode_set: vk::DescriptorSet::null(),
-            visibility_set: vk::DescriptorSet::null(),
-        };
+        let inputs = FrameInputs::new(world, &brdfs);
+        let frame = inputs.frame(HISTENCIL_TECHNIQUE_LUT, HISTENCIL_PLATFORM_PS3);
         let readback = engine.readback_buffer(u64::from(SIZE.width * SIZE.height) * 8);
 
         // The Rust lighting with the renderer's tables.

@@ -11,8 +11,8 @@ use histencil_tests::engine::{lighting_desc, plain_frame, stencil_plan};
 mod common;
 
 use common::{
-    c_boxes, c_lighting_desc, c_targets_of, device_desc, expect, last_error, lit_frame,
-    record_through_c, with_c_context, SIZE,
+    c_lighting_desc, c_targets_of, device_desc, expect, last_error, lit_frame, record_through_c,
+    with_c_context, FrameInputs, SIZE,
 };
 use std::ffi::{c_char, CString};
 use std::ptr::{null, null_mut};
@@ -36,15 +36,7 @@ fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
         let rust_desc = lighting_desc(layout, brdfs.clone(), SIZE, ds, world.scene.lights.len());
         let mut rust = DeferredLighting::new(renderer.context(), &rust_desc).unwrap();
         let readback = engine.readback_buffer(u64::from(SIZE.width * SIZE.height) * 8);
-        let lights = world.c_lights();
-        let bounds_lists = world.scene.brdf_bounds(&brdfs);
-        let boxes = c_boxes(&bounds_lists);
-        let bounds: Vec<HistencilBrdfBounds> = (boxes.iter())
-            .map(|b| HistencilBrdfBounds {
-                boxes: b.as_ptr(),
-                box_count: b.len() as u32,
-            })
-            .collect();
+        let inputs = FrameInputs::new(world, &brdfs);
         let cases = [
             (
                 HISTENCIL_TECHNIQUE_STENCIL,
@@ -63,20 +55,7 @@ fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
                 |record: &mut dyn FnMut(vk::CommandBuffer, &mut histencil::LightingTargets)| {
                     lit_frame(engine, renderer, images, &readback, record)
                 };
-            let frame = HistencilFrame {
-                size: size_of::<HistencilFrame>() as u32,
-                slot: 0,
-                technique,
-                platform,
-                view: world.c_view(),
-                light_count: lights.len() as u32,
-                lights: lights.as_ptr(),
-                brdf_bounds_count: bounds.len() as u32,
-                brdf_bounds: bounds.as_ptr(),
-                clear_hdr: 1,
-                decode_set: vk::DescriptorSet::null(),
-                visibility_set: vk::DescriptorSet::null(),
-            };
+            let frame = inputs.frame(technique, platform);
             let through_c =
                 lit(&mut |cmd, targets| record_through_c(c_lighting, cmd, &frame, targets));
             // SAFETY: the frame was waited for.

@@ -263,3 +263,49 @@ pub fn record_through_c(
     targets.hdr.state.stage = hdr.stage;
     targets.hdr.state.access = hdr.access;
 }
+
+/// What a C engine's frame points at: the world's lights and each BRDF's boxes, in the
+/// renderer's BRDF order, kept alive while frames made by [`FrameInputs::frame`] are used.
+pub struct FrameInputs {
+    pub lights: Vec<HistencilLight>,
+    /// What `bounds` points into.
+    _boxes: Vec<Vec<HistencilBox>>,
+    pub bounds: Vec<HistencilBrdfBounds>,
+    view: HistencilView,
+}
+
+impl FrameInputs {
+    pub fn new(world: &World, brdfs: &[histencil::BrdfId]) -> Self {
+        let boxes = c_boxes(&world.scene.brdf_bounds(brdfs));
+        let bounds = (boxes.iter())
+            .map(|b| HistencilBrdfBounds {
+                boxes: b.as_ptr(),
+                box_count: b.len() as u32,
+            })
+            .collect();
+        FrameInputs {
+            lights: world.c_lights(),
+            _boxes: boxes,
+            bounds,
+            view: world.c_view(),
+        }
+    }
+
+    /// Slot 0's frame of `technique` on `platform`, the HDR image cleared, no hook sets.
+    pub fn frame(&self, technique: u32, platform: u32) -> HistencilFrame {
+        HistencilFrame {
+            size: size_of::<HistencilFrame>() as u32,
+            slot: 0,
+            technique,
+            platform,
+            view: self.view,
+            light_count: self.lights.len() as u32,
+            lights: self.lights.as_ptr(),
+            brdf_bounds_count: self.bounds.len() as u32,
+            brdf_bounds: self.bounds.as_ptr(),
+            clear_hdr: 1,
+            decode_set: vk::DescriptorSet::null(),
+            visibility_set: vk::DescriptorSet::null(),
+        }
+    }
+}
