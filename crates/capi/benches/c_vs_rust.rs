@@ -141,6 +141,7 @@ fn main() {
                 clear_hdr: 1,
                 decode_set: vk::DescriptorSet::null(),
                 visibility_set: vk::DescriptorSet::null(),
+                timestamps: 0,
             };
             let (pool, cmd) = engine.command_buffer();
             // One frame recorded one way, timed; the command buffer reset after, untimed.

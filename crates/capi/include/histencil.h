@@ -332,6 +332,10 @@ typedef struct HistencilFrame {
   // The engine's descriptor set for its visibility hook (set 4): required exactly when
   // `HistencilHooks.visibility_layout` was given, else `VK_NULL_HANDLE`.
   VkDescriptorSet visibility_set;
+  // Non-zero to write a GPU timestamp after every step of the stencil, branching and LUT
+  // techniques (`histencil_lighting_step_timings` reads them once the frame has finished).
+  // Opt-in: on some drivers a timestamp between draws serialises them.
+  uint32_t timestamps;
 } HistencilFrame;
 
 // One of the engine's images, and the state it is in: what histencil's barriers start from.
@@ -382,6 +386,15 @@ typedef struct HistencilTargets {
   // The HDR image.
   struct HistencilImage *hdr;
 } HistencilTargets;
+
+// One group of a frame's lighting steps and its GPU time (`histencil_lighting_step_timings`).
+typedef struct HistencilStepTime {
+  // The group's name, NUL-terminated (`setup`, `mask-ggx`, `shade-ggx`, `cleanup`, ...): valid
+  // until the next call on the lighting.
+  const char *group;
+  // Its time summed over the frame's lights, in milliseconds.
+  double ms;
+} HistencilStepTime;
 
 // What `histencil_lightmaps_create` makes lightmaps for: fixed for their life.
 typedef struct HistencilLightmapsDesc {
@@ -702,6 +715,25 @@ enum HistencilResult histencil_lighting_record(struct HistencilLighting *lightin
 // will never be submitted.
 enum HistencilResult histencil_lighting_slot_finished(struct HistencilLighting *lighting,
                                                       uint32_t slot);
+
+// The GPU times of the last frame recorded into `slot` with `HistencilFrame.timestamps`, by
+// group of steps, once the GPU has finished it (waits for the query results). Called with a
+// null `times`, writes how many groups there are into `count`; else writes at most `*count`
+// groups and the number written. 0 groups when that frame had no timestamps.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle or a null `count`; `BAD_FRAME` for a
+// slot past `frames_in_flight`; `VULKAN` when the results cannot be read.
+//
+// Cannot be checked: that the frame has finished (the engine's fence).
+//
+// Thread safety: not at the same time as another call on `lighting`.
+//
+// # Safety
+// `count` is null or writable; `times` is null or holds `*count` writable entries.
+enum HistencilResult histencil_lighting_step_timings(struct HistencilLighting *lighting,
+                                                     uint32_t slot,
+                                                     struct HistencilStepTime *times,
+                                                     uint32_t *count);
 
 // Writes 1 to `in_flight` while a slot is recorded and not declared finished, else 0.
 //

@@ -329,6 +329,21 @@ pub struct HistencilFrame {
     /// The engine's descriptor set for its visibility hook (set 4): required exactly when
     /// `HistencilHooks.visibility_layout` was given, else `VK_NULL_HANDLE`.
     pub visibility_set: vk::DescriptorSet,
+    /// Non-zero to write a GPU timestamp after every step of the stencil, branching and LUT
+    /// techniques (`histencil_lighting_step_timings` reads them once the frame has finished).
+    /// Opt-in: on some drivers a timestamp between draws serialises them.
+    pub timestamps: u32,
+}
+
+/// One group of a frame's lighting steps and its GPU time (`histencil_lighting_step_timings`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct HistencilStepTime {
+    /// The group's name, NUL-terminated (`setup`, `mask-ggx`, `shade-ggx`, `cleanup`, ...): valid
+    /// until the next call on the lighting.
+    pub group: *const std::ffi::c_char,
+    /// Its time summed over the frame's lights, in milliseconds.
+    pub ms: f64,
 }
 
 /// Most lights a frame may pass: far past any lighting's `max_lights`, a bound on what is read.

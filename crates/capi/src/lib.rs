@@ -30,11 +30,12 @@ pub use device::{
 };
 pub use frame::{
     HistencilBox, HistencilBrdfBounds, HistencilFrame, HistencilImage, HistencilLight,
-    HistencilTargets, HistencilView, HISTENCIL_FALLOFF_GLTF, HISTENCIL_FALLOFF_INVERSE_SQUARE,
-    HISTENCIL_FALLOFF_SQUARED_WINDOW, HISTENCIL_LIGHT_DIRECTIONAL, HISTENCIL_LIGHT_POINT,
-    HISTENCIL_LIGHT_SPOT, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
-    HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
-    HISTENCIL_TECHNIQUE_LUT, HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
+    HistencilStepTime, HistencilTargets, HistencilView, HISTENCIL_FALLOFF_GLTF,
+    HISTENCIL_FALLOFF_INVERSE_SQUARE, HISTENCIL_FALLOFF_SQUARED_WINDOW,
+    HISTENCIL_LIGHT_DIRECTIONAL, HISTENCIL_LIGHT_POINT, HISTENCIL_LIGHT_SPOT,
+    HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3, HISTENCIL_PLATFORM_X360,
+    HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID, HISTENCIL_TECHNIQUE_LUT,
+    HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
 };
 pub use gbuffer::{
     histencil_brdf_encode, histencil_device_features, histencil_gbuffer_formats,
@@ -44,7 +45,8 @@ pub use gbuffer::{
 pub use lighting::{
     histencil_lighting_create, histencil_lighting_destroy, histencil_lighting_in_flight,
     histencil_lighting_record, histencil_lighting_resize, histencil_lighting_slot_finished,
-    histencil_lighting_stencil_reference, HistencilHooks, HistencilLighting, HistencilLightingDesc,
+    histencil_lighting_stencil_reference, histencil_lighting_step_timings, HistencilHooks,
+    HistencilLighting, HistencilLightingDesc,
 };
 pub use lightmaps::{
     histencil_lightmaps_create, histencil_lightmaps_destroy, histencil_lightmaps_entity_buffer,

@@ -2,9 +2,10 @@
 //! buffer each frame, told when a slot's frame has finished, resized and destroyed.
 
 use crate::frame::{
-    HistencilFrame, HistencilTargets, HISTENCIL_PLATFORM_NATIVE, HISTENCIL_PLATFORM_PS3,
-    HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID,
-    HISTENCIL_TECHNIQUE_LUT, HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
+    HistencilFrame, HistencilStepTime, HistencilTargets, HISTENCIL_PLATFORM_NATIVE,
+    HISTENCIL_PLATFORM_PS3, HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING,
+    HISTENCIL_TECHNIQUE_DEPTH_ID, HISTENCIL_TECHNIQUE_LUT, HISTENCIL_TECHNIQUE_STENCIL,
+    HISTENCIL_TECHNIQUE_TILED,
 };
 use crate::handles::{self, Kind};
 use crate::shaders::{brdf_named, shaders_of, HistencilShaders};
@@ -102,6 +103,8 @@ pub struct HistencilLighting {
     pub(crate) modules: &'static BrdfModules,
     /// How the tiled techniques classify on this context's driver (the quirk table).
     classify: TileClassify,
+    /// The group names `histencil_lighting_step_timings` last handed out.
+    step_names: Vec<std::ffi::CString>,
 }
 
 /// The most BRDFs a description names: histencil's eight and an engine's sixteen.
@@ -291,6 +294,7 @@ pub unsafe extern "C" fn histencil_lighting_create(
                 bounds: Vec::new(),
                 modules,
                 classify,
+                step_names: Vec::new(),
             },
             Kind::Lighting,
         );
@@ -403,6 +407,7 @@ pub unsafe extern "C" fn histencil_lighting_record(
         };
         let depth_id = frame.technique == HISTENCIL_TECHNIQUE_DEPTH_ID;
         let lut = frame.technique == HISTENCIL_TECHNIQUE_LUT;
+        let timestamps = frame.timestamps != 0;
         let set = |s: vk::DescriptorSet| (s != vk::DescriptorSet::null()).then_some(s);
         let hook_sets = HookSets {
             decode: set(frame.decode_set),
@@ -450,7 +455,7 @@ pub unsafe extern "C" fn histencil_lighting_record(
                     lights,
                     plan: &plan,
                     clear_hdr,
-                    timestamps: false,
+                    timestamps,
                     brdf_source: if lut {
                         BrdfSource::Table
                     } else {
@@ -516,6 +521,71 @@ pub unsafe extern "C" fn histencil_lighting_slot_finished(
         let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
         // SAFETY: this fn's # Safety is `slot_finished`'s.
         unsafe { held.lighting.slot_finished(slot) }?;
+        Ok(())
+    })
+}
+
+/// The GPU times of the last frame recorded into `slot` with `HistencilFrame.timestamps`, by
+/// group of steps, once the GPU has finished it (waits for the query results). Called with a
+/// null `times`, writes how many groups there are into `count`; else writes at most `*count`
+/// groups and the number written. 0 groups when that frame had no timestamps.
+///
+/// Errors: `INVALID_ARGUMENT` for a null or freed handle or a null `count`; `BAD_FRAME` for a
+/// slot past `frames_in_flight`; `VULKAN` when the results cannot be read.
+///
+/// Cannot be checked: that the frame has finished (the engine's fence).
+///
+/// Thread safety: not at the same time as another call on `lighting`.
+///
+/// # Safety
+/// `count` is null or writable; `times` is null or holds `*count` writable entries.
+#[no_mangle]
+pub unsafe extern "C" fn histencil_lighting_step_timings(
+    lighting: *mut HistencilLighting,
+    slot: u32,
+    times: *mut HistencilStepTime,
+    count: *mut u32,
+) -> HistencilResult {
+    call(|| {
+        // SAFETY: the header's thread-safety rule.
+        let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
+        // SAFETY: this fn's # Safety: null or writable.
+        let count = unsafe { count.as_mut() }.ok_or_else(|| Failure::invalid("count is null"))?;
+        let frames = held.lighting.desc().frames_in_flight;
+        if slot >= frames {
+            return Err(Failure {
+                result: HistencilResult::BadFrame,
+                message: format!("slot {slot} is past the lighting's {frames} frames in flight"),
+            });
+        }
+        let groups = held
+            .lighting
+            .step_timings(slot)?
+            .map(|b| b.groups)
+            .unwrap_or_default();
+        if times.is_null() {
+            *count = groups.len() as u32;
+            return Ok(());
+        }
+        held.step_names = (groups.iter())
+            .map(|(g, _)| std::ffi::CString::new(g.replace('\0', " ")).expect("no NUL left"))
+            .collect();
+        let written = groups.len().min(*count as usize);
+        for (i, ((_, ms), name)) in groups
+            .iter()
+            .zip(&held.step_names)
+            .take(written)
+            .enumerate()
+        {
+            // SAFETY: this fn's # Safety: `*count` writable entries, `i` below it.
+            unsafe {
+                times.add(i).write(HistencilStepTime {
+                    group: name.as_ptr(),
+                    ms: *ms,
+                })
+            };
+        }
+        *count = written as u32;
         Ok(())
     })
 }

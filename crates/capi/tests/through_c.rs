@@ -14,7 +14,7 @@ use common::{
     c_lighting_desc, c_targets_of, device_desc, expect, last_error, lit_frame, record_through_c,
     with_c_context, FrameInputs, SIZE,
 };
-use std::ffi::{c_char, CString};
+use std::ffi::{c_char, CStr, CString};
 use std::ptr::{null, null_mut};
 
 #[test]
@@ -273,6 +273,7 @@ fn misuse_through_c_returns_its_error_and_names_the_problem() {
                 clear_hdr: 1,
                 decode_set: vk::DescriptorSet::null(),
                 visibility_set: vk::DescriptorSet::null(),
+                timestamps: 0,
             };
             let (pool, cmd) = engine.command_buffer();
             let d = &engine.device;
@@ -560,5 +561,76 @@ fn an_engines_own_brdfs_come_through_c_from_its_folder() {
                 "not a live Shaders handle",
             );
         }
+    });
+}
+
+/// GPU timings through C: a frame recorded with `timestamps` reports its step groups' times
+/// once finished, by the count-then-fill convention; a frame without reports none.
+#[test]
+fn step_timings_come_through_c_by_group() {
+    use HistencilResult as R;
+    with_c_context(|engine, renderer, c_ctx, images, world| {
+        let names: Vec<*const c_char> = world.names.iter().map(|n| n.as_ptr()).collect();
+        let desc = HistencilLightingDesc {
+            depth_stencil_format: images.refs().depth_stencil.format,
+            ..c_lighting_desc(world, &names)
+        };
+        let inputs = FrameInputs::new(world, renderer.brdfs());
+        let readback = engine.readback_buffer(u64::from(SIZE.width * SIZE.height) * 8);
+        // SAFETY: live handles and structs; each frame is waited for before its slot is
+        // declared finished and its timings read.
+        unsafe {
+            let mut lighting = null_mut();
+            let r = histencil_lighting_create(c_ctx, &desc, &mut lighting);
+            assert_eq!(r, R::Success, "{}", last_error());
+            for timed in [1, 0] {
+                let frame = HistencilFrame {
+                    timestamps: timed,
+                    ..inputs.frame(HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_PLATFORM_PS3)
+                };
+                lit_frame(engine, renderer, images, &readback, &mut |cmd, targets| {
+                    record_through_c(lighting, cmd, &frame, targets)
+                });
+                assert_eq!(histencil_lighting_slot_finished(lighting, 0), R::Success);
+                let mut count = 0;
+                let r = histencil_lighting_step_timings(lighting, 0, null_mut(), &mut count);
+                assert_eq!(r, R::Success, "{}", last_error());
+                if timed == 0 {
+                    assert_eq!(count, 0, "an untimed frame reports no times");
+                    continue;
+                }
+                assert!(count > 2, "setup, masks and shades: {count} groups");
+                let mut times = vec![
+                    HistencilStepTime {
+                        group: null(),
+                        ms: -1.0
+                    };
+                    count as usize
+                ];
+                let r =
+                    histencil_lighting_step_timings(lighting, 0, times.as_mut_ptr(), &mut count);
+                assert_eq!(r, R::Success, "{}", last_error());
+                let groups: Vec<String> = (times.iter())
+                    .map(|t| CStr::from_ptr(t.group).to_string_lossy().into_owned())
+                    .collect();
+                assert!(
+                    times.iter().all(|t| t.ms.is_finite() && t.ms >= 0.0),
+                    "{groups:?}"
+                );
+                assert!(groups.iter().any(|g| g.contains("shade")), "{groups:?}");
+            }
+            expect(
+                histencil_lighting_step_timings(lighting, 5, null_mut(), &mut 0),
+                R::BadFrame,
+                "slot 5",
+            );
+            assert_eq!(
+                histencil_lighting_destroy(lighting),
+                R::Success,
+                "{}",
+                last_error()
+            );
+        }
+        engine.free_buffer(readback);
     });
 }

@@ -71,6 +71,7 @@ int main(void) {
     expect(histencil_lighting_record(lighting, VK_NULL_HANDLE, &frame, &targets), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "record");
     expect(histencil_lighting_slot_finished(lighting, 0), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "slot_finished");
     expect(histencil_lighting_in_flight(lighting, &in_flight), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "in_flight");
+    expect(histencil_lighting_step_timings(lighting, 0, NULL, &in_flight), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "step_timings");
     expect(histencil_lighting_resize(lighting, 64, 64), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "resize");
     expect(histencil_lighting_destroy(lighting), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "lighting_destroy(foreign)");
     expect(histencil_lighting_destroy(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "lighting is null", "lighting_destroy(NULL)");

@@ -306,6 +306,7 @@ impl FrameInputs {
             clear_hdr: 1,
             decode_set: vk::DescriptorSet::null(),
             visibility_set: vk::DescriptorSet::null(),
+            timestamps: 0,
         }
     }
 }
