@@ -303,3 +303,37 @@ fn bad_lightmap_resolutions_are_clear_errors() {
         }
     });
 }
+
+/// The largest lightmap resolution the device holds an object's probes for renders, and one
+/// past it is refused naming it. Once `render --lightmap-resolution 4094` (the documented
+/// maximum) failed on lavapipe as an unexplained buffer past `maxStorageBufferRange`: the
+/// probes are bound whole, so the maximum is the device's (2048 at the spec's guaranteed
+/// 128 MiB, lavapipe's), and it is stated as such.
+#[test]
+fn the_largest_lightmap_resolution_the_device_holds_renders_and_one_past_is_named() {
+    with_validated_context(|ctx| {
+        let max = histencil_vk::max_lightmap_side(ctx);
+        assert!(max >= 2048, "the spec guarantees 128 MiB of storage buffer: {max}");
+        assert!(max <= histencil_alpha::MAX_FORCED_SIDE);
+        let scene = sphere_near_a_light();
+        let background = {
+            let mut bare = scene.clone();
+            bare.alpha_objects.clear();
+            frame(ctx, &bare, AlphaMode::Lightmap, None)
+        };
+        let forward = frame(ctx, &scene, AlphaMode::Forward, None);
+        let at_max = frame(ctx, &scene, AlphaMode::Lightmap, Some(max));
+        let (mean, _) = alpha_error(&at_max, &forward, &background);
+        assert!(mean < 2.0, "at {max} texels the lightmap follows forward: {mean}");
+        if max < histencil_alpha::MAX_FORCED_SIDE {
+            let desc = RendererDesc {
+                lightmap_side: Some(max + 1),
+                ..RendererDesc::new(64, 64)
+            };
+            let Err(err) = Renderer::with_desc(ctx, scene, &desc) else {
+                panic!("a renderer with {}-texel lightmaps", max + 1);
+            };
+            assert!(err.to_string().contains(&format!("at most {max} on this device")), "{err}");
+        }
+    });
+}

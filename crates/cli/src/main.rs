@@ -171,8 +171,9 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "lightmap")]
     alpha: AlphaArg,
     /// Lightmap side in texels for every alpha entity (2..=4094: one region and its guard band
-    /// fill the largest atlas, 4096); default: from screen coverage
-    /// (8 to 128 texels).
+    /// fill the largest atlas, 4096; and at most what the device's maxStorageBufferRange holds
+    /// an object's probes for, 32 bytes a texel: 2048 at the spec's guaranteed minimum, the
+    /// refusal names the device's); default: from screen coverage (8 to 128 texels).
     #[arg(long)]
     lightmap_resolution: Option<u32>,
     /// Also render the alpha entities forward per pixel, and the scene without them, and print

@@ -37,8 +37,8 @@ pub mod shaders {
 
 pub use access::{aspect_of, ImageRef, ImageState, LightingTargets};
 pub use alpha::{
-    mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord, AlphaLightmaps,
-    AlphaLightmapsDesc, AlphaMode, LightmapFrame,
+    max_lightmap_side, mesh_bounds, AlphaEntity, AlphaEntityKind, AlphaEntityRecord,
+    AlphaLightmaps, AlphaLightmapsDesc, AlphaMode, LightmapFrame,
 };
 pub use brdf_modules::{
     compile as compile_brdf_set, compile_with_hooks as compile_brdf_set_with_hooks,

@@ -129,3 +129,48 @@ pub(super) fn check_frame(
 pub(super) fn bad(message: String) -> Error {
     Error::BadFrame(message)
 }
+
+/// Bytes a baked probe takes in the probes' storage buffer (`include/alpha.glsl`'s `Probe`).
+const PROBE_BYTES: u64 = 32;
+
+/// The largest lightmap side this device holds the probes of for one translucent object: the
+/// object's `side x side` probes are bound as one storage buffer, which
+/// `maxStorageBufferRange` bounds (2048 at the spec's guaranteed 128 MiB), and at most
+/// [`histencil_alpha::MAX_FORCED_SIDE`], which fills the largest atlas.
+pub fn max_lightmap_side(ctx: &crate::Context) -> u32 {
+    let probes = u64::from(ctx.max_storage_buffer_range) / PROBE_BYTES;
+    let side = probes
+        .isqrt()
+        .min(u64::from(histencil_alpha::MAX_FORCED_SIDE));
+    side as u32
+}
+
+/// Refuses a forced lightmap side past [`max_lightmap_side`], naming the device's maximum.
+pub(crate) fn check_lightmap_side(ctx: &crate::Context, side: u32) -> Result<()> {
+    let max = max_lightmap_side(ctx);
+    if side > max {
+        return Err(Error::DeviceLimit(format!(
+            "lightmap resolution {side}: an object's {side}x{side} probes need {} bytes, past \
+             this device's maxStorageBufferRange ({}); at most {max} on this device",
+            u64::from(side).pow(2) * PROBE_BYTES,
+            ctx.max_storage_buffer_range
+        )));
+    }
+    Ok(())
+}
+
+/// Refuses a frame whose probes, all entities together, pass the device's storage-buffer range,
+/// naming how many texels fit (before anything is grown or recorded).
+pub(super) fn check_probe_bytes(ctx: &crate::Context, probes: usize) -> Result<()> {
+    let bytes = probes as u64 * PROBE_BYTES;
+    let range = u64::from(ctx.max_storage_buffer_range);
+    if bytes > range {
+        return Err(Error::DeviceLimit(format!(
+            "the frame's translucent objects have {probes} probes ({bytes} bytes), past this \
+             device's maxStorageBufferRange ({range}): at most {} texels of objects a frame \
+             (smaller lightmap resolutions, or fewer objects)",
+            range / PROBE_BYTES
+        )));
+    }
+    Ok(())
+}

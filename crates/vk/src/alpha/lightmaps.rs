@@ -376,6 +376,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             light_list,
             entity_lights,
         } = records;
+        super::lightmap_checks::check_probe_bytes(ctx, probes.len())?;
         let bytes: [&[u8]; 4] = [
             bytemuck::cast_slice(&records),
             bytemuck::cast_slice(&points),

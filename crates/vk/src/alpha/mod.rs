@@ -16,6 +16,8 @@ pub(crate) mod lightmaps;
 
 pub use gpu::AlphaEntityRecord;
 pub use histencil_alpha::{mesh_bounds, AlphaEntity, AlphaEntityKind};
+pub(crate) use lightmap_checks::check_lightmap_side;
+pub use lightmap_checks::max_lightmap_side;
 pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 
 use crate::gpu::access::{Contents, ImageAccess};

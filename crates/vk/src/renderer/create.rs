@@ -87,7 +87,8 @@ impl<'c> Renderer<'c> {
     /// Before anything is made: [`crate::Error::BadResolution`] for a size the device cannot
     /// render, [`crate::Error::Lut`] for a table resolution outside
     /// `2..=`[`Lut::MAX_RESOLUTION`], [`crate::Error::Lightmap`] for a lightmap side outside
-    /// `2..=`[`histencil_alpha::MAX_FORCED_SIDE`], the scene's own errors, and
+    /// `2..=`[`histencil_alpha::MAX_FORCED_SIDE`], [`crate::Error::DeviceLimit`] for one past
+    /// [`crate::max_lightmap_side`] (the device's storage-buffer range), the scene's own errors, and
     /// [`crate::Error::Layout`] when its BRDFs do not fit the stencil bits. Then any error of
     /// making the resources, after freeing what was made.
     pub fn with_desc(ctx: &'c Context, mut scene: Scene, desc: &RendererDesc) -> Result<Self> {
@@ -98,6 +99,7 @@ impl<'c> Renderer<'c> {
         Lut::check_resolution(desc.lut_resolution)?;
         if let Some(side) = desc.lightmap_side {
             histencil_alpha::check_forced_side(side)?;
+            crate::alpha::check_lightmap_side(ctx, side)?;
         }
         scene.validate()?;
         check_brdfs(&scene, &desc.brdfs.set)?;
