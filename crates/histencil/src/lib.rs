@@ -124,8 +124,8 @@ pub mod prelude {
         Cause, Context, DeferredLighting, DepthStencilFormat, DeviceRequirements, EngineHooks,
         Error, HookSetLayout, HookSets, ImageRef, ImageState, LightHooks, LightModules,
         LightingBreakdown, LightingDesc, LightingFrame, LightingTargets, LutTables, MixedTiles,
-        StillInFlight, TileClassify, TileSide, TileStats, TiledFrame, ValidationLog,
-        ValidationMessage, GBUFFER_FORMATS, REQUIREMENTS,
+        StencilCheck, StencilReport, StillInFlight, TileClassify, TileSide, TileStats, TiledFrame,
+        ValidationLog, ValidationMessage, GBUFFER_FORMATS, REQUIREMENTS,
     };
 
     // Lightmaps for translucent entities.

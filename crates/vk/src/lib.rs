@@ -68,8 +68,8 @@ pub use lighting::hooks::{
 };
 pub use lighting::lut::{LutEvaluator, LutTables};
 pub use lighting::{
-    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, TiledFrame,
-    TILED_HDR_FORMATS,
+    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, StencilCheck,
+    StencilReport, TiledFrame, TILED_HDR_FORMATS,
 };
 pub use passes::light_pipelines::BrdfSource;
 pub use renderer::capture::SimulatorInputs;

@@ -10,7 +10,8 @@
 //! last frame of each technique and backend (stencil PS3-like, stencil native, tiled, depth-id)
 //! is compared with the engine's forward reference of the same state (lighting) and with
 //! histencil's own lightmap frame (alpha), and on each stencil frame the engine's stencil bits
-//! are checked to survive lighting; the verdict line names every frame it compared.
+//! are checked to survive lighting (and, by histencil's `StencilReport`, to be what the layout
+//! declares before it); the verdict line names every frame it compared.
 
 mod alpha;
 mod device;
@@ -31,7 +32,7 @@ use histencil::{
     DeferredLighting, DepthConvention, EngineHooks, FarPlane, FlushPolicy, HookSetLayout, HookSets,
     ImageState, LightHooks, LightModules, LightingDesc, LightingFrame, LightingTargets,
     LightmapFrame, MixedTiles, Perspective, PlanInputs, PlanSettings, StencilBits, StencilLayout,
-    TechniqueChoice, TileClassify, TileSide, TiledFrame, View, ViewDesc, Viewer,
+    StencilReport, TechniqueChoice, TileClassify, TileSide, TiledFrame, View, ViewDesc, Viewer,
 };
 // histencil's own renderer, as the reference the engine's frames are compared with.
 use histencil::vk::{AlphaMode, FrameDesc, Readback, Renderer, RendererDesc, Shading, Technique};
@@ -710,6 +711,10 @@ fn main() {
         let before = c.stencil_before.bytes();
         let after = c.stencil_after.bytes();
         let marked = before.iter().filter(|s| **s & ENGINE_MASK != 0).count();
+        // histencil's stencil check on the engine's own copy: the G-buffer pass wrote only the
+        // bits the layout gives it (no culling bit, no slot past the BRDFs, nothing undeclared).
+        let declared = StencilReport::of(&layout, before);
+        assert!(declared.is_clean(), "frame {}: {declared}", c.frame);
         let kept = (before.iter().zip(after)).all(|(b, a)| (b ^ a) & ENGINE_MASK == 0);
         let technique = technique(c.frame);
         // Only the stencil technique touches stencil: its frames are the ones that test the bits.

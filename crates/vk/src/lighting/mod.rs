@@ -21,6 +21,7 @@ mod create;
 mod frames;
 pub mod hooks;
 pub(crate) mod lut;
+mod stencil_check;
 mod tiled;
 
 use checks::{
@@ -28,6 +29,7 @@ use checks::{
     UsageNeeds,
 };
 pub use frames::{gbuffer_stencil_reference, LightingDesc, LightingFrame, TiledFrame};
+pub use stencil_check::{StencilCheck, StencilReport};
 pub use tiled::TILED_HDR_FORMATS;
 
 use crate::gpu::access::LightingTargets;
