@@ -313,7 +313,10 @@ fn bad_lightmap_resolutions_are_clear_errors() {
 fn the_largest_lightmap_resolution_the_device_holds_renders_and_one_past_is_named() {
     with_validated_context(|ctx| {
         let max = histencil_vk::max_lightmap_side(ctx);
-        assert!(max >= 2048, "the spec guarantees 128 MiB of storage buffer: {max}");
+        assert!(
+            max >= 2048,
+            "the spec guarantees 128 MiB of storage buffer: {max}"
+        );
         assert!(max <= histencil_alpha::MAX_FORCED_SIDE);
         let scene = sphere_near_a_light();
         let background = {
@@ -324,7 +327,10 @@ fn the_largest_lightmap_resolution_the_device_holds_renders_and_one_past_is_name
         let forward = frame(ctx, &scene, AlphaMode::Forward, None);
         let at_max = frame(ctx, &scene, AlphaMode::Lightmap, Some(max));
         let (mean, _) = alpha_error(&at_max, &forward, &background);
-        assert!(mean < 2.0, "at {max} texels the lightmap follows forward: {mean}");
+        assert!(
+            mean < 2.0,
+            "at {max} texels the lightmap follows forward: {mean}"
+        );
         if max < histencil_alpha::MAX_FORCED_SIDE {
             let desc = RendererDesc {
                 lightmap_side: Some(max + 1),
@@ -333,7 +339,11 @@ fn the_largest_lightmap_resolution_the_device_holds_renders_and_one_past_is_name
             let Err(err) = Renderer::with_desc(ctx, scene, &desc) else {
                 panic!("a renderer with {}-texel lightmaps", max + 1);
             };
-            assert!(err.to_string().contains(&format!("at most {max} on this device")), "{err}");
+            assert!(
+                err.to_string()
+                    .contains(&format!("at most {max} on this device")),
+                "{err}"
+            );
         }
     });
 }
