@@ -364,7 +364,8 @@ typedef struct HistencilImage {
 // The images a lighting records against, each the engine's own `HistencilImage`, read before
 // the recording and written after it with the state the commands leave it in (so the engine's
 // next barrier starts from there):
-// - `gbuffer`: histencil's G-buffer (`histencil_gbuffer_formats`, in that order), made with
+// - `gbuffer`: histencil's G-buffer (`histencil_gbuffer_formats`, in that order), or with
+//   `HistencilHooks` the images the decode reads (`surface_formats`, in that order), made with
 //   `SAMPLED` usage; its stencil-carrying depth image written by the engine's G-buffer pass
 //   with each surface's BRDF slot (`histencil_lighting_stencil_reference`), the BRDF bits
 //   cleared to 0 everywhere else first.
@@ -644,15 +645,20 @@ enum HistencilResult histencil_shading_inputs(const struct HistencilView *view,
 // (light pipelines are made at the first frame that needs them). Nothing is submitted.
 //
 // Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, a wrong `size` or a
-// count out of range; `BAD_SETUP` for a BRDF name neither histencil nor `brdf_set` holds, more engine stencil
-// bits than the stencil has beside the BRDFs, a zero extent or a depth format without stencil;
+// count out of range; `BAD_SETUP` for a BRDF name neither histencil nor `shaders` holds, more
+// engine stencil bits than the stencil has beside the BRDFs, a zero extent or a depth format
+// without stencil, hooked shaders without `hooks`, a hook resource its layout does not serve
+// (naming module, set and binding), a decode without parameter rows for a BRDF it shades;
 // `DEVICE_LIMIT`, `VULKAN` as the device says.
+//
+// Cannot be checked: that `hooks`' layouts are live, were made from exactly the bindings given,
+// on the context's device, and outlive the lighting.
 //
 // Thread safety: not at the same time as another call on `context`.
 //
 // # Safety
 // `desc` is null or points at a live description whose pointers hold what it says; `lighting`
-// is null or writable.
+// is null or writable; `desc.hooks`, when given, as "cannot be checked" says.
 enum HistencilResult histencil_lighting_create(struct HistencilContext *context,
                                                const struct HistencilLightingDesc *desc,
                                                struct HistencilLighting **lighting);

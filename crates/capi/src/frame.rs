@@ -223,7 +223,8 @@ impl HistencilImage {
 /// The images a lighting records against, each the engine's own `HistencilImage`, read before
 /// the recording and written after it with the state the commands leave it in (so the engine's
 /// next barrier starts from there):
-/// - `gbuffer`: histencil's G-buffer (`histencil_gbuffer_formats`, in that order), made with
+/// - `gbuffer`: histencil's G-buffer (`histencil_gbuffer_formats`, in that order), or with
+///   `HistencilHooks` the images the decode reads (`surface_formats`, in that order), made with
 ///   `SAMPLED` usage; its stencil-carrying depth image written by the engine's G-buffer pass
 ///   with each surface's BRDF slot (`histencil_lighting_stencil_reference`), the BRDF bits
 ///   cleared to 0 everywhere else first.

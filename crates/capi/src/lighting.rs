@@ -260,15 +260,20 @@ fn engine_hooks(hooks: &HistencilHooks, modules: &BrdfModules) -> Outcome<Engine
 /// (light pipelines are made at the first frame that needs them). Nothing is submitted.
 ///
 /// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, a wrong `size` or a
-/// count out of range; `BAD_SETUP` for a BRDF name neither histencil nor `brdf_set` holds, more engine stencil
-/// bits than the stencil has beside the BRDFs, a zero extent or a depth format without stencil;
+/// count out of range; `BAD_SETUP` for a BRDF name neither histencil nor `shaders` holds, more
+/// engine stencil bits than the stencil has beside the BRDFs, a zero extent or a depth format
+/// without stencil, hooked shaders without `hooks`, a hook resource its layout does not serve
+/// (naming module, set and binding), a decode without parameter rows for a BRDF it shades;
 /// `DEVICE_LIMIT`, `VULKAN` as the device says.
+///
+/// Cannot be checked: that `hooks`' layouts are live, were made from exactly the bindings given,
+/// on the context's device, and outlive the lighting.
 ///
 /// Thread safety: not at the same time as another call on `context`.
 ///
 /// # Safety
 /// `desc` is null or points at a live description whose pointers hold what it says; `lighting`
-/// is null or writable.
+/// is null or writable; `desc.hooks`, when given, as "cannot be checked" says.
 #[no_mangle]
 pub unsafe extern "C" fn histencil_lighting_create(
     context: *mut crate::HistencilContext,
