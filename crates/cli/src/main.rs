@@ -506,9 +506,10 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             shading,
             ctx.device_name()
         );
-        if let (Some(bookkeeping), Some(lighting)) =
-            (timings.bookkeeping_ms, timings.pass_ms("lighting"))
-        {
+        if let (Some(bookkeeping), Some(lighting)) = (
+            timings.bookkeeping_ms,
+            timings.pass_ms(histencil_vk::passes::names::LIGHTING),
+        ) {
             // What the emulator does a GPU would not: the consoles' tile bookkeeping, or AMD's
             // tiles evaluated before each draw that tests stencil.
             let work = match shading.technique().map(Technique::backend) {
@@ -518,7 +519,7 @@ fn render(args: &RenderArgs, lights: DefaultLights) -> Result<()> {
             println!(
                 "emulated hi-stencil (medians): the platform's technique {:.2} ms + the \
                  emulator's bookkeeping {bookkeeping:.2} ms ({work}) = lighting {lighting:.2} ms",
-                timings.technique_ms(&["lighting"])
+                timings.technique_ms(&[histencil_vk::passes::names::LIGHTING])
             );
         }
         if let Some(lighting) = &timings.lighting {

@@ -30,6 +30,7 @@ use crate::steady::{ClockSettings, Stability, SteadyClock};
 use crate::variants::{brdf_palette, light_size_scene, with_brdf_count, with_one_brdf};
 use crate::{LabError, Result};
 use histencil_model::{DepthIdCosts, TiledCosts, COST_FIELDS, DEPTH_ID_FIELDS, TILED_FIELDS};
+use histencil_vk::passes::names;
 use histencil_vk::{
     Backend, BrdfModules, Context, CostModel, FlushPolicy, MixedTiles, Renderer, RendererDesc,
     Technique, TileSide,
@@ -260,9 +261,9 @@ pub fn calibrate_with(
                             .render(kind.technique, histencil_vk::Readback::NONE)?
                             .timings;
                         // A tiled frame's light lists cost per light, as its shading does.
-                        let ms = t.pass_ms("lighting").unwrap_or(0.0)
-                            + t.pass_ms("tile-lights").unwrap_or(0.0);
-                        Ok((ms / *lights, t.pass_ms("tile-classify")))
+                        let ms = t.pass_ms(names::LIGHTING).unwrap_or(0.0)
+                            + t.pass_ms(names::TILE_LIGHTS).unwrap_or(0.0);
+                        Ok((ms / *lights, t.pass_ms(names::TILE_CLASSIFY)))
                     })
                     .collect()
             };

@@ -85,7 +85,12 @@ pub fn time_lighting(
     technique: Technique,
     frames: usize,
 ) -> Result<Timing> {
-    time_passes(renderer, technique, &["lighting"], frames)
+    time_passes(
+        renderer,
+        technique,
+        &[histencil_vk::passes::names::LIGHTING],
+        frames,
+    )
 }
 
 /// The lighting's time in one frame: the technique's (the lighting pass without the

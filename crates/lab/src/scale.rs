@@ -174,7 +174,7 @@ pub fn run_scale(
         for (&(_, shading), s) in techniques.iter().zip(&mut samples) {
             let t = renderer.render_frame(&FrameDesc::from(shading))?.timings;
             let pass = |name| t.pass_ms(name).unwrap_or(0.0);
-            s.0.push(pass("gbuffer"));
+            s.0.push(pass(histencil_vk::passes::names::GBUFFER));
             s.1.push(t.technique_ms(shading.lighting_passes()));
             s.2.push(t.total_ms());
             s.3.extend(t.bookkeeping_ms);

@@ -450,8 +450,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             t.start(rec);
         }
         let label = match direction {
-            Some(_) => "alpha-lightmaps-directional",
-            None => "alpha-lightmaps",
+            Some(_) => crate::passes::names::ALPHA_LIGHTMAPS_DIRECTIONAL,
+            None => crate::passes::names::ALPHA_LIGHTMAPS,
         };
         rec.step(label, |rec| {
             let pipeline = match direction {

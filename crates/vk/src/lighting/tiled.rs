@@ -164,11 +164,13 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
-        rec.timed("tile-classify", |rec| {
+        rec.timed(crate::passes::names::TILE_CLASSIFY, |rec| {
             tiled.record_classify(rec, &sets, targets, depth_sampled, clear, mixed, shape)
         });
         let lights = frame.lights.len() as u32;
-        rec.timed("tile-lights", |rec| tiled.record_light_lists(rec, lights));
+        rec.timed(crate::passes::names::TILE_LIGHTS, |rec| {
+            tiled.record_light_lists(rec, lights)
+        });
         match shade {
             TiledShade::Kernels => tiled.record_shade(&rec, mixed),
             TiledShade::DepthId => {

@@ -222,7 +222,7 @@ impl MeshPasses {
         stencil: &GbufferStencil,
         targets: &mut LightingTargets,
     ) {
-        rec.step("gbuffer", |rec| {
+        rec.step(super::names::GBUFFER, |rec| {
             let (color, discard) = (ImageAccess::ColorAttachment, Contents::Discard);
             let mut uses = uses_of(&mut targets.gbuffer, color, discard);
             let ds = ImageAccess::DepthStencilAttachment;
@@ -269,8 +269,12 @@ impl MeshPasses {
     ) {
         let depth = Load::Clear(clear_depth_stencil(inputs.depth));
         let opaque = oriented(OPAQUE, inputs.depth);
-        self.draw(rec, self.forward, inputs)
-            .hdr_pass(targets, "forward", depth, |_| Some(opaque));
+        self.draw(rec, self.forward, inputs).hdr_pass(
+            targets,
+            super::names::FORWARD,
+            depth,
+            |_| Some(opaque),
+        );
     }
 
     /// After the G-buffer pass (whose depth it reads): clears the HDR target and writes the

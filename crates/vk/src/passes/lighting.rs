@@ -263,7 +263,7 @@ impl LightingPass<'_> {
             steps: timer,
             emulation,
         };
-        rec.begin_label("lighting");
+        rec.begin_label(super::names::LIGHTING);
         let (sampled, keep) = (ImageAccess::FragmentSampled, Contents::Keep);
         let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
         rec.declare(&mut uses);

@@ -16,6 +16,7 @@ pub mod light_modules;
 pub mod light_pipelines;
 pub(crate) mod light_volumes;
 pub mod lighting;
+pub mod names;
 pub(crate) mod tiled;
 pub mod tonemap;
 

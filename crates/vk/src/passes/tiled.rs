@@ -486,7 +486,7 @@ impl TiledLighting {
         shape: TileClassify,
     ) {
         let push = self.push(clear, mixed);
-        rec.step("tiled-classify", |rec| {
+        rec.step(super::names::TILE_CLASSIFY, |rec| {
             let (sampled, keep) = (ImageAccess::ComputeSampled, Contents::Keep);
             let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
             if depth_sampled {
@@ -570,7 +570,7 @@ impl TiledLighting {
     /// the same command buffer (whose sets and push constants stay bound): each light's bit in
     /// the masks of the tiles it can reach, for [`TiledLighting::record_shade`].
     pub fn record_light_lists(&self, rec: &Recording, lights: u32) {
-        rec.step("tiled-light-lists", |rec| {
+        rec.step(super::names::TILE_LIGHTS, |rec| {
             // A workgroup per light, in rows of at most the guaranteed workgroup count.
             const ROW: u32 = 65535;
             let groups = (lights.min(ROW), lights.div_ceil(ROW));

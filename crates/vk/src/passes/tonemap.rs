@@ -76,7 +76,7 @@ impl Tonemap {
 
     /// Tonemaps `targets.hdr` into `targets.ldr`.
     pub(crate) fn record(&self, rec: &Recording, inputs: &TonemapInputs, targets: &mut Targets) {
-        rec.step("tonemap", |rec| {
+        rec.step(super::names::TONEMAP, |rec| {
             rec.declare(&mut [
                 (
                     &mut targets.hdr,

@@ -15,6 +15,7 @@ use crate::lighting::hooks::HookSets;
 use crate::lighting::{LightingFrame, TiledFrame};
 use crate::passes::geometry::{GbufferStencil, MeshInputs};
 use crate::passes::light_pipelines::BrdfSource;
+use crate::passes::names;
 use crate::passes::tiled::TiledShade;
 use crate::passes::tonemap::TonemapInputs;
 use crate::renderer::technique::{FrameDesc, MixedTiles, Shading, Technique, TileClassify};
@@ -60,7 +61,7 @@ impl<'c> Renderer<'c> {
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            rec.timed("alpha-lightmaps", |rec| {
+            rec.timed(names::ALPHA_LIGHTMAPS, |rec| {
                 alpha.record_lightmaps(rec, scene, &view, desc.alpha, desc.pass_timing)
             })?;
             let inputs = AlphaInputs {
@@ -72,13 +73,15 @@ impl<'c> Renderer<'c> {
                 depth: desc.depth,
             };
             let targets = &mut self.targets;
-            rec.timed("alpha", |rec| alpha.record_alpha(rec, &inputs, targets))?;
+            rec.timed(names::ALPHA, |rec| {
+                alpha.record_alpha(rec, &inputs, targets)
+            })?;
         }
         let inputs = TonemapInputs {
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
         };
-        rec.timed("tonemap", |rec| {
+        rec.timed(names::TONEMAP, |rec| {
             self.tonemap.record(rec, &inputs, &mut self.targets)
         });
         // Only the deferred frame has a G-buffer to read BRDF ids from.
@@ -140,7 +143,7 @@ impl<'c> Renderer<'c> {
         let ctx = self.ctx;
         // Emitted light goes into the HDR target once; the lighting adds onto it.
         let emits = self.scene.objects.iter().any(|o| o.material.emits());
-        rec.timed("gbuffer", |rec| {
+        rec.timed(names::GBUFFER, |rec| {
             self.record_gbuffer_pass(rec, desc);
             if emits {
                 let mut targets = self.targets.lighting();

@@ -5,6 +5,7 @@
 use crate::alpha::AlphaMode;
 use crate::gpu::readback::Readback;
 use crate::passes::light_pipelines::BrdfSource;
+use crate::passes::names;
 pub use crate::passes::tiled::{MixedTiles, TileClassify, TileSide};
 use histencil_model::{
     CostModel, DepthConvention, FlushPolicy, Native, PlanSettings, PlatformBackend, Ps3Like,
@@ -100,8 +101,8 @@ impl Shading {
     /// `lighting` after the G-buffer.
     pub fn lighting_pass(self) -> &'static str {
         match self {
-            Shading::Forward => "forward",
-            Shading::Deferred(_) => "lighting",
+            Shading::Forward => names::FORWARD,
+            Shading::Deferred(_) => names::LIGHTING,
         }
     }
 
@@ -111,11 +112,11 @@ impl Shading {
     /// only the passes it ran).
     pub fn lighting_passes(self) -> &'static [&'static str] {
         match self {
-            Shading::Forward => &["forward"],
+            Shading::Forward => &[names::FORWARD],
             Shading::Deferred(
                 Technique::Tiled { .. } | Technique::DepthId { .. } | Technique::Adaptive { .. },
-            ) => &["tile-classify", "tile-lights", "lighting"],
-            Shading::Deferred(_) => &["lighting"],
+            ) => &[names::TILE_CLASSIFY, names::TILE_LIGHTS, names::LIGHTING],
+            Shading::Deferred(_) => &[names::LIGHTING],
         }
     }
 }
