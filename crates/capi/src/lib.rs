@@ -120,6 +120,21 @@ impl Failure {
     }
 }
 
+/// Refuses to destroy an object while one of its slots is in flight, naming the call that
+/// declares a slot finished.
+pub(crate) fn refuse_destroy_in_flight(in_flight: bool, slot_finished: &str) -> Outcome {
+    if in_flight {
+        return Err(Failure {
+            result: HistencilResult::InFlight,
+            message: format!(
+                "frames in flight: destroy while a slot may still be read by the GPU: wait for \
+                 those frames, and say so with {slot_finished}, first"
+            ),
+        });
+    }
+    Ok(())
+}
+
 impl From<histencil::Error> for Failure {
     fn from(e: histencil::Error) -> Self {
         use histencil::Error as E;

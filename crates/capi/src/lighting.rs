@@ -660,16 +660,11 @@ pub unsafe extern "C" fn histencil_lighting_destroy(
     call(|| {
         // SAFETY: the header's thread-safety rule.
         let held = unsafe { handles::get(lighting, Kind::Lighting, "lighting") }?;
-        if held.lighting.in_flight() {
-            // Refused here, before the handle is taken, so the lighting stays whole.
-            return Err(Failure {
-                result: HistencilResult::InFlight,
-                message: "frames in flight: destroy while a slot may still be read by the GPU: \
-                          wait for those frames, and say so with \
-                          histencil_lighting_slot_finished, first"
-                    .into(),
-            });
-        }
+        // Refused before the handle is taken, so the lighting stays whole.
+        crate::refuse_destroy_in_flight(
+            held.lighting.in_flight(),
+            "histencil_lighting_slot_finished",
+        )?;
         // SAFETY: as above.
         let held = unsafe { handles::take(lighting, Kind::Lighting, "lighting") }?;
         held.lighting

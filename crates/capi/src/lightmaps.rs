@@ -571,15 +571,11 @@ pub unsafe extern "C" fn histencil_lightmaps_destroy(
     call(|| {
         // SAFETY: the header's thread-safety rule.
         let held = unsafe { handles::get(lightmaps, Kind::Lightmaps, "lightmaps") }?;
-        if held.lightmaps.in_flight() {
-            return Err(Failure {
-                result: HistencilResult::InFlight,
-                message: "frames in flight: destroy while a slot may still be read by the GPU: \
-                          wait for those frames, and say so with \
-                          histencil_lightmaps_slot_finished, first"
-                    .into(),
-            });
-        }
+        // Refused before the handle is taken, so the lightmaps stay whole.
+        crate::refuse_destroy_in_flight(
+            held.lightmaps.in_flight(),
+            "histencil_lightmaps_slot_finished",
+        )?;
         // SAFETY: as above.
         let held = unsafe { handles::take(lightmaps, Kind::Lightmaps, "lightmaps") }?;
         held.lightmaps

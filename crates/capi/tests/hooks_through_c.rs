@@ -133,16 +133,7 @@ fn hooks_compiled_at_run_time_or_read_from_a_file_light_as_histencil_does() {
             "the frame is lit ({lit_pixels} pixels)"
         );
         let tiled_ours = lit(&mut |cmd, targets| {
-            let tiled = histencil::TiledFrame {
-                slot: 0,
-                view: &world.view,
-                lights: &world.scene.lights,
-                clear_hdr: true,
-                side: histencil::TileSide::Sixteen,
-                mixed: histencil::MixedTiles::PerBrdf,
-                classify: histencil::TileClassify::for_context(renderer.context()),
-                hook_sets: HookSets::default(),
-            };
+            let tiled = world.rust_tiled_frame(renderer.context());
             // SAFETY: as above.
             unsafe { rust.record_tiled(cmd, &tiled, targets) }.unwrap();
         });

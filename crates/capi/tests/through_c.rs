@@ -62,16 +62,7 @@ fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
             let r = unsafe { histencil_lighting_slot_finished(c_lighting, 0) };
             assert_eq!(r, HistencilResult::Success, "{}", last_error());
             let through_rust = lit(&mut |cmd, targets| {
-                let tiled = histencil::TiledFrame {
-                    slot: 0,
-                    view: &world.view,
-                    lights: &world.scene.lights,
-                    clear_hdr: true,
-                    side: histencil::TileSide::Sixteen,
-                    mixed: histencil::MixedTiles::PerBrdf,
-                    classify: histencil::TileClassify::for_context(renderer.context()),
-                    hook_sets: HookSets::default(),
-                };
+                let tiled = world.rust_tiled_frame(renderer.context());
                 // SAFETY: as above.
                 unsafe {
                     match backend {

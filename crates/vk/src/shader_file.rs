@@ -16,14 +16,14 @@
 //! entries `<brdfs|spirv> <name> <length>` each followed by its bytes and a newline, then `end`.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::{Mutex, OnceLock};
 
 use histencil_brdf::BrdfSet;
 
 use crate::brdf_modules::{compile_with_hooks, modules_of, BrdfModules, Scratch};
 use crate::gpu::spirv_bindings::reflect_bindings;
-use crate::lighting::hooks::{spirv_words, LightModules};
+use crate::lighting::hooks::spirv_words;
 
 const HEAD: &str = "histencil shaders\nformat 1\n";
 /// The largest file read back: histencil's modules for 24 BRDFs with hooks are a few MiB.
@@ -42,7 +42,7 @@ pub struct ShaderFile {
     pub modules: &'static BrdfModules,
     /// The hook files the engine gave (histencil-build's `HOOK_FILES`); empty for none.
     pub hooks: Vec<String>,
-    /// The copy of the BRDF folder the set reads its GLSL from.
+    /// The copy of the BRDF folder the set reads its GLSL from, removed with this value.
     _folder: Option<Scratch>,
 }
 
@@ -210,6 +210,7 @@ fn parse(bytes: &[u8]) -> Result<Body<'_>, String> {
         return Err(format!("it names hook file `{h}`, which histencil has not"));
     }
     let (mut files, mut spirv) = (Vec::new(), HashMap::new());
+    let known = builtin_named();
     loop {
         let header = line(&mut rest, "an entry's line")?;
         if header == "end" {
@@ -232,7 +233,7 @@ fn parse(bytes: &[u8]) -> Result<Body<'_>, String> {
         match kind {
             "brdfs" if confined(name) => files.push((name, content)),
             "brdfs" => return Err(format!("`{name}` is not a BRDF folder's file")),
-            "spirv" if !builtin_named().contains_key(name) => {
+            "spirv" if !known.contains_key(name) => {
                 return Err(format!("`{name}` is not a histencil module"))
             }
             "spirv" => {
@@ -331,18 +332,6 @@ pub fn read_shader_file(path: &Path) -> Result<ShaderFile, String> {
         hooks: body.hooks,
         _folder: folder,
     })
-}
-
-impl ShaderFile {
-    /// Where the set's copy of the engine's BRDF folder is (removed with this value).
-    pub fn folder(&self) -> Option<PathBuf> {
-        self._folder.as_ref().map(|f| f.0.clone())
-    }
-
-    /// The light modules, as a lighting takes them.
-    pub fn light(&self) -> LightModules {
-        self.modules.light
-    }
 }
 
 #[cfg(test)]

@@ -310,3 +310,20 @@ impl FrameInputs {
         }
     }
 }
+
+impl World {
+    /// The Rust API's tiled frame of the world, as the C API records `HISTENCIL_TECHNIQUE_TILED`:
+    /// slot 0, 16x16 tiles, per-BRDF mixed tiles, the context's classification, no hook sets.
+    pub fn rust_tiled_frame(&self, ctx: &Context) -> histencil::TiledFrame<'_> {
+        histencil::TiledFrame {
+            slot: 0,
+            view: &self.view,
+            lights: &self.scene.lights,
+            clear_hdr: true,
+            side: histencil::TileSide::Sixteen,
+            mixed: histencil::MixedTiles::PerBrdf,
+            classify: histencil::TileClassify::for_context(ctx),
+            hook_sets: histencil::HookSets::default(),
+        }
+    }
+}
