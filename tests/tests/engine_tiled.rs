@@ -5,7 +5,8 @@
 //! frames (every side with every mixed-tile mode and with depth ids; each side classified both
 //! ways) must equal histencil's Renderer lighting the same state with the same technique
 //! (classified as the device prefers), bit for bit, and the validation layer with
-//! synchronisation validation must see nothing. A lighting whose HDR format the
+//! synchronisation validation must see nothing, nor histencil's hazard check, told of each
+//! submission and wait. A lighting whose HDR format the
 //! kernels cannot store to is refused before anything is recorded.
 
 use ash::vk;
@@ -57,6 +58,8 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
     {
         // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
         let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        // histencil's hazard check over the engine's submissions (`note_*` below).
+        assert!(ctx.check_hazards(engine.log.clone()));
         let ds_format = ctx.depth_stencil_format().vk();
         let renderer = Renderer::new(&ctx, scene.clone(), WIDTH, HEIGHT).unwrap();
         let desc = LightingDesc {
@@ -89,6 +92,7 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
             let (side, mixed) = tiling(f);
             unsafe {
                 d.wait_for_fences(&[fence], true, u64::MAX).unwrap();
+                ctx.note_wait(fence);
                 lighting.slot_finished((f % IN_FLIGHT) as u32).unwrap();
                 d.reset_fences(&[fence]).unwrap();
                 d.reset_command_pool(pool, vk::CommandPoolResetFlags::empty())
@@ -96,6 +100,7 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                 let begin = vk::CommandBufferBeginInfo::default()
                     .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
                 d.begin_command_buffer(cmd, &begin).unwrap();
+                ctx.note_begin(cmd);
                 renderer.record_gbuffer(cmd, &mut targets).unwrap();
                 let frame = TiledFrame {
                     slot: (f % IN_FLIGHT) as u32,
@@ -119,10 +124,12 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                 let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
                 let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
                 d.queue_submit2(queue, &[submit], fence).unwrap();
+                ctx.note_submit(&[cmd], fence);
             }
         }
         let fences: Vec<_> = slots.iter().map(|s| s.2).collect();
         unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+        fences.iter().for_each(|f| ctx.note_wait(*f));
         for slot in 0..IN_FLIGHT as u32 {
             // SAFETY: every slot's fence was waited for just above.
             unsafe { lighting.slot_finished(slot) }.unwrap();

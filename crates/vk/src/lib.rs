@@ -48,6 +48,8 @@ pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat,
 pub use gpu::debug::{ValidationLog, ValidationMessage};
 pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
 pub use gpu::error::{Cause, Error, Result};
+#[doc(hidden)]
+pub use gpu::hazards::{omit_hand_over, HandOver, Omitted};
 pub use gpu::limits::{describe as describe_limits, DeviceLimits, Limit, Need, NEEDS};
 pub use gpu::quirks::{Quirk, QuirkRule, Quirks, QUIRKS};
 pub use gpu::readback::{FrameImages, Readback};

@@ -637,5 +637,5 @@ fn write_lightmap_set(
         .image_info(&filter);
     // SAFETY: `set` was just allocated (`create_lightmap_set`) and no command buffer uses it;
     // binding 2 is the layout's sampler (`ALPHA_LIGHTMAP_SET`) and `sampler` is live.
-    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+    unsafe { crate::gpu::descriptors::update_sets(ctx, &[write]) };
 }

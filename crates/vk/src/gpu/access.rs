@@ -313,10 +313,7 @@ impl Recording<'_> {
         // engine's promise for its `ImageRef`s), so each old layout is right; an image declared
         // twice in one call would take its second barrier from a state the first replaced, which
         // no caller does. `dependency` lives until the call returns.
-        unsafe {
-            self.device()
-                .cmd_pipeline_barrier2(self.outside(), &dependency)
-        };
+        unsafe { self.barrier(&dependency) };
         for (image, next, _) in uses.iter_mut() {
             image.state = ImageState::after(*next);
         }
@@ -369,10 +366,7 @@ impl Recording<'_> {
         // SAFETY: outside rendering (`outside` checks it in debug builds; the callers barrier
         // between their compute, transfer and render phases); the stages are ones the queue
         // family supports, as said above, and `dependency` lives until the call returns.
-        unsafe {
-            self.device()
-                .cmd_pipeline_barrier2(self.outside(), &dependency)
-        };
+        unsafe { self.barrier(&dependency) };
     }
 }
 
@@ -468,10 +462,7 @@ impl Recording<'_> {
         let dependency = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);
         // SAFETY: the recording is outside rendering (`outside` checks it in debug builds) and the buffers are
         // alive; the barrier names only stages and accesses those buffers support.
-        unsafe {
-            self.device()
-                .cmd_pipeline_barrier2(self.outside(), &dependency)
-        };
+        unsafe { self.barrier(&dependency) };
     }
 }
 

@@ -27,7 +27,7 @@ impl Recording<'_> {
     ) {
         // SAFETY: this fn's # Safety; binding is allowed inside and outside rendering.
         unsafe {
-            self.device().cmd_bind_pipeline(self.any(), point, pipeline);
+            self.bind_pipeline(point, pipeline);
             self.bind_sets(point, layout, 0, sets);
         }
     }
@@ -52,6 +52,9 @@ impl Recording<'_> {
     /// # Safety
     /// `pipeline` is a live `point` pipeline of this recording's device.
     pub unsafe fn bind_pipeline(&self, point: vk::PipelineBindPoint, pipeline: vk::Pipeline) {
+        if let Some(h) = self.hazards() {
+            h.bind_pipeline(self.any(), point, pipeline);
+        }
         // SAFETY: this fn's # Safety; allowed inside and outside rendering.
         unsafe { self.device().cmd_bind_pipeline(self.any(), point, pipeline) }
     }
@@ -69,6 +72,9 @@ impl Recording<'_> {
     ) {
         if sets.is_empty() {
             return;
+        }
+        if let Some(h) = self.hazards() {
+            h.bind_sets(self.any(), point, first, sets);
         }
         // SAFETY: this fn's # Safety; allowed inside and outside rendering.
         unsafe {
@@ -105,6 +111,7 @@ impl Recording<'_> {
     /// `first + vertices`; rendering was begun through this recording with attachments the
     /// pipeline's formats.
     pub unsafe fn draw(&self, vertices: u32, first: u32) {
+        self.journal_shading(vk::PipelineBindPoint::GRAPHICS, &[]);
         // SAFETY: inside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe { self.device().cmd_draw(self.inside(), vertices, 1, first, 0) }
     }
@@ -117,6 +124,12 @@ impl Recording<'_> {
     /// `VERTEX_BUFFER` and `INDEX_BUFFER` usage and filled before the draw runs, and each of the
     /// first `count` u32 indices of `indices` names a vertex of `vertices`.
     pub unsafe fn draw_mesh(&self, vertices: vk::Buffer, indices: vk::Buffer, count: u32) {
+        use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
+        let inputs = [
+            (vertices, S::VERTEX_INPUT, A::VERTEX_ATTRIBUTE_READ),
+            (indices, S::VERTEX_INPUT, A::INDEX_READ),
+        ];
+        self.journal_shading(vk::PipelineBindPoint::GRAPHICS, &inputs);
         let (d, cmd) = (self.device(), self.inside());
         // SAFETY: inside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
@@ -131,6 +144,14 @@ impl Recording<'_> {
     /// # Safety
     /// `buffer` is a live buffer of this device made with `VERTEX_BUFFER` usage.
     pub unsafe fn bind_vertex_buffer(&self, buffer: vk::Buffer) {
+        // Journaled as read here, by the draws that follow.
+        if let Some(h) = self.hazards() {
+            let read = (
+                vk::PipelineStageFlags2::VERTEX_INPUT,
+                vk::AccessFlags2::VERTEX_ATTRIBUTE_READ,
+            );
+            h.read(self.any(), buffer, read);
+        }
         // SAFETY: this fn's # Safety; allowed inside and outside rendering.
         unsafe {
             self.device()
@@ -145,6 +166,7 @@ impl Recording<'_> {
     /// the device's `maxComputeWorkGroupCount`.
     pub unsafe fn dispatch(&self, groups: [u32; 3]) {
         let [x, y, z] = groups;
+        self.journal_shading(vk::PipelineBindPoint::COMPUTE, &[]);
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe { self.device().cmd_dispatch(self.outside(), x, y, z) }
     }
@@ -156,6 +178,12 @@ impl Recording<'_> {
     /// u32 counts at `offset` (a multiple of 4) written and made visible to the indirect read
     /// before the dispatch runs.
     pub unsafe fn dispatch_indirect(&self, buffer: vk::Buffer, offset: u64) {
+        let arguments = (
+            buffer,
+            vk::PipelineStageFlags2::DRAW_INDIRECT,
+            vk::AccessFlags2::INDIRECT_COMMAND_READ,
+        );
+        self.journal_shading(vk::PipelineBindPoint::COMPUTE, &[arguments]);
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
             self.device()
@@ -169,6 +197,7 @@ impl Recording<'_> {
     /// `buffer` is live, made with `TRANSFER_DST` usage, and its earlier uses were made
     /// available to a transfer write (a barrier before this call, or none since the last wait).
     pub unsafe fn fill(&self, buffer: vk::Buffer, value: u32) {
+        self.journal_transfer("fill", &[], &[buffer]);
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
             self.device()
@@ -182,6 +211,7 @@ impl Recording<'_> {
     /// As [`Self::fill`]; `bytes` is 4 to 65536 bytes, a multiple of 4, and fits the buffer.
     pub unsafe fn update(&self, buffer: vk::Buffer, bytes: &[u8]) {
         debug_assert!(!bytes.is_empty() && bytes.len() <= 65536 && bytes.len() & 3 == 0);
+        self.journal_transfer("update", &[], &[buffer]);
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
             self.device()
@@ -203,6 +233,7 @@ impl Recording<'_> {
         regions: &[vk::BufferImageCopy],
     ) {
         let layout = vk::ImageLayout::TRANSFER_DST_OPTIMAL;
+        self.journal_transfer("copy to image", &[src], &[]);
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
             self.device()
@@ -218,6 +249,9 @@ impl Recording<'_> {
     /// old layout is the image's layout (or `UNDEFINED`, discarding it); the stages are ones
     /// the recording's queue family supports, each access one its stages perform.
     pub unsafe fn barrier(&self, dependency: &vk::DependencyInfo) {
+        if let Some(h) = self.hazards() {
+            h.barrier(self.any(), dependency);
+        }
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
             self.device()
@@ -232,10 +266,29 @@ impl Recording<'_> {
     /// usage, the regions lie inside both and do not overlap in `dst`, and earlier writes of
     /// `src` and uses of `dst` were made available to the transfer.
     pub unsafe fn copy_buffer(&self, src: vk::Buffer, dst: vk::Buffer, regions: &[vk::BufferCopy]) {
+        self.journal_transfer("copy", &[src], &[dst]);
         // SAFETY: outside rendering (checked in debug builds); the rest is this fn's # Safety.
         unsafe {
             self.device()
                 .cmd_copy_buffer(self.outside(), src, dst, regions)
+        }
+    }
+
+    /// Journals a draw's or dispatch's buffers for the hazard check, when it is on.
+    fn journal_shading(
+        &self,
+        point: vk::PipelineBindPoint,
+        extra: &[(vk::Buffer, vk::PipelineStageFlags2, vk::AccessFlags2)],
+    ) {
+        if let Some(h) = self.hazards() {
+            h.shade(self.any(), point, extra);
+        }
+    }
+
+    /// Journals a transfer's buffers for the hazard check, when it is on.
+    pub(crate) fn journal_transfer(&self, what: &str, reads: &[vk::Buffer], writes: &[vk::Buffer]) {
+        if let Some(h) = self.hazards() {
+            h.transfer(self.any(), what, reads, writes);
         }
     }
 }

@@ -52,6 +52,11 @@ impl ValidationLog {
         self.lock().get(mark..).unwrap_or_default().to_vec()
     }
 
+    /// Adds a message of histencil's own (the hazard check's), as the layer's arrive.
+    pub(crate) fn push(&self, message: ValidationMessage) {
+        self.lock().push(message);
+    }
+
     /// Removes the messages after `mark` that `about` matches and says how many went: for a
     /// call that failed and was retried, whose refusal is reported another way.
     pub(crate) fn forget_since(

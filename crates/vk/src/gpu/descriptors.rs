@@ -204,7 +204,7 @@ pub(crate) fn write_frame_set(
     // SAFETY: `writes` and the buffer infos they point at live until the call returns. Every
     // caller passes a set of a `FRAME_SET` layout that no pending command buffer uses (fresh,
     // or a slot's after the slot finished) and live buffers with uniform / storage usage.
-    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    unsafe { update_sets(ctx, &writes) };
 }
 
 /// Points bindings 0, 1, ... of `set` at the sampled images `views`, read in
@@ -267,7 +267,22 @@ fn write_in_order<'a, T>(
     // of `set` has type `ty` (the callers' layouts). Every caller updates a set that no pending
     // command buffer uses: a fresh one, a slot's whose frame finished (`slot_finished`), or one
     // whose owner refuses while in flight or whose caller promises it (`set_lut_tables`).
-    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+    unsafe { update_sets(ctx, &writes) };
+}
+
+/// `vkUpdateDescriptorSets` with `writes` alone, the buffers they bind journaled for the
+/// hazard check: every descriptor write of histencil's goes through here.
+///
+/// # Safety
+/// As `vkUpdateDescriptorSets`: each write names a live set that no pending command buffer
+/// uses, a binding of its layout of the write's type, and live resources with the usage the
+/// type needs; the infos each write points at live until the call returns.
+pub(crate) unsafe fn update_sets(ctx: &Context, writes: &[vk::WriteDescriptorSet]) {
+    if let Some(hazards) = ctx.hazards.get() {
+        hazards.descriptor_writes(writes);
+    }
+    // SAFETY: this fn's # Safety.
+    unsafe { ctx.device.update_descriptor_sets(writes, &[]) };
 }
 
 /// The renderer's frame set (set 0 of its mesh, alpha and tonemap passes): its layout, pool

@@ -19,6 +19,7 @@ pub mod descriptors;
 pub(crate) mod driver;
 pub(crate) mod error;
 pub mod gpu_types;
+pub(crate) mod hazards;
 pub(crate) mod limits;
 pub(crate) mod meshes;
 pub(crate) mod pipelines;

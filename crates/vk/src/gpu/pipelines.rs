@@ -63,6 +63,9 @@ pub(crate) fn create_module(ctx: &Context, name: &str, spirv: &[u8]) -> Result<v
     // `EngineHooks::new` promises.
     let module =
         unsafe { ctx.device.create_shader_module(&info, None) }.call("vkCreateShaderModule")?;
+    if let Some(hazards) = ctx.hazards.get() {
+        hazards.module(module, &words);
+    }
     ctx.name(module, name);
     Ok(module)
 }
@@ -119,6 +122,9 @@ pub(crate) fn create_compute_pipeline(
     let pipeline = created
         .map_err(|(_, e)| e)
         .call("vkCreateComputePipelines")?[0];
+    if let Some(hazards) = ctx.hazards.get() {
+        hazards.pipeline(pipeline, &[shader]);
+    }
     ctx.name(pipeline, name);
     Ok(pipeline)
 }
@@ -339,6 +345,13 @@ pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipelin
     let pipeline = result
         .map_err(|(_, e)| e)
         .call("vkCreateGraphicsPipelines")?[0];
+    if let Some(hazards) = ctx.hazards.get() {
+        let modules: Vec<_> = [Some(vertex_module), fragment_module]
+            .into_iter()
+            .flatten()
+            .collect();
+        hazards.pipeline(pipeline, &modules);
+    }
     ctx.name(pipeline, desc.name);
     Ok(pipeline)
 }

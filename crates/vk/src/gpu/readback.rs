@@ -64,6 +64,7 @@ impl Recording<'_> {
         buffer: &Buffer,
     ) {
         self.transition(image, ImageAccess::TransferSource, Contents::Keep);
+        self.journal_transfer("copy from image", &[], &[buffer.handle]);
         let region = vk::BufferImageCopy::default()
             .image_subresource(
                 vk::ImageSubresourceLayers::default()
@@ -106,12 +107,7 @@ impl Recording<'_> {
             .dst_access_mask(vk::AccessFlags2::HOST_READ)];
         // SAFETY: the recording's command buffer is recording outside rendering; `barrier` lives until the
         // call returns and names only stages and accesses the queue family supports.
-        unsafe {
-            self.device().cmd_pipeline_barrier2(
-                self.outside(),
-                &vk::DependencyInfo::default().memory_barriers(&barrier),
-            )
-        };
+        unsafe { self.barrier(&vk::DependencyInfo::default().memory_barriers(&barrier)) };
     }
 }
 

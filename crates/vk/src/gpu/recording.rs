@@ -202,6 +202,9 @@ impl<'a> Recording<'a> {
     /// per-light labels, which open and close as the plan's steps change light).
     pub fn begin_label(&self, name: &str) {
         self.ctx.begin_label(self.cmd, name);
+        if let Some(h) = self.hazards() {
+            h.label(self.cmd, Some(name));
+        }
         self.labels.set(self.labels.get() + 1);
     }
 
@@ -212,7 +215,25 @@ impl<'a> Recording<'a> {
             "a label closed that was never opened"
         );
         self.ctx.end_label(self.cmd);
+        if let Some(h) = self.hazards() {
+            h.label(self.cmd, None);
+        }
         self.labels.set(self.labels.get().saturating_sub(1));
+    }
+
+    /// The context's hazard check, when it has one: what the commands journal their buffer
+    /// accesses and barriers to.
+    pub(crate) fn hazards(&self) -> Option<&'a crate::gpu::hazards::Hazards> {
+        self.ctx.hazards.get()
+    }
+
+    /// Tells the hazard check whether the next draws' and dispatches' atomics must run in order
+    /// (a protocol across draws, as the hi-stencil statistics' stamps): then two of them need
+    /// an execution dependency between them, where plain atomics need none.
+    pub(crate) fn ordered_atomics(&self, ordered: bool) {
+        if let Some(h) = self.hazards() {
+            h.ordered_atomics(self.cmd, ordered);
+        }
     }
 
     /// Ends the recording, checking (in debug builds) that rendering and every label it opened

@@ -88,6 +88,12 @@ pub struct Resource {
     pub count: u32,
     /// The variable's name (empty for an anonymous block).
     pub name: String,
+    /// Whether the shader may write it: a storage buffer not `readonly` (NonWritable on the
+    /// variable or on every member of its block), a storage image or texel buffer not
+    /// `readonly`. What the hazard check holds a pass's buffers to.
+    pub writes: bool,
+    /// Whether the shader may read it: all but a `writeonly` storage resource (NonReadable).
+    pub reads: bool,
 }
 
 /// A module's stages (from its entry points) and descriptor bindings, ordered by set and
@@ -113,6 +119,7 @@ mod op {
     pub const CONSTANT: u32 = 43;
     pub const VARIABLE: u32 = 59;
     pub const DECORATE: u32 = 71;
+    pub const MEMBER_DECORATE: u32 = 72;
     pub const TYPE_ACCELERATION_STRUCTURE: u32 = 5341;
 }
 
@@ -146,6 +153,8 @@ const CLASS_STORAGE_BUFFER: u32 = 12;
 const DECORATION_BUFFER_BLOCK: u32 = 3;
 const DECORATION_BINDING: u32 = 33;
 const DECORATION_DESCRIPTOR_SET: u32 = 34;
+const DECORATION_NON_WRITABLE: u32 = 24;
+const DECORATION_NON_READABLE: u32 = 25;
 const DIM_BUFFER: u32 = 5;
 const DIM_SUBPASS_DATA: u32 = 6;
 
@@ -164,6 +173,12 @@ pub fn reflect_bindings(words: &[u32]) -> Result<ModuleBindings, String> {
     let mut sets = std::collections::HashMap::new();
     let mut bindings = std::collections::HashMap::new();
     let mut buffer_blocks = std::collections::HashSet::new();
+    // NonWritable / NonReadable on variables, and per block the members so decorated.
+    let mut non_writable = std::collections::HashSet::new();
+    let mut non_readable = std::collections::HashSet::new();
+    let mut members = std::collections::HashMap::new();
+    let mut member_marks: std::collections::HashMap<(u32, u32), std::collections::HashSet<u32>> =
+        std::collections::HashMap::new();
     let mut variables = Vec::new();
     let mut stages = vk::ShaderStageFlags::empty();
     let mut at = 5;
@@ -218,6 +233,7 @@ pub fn reflect_bindings(words: &[u32]) -> Result<ModuleBindings, String> {
             }
             op::TYPE_STRUCT => {
                 types.insert(arg(0)?, Type::Struct);
+                members.insert(arg(0)?, w.len() as u32 - 1);
             }
             op::TYPE_POINTER => {
                 types.insert(arg(0)?, Type::Pointer { pointee: arg(2)? });
@@ -241,8 +257,21 @@ pub fn reflect_bindings(words: &[u32]) -> Result<ModuleBindings, String> {
                 DECORATION_BUFFER_BLOCK => {
                     buffer_blocks.insert(arg(0)?);
                 }
+                DECORATION_NON_WRITABLE => {
+                    non_writable.insert(arg(0)?);
+                }
+                DECORATION_NON_READABLE => {
+                    non_readable.insert(arg(0)?);
+                }
                 _ => {}
             },
+            op::MEMBER_DECORATE => {
+                let decoration = arg(2)?;
+                if decoration == DECORATION_NON_WRITABLE || decoration == DECORATION_NON_READABLE {
+                    let marks = member_marks.entry((arg(0)?, decoration)).or_default();
+                    marks.insert(arg(1)?);
+                }
+            }
             _ => {}
         }
         at += count;
@@ -310,16 +339,129 @@ pub fn reflect_bindings(words: &[u32]) -> Result<ModuleBindings, String> {
                 ))
             }
         };
+        // A block is read-only (write-only) when every member is, or the variable.
+        let marked = |decoration: u32, on_variable: &std::collections::HashSet<u32>| {
+            let whole_block = members.get(&element).is_some_and(|&n| {
+                member_marks
+                    .get(&(element, decoration))
+                    .is_some_and(|m| n > 0 && m.len() as u32 == n)
+            });
+            on_variable.contains(&id) || whole_block
+        };
+        let storage = matches!(
+            kind,
+            ResourceKind::StorageBuffer
+                | ResourceKind::StorageImage
+                | ResourceKind::StorageTexelBuffer
+        );
+        let writes = storage && !marked(DECORATION_NON_WRITABLE, &non_writable);
+        let reads = !(storage && marked(DECORATION_NON_READABLE, &non_readable));
         resources.push(Resource {
             set,
             binding,
             kind,
             count,
             name,
+            writes,
+            reads,
         });
     }
     resources.sort_by_key(|r| (r.set, r.binding));
     Ok(ModuleBindings { stages, resources })
+}
+
+/// How a module's code reaches a binding's memory: whether it loads, stores or uses atomics
+/// on it (all false: declared, by an include, but not used).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Reach {
+    pub loads: bool,
+    pub stores: bool,
+    pub atomics: bool,
+}
+
+/// How the module reaches each (set, binding) it declares, through the variable or any access
+/// chain of it. What the hazard check needs: a binding the code never touches is no access,
+/// and atomics of two draws are no data race where plain accesses are. A module it cannot
+/// read has no entries (the check then takes the declarations' word).
+pub(crate) fn binding_reach(words: &[u32]) -> std::collections::HashMap<(u32, u32), Reach> {
+    use std::collections::{HashMap, HashSet};
+    const FUNCTION_CALL: u32 = 57;
+    const LOAD: u32 = 61;
+    const STORE: u32 = 62;
+    const COPY_MEMORY: u32 = 63;
+    const ACCESS_CHAIN: std::ops::RangeInclusive<u32> = 65..=67;
+    const COPY_OBJECT: u32 = 83;
+    const ATOMIC_STORE: u32 = 228;
+    const ATOMICS: std::ops::RangeInclusive<u32> = 227..=242;
+    let (mut sets, mut bindings) = (HashMap::new(), HashMap::new());
+    let mut chains = Vec::new();
+    let (mut loads, mut stores, mut atomic) = (HashSet::new(), HashSet::new(), HashSet::new());
+    let mut at = 5;
+    while words.len() >= 5 && at < words.len() {
+        let count = (words[at] >> 16) as usize;
+        let opcode = words[at] & 0xffff;
+        if count == 0 || at + count > words.len() {
+            return HashMap::new();
+        }
+        let w = &words[at + 1..at + count];
+        let get = |i: usize| w.get(i).copied().unwrap_or(0);
+        match opcode {
+            op::DECORATE if get(1) == DECORATION_DESCRIPTOR_SET => {
+                sets.insert(get(0), get(2));
+            }
+            op::DECORATE if get(1) == DECORATION_BINDING => {
+                bindings.insert(get(0), get(2));
+            }
+            o if ACCESS_CHAIN.contains(&o) || o == COPY_OBJECT => chains.push((get(1), get(2))),
+            LOAD => {
+                loads.insert(get(2));
+            }
+            STORE => {
+                stores.insert(get(0));
+            }
+            COPY_MEMORY => {
+                stores.insert(get(0));
+                loads.insert(get(1));
+            }
+            FUNCTION_CALL => {
+                loads.extend(w.iter().skip(3).copied());
+                stores.extend(w.iter().skip(3).copied());
+            }
+            ATOMIC_STORE => {
+                atomic.insert(get(0));
+            }
+            o if ATOMICS.contains(&o) => {
+                atomic.insert(get(2));
+            }
+            _ => {}
+        }
+        at += count;
+    }
+    let mut out = HashMap::new();
+    for (variable, set) in &sets {
+        let Some(binding) = bindings.get(variable) else {
+            continue;
+        };
+        let mut reached = HashSet::from([*variable]);
+        loop {
+            let before = reached.len();
+            for (result, base) in &chains {
+                if reached.contains(base) {
+                    reached.insert(*result);
+                }
+            }
+            if reached.len() == before {
+                break;
+            }
+        }
+        let reach = Reach {
+            loads: reached.iter().any(|id| loads.contains(id)),
+            stores: reached.iter().any(|id| stores.contains(id)),
+            atomics: reached.iter().any(|id| atomic.contains(id)),
+        };
+        out.insert((*set, *binding), reach);
+    }
+    out
 }
 
 /// A SPIR-V literal string: UTF-8 bytes, little-endian in words, nul-terminated.
@@ -347,5 +489,44 @@ mod tests {
         // An instruction of zero words would loop for ever.
         let zero = [0x0723_0203, 0x0001_0300, 0, 10, 0, 0];
         assert!(reflect_bindings(&zero).is_err());
+    }
+
+    fn words(spirv: &[u8]) -> Vec<u32> {
+        ash::util::read_spv(&mut std::io::Cursor::new(spirv)).expect("SPIR-V")
+    }
+
+    /// What the hazard check reads of histencil's own modules: the statistics draw reaches
+    /// its touched marks and counters by atomics alone, the depth-id shade only loads the
+    /// tile lists it declares writable (tiled.glsl's blocks are not `readonly`), and the
+    /// classification stores them.
+    #[test]
+    fn binding_reach_tells_atomics_loads_and_stores_apart() {
+        let count = binding_reach(&words(crate::shaders::HI_STENCIL_COUNT_FRAG));
+        let atomics = Reach {
+            loads: false,
+            stores: false,
+            atomics: true,
+        };
+        assert_eq!(count[&(2, 1)], atomics, "touched");
+        assert_eq!(count[&(2, 2)], atomics, "statistics");
+        let shade = binding_reach(&words(crate::shaders::DEPTH_ID_SHADE_FRAG));
+        let lists = shade[&(2, 2)];
+        assert!(lists.loads && !lists.stores && !lists.atomics, "{lists:?}");
+        let reflected = reflect_bindings(&words(crate::shaders::DEPTH_ID_SHADE_FRAG)).unwrap();
+        let declared = reflected
+            .resources
+            .iter()
+            .find(|r| (r.set, r.binding) == (2, 2));
+        assert!(declared.is_some_and(|r| r.writes && r.reads));
+        // frame.glsl's lights are `readonly` (NonWritable on the block's members).
+        let lights = reflected
+            .resources
+            .iter()
+            .find(|r| (r.set, r.binding) == (0, 1));
+        assert!(lights.is_some_and(|r| !r.writes && r.reads), "{lights:?}");
+        let classify = binding_reach(&words(crate::shaders::TILE_CLASSIFY_COMP));
+        assert!(classify[&(2, 1)].stores, "{:?}", classify[&(2, 1)]);
+        // A module it cannot read reaches nothing it can name.
+        assert!(binding_reach(&[1, 2, 3]).is_empty());
     }
 }

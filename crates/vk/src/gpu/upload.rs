@@ -42,6 +42,9 @@ pub(crate) fn submit_once(
             .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: `cmd` was just allocated, so it is in the initial state; `begin` outlives it.
         unsafe { d.begin_command_buffer(cmd, &begin) }.call("vkBeginCommandBuffer")?;
+        if let Some(hazards) = ctx.hazards.get() {
+            hazards.begun(cmd);
+        }
         // SAFETY: `cmd` was just begun on this context's device, from a pool of its queue
         // family (graphics and compute), outside rendering; only `record` records into it.
         let rec = unsafe { Recording::new(ctx, cmd) };
@@ -63,6 +66,9 @@ pub(crate) fn submit_once(
             ctx.step("waiting on the GPU");
             d.wait_for_fences(&[fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
                 .call("vkWaitForFences")?;
+            if let Some(hazards) = ctx.hazards.get() {
+                hazards.waited(fence);
+            }
             pending = false;
             Ok(())
         }

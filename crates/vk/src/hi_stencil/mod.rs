@@ -107,7 +107,7 @@ fn write_read_only_view(ctx: &Context, set: vk::DescriptorSet, binding: u32, vie
     // SAFETY: `set` and `view` were made from this context's device; the set is not bound by a
     // pending command buffer (the surface's sets are written at creation, at a resize once no
     // slot is in flight, and per slot once that slot's frame is declared finished).
-    unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+    unsafe { crate::gpu::descriptors::update_sets(ctx, &[write]) };
 }
 
 /// Words of the statistics buffer (`HiStencilStats` in include/hi_stencil.glsl).

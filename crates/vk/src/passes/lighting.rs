@@ -150,10 +150,14 @@ impl Rendering {
     /// instance. Exact, not a full memory barrier (as it was until 2026-11-29): the attachments
     /// are handed over by `open`'s transitions, the stencil to the tile update by its own, and
     /// the tile surface's other buffers by the hi-stencil's reset, flush and save barriers.
-    /// That list is held by reading, not by a test: synchronisation validation does not see
-    /// these buffers' hazards (with no barrier here at all every test passed on lavapipe, which
-    /// runs draws in order, 2026-11-29). An engine's hooks bind resources histencil cannot see,
-    /// which their shaders may write: with them, the full barrier as before.
+    /// Synchronisation validation does not see these buffers' hazards (with no barrier here
+    /// at all every test passed on lavapipe, which runs draws in order, 2026-11-29); histencil's
+    /// hazard check does (`gpu/hazards`, `tests/tests/hazards.rs`). What it found: the light
+    /// shaders reach these buffers by atomics alone, which need no memory dependency between
+    /// draws, so what the split gives the statistics draws is their order (ending the
+    /// rendering, and the attachments' barriers when it opens again); this buffer barrier is
+    /// kept as the named hand-over of what they wrote. An engine's hooks bind resources
+    /// histencil cannot see, which their shaders may write: with them, the full barrier.
     fn split(&mut self, pass: &LightingPass) {
         self.close(pass);
         if pass.engine_hooks {
@@ -424,7 +428,7 @@ impl LightingPass<'_> {
         if state.tests_hi_stencil() || hierarchy_tested {
             flags |= LIGHT_DRAW_HI_STENCIL_TEST;
             if self.count_stats {
-                rendering.split(self);
+                self.split_for_counting(rendering);
                 rendering.open(self, targets);
                 let count = PassState {
                     depth: DepthState::OFF,
@@ -447,7 +451,7 @@ impl LightingPass<'_> {
         }
         if shades && self.count_stats {
             flags |= LIGHT_DRAW_COUNT;
-            rendering.split(self);
+            self.split_for_counting(rendering);
         }
         rendering.open(self, targets);
         let push = LightDrawPush {
@@ -533,6 +537,17 @@ impl LightingPass<'_> {
     }
 
     /// Records one draw; `bounds` is the light's depth range for a pass confined to it.
+    /// Splits the rendering before a statistics draw: its atomics follow the stamp protocol,
+    /// which needs the draws before it finished (ending the rendering, and the attachments'
+    /// barriers when it opens again, order them; atomics need no memory dependency). The
+    /// hazard test that leaves it out (`HandOver::LightSplit`) finds the counted draws of one
+    /// rendering unordered.
+    fn split_for_counting(&self, rendering: &mut Rendering) {
+        if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::LightSplit) {
+            rendering.split(self);
+        }
+    }
+
     fn draw(
         &self,
         key: LightPipelineKey,
@@ -552,6 +567,11 @@ impl LightingPass<'_> {
             rec.push(self.pipeline_layout, stages, 0, bytemuck::bytes_of(&push));
         }
         rec.apply_bounded(state, bounds);
+        // A statistics draw's atomics follow the stamp protocol (hi_stencil_count.frag counts a
+        // tile the first time a draw's stamp meets it): they need the draws before finished,
+        // which the split gives them. Other draws' atomics (none run) need no order.
+        let counts = push.flags & LIGHT_DRAW_COUNT != 0 || key.1 == LightShader::CountTiles;
+        rec.ordered_atomics(counts);
         match geometry {
             // SAFETY: inside rendering (`draw` checks it) with a full-screen pipeline bound just
             // above, its sets and state, which draws its triangle from the vertex index alone.
@@ -561,5 +581,6 @@ impl LightingPass<'_> {
                 self.volumes.draw(rec, kind);
             }
         }
+        rec.ordered_atomics(false);
     }
 }

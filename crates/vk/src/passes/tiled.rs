@@ -465,7 +465,7 @@ impl TiledLighting {
         // Binding 4 is `TILED_SET`'s storage image, and `hdr` is the caller's live view with
         // `STORAGE` usage (`record_tiled`'s # Safety, `check_usage`), in `GENERAL` when the
         // kernels run.
-        unsafe { ctx.device.update_descriptor_sets(&[write], &[]) };
+        unsafe { crate::gpu::descriptors::update_sets(ctx, &[write]) };
     }
 
     /// Records the classification with `sets` bound: the G-buffer (or the decode hook's
@@ -506,8 +506,11 @@ impl TiledLighting {
             // ordered before this rewrite, until this barrier). It waits for every earlier use
             // at every stage histencil records in, not a list of today's readers: the next
             // reader added needs no change here. Synchronisation validation does not see this
-            // hand-over across submissions (nor the light passes' split): held by reading.
-            rec.memory_barrier();
+            // hand-over across submissions; histencil's hazard check does
+            // (`hazard_tile_rewrite_removed_across_two_slots_submissions`).
+            if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::TileRewrite) {
+                rec.memory_barrier();
+            }
             // Each slot's dispatch starts at zero tiles.
             let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
             // SAFETY: outside rendering (`update` and `fill` check it in debug builds;
@@ -614,6 +617,9 @@ impl TiledLighting {
 /// Compute writes of the tile buffers made visible to the next compute pass and to the indirect
 /// dispatches.
 fn after_compute(rec: &Recording) {
+    if !crate::gpu::hazards::records(crate::gpu::hazards::HandOver::TileLists) {
+        return;
+    }
     rec.memory_dependency(
         (
             vk::PipelineStageFlags2::COMPUTE_SHADER,

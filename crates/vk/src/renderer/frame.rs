@@ -234,6 +234,9 @@ impl<'c> Renderer<'c> {
             d.begin_command_buffer(cmd, &begin)
                 .call("vkBeginCommandBuffer")?;
         }
+        if let Some(hazards) = self.ctx.hazards.get() {
+            hazards.begun(cmd);
+        }
         // SAFETY: `cmd` was begun just now, outside rendering, on the context's queue family
         // (graphics and compute); the renderer records into it through this recording alone.
         Ok(unsafe { Recording::new(self.ctx, cmd) })
@@ -297,6 +300,9 @@ impl<'c> Renderer<'c> {
             // SAFETY: the fence is this renderer's, submitted with the frame just now; a
             // timed-out wait leaves it as it was, to be waited for again.
             let waited = unsafe { ctx.device.wait_for_fences(&[self.fence], true, wait) };
+            if let (Ok(()), Some(hazards)) = (&waited, ctx.hazards.get()) {
+                hazards.waited(self.fence);
+            }
             match waited {
                 Err(vk::Result::TIMEOUT) if left > slice => {}
                 other => return other,

@@ -470,7 +470,7 @@ impl GpuMaterials {
             // matches a binding of `MATERIAL_SET` (material.glsl); the record's offset is a
             // multiple of 256 (every device's largest uniform alignment); the textures and
             // samplers were made above, the textures uploaded and left shader-read-only.
-            unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+            unsafe { crate::gpu::descriptors::update_sets(ctx, &writes) };
         }
         self.object_sets = plan.object_sets.iter().map(|&s| sets[s as usize]).collect();
         Ok(())

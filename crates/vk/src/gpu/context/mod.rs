@@ -196,6 +196,10 @@ pub struct Context {
     /// What engine-facing objects left behind when dropped while the GPU might still use it
     /// ([`Context::retire`]): freed at [`Context::free_retired`] or when the context drops.
     retired: Mutex<Vec<Retired>>,
+    /// The hazard check ([`crate::gpu::hazards`]): on for a context histencil creates with
+    /// validation, in debug builds, and where an engine turns it on
+    /// ([`Context::check_hazards`]).
+    pub(crate) hazards: std::sync::OnceLock<crate::gpu::hazards::Hazards>,
 }
 
 /// How to free what a dropped object left to its context ([`Context::retire`]).
@@ -311,6 +315,27 @@ impl Context {
         fence: vk::Fence,
     ) -> ash::prelude::VkResult<()> {
         let _queue = self.queue_lock.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(hazards) = self.hazards.get() {
+            let cmds: Vec<vk::CommandBuffer> = submits
+                .iter()
+                .flat_map(|s| {
+                    // SAFETY: as `vkQueueSubmit2`'s, each pointer is null or points at its
+                    // count of command buffer infos.
+                    let infos = unsafe {
+                        if s.p_command_buffer_infos.is_null() {
+                            &[][..]
+                        } else {
+                            std::slice::from_raw_parts(
+                                s.p_command_buffer_infos,
+                                s.command_buffer_info_count as usize,
+                            )
+                        }
+                    };
+                    infos.iter().map(|i| i.command_buffer)
+                })
+                .collect();
+            hazards.submitted(&cmds, fence);
+        }
         // SAFETY: the caller's, above; the lock makes this thread's access the only one of
         // histencil's.
         unsafe { self.device.queue_submit2(self.queue, submits, fence) }
@@ -322,7 +347,11 @@ impl Context {
         let _queue = self.queue_lock.lock().unwrap_or_else(|p| p.into_inner());
         // SAFETY: the device is live; histencil's own queue access is held off by the lock,
         // an engine's by `Context::from_raw`'s # Safety.
-        unsafe { self.device.device_wait_idle() }
+        let idle = unsafe { self.device.device_wait_idle() };
+        if let (Ok(()), Some(hazards)) = (&idle, self.hazards.get()) {
+            hazards.idle();
+        }
+        idle
     }
 
     /// A context on an engine's device. Nothing is created but the debug-utils function table;
@@ -443,6 +472,7 @@ impl Context {
             quirks,
             memory: MemoryAccount::new(memory_budget),
             retired: Mutex::default(),
+            hazards: Default::default(),
         })
     }
 
@@ -540,8 +570,55 @@ impl Context {
         self.validation.clone()
     }
 
+    /// Turns the hazard check on ([`crate::gpu::hazards`]), its findings going to `log` as
+    /// ERROR messages (`HISTENCIL-HAZARD-...`): for an engine's debug builds and tests. From
+    /// here on histencil journals the buffers its commands use and the barriers they record;
+    /// the engine tells it what it submits and waits for ([`Context::note_submit`],
+    /// [`Context::note_wait`], [`Context::note_idle`]), and each submission is checked against
+    /// the ones still in flight. Objects made before this call are not known to it: turn it
+    /// on before creating lightings. Returns false (and changes nothing) where it was on.
+    pub fn check_hazards(&self, log: Arc<ValidationLog>) -> bool {
+        self.hazards
+            .set(crate::gpu::hazards::Hazards::new(log))
+            .is_ok()
+    }
+
+    /// Tells the hazard check that `cmds` were submitted, in this order, signalling `fence`
+    /// (null for none): their accesses are checked against every submission not yet waited
+    /// for. Nothing where the check is off.
+    pub fn note_submit(&self, cmds: &[vk::CommandBuffer], fence: vk::Fence) {
+        if let Some(hazards) = self.hazards.get() {
+            hazards.submitted(cmds, fence);
+        }
+    }
+
+    /// Tells the hazard check that the host saw `fence` signalled: the submissions that
+    /// signalled it are complete.
+    pub fn note_wait(&self, fence: vk::Fence) {
+        if let Some(hazards) = self.hazards.get() {
+            hazards.waited(fence);
+        }
+    }
+
+    /// Tells the hazard check that the queue is idle (`vkQueueWaitIdle`, `vkDeviceWaitIdle`).
+    pub fn note_idle(&self) {
+        if let Some(hazards) = self.hazards.get() {
+            hazards.idle();
+        }
+    }
+
+    /// Tells the hazard check that `cmd` was begun (or reset): what it recorded before is gone.
+    pub fn note_begin(&self, cmd: vk::CommandBuffer) {
+        if let Some(hazards) = self.hazards.get() {
+            hazards.begun(cmd);
+        }
+    }
+
     /// Names a Vulkan object for validation messages and captures.
-    pub(crate) fn name<H: vk::Handle>(&self, handle: H, name: &str) {
+    pub(crate) fn name<H: vk::Handle + Copy>(&self, handle: H, name: &str) {
+        if let Some(hazards) = self.hazards.get() {
+            hazards.name(H::TYPE, handle.as_raw(), name);
+        }
         if let Some(dd) = &self.debug_device {
             let name = CString::new(name).expect("object names contain no NUL");
             let info = vk::DebugUtilsObjectNameInfoEXT::default()

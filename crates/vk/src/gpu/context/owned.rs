@@ -345,6 +345,10 @@ impl Context {
         let pipeline_cache =
             unsafe { device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default(), None) }
                 .unwrap_or_default();
+        let hazards = std::sync::OnceLock::new();
+        if cfg!(debug_assertions) && desc.validation {
+            let _ = hazards.set(crate::gpu::hazards::Hazards::new(validation.clone()));
+        }
         let ctx = Self {
             _entry: Some(entry),
             owned: true,
@@ -376,6 +380,7 @@ impl Context {
             quirks,
             memory: MemoryAccount::new(desc.memory_budget),
             retired: Mutex::default(),
+            hazards,
         };
         ctx.name(ctx.device.handle(), "histencil-device");
         if ctx.pipeline_cache != vk::PipelineCache::null() {
