@@ -2,7 +2,8 @@
 //! (`histencil_vk::omit_hand_over`), a frame that needs it is reported as a hazard naming the
 //! buffer and both passes, where synchronisation validation and lavapipe's in-order execution
 //! see nothing; with every hand-over in place the same frames are clean (every other test's
-//! clean log holds that too).
+//! clean log holds that too). And a shader writing a buffer its pass did not declare is an
+//! error naming the pass.
 
 use histencil_tests::instance_turn;
 use histencil_vk::{
@@ -175,4 +176,21 @@ fn hazard_tile_rewrite_removed_across_two_slots_submissions() {
         eprintln!("{m}");
     }
     assert!(!hazards(&found).is_empty(), "{found:#?}");
+}
+
+/// Check (a): a shader writing a buffer its pass did not declare is an error naming the pass,
+/// the set and binding and the buffer, since no barrier can be derived for it.
+#[test]
+fn hazard_undeclared_shader_write() {
+    let found = messages("brdfs-3", TILED, Some(HandOver::ClassifyDeclaration));
+    let undeclared: Vec<_> = found
+        .iter()
+        .filter(|m| m.contains("HISTENCIL-UNDECLARED-WRITE"))
+        .collect();
+    assert!(
+        undeclared
+            .iter()
+            .any(|m| m.contains("tile-classify: set 2 binding 1") && m.contains("`tiled-lists`")),
+        "{found:#?}"
+    );
 }

@@ -3,6 +3,7 @@
 //! evaluators of GLSL BRDFs and table lookups that hold the shader code to its Rust reference,
 //! case by case).
 
+use crate::gpu::access::BufferAccess;
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
     create_pipeline_layout, create_set_layout, create_storage_buffer_set, BindingDesc,
@@ -157,7 +158,8 @@ impl CaseKernel {
             create_storage_buffer_set(ctx, self.name, self.compute.set_layout, buffers)?;
         let recorded = submit_once(ctx, self.name, |rec| {
             // Host writes to the inputs are visible at submit; only the results need a
-            // barrier, towards the host read after the fence.
+            // barrier, towards the host read after the fence. The kernel writes binding 1.
+            rec.declare_buffers(&[(buffers[1], BufferAccess::ComputeWrite)]);
             self.compute.bind(rec, set, &count.to_le_bytes());
             // SAFETY: `rec` is `submit_once`'s, recording outside rendering, with the pipeline
             // and its set bound just above. The group count stays within the spec's minimum

@@ -9,7 +9,7 @@
 //! `commands.rs`, each checked against the rendering state.
 //!
 //! Barriers, copies and dynamic state are its methods too, written beside what they serve
-//! (`declare`, `transition`, `memory_barrier` and `buffer_barrier` in `access.rs`: a step
+//! (`declare`, `transition`, `memory_barrier` and `declare_buffers` in `access.rs`: a step
 //! declares how it uses its images next, `rec.declare(&mut [(image, access, contents), ..])`,
 //! and one barrier command takes them all there; `apply` in `state.rs`,
 //! `copy_image_to_buffer` and `host_readable` in `readback.rs`). Modelled on wgpu-hal's

@@ -88,6 +88,10 @@ impl Buffer {
         // SAFETY: `info` lives until the call returns; its size is non-zero (`max(4)`) and
         // its sharing mode exclusive, so it names no queue families.
         let handle = unsafe { ctx.device.create_buffer(&info, None) }.call("vkCreateBuffer")?;
+        ctx.buffer_uses
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .remove(&handle);
         if let Some(hazards) = ctx.hazards.get() {
             // A handle a destroyed buffer had: nothing of that one's accesses is this one's.
             hazards.forget_buffer(handle);
@@ -188,6 +192,10 @@ impl Buffer {
         // it (teardown.rs: after their fence wait or device idle, or on a creation that failed
         // before any submission), and the memory is freed only after the buffer is gone.
         unsafe { ctx.device.destroy_buffer(self.handle, None) };
+        ctx.buffer_uses
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .remove(&self.handle);
         if let (Some(hazards), false) = (ctx.hazards.get(), self.handle == vk::Buffer::null()) {
             hazards.forget_buffer(self.handle);
         }

@@ -324,23 +324,12 @@ impl HiStencilSurface {
             self.touched.handle,
             self.stats.handle,
         ];
-        // Every way a frame uses the surface: light shaders read the active tiles and count
-        // into the touched marks and statistics, the tile update writes pending tiles, a flush
-        // copies them.
-        let frame_uses = [
-            BufferAccess::FragmentRead,
-            BufferAccess::FragmentReadWrite,
-            BufferAccess::ComputeWrite,
-            BufferAccess::TransferRead,
-            BufferAccess::TransferWrite,
-        ];
-        // The previous frame's lighting (in flight, in an earlier submission) may still use
-        // the surface.
-        let fill = [BufferAccess::TransferWrite];
-        let before = surface.map(|b| (b, &frame_uses[..], &fill[..]));
-        rec.buffer_barrier(&before);
+        // The fills wait for every earlier declared use (the previous frame's lighting, in
+        // flight in an earlier submission, may still use the surface); each next use declares
+        // itself (the light passes' reads and counts, the tile updates' writes, a flush).
+        rec.declare_buffers(&surface.map(|b| (b, BufferAccess::TransferWrite)));
         // SAFETY: outside rendering (the lighting pass resets before it begins rendering;
-        // `fill` checks it); the buffers are ours, made with TRANSFER_DST, and the barrier
+        // `fill` checks it); the buffers are ours, made with TRANSFER_DST, and the declaration
         // above orders the fills after every earlier use.
         unsafe {
             rec.fill(self.active.handle, 1);
@@ -348,8 +337,6 @@ impl HiStencilSurface {
             rec.fill(self.touched.handle, 0);
             rec.fill(self.stats.handle, 0);
         }
-        let after = surface.map(|b| (b, &fill[..], &frame_uses[..]));
-        rec.buffer_barrier(&after);
         self.unflushed = false;
         // The frame's first touch draw clears the touch image whole, so no frame depends on
         // what an earlier one (recorded, perhaps never submitted) left there.
@@ -358,25 +345,16 @@ impl HiStencilSurface {
 
     /// Outside rendering: pending state becomes active.
     pub fn record_flush(&mut self, rec: &Recording) {
-        use BufferAccess::{ComputeWrite, FragmentRead, TransferRead, TransferWrite};
+        use BufferAccess::{TransferRead, TransferWrite};
         let (pending, active) = (self.pending.handle, self.active.handle);
-        // The tile updates wrote the pending tiles; light shaders may still read the active
-        // ones.
-        rec.buffer_barrier(&[
-            (pending, &[ComputeWrite], &[TransferRead]),
-            (active, &[FragmentRead, TransferWrite], &[TransferWrite]),
-        ]);
+        // After the tile updates' writes of the pending tiles and the light shaders' reads of
+        // the active ones; the next updates and light draws declare themselves.
+        rec.declare_buffers(&[(pending, TransferRead), (active, TransferWrite)]);
         let region = [vk::BufferCopy::default().size(self.pending.size)];
         // SAFETY: outside rendering (a flush closes rendering first; `copy_buffer` checks it);
         // both buffers are ours and of one size, pending with TRANSFER_SRC and active with
-        // TRANSFER_DST, and the barrier above orders the copy after their earlier uses.
+        // TRANSFER_DST, and the declaration above orders the copy after their earlier uses.
         unsafe { rec.copy_buffer(pending, active, &region) };
-        // The next tile updates overwrite the pending tiles the copy read; the light shaders
-        // read the new active ones.
-        rec.buffer_barrier(&[
-            (pending, &[TransferRead], &[ComputeWrite]),
-            (active, &[TransferWrite], &[FragmentRead, TransferWrite]),
-        ]);
         self.unflushed = false;
     }
 
@@ -524,6 +502,8 @@ impl HiStencilSurface {
         // The stencil back from the declared uses, for its transition after the dispatch.
         let depth_stencil = uses.swap_remove(0).0;
         drop(uses);
+        // The update writes the pending tiles.
+        rec.declare_buffers(&[(self.pending.handle, BufferAccess::ComputeWrite)]);
         let set = self.sets[slot as usize];
         let update = self.update.as_ref().expect("made with the surface");
         update.bind(rec, set, bytemuck::bytes_of(push));
@@ -592,20 +572,26 @@ impl HiStencilSurface {
         use BufferAccess::{FragmentRead, TransferWrite};
         let saved = self.saved.handle;
         // The last restore (an earlier frame's) read what this copy overwrites.
-        rec.buffer_barrier(&[(saved, &[FragmentRead], &[TransferWrite])]);
+        rec.declare_buffers(&[(saved, TransferWrite)]);
         rec.copy_image_to_buffer(depth_stencil, vk::ImageAspectFlags::STENCIL, &self.saved);
         rec.transition(
             depth_stencil,
             ImageAccess::DepthStencilAttachment,
             Contents::Keep,
         );
-        rec.buffer_barrier(&[(saved, &[TransferWrite], &[FragmentRead])]);
+        // The restore reads it inside the lighting's rendering, where no barrier may go.
+        rec.declare_buffers(&[(saved, FragmentRead)]);
     }
 
     /// The buffers light shaders write, with atomics: the touched marks and the statistics. A
     /// split of the lighting's rendering hands them from the draws before to those after.
     pub fn fragment_written(&self) -> [vk::Buffer; 2] {
         [self.touched.handle, self.stats.handle]
+    }
+
+    /// The buffer light shaders read: the active tiles (a flush rewrites it).
+    pub fn fragment_read(&self) -> vk::Buffer {
+        self.active.handle
     }
 
     /// Makes the statistics visible to the host; record after the last lighting draw.

@@ -172,7 +172,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             tiled.record_light_lists(rec, lights)
         });
         match shade {
-            TiledShade::Kernels => tiled.record_shade(&rec, mixed),
+            TiledShade::Kernels => tiled.record_shade(&rec, mixed, &mut targets.hdr),
             TiledShade::DepthId => {
                 let side = frame.side;
                 let (_, pass) = self
@@ -185,7 +185,16 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                     sets.visibility,
                 );
                 let push = tiled.push_bytes(clear, mixed);
-                pass.record(&rec, frame.slot, bound, &push, targets, depth_sampled);
+                let buffers = tiled.buffers();
+                pass.record(
+                    &rec,
+                    frame.slot,
+                    bound,
+                    &push,
+                    targets,
+                    depth_sampled,
+                    buffers,
+                );
             }
         }
         rec.finish();

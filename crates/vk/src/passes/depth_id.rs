@@ -17,7 +17,7 @@
 //! what the EQUAL test saves on a GPU is modelled in the simulator
 //! (`histencil_model::depth_id_stats`), not timed here.
 
-use crate::gpu::access::{uses_of, Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{uses_of, BufferAccess, Contents, ImageAccess, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::create_pipeline_layout;
 use crate::gpu::error::Result;
@@ -185,7 +185,7 @@ impl DepthIdPass {
     /// Records the id copy and each slot's shade pass after the tiled technique's
     /// classification and light lists in `cmd` (`bound`: the sets 0 to 2 they bound, then the
     /// visibility hook's set; `push`: their push constants), into frame-in-flight `slot`'s id
-    /// image. The surfaces are read by fragment shaders (with `depth_sampled`, the depth aspect
+    /// image, reading `tile_buffers` (the tiled technique's). The surfaces are read by fragment shaders (with `depth_sampled`, the depth aspect
     /// of the depth-stencil image too) and the HDR target stored to by them, left in `GENERAL`.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
@@ -196,11 +196,12 @@ impl DepthIdPass {
         push: &[u8],
         targets: &mut LightingTargets,
         depth_sampled: bool,
+        tile_buffers: [vk::Buffer; 4],
     ) {
         rec.step("depth-id", |rec| {
-            // The light lists' masks, from compute to the shade passes (the images by their
-            // transitions below).
-            rec.memory_barrier();
+            // The tile buffers the classification and light lists wrote, read by the shade
+            // passes' fragment shaders (the images by their transitions below).
+            rec.declare_buffers(&tile_buffers.map(|b| (b, BufferAccess::FragmentRead)));
             let keep = Contents::Keep;
             let sampled = ImageAccess::FragmentSampled;
             let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);

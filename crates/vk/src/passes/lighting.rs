@@ -115,6 +115,8 @@ struct Rendering {
     /// The buffers light shaders write (the hi-stencil surface's touched marks and
     /// statistics, [`HiStencilSurface::fragment_written`]): what a split hands over.
     counted: [vk::Buffer; 2],
+    /// The hi-stencil's active tiles, which they read.
+    tested: vk::Buffer,
 }
 
 impl Rendering {
@@ -122,6 +124,9 @@ impl Rendering {
         if pass.rec.is_rendering() {
             return;
         }
+        // The light shaders test the active tiles (a flush since the last opening rewrote them).
+        pass.rec
+            .declare_buffers(&[(self.tested, BufferAccess::FragmentRead)]);
         let hdr = if self.cleared {
             Load::Keep
         } else {
@@ -149,14 +154,15 @@ impl Rendering {
     /// draws that share the statistics buffer cannot be ordered inside one dynamic rendering
     /// instance. Exact, not a full memory barrier (as it was until 2026-11-29): the attachments
     /// are handed over by `open`'s transitions, the stencil to the tile update by its own, and
-    /// the tile surface's other buffers by the hi-stencil's reset, flush and save barriers.
+    /// the tile surface's other buffers by the hi-stencil's reset, flush and save
+    /// declarations (`Recording::declare_buffers` derives each barrier).
     /// Synchronisation validation does not see these buffers' hazards (with no barrier here
     /// at all every test passed on lavapipe, which runs draws in order, 2026-11-29); histencil's
     /// hazard check does (`gpu/hazards`, `tests/tests/hazards.rs`). What it found: the light
     /// shaders reach these buffers by atomics alone, which need no memory dependency between
     /// draws, so what the split gives the statistics draws is their order (ending the
-    /// rendering, and the attachments' barriers when it opens again); this buffer barrier is
-    /// kept as the named hand-over of what they wrote. An engine's hooks bind resources
+    /// rendering, and the attachments' barriers when it opens again); the declaration's
+    /// barrier hands over what they wrote. An engine's hooks bind resources
     /// histencil cannot see, which their shaders may write: with them, the full barrier.
     fn split(&mut self, pass: &LightingPass) {
         self.close(pass);
@@ -164,9 +170,9 @@ impl Rendering {
             pass.rec.memory_barrier();
             return;
         }
-        let rw = [BufferAccess::FragmentReadWrite];
-        let hand_overs = self.counted.map(|buffer| (buffer, &rw[..], &rw[..]));
-        pass.rec.buffer_barrier(&hand_overs);
+        let rw = BufferAccess::FragmentReadWrite;
+        pass.rec
+            .declare_buffers(&self.counted.map(|buffer| (buffer, rw)));
     }
 }
 
@@ -280,11 +286,15 @@ impl LightingPass<'_> {
             t.start(rec);
         }
         hi_stencil.record_reset(self.rec);
+        // The light shaders count into the hi-stencil's touched marks and statistics.
+        let counted = hi_stencil.fragment_written();
+        rec.declare_buffers(&counted.map(|b| (b, BufferAccess::FragmentReadWrite)));
         timers.mark(self, Emulation::BOOKKEEPING);
         self.bind_sets();
         let mut rendering = Rendering {
             cleared: !self.clear_hdr,
-            counted: hi_stencil.fragment_written(),
+            counted,
+            tested: hi_stencil.fragment_read(),
         };
         rendering.open(self, targets);
         if let Some(t) = timers.steps.as_deref_mut() {

@@ -10,7 +10,7 @@
 //! into the tiles of its screen rectangle whose depth range its range sphere reaches.
 //! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
-use crate::gpu::access::{uses_of, Contents, ImageAccess, LightingTargets};
+use crate::gpu::access::{uses_of, BufferAccess, Contents, ImageAccess, ImageRef, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
     binding, create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers,
@@ -436,16 +436,20 @@ impl TiledLighting {
         Ok(())
     }
 
-    /// Points every slot's tiled set at the tile buffers.
-    fn write_sets(&self, ctx: &Context) {
-        let buffers = [
+    /// The tile buffers, in the tiled set's binding order.
+    pub(crate) fn buffers(&self) -> [vk::Buffer; 4] {
+        [
             self.dispatch.handle,
             self.lists.handle,
             self.masks.handle,
             self.depths.handle,
-        ];
+        ]
+    }
+
+    /// Points every slot's tiled set at the tile buffers.
+    fn write_sets(&self, ctx: &Context) {
         for set in &self.sets {
-            write_storage_buffers(ctx, *set, &buffers);
+            write_storage_buffers(ctx, *set, &self.buffers());
         }
     }
 
@@ -502,14 +506,14 @@ impl TiledLighting {
             rec.declare(&mut uses);
             // Every slot shares the tile buffers: an earlier frame still in flight (an engine's,
             // another slot) may be using them, by the tiled shade's indirect dispatches and
-            // kernels or by the depth-id passes' fragment shaders (which nothing of histencil's
-            // ordered before this rewrite, until this barrier). It waits for every earlier use
-            // at every stage histencil records in, not a list of today's readers: the next
-            // reader added needs no change here. Synchronisation validation does not see this
-            // hand-over across submissions; histencil's hazard check does
+            // kernels or by the depth-id passes' fragment shaders. The reset's writes wait for
+            // every use declared before (`declare_buffers` derives the barrier), whichever
+            // pass it was. Synchronisation validation does not see this hand-over across
+            // submissions; histencil's hazard check does
             // (`hazard_tile_rewrite_removed_across_two_slots_submissions`).
             if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::TileRewrite) {
-                rec.memory_barrier();
+                let write = BufferAccess::TransferWrite;
+                rec.declare_buffers(&[(self.dispatch.handle, write), (self.masks.handle, write)]);
             }
             // Each slot's dispatch starts at zero tiles.
             let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
@@ -523,16 +527,16 @@ impl TiledLighting {
                 // Every tile's light mask starts empty; the light lists set bits.
                 rec.fill(self.masks.handle, 0);
             }
-            rec.memory_dependency(
-                (
-                    vk::PipelineStageFlags2::ALL_TRANSFER,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                ),
-            );
+            // The classification counts its tiles into the dispatch arguments (atomics), and
+            // writes the lists and depth ranges.
+            if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::ClassifyDeclaration) {
+                use BufferAccess::{ComputeReadWrite, ComputeWrite};
+                rec.declare_buffers(&[
+                    (self.dispatch.handle, ComputeReadWrite),
+                    (self.lists.handle, ComputeWrite),
+                    (self.depths.handle, ComputeWrite),
+                ]);
+            }
             // SAFETY: the sets match the layout made in `new`: the lighting's frame and decode
             // sets (sets 0 and 1), this slot's tiled set (2) and the visibility hook's (4, its
             // layout there when it has a set); the push is `TiledPush`, the layout's compute
@@ -564,8 +568,6 @@ impl TiledLighting {
                 rec.bind_pipeline(vk::PipelineBindPoint::COMPUTE, pipeline);
                 rec.dispatch([groups.0, groups.1, 1]);
             }
-            // The lists and depth ranges for what follows, the counts for the indirect dispatches.
-            after_compute(rec);
         });
     }
 
@@ -574,6 +576,12 @@ impl TiledLighting {
     /// the masks of the tiles it can reach, for [`TiledLighting::record_shade`].
     pub fn record_light_lists(&self, rec: &Recording, lights: u32) {
         rec.step(super::names::TILE_LIGHTS, |rec| {
+            // The light lists set bits in the tiles' light masks (after the reset's fill), by
+            // the tiles' depth ranges.
+            rec.declare_buffers(&[
+                (self.masks.handle, BufferAccess::ComputeReadWrite),
+                (self.depths.handle, BufferAccess::ComputeRead),
+            ]);
             // A workgroup per light, in rows of at most the guaranteed workgroup count.
             const ROW: u32 = 65535;
             let groups = (lights.min(ROW), lights.div_ceil(ROW));
@@ -584,16 +592,23 @@ impl TiledLighting {
                 rec.bind_pipeline(vk::PipelineBindPoint::COMPUTE, self.light_lists);
                 rec.dispatch([groups.0, groups.1, 1]);
             }
-            after_compute(rec);
         });
     }
 
     /// Records one indirect dispatch per BRDF slot over its tiles, and with
     /// [`MixedTiles::Branching`] one over the mixed tiles, after
     /// [`TiledLighting::record_classify`] with the same `mixed` in the same command buffer
-    /// (whose sets and push constants stay bound); the HDR target stays in `GENERAL`.
-    pub fn record_shade(&self, rec: &Recording, mixed: MixedTiles) {
+    /// (whose sets and push constants stay bound); the HDR target `hdr` stays in `GENERAL`.
+    pub fn record_shade(&self, rec: &Recording, mixed: MixedTiles, hdr: &mut ImageRef) {
         rec.step("tiled-shade", |rec| {
+            // The kernels read the tile buffers the classification and light lists wrote, the
+            // dispatch buffer as their arguments too.
+            if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::TileLists) {
+                let read = BufferAccess::ComputeRead;
+                let mut uses = self.buffers().map(|b| (b, read)).to_vec();
+                uses.push((self.dispatch.handle, BufferAccess::IndirectRead));
+                rec.declare_buffers(&uses);
+            }
             let branching =
                 (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
             for (slot, pipeline) in self.shade.iter().enumerate().chain(branching) {
@@ -601,35 +616,15 @@ impl TiledLighting {
                     // SAFETY: as in `record_light_lists`; `slot <= MIXED_SLOT` (at most `MAX_SLOTS`
                     // kernels, checked in `new`), so the arguments at `slot * 16` lie inside the
                     // dispatch buffer, which has `INDIRECT_BUFFER` usage, written by the
-                    // classification and made visible to the indirect read (`after_compute`).
+                    // classification and made visible to the indirect read (declared above).
                     unsafe {
                         rec.bind_pipeline(vk::PipelineBindPoint::COMPUTE, *pipeline);
                         rec.dispatch_indirect(self.dispatch.handle, (slot * 16) as u64);
                     }
                 });
                 // The next BRDF's kernel adds onto the same image (other pixels, but one image).
-                rec.memory_barrier();
+                rec.transition(hdr, ImageAccess::ComputeStorage, Contents::Keep);
             }
         });
     }
-}
-
-/// Compute writes of the tile buffers made visible to the next compute pass and to the indirect
-/// dispatches.
-fn after_compute(rec: &Recording) {
-    if !crate::gpu::hazards::records(crate::gpu::hazards::HandOver::TileLists) {
-        return;
-    }
-    rec.memory_dependency(
-        (
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_WRITE,
-        ),
-        (
-            vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT,
-            vk::AccessFlags2::SHADER_STORAGE_READ
-                | vk::AccessFlags2::SHADER_STORAGE_WRITE
-                | vk::AccessFlags2::INDIRECT_COMMAND_READ,
-        ),
-    );
 }

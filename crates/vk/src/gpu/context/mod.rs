@@ -200,6 +200,10 @@ pub struct Context {
     /// validation, in debug builds, and where an engine turns it on
     /// ([`Context::check_hazards`]).
     pub(crate) hazards: std::sync::OnceLock<crate::gpu::hazards::Hazards>,
+    /// Each buffer's last declared uses, in recording order: what the barrier a step's
+    /// declaration needs is derived from ([`Recording::declare_buffers`](crate::gpu::recording::Recording)).
+    pub(crate) buffer_uses:
+        Mutex<std::collections::HashMap<vk::Buffer, crate::gpu::access::BufferUse>>,
 }
 
 /// How to free what a dropped object left to its context ([`Context::retire`]).
@@ -473,6 +477,7 @@ impl Context {
             memory: MemoryAccount::new(memory_budget),
             retired: Mutex::default(),
             hazards: Default::default(),
+            buffer_uses: Mutex::default(),
         })
     }
 

@@ -381,6 +381,7 @@ impl Context {
             memory: MemoryAccount::new(desc.memory_budget),
             retired: Mutex::default(),
             hazards,
+            buffer_uses: Mutex::default(),
         };
         ctx.name(ctx.device.handle(), "histencil-device");
         if ctx.pipeline_cache != vk::PipelineCache::null() {

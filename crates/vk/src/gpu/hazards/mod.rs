@@ -53,6 +53,9 @@ struct CommandJournal {
     sets: [HashMap<u32, u64>; 2],
     /// The next commands' atomics must run in order ([`Hazards::ordered_atomics`]).
     ordered: bool,
+    /// The buffers the open steps declared they write, each with the number of labels open
+    /// when it was declared: a label's close drops what was declared inside it.
+    declared_writes: Vec<(usize, u64)>,
 }
 
 impl CommandJournal {
@@ -245,7 +248,19 @@ impl Hazards {
             Some(name) => c.labels.push(name.to_owned()),
             None => {
                 c.labels.pop();
+                let open = c.labels.len();
+                c.declared_writes.retain(|(depth, _)| *depth <= open);
             }
+        });
+    }
+
+    /// The buffers the step being recorded declares it writes (`Recording::declare_buffers`):
+    /// what its shaders may write, until the innermost open label closes.
+    pub fn declare_writes(&self, cmd: vk::CommandBuffer, buffers: &[vk::Buffer]) {
+        self.with(cmd, |c, _| {
+            let depth = c.labels.len();
+            c.declared_writes
+                .extend(buffers.iter().map(|b| (depth, b.as_raw())));
         });
     }
 
@@ -286,6 +301,7 @@ impl Hazards {
         point: vk::PipelineBindPoint,
         extra: &[(vk::Buffer, S, A)],
     ) {
+        let mut undeclared = Vec::new();
         self.with(cmd, |c, journal| {
             let at = c.labels.join("/");
             for &(buffer, stage, access) in extra {
@@ -311,6 +327,14 @@ impl Hazards {
                         (Some(r), None) => (r, false),
                         (None, None) => continue,
                     };
+                    if write && !c.declared_writes.iter().any(|(_, d)| *d == buffer) {
+                        let name = journal.buffer_names.get(&buffer).cloned();
+                        undeclared.push(format!(
+                            "{at} writes buffer `{}`, which its pass did not declare \
+                             (`Recording::declare_buffers`): its barriers cannot be derived",
+                            name.unwrap_or_else(|| format!("{buffer:#x}"))
+                        ));
+                    }
                     c.events.push(Event::Access(Access {
                         buffer,
                         stage: b.stage,
@@ -323,6 +347,13 @@ impl Hazards {
                 }
             }
         });
+        for text in undeclared {
+            self.log.push(ValidationMessage {
+                severity: "ERROR",
+                id: "HISTENCIL-UNDECLARED-WRITE".into(),
+                text,
+            });
+        }
     }
 
     /// A read of `buffer` at a (stage, access) outside a draw's sets: a bound vertex buffer.
@@ -484,6 +515,9 @@ pub enum HandOver {
     TileRewrite,
     /// The tile buffers the classification wrote, handed to the light lists and the shade.
     TileLists,
+    /// Not a hand-over but what barriers are derived from: the classification's declaration
+    /// of the tile buffers its shader writes.
+    ClassifyDeclaration,
 }
 
 thread_local! {
