@@ -641,6 +641,77 @@ enum HistencilResult histencil_shading_inputs(const struct HistencilView *view,
                                               uint8_t *frame_block,
                                               uint8_t *gpu_lights);
 
+// Turns the hazard check on for `context`, for an engine's debug builds and tests: from here
+// on histencil journals the buffers its commands use and the barriers they record, and checks
+// each submission the engine tells it of (`histencil_note_submit`) against those not yet
+// waited for. Turn it on before creating lightings (what was made before is not known to it).
+// Findings are read with `histencil_context_hazards`. Costs CPU time on every recorded
+// command: not for release builds.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed context.
+//
+// Thread safety: not while another call uses this context.
+//
+// # Safety
+// `context` is null or a handle from `histencil_context_create`.
+enum HistencilResult histencil_context_check_hazards(struct HistencilContext *context);
+
+// Tells the hazard check that `cmd` was begun (`vkBeginCommandBuffer`, or its pool reset):
+// what it recorded before is forgotten. Nothing where the check is off.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed context.
+//
+// Thread safety: as `histencil_context_check_hazards`.
+//
+// # Safety
+// As `histencil_context_check_hazards`.
+enum HistencilResult histencil_note_begin(struct HistencilContext *context, VkCommandBuffer cmd);
+
+// Tells the hazard check that the `count` command buffers at `cmds` were submitted, in this
+// order, signalling `fence` (`VK_NULL_HANDLE` for none): what histencil recorded in them is
+// checked against every submission not yet waited for. Nothing where the check is off.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed context, or a null `cmds` with a count.
+//
+// Thread safety: as `histencil_context_check_hazards`.
+//
+// # Safety
+// As `histencil_context_check_hazards`; `cmds` is null or points at `count` handles.
+enum HistencilResult histencil_note_submit(struct HistencilContext *context,
+                                           const VkCommandBuffer *cmds,
+                                           uint32_t count,
+                                           VkFence fence);
+
+// Tells the hazard check that the host saw `fence` signalled (`vkWaitForFences`), or with
+// `VK_NULL_HANDLE` that the queue went idle (`vkQueueWaitIdle`, `vkDeviceWaitIdle`): those
+// submissions are complete. Nothing where the check is off.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed context.
+//
+// Thread safety: as `histencil_context_check_hazards`.
+//
+// # Safety
+// As `histencil_context_check_hazards`.
+enum HistencilResult histencil_note_wait(struct HistencilContext *context, VkFence fence);
+
+// The hazard check's findings so far: their number in `count` and, where `text` is not null,
+// as many of their bytes as fit in `capacity` (one finding a line, each naming the buffer and
+// both passes, NUL-terminated, cut at a character boundary); `needed` (when not null) receives
+// the bytes the whole text takes, its NUL included. A clean run: `count` 0 and "".
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed context, or a null `count`.
+//
+// Thread safety: as `histencil_context_check_hazards`.
+//
+// # Safety
+// As `histencil_context_check_hazards`; `count` is writable; `text` is null or has
+// `capacity` writable bytes; `needed` is null or writable.
+enum HistencilResult histencil_context_hazards(struct HistencilContext *context,
+                                               uint32_t *count,
+                                               char *text,
+                                               size_t capacity,
+                                               size_t *needed);
+
 // Makes a lighting on `context`: its pipeline layout, light volumes, per-slot buffers and sets
 // (light pipelines are made at the first frame that needs them). Nothing is submitted.
 //

@@ -48,6 +48,9 @@ pub struct HistencilDeviceDesc {
 /// A device lent to histencil, and what hangs off it (its private allocator).
 pub struct HistencilContext {
     pub(crate) ctx: Arc<Context>,
+    /// Where the hazard check, once turned on (`histencil_context_check_hazards`), keeps its
+    /// findings.
+    pub(crate) hazards: Arc<histencil::ValidationLog>,
 }
 
 /// Makes a context on the engine's device. Creates nothing of Vulkan's but histencil's private
@@ -81,7 +84,13 @@ pub unsafe extern "C" fn histencil_context_create(
         // SAFETY: `Context::from_raw`'s # Safety is the engine's, as the header states it for
         // this call: live handles of one device, kept past the context.
         let ctx = unsafe { Context::from_raw(lent) }?;
-        let handle = handles::make(HistencilContext { ctx: Arc::new(ctx) }, Kind::Context);
+        let handle = handles::make(
+            HistencilContext {
+                ctx: Arc::new(ctx),
+                hazards: Arc::default(),
+            },
+            Kind::Context,
+        );
         // SAFETY: checked non-null above; this fn's # Safety makes it writable.
         unsafe { context.write(handle) };
         Ok(())

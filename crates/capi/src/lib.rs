@@ -19,6 +19,7 @@ mod device;
 mod frame;
 mod gbuffer;
 mod handles;
+mod hazards;
 mod lighting;
 mod lightmaps;
 mod lut;
@@ -41,6 +42,10 @@ pub use gbuffer::{
     histencil_brdf_encode, histencil_device_features, histencil_gbuffer_formats,
     histencil_shading_inputs, HistencilBrdfParam, HISTENCIL_API_VERSION,
     HISTENCIL_FRAME_UNIFORMS_BYTES, HISTENCIL_GBUFFER_IMAGES, HISTENCIL_GPU_LIGHT_BYTES,
+};
+pub use hazards::{
+    histencil_context_check_hazards, histencil_context_hazards, histencil_note_begin,
+    histencil_note_submit, histencil_note_wait,
 };
 pub use lighting::{
     histencil_lighting_create, histencil_lighting_destroy, histencil_lighting_in_flight,

@@ -66,6 +66,17 @@ int main(void) {
     context = (HistencilContext *)&device;
     expect(histencil_lighting_create(context, &desc, &lighting), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "lighting_create(foreign)");
     expect(histencil_context_destroy(context), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "context_destroy(foreign)");
+    /* The hazard check's calls, on the same foreign pointer and on null. */
+    {
+        VkCommandBuffer none = VK_NULL_HANDLE;
+        uint32_t found = 0;
+        expect(histencil_context_check_hazards(NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "context is null", "context_check_hazards(NULL)");
+        expect(histencil_context_check_hazards(context), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "context_check_hazards(foreign)");
+        expect(histencil_note_begin(context, none), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "note_begin(foreign)");
+        expect(histencil_note_submit(context, &none, 1, VK_NULL_HANDLE), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "note_submit(foreign)");
+        expect(histencil_note_wait(context, VK_NULL_HANDLE), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "note_wait(foreign)");
+        expect(histencil_context_hazards(context, &found, NULL, 0, NULL), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Context handle", "context_hazards(foreign)");
+    }
     lighting = (HistencilLighting *)&desc;
     expect(histencil_lighting_stencil_reference(lighting, "lambert", &reference, &write_mask), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "stencil_reference");
     expect(histencil_lighting_record(lighting, VK_NULL_HANDLE, &frame, &targets), HISTENCIL_RESULT_INVALID_ARGUMENT, "not a live Lighting handle", "record");

@@ -250,6 +250,7 @@ void record_lighting(HistencilLighting *lighting, VkCommandBuffer cmd, uint32_t 
 
 struct Results {
     int misuse_failed = 0;  // misuse cases not refused as the header says
+    uint32_t hazards = 0;  // histencil's hazard check's findings over the engine's frames
     uint32_t frames = 0;  // frames rendered and compared
     int worst[kTechniqueCount] = {};
     uint32_t compared[kTechniqueCount] = {};
@@ -278,6 +279,10 @@ void run(Results &results) {
     }
     // histencil: the context on the engine's device, and its shaders for the engine's BRDFs.
     Context context(gpu);
+    // histencil's hazard check, as an engine's debug build turns it on: every buffer histencil's
+    // commands use, held to Vulkan's synchronisation rule across this engine's frames in flight
+    // (told of each begin, submit and wait below). Before the lighting is made.
+    hcheck(histencil_context_check_hazards(context.handle), "histencil_context_check_hazards");
     const Shaders shaders(context, CPP_ENGINE_HISTENCIL_SHADERS);
     const World world(kWidth, kHeight, shaders.handle);
 
@@ -376,6 +381,7 @@ void run(Results &results) {
     auto finish = [&](Slot &s, uint32_t index) {
         if (!s.pending) return;
         vk_check(vkWaitForFences(gpu.device, 1, &s.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+        hcheck(histencil_note_wait(context.handle, s.fence), "histencil_note_wait");
         s.pending = false;
         hcheck(histencil_lighting_slot_finished(lighting.handle, index), "histencil_lighting_slot_finished");
         const auto *bytes = static_cast<const uint16_t *>(s.readback.mapped);
@@ -402,6 +408,7 @@ void run(Results &results) {
         VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
         begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         vk_check(vkBeginCommandBuffer(s.cmd, &begin), "vkBeginCommandBuffer");
+        hcheck(histencil_note_begin(context.handle, s.cmd), "histencil_note_begin");
         passes.record_gbuffer(s.cmd, index, targets, stencil);
 
         record_lighting(lighting.handle, s.cmd, index, kTechniques[technique], world.view, lights,
@@ -425,11 +432,23 @@ void run(Results &results) {
         submit.commandBufferCount = 1;
         submit.pCommandBuffers = &s.cmd;
         vk_check(vkQueueSubmit(gpu.queue, 1, &submit, s.fence), "vkQueueSubmit");
+        hcheck(histencil_note_submit(context.handle, &s.cmd, 1, s.fence), "histencil_note_submit");
         s.pending = true;
         s.frame = frame;
         s.technique = technique;
     }
     for (uint32_t i = 0; i < kSlots; ++i) finish(slots[(kFrames + i) % kSlots], (kFrames + i) % kSlots);
+    // What the hazard check found, each finding a line naming the buffer and both passes.
+    size_t needed = 0;
+    hcheck(histencil_context_hazards(context.handle, &results.hazards, nullptr, 0, &needed),
+           "histencil_context_hazards");
+    if (results.hazards > 0) {
+        std::string text(needed, '\0');
+        hcheck(histencil_context_hazards(context.handle, &results.hazards, text.data(), needed,
+                                         nullptr),
+               "histencil_context_hazards");
+        std::fprintf(stderr, "%s\n", text.c_str());
+    }
     // Leaving the scope frees, in order: the lighting, the engine's own objects, histencil's shaders
     // and context, then the device and the instance.
 }
@@ -456,9 +475,11 @@ int main() {
     for (uint32_t n : results.compared) every_technique = every_technique && n > 0;
     if (results.dark_frame) std::fprintf(stderr, "cpp engine: a forward reference was mostly dark\n");
     std::printf("cpp engine: lighting max %d/255 vs forward over %u frames (stencil PS3-like: %d/255; "
-                "stencil native: %d/255; tiled: %d/255), %u validation messages\n",
-                worst, results.frames, results.worst[0], results.worst[1], results.worst[2], messages);
+                "stencil native: %d/255; tiled: %d/255), %u validation messages, %u hazards\n",
+                worst, results.frames, results.worst[0], results.worst[1], results.worst[2], messages,
+                results.hazards);
     const bool pass = !failed && g_histencil_failures == 0 && results.misuse_failed == 0 &&
-                      every_technique && !results.dark_frame && worst <= kTolerance && messages == 0;
+                      every_technique && !results.dark_frame && worst <= kTolerance && messages == 0 &&
+                      results.hazards == 0;
     return pass ? EXIT_SUCCESS : EXIT_FAILURE;
 }

@@ -429,6 +429,13 @@ pub fn buffer_access_info(access: BufferAccess) -> (vk::PipelineStageFlags2, vk:
     }
 }
 
+/// What a hazard test leaves out of a declaration ([`Recording::declare_buffers_leaving_out`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum LeaveOut {
+    Barrier,
+    Declaration,
+}
+
 impl BufferAccess {
     /// Whether it writes.
     pub fn writes(self) -> bool {
@@ -495,7 +502,19 @@ impl Recording<'_> {
     /// and any other buffer a shader writes is an error (`HISTENCIL-UNDECLARED-WRITE`, naming
     /// the pass, set and binding), for no barrier could be derived for it.
     pub(crate) fn declare_buffers(&self, uses: &[(vk::Buffer, BufferAccess)]) {
-        if let Some(h) = self.hazards() {
+        self.declare_buffers_leaving_out(uses, None);
+    }
+
+    /// [`Self::declare_buffers`] less one of its parts, for a hazard test to prove the check
+    /// finds it missing (`crate::gpu::hazards::HandOver`): the barrier (the uses still
+    /// recorded as the buffers' last), or the declaration the check holds shaders to (the
+    /// barrier still recorded). `None` leaves out nothing.
+    pub(crate) fn declare_buffers_leaving_out(
+        &self,
+        uses: &[(vk::Buffer, BufferAccess)],
+        leave_out: Option<LeaveOut>,
+    ) {
+        if let (Some(h), false) = (self.hazards(), leave_out == Some(LeaveOut::Declaration)) {
             let writes: Vec<vk::Buffer> = uses
                 .iter()
                 .filter(|(_, a)| a.writes())
@@ -529,7 +548,7 @@ impl Recording<'_> {
                 })
                 .collect()
         };
-        if barriers.is_empty() {
+        if barriers.is_empty() || leave_out == Some(LeaveOut::Barrier) {
             return;
         }
         let dependency = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);

@@ -10,6 +10,7 @@
 //! into the tiles of its screen rectangle whose depth range its range sphere reaches.
 //! Shaders: `tile_classify.comp`, `tile_lights.comp`, `tile_shade.comp`, `include/tiled.glsl`.
 
+use crate::gpu::access::LeaveOut::{self, Barrier, Declaration};
 use crate::gpu::access::{uses_of, BufferAccess, Contents, ImageAccess, ImageRef, LightingTargets};
 use crate::gpu::context::Context;
 use crate::gpu::descriptors::{
@@ -17,6 +18,7 @@ use crate::gpu::descriptors::{
     BindingDesc, BindingKind,
 };
 use crate::gpu::error::{Error, Result};
+use crate::gpu::hazards::HandOver;
 use crate::gpu::limits::Limit;
 use crate::gpu::pipelines::create_compute_pipeline;
 use crate::gpu::quirks::Quirk;
@@ -511,10 +513,9 @@ impl TiledLighting {
             // pass it was. Synchronisation validation does not see this hand-over across
             // submissions; histencil's hazard check does
             // (`hazard_tile_rewrite_removed_across_two_slots_submissions`).
-            if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::TileRewrite) {
-                let write = BufferAccess::TransferWrite;
-                rec.declare_buffers(&[(self.dispatch.handle, write), (self.masks.handle, write)]);
-            }
+            let write = BufferAccess::TransferWrite;
+            let rewrite = [(self.dispatch.handle, write), (self.masks.handle, write)];
+            rec.declare_buffers_leaving_out(&rewrite, omitted(HandOver::TileRewrite, Barrier));
             // Each slot's dispatch starts at zero tiles.
             let reset: Vec<u32> = (0..=MIXED_SLOT).flat_map(|_| [0, 1, 1, 0]).collect();
             // SAFETY: outside rendering (`update` and `fill` check it in debug builds;
@@ -529,14 +530,14 @@ impl TiledLighting {
             }
             // The classification counts its tiles into the dispatch arguments (atomics), and
             // writes the lists and depth ranges.
-            if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::ClassifyDeclaration) {
-                use BufferAccess::{ComputeReadWrite, ComputeWrite};
-                rec.declare_buffers(&[
-                    (self.dispatch.handle, ComputeReadWrite),
-                    (self.lists.handle, ComputeWrite),
-                    (self.depths.handle, ComputeWrite),
-                ]);
-            }
+            use BufferAccess::{ComputeReadWrite, ComputeWrite};
+            let classify = [
+                (self.dispatch.handle, ComputeReadWrite),
+                (self.lists.handle, ComputeWrite),
+                (self.depths.handle, ComputeWrite),
+            ];
+            let left_out = omitted(HandOver::ClassifyDeclaration, Declaration);
+            rec.declare_buffers_leaving_out(&classify, left_out);
             // SAFETY: the sets match the layout made in `new`: the lighting's frame and decode
             // sets (sets 0 and 1), this slot's tiled set (2) and the visibility hook's (4, its
             // layout there when it has a set); the push is `TiledPush`, the layout's compute
@@ -603,12 +604,10 @@ impl TiledLighting {
         rec.step("tiled-shade", |rec| {
             // The kernels read the tile buffers the classification and light lists wrote, the
             // dispatch buffer as their arguments too.
-            if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::TileLists) {
-                let read = BufferAccess::ComputeRead;
-                let mut uses = self.buffers().map(|b| (b, read)).to_vec();
-                uses.push((self.dispatch.handle, BufferAccess::IndirectRead));
-                rec.declare_buffers(&uses);
-            }
+            let read = BufferAccess::ComputeRead;
+            let mut uses = self.buffers().map(|b| (b, read)).to_vec();
+            uses.push((self.dispatch.handle, BufferAccess::IndirectRead));
+            rec.declare_buffers_leaving_out(&uses, omitted(HandOver::TileLists, Barrier));
             let branching =
                 (mixed == MixedTiles::Branching).then_some((MIXED_SLOT, &self.branching));
             for (slot, pipeline) in self.shade.iter().enumerate().chain(branching) {
@@ -627,4 +626,9 @@ impl TiledLighting {
             }
         });
     }
+}
+
+/// What a hazard test leaves out of a declaration where it omits `hand_over` (nothing else).
+fn omitted(hand_over: HandOver, part: LeaveOut) -> Option<LeaveOut> {
+    (!crate::gpu::hazards::records(hand_over)).then_some(part)
 }
