@@ -202,6 +202,11 @@ fn main() {
     // SAFETY: the engine's handles outlive the context, its device was made with histencil's
     // REQUIREMENTS, and the engine submits from this thread only.
     let ctx = unsafe { Context::from_raw(gpu.lend()) }.expect("histencil on the engine's device");
+    // histencil's hazard check, as an engine's debug build turns it on: the buffers histencil's
+    // commands use, held to Vulkan's synchronisation rule across this engine's frames in flight
+    // (told of each begin, submit and wait below). Before the lightings are made.
+    let hazards = std::sync::Arc::new(histencil::vk::ValidationLog::default());
+    ctx.check_hazards(hazards.clone());
 
     let gbuffer_pass = GBufferPass::new(&gpu, GBufferKind::Compact);
     use vk::ImageUsageFlags as U;
@@ -408,6 +413,7 @@ fn main() {
             // Wait for the frame that last used this slot: the only wait, and the engine's own;
             // then tell the lighting, which refuses to record a slot still in flight.
             d.wait_for_fences(&[slot.fence], true, u64::MAX).unwrap();
+            ctx.note_wait(slot.fence);
             lighting.slot_finished((f % IN_FLIGHT) as u32).unwrap();
             lightmaps.slot_finished((f % IN_FLIGHT) as u32).unwrap();
             d.reset_fences(&[slot.fence]).unwrap();
@@ -420,6 +426,7 @@ fn main() {
             let begin = vk::CommandBufferBeginInfo::default()
                 .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(slot.cmd, &begin).unwrap();
+            ctx.note_begin(slot.cmd);
             gbuffer_pass.record(
                 d,
                 slot.cmd,
@@ -571,10 +578,12 @@ fn main() {
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
             let submit = vk::SubmitInfo2::default().command_buffer_infos(&cmds);
             d.queue_submit2(gpu.queue, &[submit], slot.fence).unwrap();
+            ctx.note_submit(&[slot.cmd], slot.fence);
         }
     }
     let fences: Vec<_> = slots.iter().map(|s| s.fence).collect();
     unsafe { d.wait_for_fences(&fences, true, u64::MAX) }.unwrap();
+    fences.iter().for_each(|f| ctx.note_wait(*f));
     for slot in 0..IN_FLIGHT as u32 {
         // SAFETY: every slot's fence was waited for just above.
         unsafe { lighting.slot_finished(slot) }.unwrap();
@@ -809,6 +818,10 @@ fn main() {
     drop(ctx);
     gpu.destroy();
     let messages = device::MESSAGES.load(Ordering::SeqCst);
+    for finding in hazards.problems() {
+        eprintln!("{finding}");
+    }
+    let hazards = hazards.len();
     let names: Vec<&str> = brdf_modules
         .set
         .engine()
@@ -819,7 +832,7 @@ fn main() {
     println!(
         "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward \
          over frames {}; engine stencil bits {} on {stencil_frames} stencil frames; {messages} \
-         validation messages, G-buffer {bytes} bytes per pixel, {SHADOWED_LIGHTS} shadowed \
+         validation messages, {hazards} hazards, G-buffer {bytes} bytes per pixel, {SHADOWED_LIGHTS} shadowed \
          lights, {own} BRDFs of its own ({names}), through the hooks",
         compared.join("; "),
         if intact { "intact" } else { "NOT intact" }
@@ -827,7 +840,14 @@ fn main() {
     let alpha_ok = alpha_worst <= ALPHA_TOLERANCE && alpha_pixels > 0;
     // The shadow must darken something, or the visibility hook went unused.
     let bits_tested = stencil_frames > 0;
-    if worst > 1 || !alpha_ok || !intact || !bits_tested || messages > 0 || shadowed_pixels == 0 {
+    if worst > 1
+        || !alpha_ok
+        || !intact
+        || !bits_tested
+        || messages > 0
+        || hazards > 0
+        || shadowed_pixels == 0
+    {
         std::process::exit(1);
     }
 }
