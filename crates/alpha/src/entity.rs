@@ -115,8 +115,9 @@ impl AlphaEntity<'_> {
     }
 
     /// What is wrong with the entity, if anything: an opacity outside `[0, 1]`, a material its
-    /// BRDF refuses, a transform or bounds that are not finite, particles that are not finite
-    /// or not of positive size, or a layout its particles cannot fill.
+    /// BRDF refuses, a transform or bounds that are not finite, a probe mesh that is not a
+    /// triangle list of its vertices ([`histencil_scene::Mesh::problem`]), particles that are
+    /// not finite or not of positive size, or a layout its particles cannot fill.
     pub fn problem(&self) -> Option<String> {
         if !(0.0..=1.0).contains(&self.opacity) {
             return Some(format!("opacity {} is outside [0, 1]", self.opacity));
@@ -128,10 +129,15 @@ impl AlphaEntity<'_> {
             AlphaEntityKind::Object {
                 transform,
                 local_bounds: (lo, hi),
-                ..
+                probe_mesh,
             } => {
                 if !transform.is_finite() || transform.determinant() == 0.0 {
                     return Some("its transform must be finite and invertible".into());
+                }
+                // The bake reads its triangles: one past the vertices would leave texels
+                // unbaked (unlit) with no word.
+                if let Some(p) = probe_mesh.problem() {
+                    return Some(format!("its probe mesh: {p}"));
                 }
                 if !(lo.is_finite() && hi.is_finite()) || lo.cmpgt(hi).any() {
                     return Some("its bounds must be finite with min <= max".into());
@@ -201,4 +207,35 @@ pub fn scene_alpha_entities<'a>(scene: &'a Scene, meshes: &'a ProbeMeshes) -> Ve
         opacity: s.opacity,
     });
     objects.chain(systems).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use histencil_scene::uv_sphere;
+
+    /// A probe mesh whose index runs past its vertices is refused, not baked with texels left
+    /// unlit in silence.
+    #[test]
+    fn an_object_whose_probe_mesh_indexes_past_its_vertices_is_refused() {
+        fn entity(mesh: &Mesh) -> AlphaEntity<'_> {
+            AlphaEntity {
+                kind: AlphaEntityKind::Object {
+                    probe_mesh: mesh,
+                    transform: Mat4::IDENTITY,
+                    local_bounds: (Vec3::splat(-1.0), Vec3::ONE),
+                },
+                material: Material::lambert(Vec3::splat(0.8)),
+                opacity: 0.5,
+            }
+        }
+        let mut mesh = uv_sphere(8, 4);
+        assert_eq!(entity(&mesh).problem(), None);
+        mesh.indices[7] = 10_000;
+        let problem = entity(&mesh).problem().expect("refused");
+        assert!(
+            problem.contains("probe mesh: index 7 is 10000"),
+            "{problem}"
+        );
+    }
 }

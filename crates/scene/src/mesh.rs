@@ -53,6 +53,31 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// What makes the mesh unusable as a triangle list, if anything: indices not three per
+    /// triangle, an index past the vertices, a position, normal or texture coordinate that is
+    /// not finite. What a consumer would otherwise skip or read out of bounds in silence.
+    pub fn problem(&self) -> Option<String> {
+        if !self.indices.len().is_multiple_of(3) {
+            return Some(format!(
+                "{} indices, not three per triangle",
+                self.indices.len()
+            ));
+        }
+        let count = self.vertices.len();
+        if let Some(i) = self.indices.iter().position(|&i| i as usize >= count) {
+            return Some(format!(
+                "index {i} is {}, past its {count} vertices",
+                self.indices[i]
+            ));
+        }
+        let finite =
+            |v: &Vertex| (v.position.iter().chain(&v.normal).chain(&v.uv)).all(|x| x.is_finite());
+        if let Some(i) = self.vertices.iter().position(|v| !finite(v)) {
+            return Some(format!("vertex {i} is not finite"));
+        }
+        None
+    }
+
     fn push_triangle_fan_quad(
         &mut self,
         corners: [[f32; 3]; 4],
@@ -215,6 +240,24 @@ pub fn light_cone(sides: u32) -> Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_mesh_with_an_index_past_its_vertices_or_a_nan_says_so() {
+        assert_eq!(uv_sphere(8, 4).problem(), None);
+        let mut m = unit_box();
+        m.indices[4] = m.vertices.len() as u32;
+        assert!(
+            m.problem().unwrap().contains("index 4"),
+            "{:?}",
+            m.problem()
+        );
+        let mut m = unit_box();
+        m.indices.pop();
+        assert!(m.problem().unwrap().contains("three per triangle"));
+        let mut m = unit_box();
+        m.vertices[2].normal[1] = f32::NAN;
+        assert!(m.problem().unwrap().contains("vertex 2"));
+    }
 
     fn assert_outward(m: &Mesh, name: &str) {
         let inside = if name == "light cone" {
