@@ -49,14 +49,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         }
 
         let slots = self.desc.frames_in_flight;
-        let sizes = [
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::UNIFORM_BUFFER)
-                .descriptor_count(slots),
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(slots * (1 + ALPHA_SET.len() as u32)),
-        ];
+        let sizes = crate::gpu::descriptors::pool_sizes(&[(FRAME_SET, slots), (ALPHA_SET, slots)]);
         let info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(2 * slots)
             .pool_sizes(&sizes);

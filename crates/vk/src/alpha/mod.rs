@@ -592,14 +592,7 @@ fn create_lightmap_set(
     parts: &mut Parts,
     layout: vk::DescriptorSetLayout,
 ) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
-    let sizes = [
-        vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::SAMPLED_IMAGE)
-            .descriptor_count(2),
-        vk::DescriptorPoolSize::default()
-            .ty(vk::DescriptorType::SAMPLER)
-            .descriptor_count(1),
-    ];
+    let sizes = crate::gpu::descriptors::pool_sizes(&[(ALPHA_LIGHTMAP_SET, 1)]);
     let info = vk::DescriptorPoolCreateInfo::default()
         .max_sets(1)
         .pool_sizes(&sizes);

@@ -297,37 +297,50 @@ pub struct Descriptors {
     pub frame_set: vk::DescriptorSet,
 }
 
-/// A pool holding one set of `layout` (whose bindings need `sizes`), and that set, named
-/// `name` (the pool `name-pool`). Nothing is left behind on an error.
+/// A pool's sizes for `sets`: each a binding table (what its set layout was made from) and how
+/// many sets of it the pool holds, the descriptors summed by type. The pools are sized from the
+/// tables the layouts and shaders are held to, not counted by hand beside them. Pure, so it is
+/// unit-tested.
+pub(crate) fn pool_sizes(sets: &[(&[BindingDesc], u32)]) -> Vec<vk::DescriptorPoolSize> {
+    BindingKind::ALL
+        .iter()
+        .filter_map(|kind| {
+            let count: u32 = (sets.iter())
+                .map(|(table, n)| n * table.iter().filter(|b| b.kind == *kind).count() as u32)
+                .sum();
+            (count > 0).then(|| {
+                vk::DescriptorPoolSize::default()
+                    .ty(kind.descriptor_type())
+                    .descriptor_count(count)
+            })
+        })
+        .collect()
+}
+
+/// A pool holding one set of `layout` (made from `table`), and that set, named `name` (the
+/// pool `name-pool`). Nothing is left behind on an error.
 pub(crate) fn one_set(
     ctx: &Context,
     name: &str,
     layout: vk::DescriptorSetLayout,
-    sizes: &[(vk::DescriptorType, u32)],
+    table: &[BindingDesc],
 ) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
-    let (pool, sets) = sets_of(ctx, name, layout, 1, sizes)?;
+    let (pool, sets) = sets_of(ctx, name, layout, 1, table)?;
     ctx.name(sets[0], name);
     Ok((pool, sets[0]))
 }
 
 /// A pool named `{name}-pool` and `count` sets of `layout` from it (one per frame in flight),
-/// named `{name}-0`, `{name}-1`, ...; `sizes` are the descriptors of one set. On failure
-/// nothing is left.
+/// named `{name}-0`, `{name}-1`, ...; `table` is the binding table `layout` was made from.
+/// On failure nothing is left.
 pub(crate) fn sets_of(
     ctx: &Context,
     name: &str,
     layout: vk::DescriptorSetLayout,
     count: u32,
-    sizes: &[(vk::DescriptorType, u32)],
+    table: &[BindingDesc],
 ) -> Result<(vk::DescriptorPool, Vec<vk::DescriptorSet>)> {
-    let sizes: Vec<_> = sizes
-        .iter()
-        .map(|&(ty, n)| {
-            vk::DescriptorPoolSize::default()
-                .ty(ty)
-                .descriptor_count(n * count)
-        })
-        .collect();
+    let sizes = pool_sizes(&[(table, count)]);
     let pool_info = vk::DescriptorPoolCreateInfo::default()
         .max_sets(count)
         .pool_sizes(&sizes);
@@ -426,11 +439,7 @@ impl Descriptors {
             // whose pipeline layout the simulator's footprint capture binds this set with.
             let stages = GRAPHICS_STAGES | vk::ShaderStageFlags::COMPUTE;
             d.frame_layout = create_set_layout(ctx, "frame-set-layout", FRAME_SET, stages)?;
-            let sizes = [
-                (vk::DescriptorType::UNIFORM_BUFFER, 1),
-                (vk::DescriptorType::STORAGE_BUFFER, 1),
-            ];
-            (d.pool, d.frame_set) = one_set(ctx, "frame-set", d.frame_layout, &sizes)?;
+            (d.pool, d.frame_set) = one_set(ctx, "frame-set", d.frame_layout, FRAME_SET)?;
             Ok(())
         })?;
         write_frame_set(ctx, d.frame_set, frame_uniforms, lights);
@@ -452,3 +461,34 @@ impl Descriptors {
 }
 
 crate::gpu::teardown::destroy_by_method!(Descriptors);
+
+#[cfg(test)]
+mod pool_tests {
+    use super::*;
+
+    /// The pools come from the tables: the lighting's, for two slots with the built-in decode,
+    /// holds two frame sets' uniform and light buffers, two G-buffer sets' images and the
+    /// hi-stencil and LUT sets' buffers, and no type it has no binding of.
+    #[test]
+    fn pool_sizes_sum_each_tables_descriptors_by_type() {
+        let storage = [
+            binding(0, BindingKind::StorageBuffer, "a"),
+            binding(1, BindingKind::StorageBuffer, "b"),
+        ];
+        let sizes = pool_sizes(&[(FRAME_SET, 2), (GBUFFER_SET, 2), (&storage, 1)]);
+        let count = |ty| {
+            (sizes.iter())
+                .find(|s| s.ty == ty)
+                .map(|s| s.descriptor_count)
+        };
+        assert_eq!(count(vk::DescriptorType::UNIFORM_BUFFER), Some(2));
+        assert_eq!(count(vk::DescriptorType::STORAGE_BUFFER), Some(2 + 2));
+        assert_eq!(
+            count(vk::DescriptorType::SAMPLED_IMAGE),
+            Some(2 * GBUFFER_SET.len() as u32)
+        );
+        assert_eq!(count(vk::DescriptorType::SAMPLER), None);
+        // A table of no sets adds nothing.
+        assert!(pool_sizes(&[(FRAME_SET, 0)]).is_empty());
+    }
+}

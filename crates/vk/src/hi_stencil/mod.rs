@@ -256,11 +256,8 @@ impl HiStencilSurface {
         layout: vk::DescriptorSetLayout,
         slots: u32,
     ) -> Result<()> {
-        let sizes = [
-            (vk::DescriptorType::STORAGE_BUFFER, 1),
-            (vk::DescriptorType::SAMPLED_IMAGE, 2),
-        ];
-        (self.pool, self.sets) = sets_of(ctx, "hi-stencil-update-set", layout, slots, &sizes)?;
+        let table = HI_STENCIL_UPDATE_SET;
+        (self.pool, self.sets) = sets_of(ctx, "hi-stencil-update-set", layout, slots, table)?;
         self.views = vec![vk::ImageView::null(); slots as usize];
         self.point_sets(ctx);
         Ok(())

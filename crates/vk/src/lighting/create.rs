@@ -75,19 +75,15 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let slots = self.desc.frames_in_flight;
         self.hi_stencil = Some(HiStencilSurface::new(ctx, surface, slots)?);
 
-        let storage_per_slot = 1;
-        let shared_storage = (HI_STENCIL_SET.len() + LUT_SET.len()) as u32;
-        let sizes = [
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::UNIFORM_BUFFER)
-                .descriptor_count(slots),
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(slots * storage_per_slot + shared_storage),
-            vk::DescriptorPoolSize::default()
-                .ty(vk::DescriptorType::SAMPLED_IMAGE)
-                .descriptor_count(slots * GBUFFER_SET.len() as u32),
-        ];
+        // Per slot its frame set, and with the built-in decode its G-buffer set; the hi-stencil
+        // and LUT sets once.
+        let decode_sets = if builtin { slots } else { 0 };
+        let sizes = crate::gpu::descriptors::pool_sizes(&[
+            (FRAME_SET, slots),
+            (GBUFFER_SET, decode_sets),
+            (HI_STENCIL_SET, 1),
+            (LUT_SET, 1),
+        ]);
         let sets_per_slot = if builtin { 2 } else { 1 };
         let info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(sets_per_slot * slots + 2)

@@ -429,11 +429,7 @@ impl TiledLighting {
     /// The pool and every slot's tiled set, its buffers written (the HDR target is written per
     /// frame, [`TiledLighting::set_target`]).
     fn create_sets(&mut self, ctx: &Context, slots: u32) -> Result<()> {
-        let sizes = [
-            (vk::DescriptorType::STORAGE_BUFFER, 4),
-            (vk::DescriptorType::STORAGE_IMAGE, 1),
-        ];
-        (self.pool, self.sets) = sets_of(ctx, "tiled-set", self.set_layout, slots, &sizes)?;
+        (self.pool, self.sets) = sets_of(ctx, "tiled-set", self.set_layout, slots, TILED_SET)?;
         self.write_sets(ctx);
         Ok(())
     }

@@ -50,8 +50,7 @@ impl Tonemap {
         build(ctx, |t: &mut Self| {
             (t.set_layout, t.pipeline_layout) =
                 pass_layouts(ctx, "tonemap", frame_layout, TONEMAP_SET)?;
-            let sizes = [(vk::DescriptorType::SAMPLED_IMAGE, 1)];
-            (t.pool, t.set) = one_set(ctx, "tonemap-set", t.set_layout, &sizes)?;
+            (t.pool, t.set) = one_set(ctx, "tonemap-set", t.set_layout, TONEMAP_SET)?;
             write_sampled_images(ctx, t.set, &[hdr_view]);
             let ldr = [ldr_format];
             t.pipeline = create_pipeline(

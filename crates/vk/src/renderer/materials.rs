@@ -406,12 +406,8 @@ impl GpuMaterials {
         layout: vk::DescriptorSetLayout,
     ) -> Result<()> {
         let count = plan.sets.len() as u32;
-        let sizes = [
-            (vk::DescriptorType::UNIFORM_BUFFER, count),
-            (vk::DescriptorType::SAMPLED_IMAGE, MAP_COUNT as u32 * count),
-            (vk::DescriptorType::SAMPLER, MAP_COUNT as u32 * count),
-        ]
-        .map(|(ty, n)| vk::DescriptorPoolSize::default().ty(ty).descriptor_count(n));
+        let table = crate::passes::geometry::MATERIAL_SET;
+        let sizes = crate::gpu::descriptors::pool_sizes(&[(table, count)]);
         let pool_info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(count)
             .pool_sizes(&sizes);
