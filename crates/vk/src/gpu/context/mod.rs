@@ -575,7 +575,7 @@ impl Context {
         self.validation.clone()
     }
 
-    /// Turns the hazard check on ([`crate::gpu::hazards`]), its findings going to `log` as
+    /// Turns the hazard check on (the book's "The hazard check"), its findings going to `log` as
     /// ERROR messages (`HISTENCIL-HAZARD-...`): for an engine's debug builds and tests. From
     /// here on histencil journals the buffers its commands use and the barriers they record;
     /// the engine tells it what it submits and waits for ([`Context::note_submit`],
