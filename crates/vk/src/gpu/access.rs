@@ -436,11 +436,16 @@ pub(crate) enum LeaveOut {
     Declaration,
 }
 
+/// The write accesses histencil's buffers see: what a barrier makes available.
+pub(crate) const BUFFER_WRITES: vk::AccessFlags2 = vk::AccessFlags2::from_raw(
+    vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw() | vk::AccessFlags2::TRANSFER_WRITE.as_raw(),
+);
+
 impl BufferAccess {
     /// Whether it writes.
     pub fn writes(self) -> bool {
         let (_, access) = buffer_access_info(self);
-        access.intersects(vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::TRANSFER_WRITE)
+        access.intersects(BUFFER_WRITES)
     }
 }
 
@@ -466,13 +471,12 @@ type Scopes = (
 /// after reads needs nothing.
 pub(crate) fn hand_over(last: BufferUse, next: BufferAccess) -> (Option<Scopes>, BufferUse) {
     let (stage, access) = buffer_access_info(next);
-    let written = vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::TRANSFER_WRITE;
     if next.writes() {
         let (write_stage, write_access) = last.write.unwrap_or_default();
         let src = (write_stage | last.reads, write_access);
         let barrier = (!src.0.is_empty()).then_some((src, (stage, access)));
         let after = BufferUse {
-            write: Some((stage, access & written)),
+            write: Some((stage, access & BUFFER_WRITES)),
             reads: vk::PipelineStageFlags2::empty(),
             visible_to: vk::PipelineStageFlags2::empty(),
         };

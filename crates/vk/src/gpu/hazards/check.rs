@@ -145,7 +145,7 @@ fn covers(mask: A, access: A) -> bool {
         | A::INDEX_READ
         | A::VERTEX_ATTRIBUTE_READ
         | A::TRANSFER_READ;
-    let writes = A::SHADER_STORAGE_WRITE | A::TRANSFER_WRITE;
+    let writes = crate::gpu::access::BUFFER_WRITES;
     let mut full = mask;
     if mask.contains(A::MEMORY_READ) {
         full |= reads;
@@ -195,7 +195,7 @@ impl Tracker {
                         continue;
                     }
                     let direct = unfold(d.src.0).contains(p.access.stage);
-                    let writes = p.access.access & (A::SHADER_STORAGE_WRITE | A::TRANSFER_WRITE);
+                    let writes = p.access.access & crate::gpu::access::BUFFER_WRITES;
                     let made_available = direct && covers(d.src.1, writes);
                     if p.available || made_available {
                         available = true;
@@ -205,7 +205,14 @@ impl Tracker {
                 }
                 p.ordered_before = ordered;
                 p.available = available;
-                p.visible.extend(visible);
+                // One entry per set of stages: a write that stays pending across many barriers
+                // (an engine that reports no waits) keeps a bounded list.
+                for (stages, access) in visible {
+                    match p.visible.iter_mut().find(|(s, _)| *s == stages) {
+                        Some(entry) => entry.1 |= access,
+                        None => p.visible.push((stages, access)),
+                    }
+                }
             }
         }
     }
@@ -421,6 +428,17 @@ mod tests {
         let rw = (FR.0, A::SHADER_STORAGE_WRITE);
         let hand_over = barrier(rw, (S::ALL_TRANSFER, A::TRANSFER_READ), Memory::Buffer(7));
         assert!(run(&[counted[0].clone(), hand_over, copy]).is_empty());
+    }
+
+    #[test]
+    fn a_write_pending_across_many_barriers_keeps_one_visibility_per_stage_set() {
+        let mut t = Tracker::default();
+        t.apply(&access(CW.0, CW.1, true), 1);
+        for _ in 0..1000 {
+            t.apply(&barrier(CW, FR, Memory::Global), 1);
+        }
+        assert_eq!(t.pending[&7][0].visible.len(), 1);
+        assert!(t.apply(&access(FR.0, FR.1, false), 1).is_empty());
     }
 
     #[test]
