@@ -500,6 +500,7 @@ mod tests {
                         lo: 1.1,
                         hi: 1.3,
                         samples: 5,
+                        halves: None,
                     },
                 ),
                 (
@@ -509,6 +510,7 @@ mod tests {
                         lo: 0.7,
                         hi: 0.9,
                         samples: 5,
+                        halves: None,
                     },
                 ),
             ],

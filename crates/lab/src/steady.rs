@@ -11,8 +11,23 @@
 //! canary asks no clock counter of the driver (Vulkan has none), so it works on every device:
 //! it sees what the measured work would see.
 //!
+//! A canary can miss what slows the measured work. On lavapipe beside one busy process, a
+//! `compare` at 320x180 read its canary alike (56-62 ms quiet, 52-60 ms loaded) while the set
+//! it guarded changed its times and even its ratio (stencil over branching at 1 % lights 1.17
+//! quiet, 0.945 loaded). The canary is another workload, three frames at the edges of a round;
+//! the load took the cores the round's own work ran on. So the clock also reads that directly:
+//! how much CPU time other processes (and the hypervisor, as steal) took while the round's
+//! work ran, in cores: the machine's busy time from `/proc/stat` less this process's own from
+//! `/proc/self/stat`. A round beside more than [`ClockSettings::max_foreign_load`] strays like
+//! a canary that strayed: thrown away and retaken, kept flagged unsteady where it goes on.
+//! Work of this process's own threads is not foreign: a load made inside it (`compare
+//! --beside-load`) is for the canary to see, as it does. The reading is taken only where
+//! `/proc/stat` counts the cores this process may use (a container's view of its host's cores
+//! would count other tenants); elsewhere no round strays by it.
+//!
 //! The decisions are pure functions ([`settled`], [`strays`]) and [`Clock`] is generic over the
-//! canary and the round's work, so the whole policy is unit-tested without a GPU.
+//! canary, the load meter and the round's work, so the whole policy is unit-tested without
+//! a GPU.
 
 use histencil_vk::{Backend, FlushPolicy, Readback, Renderer, Technique};
 use std::time::{Duration, Instant};
@@ -35,6 +50,9 @@ pub struct ClockSettings {
     /// canary is warmed up again and its new time becomes the reference. A round strays at most
     /// twice this often; its last try is kept and flagged unsteady.
     pub retakes_before_rewarm: usize,
+    /// A round during whose work other processes kept more than this many cores busy (their
+    /// CPU time over the round's wall time) strays, whatever its canary read.
+    pub max_foreign_load: f64,
 }
 
 impl Default for ClockSettings {
@@ -48,6 +66,9 @@ impl Default for ClockSettings {
             max_warm_up_frames: 200,
             max_warm_up: Duration::from_secs(10),
             retakes_before_rewarm: 3,
+            // Half a core: one busy process is a whole core, a quiet machine's daemons and the
+            // readings' 10 ms ticks a few hundredths over a round.
+            max_foreign_load: 0.5,
         }
     }
 }
@@ -89,13 +110,16 @@ pub struct WarmUp {
     pub reference_ms: f64,
 }
 
-/// A round thrown away because its canary strayed.
+/// A round thrown away because its canary strayed or other processes took cores during it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Retake {
     pub round: usize,
-    /// The canary time that strayed, and the reference it strayed from.
+    /// The canary time that strayed (or the last one, where the foreign load strayed), and the
+    /// reference it is held to.
     pub canary_ms: f64,
     pub reference_ms: f64,
+    /// Cores other processes kept busy during the round's work, where it ran and was measured.
+    pub foreign_load: Option<f64>,
 }
 
 /// The canary after a kept round, and the reference in force then.
@@ -104,6 +128,8 @@ pub struct CanaryTime {
     pub round: usize,
     pub ms: f64,
     pub reference_ms: f64,
+    /// Cores other processes kept busy during the round's work, where measured.
+    pub foreign_load: Option<f64>,
 }
 
 /// How steady one measurement set's clock was.
@@ -130,6 +156,14 @@ impl SetStability {
         let hi = ratios.fold(0.0, f64::max);
         (!self.canary.is_empty()).then_some((lo, hi))
     }
+
+    /// The most cores other processes kept busy during any kept round; `None` where unmeasured.
+    pub fn most_foreign_load(&self) -> Option<f64> {
+        self.canary
+            .iter()
+            .filter_map(|c| c.foreign_load)
+            .reduce(f64::max)
+    }
 }
 
 /// The steady clock's record of a run: what the canary was, and every set's stability.
@@ -142,6 +176,21 @@ pub struct Stability {
 }
 
 impl Stability {
+    /// Where other processes kept more than [`ClockSettings::max_foreign_load`] cores busy in
+    /// kept rounds: `(those rounds, all kept rounds, the most cores)`. A run like that is a run
+    /// of a busy machine, whatever its canary read: its report and `compare merge` say so.
+    pub fn busy_elsewhere(&self) -> Option<(usize, usize, f64)> {
+        let limit = self.settings.max_foreign_load;
+        let kept = self.sets.iter().flat_map(|s| &s.canary);
+        let busy: Vec<f64> = kept
+            .clone()
+            .filter_map(|c| c.foreign_load)
+            .filter(|l| *l > limit)
+            .collect();
+        let most = busy.iter().copied().reduce(f64::max)?;
+        Some((busy.len(), kept.count(), most))
+    }
+
     /// The record as JSON: the canary, the tolerance, and per set its warm-ups, kept rounds'
     /// canary times (with the reference in force), retaken and unsteady rounds.
     pub fn json(&self) -> serde_json::Value {
@@ -152,6 +201,7 @@ impl Stability {
             "tolerance": s.tolerance,
             "settle_window": s.window,
             "retakes_before_rewarm": s.retakes_before_rewarm,
+            "max_foreign_load_cores": s.max_foreign_load,
             "sets": self.sets.iter().map(|set| json!({
                 "set": set.set,
                 "warm_ups": set.warm_ups.iter().map(|w| json!({
@@ -164,11 +214,22 @@ impl Stability {
                 })).collect::<Vec<_>>(),
                 "canary_ms": set.canary.iter().map(|c| c.ms).collect::<Vec<_>>(),
                 "canary_reference_ms": set.canary.iter().map(|c| c.reference_ms).collect::<Vec<_>>(),
-                "retaken": set.retaken.iter().map(|r| json!({
-                    "round": r.round,
-                    "canary_ms": r.canary_ms,
-                    "reference_ms": r.reference_ms,
-                })).collect::<Vec<_>>(),
+                // Cores other processes kept busy per kept round, where every one was measured
+                // (an empty list where the meter could not be read).
+                "foreign_load_cores": set.canary.iter().map(|c| c.foreign_load)
+                    .collect::<Option<Vec<_>>>()
+                    .unwrap_or_default(),
+                "retaken": set.retaken.iter().map(|r| {
+                    let mut retake = json!({
+                        "round": r.round,
+                        "canary_ms": r.canary_ms,
+                        "reference_ms": r.reference_ms,
+                    });
+                    if let Some(w) = r.foreign_load {
+                        retake["foreign_load_cores"] = json!(w);
+                    }
+                    retake
+                }).collect::<Vec<_>>(),
                 "unsteady_rounds": set.unsteady,
             })).collect::<Vec<_>>(),
         })
@@ -183,12 +244,17 @@ impl Stability {
              Canary: {}, warmed up until {} canary times in a row agree within \
              ±{tolerance:.0} % (their median is the reference), then timed between every two \
              rounds; a round whose canary before or after strays beyond ±{tolerance:.0} % is \
-             thrown away and retaken, {} strays in a row warm the canary up again (the \
-             conditions changed for good), and a round that strays twice that often is kept \
-             and flagged unsteady.\n\n\
+             thrown away and retaken, and so is a round during which other processes kept more \
+             than {:.2} cores busy (what a canary misses); {} strays in a row warm the \
+             canary up again (the conditions changed for good), and a round that strays twice \
+             that often is kept and flagged unsteady.\n\n\
              | set | warm-ups: canary times (s) -> reference | kept rounds' canary over its \
-             reference | rounds retaken | unsteady |\n|---|---|---|---|---|\n",
-            self.workload, self.settings.window, self.settings.retakes_before_rewarm
+             reference | most cores busy elsewhere | rounds retaken | unsteady |\n\
+             |---|---|---|---|---|---|\n",
+            self.workload,
+            self.settings.window,
+            self.settings.max_foreign_load,
+            self.settings.retakes_before_rewarm
         );
         for set in &self.sets {
             let warm: Vec<String> = set
@@ -225,13 +291,15 @@ impl Stability {
             let unsteady: Vec<usize> = set.unsteady.iter().map(|r| r + 1).collect();
             let _ = writeln!(
                 md,
-                "| {} | {} | {range} | {} ({} tries) | {} |",
+                "| {} | {} | {range} | {} | {} ({} tries) | {} |",
                 set.set,
                 if warm.is_empty() {
                     "none (the last reference held)".to_owned()
                 } else {
                     warm.join("; ")
                 },
+                set.most_foreign_load()
+                    .map_or("-".to_owned(), |w| format!("{w:.2}")),
                 list(&retaken),
                 set.retaken.len(),
                 list(&unsteady)
@@ -259,7 +327,13 @@ pub struct Clock {
     record: Stability,
     /// What happened since the last [`Clock::take_news`].
     news: Vec<News>,
+    /// Reads `(CPU seconds other processes have taken, wall seconds)`, both cumulative;
+    /// `None` where it cannot be read.
+    meter: Option<Box<Meter>>,
 }
+
+/// A load meter: cumulative `(CPU seconds other processes took, wall seconds)`, or `None`.
+pub type Meter = dyn FnMut() -> Option<(f64, f64)>;
 
 impl Clock {
     pub fn new(workload: impl Into<String>, settings: ClockSettings) -> Self {
@@ -273,7 +347,19 @@ impl Clock {
                 sets: Vec::new(),
             },
             news: Vec::new(),
+            meter: None,
         }
+    }
+
+    /// Reads the load beside each round from `meter` ([`foreign_cpu_seconds`] on a device): a
+    /// round beside more than [`ClockSettings::max_foreign_load`] strays.
+    pub fn with_meter(mut self, meter: Box<Meter>) -> Self {
+        self.meter = Some(meter);
+        self
+    }
+
+    fn read_meter(&mut self) -> Option<(f64, f64)> {
+        self.meter.as_mut().and_then(|m| m())
     }
 
     /// The retakes and warm-ups since the last call, in order: what a progress line says.
@@ -374,6 +460,7 @@ impl Clock {
         let rewarm = self.settings.retakes_before_rewarm.max(1);
         let mut strays_in_a_row = 0;
         loop {
+            let mut measured = None;
             let last_try = strays_in_a_row >= 2 * rewarm || Instant::now() >= deadline;
             let before = match self.last_steady.take() {
                 Some(ms) => ms,
@@ -382,9 +469,18 @@ impl Clock {
             let strayed = if self.strays(before) && !last_try {
                 before
             } else {
+                let start = self.read_meter();
                 let kept = work()?;
+                let foreign_load = match (start, self.read_meter()) {
+                    (Some((c0, t0)), Some((c1, t1))) if t1 > t0 => {
+                        Some((c1 - c0).max(0.0) / (t1 - t0))
+                    }
+                    _ => None,
+                };
+                measured = foreign_load;
                 let after = canary()?;
-                let steady = !self.strays(before) && !self.strays(after);
+                let beside_load = foreign_load.is_some_and(|l| l > self.settings.max_foreign_load);
+                let steady = !self.strays(before) && !self.strays(after) && !beside_load;
                 if steady || last_try {
                     let reference_ms = self.reference_ms.unwrap_or(0.0);
                     let set = self.set();
@@ -392,6 +488,7 @@ impl Clock {
                         round: index,
                         ms: after,
                         reference_ms,
+                        foreign_load,
                     });
                     if !steady {
                         set.unsteady.push(index);
@@ -399,6 +496,7 @@ impl Clock {
                     self.last_steady = (!self.strays(after)).then_some(after);
                     return Ok(kept);
                 }
+                self.last_steady = (!self.strays(after)).then_some(after);
                 if self.strays(before) {
                     before
                 } else {
@@ -409,6 +507,7 @@ impl Clock {
                 round: index,
                 canary_ms: strayed,
                 reference_ms: self.reference_ms.unwrap_or(0.0),
+                foreign_load: measured,
             };
             self.news.push(News::Retaken(retake));
             self.set().retaken.push(retake);
@@ -418,6 +517,44 @@ impl Clock {
             }
         }
     }
+}
+
+/// CPU seconds every process but this one has taken (and the hypervisor, as steal) since the
+/// machine started: `/proc/stat`'s busy time (user, nice, system, irq, softirq, steal) less
+/// this process's (`/proc/self/stat`'s utime and stime, all its threads), both in the kernel's
+/// 100 Hz ticks. `None` where either cannot be read, or where `/proc/stat` counts other cores
+/// than this process may use (a container, whose `/proc/stat` is its host's: other tenants'
+/// work is not this machine's load).
+pub fn foreign_cpu_seconds() -> Option<f64> {
+    const TICKS_PER_SECOND: f64 = 100.0;
+    let stat = std::fs::read_to_string("/proc/stat").ok()?;
+    let cores = stat
+        .lines()
+        .filter(|l| l.starts_with("cpu") && !l.starts_with("cpu "))
+        .count();
+    if Some(cores) != std::thread::available_parallelism().ok().map(|n| n.get()) {
+        return None;
+    }
+    let total: Vec<f64> = stat
+        .lines()
+        .next()?
+        .split_whitespace()
+        .skip(1)
+        .map(|t| t.parse().ok())
+        .collect::<Option<_>>()?;
+    // user nice system idle iowait irq softirq steal: all but idle and iowait.
+    let busy: f64 = [0, 1, 2, 5, 6, 7]
+        .iter()
+        .filter_map(|&i| total.get(i))
+        .sum();
+    let own = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The fields after the command's closing parenthesis (a command may contain spaces):
+    // state is field 3, utime and stime fields 14 and 15.
+    let after = own.get(own.rfind(')')? + 1..)?;
+    let fields: Vec<&str> = after.split_whitespace().collect();
+    let own_ticks: f64 =
+        fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    Some((busy - own_ticks).max(0.0) / TICKS_PER_SECOND)
 }
 
 /// The steady clock with its canary on a device: branching's lighting (native backend), the
@@ -466,8 +603,10 @@ impl<'c> SteadyClock<'c> {
         renderer.render(CANARY, Readback::NONE)?;
         let workload =
             format!("the median of {CANARY_FRAMES} frames of branching's lighting on {scene}");
+        let origin = Instant::now();
+        let meter = move || Some((foreign_cpu_seconds()?, origin.elapsed().as_secs_f64()));
         Ok(Self {
-            clock: Some(Clock::new(workload, settings)),
+            clock: Some(Clock::new(workload, settings).with_meter(Box::new(meter))),
             renderer: Some(renderer),
         })
     }
@@ -521,10 +660,12 @@ impl<'c> SteadyClock<'c> {
         for news in clock.take_news() {
             progress(&match news {
                 News::Retaken(r) => format!(
-                    "{set}: round {} retaken, canary {:.3} ms against {:.3} ms",
+                    "{set}: round {} retaken, canary {:.3} ms against {:.3} ms{}",
                     r.round + 1,
                     r.canary_ms,
-                    r.reference_ms
+                    r.reference_ms,
+                    r.foreign_load
+                        .map_or(String::new(), |l| format!(", {l:.2} cores busy elsewhere"))
                 ),
                 News::WarmedUp(w) if w.before_round == 0 => format!(
                     "{set}: steady clock warmed up in {} canary times ({:.1} s), canary {:.3} ms{}",
@@ -699,6 +840,52 @@ mod tests {
         let set = &clock.stability().sets[0];
         assert_eq!((works, set.retaken.len()), (1, 0));
         assert_eq!(set.unsteady, [0]);
+    }
+
+    /// The canary misses a load that takes the round's own cores (it reads alike, as on
+    /// lavapipe beside a busy process); the meter does not: from the round the load starts in,
+    /// rounds beside more than the limit are retaken, and where the load lasts they are kept
+    /// flagged unsteady, with the load in the record.
+    #[test]
+    fn a_round_beside_another_process_strays_though_the_canary_held() {
+        use std::cell::Cell;
+        use std::rc::Rc;
+        // (others' CPU seconds, wall seconds), advanced by the work: one second per round,
+        // others taking 0.01 s quietly and 0.7 s under load.
+        let counters = Rc::new(Cell::new((0.0, 0.0)));
+        let meter = {
+            let counters = counters.clone();
+            move || Some(counters.get())
+        };
+        let mut clock = Clock::new("test", settings()).with_meter(Box::new(meter));
+        let mut canary = replay(vec![1.0]);
+        clock.begin_set("set", &mut canary).unwrap();
+        let load_from = 2;
+        let mut works = 0;
+        for index in 0..4 {
+            clock
+                .round(index, far(), &mut canary, &mut || {
+                    works += 1;
+                    let (w, t) = counters.get();
+                    let others = if index >= load_from { 0.7 } else { 0.01 };
+                    counters.set((w + others, t + 1.0));
+                    Ok::<_, ()>(())
+                })
+                .unwrap();
+        }
+        let set = &clock.stability().sets[0];
+        let near = |w: Option<f64>, v: f64| w.is_some_and(|w| (w - v).abs() < 1e-9);
+        assert!(set
+            .retaken
+            .iter()
+            .all(|r| r.round >= load_from && near(r.foreign_load, 0.7)));
+        // Each loaded round: six tries (a warm-up after three), the last kept, flagged.
+        assert_eq!(set.retaken.len(), 2 * 6);
+        assert_eq!(set.unsteady, [2, 3]);
+        assert_eq!(works, 2 + 2 * 7);
+        assert!(near(set.canary[0].foreign_load, 0.01));
+        assert!(near(set.most_foreign_load(), 0.7));
+        assert!(clock.stability().markdown().contains("| 0.70 |"));
     }
 
     #[test]

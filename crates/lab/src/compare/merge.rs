@@ -12,6 +12,7 @@
 //! beside a load: `compare --beside-load`) a failure of the verdicts themselves, which
 //! [`Merged::same_device_reversals`] gives the CLI to exit non-zero on.
 
+use super::report::interval_json;
 use crate::plot::{self, Axis, Series};
 use crate::stats::{Interval, Verdict};
 use crate::{write_file, LabError, Result};
@@ -48,6 +49,9 @@ pub struct DeviceReport {
     pub rounds: u64,
     /// Busy threads beside the run (0: quiet; absent in reports from before the option).
     pub beside_load: u64,
+    /// The most cores other processes kept busy in a kept round, where beyond the steady
+    /// clock's limit ([`crate::steady::Stability::busy_elsewhere`]): a busy machine's run.
+    pub busy_elsewhere: Option<f64>,
     /// The depth bounds test was on (absent, so off, in reports from before it existed).
     pub depth_bounds: bool,
     /// `(technique, cells by BRDF count)`.
@@ -86,12 +90,32 @@ fn text(file: &Path, v: &Value, path: &str) -> Result<String> {
         .ok_or_else(|| bad(file, format!("{path} is not a string")))
 }
 
+/// The most cores other processes kept busy in a kept round of the report's steady clock, where
+/// beyond its limit; `None` for a quiet run, a run without the clock, and reports before the
+/// clock read the load.
+fn busy_elsewhere(stability: &Value) -> Option<f64> {
+    let limit = stability["max_foreign_load_cores"].as_f64()?;
+    stability["sets"]
+        .as_array()?
+        .iter()
+        .filter_map(|set| set["foreign_load_cores"].as_array())
+        .flatten()
+        .filter_map(Value::as_f64)
+        .filter(|l| *l > limit)
+        .reduce(f64::max)
+}
+
 fn interval(file: &Path, v: &Value, path: &str) -> Result<Interval> {
     Ok(Interval {
         lo: number(file, v, &format!("{path}.lo"))?,
         median: number(file, v, &format!("{path}.median"))?,
         hi: number(file, v, &format!("{path}.hi"))?,
         samples: number(file, v, &format!("{path}.samples"))? as usize,
+        // Reports before the halves were kept have none: their verdicts stand as the whole
+        // interval gives them.
+        halves: field(file, v, &format!("{path}.halves"))
+            .ok()
+            .and_then(|h| Some((h.get(0)?.as_f64()?, h.get(1)?.as_f64()?))),
     })
 }
 
@@ -150,6 +174,7 @@ impl DeviceReport {
             height: number(&file, &v, "settings.height")? as u64,
             rounds: number(&file, &v, "table_sampling.rounds")? as u64,
             beside_load: v["settings"]["beside_load_threads"].as_u64().unwrap_or(0),
+            busy_elsewhere: busy_elsewhere(&v["stability"]),
             // Reports from before the depth bounds test ran without it.
             depth_bounds: v["settings"]["depth_bounds"].as_bool().unwrap_or(false),
             rows,
@@ -159,10 +184,16 @@ impl DeviceReport {
 
     /// The conditions of the run: "quiet", or the load beside it.
     fn conditions(&self) -> String {
-        let load = match self.beside_load {
+        let mut load = match self.beside_load {
             0 => "quiet".into(),
             n => format!("beside {n} busy threads"),
         };
+        if let Some(most) = self.busy_elsewhere {
+            load = match self.beside_load {
+                0 => format!("beside other processes (up to {most:.2} cores)"),
+                _ => format!("{load} and other processes (up to {most:.2} cores)"),
+            };
+        }
         if self.depth_bounds {
             format!("{load}, depth bounds test")
         } else {
@@ -259,8 +290,9 @@ impl Merged {
                 )));
             }
             if let Some(j) = reports[..i].iter().position(|o| {
-                (&o.device, &o.driver, o.beside_load, o.depth_bounds)
-                    == (&r.device, &r.driver, r.beside_load, r.depth_bounds)
+                let busy = |d: &DeviceReport| d.busy_elsewhere.is_some();
+                (&o.device, &o.driver, o.beside_load, busy(o), o.depth_bounds)
+                    == (&r.device, &r.driver, r.beside_load, busy(r), r.depth_bounds)
             }) {
                 return Err(LabError::Settings(format!(
                     "{} and {} are the same device, driver and load ({}, {}, {}): one report per \
@@ -512,10 +544,6 @@ impl Merged {
     }
 }
 
-fn interval_json(i: &Interval) -> Value {
-    json!({"median": i.median, "lo": i.lo, "hi": i.hi, "samples": i.samples})
-}
-
 /// `1.234 ms [1.2, 1.3]`, and over one BRDF `(+3.2 % [+1.1, +5.0], slower)`.
 fn cell_text(c: &MergedCell) -> String {
     let i = &c.lighting;
@@ -545,6 +573,7 @@ mod tests {
             median: m,
             hi: m * 1.1,
             samples: 10,
+            halves: None,
         };
         DeviceReport {
             dir: dir.into(),
@@ -555,6 +584,7 @@ mod tests {
             height: 180,
             rounds: 10,
             beside_load: 0,
+            busy_elsewhere: None,
             depth_bounds: false,
             rows: vec![(
                 "stencil".into(),
@@ -640,6 +670,7 @@ mod tests {
             median,
             hi,
             samples: 10,
+            halves: None,
         };
         let mut q = report("q", "fast", "Mesa 22.3", "huge-lights");
         let mut loaded = report("l", "fast", "Mesa 22.3", "huge-lights");
@@ -685,6 +716,37 @@ mod tests {
                 merged.same_device_reversals().len()
             ),
             (1, 0)
+        );
+    }
+
+    /// A run during which other processes kept cores busy (its steady clock's record) is a run
+    /// of other conditions: it merges beside a quiet run of the same device and driver, and the
+    /// merged table names the load.
+    #[test]
+    fn a_run_beside_other_processes_is_named_as_its_own_conditions() {
+        let stability = |loads: &[f64]| {
+            json!({"max_foreign_load_cores": 0.5,
+                   "sets": [{"foreign_load_cores": loads}, {"foreign_load_cores": []}]})
+        };
+        assert_eq!(busy_elsewhere(&stability(&[0.0, 0.06, 0.02])), None);
+        assert_eq!(busy_elsewhere(&stability(&[0.99, 1.03, 0.2])), Some(1.03));
+        assert_eq!(
+            busy_elsewhere(&json!({})),
+            None,
+            "a report before the clock read it"
+        );
+        let q = report("q", "fast", "Mesa 22.3", "huge-lights");
+        let mut busy = report("b", "fast", "Mesa 22.3", "huge-lights");
+        assert!(
+            Merged::new(vec![q.clone(), busy.clone()]).is_err(),
+            "one report per condition"
+        );
+        busy.busy_elsewhere = Some(1.03);
+        let merged = Merged::new(vec![q, busy]).unwrap();
+        let md = merged.markdown();
+        assert!(
+            md.contains("| run 2 | fast | Mesa 22.3 | beside other processes (up to 1.03 cores) |"),
+            "{md}"
         );
     }
 

@@ -202,8 +202,9 @@ impl CompareReport {
              reaches 95 % and the whole range is shown]; overheads are the median of \
              the per-round ratios to the row's 1-BRDF time, with their interval. Verdicts have \
              a practical margin of ±{:.0} %: faster or slower only where the whole interval lies \
-             beyond it, \"within ±{:.0} %\" where it lies wholly inside, \"undecided\" otherwise \
-             and below {} rounds. Error against the forward reference of the same scene: 8-bit \
+             beyond it, \"within ±{:.0} %\" where it lies wholly inside, and each half of the \
+             rounds in the order taken has its median there too (a load that started or stopped \
+             part way leaves the halves apart); \"undecided\" otherwise and below {} rounds. Error against the forward reference of the same scene: 8-bit \
              max / mean, and mean FLIP.\n",
             self.device, self.driver, self.scene, self.scene_lights, self.width, self.height,
             self.frames, 100.0 * MARGIN, 100.0 * MARGIN, MIN_VERDICT_ROUNDS
@@ -224,6 +225,16 @@ impl CompareReport {
                 md,
                 "Conditions: {} busy threads ran beside the measurement (`--beside-load`){from}.\n",
                 self.beside_load
+            );
+        }
+        if let Some((busy, kept, most)) = self.stability.as_ref().and_then(|s| s.busy_elsewhere()) {
+            let _ = writeln!(
+                md,
+                "Conditions: **not a quiet machine**. Other processes kept up to {most:.2} cores \
+                 busy in {busy} of the {kept} kept rounds (retaken while the budget lasted, then \
+                 kept flagged unsteady: \"Steady clock\" below). On a CPU driver such a load can \
+                 change the techniques' ratios, not only their times; this run's verdicts are \
+                 about a busy machine.\n"
             );
         }
         let _ = writeln!(
@@ -600,6 +611,7 @@ impl CompareReport {
                                 lo: iv.lo / n,
                                 median: iv.median / n,
                                 hi: iv.hi / n,
+                                halves: iv.halves.map(|(a, b)| (a / n, b / n)),
                                 ..iv
                             },
                         )
@@ -722,8 +734,11 @@ fn table_head(columns: &[String]) -> String {
     )
 }
 
-fn interval_json(i: &crate::stats::Interval) -> Value {
-    json!({"median": i.median, "lo": i.lo, "hi": i.hi, "samples": i.samples})
+/// An interval as the reports store it, with the halves its verdict was held to, so that a
+/// merge gives the verdicts the run gave.
+pub(super) fn interval_json(i: &crate::stats::Interval) -> Value {
+    json!({"median": i.median, "lo": i.lo, "hi": i.hi, "samples": i.samples,
+           "halves": i.halves.map(|(a, b)| [a, b])})
 }
 
 fn error_text(e: &ImageError) -> String {
