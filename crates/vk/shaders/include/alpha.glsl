@@ -84,6 +84,16 @@ vec3 ribbon_point(AlphaEntity e, float t) {
 bool lightmap_probe(AlphaEntity e, ivec2 local, out vec3 P, out vec3 N) {
     P = vec3(0.0);
     N = vec3(0.0, 0.0, 1.0);
+    // A texel outside the region has no probe. The draw's scissor is the region, but a 2x2
+    // quad that straddles its edge runs its outside texels too, as helper invocations, and
+    // their loads are real: on SwiftShader a quad at an odd region origin read probe -514 of
+    // a 513-texel object, 16 KiB before the buffer, and crashed (lavapipe and the layers saw
+    // nothing). Every index below is in bounds once `local` is inside the region.
+    uint columns = tile_columns(e);
+    uvec2 extent = uvec2(columns, (max(e.shape.y, 1u) + columns - 1u) / columns) * e.region.zw;
+    if (any(lessThan(local, ivec2(0))) || any(greaterThanEqual(uvec2(local), extent))) {
+        return false;
+    }
     uint kind = e.shape.x;
     if (kind == ALPHA_OBJECT) {
         AlphaProbe probe = probes[e.shape.z + uint(local.y) * e.region.z + uint(local.x)];
