@@ -6,6 +6,11 @@
 
 void main() {
     uvec2 px = uvec2(gl_FragCoord.xy);
+    // A quad on the frame's right or bottom edge of an odd size runs texels past it as helper
+    // invocations; their index would read past the saved bytes (see lightmap_probe).
+    if (any(greaterThanEqual(px, uvec2(frame.viewport.xy)))) {
+        discard;
+    }
     uint index = px.y * uint(frame.viewport.x) + px.x;
     if ((stencil_byte(saved_stencil[index >> 2], index) & light_draw.bit) == 0u) {
         discard;
