@@ -53,17 +53,83 @@ pub const GLSLC_OPTIONS: [&str; 4] = [
 /// The hook files an engine may supply; a file its folder lacks is histencil's.
 pub const HOOK_FILES: [&str; 2] = ["surface_decode.glsl", "light_visibility.glsl"];
 
-/// The light shaders that call the hooks, compiled per engine.
-pub const HOOKED_STAGES: [&str; 8] = [
-    "deferred_light.frag",
-    "lut_light.frag",
-    "tile_classify.comp",
-    "tile_shade.comp",
-    "tile_classify_8.comp",
-    "tile_shade_8.comp",
-    "depth_id_copy.frag",
-    "depth_id_shade.frag",
-];
+/// A shader stage histencil compiles again for an engine: for its hooks, its BRDFs, or both.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stage {
+    /// The file under histencil's `shaders/`; its stem is the module's field name
+    /// ([`Stage::field`]) in `LightModules` (a hooked stage) or `BrdfModules` (the others).
+    pub file: &'static str,
+    /// It calls the decode and visibility hooks: a light shader, compiled per engine's hooks
+    /// into `LightModules`.
+    pub hooked: bool,
+    /// It evaluates a BRDF (includes `brdf/eval.glsl`): compiled per BRDF set.
+    pub evaluates_brdf: bool,
+}
+
+impl Stage {
+    /// The module's field name: the file's stem (`deferred_light` of `deferred_light.frag`).
+    pub fn field(&self) -> &'static str {
+        self.file.split('.').next().unwrap_or(self.file)
+    }
+}
+
+/// Every stage compiled per engine, once: [`HOOKED_STAGES`], [`BRDF_STAGES`], the fields of the
+/// generated `LightModules` and `BrdfModules` expressions and histencil's run-time compile all
+/// come from this table. A stage added here is compiled into both wherever it belongs; its
+/// field must exist in the struct its flags put it in (the compiler says so where it does not).
+pub const STAGES: [Stage; 14] = {
+    const fn stage(file: &'static str, hooked: bool, evaluates_brdf: bool) -> Stage {
+        Stage {
+            file,
+            hooked,
+            evaluates_brdf,
+        }
+    }
+    [
+        stage("deferred_light.frag", true, true),
+        stage("lut_light.frag", true, true),
+        stage("tile_classify.comp", true, false),
+        stage("tile_shade.comp", true, true),
+        stage("tile_classify_8.comp", true, false),
+        stage("tile_shade_8.comp", true, true),
+        stage("depth_id_copy.frag", true, false),
+        stage("depth_id_shade.frag", true, true),
+        stage("forward.frag", false, true),
+        stage("lightmap.frag", false, true),
+        stage("lightmap_directional.frag", false, true),
+        stage("alpha_object.frag", false, true),
+        stage("particle.frag", false, true),
+        stage("brdf_eval.comp", false, true),
+    ]
+};
+
+/// The files of the [`STAGES`] `keep` selects, in the table's order (a const fn: the lists
+/// below are consts of the table, not copies of it).
+const fn files<const N: usize>(
+    hooked: Option<bool>,
+    evaluates_brdf: Option<bool>,
+) -> [&'static str; N] {
+    let mut out = [""; N];
+    let (mut i, mut n) = (0, 0);
+    while i < STAGES.len() {
+        let s = STAGES[i];
+        let keep = match (hooked, evaluates_brdf) {
+            (Some(h), _) => s.hooked == h,
+            (None, Some(e)) => s.evaluates_brdf == e,
+            (None, None) => true,
+        };
+        if keep {
+            out[n] = s.file;
+            n += 1;
+        }
+        i += 1;
+    }
+    assert!(n == N, "the list's length is not its count in STAGES");
+    out
+}
+
+/// The light shaders that call the hooks, compiled per engine ([`STAGES`] that are hooked).
+pub const HOOKED_STAGES: [&str; 8] = files(Some(true), None);
 
 /// Why the light shaders could not be compiled.
 #[derive(Debug)]
@@ -262,20 +328,8 @@ fn ids_and_names(set: &BrdfSet) -> (String, String) {
 }
 
 /// The stages that evaluate a BRDF (each includes `brdf/eval.glsl`): what a BRDF set is compiled
-/// into, in the order of `BrdfModules`' fields ([`compile_brdf_modules`]).
-pub const BRDF_STAGES: [&str; 11] = [
-    "deferred_light.frag",
-    "lut_light.frag",
-    "tile_shade.comp",
-    "tile_shade_8.comp",
-    "depth_id_shade.frag",
-    "forward.frag",
-    "lightmap.frag",
-    "lightmap_directional.frag",
-    "alpha_object.frag",
-    "particle.frag",
-    "brdf_eval.comp",
-];
+/// into ([`compile_brdf_modules`]; [`STAGES`] that evaluate a BRDF).
+pub const BRDF_STAGES: [&str; 11] = files(None, Some(true));
 
 /// Writes what histencil's shaders include to evaluate `set` into `folder` (its `brdf_set/`
 /// files, and a copy of the engine's GLSL under `engine/`, so that no name of the engine's can
@@ -377,8 +431,10 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
         generated.as_path(),
         defaults.as_path(),
     ];
-    let mut spirv = Vec::new();
-    for stage in BRDF_STAGES {
+    // Each stage's field, by the table: a hooked stage's in `light`, the others' beside it.
+    let (mut light_fields, mut fields) = (String::new(), String::new());
+    for table in STAGES.iter().filter(|s| s.evaluates_brdf) {
+        let stage = table.file;
         let out = target.join(format!("{stage}.spv"));
         run_glslc(glslc_command(&shaders.join(stage), &includes, &out), stage).map_err(
             |e| match e {
@@ -389,22 +445,19 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
                 other => other,
             },
         )?;
-        spirv.push(format!("include_bytes!({:?})", out.display().to_string()));
+        let (into, indent) = match table.hooked {
+            true => (&mut light_fields, "        "),
+            false => (&mut fields, "    "),
+        };
+        *into += &format!(
+            "{indent}{}: include_bytes!({:?}),\n",
+            table.field(),
+            out.display().to_string()
+        );
     }
     let (ids, names) = ids_and_names(set);
     let expression = format!(
-        "::histencil::BrdfModules {{\n    set: {set},\n    light: ::histencil::LightModules {{\n        deferred_light: {},\n        lut_light: {},\n        tile_shade: {},\n        tile_shade_8: {},\n        depth_id_shade: {},\n        brdfs: &[{ids}],\n        brdf_names: &[{names}],\n        ..::histencil::LightModules::BUILTIN\n    }},\n    forward: {},\n    lightmap: {},\n    lightmap_directional: {},\n    alpha_object: {},\n    particle: {},\n    brdf_eval: {},\n}}\n",
-        spirv[0],
-        spirv[1],
-        spirv[2],
-        spirv[3],
-        spirv[4],
-        spirv[5],
-        spirv[6],
-        spirv[7],
-        spirv[8],
-        spirv[9],
-        spirv[10],
+        "::histencil::BrdfModules {{\n    set: {set},\n    light: ::histencil::LightModules {{\n{light_fields}        brdfs: &[{ids}],\n        brdf_names: &[{names}],\n        ..::histencil::LightModules::BUILTIN\n    }},\n{fields}}}\n",
         set = set.rust_expression(),
     );
     let rust = out_dir.join("histencil_brdf_modules.rs");
@@ -453,7 +506,8 @@ pub fn compile_light_shaders_for(
     ]);
     // Unqualified: the engine names it through `histencil` or `histencil_vk`, whichever it uses.
     let mut fields = String::from("LightModules {\n");
-    for stage in HOOKED_STAGES {
+    for table in STAGES.iter().filter(|s| s.hooked) {
+        let stage = table.file;
         let source = shaders.join(stage);
         let out = target.join(format!("{stage}.spv"));
         run_glslc(glslc_command(&source, &includes, &out), stage).map_err(|e| match e {
@@ -464,9 +518,9 @@ pub fn compile_light_shaders_for(
             },
             other => other,
         })?;
-        let field = stage.split('.').next().unwrap_or(stage);
         fields += &format!(
-            "    {field}: include_bytes!({:?}),\n",
+            "    {}: include_bytes!({:?}),\n",
+            table.field(),
             out.display().to_string()
         );
     }

@@ -198,16 +198,13 @@ pub fn compile_with_hooks(
         root.join("hooks"),
     ]);
     let includes: Vec<&Path> = includes.iter().map(PathBuf::as_path).collect();
-    let mut stages: Vec<&str> = histencil_build::BRDF_STAGES.to_vec();
-    if hooks.is_some() {
-        for stage in histencil_build::HOOKED_STAGES {
-            if !stages.contains(&stage) {
-                stages.push(stage);
-            }
-        }
-    }
+    // The BRDF stages, and with hooks every hooked stage too: the build's table.
+    let stages = histencil_build::STAGES
+        .iter()
+        .filter(|s| s.evaluates_brdf || (hooks.is_some() && s.hooked));
     let mut spirv = HashMap::new();
-    for stage in stages {
+    for table in stages {
+        let stage = table.file;
         let out = root.join(format!("{stage}.spv"));
         let command =
             histencil_build::glslc_command(&root.join("stages").join(stage), &includes, &out);
@@ -223,8 +220,7 @@ pub fn compile_with_hooks(
                 .replace(&root.display().to_string(), "histencil-vk/shaders")
         })?;
         let bytes = std::fs::read(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-        let field = stage.split('.').next().unwrap_or(stage);
-        spirv.insert(field.to_owned(), &*Box::leak(bytes.into_boxed_slice()));
+        spirv.insert(table.field(), &*Box::leak(bytes.into_boxed_slice()));
     }
     let modules: &'static BrdfModules = Box::leak(Box::new(
         modules_of(set, |field| spirv.get(field).copied()).expect("every BRDF stage compiled"),
@@ -249,9 +245,9 @@ pub(crate) fn modules_of(
         ..LightModules::BUILTIN
     };
     let evaluates = |field: &str| {
-        histencil_build::BRDF_STAGES
+        histencil_build::STAGES
             .iter()
-            .any(|s| s.split('.').next() == Some(field))
+            .any(|s| s.evaluates_brdf && s.field() == field)
     };
     for (field, module) in light.named_mut() {
         match stage(field) {

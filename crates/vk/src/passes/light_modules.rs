@@ -90,3 +90,24 @@ impl LightModules {
         ]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The modules by name are the build's table's hooked stages, in its order: the run-time
+    /// compile sets them by these names, the build writes the fields by them.
+    #[test]
+    fn the_modules_by_name_are_the_hooked_stages_of_the_build_table() {
+        let table: Vec<&str> = histencil_build::STAGES
+            .iter()
+            .filter(|s| s.hooked)
+            .map(|s| s.field())
+            .collect();
+        let named: Vec<&str> = LightModules::BUILTIN.named().map(|(n, _)| n).to_vec();
+        let mut builtin = LightModules::BUILTIN;
+        let named_mut: Vec<&str> = builtin.named_mut().map(|(n, _)| n).to_vec();
+        assert_eq!(named, table);
+        assert_eq!(named_mut, table);
+    }
+}
