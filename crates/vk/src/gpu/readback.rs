@@ -91,24 +91,6 @@ impl Recording<'_> {
             )
         };
     }
-
-    /// Makes the writes of `stage` so far (copies, or shader storage writes) visible to host reads
-    /// after the fence.
-    pub(crate) fn host_readable(&self, stage: vk::PipelineStageFlags2) {
-        let writes = if stage == vk::PipelineStageFlags2::COPY {
-            vk::AccessFlags2::TRANSFER_WRITE
-        } else {
-            vk::AccessFlags2::SHADER_STORAGE_WRITE
-        };
-        let barrier = [vk::MemoryBarrier2::default()
-            .src_stage_mask(stage)
-            .src_access_mask(writes)
-            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-            .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-        // SAFETY: the recording's command buffer is recording outside rendering; `barrier` lives until the
-        // call returns and names only stages and accesses the queue family supports.
-        unsafe { self.barrier(&vk::DependencyInfo::default().memory_barriers(&barrier)) };
-    }
 }
 
 #[derive(Default)]

@@ -8,11 +8,13 @@
 //! themselves (binds, pushes, draws, dispatches, fills, copies) are its methods in
 //! `commands.rs`, each checked against the rendering state.
 //!
-//! Barriers, copies and dynamic state are its methods too, written beside what they serve
-//! (`declare`, `transition`, `memory_barrier` and `declare_buffers` in `access.rs`: a step
-//! declares how it uses its images next, `rec.declare(&mut [(image, access, contents), ..])`,
-//! and one barrier command takes them all there; `apply` in `state.rs`,
-//! `copy_image_to_buffer` and `host_readable` in `readback.rs`). Modelled on wgpu-hal's
+//! Barriers, copies and dynamic state are its methods too, written beside what they serve.
+//! Every barrier is derived in `access.rs` from what a step declares: `declare` and
+//! `transition` for images (`rec.declare(&mut [(image, access, contents), ..])`, one barrier
+//! command taking them all there), `declare_buffers` for buffers, `declare_upload` for an
+//! upload's levelled images, `host_readable` for what the host reads after the fence, and
+//! `memory_barrier` where an engine's hooks bind what histencil cannot see. `apply` is in
+//! `state.rs`, `copy_image_to_buffer` in `readback.rs`. Modelled on wgpu-hal's
 //! `CommandEncoder` and Granite's `CommandBuffer`, which own `begin_render_pass` /
 //! `end_render_pass` so pass state cannot be forgotten, and on kajiya's `record_pass_cb`, which
 //! wraps each pass in its label: [`Recording::step`] does the label. A recording may also carry

@@ -3,6 +3,7 @@
 //! one staging buffer into device-local memory ([`upload`]); the staging memory is freed
 //! before the function returns.
 
+use crate::gpu::access::Upload;
 use crate::gpu::context::Context;
 use crate::gpu::error::{Result, VkCall};
 use crate::gpu::recording::Recording;
@@ -160,27 +161,11 @@ pub(crate) fn upload(
                 unsafe { rec.copy_buffer(src, b.dst, &[region]) };
             }
         }
-        let whole = |levels: u32| {
-            vk::ImageSubresourceRange::default()
-                .aspect_mask(vk::ImageAspectFlags::COLOR)
-                .level_count(levels)
-                .layer_count(1)
-        };
-        let to_transfer: Vec<_> = images
+        let levels: Vec<_> = images
             .iter()
-            .map(|i| {
-                vk::ImageMemoryBarrier2::default()
-                    .dst_stage_mask(vk::PipelineStageFlags2::COPY)
-                    .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                    .old_layout(vk::ImageLayout::UNDEFINED)
-                    .new_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-                    .image(i.dst)
-                    .subresource_range(whole(i.levels.len() as u32))
-            })
+            .map(|i| (i.dst, i.levels.len() as u32))
             .collect();
-        // SAFETY: `to_transfer` lives until the call returns and names live colour images the
-        // caller made, every level of each, from UNDEFINED (nothing in them yet) to the copy.
-        unsafe { rec.barrier(&vk::DependencyInfo::default().image_memory_barriers(&to_transfer)) };
+        rec.declare_upload(&levels, Upload::Copies);
         for image in images {
             let regions: Vec<_> = image
                 .levels
@@ -209,43 +194,9 @@ pub(crate) fn upload(
             // multiple of the texel size.
             unsafe { rec.copy_buffer_to_image(src, image.dst, &regions) };
         }
-        let to_shader: Vec<_> = images
-            .iter()
-            .map(|i| {
-                vk::ImageMemoryBarrier2::default()
-                    .src_stage_mask(vk::PipelineStageFlags2::COPY)
-                    .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                    .dst_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
-                    .dst_access_mask(vk::AccessFlags2::SHADER_SAMPLED_READ)
-                    .old_layout(vk::ImageLayout::TRANSFER_DST_OPTIMAL)
-                    .new_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)
-                    .image(i.dst)
-                    .subresource_range(whole(i.levels.len() as u32))
-            })
-            .collect();
-        // Later submissions' reads of the buffers wait for the copies through this barrier
-        // (submission order carries the execution dependency on).
-        let buffer_reads = [vk::MemoryBarrier2::default()
-            .src_stage_mask(vk::PipelineStageFlags2::COPY)
-            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .dst_stage_mask(
-                vk::PipelineStageFlags2::VERTEX_INPUT
-                    | vk::PipelineStageFlags2::VERTEX_SHADER
-                    | vk::PipelineStageFlags2::FRAGMENT_SHADER
-                    | vk::PipelineStageFlags2::COMPUTE_SHADER,
-            )
-            .dst_access_mask(
-                vk::AccessFlags2::VERTEX_ATTRIBUTE_READ
-                    | vk::AccessFlags2::INDEX_READ
-                    | vk::AccessFlags2::UNIFORM_READ
-                    | vk::AccessFlags2::SHADER_STORAGE_READ,
-            )];
-        let dependency = vk::DependencyInfo::default()
-            .memory_barriers(&buffer_reads)
-            .image_memory_barriers(&to_shader);
-        // SAFETY: the barrier structs live until the call returns and name the images just
-        // copied to, in TRANSFER_DST_OPTIMAL; the stages are a graphics and compute queue's.
-        unsafe { rec.barrier(&dependency) };
+        // Later submissions' reads of the buffers and images wait for the copies through this
+        // barrier (submission order carries the execution dependency on).
+        rec.declare_upload(&levels, Upload::Reads);
     });
     staging.destroy(ctx);
     done

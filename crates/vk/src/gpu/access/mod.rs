@@ -1,10 +1,17 @@
-//! Declared image accesses and the one place barriers are derived from them. A pass says how it
-//! will use an image next; `transition` turns "the image's current state -> next access" into a
+//! Declared accesses and the one place barriers are derived from them. A pass says how it will
+//! use an image next; `transition` turns "the image's current state -> next access" into a
 //! barrier, whoever owns the image: histencil's own targets and an engine's images handed in as
-//! [`ImageRef`]s go through the same code.
+//! [`ImageRef`]s go through the same code. Buffers are declared likewise (`buffers.rs`); an
+//! upload's levelled images, the host's reads after a fence and the broad memory barrier the
+//! light passes' split keeps for an engine's hooks are here too, so no barrier is written
+//! anywhere else.
 
 use crate::gpu::recording::Recording;
 use ash::vk;
+
+mod buffers;
+pub use buffers::{buffer_access_info, BufferAccess};
+pub(crate) use buffers::{BufferUse, LeaveOut, BUFFER_WRITES};
 
 /// Where an image stands: its layout and the last stages and accesses that touched it (the
 /// source half of the next barrier).
@@ -370,6 +377,99 @@ impl Recording<'_> {
     }
 }
 
+impl Recording<'_> {
+    /// Makes the writes of `stage` so far (copies, or shader storage writes) visible to host reads
+    /// after the fence.
+    pub(crate) fn host_readable(&self, stage: vk::PipelineStageFlags2) {
+        let writes = if stage == vk::PipelineStageFlags2::COPY {
+            vk::AccessFlags2::TRANSFER_WRITE
+        } else {
+            vk::AccessFlags2::SHADER_STORAGE_WRITE
+        };
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(stage)
+            .src_access_mask(writes)
+            .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+            .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+        // SAFETY: the recording's command buffer is recording outside rendering; `barrier` lives until the
+        // call returns and names only stages and accesses the queue family supports.
+        unsafe { self.barrier(&vk::DependencyInfo::default().memory_barriers(&barrier)) };
+    }
+}
+
+/// Where an upload takes its images ([`Recording::declare_upload`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Upload {
+    /// Before the copies: every level from UNDEFINED (nothing in it yet) to a copy destination.
+    Copies,
+    /// After them: to fragment shaders' sampling, and every buffer the copies wrote visible to
+    /// the vertex, index, uniform and storage reads after.
+    Reads,
+}
+
+impl Recording<'_> {
+    /// The barrier of an upload's phase `next` for `images`, colour images with their mip level
+    /// counts (uploads have levels, which [`ImageRef`] does not), in one command. The reads
+    /// after it come in later submissions (creation waits for its upload), which submission
+    /// order orders after it.
+    pub(crate) fn declare_upload(&self, images: &[(vk::Image, u32)], next: Upload) {
+        use vk::{AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+        let ((src_stage, src_access, old), (dst_stage, dst_access, new)) = match next {
+            Upload::Copies => (
+                (S::NONE, A::NONE, L::UNDEFINED),
+                (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
+            ),
+            Upload::Reads => (
+                (S::COPY, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL),
+                (
+                    S::FRAGMENT_SHADER,
+                    A::SHADER_SAMPLED_READ,
+                    L::SHADER_READ_ONLY_OPTIMAL,
+                ),
+            ),
+        };
+        let barriers: Vec<_> = images
+            .iter()
+            .map(|&(image, levels)| {
+                vk::ImageMemoryBarrier2::default()
+                    .src_stage_mask(src_stage)
+                    .src_access_mask(src_access)
+                    .dst_stage_mask(dst_stage)
+                    .dst_access_mask(dst_access)
+                    .old_layout(old)
+                    .new_layout(new)
+                    .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                    .image(image)
+                    .subresource_range(
+                        subresource_range(vk::ImageAspectFlags::COLOR).level_count(levels),
+                    )
+            })
+            .collect();
+        let buffer_reads = [vk::MemoryBarrier2::default()
+            .src_stage_mask(S::COPY)
+            .src_access_mask(A::TRANSFER_WRITE)
+            .dst_stage_mask(
+                S::VERTEX_INPUT | S::VERTEX_SHADER | S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+            )
+            .dst_access_mask(
+                A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ | A::UNIFORM_READ | A::SHADER_STORAGE_READ,
+            )];
+        let mut dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+        if next == Upload::Reads {
+            dependency = dependency.memory_barriers(&buffer_reads);
+        } else if barriers.is_empty() {
+            return;
+        }
+        // SAFETY: outside rendering (`submit_once`'s recording, checked by `outside` in debug
+        // builds); each image is a live colour image of the caller's with `levels` levels, in
+        // the layout `old` names (nothing recorded into it but this upload's own commands);
+        // the stages are a graphics and compute queue's; `dependency` lives until the call
+        // returns.
+        unsafe { self.barrier(&dependency) };
+    }
+}
+
 /// The stages histencil records work in (named rather than `ALL_COMMANDS`, which the
 /// best-practices layer flags), all supported by the graphics and compute queue family it
 /// records on: what a full barrier waits for, and what a memory dependency may name.
@@ -386,252 +486,9 @@ fn recorded_stages() -> vk::PipelineStageFlags2 {
         | S::ALL_TRANSFER
 }
 
-/// How a buffer is used, as [`ImageAccess`] says it of an image: the stages and accesses a
-/// barrier between two uses waits for or makes visible (the table kajiya's `vk-sync` keeps).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BufferAccess {
-    /// Written by a fill or a copy.
-    TransferWrite,
-    /// Read by a copy.
-    TransferRead,
-    /// Read by fragment shaders as a storage buffer.
-    FragmentRead,
-    /// Read and written (atomics) by fragment shaders as a storage buffer.
-    FragmentReadWrite,
-    /// Written by compute shaders as a storage buffer.
-    ComputeWrite,
-    /// Read by compute shaders as a storage buffer.
-    ComputeRead,
-    /// Read and written (atomics) by compute shaders as a storage buffer.
-    ComputeReadWrite,
-    /// Read as an indirect dispatch's or draw's arguments.
-    IndirectRead,
-}
-
-/// The stages and access mask of a [`BufferAccess`]. Pure, so it is unit-tested.
-pub fn buffer_access_info(access: BufferAccess) -> (vk::PipelineStageFlags2, vk::AccessFlags2) {
-    use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
-    match access {
-        BufferAccess::TransferWrite => (S::ALL_TRANSFER, A::TRANSFER_WRITE),
-        BufferAccess::TransferRead => (S::ALL_TRANSFER, A::TRANSFER_READ),
-        BufferAccess::FragmentRead => (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ),
-        BufferAccess::FragmentReadWrite => (
-            S::FRAGMENT_SHADER,
-            A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-        ),
-        BufferAccess::ComputeWrite => (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
-        BufferAccess::ComputeRead => (S::COMPUTE_SHADER, A::SHADER_STORAGE_READ),
-        BufferAccess::ComputeReadWrite => (
-            S::COMPUTE_SHADER,
-            A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-        ),
-        BufferAccess::IndirectRead => (S::DRAW_INDIRECT, A::INDIRECT_COMMAND_READ),
-    }
-}
-
-/// What a hazard test leaves out of a declaration ([`Recording::declare_buffers_leaving_out`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum LeaveOut {
-    Barrier,
-    Declaration,
-}
-
-/// The write accesses histencil's buffers see: what a barrier makes available.
-pub(crate) const BUFFER_WRITES: vk::AccessFlags2 = vk::AccessFlags2::from_raw(
-    vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw() | vk::AccessFlags2::TRANSFER_WRITE.as_raw(),
-);
-
-impl BufferAccess {
-    /// Whether it writes.
-    pub fn writes(self) -> bool {
-        let (_, access) = buffer_access_info(self);
-        access.intersects(BUFFER_WRITES)
-    }
-}
-
-/// A buffer's last declared uses: its last write (stages and write accesses), the stages that
-/// read it since, and the stages that write was made visible to.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct BufferUse {
-    write: Option<(vk::PipelineStageFlags2, vk::AccessFlags2)>,
-    reads: vk::PipelineStageFlags2,
-    visible_to: vk::PipelineStageFlags2,
-}
-
-/// A dependency's (stages, accesses) before and after.
-type Scopes = (
-    (vk::PipelineStageFlags2, vk::AccessFlags2),
-    (vk::PipelineStageFlags2, vk::AccessFlags2),
-);
-
-/// The barrier a buffer needs between its last declared uses `last` and `next`, and what it
-/// has been used as after. Pure, so it is unit-tested: a write waits for the last write and
-/// every read since (an execution dependency for those, the write made available); a read
-/// waits for the last write unless a barrier made it visible to its stage already; a read
-/// after reads needs nothing.
-pub(crate) fn hand_over(last: BufferUse, next: BufferAccess) -> (Option<Scopes>, BufferUse) {
-    let (stage, access) = buffer_access_info(next);
-    if next.writes() {
-        let (write_stage, write_access) = last.write.unwrap_or_default();
-        let src = (write_stage | last.reads, write_access);
-        let barrier = (!src.0.is_empty()).then_some((src, (stage, access)));
-        let after = BufferUse {
-            write: Some((stage, access & BUFFER_WRITES)),
-            reads: vk::PipelineStageFlags2::empty(),
-            visible_to: vk::PipelineStageFlags2::empty(),
-        };
-        return (barrier, after);
-    }
-    let mut after = BufferUse {
-        reads: last.reads | stage,
-        ..last
-    };
-    match last.write {
-        Some(write) if !last.visible_to.contains(stage) => {
-            after.visible_to |= stage;
-            (Some((write, (stage, access))), after)
-        }
-        _ => (None, after),
-    }
-}
-
-impl Recording<'_> {
-    /// Declares how the step being recorded uses `uses`' buffers next, and records the one
-    /// barrier command that hands each over from its last declared uses (in recording order,
-    /// across command buffers: [`BufferUse`]); nothing where none is needed (a read after a
-    /// read, or a read the last write was already made visible to). Outside rendering.
-    ///
-    /// The hazard check holds the declarations to the shaders: until the innermost open label
-    /// closes, its draws and dispatches may write the buffers declared with a write access,
-    /// and any other buffer a shader writes is an error (`HISTENCIL-UNDECLARED-WRITE`, naming
-    /// the pass, set and binding), for no barrier could be derived for it.
-    pub(crate) fn declare_buffers(&self, uses: &[(vk::Buffer, BufferAccess)]) {
-        self.declare_buffers_leaving_out(uses, None);
-    }
-
-    /// [`Self::declare_buffers`] less one of its parts, for a hazard test to prove the check
-    /// finds it missing (`crate::gpu::hazards::HandOver`): the barrier (the uses still
-    /// recorded as the buffers' last), or the declaration the check holds shaders to (the
-    /// barrier still recorded). `None` leaves out nothing.
-    pub(crate) fn declare_buffers_leaving_out(
-        &self,
-        uses: &[(vk::Buffer, BufferAccess)],
-        leave_out: Option<LeaveOut>,
-    ) {
-        if let (Some(h), false) = (self.hazards(), leave_out == Some(LeaveOut::Declaration)) {
-            let writes: Vec<vk::Buffer> = uses
-                .iter()
-                .filter(|(_, a)| a.writes())
-                .map(|(b, _)| *b)
-                .collect();
-            h.declare_writes(self.any(), &writes);
-        }
-        let barriers: Vec<vk::BufferMemoryBarrier2> = {
-            let mut last = self
-                .ctx()
-                .buffer_uses
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
-            uses.iter()
-                .filter_map(|&(buffer, access)| {
-                    let state = last.entry(buffer).or_default();
-                    let (barrier, next) = hand_over(*state, access);
-                    *state = next;
-                    barrier.map(|(src, dst)| {
-                        vk::BufferMemoryBarrier2::default()
-                            .src_stage_mask(src.0)
-                            .src_access_mask(src.1)
-                            .dst_stage_mask(dst.0)
-                            .dst_access_mask(dst.1)
-                            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .buffer(buffer)
-                            .offset(0)
-                            .size(vk::WHOLE_SIZE)
-                    })
-                })
-                .collect()
-        };
-        if barriers.is_empty() || leave_out == Some(LeaveOut::Barrier) {
-            return;
-        }
-        let dependency = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);
-        // SAFETY: outside rendering (`barrier` checks it in debug builds); the buffers are live
-        // (the callers' own), and each barrier names only stages and accesses of the buffer
-        // access table, which the recording's queue family supports.
-        unsafe { self.barrier(&dependency) };
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn declared_buffer_uses_derive_the_hand_overs_they_need_and_no_more() {
-        use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
-        use BufferAccess::*;
-        // The first use of a buffer: nothing before it.
-        let (barrier, filled) = hand_over(BufferUse::default(), TransferWrite);
-        assert_eq!(barrier, None);
-        // Read after the fill: the write made visible to the fragment shader.
-        let (barrier, read) = hand_over(filled, FragmentRead);
-        let transfer = (S::ALL_TRANSFER, A::TRANSFER_WRITE);
-        assert_eq!(
-            barrier,
-            Some((transfer, (S::FRAGMENT_SHADER, A::SHADER_STORAGE_READ)))
-        );
-        // A second read of the same stage: already visible.
-        let (barrier, read) = hand_over(read, FragmentRead);
-        assert_eq!(barrier, None);
-        // A write after the reads waits for them (execution) and for the fill (memory).
-        let (barrier, _) = hand_over(read, TransferWrite);
-        let src = (S::ALL_TRANSFER | S::FRAGMENT_SHADER, A::TRANSFER_WRITE);
-        assert_eq!(barrier, Some((src, transfer)));
-        // Atomics after atomics (the light passes' split): their writes handed over.
-        let (_, counted) = hand_over(BufferUse::default(), FragmentReadWrite);
-        let (barrier, _) = hand_over(counted, FragmentReadWrite);
-        let rw = (
-            S::FRAGMENT_SHADER,
-            A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
-        );
-        assert_eq!(
-            barrier,
-            Some(((S::FRAGMENT_SHADER, A::SHADER_STORAGE_WRITE), rw))
-        );
-    }
-
-    #[test]
-    fn buffer_accesses_name_their_stage_and_only_writes_are_made_available() {
-        use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
-        let all = [
-            BufferAccess::TransferWrite,
-            BufferAccess::TransferRead,
-            BufferAccess::FragmentRead,
-            BufferAccess::FragmentReadWrite,
-            BufferAccess::ComputeWrite,
-            BufferAccess::ComputeRead,
-            BufferAccess::ComputeReadWrite,
-            BufferAccess::IndirectRead,
-        ];
-        for access in all {
-            let (stage, mask) = buffer_access_info(access);
-            assert!(!stage.is_empty() && !mask.is_empty(), "{access:?}");
-            assert!(
-                !stage.contains(S::ALL_COMMANDS),
-                "{access:?}: name the stage"
-            );
-            let writes = mask.intersects(A::TRANSFER_WRITE | A::SHADER_STORAGE_WRITE);
-            let named_write = matches!(
-                access,
-                BufferAccess::TransferWrite
-                    | BufferAccess::FragmentReadWrite
-                    | BufferAccess::ComputeWrite
-                    | BufferAccess::ComputeReadWrite
-            );
-            assert_eq!(writes, named_write, "{access:?}");
-        }
-    }
 
     /// Each access's usage holds what its layout needs: Vulkan allows a barrier into a layout
     /// only for images with that layout's usage (VUID-VkImageMemoryBarrier2-oldLayout-01208 to
