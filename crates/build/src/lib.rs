@@ -76,7 +76,9 @@ impl Stage {
 /// Every stage compiled per engine, once: [`HOOKED_STAGES`], [`BRDF_STAGES`], the fields of the
 /// generated `LightModules` and `BrdfModules` expressions and histencil's run-time compile all
 /// come from this table. A stage added here is compiled into both wherever it belongs; its
-/// field must exist in the struct its flags put it in (the compiler says so where it does not).
+/// field must exist in the struct its flags put it in: a build script's generated expression
+/// does not compile otherwise, and histencil-vk's tests hold its run-time assembly of the
+/// modules to this table.
 pub const STAGES: [Stage; 14] = {
     const fn stage(file: &'static str, hooked: bool, evaluates_brdf: bool) -> Stage {
         Stage {
@@ -103,20 +105,23 @@ pub const STAGES: [Stage; 14] = {
     ]
 };
 
-/// The files of the [`STAGES`] `keep` selects, in the table's order (a const fn: the lists
-/// below are consts of the table, not copies of it).
-const fn files<const N: usize>(
-    hooked: Option<bool>,
-    evaluates_brdf: Option<bool>,
-) -> [&'static str; N] {
+/// Which of the [`STAGES`] a list holds.
+#[derive(Clone, Copy)]
+enum Select {
+    Hooked,
+    EvaluatesBrdf,
+}
+
+/// The files of the [`STAGES`] `select` names, in the table's order (a const fn: the lists
+/// below are consts of the table, not copies of it; `N` is checked against the table).
+const fn files<const N: usize>(select: Select) -> [&'static str; N] {
     let mut out = [""; N];
     let (mut i, mut n) = (0, 0);
     while i < STAGES.len() {
         let s = STAGES[i];
-        let keep = match (hooked, evaluates_brdf) {
-            (Some(h), _) => s.hooked == h,
-            (None, Some(e)) => s.evaluates_brdf == e,
-            (None, None) => true,
+        let keep = match select {
+            Select::Hooked => s.hooked,
+            Select::EvaluatesBrdf => s.evaluates_brdf,
         };
         if keep {
             out[n] = s.file;
@@ -129,7 +134,7 @@ const fn files<const N: usize>(
 }
 
 /// The light shaders that call the hooks, compiled per engine ([`STAGES`] that are hooked).
-pub const HOOKED_STAGES: [&str; 8] = files(Some(true), None);
+pub const HOOKED_STAGES: [&str; 8] = files(Select::Hooked);
 
 /// Why the light shaders could not be compiled.
 #[derive(Debug)]
@@ -144,9 +149,9 @@ pub enum BuildError {
     /// The engine's BRDF folder or set was refused (the manifest's path and line), or one of
     /// its GLSL files could not be read.
     Brdfs(String),
-    /// `glslc` rejected a stage compiled with the hooks.
+    /// `glslc` rejected a stage compiled with the hooks or a BRDF set (one of [`STAGES`]).
     Compile {
-        /// The stage's file name, one of [`HOOKED_STAGES`].
+        /// The stage's file name.
         stage: String,
         /// glslc's error output, which names the hook file and line at fault.
         message: String,
@@ -329,7 +334,7 @@ fn ids_and_names(set: &BrdfSet) -> (String, String) {
 
 /// The stages that evaluate a BRDF (each includes `brdf/eval.glsl`): what a BRDF set is compiled
 /// into ([`compile_brdf_modules`]; [`STAGES`] that evaluate a BRDF).
-pub const BRDF_STAGES: [&str; 11] = files(None, Some(true));
+pub const BRDF_STAGES: [&str; 11] = files(Select::EvaluatesBrdf);
 
 /// Writes what histencil's shaders include to evaluate `set` into `folder` (its `brdf_set/`
 /// files, and a copy of the engine's GLSL under `engine/`, so that no name of the engine's can
@@ -433,8 +438,8 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
     ];
     // Each stage's field, by the table: a hooked stage's in `light`, the others' beside it.
     let (mut light_fields, mut fields) = (String::new(), String::new());
-    for table in STAGES.iter().filter(|s| s.evaluates_brdf) {
-        let stage = table.file;
+    for row in STAGES.iter().filter(|s| s.evaluates_brdf) {
+        let stage = row.file;
         let out = target.join(format!("{stage}.spv"));
         run_glslc(glslc_command(&shaders.join(stage), &includes, &out), stage).map_err(
             |e| match e {
@@ -445,13 +450,14 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
                 other => other,
             },
         )?;
-        let (into, indent) = match table.hooked {
-            true => (&mut light_fields, "        "),
-            false => (&mut fields, "    "),
+        let (into, indent) = if row.hooked {
+            (&mut light_fields, "        ")
+        } else {
+            (&mut fields, "    ")
         };
         *into += &format!(
             "{indent}{}: include_bytes!({:?}),\n",
-            table.field(),
+            row.field(),
             out.display().to_string()
         );
     }
@@ -506,8 +512,8 @@ pub fn compile_light_shaders_for(
     ]);
     // Unqualified: the engine names it through `histencil` or `histencil_vk`, whichever it uses.
     let mut fields = String::from("LightModules {\n");
-    for table in STAGES.iter().filter(|s| s.hooked) {
-        let stage = table.file;
+    for row in STAGES.iter().filter(|s| s.hooked) {
+        let stage = row.file;
         let source = shaders.join(stage);
         let out = target.join(format!("{stage}.spv"));
         run_glslc(glslc_command(&source, &includes, &out), stage).map_err(|e| match e {
@@ -520,7 +526,7 @@ pub fn compile_light_shaders_for(
         })?;
         fields += &format!(
             "    {}: include_bytes!({:?}),\n",
-            table.field(),
+            row.field(),
             out.display().to_string()
         );
     }

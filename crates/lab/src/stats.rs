@@ -161,13 +161,16 @@ impl Verdict {
     /// driver it can change the techniques' ratio itself, not only their times (llvmpipe's
     /// rasterizer thread and the submitting thread share the cores with the load, and many
     /// small draws suffer otherwise than a few large ones: on lavapipe at 320x180 stencil over
-    /// branching at 1 % lights read 1.17 quietly and 0.945 beside one busy process). Rounds from before and
-    /// after such a change mix two answers, and the interval of their median can exclude the
-    /// margin on the side of whichever condition has more rounds so far. Asking each half to
-    /// agree turns that mix into "undecided", and more rounds, while the halves disagree: a
-    /// median that moved across an edge during the run is a change of conditions, not a
-    /// property of the techniques. Under steady conditions the halves agree wherever the whole
-    /// interval clears an edge, but for chance.
+    /// branching at 1 % lights read 1.17 quietly and 0.945 beside one busy process). Rounds
+    /// from before and after such a change mix two answers, and the interval of their median
+    /// can exclude the margin on the side of whichever condition has more rounds so far.
+    /// Asking each half to agree turns that mix into "undecided", and more rounds, while the
+    /// halves disagree: a median that moved across an edge during the run is a change of
+    /// conditions, not a property of the techniques. Under steady conditions the halves agree
+    /// wherever the whole interval clears an edge, but for chance (at 10 rounds always: an
+    /// interval beyond an edge there has 9 of 10 rounds beyond it). A burst centred on the
+    /// run's middle, or a periodic load, spoils both halves alike: that is the steady clock's
+    /// to see.
     pub fn at_margin(ratio: &Interval, margin: f64) -> Verdict {
         let (lo_edge, hi_edge) = (1.0 - margin, 1.0 + margin);
         let verdict = if ratio.samples < MIN_VERDICT_ROUNDS {
@@ -204,6 +207,19 @@ impl Verdict {
         let m = ratio.median;
         if ratio.samples == 0 || !m.is_finite() {
             return None;
+        }
+        // The interval clears an edge and only the halves disagree: conditions changed part
+        // way, and the rounds after the change must come to hold most of both halves (four
+        // times the rounds before it): ask for twice the rounds so far, and again after.
+        let whole = Self::at_margin(
+            &Interval {
+                halves: None,
+                ..*ratio
+            },
+            margin,
+        );
+        if whole.decided() && !Self::at_margin(ratio, margin).decided() {
+            return Some((2 * ratio.samples).max(MIN_VERDICT_ROUNDS));
         }
         // How far the interval must stay from the median, and how far it reaches now.
         let (room, reach) = if m < lo_edge {
@@ -535,6 +551,13 @@ mod tests {
             Verdict::rounds_to_decide(&at(1.1, 1.2, 1.3, 4), MARGIN),
             Some(10)
         );
+        // Cleared an edge, but the halves disagree (a load came part way): twice the rounds.
+        let split = Interval {
+            halves: Some((1.2, 0.94)),
+            ..at(1.1, 1.2, 1.3, 30)
+        };
+        assert_eq!(Verdict::of(&split), Verdict::Undecided);
+        assert_eq!(Verdict::rounds_to_decide(&split, MARGIN), Some(60));
         // Within the margin: the nearer edge counts.
         assert_eq!(
             Verdict::rounds_to_decide(&at(0.96, 1.0, 1.08, 10), MARGIN),

@@ -196,7 +196,7 @@ impl Stability {
     pub fn json(&self) -> serde_json::Value {
         use serde_json::json;
         let s = &self.settings;
-        json!({
+        let mut out = json!({
             "canary": self.workload,
             "tolerance": s.tolerance,
             "settle_window": s.window,
@@ -214,11 +214,11 @@ impl Stability {
                 })).collect::<Vec<_>>(),
                 "canary_ms": set.canary.iter().map(|c| c.ms).collect::<Vec<_>>(),
                 "canary_reference_ms": set.canary.iter().map(|c| c.reference_ms).collect::<Vec<_>>(),
-                // Cores other processes kept busy per kept round, where every one was measured
-                // (an empty list where the meter could not be read).
-                "foreign_load_cores": set.canary.iter().map(|c| c.foreign_load)
-                    .collect::<Option<Vec<_>>>()
-                    .unwrap_or_default(),
+                // [round, cores other processes kept busy] of each kept round whose load was
+                // read (rounds too short to read, or a meter that cannot, have none).
+                "foreign_load_cores": set.canary.iter()
+                    .filter_map(|c| c.foreign_load.map(|l| json!([c.round, l])))
+                    .collect::<Vec<_>>(),
                 "retaken": set.retaken.iter().map(|r| {
                     let mut retake = json!({
                         "round": r.round,
@@ -232,7 +232,14 @@ impl Stability {
                 }).collect::<Vec<_>>(),
                 "unsteady_rounds": set.unsteady,
             })).collect::<Vec<_>>(),
-        })
+        });
+        // What `compare merge` reads: the kept rounds beside other processes' load (absent
+        // for a quiet run: the report holds no nulls).
+        if let Some((busy, kept, most)) = self.busy_elsewhere() {
+            out["busy_elsewhere"] =
+                json!({"rounds": busy, "kept_rounds": kept, "most_cores": most});
+        }
+        out
     }
 
     /// A report's section: what the canary is and how steady each set's clock was.
@@ -334,6 +341,11 @@ pub struct Clock {
 
 /// A load meter: cumulative `(CPU seconds other processes took, wall seconds)`, or `None`.
 pub type Meter = dyn FnMut() -> Option<(f64, f64)>;
+
+/// The shortest round whose load is read: the kernel counts CPU time in 10 ms ticks, so a
+/// round's difference is off by a tick or two per core, which over 0.25 s is under a tenth of
+/// a core each; over a 20 ms round (five frames on a GPU) it would be whole cores.
+pub const MIN_METERED_SECONDS: f64 = 0.25;
 
 impl Clock {
     pub fn new(workload: impl Into<String>, settings: ClockSettings) -> Self {
@@ -472,7 +484,7 @@ impl Clock {
                 let start = self.read_meter();
                 let kept = work()?;
                 let foreign_load = match (start, self.read_meter()) {
-                    (Some((c0, t0)), Some((c1, t1))) if t1 > t0 => {
+                    (Some((c0, t0)), Some((c1, t1))) if t1 - t0 >= MIN_METERED_SECONDS => {
                         Some((c1 - c0).max(0.0) / (t1 - t0))
                     }
                     _ => None,

@@ -203,8 +203,8 @@ pub fn compile_with_hooks(
         .iter()
         .filter(|s| s.evaluates_brdf || (hooks.is_some() && s.hooked));
     let mut spirv = HashMap::new();
-    for table in stages {
-        let stage = table.file;
+    for row in stages {
+        let stage = row.file;
         let out = root.join(format!("{stage}.spv"));
         let command =
             histencil_build::glslc_command(&root.join("stages").join(stage), &includes, &out);
@@ -220,7 +220,7 @@ pub fn compile_with_hooks(
                 .replace(&root.display().to_string(), "histencil-vk/shaders")
         })?;
         let bytes = std::fs::read(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-        spirv.insert(table.field(), &*Box::leak(bytes.into_boxed_slice()));
+        spirv.insert(row.field(), &*Box::leak(bytes.into_boxed_slice()));
     }
     let modules: &'static BrdfModules = Box::leak(Box::new(
         modules_of(set, |field| spirv.get(field).copied()).expect("every BRDF stage compiled"),
@@ -369,4 +369,29 @@ pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> 
     }
     probed.lock().unwrap_or_else(|p| p.into_inner()).push(key);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The modules a compile assembles are the build table's stages, every one and no other:
+    /// a stage added to the table without a field here would be compiled and dropped.
+    #[test]
+    fn the_modules_are_assembled_from_every_stage_of_the_build_table() {
+        let asked = std::cell::RefCell::new(Vec::new());
+        let modules = modules_of(&BrdfSet::default(), |field| {
+            asked.borrow_mut().push(field.to_owned());
+            Some(&[0u8; 4][..])
+        });
+        assert!(modules.is_some());
+        let mut asked = asked.into_inner();
+        asked.sort();
+        let mut table: Vec<String> = histencil_build::STAGES
+            .iter()
+            .map(|s| s.field().to_owned())
+            .collect();
+        table.sort();
+        assert_eq!(asked, table);
+    }
 }

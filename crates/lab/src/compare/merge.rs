@@ -91,18 +91,11 @@ fn text(file: &Path, v: &Value, path: &str) -> Result<String> {
 }
 
 /// The most cores other processes kept busy in a kept round of the report's steady clock, where
-/// beyond its limit; `None` for a quiet run, a run without the clock, and reports before the
-/// clock read the load.
+/// beyond its limit (the clock's `busy_elsewhere`, which the report's conditions line states
+/// too); `None` for a quiet run, a run without the clock, and reports before the clock read
+/// the load.
 fn busy_elsewhere(stability: &Value) -> Option<f64> {
-    let limit = stability["max_foreign_load_cores"].as_f64()?;
-    stability["sets"]
-        .as_array()?
-        .iter()
-        .filter_map(|set| set["foreign_load_cores"].as_array())
-        .flatten()
-        .filter_map(Value::as_f64)
-        .filter(|l| *l > limit)
-        .reduce(f64::max)
+    stability["busy_elsewhere"]["most_cores"].as_f64()
 }
 
 fn interval(file: &Path, v: &Value, path: &str) -> Result<Interval> {
@@ -336,10 +329,15 @@ impl Merged {
     }
 
     /// The reversals between two runs of one device and driver (different loads): a verdict
-    /// that a change of conditions turned around, which the margin exists to prevent.
+    /// that a change of conditions turned around, which the margin exists to prevent. A run
+    /// beside other processes' load against one without is left out: that load is of unknown
+    /// size and kind, and on a CPU driver it changes the ratios themselves (its reversals are
+    /// still listed, as findings); a load histencil made (`--beside-load`) is judged.
     pub fn same_device_reversals(&self) -> Vec<(String, usize, usize)> {
-        let same =
-            |a: &DeviceReport, b: &DeviceReport| (&a.device, &a.driver) == (&b.device, &b.driver);
+        let same = |a: &DeviceReport, b: &DeviceReport| {
+            (&a.device, &a.driver, a.busy_elsewhere.is_some())
+                == (&b.device, &b.driver, b.busy_elsewhere.is_some())
+        };
         self.reversals()
             .into_iter()
             .filter(|(_, a, b)| same(&self.reports[*a], &self.reports[*b]))
@@ -724,9 +722,23 @@ mod tests {
     /// merged table names the load.
     #[test]
     fn a_run_beside_other_processes_is_named_as_its_own_conditions() {
+        use crate::steady::{CanaryTime, ClockSettings, SetStability, Stability};
         let stability = |loads: &[f64]| {
-            json!({"max_foreign_load_cores": 0.5,
-                   "sets": [{"foreign_load_cores": loads}, {"foreign_load_cores": []}]})
+            let canary = loads.iter().enumerate().map(|(round, l)| CanaryTime {
+                round,
+                ms: 1.0,
+                reference_ms: 1.0,
+                foreign_load: Some(*l),
+            });
+            Stability {
+                workload: "test".into(),
+                settings: ClockSettings::default(),
+                sets: vec![SetStability {
+                    canary: canary.collect(),
+                    ..SetStability::default()
+                }],
+            }
+            .json()
         };
         assert_eq!(busy_elsewhere(&stability(&[0.0, 0.06, 0.02])), None);
         assert_eq!(busy_elsewhere(&stability(&[0.99, 1.03, 0.2])), Some(1.03));
@@ -742,7 +754,20 @@ mod tests {
             "one report per condition"
         );
         busy.busy_elsewhere = Some(1.03);
+        // A reversal against it is listed, not judged (the CLI exits 0).
+        let interval = |lo, median, hi| Interval {
+            lo,
+            median,
+            hi,
+            samples: 10,
+            halves: None,
+        };
+        let mut q = q;
+        q.sizes[0].stencil_over_branching = interval(1.1, 1.2, 1.3);
+        busy.sizes[0].stencil_over_branching = interval(0.7, 0.8, 0.9);
         let merged = Merged::new(vec![q, busy]).unwrap();
+        assert_eq!(merged.reversals().len(), 1);
+        assert!(merged.same_device_reversals().is_empty());
         let md = merged.markdown();
         assert!(
             md.contains("| run 2 | fast | Mesa 22.3 | beside other processes (up to 1.03 cores) |"),

@@ -204,8 +204,9 @@ impl CompareReport {
              a practical margin of ±{:.0} %: faster or slower only where the whole interval lies \
              beyond it, \"within ±{:.0} %\" where it lies wholly inside, and each half of the \
              rounds in the order taken has its median there too (a load that started or stopped \
-             part way leaves the halves apart); \"undecided\" otherwise and below {} rounds. Error against the forward reference of the same scene: 8-bit \
-             max / mean, and mean FLIP.\n",
+             part way leaves the halves apart); \"undecided\" otherwise and below {} rounds. \
+             Error against the forward reference of the same scene: 8-bit max / mean, and mean \
+             FLIP.\n",
             self.device, self.driver, self.scene, self.scene_lights, self.width, self.height,
             self.frames, 100.0 * MARGIN, 100.0 * MARGIN, MIN_VERDICT_ROUNDS
         );
@@ -737,8 +738,12 @@ fn table_head(columns: &[String]) -> String {
 /// An interval as the reports store it, with the halves its verdict was held to, so that a
 /// merge gives the verdicts the run gave.
 pub(super) fn interval_json(i: &crate::stats::Interval) -> Value {
-    json!({"median": i.median, "lo": i.lo, "hi": i.hi, "samples": i.samples,
-           "halves": i.halves.map(|(a, b)| [a, b])})
+    let mut out = json!({"median": i.median, "lo": i.lo, "hi": i.hi, "samples": i.samples});
+    // Absent below two rounds, and for an interval read from an older report: no nulls.
+    if let Some((first, second)) = i.halves {
+        out["halves"] = json!([first, second]);
+    }
+    out
 }
 
 fn error_text(e: &ImageError) -> String {

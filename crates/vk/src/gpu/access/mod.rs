@@ -391,8 +391,9 @@ impl Recording<'_> {
             .src_access_mask(writes)
             .dst_stage_mask(vk::PipelineStageFlags2::HOST)
             .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-        // SAFETY: the recording's command buffer is recording outside rendering; `barrier` lives until the
-        // call returns and names only stages and accesses the queue family supports.
+        // SAFETY: the recording's command buffer is recording outside rendering; `barrier`
+        // lives until the call returns and names only stages and accesses the queue family
+        // supports.
         unsafe { self.barrier(&vk::DependencyInfo::default().memory_barriers(&barrier)) };
     }
 }
