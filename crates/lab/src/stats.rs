@@ -42,6 +42,18 @@ impl Interval {
         }
     }
 
+    /// An interval of 10 rounds with no halves: what the tests judge by hand.
+    #[cfg(test)]
+    pub(crate) fn of_ten(lo: f64, median: f64, hi: f64) -> Interval {
+        Interval {
+            lo,
+            median,
+            hi,
+            samples: 10,
+            halves: None,
+        }
+    }
+
     /// Whether the interval contains `value`.
     pub fn contains(&self, value: f64) -> bool {
         self.lo <= value && value <= self.hi
@@ -781,13 +793,7 @@ mod tests {
         // The measured flip (1.149 [1.053, 1.182] quiet, 0.959 [0.941, 0.973] loaded, from 5
         // rounds, so undecided now), as if from 10 rounds: at the margin the first is slower,
         // the second undecided (it reaches into ±5 %), so no reversal.
-        let interval = |lo, median, hi| Interval {
-            lo,
-            median,
-            hi,
-            samples: 10,
-            halves: None,
-        };
+        let interval = Interval::of_ten;
         let quiet = Verdict::of(&interval(1.053, 1.149, 1.182));
         let loaded = Verdict::of(&interval(0.941, 0.959, 0.973));
         assert_eq!((quiet, loaded), (Verdict::Slower, Verdict::Undecided));

@@ -663,13 +663,7 @@ mod tests {
 
     #[test]
     fn a_verdict_turned_around_by_load_on_one_device_is_a_same_device_reversal() {
-        let interval = |lo, median, hi| Interval {
-            lo,
-            median,
-            hi,
-            samples: 10,
-            halves: None,
-        };
+        let interval = Interval::of_ten;
         let mut q = report("q", "fast", "Mesa 22.3", "huge-lights");
         let mut loaded = report("l", "fast", "Mesa 22.3", "huge-lights");
         loaded.beside_load = 2;
@@ -755,13 +749,7 @@ mod tests {
         );
         busy.busy_elsewhere = Some(1.03);
         // A reversal against it is listed, not judged (the CLI exits 0).
-        let interval = |lo, median, hi| Interval {
-            lo,
-            median,
-            hi,
-            samples: 10,
-            halves: None,
-        };
+        let interval = Interval::of_ten;
         let mut q = q;
         q.sizes[0].stencil_over_branching = interval(1.1, 1.2, 1.3);
         busy.sizes[0].stencil_over_branching = interval(0.7, 0.8, 0.9);
