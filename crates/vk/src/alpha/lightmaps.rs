@@ -449,11 +449,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             t.reset(rec);
             t.start(rec);
         }
-        let label = match direction {
-            Some(_) => crate::passes::names::ALPHA_LIGHTMAPS_DIRECTIONAL,
-            None => crate::passes::names::ALPHA_LIGHTMAPS,
-        };
-        rec.step(label, |rec| {
+        // One name with or without a direction map: the frame times this pass by it.
+        rec.step(crate::passes::names::ALPHA_LIGHTMAPS, |rec| {
             let pipeline = match direction {
                 Some(direction) => {
                     begin_all_cleared(rec, &mut [atlas, direction], CLEAR_BLACK);

@@ -475,7 +475,7 @@ impl<'c> AlphaLighting<'c> {
             depth,
         } = *inputs;
         let [object_pipeline, particle_pipeline] = self.pipelines(rec.ctx(), mode)?;
-        rec.step(crate::passes::names::ALPHA, |rec| {
+        rec.pass(crate::passes::names::ALPHA, |rec| {
             // SAFETY: the sets match the layout's sets 0 to 2 (`create` made it from their
             // layouts): the renderer's frame set, the lightmaps' slot 0 alpha set (written by
             // `record_lightmaps` this frame) and the lightmap set; all live as long as `self`.

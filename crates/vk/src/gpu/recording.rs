@@ -19,10 +19,14 @@
 //! `end_render_pass` so pass state cannot be forgotten, and on kajiya's `record_pass_cb`, which
 //! wraps each pass in its label: [`Recording::step`] does the label. A recording may also carry
 //! a clock (`start_clock`, in `timing.rs`; the renderer's frame has one): then
-//! `rec.timed(name, body)` writes a timestamp after the pass's commands, which is both the
+//! `rec.pass(name, body)` is the label and a timestamp after the pass's commands in one call
+//! (the tone map, the alpha pass, the tiled classification and light lists), which is both the
 //! frame's per-pass GPU time and the GPU-written marker a stalled wait reports
-//! (`timing::progress_words`: the marks the GPU has written name the passes it finished). A
-//! recording without one (an engine's command buffer) records the same commands, untimed.
+//! (`timing::progress_words`: the marks the GPU has written name the passes it finished).
+//! `rec.timed(name, body)` is the timestamp alone, for the passes whose label is recorded
+//! inside another recording of the command buffer or spans less than the time (the G-buffer
+//! with the emissive pass, the lighting, the lightmaps). A recording without a clock (an
+//! engine's command buffer) records the same commands, untimed.
 //!
 //! Methods take `&self`: the state is in `Cell`s, which makes a `Recording` `!Sync` (and the
 //! clock's `Rc` `!Send`), so one thread records through it, as Vulkan's external

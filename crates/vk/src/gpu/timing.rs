@@ -393,6 +393,16 @@ impl Recording<'_> {
         out
     }
 
+    /// Records a pass: `body` inside its debug label `name` and, where this recording has a
+    /// clock, a timestamp that ends the pass under the same name ([`Self::timed`]). The one call
+    /// a pass makes, so that its label and its time cannot be spelled apart or cover different
+    /// commands; without a clock (an engine's command buffer) the label alone.
+    pub fn pass<R>(&self, name: &'static str, body: impl FnOnce(&Self) -> R) -> R {
+        let out = self.step(name, body);
+        self.mark(name);
+        out
+    }
+
     fn mark(&self, name: &'static str) {
         let Some(clock) = &self.clock else { return };
         let mut names = clock.names.borrow_mut();

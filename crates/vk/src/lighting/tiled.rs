@@ -164,13 +164,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
-        rec.timed(crate::passes::names::TILE_CLASSIFY, |rec| {
-            tiled.record_classify(rec, &sets, targets, depth_sampled, clear, mixed, shape)
-        });
-        let lights = frame.lights.len() as u32;
-        rec.timed(crate::passes::names::TILE_LIGHTS, |rec| {
-            tiled.record_light_lists(rec, lights)
-        });
+        // Each a timed pass of its own, by the clock lent to `rec`.
+        tiled.record_classify(&rec, &sets, targets, depth_sampled, clear, mixed, shape);
+        tiled.record_light_lists(&rec, frame.lights.len() as u32);
         match shade {
             TiledShade::Kernels => tiled.record_shade(&rec, mixed, &mut targets.hdr),
             TiledShade::DepthId => {

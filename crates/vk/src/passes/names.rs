@@ -15,10 +15,8 @@ pub const FORWARD: &str = "forward";
 pub const TILE_CLASSIFY: &str = "tile-classify";
 /// The tiled techniques' light lists: each light's bit in the tiles it reaches.
 pub const TILE_LIGHTS: &str = "tile-lights";
-/// The alpha entities' lightmaps.
+/// The alpha entities' lightmaps (with their direction maps, where asked for).
 pub const ALPHA_LIGHTMAPS: &str = "alpha-lightmaps";
-/// The alpha entities' lightmaps with their direction maps.
-pub const ALPHA_LIGHTMAPS_DIRECTIONAL: &str = "alpha-lightmaps-directional";
 /// The alpha entities, drawn over the lit frame.
 pub const ALPHA: &str = "alpha";
 /// The tonemap to the 8-bit image.

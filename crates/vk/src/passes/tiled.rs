@@ -488,7 +488,7 @@ impl TiledLighting {
         shape: TileClassify,
     ) {
         let push = self.push(clear, mixed);
-        rec.step(super::names::TILE_CLASSIFY, |rec| {
+        rec.pass(super::names::TILE_CLASSIFY, |rec| {
             let (sampled, keep) = (ImageAccess::ComputeSampled, Contents::Keep);
             let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
             if depth_sampled {
@@ -572,7 +572,7 @@ impl TiledLighting {
     /// the same command buffer (whose sets and push constants stay bound): each light's bit in
     /// the masks of the tiles it can reach, for [`TiledLighting::record_shade`].
     pub fn record_light_lists(&self, rec: &Recording, lights: u32) {
-        rec.step(super::names::TILE_LIGHTS, |rec| {
+        rec.pass(super::names::TILE_LIGHTS, |rec| {
             // The light lists set bits in the tiles' light masks (after the reset's fill), by
             // the tiles' depth ranges.
             rec.declare_buffers(&[

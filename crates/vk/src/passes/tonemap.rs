@@ -75,7 +75,7 @@ impl Tonemap {
 
     /// Tonemaps `targets.hdr` into `targets.ldr`.
     pub(crate) fn record(&self, rec: &Recording, inputs: &TonemapInputs, targets: &mut Targets) {
-        rec.step(super::names::TONEMAP, |rec| {
+        rec.pass(super::names::TONEMAP, |rec| {
             rec.declare(&mut [
                 (
                     &mut targets.hdr,

@@ -73,17 +73,15 @@ impl<'c> Renderer<'c> {
                 depth: desc.depth,
             };
             let targets = &mut self.targets;
-            rec.timed(names::ALPHA, |rec| {
-                alpha.record_alpha(rec, &inputs, targets)
-            })?;
+            // A timed pass of its own (`names::ALPHA`).
+            alpha.record_alpha(rec, &inputs, targets)?;
         }
         let inputs = TonemapInputs {
             frame_set: self.descriptors.frame_set,
             extent: self.extent,
         };
-        rec.timed(names::TONEMAP, |rec| {
-            self.tonemap.record(rec, &inputs, &mut self.targets)
-        });
+        // A timed pass of its own (`names::TONEMAP`).
+        self.tonemap.record(rec, &inputs, &mut self.targets);
         // Only the deferred frame has a G-buffer to read BRDF ids from.
         let readback = Readback {
             brdf_ids: desc.readback.brdf_ids && deferred.is_some(),
