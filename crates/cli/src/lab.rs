@@ -80,7 +80,8 @@ pub struct CompareArgs {
     #[arg(long, default_value_t = PREDICTED_BUDGET_CAP_S, conflicts_with = "budget_s")]
     budget_cap_s: f64,
     /// Run this many busy threads beside the measurement: the same run under contention, to
-    /// merge with a quiet one (`compare merge`), where no decided verdict may reverse.
+    /// merge with a quiet one (`compare merge`), which lists the verdicts the load turned round
+    /// (on a CPU driver a load on the cores changes the techniques' ratios themselves).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u16).range(0..=64))]
     beside_load: u16,
     /// Start the --beside-load threads as the table's round N (from 1) begins instead of before
@@ -115,9 +116,10 @@ pub enum Until {
 
 #[derive(clap::Subcommand)]
 enum CompareCommand {
-    /// Put several `compare` runs (devices, drivers, or one device quiet and loaded) side by
-    /// side: one table and one plot, the device and driver named in each column. Exits 1 when
-    /// a decided verdict reverses between two runs of one device and driver.
+    /// Put several `compare` runs (devices, drivers, one device quiet and loaded, or repeats) side
+    /// by side: one table and one plot, the device and driver named in each column. Exits 1 when
+    /// a decided verdict reverses between two runs of one device, driver and conditions (a
+    /// repeat); a reversal between a quiet and a loaded run is listed as a finding.
     Merge(CompareMergeArgs),
 }
 
@@ -146,7 +148,7 @@ fn compare_merge(args: &CompareMergeArgs) -> Result<()> {
     let reversed = merged.same_device_reversals();
     if !reversed.is_empty() {
         bail!(
-            "{} decided verdict(s) reversed between runs of one device and driver: {}",
+            "{} decided verdict(s) reversed between runs of one device, driver and conditions: {}",
             reversed.len(),
             reversed
                 .iter()

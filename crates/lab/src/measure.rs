@@ -118,8 +118,8 @@ pub fn frame(renderer: &mut Renderer, desc: impl Into<FrameDesc>) -> Result<Rgba
     Ok(images.ldr.expect("the LDR frame was asked for"))
 }
 
-/// Busy threads that spin until dropped: a measurement run under contention on purpose, to test
-/// whether its verdicts survive a change of conditions (`compare --beside-load`).
+/// Busy threads that spin until dropped: a measurement run under contention on purpose, to see
+/// what a change of conditions does to its verdicts (`compare --beside-load`).
 pub struct BusyThreads {
     stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
     threads: Vec<std::thread::JoinHandle<()>>,

@@ -7,9 +7,11 @@
 //! that device's run) with its verdict. Across devices the table says only which is lower where
 //! the two intervals do not overlap, and "overlap" where they do.
 //!
-//! Verdicts that reverse (faster in one report, slower in another) are listed: across devices a
-//! finding, between two runs of one device and driver under different conditions (quiet, and
-//! beside a load: `compare --beside-load`) a failure of the verdicts themselves, which
+//! Verdicts that reverse (faster in one report, slower in another) are listed. Across devices,
+//! and between a quiet and a loaded run of one device (`compare --beside-load`, or other
+//! processes' load the steady clock read), a reversal is a finding: a load on the cores changes
+//! a CPU driver's ratios themselves. Between two runs of one device, driver and conditions (a
+//! repeat) it is a failure of the verdicts, noise the margin should have absorbed, which
 //! [`Merged::same_device_reversals`] gives the CLI to exit non-zero on.
 
 use super::report::interval_json;
@@ -241,7 +243,8 @@ pub struct Merged {
 
 impl Merged {
     /// Refuses fewer than two reports, and reports of different workloads (scene, size,
-    /// techniques, BRDF counts) or light sizes, or the same device and driver twice.
+    /// techniques, BRDF counts) or light sizes. One device, driver and conditions twice is a
+    /// repeat, whose reversals the merge judges.
     ///
     /// # Errors
     /// [`LabError::Settings`] naming the report that differs and how.
@@ -253,10 +256,10 @@ impl Merged {
         };
         if reports.len() < 2 {
             return Err(LabError::Settings(
-                "compare merge puts two or more devices side by side; got one report".into(),
+                "compare merge puts two or more runs side by side; got one report".into(),
             ));
         }
-        for (i, r) in reports.iter().enumerate().skip(1) {
+        for r in reports.iter().skip(1) {
             if r.workload() != first.workload() {
                 let (s, w, h, _) = r.workload();
                 return Err(LabError::Settings(format!(
@@ -280,21 +283,6 @@ impl Merged {
                     coverages(r),
                     first.dir.display(),
                     coverages(first)
-                )));
-            }
-            if let Some(j) = reports[..i].iter().position(|o| {
-                let busy = |d: &DeviceReport| d.busy_elsewhere.is_some();
-                (&o.device, &o.driver, o.beside_load, busy(o), o.depth_bounds)
-                    == (&r.device, &r.driver, r.beside_load, busy(r), r.depth_bounds)
-            }) {
-                return Err(LabError::Settings(format!(
-                    "{} and {} are the same device, driver and load ({}, {}, {}): one report per \
-                     device or condition",
-                    reports[j].dir.display(),
-                    r.dir.display(),
-                    r.device,
-                    r.driver,
-                    r.conditions()
                 )));
             }
         }
@@ -328,15 +316,19 @@ impl Merged {
         out
     }
 
-    /// The reversals between two runs of one device and driver (different loads): a verdict
-    /// that a change of conditions turned around, which the margin exists to prevent. A run
-    /// beside other processes' load against one without is left out: that load is of unknown
-    /// size and kind, and on a CPU driver it changes the ratios themselves (its reversals are
-    /// still listed, as findings); a load histencil made (`--beside-load`) is judged.
+    /// The reversals between two runs of one device and driver under the same conditions (a
+    /// repeat: the same load beside it, by histencil or other processes, and the same depth
+    /// bounds test): noise turning a verdict round, which the margin and the intervals exist to
+    /// prevent. Between a quiet and a loaded run a reversal is a finding, listed with the others
+    /// and not judged: on lavapipe a load on the cores changes the techniques' ratios
+    /// themselves (llvmpipe's rasterizer shares the cores with it, and many small draws fare
+    /// otherwise than a few large ones: the talk's stencil on the AMD pretest platform over
+    /// branching at 3 BRDFs read 1.11 quiet and 0.86 beside two busy threads, 64x64, 15 rounds).
     pub fn same_device_reversals(&self) -> Vec<(String, usize, usize)> {
         let same = |a: &DeviceReport, b: &DeviceReport| {
-            (&a.device, &a.driver, a.busy_elsewhere.is_some())
-                == (&b.device, &b.driver, b.busy_elsewhere.is_some())
+            let busy = |d: &DeviceReport| d.busy_elsewhere.is_some();
+            (&a.device, &a.driver, a.beside_load, busy(a), a.depth_bounds)
+                == (&b.device, &b.driver, b.beside_load, busy(b), b.depth_bounds)
         };
         self.reversals()
             .into_iter()
@@ -608,19 +600,21 @@ mod tests {
     }
 
     #[test]
-    fn merging_refuses_what_is_not_one_workload_on_two_devices() {
+    fn merging_refuses_what_is_not_one_workload() {
         let a = report("a", "fast", "Mesa 22.3", "huge-lights");
         let err = |reports| Merged::new(reports).unwrap_err().to_string();
-        assert!(err(vec![a.clone()]).contains("two or more devices"));
+        assert!(err(vec![a.clone()]).contains("two or more runs"));
         assert!(
             err(vec![a.clone(), report("b", "fast", "Mesa 25.0", "town")])
                 .contains("merge runs of one workload")
         );
-        assert!(err(vec![
+        // A repeat of one device, driver and conditions merges: its reversals are what the
+        // merge judges.
+        assert!(Merged::new(vec![
             a.clone(),
             report("b", "fast", "Mesa 22.3", "huge-lights")
         ])
-        .contains("the same device, driver and load"));
+        .is_ok());
         // The depth bounds test on and off: one device under two conditions.
         let mut bounded = report("b", "fast", "Mesa 22.3", "huge-lights");
         bounded.depth_bounds = true;
@@ -662,11 +656,10 @@ mod tests {
     }
 
     #[test]
-    fn a_verdict_turned_around_by_load_on_one_device_is_a_same_device_reversal() {
+    fn a_verdict_turned_around_in_a_repeat_is_a_same_device_reversal_and_by_load_a_finding() {
         let interval = Interval::of_ten;
         let mut q = report("q", "fast", "Mesa 22.3", "huge-lights");
         let mut loaded = report("l", "fast", "Mesa 22.3", "huge-lights");
-        loaded.beside_load = 2;
         // The verdicts come from the intervals, whatever word a report stored.
         q.sizes[0].stencil_over_branching = interval(1.1, 1.2, 1.3);
         q.sizes[0].faster = "stencil".into();
@@ -684,11 +677,17 @@ mod tests {
         assert!(merged
             .markdown()
             .contains("0 reverse (faster in one run, slower in another) and 1 differ otherwise"));
+        // A repeat (the same conditions) that reverses: judged.
         loaded.sizes[0].stencil_over_branching = interval(0.7, 0.8, 0.9);
         let merged = Merged::new(vec![q.clone(), loaded.clone()]).unwrap();
         let reversed = merged.same_device_reversals();
         assert_eq!(reversed.len(), 1, "{reversed:?}");
         assert_eq!(reversed[0].0, "stencil over branching at 1 % light size");
+        // The same reversal beside busy threads: listed, a finding, not judged.
+        loaded.beside_load = 2;
+        let merged = Merged::new(vec![q.clone(), loaded.clone()]).unwrap();
+        assert_eq!(merged.reversals().len(), 1);
+        assert!(merged.same_device_reversals().is_empty());
         let md = merged.markdown();
         assert!(md.contains("1 reverse"), "{md}");
         assert!(
@@ -743,10 +742,6 @@ mod tests {
         );
         let q = report("q", "fast", "Mesa 22.3", "huge-lights");
         let mut busy = report("b", "fast", "Mesa 22.3", "huge-lights");
-        assert!(
-            Merged::new(vec![q.clone(), busy.clone()]).is_err(),
-            "one report per condition"
-        );
         busy.busy_elsewhere = Some(1.03);
         // A reversal against it is listed, not judged (the CLI exits 0).
         let interval = Interval::of_ten;
