@@ -559,9 +559,10 @@ fn compare_samples_until_the_talks_cells_are_decided_within_a_predicted_budget()
 }
 
 /// The steady clock sees conditions change part way: busy threads, two per core, start as the
-/// table's fourth round begins. That round's canary strays beyond the tolerance, the round is
-/// thrown away and retaken, and after the stated strays in a row the canary is warmed up again
-/// on a reference the load slowed; the report carries the record. (On llvmpipe the "clock" is
+/// table's fourth round begins. From that round on (that one, or the next where the threads
+/// took the cores only after its canary: one CI run saw it so) a canary strays beyond the
+/// tolerance, the round is thrown away and retaken, and after the stated strays in a row the
+/// canary is warmed up again on a reference the load slowed; the report carries the record. (On llvmpipe the "clock" is
 /// the CPU's share, which the busy threads take; on a GPU it is the GPU's clock.)
 #[test]
 fn the_steady_clock_sees_a_load_that_starts_part_way_and_retakes_the_round() {
@@ -593,8 +594,8 @@ fn the_steady_clock_sees_a_load_that_starts_part_way_and_retakes_the_round() {
     let first = table
         .retaken
         .iter()
-        .find(|r| r.round == 3)
-        .expect("the round the load began in was retaken");
+        .find(|r| r.round >= 3)
+        .expect("a round from the one the load began in was retaken");
     assert!(
         first.canary_ms > first.reference_ms * (1.0 + tolerance),
         "{first:?}"
@@ -602,8 +603,8 @@ fn the_steady_clock_sees_a_load_that_starts_part_way_and_retakes_the_round() {
     let again = table
         .warm_ups
         .iter()
-        .find(|w| w.before_round == 3)
-        .expect("the canary warmed up again where the load began");
+        .find(|w| w.before_round >= 3)
+        .expect("the canary warmed up again once the load began");
     assert!(
         again.reference_ms > first.reference_ms * (1.0 + tolerance),
         "the new reference {} ms is the loaded clock's, against {} ms",
