@@ -91,11 +91,7 @@ pub fn median_interval(samples: &[f64]) -> Interval {
     if n == 0 {
         return Interval::default();
     }
-    let median = if n % 2 == 1 {
-        sorted[n / 2]
-    } else {
-        (sorted[n / 2 - 1] + sorted[n / 2]) / 2.0
-    };
+    let median = histencil_vk::median_of_sorted(&sorted);
     // [x_(j), x_(n+1-j)] (1-based ranks) covers the median with probability
     // 1 - 2 P(X <= j - 1): take the largest j for which that is still at least 95 %.
     let mut j = 0;
@@ -116,16 +112,12 @@ pub fn median_interval(samples: &[f64]) -> Interval {
     }
 }
 
-/// The median of unsorted finite `samples` (not empty).
-fn median_of(samples: &[f64]) -> f64 {
+/// The median of unsorted `samples` (NaN for none): the steady clock's reference, and each
+/// half's in [`median_interval`].
+pub(crate) fn median_of(samples: &[f64]) -> f64 {
     let mut sorted = samples.to_vec();
     sorted.sort_by(f64::total_cmp);
-    let n = sorted.len();
-    if n % 2 == 1 {
-        sorted[n / 2]
-    } else {
-        (sorted[n / 2 - 1] + sorted[n / 2]) / 2.0
-    }
+    histencil_vk::median_of_sorted(&sorted)
 }
 
 /// The interval of `numerator[i] / denominator[i]`, paired by round `i`.

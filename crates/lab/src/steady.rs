@@ -81,19 +81,13 @@ pub fn settled(times: &[f64], window: usize, tolerance: f64) -> Option<f64> {
     let last = times.get(times.len().checked_sub(window)?..)?;
     let lo = last.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = last.iter().copied().fold(0.0, f64::max);
-    (lo > 0.0 && hi <= lo * (1.0 + tolerance)).then(|| median(last))
+    (lo > 0.0 && hi <= lo * (1.0 + tolerance)).then(|| crate::stats::median_of(last))
 }
 
 /// Whether a canary time of `ms` strays from `reference` beyond `tolerance` (either way: a
 /// faster clock is as much a change of conditions as a slower one).
 pub fn strays(ms: f64, reference: f64, tolerance: f64) -> bool {
     !(ms.is_finite() && reference > 0.0 && (ms / reference - 1.0).abs() <= tolerance)
-}
-
-fn median(times: &[f64]) -> f64 {
-    let mut sorted = times.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    histencil_vk::median_of_sorted(&sorted)
 }
 
 /// One warm-up: the canary run until its time settled (or the caps ran out).
@@ -441,7 +435,7 @@ impl Clock {
             times.push(canary()?);
         };
         let tail = &times[times.len().saturating_sub(s.window)..];
-        let reference_ms = reference.unwrap_or_else(|| median(tail));
+        let reference_ms = reference.unwrap_or_else(|| crate::stats::median_of(tail));
         self.reference_ms = Some(reference_ms);
         self.last_steady = times.last().copied().filter(|t| !self.strays(*t));
         let warm_up = WarmUp {
@@ -472,14 +466,13 @@ impl Clock {
         let rewarm = self.settings.retakes_before_rewarm.max(1);
         let mut strays_in_a_row = 0;
         loop {
-            let mut measured = None;
             let last_try = strays_in_a_row >= 2 * rewarm || Instant::now() >= deadline;
             let before = match self.last_steady.take() {
                 Some(ms) => ms,
                 None => canary()?,
             };
-            let strayed = if self.strays(before) && !last_try {
-                before
+            let (strayed, foreign_load) = if self.strays(before) && !last_try {
+                (before, None)
             } else {
                 let start = self.read_meter();
                 let kept = work()?;
@@ -489,10 +482,10 @@ impl Clock {
                     }
                     _ => None,
                 };
-                measured = foreign_load;
                 let after = canary()?;
                 let beside_load = foreign_load.is_some_and(|l| l > self.settings.max_foreign_load);
                 let steady = !self.strays(before) && !self.strays(after) && !beside_load;
+                self.last_steady = (!self.strays(after)).then_some(after);
                 if steady || last_try {
                     let reference_ms = self.reference_ms.unwrap_or(0.0);
                     let set = self.set();
@@ -505,21 +498,16 @@ impl Clock {
                     if !steady {
                         set.unsteady.push(index);
                     }
-                    self.last_steady = (!self.strays(after)).then_some(after);
                     return Ok(kept);
                 }
-                self.last_steady = (!self.strays(after)).then_some(after);
-                if self.strays(before) {
-                    before
-                } else {
-                    after
-                }
+                let strayed = if self.strays(before) { before } else { after };
+                (strayed, foreign_load)
             };
             let retake = Retake {
                 round: index,
                 canary_ms: strayed,
                 reference_ms: self.reference_ms.unwrap_or(0.0),
-                foreign_load: measured,
+                foreign_load,
             };
             self.news.push(News::Retaken(retake));
             self.set().retaken.push(retake);
