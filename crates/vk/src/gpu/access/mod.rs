@@ -447,21 +447,28 @@ impl Recording<'_> {
                     )
             })
             .collect();
-        let buffer_reads = [vk::MemoryBarrier2::default()
-            .src_stage_mask(S::COPY)
-            .src_access_mask(A::TRANSFER_WRITE)
-            .dst_stage_mask(
-                S::VERTEX_INPUT | S::VERTEX_SHADER | S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
-            )
-            .dst_access_mask(
-                A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ | A::UNIFORM_READ | A::SHADER_STORAGE_READ,
-            )];
-        let mut dependency = vk::DependencyInfo::default().image_memory_barriers(&barriers);
-        if next == Upload::Reads {
-            dependency = dependency.memory_barriers(&buffer_reads);
-        } else if barriers.is_empty() {
+        // After the copies, the buffers they wrote too.
+        let buffer_reads: &[_] = match next {
+            Upload::Copies => &[],
+            Upload::Reads => &[vk::MemoryBarrier2::default()
+                .src_stage_mask(S::COPY)
+                .src_access_mask(A::TRANSFER_WRITE)
+                .dst_stage_mask(
+                    S::VERTEX_INPUT | S::VERTEX_SHADER | S::FRAGMENT_SHADER | S::COMPUTE_SHADER,
+                )
+                .dst_access_mask(
+                    A::VERTEX_ATTRIBUTE_READ
+                        | A::INDEX_READ
+                        | A::UNIFORM_READ
+                        | A::SHADER_STORAGE_READ,
+                )],
+        };
+        if barriers.is_empty() && buffer_reads.is_empty() {
             return;
         }
+        let dependency = vk::DependencyInfo::default()
+            .image_memory_barriers(&barriers)
+            .memory_barriers(buffer_reads);
         // SAFETY: outside rendering (`submit_once`'s recording, checked by `outside` in debug
         // builds); each image is a live colour image of the caller's with `levels` levels, in
         // the layout `old` names (nothing recorded into it but this upload's own commands);
