@@ -439,27 +439,12 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
     // Each stage's field, by the table: a hooked stage's in `light`, the others' beside it.
     let (mut light_fields, mut fields) = (String::new(), String::new());
     for row in STAGES.iter().filter(|s| s.evaluates_brdf) {
-        let stage = row.file;
-        let out = target.join(format!("{stage}.spv"));
-        run_glslc(glslc_command(&shaders.join(stage), &includes, &out), stage).map_err(
-            |e| match e {
-                BuildError::Compile { stage, message } => BuildError::Compile {
-                    stage,
-                    message: engine_paths(&message, set, &set_folder),
-                },
-                other => other,
-            },
-        )?;
-        let (into, indent) = if row.hooked {
-            (&mut light_fields, "        ")
+        let field = compile_stage(row, (&shaders, &includes, &target), set, &set_folder)?;
+        if row.hooked {
+            light_fields += &format!("        {field}");
         } else {
-            (&mut fields, "    ")
-        };
-        *into += &format!(
-            "{indent}{}: include_bytes!({:?}),\n",
-            row.field(),
-            out.display().to_string()
-        );
+            fields += &format!("    {field}");
+        }
     }
     let (ids, names) = ids_and_names(set);
     let expression = format!(
@@ -470,6 +455,32 @@ pub fn compile_brdf_modules(set: &BrdfSet, out_dir: &Path) -> Result<PathBuf, Bu
     std::fs::write(&rust, expression)
         .map_err(|e| BuildError::Io(format!("{}: {e}", rust.display())))?;
     Ok(rust)
+}
+
+/// Compiles `row`'s stage from histencil's `shaders` folder into `target` with `includes`
+/// searched, and returns its line of a generated expression (`field: include_bytes!(..),`).
+/// glslc's message names the engine's BRDF files by their own paths, not their copies' under
+/// `set_folder`.
+fn compile_stage(
+    row: &Stage,
+    (shaders, includes, target): (&Path, &[&Path], &Path),
+    set: &BrdfSet,
+    set_folder: &Path,
+) -> Result<String, BuildError> {
+    let stage = row.file;
+    let out = target.join(format!("{stage}.spv"));
+    run_glslc(glslc_command(&shaders.join(stage), includes, &out), stage).map_err(|e| match e {
+        BuildError::Compile { stage, message } => BuildError::Compile {
+            stage,
+            message: engine_paths(&message, set, set_folder),
+        },
+        other => other,
+    })?;
+    Ok(format!(
+        "{}: include_bytes!({:?}),\n",
+        row.field(),
+        out.display().to_string()
+    ))
 }
 
 /// Compiles [`HOOKED_STAGES`] for the engine's BRDF `set`, with the hook files in `hook_folder`
@@ -513,22 +524,8 @@ pub fn compile_light_shaders_for(
     // Unqualified: the engine names it through `histencil` or `histencil_vk`, whichever it uses.
     let mut fields = String::from("LightModules {\n");
     for row in STAGES.iter().filter(|s| s.hooked) {
-        let stage = row.file;
-        let source = shaders.join(stage);
-        let out = target.join(format!("{stage}.spv"));
-        run_glslc(glslc_command(&source, &includes, &out), stage).map_err(|e| match e {
-            // The engine's BRDF files by their own paths, not their copies'.
-            BuildError::Compile { stage, message } => BuildError::Compile {
-                stage,
-                message: engine_paths(&message, set, &set_folder),
-            },
-            other => other,
-        })?;
-        fields += &format!(
-            "    {}: include_bytes!({:?}),\n",
-            row.field(),
-            out.display().to_string()
-        );
+        let field = compile_stage(row, (&shaders, &includes, &target), set, &set_folder)?;
+        fields += &format!("    {field}");
     }
     let (ids, names) = ids_and_names(set);
     fields += &format!("    brdfs: &[{ids}],\n    brdf_names: &[{names}],\n}}\n");
