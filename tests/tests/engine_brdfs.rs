@@ -97,6 +97,38 @@ fn folder(name: &str, files: &[(&str, &str)]) -> PathBuf {
     dir
 }
 
+/// A set of one engine BRDF without parameters, `name` in `name.glsl` (`body` its GLSL), with
+/// no built-in beside it, compiled.
+fn one_brdf(name: &str, body: &str, tint: bool) -> (BrdfSet, &'static BrdfModules) {
+    let file = format!("{name}.glsl");
+    let dir = folder(&format!("engine-brdfs-{name}"), &[(&file, body)]);
+    let spec = EngineBrdfSpec {
+        name: name.into(),
+        glsl: file,
+        function: name.into(),
+        white: None,
+        params: vec![],
+        tangent: false,
+        tint,
+    };
+    let set = BrdfSet::new(&[], vec![spec])
+        .unwrap()
+        .with_folder(dir.canonicalize().unwrap());
+    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    (set, modules)
+}
+
+/// What the probe an engine runs itself (`probe_brdfs`) says of `modules`, which it must refuse.
+fn probe_refusal(modules: &'static BrdfModules) -> String {
+    let mut text = String::new();
+    with_validated_context(|ctx| {
+        text = histencil_vk::probe_brdfs(ctx, modules)
+            .expect_err("the probe refuses it")
+            .to_string();
+    });
+    text
+}
+
 #[test]
 fn an_engine_brdf_spelling_lambert_gives_the_builtin_frames_bit_for_bit() {
     let dir = folder(
@@ -117,6 +149,7 @@ fn an_engine_brdf_spelling_lambert_gives_the_builtin_frames_bit_for_bit() {
             default: 1.0,
         }],
         tangent: false,
+        tint: false,
     };
     // Only Blinn-Phong kept beside it: the others are left out of every switch.
     let set = BrdfSet::new(&[BrdfId::BlinnPhong], vec![spec])
@@ -185,28 +218,125 @@ fn the_example_brdfs_are_held_to_forward_by_every_technique() {
     });
 }
 
+/// An engine BRDF whose function takes the tint is called with the pixel's colour by every
+/// technique: spelling glTF's metallic-roughness so (`tint * tinted + white` from histencil's
+/// own GLSL) gives the built-in's frames bit for bit. A tint reaching it wrong anywhere (a
+/// white surface's, another pixel's) would change them.
 #[test]
-fn a_material_the_set_does_not_hold_and_a_non_finite_brdf_are_refused_before_recording() {
-    let scene = histencil_scene::embedded("default").unwrap();
+fn an_engine_brdf_taking_the_tint_gives_the_builtin_gltf_frames_bit_for_bit() {
     let dir = folder(
-        "engine-brdfs-spiky",
+        "engine-brdfs-gltf-tinted",
         &[(
-            "spiky.glsl",
-            "vec3 spiky(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(p.x / dot(N, L));\n}\n",
+            "mine.glsl",
+            "vec3 my_gltf(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L) {\n    vec2 g = brdf_gltf_metal_rough(p.x, p.y, N, V, L);\n    return tint * g.x + g.y;\n}\n",
         )],
     );
+    let params = ["alpha", "metallic"].map(|name| EngineParam {
+        name: name.into(),
+        range: Range::new(0.0, 1.0),
+        default: 0.5,
+    });
     let spec = EngineBrdfSpec {
-        name: "spiky".into(),
-        glsl: "spiky.glsl".into(),
-        function: "spiky".into(),
+        name: "my_gltf".into(),
+        glsl: "mine.glsl".into(),
+        function: "my_gltf".into(),
         white: None,
-        params: vec![],
+        params: params.to_vec(),
         tangent: false,
+        tint: true,
     };
-    let set = BrdfSet::new(&[], vec![spec])
+    let set = BrdfSet::new(&BrdfId::ALL, vec![spec])
         .unwrap()
         .with_folder(dir.canonicalize().unwrap());
     let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    let builtin = histencil_scene::embedded("pbr-mixed").unwrap();
+    let mut engine = builtin.clone();
+    let mut swapped = 0;
+    for o in &mut engine.objects {
+        if let Brdf::GltfMetalRough { alpha, metallic } = o.material.brdf {
+            let given = [("alpha", alpha), ("metallic", metallic)];
+            o.material.brdf = set.engine_brdf("my_gltf", &given).unwrap();
+            swapped += 1;
+        }
+    }
+    assert!(swapped > 0);
+    with_validated_context(|ctx| {
+        for (name, shading) in techniques() {
+            let expected = render(ctx, &builtin, BrdfModules::builtin(), shading);
+            let actual = render(ctx, &engine, modules, shading);
+            let d = diff(&expected, &actual);
+            assert_eq!(d.max, 0, "{name}: the engine's glTF differs: {d:?}");
+        }
+    });
+}
+
+/// A metallic-roughness that goes with the base colour squared (`tests/brdfs/metal-rough`), as
+/// engines write it and no `tint * f + white` can: every exact technique holds it to forward;
+/// the LUT refuses it, naming why; the probe evaluates it at several colours.
+#[test]
+fn a_brdf_of_the_colour_squared_is_held_to_forward_and_refused_by_the_lut() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("brdfs/metal-rough");
+    let set = BrdfSet::load(&dir).expect("tests/brdfs/metal-rough loads");
+    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
+    let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
+    let mut swapped = 0;
+    for (i, o) in scene.objects.iter_mut().enumerate() {
+        if !matches!(o.material.brdf, Brdf::Lambert { .. } | Brdf::Ggx { .. }) {
+            let given = [
+                ("roughness", 0.3 + 0.1 * (i % 4) as f64),
+                ("metallic", (i % 3) as f64 / 2.0),
+            ];
+            o.material.brdf = set.engine_brdf("metal_rough_rgb", &given).unwrap();
+            swapped += 1;
+        }
+    }
+    assert!(swapped > 0);
+    with_validated_context(|ctx| {
+        histencil_vk::probe_brdfs(ctx, modules).expect("finite and not negative");
+        let forward = render(ctx, &scene, modules, Shading::Forward);
+        assert!(lit_fraction(&forward) > 0.2);
+        for (name, shading) in techniques().into_iter().skip(1) {
+            let image = render(ctx, &scene, modules, shading);
+            assert_close(&format!("engine-brdfs-rgb-{name}"), &forward, &image, 1);
+        }
+        let desc = RendererDesc {
+            brdfs: modules,
+            ..RendererDesc::new(SIZE, SIZE)
+        };
+        let mut renderer = Renderer::with_desc(ctx, scene.clone(), &desc).unwrap();
+        let lut = Technique::Lut {
+            backend: Backend::Native,
+            flush: FlushPolicy::Auto,
+        };
+        let err = renderer.render(lut, Readback::ALL).err().unwrap();
+        let text = err.to_string();
+        assert!(
+            text.contains("`metal_rough_rgb`: its function takes the tint"),
+            "{text}"
+        );
+        assert_eq!(err.cause(), histencil_vk::Cause::Data);
+    });
+    // Negative for some colours only: the probe's colours find it.
+    let (_, modules) = one_brdf(
+        "dim",
+        "vec3 dim(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(max(dot(N, L), 0.0)) * (1.0 - 1.5 * tint);\n}\n",
+        true,
+    );
+    let text = probe_refusal(modules);
+    assert!(
+        text.contains("engine BRDF `dim` returns -") && text.contains("for a surface of colour"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_material_the_set_does_not_hold_and_a_non_finite_brdf_are_refused_before_recording() {
+    let scene = histencil_scene::embedded("default").unwrap();
+    let (set, modules) = one_brdf(
+        "spiky",
+        "vec3 spiky(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(p.x / dot(N, L));\n}\n",
+        false,
+    );
     with_validated_context(|ctx| {
         let desc = RendererDesc {
             brdfs: modules,
@@ -230,34 +360,16 @@ fn a_material_the_set_does_not_hold_and_a_non_finite_brdf_are_refused_before_rec
     });
     // Negative light (an outside engine's BRDF read another's parameter row and gave it) is
     // refused as a NaN is, by the probe an engine runs itself (`probe_brdfs`).
-    let dir = folder(
-        "engine-brdfs-negative",
-        &[(
-            "negative.glsl",
-            "vec3 negative(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(max(dot(N, L), 0.0) - 0.25);\n}\n",
-        )],
+    let (_, modules) = one_brdf(
+        "negative",
+        "vec3 negative(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(max(dot(N, L), 0.0) - 0.25);\n}\n",
+        false,
     );
-    let spec = EngineBrdfSpec {
-        name: "negative".into(),
-        glsl: "negative.glsl".into(),
-        function: "negative".into(),
-        white: None,
-        params: vec![],
-        tangent: false,
-    };
-    let set = BrdfSet::new(&[], vec![spec])
-        .unwrap()
-        .with_folder(dir.canonicalize().unwrap());
-    let modules = histencil_vk::compile_brdf_set(&set).expect("compiles");
-    with_validated_context(|ctx| {
-        let text = histencil_vk::probe_brdfs(ctx, modules)
-            .unwrap_err()
-            .to_string();
-        assert!(
-            text.contains("engine BRDF `negative` returns -") && text.contains("not negative"),
-            "{text}"
-        );
-    });
+    let text = probe_refusal(modules);
+    assert!(
+        text.contains("engine BRDF `negative` returns -") && text.contains("not negative"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -276,6 +388,7 @@ fn glsl_that_does_not_compile_names_the_engine_file_and_line() {
         white: None,
         params: vec![],
         tangent: false,
+        tint: false,
     };
     let real = dir.canonicalize().unwrap();
     let set = BrdfSet::new(&[], vec![spec])
@@ -294,6 +407,7 @@ fn glsl_that_does_not_compile_names_the_engine_file_and_line() {
             white: None,
             params: vec![],
             tangent: false,
+            tint: false,
         }],
     )
     .unwrap()
@@ -355,12 +469,9 @@ fn the_lab_measures_the_engine_brdfs() {
             .as_ref()
             .expect("a steady clock by default");
         assert_eq!(stability.sets.len(), 2, "{stability:?}");
-        assert!(report.rows.iter().all(|r| r.name != "lut"));
-        let why = report.lut_left_out.as_deref().unwrap_or_default();
-        assert!(
-            why.contains("`charlie_sheen`: it has a white part"),
-            "{why}"
-        );
+        // The sheen's white part is held beside its tinted part: the LUT row is measured.
+        assert!(report.rows.iter().any(|r| r.name == "lut"));
+        assert_eq!(report.lut_left_out, None);
         assert!(report
             .markdown()
             .contains("the 2-BRDF column adds `charlie_sheen`"));
@@ -446,6 +557,7 @@ fn an_engine_brdfs_lut_table_is_filled_by_its_glsl() {
         white: None,
         params: params.to_vec(),
         tangent,
+        tint: false,
     };
     let set = BrdfSet::new(
         &BrdfId::ALL,
@@ -505,22 +617,33 @@ fn an_engine_brdfs_lut_table_is_filled_by_its_glsl() {
             .unwrap()
             .to_string();
         assert!(err.contains("`combed`: it reads the tangent"), "{err}");
+        // The example folder's own scene: the toon ramp and the Charlie sheen, whose table
+        // holds its white lobe beside its tinted base. Every object is lit, and the frame is
+        // within 1/255 of forward on the mean (the toon's hard band edges are the most a
+        // table misses).
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/brdfs");
         let example = BrdfSet::load(&dir).unwrap();
         let example_modules = histencil_vk::compile_brdf_set(&example).unwrap();
-        let mut sheen = histencil_scene::embedded("brdfs-3").unwrap();
-        histencil_scene::retarget_brdfs(&mut sheen, &example);
-        let desc = RendererDesc {
-            brdfs: example_modules,
-            ..RendererDesc::new(SIZE, SIZE)
-        };
-        let mut renderer = Renderer::with_desc(ctx, sheen, &desc).unwrap();
-        let err = renderer.render(lut, Readback::ALL).err().unwrap();
-        let text = err.to_string();
-        assert!(
-            text.contains("`charlie_sheen`: it has a white part"),
-            "{text}"
-        );
-        assert_eq!(err.cause(), histencil_vk::Cause::Data);
+        let own = histencil_scene::load_gltf_in(&dir.join("own-brdfs.gltf"), &example)
+            .unwrap()
+            .scene;
+        let sheen = example.engine_brdf("charlie_sheen", &[]).unwrap();
+        let tables =
+            histencil_vk::LutTables::with_modules(ctx, example_modules, &[sheen], 9).unwrap();
+        assert!(tables.luts()[0].has_white());
+        let forward = render(ctx, &own, example_modules, Shading::Forward);
+        let (table, ids) = render_ids(ctx, &own, example_modules, lut);
+        let ids = ids.unwrap();
+        for brdf in ["toon", "charlie_sheen"] {
+            let pixels: Vec<_> = (ids.iter().zip(table.pixels()))
+                .filter(|(id, _)| id.is_some_and(|b| b.name() == brdf))
+                .collect();
+            let lit = pixels.iter().filter(|(_, p)| p.0[..3] != [0; 3]).count();
+            println!("{brdf}: {lit} of {} pixels lit", pixels.len());
+            assert!(!pixels.is_empty() && lit * 2 > pixels.len(), "{brdf} unlit");
+        }
+        let e = diff(&forward, &table);
+        println!("own-brdfs.gltf, LUT against forward: {e:?}");
+        assert!(e.mean <= 1.0, "{e:?}");
     });
 }

@@ -53,7 +53,12 @@ fn glsl_lookup_equals_the_rust_lookup() {
     // The Rust lookup computes its coordinates in f64 and interpolates in f32; the GLSL does
     // both in f32. The difference is the coordinates' rounding times the table's slope.
     const RELATIVE: f64 = 2e-4;
-    let materials = report_materials();
+    // With glTF's metallic-roughness, whose entries hold a white factor beside the tinted one.
+    let mut materials = report_materials();
+    materials.push(Brdf::GltfMetalRough {
+        alpha: 0.3,
+        metallic: 0.5,
+    });
     let mut directions: Vec<[V3<f32>; 4]> = report_directions(2048)
         .into_iter()
         .chain(hard_directions())
@@ -71,8 +76,9 @@ fn glsl_lookup_equals_the_rust_lookup() {
             let mut worst = vec![0f64; materials.len()];
             for ((table, dirs), g) in cases.iter().zip(&gpu) {
                 let lut = &tables.luts()[*table as usize];
-                let cpu = lut.lookup(to_f64(*dirs));
-                for k in 0..3 {
+                let (cpu, g) = (lut.lookup(to_f64(*dirs)).channels(), g.channels());
+                assert!(lut.has_white() || g[3] == 0.0, "{:?}: {g:?}", lut.brdf);
+                for k in 0..4 {
                     assert!(g[k].is_finite(), "{:?} {dirs:?}: {g:?}", lut.brdf);
                     let scale = f64::from(cpu[k].abs()).max(1.0);
                     let e = f64::from((g[k] - cpu[k]).abs()) / scale;
@@ -94,10 +100,11 @@ fn glsl_lookup_equals_the_rust_lookup() {
     });
 }
 
-/// The six-BRDF room lit by two directional lights: the light arriving at every pixel is then
+/// An embedded room (`brdfs-6`; `pbr-mixed`, with glTF's metallic-roughness, whose tables hold
+/// a white factor) lit by two directional lights: the light arriving at every pixel is then
 /// exactly the lights' colour, so a pixel's error is bounded by its table's error alone.
-fn directionally_lit_room() -> Scene {
-    let mut scene = histencil_scene::embedded("brdfs-6").unwrap();
+fn directionally_lit_room(name: &str) -> Scene {
+    let mut scene = histencil_scene::embedded(name).unwrap();
     let directional = |direction: Vec3, color: Vec3| Light {
         kind: LightKind::Directional {
             direction: direction.normalize(),
@@ -130,7 +137,14 @@ fn per_model_bounds(scene: &Scene, luts: &[Lut]) -> Vec<(BrdfId, f32, f64)> {
             .iter()
             .find(|(b, _)| *b == brdf)
             .expect("a table per material");
+        // A white part is not scaled by the tint: the table's error bounds a surface of tint
+        // up to 1 (LutAccuracy), and scales past it.
         let tint = object.material.tint.max_element();
+        let tint = if brdf.has_white_part() {
+            tint.max(1.0)
+        } else {
+            tint
+        };
         match bounds.iter_mut().find(|(id, ..)| *id == brdf.id()) {
             Some(b) => {
                 b.1 = b.1.max(tint);
@@ -170,10 +184,23 @@ fn against_prediction(
     (worst_ratio, sum / (3 * ids.len()) as f64)
 }
 
+/// Every pixel of a LUT frame stays within the error its tables predict, and the mean error falls
+/// as the tables' resolution rises: on the talk's models, and on glTF's metallic-roughness, whose
+/// polished white specular is the hardest a table holds (at the default 32 points it is past the
+/// talk's models' bound, `histencil_check::judge::LUT`, which is why the check holds it here).
 #[test]
 fn frame_error_stays_within_the_tables_and_falls_with_resolution() {
+    frame_error_within_the_tables("brdfs-6");
+}
+
+#[test]
+fn a_white_parts_frame_error_stays_within_the_tables_and_falls_with_resolution() {
+    frame_error_within_the_tables("pbr-mixed");
+}
+
+fn frame_error_within_the_tables(name: &str) {
     const SIZE: u32 = 128;
-    let scene = directionally_lit_room();
+    let scene = &directionally_lit_room(name);
     let light_sum: f64 = scene
         .lights
         .iter()
@@ -203,7 +230,7 @@ fn frame_error_stays_within_the_tables_and_falls_with_resolution() {
         for resolution in [4, 8, 16, 32, 64] {
             let mut renderer = at(resolution);
             let frame = renderer.render(LUT, readback).unwrap();
-            let bounds = per_model_bounds(&scene, renderer.lut_tables().unwrap().luts());
+            let bounds = per_model_bounds(scene, renderer.lut_tables().unwrap().luts());
             let (ratio, mean) = against_prediction(
                 frame.images.hdr.as_ref().unwrap(),
                 &forward_hdr,
@@ -213,7 +240,7 @@ fn frame_error_stays_within_the_tables_and_falls_with_resolution() {
             );
             let ldr = diff(frame.images.ldr.as_ref().unwrap(), &forward_ldr);
             println!(
-                "res {resolution}: HDR mean error {mean:.2e}, worst error / predicted {ratio:.3}; \
+                "{name} res {resolution}: HDR mean error {mean:.2e}, worst error / predicted {ratio:.3}; \
                  8-bit max {} mean {:.3}",
                 ldr.max, ldr.mean
             );

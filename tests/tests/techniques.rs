@@ -69,10 +69,7 @@ fn check(scene_name: &str) {
     let scene = histencil_scene::embedded(scene_name).unwrap();
     with_validated_context(|ctx| {
         let mut renderer = Renderer::new(ctx, scene, SIZE, SIZE).expect("renderer");
-        let tabulable = renderer
-            .brdfs()
-            .iter()
-            .all(|b| *b != BrdfId::GltfMetalRough);
+        let scene_brdfs = renderer.brdfs().to_vec();
         let forward = renderer
             .render(Shading::Forward, Readback::ALL)
             .expect("forward")
@@ -147,8 +144,8 @@ fn check(scene_name: &str) {
             );
         }
         // The LUT technique is approximate: its own tolerance, at the default resolution, with
-        // hi-stencil (ps3) and without (native). It has no table for glTF's metallic-roughness
-        // BRDF, and says so.
+        // hi-stencil (ps3) and without (native). glTF's metallic-roughness BRDF is held as its
+        // two factors per entry, the tinted and the white part.
         let luts =
             [("lut-native", Backend::Native), ("lut-ps3", Backend::Ps3)].map(|(label, backend)| {
                 (
@@ -159,15 +156,17 @@ fn check(scene_name: &str) {
                     },
                 )
             });
-        for (label, technique) in luts.iter().filter(|_| tabulable) {
-            let (_, d) = against_forward(label, *technique, LUT_TOLERANCE);
-            assert!(d.mean <= LUT_MEAN_TOLERANCE, "{scene_name} {label}: {d:?}");
-        }
-        for (label, technique) in luts.iter().filter(|_| !tabulable) {
-            let refused = renderer.render(*technique, Readback::ALL).err();
+        // A white specular's table error grows as its roughness falls, past this bound at the
+        // default resolution: a scene with one is held to its tables' predicted error in
+        // tests/tests/lut.rs, and here only lit, validation-clean.
+        let white = scene_brdfs.contains(&BrdfId::GltfMetalRough);
+        for (label, technique) in &luts {
+            let tolerance = if white { u8::MAX } else { LUT_TOLERANCE };
+            let (image, d) = against_forward(label, *technique, tolerance);
+            assert!(lit_fraction(&image) > 0.2, "{scene_name} {label}: too dark");
             assert!(
-                matches!(refused, Some(histencil_vk::Error::LutUntabulable { .. })),
-                "{scene_name} {label}: {refused:?}"
+                white || d.mean <= LUT_MEAN_TOLERANCE,
+                "{scene_name} {label}: {d:?}"
             );
         }
         let (_, branching) = &images[0];
@@ -189,16 +188,12 @@ fn check(scene_name: &str) {
         );
         drop(renderer);
         // Every technique on one context: the device limits they needed are the table's.
-        let reached: &[Limit] = if tabulable {
-            &[
-                Limit::PerStageStorageBuffers,
-                Limit::ComputeWorkGroupInvocations,
-                Limit::ComputeWorkGroupSize,
-            ]
-        } else {
-            &[]
-        };
-        assert_needs_hold(ctx, reached);
+        let reached = [
+            Limit::PerStageStorageBuffers,
+            Limit::ComputeWorkGroupInvocations,
+            Limit::ComputeWorkGroupSize,
+        ];
+        assert_needs_hold(ctx, &reached);
     });
 }
 

@@ -268,7 +268,11 @@ pub fn worst_per_model(
     for (case, value) in cases.iter().zip(actual) {
         let reference = case.brdf.reference_parts(case.dirs).channels();
         let tinted = if case.brdf.is_rgb() { 0..3 } else { 0..1 };
-        let white = if case.brdf.is_tabulable() { 3..3 } else { 3..4 };
+        let white = if case.brdf.has_white_part() {
+            3..4
+        } else {
+            3..3
+        };
         for k in tinted.chain(white) {
             assert!(
                 reference[k].is_finite(),

@@ -2,6 +2,15 @@
 //! holds `f_r * cos(theta_L)` of one material, sampled on a regular grid over the model's
 //! geometric axes and looked up with multilinear interpolation.
 //!
+//! # Two factors per entry
+//! A value is affine in the surface's colour, `tint * tinted + white` ([`crate::Parts`]), so an
+//! entry holds both factors where the model has a white part: the tinted RGB and the white
+//! scalar, as a split-sum table stores a scale and a bias per entry. glTF's metallic-roughness
+//! (its dielectric specular is white) and an engine BRDF with a `white` function are held so;
+//! a model without one stores the tinted RGB alone. What no table holds is a value that is not
+//! affine in the tint: an engine BRDF whose function takes the tint itself is refused, naming
+//! why ([`crate::BrdfSet::tabulable`]).
+//!
 //! # Parameterisation
 //! The axes are angles (not cosines): the specular lobes are as wide in angle at grazing as at
 //! normal incidence, so a uniform angle grid spends its samples evenly. Grid point `i` of `res`
@@ -12,13 +21,14 @@
 //! | lambert | `N.L` in [0, 1] (exact: Lambert is linear in it) | `res` |
 //! | blinn_phong, oren_nayar_*, ggx | `theta_L`, `theta_V` in [0, pi/2], `phi` (azimuth between L and V about N) in [0, pi] | `res^3` |
 //! | kajiya_kay | angles `T^L`, `T^V` in [0, pi] | `res^2` |
+//! | gltf_metal_rough | as blinn_phong | `res^3`, tinted and white |
 //! | penner_skin | `theta` (N to L) in [0, pi], curvature as `k / (k + 1)` with `k` in 1/mm | `res^2`, RGB |
-//! | an engine's, without white part or tangent | as blinn_phong | `res^3`, RGB |
+//! | an engine's that reads no tangent and takes no tint | as blinn_phong | `res^3`, RGB (and white, with a white part) |
 //!
 //! An engine BRDF ([`crate::BrdfSet`]) has no CPU spelling: its table is the same grid
 //! ([`Lut::grid`]) filled by its own GLSL on the GPU (histencil-vk's `LutTables`), then
 //! [`Lut::from_values`]. One that reads no tangent is taken to be isotropic, a function of the
-//! three angles; one that reads the tangent, or has a white part, is refused
+//! three angles; one that reads the tangent, or takes the tint, is refused
 //! ([`crate::BrdfSet::tabulable`]).
 //!
 //! Every parameter is fixed at bake time except the skin's curvature, which varies per pixel and
@@ -28,7 +38,7 @@
 //! ([`LutAccuracy::measure`]) states it against resolution.
 
 use crate::cases::{halton, sphere_point};
-use crate::model::Brdf;
+use crate::model::{Brdf, Parts};
 use crate::vector::{above_horizon, angle_between, dot, normalize, scale, sub, V3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -190,16 +200,10 @@ pub enum LutError {
     /// The resolution is outside `2..=`[`Lut::MAX_RESOLUTION`].
     #[error("LUT resolution {0} is out of range (2..={max})", max = Lut::MAX_RESOLUTION)]
     Resolution(u32),
-    /// A table holds `f / tint`, which the shader multiplies by the pixel's tint; a model with a
-    /// white part ([`crate::Parts`]) is not the tint times anything a table could hold.
-    #[error(
-        "no look-up table for {0}: its value is not the tint times a function of the angles \
-         (its dielectric specular is white)"
-    )]
-    Untabulable(&'static str),
-    /// An engine BRDF a table cannot hold: one with a white part (as [`LutError::Untabulable`]),
-    /// or one that reads the tangent (the tables are over the three angles of an isotropic
-    /// BRDF; the fibre table's axes are Kajiya-Kay's own).
+    /// An engine BRDF a table cannot hold: one whose function takes the tint (a value that is
+    /// not affine in the tint has no two factors to store), or one that reads the tangent (the
+    /// tables are over the three angles of an isotropic BRDF; the fibre table's axes are
+    /// Kajiya-Kay's own); or any engine BRDF given to [`Lut::bake`], which has no CPU spelling.
     #[error("no look-up table for engine BRDF `{brdf}`: {reason}")]
     EngineUntabulable {
         /// Its name.
@@ -207,7 +211,8 @@ pub enum LutError {
         /// Why a table cannot hold it.
         reason: &'static str,
     },
-    /// Values handed to [`Lut::from_values`] that are not one per grid point.
+    /// Values handed to [`Lut::from_values`] that are not one per grid point (the white
+    /// part's: one per grid point for a model with a white part, none for another).
     #[error("a {resolution}-point table of {brdf} has {expected} grid points, not {given}")]
     ValueCount {
         /// The material's model.
@@ -234,12 +239,16 @@ pub struct Lut {
     pub axes: LutAxes,
     /// Grid points per axis.
     pub resolution: u32,
-    /// `f_r * cos` at the grid points, RGB, first axis fastest.
+    /// The tinted factor of `f_r * cos` at the grid points, RGB, first axis fastest.
     pub values: Vec<[f32; 3]>,
+    /// The white factor at the same points, for a model with a white part ([`Lut::has_white`]);
+    /// empty for the others, whose entries are the tinted RGB alone.
+    pub white: Vec<f32>,
 }
 
 impl Lut {
-    /// 512 points per axis is 512 MiB of RGB f32 for a 3D table: beyond anything useful.
+    /// 512 points per axis is 512 MiB of RGB f32 for a 3D table (a third more with a white
+    /// part): beyond anything useful.
     pub const MAX_RESOLUTION: u32 = 512;
 
     /// `Ok` for a resolution [`Lut::bake`] accepts: 2 to [`Lut::MAX_RESOLUTION`] points per axis.
@@ -254,21 +263,29 @@ impl Lut {
     /// Samples `brdf` (its f64 reference) at `resolution` points per axis.
     pub fn bake(brdf: Brdf, resolution: u32) -> Result<Self, LutError> {
         Self::check_resolution(resolution)?;
-        if !brdf.is_tabulable() {
-            return Err(match brdf {
-                Brdf::Engine { id, .. } => LutError::EngineUntabulable {
-                    brdf: id.name(),
-                    reason: "it has no CPU spelling; its table is baked by its GLSL \
-                             (histencil-vk's LutTables)",
-                },
-                _ => LutError::Untabulable(brdf.name()),
+        if let Brdf::Engine { id, .. } = brdf {
+            return Err(LutError::EngineUntabulable {
+                brdf: id.name(),
+                reason: "it has no CPU spelling; its table is baked by its GLSL \
+                         (histencil-vk's LutTables)",
             });
         }
-        let values = Self::grid(brdf, resolution)?
+        let parts: Vec<_> = Self::grid(brdf, resolution)?
             .into_iter()
-            .map(|(dirs, at)| at.reference(dirs).map(|x| x as f32))
+            .map(|(dirs, at)| at.reference_parts(dirs))
             .collect();
-        Self::from_values(brdf, resolution, values)
+        let values = parts.iter().map(|p| p.tinted.map(|x| x as f32)).collect();
+        let white = if brdf.has_white_part() {
+            parts.iter().map(|p| p.white as f32).collect()
+        } else {
+            Vec::new()
+        };
+        Self::from_values(brdf, resolution, values, white)
+    }
+
+    /// Whether the entries hold a white factor beside the tinted RGB.
+    pub fn has_white(&self) -> bool {
+        !self.white.is_empty()
     }
 
     /// Every grid point of `brdf`'s table at `resolution` points per axis, first axis fastest:
@@ -306,25 +323,31 @@ impl Lut {
             .collect())
     }
 
-    /// A table of `brdf` from its values at the points of [`Lut::grid`], in that order.
+    /// A table of `brdf` from its factors at the points of [`Lut::grid`], in that order: the
+    /// tinted RGB, and the white part (empty for a table without one).
     ///
     /// # Errors
-    /// [`LutError::Resolution`], and [`LutError::ValueCount`] unless there is one value per
-    /// grid point.
+    /// [`LutError::Resolution`], and [`LutError::ValueCount`] unless there is one tinted value
+    /// per grid point and, when `white` is given, one white value per grid point.
     pub fn from_values(
         brdf: Brdf,
         resolution: u32,
         values: Vec<[f32; 3]>,
+        white: Vec<f32>,
     ) -> Result<Self, LutError> {
         Self::check_resolution(resolution)?;
         let axes = LutAxes::of(&brdf);
         let expected = (resolution as usize).pow(axes.dimensions() as u32);
-        if values.len() != expected {
+        // The white part may be absent; the tinted part may not.
+        let wrong = [(values.len(), false), (white.len(), true)]
+            .into_iter()
+            .find(|&(given, optional)| given != expected && !(optional && given == 0));
+        if let Some((given, _)) = wrong {
             return Err(LutError::ValueCount {
                 brdf: brdf.name(),
                 resolution,
                 expected,
-                given: values.len(),
+                given,
             });
         }
         Ok(Self {
@@ -332,14 +355,20 @@ impl Lut {
             axes,
             resolution,
             values,
+            white,
         })
     }
 
-    /// The table's value at a shading point: multilinear interpolation between grid points,
-    /// in f32 as a shader does it. Gated points give 0.
-    pub fn lookup(&self, dirs: [V3<f64>; 4]) -> [f32; 3] {
+    /// The table's two factors at a shading point: multilinear interpolation between grid
+    /// points, in f32 as a shader does it (the white part 0 for a table without one). Gated
+    /// points give 0.
+    pub fn lookup(&self, dirs: [V3<f64>; 4]) -> Parts<f32> {
+        let mut out = Parts {
+            tinted: [0.0; 3],
+            white: 0.0,
+        };
         let Some(u) = self.axes.coordinates(dirs, self.curvature_per_mm()) else {
-            return [0.0; 3];
+            return out;
         };
         let dims = self.axes.dimensions();
         let r = self.resolution as usize;
@@ -353,7 +382,6 @@ impl Lut {
             base[a] = i;
             frac[a] = x - i as f32;
         }
-        let mut out = [0f32; 3];
         for corner in 0..(1usize << dims) {
             let mut weight = 1f32;
             let mut index = 0usize;
@@ -364,8 +392,11 @@ impl Lut {
                 index += (base[a] + upper) * stride;
                 stride *= r;
             }
-            for (o, v) in out.iter_mut().zip(self.values[index]) {
+            for (o, v) in out.tinted.iter_mut().zip(self.values[index]) {
                 *o += weight * v;
+            }
+            if let Some(w) = self.white.get(index) {
+                out.white += weight * w;
             }
         }
         out
@@ -382,9 +413,10 @@ impl Lut {
         }
     }
 
-    /// Bytes of the table as RGB f32.
+    /// Bytes of the table: RGB f32 per entry, and an f32 more with a white part.
     pub fn size_bytes(&self) -> usize {
         self.values.len() * std::mem::size_of::<[f32; 3]>()
+            + self.white.len() * std::mem::size_of::<f32>()
     }
 }
 
@@ -401,7 +433,9 @@ pub fn report_directions(count: usize) -> Vec<[V3<f64>; 4]> {
 }
 
 /// A table's error against the f64 reference over [`report_directions`], in the units of the
-/// BRDF's value (`f_r * cos`), worst channel.
+/// BRDF's value (`f_r * cos`), worst channel: per channel `|tinted error| + |white error|`,
+/// which bounds the error of a surface of any tint in [0, 1] (for a table without a white part
+/// that is the tinted error alone, a white surface's).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LutAccuracy {
     /// The largest error over the set.
@@ -418,10 +452,12 @@ impl LutAccuracy {
     pub fn measure(lut: &Lut, directions: &[[V3<f64>; 4]]) -> Self {
         let (mut max_abs, mut sum, mut peak) = (0f64, 0f64, 0f64);
         for dirs in directions {
-            let reference = lut.brdf.reference(*dirs);
+            let parts = lut.brdf.reference_parts(*dirs);
+            let reference = parts.at_white();
             let table = lut.lookup(*dirs);
+            let white = (f64::from(table.white) - parts.white).abs();
             let error = (0..3)
-                .map(|k| (f64::from(table[k]) - reference[k]).abs())
+                .map(|k| (f64::from(table.tinted[k]) - parts.tinted[k]).abs() + white)
                 .fold(0.0, f64::max);
             max_abs = max_abs.max(error);
             sum += error;
@@ -493,10 +529,19 @@ mod tests {
             .iter()
             .map(|(dirs, at)| at.reference(*dirs).map(|x| x as f32))
             .collect();
-        let again = Lut::from_values(ggx, 5, values).unwrap();
+        let again = Lut::from_values(ggx, 5, values, Vec::new()).unwrap();
         assert_eq!(again.values, baked.values);
+        assert!(!baked.has_white());
         assert!(matches!(
-            Lut::from_values(ggx, 5, vec![[0.0; 3]; 124]),
+            Lut::from_values(ggx, 5, vec![[0.0; 3]; 125], vec![0.0; 3]),
+            Err(LutError::ValueCount {
+                expected: 125,
+                given: 3,
+                ..
+            })
+        ));
+        assert!(matches!(
+            Lut::from_values(ggx, 5, vec![[0.0; 3]; 124], Vec::new()),
             Err(LutError::ValueCount {
                 expected: 125,
                 given: 124,
@@ -515,7 +560,36 @@ mod tests {
         let lut = Lut::bake(brdf, 5).unwrap();
         let (dirs, _) = lut.axes.directions([0.25, 0.5, 0.75]);
         let reference = brdf.reference(dirs)[0];
-        assert!((f64::from(lut.lookup(dirs)[0]) - reference).abs() < 1e-6 * reference.max(1.0));
+        let found = f64::from(lut.lookup(dirs).tinted[0]);
+        assert!((found - reference).abs() < 1e-6 * reference.max(1.0));
+    }
+
+    /// glTF's metallic-roughness is `base * tinted + white`: its table holds both factors, and
+    /// at a grid point gives each as the reference does, for any base colour.
+    #[test]
+    fn a_table_with_a_white_part_holds_both_factors() {
+        let brdf = Brdf::GltfMetalRough {
+            alpha: 0.3,
+            metallic: 0.4,
+        };
+        let lut = Lut::bake(brdf, 5).unwrap();
+        assert!(lut.has_white());
+        assert_eq!(lut.size_bytes(), 125 * 16);
+        let (dirs, _) = lut.axes.directions([0.25, 0.5, 0.75]);
+        let reference = brdf.reference_parts(dirs);
+        assert!(reference.white > 1e-3, "{reference:?}");
+        let found = lut.lookup(dirs);
+        let close = |a: f32, b: f64| (f64::from(a) - b).abs() < 1e-6 * b.max(1.0);
+        assert!(
+            close(found.white, reference.white),
+            "{found:?} {reference:?}"
+        );
+        assert!(close(found.tinted[1], reference.tinted[1]), "{found:?}");
+        let tint = [0.9, 0.2, 0.05];
+        let shaded = found.tinted_by(tint.map(|x| x as f32));
+        for (k, t) in tint.into_iter().enumerate() {
+            assert!(close(shaded[k], t * reference.tinted[k] + reference.white));
+        }
     }
 
     #[test]

@@ -11,6 +11,7 @@
 //! function = "toon"              # vec3 toon(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L); the name if left out
 //! white = "toon_rim"             # optional: float toon_rim(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L)
 //! tangent = false                # whether it reads T
+//! tint = false                   # whether the function takes the colour: vec3 toon(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L)
 //! params = [{ name = "bands", min = 1, max = 8, default = 3 }]
 //! ```
 //!
@@ -195,7 +196,9 @@ fn read_spec(t: &Table<'_>) -> Result<EngineBrdfSpec, ManifestError> {
     let what = format!("BRDF `{name}`");
     t.only(
         &what,
-        &["name", "glsl", "function", "white", "tangent", "params"],
+        &[
+            "name", "glsl", "function", "white", "tangent", "tint", "params",
+        ],
     )?;
     let mut params = Vec::new();
     for p in t.tables("params")? {
@@ -213,6 +216,7 @@ fn read_spec(t: &Table<'_>) -> Result<EngineBrdfSpec, ManifestError> {
         function: t.string("function")?.unwrap_or_else(|| name.clone()),
         white: t.string("white")?,
         tangent: t.bool("tangent")?,
+        tint: t.bool("tint")?,
         params,
         name,
     })

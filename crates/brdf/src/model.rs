@@ -41,6 +41,14 @@ impl<R: Real> Parts<R> {
         let [r, g, b] = self.tinted;
         [r, g, b, self.white]
     }
+
+    /// The parts from their [`Parts::channels`], as the GPU evaluators return them (a `vec4`).
+    pub fn from_channels([r, g, b, white]: [R; 4]) -> Self {
+        Self {
+            tinted: [r, g, b],
+            white,
+        }
+    }
 }
 
 /// A BRDF model and its parameters.
@@ -494,12 +502,19 @@ impl Brdf {
         self.id().name()
     }
 
-    /// Whether the value is the tint times a function of the angles (no white part), which a
-    /// look-up table of `f / tint` can hold, baked from a CPU spelling: every built-in model but
-    /// glTF's metallic-roughness. Not an engine's BRDF, which has no CPU spelling: whether its
-    /// GLSL can fill a table is its set's to say ([`crate::BrdfSet::tabulable`]).
+    /// Whether a look-up table can be baked from a CPU spelling: every built-in model (a table
+    /// entry holds both factors of `tint * tinted + white`, so glTF's metallic-roughness too).
+    /// Not an engine's BRDF, which has no CPU spelling: whether its GLSL can fill a table is its
+    /// set's to say ([`crate::BrdfSet::tabulable`]).
     pub fn is_tabulable(&self) -> bool {
-        !matches!(self, Brdf::GltfMetalRough { .. } | Brdf::Engine { .. })
+        !matches!(self, Brdf::Engine { .. })
+    }
+
+    /// Whether a built-in's value has a white part ([`Parts::white`]): glTF's
+    /// metallic-roughness alone. An engine BRDF's is its set's to say
+    /// ([`crate::EngineBrdfSpec::white`]); false here.
+    pub fn has_white_part(&self) -> bool {
+        matches!(self, Brdf::GltfMetalRough { .. })
     }
 
     /// Only skin is coloured; every other model returns one value.

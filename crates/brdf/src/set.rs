@@ -15,7 +15,13 @@
 //! silhouettes, as interpolated normals give); `T` is histencil's fibre direction (world +Y
 //! projected onto the surface: not unit, zero where `N` is vertical). With a white part (as
 //! glTF's BRDF has: a dielectric's specular is not tinted), a second function
-//! `float name(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L)` gives the part added untinted. The file
+//! `float name(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L)` gives the part added untinted.
+//!
+//! A BRDF whose value is not affine in the surface's colour (glTF's metallic-roughness mixes a
+//! Fresnel-weighted diffuse that goes with the base colour squared) takes the colour itself:
+//! declared with `tint = true`, its function is
+//! `vec3 name(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L)` and returns the whole
+//! `f_r * N.L` of a surface of that colour, per channel, with no white part. The file
 //! may use histencil's helpers (`brdf/common.glsl`: `PI`, `INV_PI`, `brdf_pow`,
 //! `brdf_normalize`, `brdf_above_horizon`), which are included before it.
 //!
@@ -60,6 +66,10 @@ pub struct EngineBrdfSpec {
     pub params: Vec<EngineParam>,
     /// Whether it reads `T`: said so a decode hook that gives no tangent can refuse it.
     pub tangent: bool,
+    /// Whether its function takes the surface's colour and returns the whole value
+    /// (`vec3 name(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L)`), for a BRDF that is
+    /// not `tint * f + white`; such a BRDF has no `white` function.
+    pub tint: bool,
 }
 
 /// Why a set of BRDFs was refused.
@@ -106,6 +116,10 @@ pub enum SetError {
         /// What is wrong, in words.
         why: String,
     },
+    /// A BRDF whose function takes the tint and that also names a white part: the function
+    /// returns the whole value, so there is nothing to add.
+    #[error("BRDF `{0}` takes the tint (`tint = true`) and names a `white` function: a function that takes the tint returns the whole value; drop `white` or `tint`")]
+    TintAndWhite(String),
     /// A GLSL path that does not end in `.glsl` (the files copied for the compiler are those).
     #[error("BRDF `{brdf}`: `{path}` must be a `.glsl` file")]
     NotGlsl {
@@ -207,6 +221,9 @@ fn check_spec(spec: &EngineBrdfSpec) -> Result<(), SetError> {
                 name: function.clone(),
             });
         }
+    }
+    if spec.tint && spec.white.is_some() {
+        return Err(SetError::TintAndWhite(spec.name.clone()));
     }
     if !is_confined(&spec.glsl) {
         return Err(SetError::OutsideFolder {
@@ -437,26 +454,24 @@ impl BrdfSet {
         Ok(())
     }
 
-    /// Whether the LUT technique can hold `brdf` in a table: a built-in as
-    /// [`Brdf::is_tabulable`] says; an engine BRDF of this set when it has no white part (a table
-    /// holds `f / tint`) and reads no tangent (its table is over the three angles of an
+    /// Whether the LUT technique can hold `brdf` in a table: every built-in
+    /// ([`Brdf::is_tabulable`]); an engine BRDF of this set unless its function takes the tint
+    /// (an entry holds two factors, `tint * tinted + white`, and a value that is not affine in
+    /// the tint has none) or it reads the tangent (its table is over the three angles of an
     /// isotropic BRDF, [`crate::lut::LutAxes::Isotropic`]).
     ///
     /// # Errors
-    /// [`LutError`] saying why not; [`LutError::EngineUntabulable`] for an engine BRDF this set
-    /// does not hold.
+    /// [`LutError::EngineUntabulable`] saying why not, also for an engine BRDF this set does
+    /// not hold.
     pub fn tabulable(&self, brdf: &Brdf) -> Result<(), LutError> {
         let Brdf::Engine { id, .. } = brdf else {
-            return if brdf.is_tabulable() {
-                Ok(())
-            } else {
-                Err(LutError::Untabulable(brdf.name()))
-            };
+            return Ok(());
         };
         let reason = match self.spec(BrdfId::Engine(*id)) {
             None => "it is not in the BRDF set",
-            Some(spec) if spec.white.is_some() => {
-                "it has a white part, and a table holds the tint's factor alone"
+            Some(spec) if spec.tint => {
+                "its function takes the tint, and a table entry holds two factors of it \
+                 (tinted and white), not a function of it"
             }
             Some(spec) if spec.tangent => {
                 "it reads the tangent, and a table is over the three angles of an isotropic BRDF"
@@ -467,6 +482,17 @@ impl BrdfSet {
             brdf: id.name(),
             reason,
         })
+    }
+
+    /// Whether `brdf`'s value has a white part: a built-in as [`Brdf::has_white_part`], an
+    /// engine BRDF of this set when it names a `white` function.
+    pub fn has_white_part(&self, brdf: &Brdf) -> bool {
+        match brdf {
+            Brdf::Engine { id, .. } => self
+                .spec(BrdfId::Engine(*id))
+                .is_some_and(|s| s.white.is_some()),
+            _ => brdf.has_white_part(),
+        }
     }
 
     /// The files the shaders include to evaluate the set (`brdf/eval.glsl` includes them), as
@@ -498,6 +524,16 @@ impl BrdfSet {
             let call = |f: &str| format!("{f}(p, N, T, V, L)");
             let tinted_part = call(&spec.function);
             match &spec.white {
+                // The whole value of a surface of colour `tint`; a white surface's for the
+                // switch, and as its parts (no white part), which the probe and brdf-eval read.
+                None if spec.tint => {
+                    let function = &spec.function;
+                    let white_surface = format!("{function}(p, vec3(1.0), N, T, V, L)");
+                    cases += &format!("    case {constant}:\n        return {white_surface};\n");
+                    tinted += &format!(
+                        "    if (model == {constant}) {{\n        return {function}(p, tint, N, T, V, L);\n    }}\n"
+                    );
+                }
                 None => cases += &format!("    case {constant}:\n        return {tinted_part};\n"),
                 Some(white) => {
                     let white = call(white);
@@ -555,7 +591,7 @@ impl BrdfSet {
                 })
                 .collect();
             out += &format!(
-                "        ::histencil::brdf::EngineBrdfSpec {{\n            name: {:?}.into(),\n            glsl: {:?}.into(),\n            function: {:?}.into(),\n            white: {},\n            params: vec![{}],\n            tangent: {},\n        }},\n",
+                "        ::histencil::brdf::EngineBrdfSpec {{\n            name: {:?}.into(),\n            glsl: {:?}.into(),\n            function: {:?}.into(),\n            white: {},\n            params: vec![{}],\n            tangent: {},\n            tint: {},\n        }},\n",
                 spec.name,
                 spec.glsl,
                 spec.function,
@@ -563,7 +599,8 @@ impl BrdfSet {
                     .as_ref()
                     .map_or("None".into(), |w| format!("Some({w:?}.into())")),
                 params.join(", "),
-                spec.tangent
+                spec.tangent,
+                spec.tint
             );
         }
         out + "    ],\n)\n.expect(\"the set histencil-build compiled\")\n"
@@ -619,23 +656,30 @@ mod tests {
                 default: 3.0,
             }],
             tangent: false,
+            tint: false,
         }
     }
 
     #[test]
-    fn a_table_holds_an_engine_brdf_without_white_part_or_tangent() {
+    fn a_table_holds_an_engine_brdf_unless_it_takes_the_tint_or_reads_the_tangent() {
         let mut sheen = toon();
         sheen.name = "sheen".into();
         sheen.white = Some("sheen_white".into());
         let mut hair = toon();
         hair.name = "hair".into();
         hair.tangent = true;
-        let set = BrdfSet::new(&[BrdfId::Ggx], vec![toon(), sheen, hair]).unwrap();
+        let mut metal = toon();
+        metal.name = "metal".into();
+        metal.tint = true;
+        let set = BrdfSet::new(&[BrdfId::Ggx], vec![toon(), sheen, hair, metal]).unwrap();
         let of = |name: &str| set.engine_brdf(name, &[]).unwrap();
         assert_eq!(set.tabulable(&of("toon")), Ok(()));
+        // Two factors per entry: the white part is held beside the tinted one.
+        assert_eq!(set.tabulable(&of("sheen")), Ok(()));
+        assert!(set.has_white_part(&of("sheen")) && !set.has_white_part(&of("toon")));
         let refused = |name: &str| set.tabulable(&of(name)).unwrap_err().to_string();
-        assert!(refused("sheen").contains("`sheen`: it has a white part"));
         assert!(refused("hair").contains("`hair`: it reads the tangent"));
+        assert!(refused("metal").contains("`metal`: its function takes the tint"));
         let ggx = Brdf::Ggx {
             alpha: 0.16,
             f0: 0.04,
@@ -646,10 +690,8 @@ mod tests {
             alpha: 0.25,
             metallic: 0.0,
         };
-        assert!(matches!(
-            set.tabulable(&gltf),
-            Err(LutError::Untabulable(_))
-        ));
+        assert_eq!(set.tabulable(&gltf), Ok(()));
+        assert!(set.has_white_part(&gltf));
         // Another set's engine BRDF: not this one's to tabulate.
         let other = BrdfSet::new(&[], vec![toon()]).unwrap();
         let toon_there = other.engine_brdf("toon", &[]).unwrap();
@@ -657,6 +699,30 @@ mod tests {
         renamed.name = "ramp".into();
         let mine = BrdfSet::new(&[], vec![renamed]).unwrap();
         assert!(mine.tabulable(&toon_there).is_err());
+    }
+
+    /// A function that takes the tint returns the whole value: every technique calls it with
+    /// the pixel's colour (`brdf_eval_tinted`), the switch and the parts with a white surface's;
+    /// a white part beside it is refused.
+    #[test]
+    fn a_brdf_that_takes_the_tint_is_called_with_it() {
+        let mut metal = toon();
+        metal.name = "metal".into();
+        metal.function = "metal_rough".into();
+        metal.tint = true;
+        let set = BrdfSet::new(&[], vec![metal.clone()]).unwrap();
+        let files = set.glsl_files("engine");
+        let text = |name: &str| &files.iter().find(|(n, _)| *n == name).unwrap().1;
+        assert!(text("brdf_set/tinted.glsl").contains("return metal_rough(p, tint, N, T, V, L);"));
+        assert!(text("brdf_set/eval_cases.glsl")
+            .contains("return metal_rough(p, vec3(1.0), N, T, V, L);"));
+        assert!(!text("brdf_set/parts.glsl").contains("metal_rough"));
+        assert!(set.rust_expression().contains("tint: true"));
+        metal.white = Some("metal_white".into());
+        assert_eq!(
+            BrdfSet::new(&[], vec![metal]),
+            Err(SetError::TintAndWhite("metal".into()))
+        );
     }
 
     #[test]

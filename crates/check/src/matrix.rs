@@ -232,9 +232,13 @@ pub struct SceneNeeds {
     /// The preserved stencil bits its layout leaves (`StencilLayout::preserved_mask`).
     pub preserved_mask: u8,
     pub has_alpha: bool,
-    /// The LUT technique can light it: no material's parameters vary per texel
-    /// (`Material::parameters_vary`), which a table per material cannot follow, and every BRDF
-    /// is its tint times a table (`Brdf::is_tabulable`; not glTF's metallic-roughness).
+    /// The LUT technique can be held to the check's LUT bound on it: no material's parameters
+    /// vary per texel (`Material::parameters_vary`), which a table per material cannot follow,
+    /// no BRDF is an engine's (its table's error is its function's, which no bound here knows),
+    /// and no BRDF has a white part. Tables hold glTF's metallic-roughness (two factors per
+    /// entry), but the bound ([`crate::judge::LUT`]) is the talk's models' interpolation error
+    /// at the default resolution, and a white specular's error grows as its roughness falls: it
+    /// is held to its tables' own predicted error instead (`tests/tests/lut.rs`).
     pub lut: bool,
     /// The most lights whose range can hold one point ([`lights_at_a_point`]): the f16 blends
     /// a light-volume technique can make at one pixel.
@@ -254,10 +258,10 @@ impl SceneNeeds {
         Ok(Self {
             preserved_mask: layout.preserved_mask(),
             has_alpha: scene.alpha_entity_count() > 0,
-            lut: !scene
-                .objects
-                .iter()
-                .any(|o| o.material.parameters_vary() || !o.material.brdf.is_tabulable()),
+            lut: !scene.objects.iter().any(|o| {
+                let brdf = &o.material.brdf;
+                o.material.parameters_vary() || brdf.has_white_part() || !brdf.is_tabulable()
+            }),
             lights_at_a_point: lights_at_a_point(&scene.lights),
             emissive: scene.objects.iter().any(|o| o.material.emits()),
             alpha_layers: alpha_layers(scene),

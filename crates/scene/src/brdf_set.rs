@@ -65,6 +65,7 @@ mod tests {
                 default: 0.5,
             }],
             tangent: false,
+            tint: false,
         }
     }
 

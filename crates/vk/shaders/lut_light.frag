@@ -33,6 +33,8 @@ void main() {
         return;
     }
     vec3 V = normalize(frame.eye.xyz - s.position);
-    vec3 f = lut_lookup(decode_lut_material(gl_FragCoord.xy), s.normal, fibre_tangent(s.normal), V, L);
-    out_color = vec4(incident * (s.tint * f) * light_visibility(index, light, s), 0.0);
+    vec4 f = lut_lookup(decode_lut_material(gl_FragCoord.xy), s.normal, fibre_tangent(s.normal), V, L);
+    // Both factors of the entry, as brdf_eval_tinted combines a BRDF's parts. Without a white
+    // part f.a is 0, and adding it changes no bit (fused or not, x * y + 0 rounds as x * y).
+    out_color = vec4(incident * (s.tint * f.rgb + f.a) * light_visibility(index, light, s), 0.0);
 }

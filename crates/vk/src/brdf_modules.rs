@@ -325,7 +325,11 @@ pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> 
         return Ok(());
     }
     let directions = probe_directions();
+    // A BRDF whose function takes the tint has no parts: it is probed as a surface of each of
+    // these colours (black, white, and one saturated), as every technique calls it.
+    const TINTS: [[f32; 3]; 3] = [[0.0; 3], [1.0; 3], [1.0, 0.25, 0.0]];
     let mut cases: Vec<(Brdf, [V3<f32>; 4])> = Vec::new();
+    let mut tinted: Vec<crate::tools::brdf_eval::TintedCase> = Vec::new();
     for (id, spec) in modules.set.engine() {
         let mut corners: Vec<Vec<(&str, f64)>> = vec![Vec::new()];
         for p in &spec.params {
@@ -344,24 +348,41 @@ pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> 
                 .set
                 .engine_brdf(id.name(), &given)
                 .expect("the set's own ranges");
-            cases.extend(directions.iter().map(|d| (brdf, *d)));
+            if spec.tint {
+                let at = |tint| directions.iter().map(move |d| (brdf, tint, *d));
+                tinted.extend(TINTS.into_iter().flat_map(at));
+            } else {
+                cases.extend(directions.iter().map(|d| (brdf, *d)));
+            }
         }
     }
     let mut evaluator = crate::BrdfEvaluator::with_module(ctx, modules.brdf_eval)?;
-    let values = evaluator.evaluate(ctx, &cases);
+    let values = evaluator.evaluate(ctx, &cases).and_then(|parts| {
+        let with_tint = evaluator.evaluate_tinted(ctx, &tinted)?;
+        Ok((parts, with_tint))
+    });
     evaluator.destroy(ctx);
-    for ((brdf, [n, _, v, l]), parts) in cases.iter().zip(values?) {
+    let (parts, with_tint) = values?;
+    let values = cases
+        .iter()
+        .map(|(brdf, dirs)| (brdf, None, dirs))
+        .zip(parts.iter().map(|p| p.channels().to_vec()))
+        .chain(
+            tinted
+                .iter()
+                .map(|(brdf, tint, dirs)| (brdf, Some(tint), dirs))
+                .zip(with_tint.iter().map(|v| v.to_vec())),
+        );
+    for ((brdf, tint, [n, _, v, l]), channels) in values {
         // Negative light (a BRDF reading another's parameters, say) is refused as a NaN is:
         // every technique and the forward reference would subtract it alike.
-        let bad = parts
-            .channels()
-            .into_iter()
-            .find(|x| !x.is_finite() || *x < 0.0);
+        let bad = channels.into_iter().find(|x| !x.is_finite() || *x < 0.0);
         if let Some(x) = bad {
+            let colour = tint.map_or(String::new(), |t| format!(" for a surface of colour {t:?}"));
             return Err(Error::BrdfSet(format!(
-                "engine BRDF `{}` returns {x} with parameters {:?} at N {n:?}, V {v:?}, L {l:?}: \
-                 it must be finite and not negative wherever it is evaluated (the forward \
-                 reference would hold the same value, so no comparison could see it)",
+                "engine BRDF `{}` returns {x} with parameters {:?}{colour} at N {n:?}, V {v:?}, \
+                 L {l:?}: it must be finite and not negative wherever it is evaluated (the \
+                 forward reference would hold the same value, so no comparison could see it)",
                 brdf.name(),
                 &brdf.packed_params()[..3],
             )));

@@ -86,7 +86,7 @@ pub use renderer::technique::{
 pub use renderer::{Frame, Renderer, RendererDesc, DEFAULT_LUT_RESOLUTION};
 #[cfg(feature = "files")]
 pub use shader_file::{read_shader_file, write_shader_file, ShaderFile};
-pub use tools::brdf_eval::BrdfEvaluator;
+pub use tools::brdf_eval::{BrdfEvaluator, TintedCase};
 #[cfg(feature = "tools")]
 pub use tools::image_error::{difference_image, masked_error, MaskedError};
 #[cfg(feature = "tools")]

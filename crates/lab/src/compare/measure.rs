@@ -31,8 +31,9 @@ pub(super) struct Table<'c> {
 }
 
 /// Why the table has no LUT row, if it has none: a model of its widest column that no table
-/// can hold (`BrdfSet::tabulable`: glTF's metallic-roughness, an engine BRDF with a white part
-/// or reading the tangent). An engine BRDF that a table can hold is baked by its own GLSL.
+/// can hold (`BrdfSet::tabulable`: an engine BRDF whose function takes the tint, or that reads
+/// the tangent). An engine BRDF that a table can hold is baked by its own GLSL, its white part
+/// beside its tinted one.
 pub(super) fn lut_refusal(settings: &CompareSettings) -> Option<String> {
     let widest = settings.brdf_counts.iter().copied().max().unwrap_or(1);
     brdf_palette(&settings.scene, widest)

@@ -17,15 +17,17 @@
 struct LutTable {
     uint axes;       // LUT_AXES_*
     uint resolution; // grid points per axis
-    uint offset;     // first grid point in lut_values (in RGB triples)
+    uint offset;     // first float of the table in lut_values
     float curvature; // the skin table's lookup curvature (1/mm); 0 otherwise
+    uint channels;   // floats per grid point: 3 (tinted RGB), or 4 with the white part after it
 };
 
 layout(set = LUT_SET, binding = LUT_BINDING, std430) readonly buffer LutTables {
     LutTable lut_tables[];
 };
 
-// RGB f32 per grid point, first axis fastest.
+// Per grid point, first axis fastest: the tinted factor (RGB f32), then the white one (f32)
+// where the table has a white part (channels 4): f * N.L = tint * tinted + white.
 layout(set = LUT_SET, binding = LUT_BINDING + 1, std430) readonly buffer LutValues {
     float lut_values[];
 };
@@ -96,16 +98,21 @@ bool lut_coordinates(LutTable table, vec3 N, vec3 T, vec3 V, vec3 L, out vec3 u)
     return false;
 }
 
-vec3 lut_value(uint index) {
-    return vec3(lut_values[3u * index], lut_values[3u * index + 1u], lut_values[3u * index + 2u]);
+// Grid point `point` of `table`: the tinted factor in rgb, the white one in a (0 without one).
+vec4 lut_value(LutTable table, uint point) {
+    uint at = table.offset + table.channels * point;
+    float white = table.channels == 4u ? lut_values[at + 3u] : 0.0;
+    return vec4(lut_values[at], lut_values[at + 1u], lut_values[at + 2u], white);
 }
 
-// `f_r * cos(theta_L)` of table `index` at a shading point, interpolated between grid points.
-vec3 lut_lookup(uint index, vec3 N, vec3 T, vec3 V, vec3 L) {
+// The two factors of `f_r * cos(theta_L)` of table `index` at a shading point, interpolated
+// between grid points: the tinted one in rgb, the white one in a (histencil_brdf::Lut::lookup).
+// A surface of colour `tint` takes tint * f.rgb + f.a.
+vec4 lut_lookup(uint index, vec3 N, vec3 T, vec3 V, vec3 L) {
     LutTable table = lut_tables[index];
     vec3 u;
     if (!lut_coordinates(table, N, T, V, L, u)) {
-        return vec3(0.0);
+        return vec4(0.0);
     }
     uint dims = lut_dimensions(table.axes);
     uint r = table.resolution;
@@ -119,7 +126,7 @@ vec3 lut_lookup(uint index, vec3 N, vec3 T, vec3 V, vec3 L) {
         base[a] = i;
         frac[a] = x - float(i);
     }
-    vec3 result = vec3(0.0);
+    vec4 result = vec4(0.0);
     for (uint corner = 0u; corner < (1u << dims); corner++) {
         float weight = 1.0;
         uint offset = 0u;
@@ -130,7 +137,7 @@ vec3 lut_lookup(uint index, vec3 N, vec3 T, vec3 V, vec3 L) {
             offset += (base[a] + upper) * stride;
             stride *= r;
         }
-        result += weight * lut_value(table.offset + offset);
+        result += weight * lut_value(table, offset);
     }
     return result;
 }

@@ -97,11 +97,13 @@ pub enum Error {
         /// The name of its BRDF.
         brdf: &'static str,
     },
-    /// The LUT technique on a BRDF that a table divided by the tint cannot hold
-    /// ([`histencil_brdf::BrdfSet::tabulable`]).
+    /// The LUT technique on a BRDF that no table can hold
+    /// ([`histencil_brdf::BrdfSet::tabulable`]: an engine BRDF whose function takes the tint, or
+    /// that reads the tangent).
     #[error(
-        "the LUT technique cannot light object `{object}`: {why} (a table holds a material's \
-         BRDF divided by its tint); light this scene with stencil, branching or adaptive"
+        "the LUT technique cannot light object `{object}`: {why} (a table entry holds a \
+         material's BRDF as two factors of its tint, tinted and white, over the three angles of an \
+         isotropic BRDF); light this scene with stencil, branching or adaptive"
     )]
     LutUntabulable {
         /// The scene object's name.

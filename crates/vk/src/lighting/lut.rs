@@ -13,7 +13,7 @@ use crate::shaders;
 use crate::{BrdfEvaluator, BrdfModules};
 use ash::vk;
 use histencil_brdf::lut::{Lut, LutAxes};
-use histencil_brdf::{Brdf, V3};
+use histencil_brdf::{Brdf, Parts, V3};
 use std::ops::Deref;
 
 /// Set 3 of the light pipelines: the LUT technique's tables (include/lut.glsl), bound only by
@@ -36,9 +36,11 @@ pub(crate) const LUT_EVAL_SET: &[BindingDesc] = &[
 struct GpuLutTable {
     axes: u32,
     resolution: u32,
-    /// First grid point in the values buffer, in RGB triples.
+    /// The table's first float in the values buffer.
     offset: u32,
     curvature: f32,
+    /// Floats per grid point: 3 (tinted RGB), 4 with the white part after them.
+    channels: u32,
 }
 
 /// One table per material, baked at one resolution and uploaded. `C` holds the context:
@@ -69,11 +71,13 @@ impl<C: Deref<Target = Context>> LutTables<C> {
     /// As [`LutTables::new`], for the BRDFs of `modules`' set: a built-in's table is baked from
     /// its f64 reference on the CPU, an engine BRDF's is filled on the GPU by its own GLSL
     /// (`modules.brdf_eval`) at the same grid points ([`Lut::grid`]) and read back, so that
-    /// [`LutTables::luts`] holds what the GPU looks up, whoever baked it.
+    /// [`LutTables::luts`] holds what the GPU looks up, whoever baked it. An entry holds both
+    /// factors of a BRDF with a white part (glTF's, an engine's `white`): `tint * tinted + white`.
     ///
     /// # Errors
     /// As [`LutTables::new`]; [`Error::Lut`] also for an engine BRDF the set holds no table of
-    /// ([`histencil_brdf::BrdfSet::tabulable`]: a white part, or the tangent read), and
+    /// ([`histencil_brdf::BrdfSet::tabulable`]: its function takes the tint, or it reads the
+    /// tangent), and
     /// [`Error::BrdfSet`] for a material of a BRDF the set does not hold.
     pub fn with_modules(
         ctx: C,
@@ -90,9 +94,12 @@ impl<C: Deref<Target = Context>> LutTables<C> {
             modules.set.tabulable(b)?;
         }
         // Before anything is baked: a table past the device's range is refused at once.
+        let channels = |b: &Brdf| if modules.set.has_white_part(b) { 4 } else { 3 };
         let bytes: u64 = materials
             .iter()
-            .map(|b| u64::from(resolution).pow(LutAxes::of(b).dimensions() as u32) * 12)
+            .map(|b| {
+                u64::from(resolution).pow(LutAxes::of(b).dimensions() as u32) * channels(b) * 4
+            })
             .sum();
         let limit = u64::from(ctx.max_storage_buffer_range);
         if bytes > limit {
@@ -105,10 +112,18 @@ impl<C: Deref<Target = Context>> LutTables<C> {
             headers.push(GpuLutTable {
                 axes: lut.axes.index(),
                 resolution,
-                offset: (values.len() / 3) as u32,
+                offset: values.len() as u32,
                 curvature: lut.curvature_per_mm() as f32,
+                channels: if lut.has_white() { 4 } else { 3 },
             });
-            values.extend(lut.values.iter().flatten());
+            if lut.has_white() {
+                for (rgb, white) in lut.values.iter().zip(&lut.white) {
+                    values.extend(rgb);
+                    values.push(*white);
+                }
+            } else {
+                values.extend(lut.values.iter().flatten());
+            }
         }
         let owner = ctx;
         let ctx: &Context = &owner;
@@ -181,14 +196,15 @@ impl<C: Deref<Target = Context>> Drop for LutTables<C> {
     }
 }
 
-/// Grid points evaluated per dispatch: 96 bytes of case and 16 of result each, 112 MiB a run
+/// Grid points evaluated per dispatch: 112 bytes of case and 16 of result each, 128 MiB a run
 /// at most, and within the case kernels' 65535 workgroups of 64.
 const BAKE_BATCH: usize = 1 << 20;
 
 /// Each material's table: a built-in's baked from its reference on the CPU, an engine BRDF's
 /// evaluated at the grid points by the set's own `brdf_eval.comp` (the function every
-/// technique shades with, white tint: a tabulable BRDF has no white part). The evaluator is
-/// made at the first engine BRDF, so histencil's own tables touch neither pipeline nor queue.
+/// technique shades with, in its two parts; a tabulable BRDF does not take the tint). The
+/// evaluator is made at the first engine BRDF, so histencil's own tables touch neither pipeline
+/// nor queue.
 fn bake(
     ctx: &Context,
     modules: &'static BrdfModules,
@@ -203,15 +219,21 @@ fn bake(
         };
         let grid = Lut::grid(b, resolution)?;
         let mut values = Vec::with_capacity(grid.len());
+        let mut white = Vec::new();
         for batch in grid.chunks(BAKE_BATCH) {
             let cases: Vec<(Brdf, [V3<f32>; 4])> = batch
                 .iter()
                 .map(|(dirs, at)| (*at, dirs.map(|d| d.map(|x| x as f32))))
                 .collect();
-            let parts = evaluator.evaluate(ctx, &cases)?;
-            values.extend(parts.into_iter().map(|p| p.tinted));
+            for p in evaluator.evaluate(ctx, &cases)? {
+                values.push(p.tinted);
+                white.push(p.white);
+            }
         }
-        Ok(Lut::from_values(b, resolution, values)?)
+        if !modules.set.has_white_part(&b) {
+            white.clear();
+        }
+        Ok(Lut::from_values(b, resolution, values, white)?)
     };
     let baked = materials
         .iter()
@@ -255,7 +277,7 @@ impl LutEvaluator {
         Ok(Self { kernel })
     }
 
-    /// Table `index`'s value at directions `[N, T, V, L]`, per case, RGB.
+    /// Table `index`'s two factors at directions `[N, T, V, L]`, per case.
     ///
     /// # Panics
     /// If a case names a table `tables` does not have: a caller bug.
@@ -264,7 +286,7 @@ impl LutEvaluator {
         ctx: &Context,
         tables: &LutTables<impl Deref<Target = Context>>,
         cases: &[(u32, [V3<f32>; 4])],
-    ) -> Result<Vec<[f32; 3]>> {
+    ) -> Result<Vec<Parts<f32>>> {
         let gpu: Vec<GpuLutCase> = cases
             .iter()
             .map(|(table, [n, t, v, l])| {
@@ -285,7 +307,7 @@ impl LutEvaluator {
             gpu.len() as u32,
             &tables.buffers(),
         )?;
-        Ok(values.into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
+        Ok(values.into_iter().map(Parts::from_channels).collect())
     }
 
     /// Frees the pipeline and its layouts; call it once, before the context goes.
@@ -300,7 +322,7 @@ mod tests {
 
     #[test]
     fn header_matches_the_glsl_struct() {
-        assert_eq!(std::mem::size_of::<GpuLutTable>(), 16);
+        assert_eq!(std::mem::size_of::<GpuLutTable>(), 20);
         assert_eq!(std::mem::size_of::<GpuLutCase>(), 96);
     }
 }

@@ -229,8 +229,8 @@ impl<'c> Renderer<'c> {
     /// [`crate::Error::LutTexturedParameters`] when an object's metallic-roughness map changes
     /// its BRDF's parameters per texel ([`histencil_scene::Material::parameters_vary`]),
     /// [`crate::Error::LutUntabulable`] when a table cannot hold an object's BRDF
-    /// ([`histencil_brdf::BrdfSet::tabulable`]: glTF's metallic-roughness, an engine BRDF with a
-    /// white part or reading the tangent),
+    /// ([`histencil_brdf::BrdfSet::tabulable`]: an engine BRDF whose function takes the tint or
+    /// that reads the tangent),
     /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
     /// [`LutTables::new`].
     pub fn lut_tables(&mut self) -> Result<&LutTables<&'c Context>> {

@@ -20,10 +20,30 @@ pub(crate) const BRDF_EVAL_SET: &[BindingDesc] = &[
 struct GpuBrdfCase {
     model: [u32; 4],
     params: [f32; 4],
+    /// A surface colour in xyz, and w 1 to evaluate the value of a surface of that colour
+    /// (`brdf_eval_tinted`) instead of the two parts.
+    tint: [f32; 4],
     n: [f32; 4],
     t: [f32; 4],
     v: [f32; 4],
     l: [f32; 4],
+}
+
+/// A BRDF, a surface colour and directions `[N, T, V, L]`: one case of
+/// [`BrdfEvaluator::evaluate_tinted`].
+pub type TintedCase = (Brdf, [f32; 3], [V3<f32>; 4]);
+
+fn case(brdf: &Brdf, tint: Option<[f32; 3]>, [n, t, v, l]: &[V3<f32>; 4]) -> GpuBrdfCase {
+    let tint = tint.map_or([0.0; 4], |[r, g, b]| [r, g, b, 1.0]);
+    GpuBrdfCase {
+        model: [brdf.model_index(), 0, 0, 0],
+        params: brdf.packed_params().map(|p| p as f32),
+        tint,
+        n: pad(*n),
+        t: pad(*t),
+        v: pad(*v),
+        l: pad(*l),
+    }
 }
 
 /// The BRDF evaluation kernel; buffers are made per call.
@@ -53,25 +73,26 @@ impl BrdfEvaluator {
     ) -> Result<Vec<Parts<f32>>> {
         let gpu: Vec<GpuBrdfCase> = cases
             .iter()
-            .map(|(brdf, [n, t, v, l])| GpuBrdfCase {
-                model: [brdf.model_index(), 0, 0, 0],
-                params: brdf.packed_params().map(|p| p as f32),
-                n: pad(*n),
-                t: pad(*t),
-                v: pad(*v),
-                l: pad(*l),
-            })
+            .map(|(brdf, dirs)| case(brdf, None, dirs))
             .collect();
         let values = self
             .kernel
             .run(ctx, bytemuck::cast_slice(&gpu), gpu.len() as u32, &[])?;
-        Ok(values
-            .into_iter()
-            .map(|[r, g, b, white]| Parts {
-                tinted: [r, g, b],
-                white,
-            })
-            .collect())
+        Ok(values.into_iter().map(Parts::from_channels).collect())
+    }
+
+    /// `f_r * cos(theta_L)` of each case's surface of colour `tint`, as every technique
+    /// shades it (`brdf_eval_tinted`): the only spelling of an engine BRDF whose function takes
+    /// the tint, which has no parts.
+    pub fn evaluate_tinted(&self, ctx: &Context, cases: &[TintedCase]) -> Result<Vec<[f32; 3]>> {
+        let gpu: Vec<GpuBrdfCase> = cases
+            .iter()
+            .map(|(brdf, tint, dirs)| case(brdf, Some(*tint), dirs))
+            .collect();
+        let values = self
+            .kernel
+            .run(ctx, bytemuck::cast_slice(&gpu), gpu.len() as u32, &[])?;
+        Ok(values.into_iter().map(|[r, g, b, _]| [r, g, b]).collect())
     }
 
     /// Frees the pipeline and its layouts; call it once, before the context goes.
