@@ -1,5 +1,5 @@
 //! The book's two-target hooks (`examples/hooks/two_target`: an RG16 octahedral normal, RGBA8
-//! tint with the BRDF id in alpha, depth from the depth attachment, one shadow map in set 1)
+//! tint with the material index in alpha, a row of BRDF id and parameters per material, depth from the depth attachment, one shadow map in set 1)
 //! compile with histencil's light shaders as `histencil_build` compiles an engine's, fit the set
 //! layout the book describes (and are refused, naming the binding, by one that lacks a binding),
 //! and make a lighting whose light pipelines the validation layer accepts. The engine chapter
@@ -13,22 +13,23 @@ use histencil_vk::{
 };
 
 /// The images the decode reads, in `LightingTargets::gbuffer` order: target 0 the normal,
-/// target 1 the tint and BRDF id (the header of `surface_decode.glsl`).
+/// target 1 the tint and material index (the header of `surface_decode.glsl`).
 const SURFACE_FORMATS: [vk::Format; 2] = [vk::Format::R16G16_UNORM, vk::Format::R8G8B8A8_UNORM];
 
 const ALL_LIGHT_STAGES: vk::ShaderStageFlags = vk::ShaderStageFlags::from_raw(
     vk::ShaderStageFlags::FRAGMENT.as_raw() | vk::ShaderStageFlags::COMPUTE.as_raw(),
 );
 
-/// The one hook layout (set 1) the two hooks' headers declare: the decode's normal, tint-and-id
-/// and depth images and its BRDF parameters, then the visibility's shadow map and block.
+/// The one hook layout (set 1) the two hooks' headers declare: the decode's normal,
+/// tint-and-material and depth images and its material rows, then the visibility's shadow map
+/// and block.
 fn two_target_bindings() -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
     use vk::DescriptorType as T;
     [
         T::SAMPLED_IMAGE,          // 0 two_target_normal
-        T::SAMPLED_IMAGE,          // 1 two_target_tint_brdf
+        T::SAMPLED_IMAGE,          // 1 two_target_tint_material
         T::SAMPLED_IMAGE,          // 2 two_target_depth
-        T::UNIFORM_BUFFER,         // 3 two_target_brdfs
+        T::UNIFORM_BUFFER,         // 3 two_target_materials
         T::COMBINED_IMAGE_SAMPLER, // 4 two_target_shadow_map
         T::UNIFORM_BUFFER,         // 5 two_target_shadow
     ]
@@ -67,7 +68,7 @@ fn the_two_target_hooks_compile_and_fit_the_layout_the_book_gives() {
     let modules = TWO_TARGET;
     let bindings = two_target_bindings();
     hooks(modules, &bindings).expect("the layout the hooks' headers declare");
-    // The BRDF parameters' block left out of the layout: refused, naming it.
+    // The material rows' block left out of the layout: refused, naming it.
     let without_params: Vec<_> = bindings
         .iter()
         .filter(|b| b.binding != 3)
@@ -77,8 +78,9 @@ fn the_two_target_hooks_compile_and_fit_the_layout_the_book_gives() {
         Err(e @ Error::BadSetup(_)) => e.to_string(),
         other => panic!("expected a setup error, got {other:?}"),
     };
-    // The reflected name of a uniform block is its instance name (`two_target_brdfs`).
-    let words = "deferred_light: reads set 1 binding 3 (`two_target_brdfs`), a uniform buffer, \
+    // The reflected name of a uniform block is its instance name (`two_target_materials`).
+    let words =
+        "deferred_light: reads set 1 binding 3 (`two_target_materials`), a uniform buffer, \
                  and the decode layout (set 1) has no such binding";
     assert!(err.contains(words), "{err}\nshould say: {words}");
 }

@@ -393,3 +393,50 @@ fn a_decode_hook_without_rows_for_the_ids_the_lighting_shades_is_refused_at_crea
     }
     engine.destroy().assert_clean();
 }
+
+/// Parameters per material: rows indexed by a material index the G-buffer carries, each a BRDF
+/// id and its parameters (`MaterialRows`, `BrdfParams::Materials`, the book's two-target
+/// hook). Two materials of one BRDF are two rows and one BRDF to shade; rows naming a BRDF the
+/// lighting does not shade are refused (`DeferredLighting::check_materials`), naming the
+/// material, since its pixels would get no light pass and no error.
+#[test]
+fn material_rows_are_held_to_the_brdfs_the_lighting_shades() {
+    use histencil_brdf::{Brdf, BrdfId, BrdfSet, MaterialRows};
+    let set = BrdfSet::new(&BrdfId::ALL, vec![]).unwrap();
+    let ggx = |alpha| Brdf::Ggx {
+        alpha,
+        f0: 0.04,
+        f90: 1.0,
+    };
+    let rows = MaterialRows::new(&set, &[ggx(0.2), Brdf::Lambert { rho: 0.8 }, ggx(0.6)]).unwrap();
+    assert_eq!(rows.brdfs(), [BrdfId::Ggx, BrdfId::Lambert]);
+    let engine = Engine::start();
+    {
+        // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
+        let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
+        let layout = histencil_model::StencilLayout::new(2, 0).unwrap();
+        let extent = vk::Extent2D {
+            width: 16,
+            height: 16,
+        };
+        let ds = ctx.depth_stencil_format().vk();
+        let desc = lighting_desc(layout, rows.brdfs(), extent, ds, 1);
+        let lighting = DeferredLighting::new(&ctx, &desc).expect("lighting");
+        lighting
+            .check_materials(&rows)
+            .expect("every material's BRDF is shaded");
+        let cloth = Brdf::OrenNayarFull {
+            rho: 0.7,
+            sigma: 0.3,
+        };
+        let more = MaterialRows::new(&set, &[ggx(0.2), Brdf::Lambert { rho: 0.8 }, cloth]).unwrap();
+        let m = lighting.check_materials(&more).unwrap_err().to_string();
+        assert!(
+            m.contains("material 2 is `oren_nayar_full`") && m.contains("unlit"),
+            "{m}"
+        );
+        drop(lighting);
+        assert!(ctx.validation_log().is_empty());
+    }
+    engine.destroy().assert_clean();
+}

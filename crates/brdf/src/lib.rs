@@ -26,6 +26,8 @@
 //! as `Brdf::parse`) reads and writes the `brdf-eval` case files.
 //!
 //! [`BrdfId`] is the renderer's list of shading models stored in the G-buffer and stencil;
+//! [`MaterialRows`] lays an engine's materials out as rows its decode hook reads by material
+//! index, so materials of one BRDF keep their own parameters.
 //! [`BrdfSet`] adds an engine's own (GLSL functions, read from a `brdfs.toml` folder with the
 //! `files` feature) to the built-ins it keeps.
 
@@ -42,6 +44,7 @@ mod includes;
 pub mod lut;
 #[cfg(feature = "manifest")]
 mod manifest;
+mod materials;
 mod model;
 mod models;
 mod set;
@@ -51,6 +54,7 @@ mod weights;
 pub use id::{BrdfId, EngineBrdf, UnknownBrdf, ENGINE_FIRST, MAX_ENGINE_BRDFS};
 #[cfg(feature = "manifest")]
 pub use manifest::{ManifestError, MANIFEST};
+pub use materials::{MaterialError, MaterialRows, MATERIAL_ROW_BYTES};
 pub use model::{ranges, Brdf, BrdfError, Parts, Range, MODEL_NAMES};
 pub use models::*;
 pub use set::{BrdfSet, EngineBrdfSpec, EngineParam, SetError, MAX_ENGINE_PARAMS, MODEL_IDS};

@@ -85,9 +85,11 @@ pub struct HistencilHooks {
     /// Their formats, in `HistencilTargets.gbuffer` order.
     pub surface_formats: *const vk::Format,
     /// How the decode reads each BRDF's parameters: 0 from the pixel itself (the G-buffer
-    /// carries them), else from rows indexed by BRDF id, ids 0 to `brdf_param_rows - 1`
-    /// (`BRDF_ID_COUNT` in `brdf_set/ids.glsl` sizes them). A lighting shading an id without a
-    /// row is refused: its surfaces would be unlit with no error anywhere.
+    /// carries them, or a material index whose row of BRDF id and parameters the hook reads, as
+    /// the book's two-target hook does: 32 bytes a row, `vec4` parameters then `uvec4` id), else
+    /// from rows indexed by BRDF id, ids 0 to `brdf_param_rows - 1` (`BRDF_ID_COUNT` in
+    /// `brdf_set/ids.glsl` sizes them). A lighting shading an id without a row is refused: its
+    /// surfaces would be unlit with no error anywhere.
     pub brdf_param_rows: u32,
 }
 

@@ -105,7 +105,7 @@ pub use histencil_vk as vk;
 /// it too, beside the modules and [`Result`].
 pub mod prelude {
     // BRDFs (histencil's and an engine's own) and lights.
-    pub use histencil_brdf::{Brdf, BrdfId, BrdfSet, EngineBrdfSpec, EngineParam};
+    pub use histencil_brdf::{Brdf, BrdfId, BrdfSet, EngineBrdfSpec, EngineParam, MaterialRows};
     pub use histencil_scene::{
         Falloff, Light, LightKind, Material, Mesh, ParticleLayout, ParticleSystem,
     };

@@ -829,11 +829,14 @@ fn main() {
         .collect();
     let own = world.brdfs.iter().filter(|b| !b.is_builtin()).count();
     let names = names.join(", ");
+    let materials = world.material_count();
+    let brdf_count = world.brdfs.len();
     println!(
         "engine example: {FRAMES} frames, {IN_FLIGHT} in flight, lighting max {worst}/255 vs forward \
          over frames {}; engine stencil bits {} on {stencil_frames} stencil frames; {messages} \
          validation messages, {hazards} hazards, G-buffer {bytes} bytes per pixel, {SHADOWED_LIGHTS} shadowed \
-         lights, {own} BRDFs of its own ({names}), through the hooks",
+         lights, {materials} materials of {brdf_count} BRDFs, {own} of them its own ({names}), through \
+         the hooks",
         compared.join("; "),
         if intact { "intact" } else { "NOT intact" }
     );

@@ -1,5 +1,5 @@
 //! The engine's world: a floor and eight boxes in six BRDFs (two of them the engine's own, from
-//! `../brdfs`), a glass sphere and a smoke cloud
+//! `../brdfs`; three BRDFs in two materials each, with their own parameters), a glass sphere and a smoke cloud
 //! (translucent), 64 point lights and a camera, all animated by frame number. Its own types;
 //! `histencil_scene` for its procedural meshes and particles and for the forward reference.
 
@@ -32,6 +32,23 @@ pub struct World {
     pub objects: Vec<Object>,
     /// The BRDFs in use; an index here is a stencil slot.
     pub brdfs: Vec<BrdfId>,
+}
+
+/// Materials carry their own parameters, not their BRDF's: the boxes past the first round of
+/// BRDFs are a second material of the same BRDF (a rougher GGX, a rougher Oren-Nayar, a
+/// sharper Blinn-Phong), one stencil id and one light shader with the first. The compact
+/// G-buffer stores each pixel's parameters, so nothing else changes.
+fn second_material(brdf: Brdf, round: usize) -> Brdf {
+    match (brdf, round) {
+        (Brdf::Ggx { f0, f90, .. }, 1) => Brdf::Ggx {
+            alpha: 0.6,
+            f0,
+            f90,
+        },
+        (Brdf::OrenNayarFull { rho, .. }, 1) => Brdf::OrenNayarFull { rho, sigma: 0.15 },
+        (Brdf::BlinnPhong { .. }, 1) => Brdf::BlinnPhong { exponent: 200.0 },
+        _ => brdf,
+    }
 }
 
 impl World {
@@ -78,7 +95,7 @@ impl World {
                     Quat::from_rotation_y(angle * 0.7),
                     Vec3::new(3.0 * angle.cos(), height, 3.0 * angle.sin()),
                 ),
-                brdf: brdfs[i % brdfs.len()],
+                brdf: second_material(brdfs[i % brdfs.len()], i / brdfs.len()),
                 tint: Vec3::new(0.9, 0.5 + 0.05 * i as f32, 0.3 + 0.08 * i as f32),
                 stencil: DYNAMIC,
             });
@@ -93,6 +110,18 @@ impl World {
             objects,
             brdfs: ids,
         }
+    }
+
+    /// How many distinct materials (a BRDF with its parameters) the objects have: more than
+    /// BRDFs, since materials of one BRDF keep their own parameters.
+    pub fn material_count(&self) -> usize {
+        let mut seen: Vec<Brdf> = Vec::new();
+        for o in &self.objects {
+            if !seen.contains(&o.brdf) {
+                seen.push(o.brdf);
+            }
+        }
+        seen.len()
     }
 
     pub fn slot(&self, object: &Object) -> u32 {

@@ -8,11 +8,12 @@
 //                         octahedral, unfolded to [0, 1]^2 (with R16G16_SNORM, drop the
 //                         `* 2.0 - 1.0` in two_target_octahedral_decode)
 //   binding 1  texture2D  G-buffer target 1, R8G8B8A8_UNORM (or _SRGB: alpha stays linear):
-//                         rgb the tint, a the BRDF id / 255 (histencil_brdf::BrdfId::index)
+//                         rgb the tint, a the material index / 255 (0 to 255)
 //   binding 2  texture2D  the depth-stencil image's depth aspect, through a depth-only view,
 //                         in DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL
-//   binding 3  uniform    the packed parameters of each BRDF id (histencil_brdf::Brdf::
-//                         packed_params): every surface of a BRDF shares them, its tint varies
+//   binding 3  uniform    one row per material (histencil_brdf::MaterialRows::bytes): its BRDF
+//                         id and parameters, so two materials of one BRDF keep their own
+//                         roughness; TWO_TARGET_MATERIALS rows, 8 KiB
 // The surface formats given to EngineHooks::new, in LightingTargets::gbuffer order:
 // [R16G16_UNORM, R8G8B8A8_UNORM]. The depth-stencil is LightingTargets::depth_stencil, not one.
 // No geometry where depth still holds its clear value, the far plane's (frame.settings.y).
@@ -26,16 +27,20 @@
 #include "surface.glsl" // struct Surface
 
 layout(set = 1, binding = 0) uniform texture2D two_target_normal;
-layout(set = 1, binding = 1) uniform texture2D two_target_tint_brdf;
+layout(set = 1, binding = 1) uniform texture2D two_target_tint_material;
 layout(set = 1, binding = 2) uniform texture2D two_target_depth;
-// One row per BRDF id (BrdfId::index), each Brdf::packed_params as four floats: BRDF_ID_COUNT
-// rows, every id of the set the light shaders are compiled for (8 for histencil's own, more
-// with engine BRDFs), said to histencil as BrdfParams::Rows(BRDF_ID_COUNT).
-#include "brdf_set/ids.glsl"
-#define TWO_TARGET_BRDF_ROWS BRDF_ID_COUNT
-layout(set = 1, binding = 3, std140) uniform TwoTargetBrdfs {
-    vec4 packed_params[TWO_TARGET_BRDF_ROWS];
-} two_target_brdfs;
+// One row per material, indexed by the material index target 1 carries: said to histencil as
+// BrdfParams::Materials. A row is 32 bytes in std140 as in histencil_brdf::MaterialRows::bytes;
+// an 8-bit index names at most 256, so every index the G-buffer can hold has a row (8 KiB, within
+// the 16 KiB uniform range every device binds). Rows past the engine's materials are zeros.
+#define TWO_TARGET_MATERIALS 256
+struct TwoTargetMaterial {
+    vec4 params; // Brdf::packed_params
+    uvec4 brdf;  // x: BrdfId::index
+};
+layout(set = 1, binding = 3, std140) uniform TwoTargetMaterials {
+    TwoTargetMaterial rows[TWO_TARGET_MATERIALS];
+} two_target_materials;
 
 // The unit vector whose octahedral encoding, unfolded to [0, 1]^2, is `f`.
 vec3 two_target_octahedral_decode(vec2 f) {
@@ -52,21 +57,23 @@ bool decode_surface(vec2 frag_coord, out Surface s) {
     if (depth == frame.settings.y) {
         return false; // nothing drawn here: s is not read
     }
-    vec4 tint_brdf = texelFetch(two_target_tint_brdf, px, 0);
+    vec4 tint_material = texelFetch(two_target_tint_material, px, 0);
     // Device depth to linear depth (-z in view space) for any perspective projection, standard
     // or reversed Z, finite or infinite far plane: depth = -P22 + P32 / linear_depth.
     float linear_depth = frame.proj[3][2] / (depth + frame.proj[2][2]);
     s.position = world_position_on_ray(frag_coord, linear_depth);
     s.normal = two_target_octahedral_decode(texelFetch(two_target_normal, px, 0).rg);
-    s.tint = tint_brdf.rgb;
-    s.brdf = uint(round(tint_brdf.a * 255.0));
-    s.params = two_target_brdfs.packed_params[min(s.brdf, TWO_TARGET_BRDF_ROWS - 1u)];
+    s.tint = tint_material.rgb;
+    TwoTargetMaterial row = two_target_materials.rows[uint(round(tint_material.a * 255.0))];
+    s.brdf = row.brdf.x;
+    s.params = row.params;
     return true;
 }
 
-// This engine makes no BRDF tables (the LUT technique): every pixel is table 0.
+// The LUT technique's table: one per material, so the material index names it (an engine that
+// makes tables makes them from MaterialRows::materials, in that order: LutTables).
 uint decode_lut_material(vec2 frag_coord) {
-    return 0u;
+    return uint(round(texelFetch(two_target_tint_material, ivec2(frag_coord), 0).a * 255.0));
 }
 
 #endif

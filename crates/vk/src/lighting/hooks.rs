@@ -73,8 +73,14 @@ pub enum BrdfParams {
     /// G-buffer does): every id.
     PerPixel,
     /// From rows indexed by the BRDF id (`BrdfId::index`), each a `Brdf::packed_params`: ids 0
-    /// to `rows - 1`. Size them from the set: `BRDF_ID_COUNT` in `brdf_set/ids.glsl`.
+    /// to `rows - 1`. Size them from the set: `BRDF_ID_COUNT` in `brdf_set/ids.glsl`. Every
+    /// surface of a BRDF then shares its parameters.
     Rows(u32),
+    /// From rows indexed by a material index the G-buffer carries, each a BRDF id and its
+    /// parameters ([`histencil_brdf::MaterialRows`]): materials of one BRDF keep their own
+    /// parameters. The rows are the engine's data, so they are held to a lighting by
+    /// [`crate::DeferredLighting::check_materials`], not here.
+    Materials,
 }
 
 /// What each of an engine's layouts holds ([`EngineHooks::register_layouts`]).
@@ -400,7 +406,7 @@ impl LightHooks {
         };
         let builtins = BrdfId::ALL.len() as u32;
         let (rows, said) = match e.brdf_params {
-            Some(BrdfParams::PerPixel) => return Ok(()),
+            Some(BrdfParams::PerPixel | BrdfParams::Materials) => return Ok(()),
             Some(BrdfParams::Rows(rows)) => (rows, true),
             None => (builtins, false),
         };
@@ -422,7 +428,8 @@ impl LightHooks {
         Err(Error::BadSetup(format!(
             "{declared}, and the lighting shades {}: those pixels would read no parameters \
              and come out unlit. Size the hook's rows from the set (BRDF_ID_COUNT in \
-             brdf_set/ids.glsl) and say BrdfParams::Rows(BRDF_ID_COUNT), or BrdfParams::PerPixel \
+             brdf_set/ids.glsl) and say BrdfParams::Rows(BRDF_ID_COUNT), BrdfParams::Materials \
+             for rows per material, or BrdfParams::PerPixel \
              when the G-buffer carries them",
             past.join(", ")
         )))

@@ -299,6 +299,30 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         &self.desc
     }
 
+    /// Holds an engine's material rows ([`crate::BrdfParams::Materials`]) to this lighting:
+    /// every material's BRDF must be one it shades ([`LightingDesc::brdfs`]). A material of
+    /// another BRDF would get no light pass under the stencil technique and no tile class under
+    /// tiled: its pixels unlit, with no error anywhere. Call it whenever the rows change.
+    ///
+    /// # Errors
+    /// [`Error::BadSetup`] naming the first such material, its BRDF and the lighting's BRDFs.
+    pub fn check_materials(&self, rows: &histencil_brdf::MaterialRows) -> Result<()> {
+        let shaded = &self.desc.brdfs;
+        let Some((index, brdf)) =
+            (rows.materials().iter().enumerate()).find(|(_, m)| !shaded.contains(&m.id()))
+        else {
+            return Ok(());
+        };
+        let names: Vec<String> = shaded.iter().map(|b| format!("`{b}`")).collect();
+        Err(bad_setup(format!(
+            "material {index} is `{}`, which this lighting does not shade (it shades {}): its \
+             pixels would come out unlit. Make the lighting with LightingDesc::brdfs = \
+             MaterialRows::brdfs()",
+            brdf.id(),
+            names.join(", ")
+        )))
+    }
+
     /// Says the GPU has finished the frame last recorded into `slot`, so the slot may be
     /// recorded again and, once every slot is finished, the lighting resized or destroyed. An
     /// engine calls it after waiting for that frame's fence (or timeline value); a slot whose
