@@ -220,8 +220,8 @@ fn the_example_brdfs_are_held_to_forward_by_every_technique() {
 
 /// An engine BRDF whose function takes the tint is called with the pixel's colour by every
 /// technique: spelling glTF's metallic-roughness so (`tint * tinted + white` from histencil's
-/// own GLSL) gives the built-in's frames bit for bit. A tint reaching it wrong anywhere (a
-/// white surface's, another pixel's) would change them.
+/// own GLSL) gives the built-in's frames bit for bit, in every technique and every alpha mode. A
+/// tint reaching it wrong anywhere (a white surface's, another pixel's) would change them.
 #[test]
 fn an_engine_brdf_taking_the_tint_gives_the_builtin_gltf_frames_bit_for_bit() {
     let dir = folder(
@@ -260,12 +260,45 @@ fn an_engine_brdf_taking_the_tint_gives_the_builtin_gltf_frames_bit_for_bit() {
         }
     }
     assert!(swapped > 0);
+    // And a translucent sphere of it, in every alpha mode.
+    let mut glass = histencil_scene::embedded("alpha").unwrap();
+    glass.alpha_objects[0].material.brdf = Brdf::GltfMetalRough {
+        alpha: 0.3,
+        metallic: 0.4,
+    };
+    glass.alpha_objects[0].material.tint = glam::Vec3::new(0.9, 0.4, 0.1);
+    let mut engine_glass = glass.clone();
+    let given = [("alpha", 0.3), ("metallic", 0.4)];
+    engine_glass.alpha_objects[0].material.brdf = set.engine_brdf("my_gltf", &given).unwrap();
     with_validated_context(|ctx| {
         for (name, shading) in techniques() {
             let expected = render(ctx, &builtin, BrdfModules::builtin(), shading);
             let actual = render(ctx, &engine, modules, shading);
             let d = diff(&expected, &actual);
             assert_eq!(d.max, 0, "{name}: the engine's glTF differs: {d:?}");
+        }
+        use histencil_vk::{AlphaMode, FrameDesc};
+        let light = |scene: &histencil_scene::Scene, brdfs, alpha| {
+            let desc = RendererDesc {
+                brdfs,
+                ..RendererDesc::new(SIZE, SIZE)
+            };
+            let mut renderer = Renderer::with_desc(ctx, scene.clone(), &desc).unwrap();
+            let frame = FrameDesc {
+                alpha,
+                ..FrameDesc::new(Shading::Forward, Readback::ALL)
+            };
+            renderer.render_frame(&frame).unwrap().images.ldr.unwrap()
+        };
+        for mode in [
+            AlphaMode::Forward,
+            AlphaMode::Lightmap,
+            AlphaMode::Probe,
+            AlphaMode::Directional,
+        ] {
+            let expected = light(&glass, BrdfModules::builtin(), mode);
+            let d = diff(&expected, &light(&engine_glass, modules, mode));
+            assert_eq!(d.max, 0, "{mode:?}: the engine's glTF glass differs: {d:?}");
         }
     });
 }
@@ -534,8 +567,8 @@ fn an_alpha_entity_with_an_engine_brdf_is_lit_in_every_alpha_mode() {
 /// points: one spelling GGX with histencil's GLSL fills the table that the built-in GGX's f64
 /// reference bakes, within the GLSL's own error against that reference (`brdf_gpu.rs`: 1e-2 of
 /// max(1, |value|) on hard cases, which grazing grid points are), and lights the LUT frame as the
-/// built-in's table does. A BRDF no table can hold is refused, saying why: Charlie sheen's white
-/// part, a BRDF reading the tangent.
+/// built-in's table does. A BRDF no table can hold is refused, saying why (one reading the
+/// tangent); Charlie sheen's table holds its white lobe beside its tinted base.
 #[test]
 fn an_engine_brdfs_lut_table_is_filled_by_its_glsl() {
     let dir = folder(
