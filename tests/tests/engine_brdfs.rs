@@ -505,6 +505,8 @@ fn the_lab_measures_the_engine_brdfs() {
         // The sheen's white part is held beside its tinted part: the LUT row is measured.
         assert!(report.rows.iter().any(|r| r.name == "lut"));
         assert_eq!(report.lut_left_out, None);
+        // Its error is stated against the tables' resolution.
+        assert!(report.markdown().contains("tables hold 32 points per axis"));
         assert!(report
             .markdown()
             .contains("the 2-BRDF column adds `charlie_sheen`"));

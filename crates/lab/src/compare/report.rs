@@ -51,6 +51,14 @@ impl CompareReport {
             )
         };
         let line = match &self.lut_left_out {
+            None if self.rows.iter().any(|r| r.name == "lut") => {
+                line + &format!(
+                    " The LUT row's tables hold {} points per axis: its error against forward is \
+                     theirs at that resolution (`histencil sweep --param lut-res` gives it \
+                     against resolution).",
+                    histencil_vk::DEFAULT_LUT_RESOLUTION
+                )
+            }
             None => line,
             Some(why) => line + &format!(" The LUT row is left out: {why}."),
         };
