@@ -247,8 +247,8 @@ pub struct Lut {
 }
 
 impl Lut {
-    /// 512 points per axis is 512 MiB of RGB f32 for a 3D table (a third more with a white
-    /// part): beyond anything useful.
+    /// 512 points per axis is 1.5 GiB of RGB f32 for a 3D table (2 GiB with a white part):
+    /// beyond anything useful, and refused by the device's storage-buffer range long before.
     pub const MAX_RESOLUTION: u32 = 512;
 
     /// `Ok` for a resolution [`Lut::bake`] accepts: 2 to [`Lut::MAX_RESOLUTION`] points per axis.
@@ -328,7 +328,8 @@ impl Lut {
     ///
     /// # Errors
     /// [`LutError::Resolution`], and [`LutError::ValueCount`] unless there is one tinted value
-    /// per grid point and, when `white` is given, one white value per grid point.
+    /// per grid point and, when `white` is given (always for glTF's metallic-roughness), one
+    /// white value per grid point.
     pub fn from_values(
         brdf: Brdf,
         resolution: u32,
@@ -338,8 +339,10 @@ impl Lut {
         Self::check_resolution(resolution)?;
         let axes = LutAxes::of(&brdf);
         let expected = (resolution as usize).pow(axes.dimensions() as u32);
-        // The white part may be absent; the tinted part may not.
-        let wrong = [(values.len(), false), (white.len(), true)]
+        // The white part may be absent, except for a built-in that has one (an engine BRDF's is
+        // its set's to say); the tinted part may not.
+        let white_optional = !brdf.has_white_part();
+        let wrong = [(values.len(), false), (white.len(), white_optional)]
             .into_iter()
             .find(|&(given, optional)| given != expected && !(optional && given == 0));
         if let Some((given, _)) = wrong {
@@ -575,6 +578,11 @@ mod tests {
         let lut = Lut::bake(brdf, 5).unwrap();
         assert!(lut.has_white());
         assert_eq!(lut.size_bytes(), 125 * 16);
+        // Its white part cannot be left out: the dielectric specular would go in silence.
+        assert!(matches!(
+            Lut::from_values(brdf, 5, lut.values.clone(), Vec::new()),
+            Err(LutError::ValueCount { given: 0, .. })
+        ));
         let (dirs, _) = lut.axes.directions([0.25, 0.5, 0.75]);
         let reference = brdf.reference_parts(dirs);
         assert!(reference.white > 1e-3, "{reference:?}");

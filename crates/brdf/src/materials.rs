@@ -18,8 +18,9 @@
 //! };
 //! ```
 //!
-//! `examples/hooks/two_target/surface_decode.glsl` reads them from a storage buffer; the book's
-//! "hooks" chapter shows the whole hook.
+//! `examples/hooks/two_target/surface_decode.glsl` reads them from a uniform block of 256 rows
+//! (an 8-bit index in its G-buffer): [`MaterialRows::check_capacity`] holds the rows to what a
+//! hook declares. The book's "hooks" chapter shows the whole hook.
 
 use crate::id::BrdfId;
 use crate::model::{Brdf, BrdfError};
@@ -34,6 +35,14 @@ pub enum MaterialError {
     /// No material at all: a decode hook would index an empty buffer.
     #[error("no materials: give at least one (a decode hook indexes the rows by material)")]
     Empty,
+    /// More materials than the decode hook's rows hold (or its G-buffer's index can name).
+    #[error("{count} materials, and the decode hook holds {rows} rows: materials past them could not be named or read")]
+    TooMany {
+        /// How many materials.
+        count: usize,
+        /// The rows the hook declares.
+        rows: usize,
+    },
     /// A material whose BRDF the set does not hold, or whose parameters it refuses.
     #[error("material {index}: {source}")]
     Material {
@@ -68,6 +77,20 @@ impl MaterialRows {
         Ok(Self {
             materials: materials.to_vec(),
         })
+    }
+
+    /// Refuses more materials than `rows`, the rows the decode hook declares (256 in the book's
+    /// two-target hook, whose G-buffer holds an 8-bit index): a material past them would be
+    /// written past the hook's buffer and never read.
+    ///
+    /// # Errors
+    /// [`MaterialError::TooMany`].
+    pub fn check_capacity(&self, rows: usize) -> Result<(), MaterialError> {
+        let count = self.materials.len();
+        if count > rows {
+            return Err(MaterialError::TooMany { count, rows });
+        }
+        Ok(())
     }
 
     /// The materials, by index.
@@ -152,5 +175,9 @@ mod tests {
             "{err}"
         );
         assert_eq!(MaterialRows::new(&set, &[]), Err(MaterialError::Empty));
+        let rows = MaterialRows::new(&set, &[ggx(0.2); 3]).unwrap();
+        assert_eq!(rows.check_capacity(3), Ok(()));
+        let err = rows.check_capacity(2).unwrap_err();
+        assert_eq!(err, MaterialError::TooMany { count: 3, rows: 2 });
     }
 }

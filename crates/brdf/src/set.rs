@@ -17,8 +17,9 @@
 //! glTF's BRDF has: a dielectric's specular is not tinted), a second function
 //! `float name(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L)` gives the part added untinted.
 //!
-//! A BRDF whose value is not affine in the surface's colour (glTF's metallic-roughness mixes a
-//! Fresnel-weighted diffuse that goes with the base colour squared) takes the colour itself:
+//! A BRDF whose value is not affine in the surface's colour (many engines' metallic-roughness,
+//! whose Fresnel takes F0 = mix(0.04, base, metallic) and weighs the diffuse, goes with the base
+//! colour squared; glTF's own Appendix B, histencil's built-in, is affine) takes the colour itself:
 //! declared with `tint = true`, its function is
 //! `vec3 name(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L)` and returns the whole
 //! `f_r * N.L` of a surface of that colour, per channel, with no white part. The file

@@ -161,7 +161,7 @@ struct RenderArgs {
     #[arg(long, value_enum, default_value = "auto")]
     flush: FlushArg,
     /// With `--technique lut`: grid points per axis of every BRDF table (2..=512; a 3D table
-    /// takes 12 * N^3 bytes).
+    /// takes 12 * N^3 bytes, 16 * N^3 with a white part).
     #[arg(long, default_value_t = histencil_vk::DEFAULT_LUT_RESOLUTION)]
     lut_resolution: u32,
     /// How translucent objects and particles are lit: `lightmap` (the talk's per-entity GPU

@@ -1,7 +1,7 @@
 #version 460
 // Looks BRDF tables up with the GLSL spelling, for the comparison against Rust's Lut::lookup
-// (crates/vk/src/lighting/lut.rs, LutEvaluator). The cases are brdf_eval.comp's, with `model.x`
-// naming the table; a result is the tinted factor in rgb and the white one in a.
+// (crates/vk/src/lighting/lut.rs, LutEvaluator). A case is a table and four directions; a result
+// is the tinted factor in rgb and the white one in a.
 
 #define LUT_SET 0
 #define LUT_BINDING 2

@@ -109,6 +109,11 @@ vec4 lut_value(LutTable table, uint point) {
 // between grid points: the tinted one in rgb, the white one in a (histencil_brdf::Lut::lookup).
 // A surface of colour `tint` takes tint * f.rgb + f.a.
 vec4 lut_lookup(uint index, vec3 N, vec3 T, vec3 V, vec3 L) {
+    // A decode hook's table index past the tables (a material index with fewer tables than
+    // materials) reads no header past the buffer's end.
+    if (index >= uint(lut_tables.length())) {
+        return vec4(0.0);
+    }
     LutTable table = lut_tables[index];
     vec3 u;
     if (!lut_coordinates(table, N, T, V, L, u)) {

@@ -324,5 +324,9 @@ mod tests {
     fn header_matches_the_glsl_struct() {
         assert_eq!(std::mem::size_of::<GpuLutTable>(), 20);
         assert_eq!(std::mem::size_of::<GpuLutCase>(), 96);
+        assert_eq!(
+            std::mem::size_of::<crate::tools::brdf_eval::GpuBrdfCase>(),
+            112
+        );
     }
 }

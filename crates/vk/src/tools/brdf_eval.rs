@@ -17,7 +17,7 @@ pub(crate) const BRDF_EVAL_SET: &[BindingDesc] = &[
 /// std430 mirror of `BrdfCase` in `crates/vk/shaders/brdf_eval.comp`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct GpuBrdfCase {
+pub(crate) struct GpuBrdfCase {
     model: [u32; 4],
     params: [f32; 4],
     /// A surface colour in xyz, and w 1 to evaluate the value of a surface of that colour
@@ -65,7 +65,10 @@ impl BrdfEvaluator {
     }
 
     /// `f_r * cos(theta_L)` of each case in its two parts, `tint * tinted + white`
-    /// ([`histencil_brdf::Parts`]; scalar models repeat their value in the tinted channels).
+    /// ([`histencil_brdf::Parts`]; scalar models repeat their value in the tinted channels). An
+    /// engine BRDF whose function takes the tint has no parts: it gives a white surface's value
+    /// as `tinted` and 0 as `white`, which no other tint scales; use
+    /// [`BrdfEvaluator::evaluate_tinted`] for it.
     pub fn evaluate(
         &self,
         ctx: &Context,
