@@ -36,15 +36,13 @@
 use crate::gpu::context::Context;
 use ash::vk;
 use std::cell::{Cell, RefCell};
-use std::rc::Rc;
 
 /// Where a recording's timed passes write their end timestamps (`Recording::timed`): a
 /// timestamp pool, how many marks it holds, and the names of the marks written so far (`start`
-/// first). Shared by the recordings of one command buffer: the renderer's frame and the
-/// lighting's own recording of the same buffer, whose tiled passes are timed too.
+/// first). One recording's own: an entry point the renderer shares with engines records through
+/// the renderer's recording (`DeferredLighting::record_tiled_with`), so its passes are timed by
+/// this clock without one being lent.
 pub(crate) struct PassClock {
-    /// The command buffer whose recordings write the marks (reset there, by `start_clock`).
-    pub(super) cmd: vk::CommandBuffer,
     pub(super) pool: vk::QueryPool,
     pub(super) capacity: u32,
     pub(super) names: RefCell<Vec<&'static str>>,
@@ -59,7 +57,7 @@ pub(crate) struct Recording<'a> {
     /// Debug labels opened through this recording and not yet closed.
     labels: Cell<u32>,
     /// The clock its timed passes write to, when it has one.
-    pub(super) clock: Option<Rc<PassClock>>,
+    pub(super) clock: Option<PassClock>,
 }
 
 impl<'a> Recording<'a> {
@@ -71,7 +69,7 @@ impl<'a> Recording<'a> {
     /// dispatches), and is outside any render pass or dynamic rendering; until this value is
     /// dropped only this value's users record into it. (A recording of `cmd` made earlier, and
     /// outside rendering, may hand `cmd` to an entry point that makes its own recording, as
-    /// the renderer's frame does with the lighting's: it records nothing until that returns.)
+    /// an engine's call does: it records nothing until that returns.)
     pub unsafe fn new(ctx: &'a Context, cmd: vk::CommandBuffer) -> Self {
         Self {
             ctx,
@@ -249,7 +247,7 @@ impl<'a> Recording<'a> {
         debug_assert!(!self.rendering.get(), "a recording left rendering open");
         debug_assert_eq!(self.labels.get(), 0, "a recording left a label open");
         self.clock
-            .map(|clock| clock.names.borrow().clone())
+            .map(|clock| clock.names.into_inner())
             .unwrap_or_default()
     }
 }

@@ -5,7 +5,6 @@ use crate::gpu::error::{Result, VkCall};
 use crate::gpu::recording::{PassClock, Recording};
 use ash::vk;
 use std::cell::RefCell;
-use std::rc::Rc;
 
 const MAX_MARKS: u32 = 16;
 
@@ -357,30 +356,12 @@ impl Recording<'_> {
     /// is the pool's own count (`Timestamps::time`'s), which the queries' validity relies on.
     fn start_clock(&mut self, pool: vk::QueryPool, capacity: u32) {
         reset_marks(self, pool, capacity);
-        self.clock = Some(Rc::new(PassClock {
-            cmd: self.any(),
+        self.clock = Some(PassClock {
             pool,
             capacity,
             names: RefCell::new(Vec::new()),
-        }));
+        });
         self.mark("start");
-    }
-
-    /// The clock this recording's timed passes write to, for a recording of the same command
-    /// buffer made inside this one's (an entry point the renderer shares with engines).
-    pub fn clock(&self) -> Option<Rc<PassClock>> {
-        self.clock.clone()
-    }
-
-    /// Times this recording's passes by `clock`, another recording's of the same command buffer
-    /// (its [`Self::clock`]); `None` leaves them untimed.
-    pub fn time_by(&mut self, clock: Option<Rc<PassClock>>) {
-        debug_assert!(
-            clock.as_ref().is_none_or(|c| c.cmd == self.any()),
-            "a clock lent to a recording of another command buffer, where its queries were \
-             never reset"
-        );
-        self.clock = clock;
     }
 
     /// Records `body`, then, where this recording has a clock, a timestamp that ends the pass

@@ -7,7 +7,7 @@ use super::{DeferredLighting, TiledFrame};
 use crate::gpu::access::LightingTargets;
 use crate::gpu::context::Context;
 use crate::gpu::error::Result;
-use crate::gpu::recording::{PassClock, Recording};
+use crate::gpu::recording::Recording;
 use crate::gpu::resources::Buffer;
 use crate::lighting::hooks::LightHooks;
 use crate::passes::depth_id::{DepthIdDesc, DepthIdPass};
@@ -15,7 +15,6 @@ use crate::passes::tiled::{MixedTiles, TileSide};
 use crate::passes::tiled::{TiledDesc, TiledLighting, TiledSets, TiledShade};
 use ash::vk;
 use std::ops::Deref;
-use std::rc::Rc;
 
 /// The HDR formats the tiled and depth-id techniques take (their kernels write the HDR image
 /// as a storage image declared `rgba16f`); the light-volume techniques take any colour format
@@ -81,9 +80,10 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         unsafe { self.record_tiled_with(cmd, frame, targets, TiledShade::DepthId, None) }
     }
 
-    /// [`DeferredLighting::record_tiled`], timing the classification (`tile-classify`) and the
-    /// light lists (`tile-lights`) as passes of their own by `clock` (the renderer's frame's:
-    /// `Recording::timed`), when given one.
+    /// [`DeferredLighting::record_tiled`], through `outer` when given (the renderer's frame's
+    /// recording of `cmd`, whose clock then times the classification, `tile-classify`, and the
+    /// light lists, `tile-lights`, as passes of their own), else through a recording of its own
+    /// of the engine's `cmd`, untimed.
     ///
     /// # Safety
     /// As [`DeferredLighting::record_tiled`].
@@ -93,7 +93,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &TiledFrame,
         targets: &mut LightingTargets,
         shade: TiledShade,
-        clock: Option<Rc<PassClock>>,
+        outer: Option<&Recording>,
     ) -> Result<()> {
         if shade == TiledShade::DepthId && frame.mixed == MixedTiles::Branching {
             return Err(bad(
@@ -155,20 +155,23 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             visibility: frame.hook_sets.visibility,
         };
         self.pending.recorded(frame.slot, cmd);
+        debug_assert!(
+            outer.is_none_or(|r| r.any() == cmd),
+            "another buffer's recording"
+        );
         // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
         // family with graphics and compute, outside any render pass; this call alone records
-        // into it now (the clock, if any, is the caller's recording's of `cmd`, which records
-        // nothing until this returns).
-        let mut rec = unsafe { Recording::new(ctx, cmd) };
-        rec.time_by(clock);
+        // into it now. Made only for an engine's call: the renderer's records through its own.
+        let owned = outer.is_none().then(|| unsafe { Recording::new(ctx, cmd) });
+        let rec = outer.or(owned.as_ref()).expect("one of the two");
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
-        // Each a timed pass of its own, by the clock lent to `rec`.
-        tiled.record_classify(&rec, &sets, targets, depth_sampled, clear, mixed, shape);
-        tiled.record_light_lists(&rec, frame.lights.len() as u32);
+        // Each a pass of its own, timed where `rec` has a clock (the renderer's).
+        tiled.record_classify(rec, &sets, targets, depth_sampled, clear, mixed, shape);
+        tiled.record_light_lists(rec, frame.lights.len() as u32);
         match shade {
-            TiledShade::Kernels => tiled.record_shade(&rec, mixed, &mut targets.hdr),
+            TiledShade::Kernels => tiled.record_shade(rec, mixed, &mut targets.hdr),
             TiledShade::DepthId => {
                 let side = frame.side;
                 let (_, pass) = self
@@ -183,7 +186,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 let push = tiled.push_bytes(clear, mixed);
                 let buffers = tiled.buffers();
                 pass.record(
-                    &rec,
+                    rec,
                     frame.slot,
                     bound,
                     &push,
@@ -193,7 +196,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 );
             }
         }
-        rec.finish();
+        if let Some(own) = owned {
+            own.finish();
+        }
         Ok(())
     }
 

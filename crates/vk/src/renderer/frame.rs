@@ -168,14 +168,13 @@ impl<'c> Renderer<'c> {
                 hook_sets: HookSets::default(),
             };
             let mut targets = self.targets.lighting();
-            // The classification and light lists are timed passes of their own, by this
-            // recording's clock.
-            let clock = rec.clock();
             // SAFETY: as for `record_emulating` below; and the HDR target has `STORAGE` usage
-            // (`Targets::new`), and the built-in hooks bind no engine resources.
+            // (`Targets::new`), and the built-in hooks bind no engine resources. The lighting
+            // records through `rec`, so the classification and light lists are timed passes of
+            // this frame's clock.
             rec.timed(lighting_pass, |rec| unsafe {
                 let (cmd, lighting) = (rec.outside(), &mut self.lighting);
-                lighting.record_tiled_with(cmd, &frame, &mut targets, shade, clock)
+                lighting.record_tiled_with(cmd, &frame, &mut targets, shade, Some(rec))
             })?;
             self.targets.lit(&targets);
             return Ok(());
