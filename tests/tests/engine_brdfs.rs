@@ -362,6 +362,53 @@ fn a_brdf_of_the_colour_squared_is_held_to_forward_and_refused_by_the_lut() {
     );
 }
 
+/// A wrapped diffuse lights where `N.L <= 0`, where a table's axes end: the LUT would drop that
+/// light in silence (an outside trial's wrap lobe came out 44/255 dark). The probe finds it and
+/// the LUT refuses the BRDF by name, in `LutTables` and in a renderer's LUT frame alike.
+#[test]
+fn a_brdf_that_lights_below_the_horizon_has_no_table() {
+    let (set, modules) = one_brdf(
+        "wrapped",
+        "vec3 wrapped(vec4 p, vec3 N, vec3 T, vec3 V, vec3 L) {\n    return vec3(0.8 * INV_PI * max((dot(N, L) + 0.5) / 1.5, 0.0));\n}\n",
+        false,
+    );
+    let wrapped = set.engine_brdf("wrapped", &[]).unwrap();
+    assert_eq!(
+        set.tabulable(&wrapped),
+        Ok(()),
+        "the set alone cannot see it"
+    );
+    let mut scene = histencil_scene::embedded("default").unwrap();
+    histencil_scene::retarget_brdfs(&mut scene, &set);
+    with_validated_context(|ctx| {
+        let err = histencil_vk::LutTables::with_modules(ctx, modules, &[wrapped], 9)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(
+            err.contains("`wrapped`: it returns light where N.L <= 0"),
+            "{err}"
+        );
+        let desc = RendererDesc {
+            brdfs: modules,
+            ..RendererDesc::new(SIZE, SIZE)
+        };
+        let mut renderer = Renderer::with_desc(ctx, scene, &desc).unwrap();
+        let lut = Technique::Lut {
+            backend: Backend::Native,
+            flush: FlushPolicy::Auto,
+        };
+        let err = renderer.render(lut, Readback::ALL).err().unwrap();
+        assert!(
+            matches!(err, histencil_vk::Error::LutUntabulable { .. }),
+            "{err}"
+        );
+        // Every other technique lights it.
+        let frame = renderer.render(Technique::DEFERRED, Readback::ALL).unwrap();
+        assert!(lit_fraction(frame.images.ldr.as_ref().unwrap()) > 0.2);
+    });
+}
+
 #[test]
 fn a_material_the_set_does_not_hold_and_a_non_finite_brdf_are_refused_before_recording() {
     let scene = histencil_scene::embedded("default").unwrap();

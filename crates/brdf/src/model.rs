@@ -142,6 +142,17 @@ pub enum BrdfError {
     #[error("unknown BRDF `{0}` (known: {names}; an engine's own BRDFs are known only with its \
              BRDF set: `--brdfs DIR` on the command line)", names = MODEL_NAMES.join(", "))]
     UnknownModel(String),
+    /// A name that a set with BRDFs of an engine's own does not hold
+    /// ([`crate::BrdfSet::parse`]): its names are listed, with the nearest when one is close.
+    #[error("unknown BRDF `{name}` (the BRDF set holds: {known}){nearest}")]
+    UnknownInSet {
+        /// The name given.
+        name: String,
+        /// The set's names, built-ins first.
+        known: String,
+        /// `; did you mean `x`?` when a name of the set is one or two edits away, else empty.
+        nearest: String,
+    },
     /// A parameter the model does not take.
     #[error("{model}: unknown parameter `{param}` (accepted: {accepted})")]
     UnknownParam {

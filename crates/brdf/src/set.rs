@@ -566,6 +566,48 @@ impl BrdfSet {
         ]
     }
 
+    /// What glslc's `message` cannot say when it points into the GLSL this set generates
+    /// (`brdf_set/...`, [`BrdfSet::glsl_files`]) rather than the engine's own file: which BRDF of
+    /// the manifest is called there, and the signature its function must have, for each BRDF
+    /// whose function the message names. `None` when the message is not about such a call.
+    pub fn generated_call_hint(&self, message: &str) -> Option<String> {
+        if !message.contains("brdf_set/") {
+            return None;
+        }
+        let args = "vec3 N, vec3 T, vec3 V, vec3 L";
+        let mut lines = Vec::new();
+        for (_, spec) in self.engine() {
+            let named =
+                |f: &str| message.contains(&format!("'{f}'")) || message.contains(&format!("{f}("));
+            let (function, glsl) = (&spec.function, &spec.glsl);
+            if named(function) {
+                let signature = if spec.tint {
+                    format!("vec3 {function}(vec4 p, vec3 tint, {args}) (`tint = true`)")
+                } else {
+                    format!("vec3 {function}(vec4 p, {args}) (with `tint = true`, it takes `vec3 tint` after `p`)")
+                };
+                lines.push(format!(
+                    "BRDF `{}` of the manifest is called as `{signature}`: `{glsl}` must define \
+                     it so",
+                    spec.name
+                ));
+            }
+            if let Some(white) = spec.white.as_ref().filter(|w| named(w)) {
+                lines.push(format!(
+                    "BRDF `{}` of the manifest calls its white part as `float {white}(vec4 p, \
+                     {args})`: `{glsl}` must define it so",
+                    spec.name
+                ));
+            }
+        }
+        (!lines.is_empty()).then(|| {
+            format!(
+                "the brdf_set/ files are histencil's, generated from the manifest: {}",
+                lines.join("; ")
+            )
+        })
+    }
+
     /// A Rust expression that makes this set again (without its folder), for `include!` in an
     /// engine whose build script compiled it (histencil-build). Every name is spelt by its full
     /// path through the `histencil` crate an engine depends on, so the file compiles whatever
@@ -621,7 +663,10 @@ impl BrdfSet {
         params: &serde_json::Map<String, serde_json::Value>,
     ) -> Result<Brdf, BrdfError> {
         let Some((id, _)) = self.engine.iter().find(|(_, s)| s.name == name) else {
-            return Brdf::parse(name, params);
+            return Brdf::parse(name, params).map_err(|e| match e {
+                BrdfError::UnknownModel(name) if !self.is_builtin_only() => self.unknown(name),
+                other => other,
+            });
         };
         let mut given = Vec::new();
         for (key, value) in params {
@@ -635,6 +680,52 @@ impl BrdfSet {
         }
         self.engine_brdf(name, &given)
     }
+}
+
+#[cfg(feature = "files")]
+impl BrdfSet {
+    /// The refusal of a name this set does not hold: its names, and the nearest of them when a
+    /// typo is likely (one or two edits).
+    fn unknown(&self, name: String) -> BrdfError {
+        let names: Vec<&str> = self.ids().iter().map(|b| b.name()).collect();
+        let nearest = (names.iter())
+            .map(|n| (edits(n, &name), *n))
+            .filter(|(d, _)| *d <= 2)
+            .min()
+            .map_or(String::new(), |(_, n)| format!("; did you mean `{n}`?"));
+        BrdfError::UnknownInSet {
+            name,
+            known: names.join(", "),
+            nearest,
+        }
+    }
+}
+
+/// The edit distance between `a` and `b` (insertions, deletions, substitutions, and swaps of
+/// two neighbours, the commonest typo).
+#[cfg(feature = "files")]
+fn edits(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut best = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                best = best.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = best;
+        }
+    }
+    d[a.len()][b.len()]
 }
 
 /// The first id after the set's last engine BRDF could take: ids below it are histencil's or an
@@ -724,6 +815,59 @@ mod tests {
             BrdfSet::new(&[], vec![metal]),
             Err(SetError::TintAndWhite("metal".into()))
         );
+    }
+
+    /// glslc names the generated file where a function's signature does not match the call:
+    /// the hint names the BRDF, its file and the signature the call wants.
+    #[test]
+    fn a_mismatched_signature_is_explained_from_the_manifest() {
+        let mut metal = toon();
+        metal.name = "metal".into();
+        metal.function = "metal_rough".into();
+        metal.tint = true;
+        let set = BrdfSet::new(&[], vec![toon(), metal]).unwrap();
+        let message = "/out/set/brdf_set/tinted.glsl:3: error: 'metal_rough' : no matching \
+                       overloaded function found";
+        let hint = set.generated_call_hint(message).unwrap();
+        assert!(
+            hint.contains("BRDF `metal`")
+                && hint.contains(
+                    "vec3 metal_rough(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L)"
+                )
+                && hint.contains("`toon.glsl` must define it")
+                && !hint.contains("BRDF `toon`"),
+            "{hint}"
+        );
+        assert_eq!(
+            set.generated_call_hint("toon.glsl:3: error: 'x' : undeclared"),
+            None
+        );
+    }
+
+    /// A misspelt name in a scene read with an engine's set names the set's BRDFs, its own
+    /// among them, and the nearest; without engine BRDFs the built-ins' refusal stands.
+    #[cfg(feature = "files")]
+    #[test]
+    fn an_unknown_name_lists_the_sets_brdfs_and_the_nearest() {
+        let mut metal = toon();
+        metal.name = "ue4_standard".into();
+        let set = BrdfSet::new(&[BrdfId::Lambert], vec![toon(), metal]).unwrap();
+        let none = serde_json::Map::new();
+        let text = set.parse("ue4_standrad", &none).unwrap_err().to_string();
+        assert!(
+            text.contains("holds: lambert, toon, ue4_standard")
+                && text.ends_with("did you mean `ue4_standard`?"),
+            "{text}"
+        );
+        let far = set.parse("velvet", &none).unwrap_err().to_string();
+        assert!(!far.contains("did you mean"), "{far}");
+        let builtin = BrdfSet::new(&BrdfId::ALL, vec![]).unwrap();
+        assert!(matches!(
+            builtin.parse("velvet", &none),
+            Err(BrdfError::UnknownModel(_))
+        ));
+        assert_eq!(edits("abc", "acb"), 1);
+        assert_eq!(edits("", "ab"), 2);
     }
 
     #[test]

@@ -383,14 +383,20 @@ pub fn stage_brdf_set(set: &BrdfSet, folder: &Path) -> Result<Vec<PathBuf>, Buil
 }
 
 /// glslc's `message` about a stage compiled with a set staged in `staged` by
-/// [`stage_brdf_set`], with the engine's files named by their own paths, not their copies'.
+/// [`stage_brdf_set`], with the engine's files named by their own paths, not their copies', and,
+/// where it points into the generated `brdf_set/` files, which BRDF of the manifest is called
+/// there and with what signature ([`BrdfSet::generated_call_hint`]).
 pub fn engine_paths(message: &str, set: &BrdfSet, staged: &Path) -> String {
-    match set.folder() {
+    let message = match set.folder() {
         Some(folder) => message.replace(
             &staged.join("engine").display().to_string(),
             &folder.display().to_string(),
         ),
         None => message.to_owned(),
+    };
+    match set.generated_call_hint(&message) {
+        Some(hint) => format!("{message}\n{hint}"),
+        None => message,
     }
 }
 

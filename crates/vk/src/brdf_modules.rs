@@ -13,7 +13,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
-use histencil_brdf::{Brdf, BrdfSet, V3};
+use histencil_brdf::lut::LutError;
+use histencil_brdf::{Brdf, BrdfId, BrdfSet, V3};
 
 use crate::gpu::context::Context;
 use crate::gpu::error::{Error, Result};
@@ -300,34 +301,83 @@ fn probe_directions() -> Vec<[V3<f32>; 4]> {
 
 /// Refuses an engine BRDF that returns NaN, an infinity or a negative value anywhere it is
 /// probed (its parameters at their defaults, each at its ends, all at their ends, at
-/// `probe_directions`), naming the BRDF and the point: such a value is written into every technique's frame and the forward
+/// `probe_directions`; one that takes the tint at each of `PROBE_TINTS`), naming the BRDF and
+/// the point: such a value is written into every technique's frame and the forward
 /// reference's alike, where no comparison between them can see it. Histencil's own BRDFs are
 /// held to their f64 reference instead, and pass at once.
 ///
 /// # Errors
 /// [`Error::BrdfSet`] naming the BRDF, its parameters and the directions; Vulkan errors.
 pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> {
+    probe(ctx, modules).map(|_| ())
+}
+
+/// Whether the LUT technique can hold `brdf` of `modules`' set in a table: the set's own answer
+/// ([`BrdfSet::tabulable`]), and for an engine BRDF the probe's: one that returns light where
+/// `N.L <= 0` (a wrap or translucent lobe) is refused, since a table's axes end at the horizon
+/// and it would drop that light in silence. `Ok(None)` where a table can hold it.
+///
+/// # Errors
+/// The probe's ([`probe_finite`]).
+pub fn lut_refusal(
+    ctx: &Context,
+    modules: &'static BrdfModules,
+    brdf: &Brdf,
+) -> Result<Option<LutError>> {
+    if let Err(why) = modules.set.tabulable(brdf) {
+        return Ok(Some(why));
+    }
+    let Brdf::Engine { id, .. } = brdf else {
+        return Ok(None);
+    };
+    let below = probe(ctx, modules)?;
+    Ok(below
+        .contains(&BrdfId::Engine(*id))
+        .then_some(LutError::EngineUntabulable {
+            brdf: id.name(),
+            reason: "it returns light where N.L <= 0 (a wrap or translucent lobe), and a \
+                     table's axes end at the horizon: it would drop that light",
+        }))
+}
+
+/// The surface colours a BRDF that takes the tint is probed at: each channel at 0, a half and 1
+/// (27 colours, black, white and the saturated ones among them).
+fn probe_tints() -> Vec<[f32; 3]> {
+    let steps = [0.0, 0.5, 1.0];
+    let mut out = Vec::new();
+    for r in steps {
+        for g in steps {
+            for b in steps {
+                out.push([r, g, b]);
+            }
+        }
+    }
+    out
+}
+
+/// [`probe_finite`], once per set and device, returning the engine BRDFs that light where
+/// `N.L <= 0` ([`lut_refusal`]).
+fn probe(ctx: &Context, modules: &'static BrdfModules) -> Result<Vec<BrdfId>> {
     if modules.set.is_builtin_only() {
-        return Ok(());
+        return Ok(Vec::new());
     }
     // Once per modules and device: a check builds several renderers of one set.
-    static PROBED: OnceLock<Mutex<Vec<(usize, String)>>> = OnceLock::new();
+    type Probed = Vec<((usize, String), Vec<BrdfId>)>;
+    static PROBED: OnceLock<Mutex<Probed>> = OnceLock::new();
     let key = (
         modules as *const BrdfModules as usize,
         ctx.device_name().to_owned(),
     );
     let probed = PROBED.get_or_init(Default::default);
-    if probed
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .contains(&key)
-    {
-        return Ok(());
+    let known = probed.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some((_, below)) = known.iter().find(|(k, _)| *k == key) {
+        return Ok(below.clone());
     }
+    drop(known);
     let directions = probe_directions();
     // A BRDF whose function takes the tint has no parts: it is probed as a surface of each of
-    // these colours (black, white, and one saturated), as every technique calls it.
-    const TINTS: [[f32; 3]; 3] = [[0.0; 3], [1.0; 3], [1.0, 0.25, 0.0]];
+    // the probe's colours, as every technique calls it.
+    let tints = probe_tints();
     let mut cases: Vec<(Brdf, [V3<f32>; 4])> = Vec::new();
     let mut tinted: Vec<crate::tools::brdf_eval::TintedCase> = Vec::new();
     for (id, spec) in modules.set.engine() {
@@ -350,7 +400,7 @@ pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> 
                 .expect("the set's own ranges");
             if spec.tint {
                 let at = |tint| directions.iter().map(move |d| (brdf, tint, *d));
-                tinted.extend(TINTS.into_iter().flat_map(at));
+                tinted.extend(tints.iter().copied().flat_map(at));
             } else {
                 cases.extend(directions.iter().map(|d| (brdf, *d)));
             }
@@ -373,7 +423,12 @@ pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> 
                 .map(|(brdf, tint, dirs)| (brdf, Some(tint), dirs))
                 .zip(with_tint.iter().map(|v| v.to_vec())),
         );
+    let mut below: Vec<BrdfId> = Vec::new();
     for ((brdf, tint, [n, _, v, l]), channels) in values {
+        let n_dot_l: f32 = n.iter().zip(l).map(|(a, b)| a * b).sum();
+        if n_dot_l <= 0.0 && channels.iter().any(|x| *x > 0.0) && !below.contains(&brdf.id()) {
+            below.push(brdf.id());
+        }
         // Negative light (a BRDF reading another's parameters, say) is refused as a NaN is:
         // every technique and the forward reference would subtract it alike.
         let bad = channels.into_iter().find(|x| !x.is_finite() || *x < 0.0);
@@ -388,8 +443,9 @@ pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> 
             )));
         }
     }
-    probed.lock().unwrap_or_else(|p| p.into_inner()).push(key);
-    Ok(())
+    let mut known = probed.lock().unwrap_or_else(|p| p.into_inner());
+    known.push((key, below.clone()));
+    Ok(below)
 }
 
 #[cfg(test)]

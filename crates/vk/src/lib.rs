@@ -41,7 +41,7 @@ pub use alpha::{
     AlphaLightmaps, AlphaLightmapsDesc, AlphaMode, LightmapFrame,
 };
 pub use brdf_modules::{
-    compile as compile_brdf_set, compile_with_hooks as compile_brdf_set_with_hooks,
+    compile as compile_brdf_set, compile_with_hooks as compile_brdf_set_with_hooks, lut_refusal,
     probe_finite as probe_brdfs, BrdfModules,
 };
 pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};

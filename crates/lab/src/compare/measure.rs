@@ -31,15 +31,20 @@ pub(super) struct Table<'c> {
 }
 
 /// Why the table has no LUT row, if it has none: a model of its widest column that no table
-/// can hold (`BrdfSet::tabulable`: an engine BRDF whose function takes the tint, or that reads
-/// the tangent). An engine BRDF that a table can hold is baked by its own GLSL, its white part
-/// beside its tinted one.
-pub(super) fn lut_refusal(settings: &CompareSettings) -> Option<String> {
+/// can hold (`histencil_vk::lut_refusal`: an engine BRDF whose function takes the tint, that
+/// reads the tangent, or that lights where `N.L <= 0`). An engine BRDF that a table can hold is
+/// baked by its own GLSL, its white part beside its tinted one.
+///
+/// # Errors
+/// The BRDF probe's, which decides the last of those on the device.
+pub(super) fn lut_refusal(ctx: &Context, settings: &CompareSettings) -> Result<Option<String>> {
     let widest = settings.brdf_counts.iter().copied().max().unwrap_or(1);
-    brdf_palette(&settings.scene, widest)
-        .iter()
-        .find_map(|b| settings.brdfs.set.tabulable(b).err())
-        .map(|e| e.to_string())
+    for b in brdf_palette(&settings.scene, widest) {
+        if let Some(why) = histencil_vk::lut_refusal(ctx, settings.brdfs, &b)? {
+            return Ok(Some(why.to_string()));
+        }
+    }
+    Ok(None)
 }
 
 /// One round of the table: per column and row the technique's time and the emulator's, per
@@ -61,7 +66,7 @@ pub(super) fn measure_table<'c>(
     steady: &mut SteadyClock,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Table<'c>> {
-    let lut_left_out = lut_refusal(settings).is_some();
+    let lut_left_out = lut_refusal(ctx, settings)?.is_some();
     let rows_spec: Vec<_> = table_rows()
         .into_iter()
         .filter(|(name, _)| !lut_left_out || *name != "lut")

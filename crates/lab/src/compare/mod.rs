@@ -674,7 +674,7 @@ pub fn run_compare(
             .engine()
             .map(|(_, spec)| spec.name.clone())
             .collect(),
-        lut_left_out: lut_refusal(settings),
+        lut_left_out: lut_refusal(ctx, settings)?,
         first_left_out: table.first_left_out,
         width: settings.width,
         height: settings.height,

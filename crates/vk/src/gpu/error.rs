@@ -98,12 +98,11 @@ pub enum Error {
         brdf: &'static str,
     },
     /// The LUT technique on a BRDF that no table can hold
-    /// ([`histencil_brdf::BrdfSet::tabulable`]: an engine BRDF whose function takes the tint, or
-    /// that reads the tangent).
+    /// ([`crate::lut_refusal`]: an engine BRDF whose function takes the tint, that reads the
+    /// tangent, or that lights where `N.L <= 0`).
     #[error(
-        "the LUT technique cannot light object `{object}`: {why} (a table entry holds a \
-         material's BRDF as two factors of its tint, tinted and white, over the three angles of an \
-         isotropic BRDF); light this scene with stencil, branching or adaptive"
+        "the LUT technique cannot light object `{object}`: {why}; light this scene with \
+         stencil, branching, adaptive, tiled or depth-id"
     )]
     LutUntabulable {
         /// The scene object's name.

@@ -76,8 +76,8 @@ impl<C: Deref<Target = Context>> LutTables<C> {
     ///
     /// # Errors
     /// As [`LutTables::new`]; [`Error::Lut`] also for an engine BRDF the set holds no table of
-    /// ([`histencil_brdf::BrdfSet::tabulable`]: its function takes the tint, or it reads the
-    /// tangent), and
+    /// ([`crate::lut_refusal`]: its function takes the tint, it reads the tangent, or it lights
+    /// where `N.L <= 0`), and
     /// [`Error::BrdfSet`] for a material of a BRDF the set does not hold.
     pub fn with_modules(
         ctx: C,
@@ -91,7 +91,9 @@ impl<C: Deref<Target = Context>> LutTables<C> {
                 .set
                 .check(b)
                 .map_err(|e| Error::BrdfSet(e.to_string()))?;
-            modules.set.tabulable(b)?;
+            if let Some(why) = crate::brdf_modules::lut_refusal(&ctx, modules, b)? {
+                return Err(why.into());
+            }
         }
         // Before anything is baked: a table past the device's range is refused at once.
         let channels = |b: &Brdf| if modules.set.has_white_part(b) { 4 } else { 3 };

@@ -229,8 +229,8 @@ impl<'c> Renderer<'c> {
     /// [`crate::Error::LutTexturedParameters`] when an object's metallic-roughness map changes
     /// its BRDF's parameters per texel ([`histencil_scene::Material::parameters_vary`]),
     /// [`crate::Error::LutUntabulable`] when a table cannot hold an object's BRDF
-    /// ([`histencil_brdf::BrdfSet::tabulable`]: an engine BRDF whose function takes the tint or
-    /// that reads the tangent),
+    /// ([`crate::lut_refusal`]: an engine BRDF whose function takes the tint, that reads the
+    /// tangent, or that lights where `N.L <= 0`),
     /// [`crate::Error::TooManyMaterials`] beyond what the G-buffer indexes, and those of
     /// [`LutTables::new`].
     pub fn lut_tables(&mut self) -> Result<&LutTables<&'c Context>> {
@@ -246,13 +246,15 @@ impl<'c> Renderer<'c> {
                     brdf: o.material.brdf.id().name(),
                 });
             }
-            let set = &self.desc.brdfs.set;
-            if let Some((o, why)) = self
-                .scene
-                .objects
-                .iter()
-                .find_map(|o| set.tabulable(&o.material.brdf).err().map(|e| (o, e)))
-            {
+            let modules = self.desc.brdfs;
+            let mut refused = None;
+            for o in &self.scene.objects {
+                if let Some(why) = crate::lut_refusal(self.ctx, modules, &o.material.brdf)? {
+                    refused = Some((o, why));
+                    break;
+                }
+            }
+            if let Some((o, why)) = refused {
                 return Err(crate::Error::LutUntabulable {
                     object: o.name.clone(),
                     brdf: o.material.brdf.id().name(),
