@@ -108,6 +108,10 @@
 // The particles are a ribbon's control points, in order.
 #define HISTENCIL_PARTICLES_RIBBON 4
 
+// Bytes of one material row: four floats of parameters (`vec4`), then the BRDF id and three
+// zeros (`uvec4`); the same in std140 and std430.
+#define HISTENCIL_MATERIAL_ROW_BYTES 32
+
 // What every call returns. On anything but `HISTENCIL_RESULT_SUCCESS`,
 // `histencil_last_error()` says what, on the calling thread.
 typedef enum HistencilResult {
@@ -247,9 +251,8 @@ typedef struct HistencilHooks {
   const VkFormat *surface_formats;
   // How the decode reads each BRDF's parameters: 0 from the pixel itself (the G-buffer
   // carries them, or a material index whose row of BRDF id and parameters the hook reads, as
-  // the book's two-target hook does: 32 bytes a row, `vec4` parameters then `uvec4` id; no
-  // call here holds such rows to the BRDFs a lighting shades, as Rust's
-  // `DeferredLighting::check_materials` does, so make the lighting with each BRDF they name), else
+  // the book's two-target hook does: `histencil_material_rows_write` writes them and
+  // `histencil_lighting_check_materials` holds them to the lighting's BRDFs), else
   // from rows indexed by BRDF id, ids 0 to `brdf_param_rows - 1` (`BRDF_ID_COUNT` in
   // `brdf_set/ids.glsl` sizes them). A lighting shading an id without a row is refused: its
   // surfaces would be unlit with no error anywhere.
@@ -978,6 +981,45 @@ enum HistencilResult histencil_lighting_set_lut_tables(struct HistencilLighting 
 // # Safety
 // `tables` is null or a handle from `histencil_lut_tables_create` (a freed one is refused).
 enum HistencilResult histencil_lut_tables_destroy(struct HistencilLutTables *tables);
+
+// Writes the rows of `material_count` materials (BRDFs by name with their parameters, of
+// histencil's own BRDFs and those of `shaders`) into `rows`, `HISTENCIL_MATERIAL_ROW_BYTES`
+// each, in order: what a decode hook reading rows by material index binds (the book's
+// two-target hook: a uniform block of 256 rows). Nothing is written on an error.
+//
+// Errors: `INVALID_ARGUMENT` for a null pointer, no material, too many materials, or `rows_size`
+// under `material_count * HISTENCIL_MATERIAL_ROW_BYTES`; `BAD_SETUP` for a BRDF the set lacks
+// or parameters out of range, naming the material.
+//
+// Thread safety: any thread.
+//
+// # Safety
+// `shaders` is null (histencil's own BRDFs) or a live handle; `materials` is null or points at
+// `material_count` materials whose pointers hold what they say; `rows` is null or writable for
+// `rows_size` bytes.
+enum HistencilResult histencil_material_rows_write(const struct HistencilShaders *shaders,
+                                                   const struct HistencilMaterial *materials,
+                                                   uint32_t material_count,
+                                                   uint8_t *rows,
+                                                   size_t rows_size);
+
+// Holds `material_count` materials (as `histencil_material_rows_write` takes them) to the BRDFs
+// `lighting` shades (its `brdf_names`): a material of another BRDF would get no light pass
+// under the stencil technique and no tile class under tiled, its pixels unlit with no error.
+// Call it whenever the rows change.
+//
+// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, no material or too
+// many; `BAD_SETUP` for a BRDF the lighting's set lacks, parameters out of range, or a
+// material whose BRDF the lighting does not shade, naming the material.
+//
+// Thread safety: not at the same time as another call naming `lighting`.
+//
+// # Safety
+// `lighting` is null or a handle (a freed one is refused); `materials` is null or points at
+// `material_count` materials whose pointers hold what they say.
+enum HistencilResult histencil_lighting_check_materials(struct HistencilLighting *lighting,
+                                                        const struct HistencilMaterial *materials,
+                                                        uint32_t material_count);
 
 // Compiles histencil's shaders (glslc, as `histencil render --brdfs` does; compiled once per
 // set and hooks in a process) for the BRDF folder `brdf_folder` (its `brdfs.toml` and the GLSL

@@ -23,6 +23,7 @@ mod hazards;
 mod lighting;
 mod lightmaps;
 mod lut;
+mod materials;
 mod shaders;
 
 pub use device::{
@@ -64,6 +65,9 @@ pub use lightmaps::{
 pub use lut::{
     histencil_lighting_set_lut_tables, histencil_lut_tables_create, histencil_lut_tables_destroy,
     HistencilLutTables, HistencilMaterial,
+};
+pub use materials::{
+    histencil_lighting_check_materials, histencil_material_rows_write, HISTENCIL_MATERIAL_ROW_BYTES,
 };
 pub use shaders::{
     histencil_shaders_compile, histencil_shaders_destroy, histencil_shaders_load,

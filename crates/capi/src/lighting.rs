@@ -86,9 +86,8 @@ pub struct HistencilHooks {
     pub surface_formats: *const vk::Format,
     /// How the decode reads each BRDF's parameters: 0 from the pixel itself (the G-buffer
     /// carries them, or a material index whose row of BRDF id and parameters the hook reads, as
-    /// the book's two-target hook does: 32 bytes a row, `vec4` parameters then `uvec4` id; no
-    /// call here holds such rows to the BRDFs a lighting shades, as Rust's
-    /// `DeferredLighting::check_materials` does, so make the lighting with each BRDF they name), else
+    /// the book's two-target hook does: `histencil_material_rows_write` writes them and
+    /// `histencil_lighting_check_materials` holds them to the lighting's BRDFs), else
     /// from rows indexed by BRDF id, ids 0 to `brdf_param_rows - 1` (`BRDF_ID_COUNT` in
     /// `brdf_set/ids.glsl` sizes them). A lighting shading an id without a row is refused: its
     /// surfaces would be unlit with no error anywhere.

@@ -112,6 +112,69 @@ fn lut_frames_through_c_are_the_rust_apis_bit_for_bit() {
             d.end_command_buffer(cmd).unwrap();
             d.destroy_command_pool(pool, None);
 
+            // The same materials as rows a decode hook reads by material index: written as
+            // MaterialRows writes them, held to the lighting's BRDFs, and one of a BRDF the
+            // lighting does not shade refused by name.
+            let count = materials.len() as u32;
+            let row = HISTENCIL_MATERIAL_ROW_BYTES as usize;
+            let mut rows = vec![0u8; materials.len() * row];
+            let r = histencil_material_rows_write(
+                null(),
+                materials.as_ptr(),
+                count,
+                rows.as_mut_ptr(),
+                rows.len(),
+            );
+            assert_eq!(r, R::Success, "{}", last_error());
+            let set = histencil::brdf::BrdfSet::new(&histencil::BrdfId::ALL, vec![]).unwrap();
+            let expected = histencil::brdf::MaterialRows::new(&set, &brdfs_of_tables).unwrap();
+            assert_eq!(rows, expected.bytes());
+            let short = histencil_material_rows_write(
+                null(),
+                materials.as_ptr(),
+                count,
+                rows.as_mut_ptr(),
+                rows.len() - 1,
+            );
+            assert_eq!(short, R::InvalidArgument, "{}", last_error());
+            let r = histencil_lighting_check_materials(lighting, materials.as_ptr(), count);
+            assert_eq!(r, R::Success, "{}", last_error());
+            let candidates = [
+                histencil::brdf::Brdf::KajiyaKay {
+                    kd: 0.4,
+                    ks: 0.6,
+                    p: 30.0,
+                },
+                histencil::brdf::Brdf::Lambert { rho: 0.5 },
+                histencil::brdf::Brdf::BlinnPhong { exponent: 16.0 },
+            ];
+            let other = (candidates.into_iter())
+                .find(|b| !brdfs.contains(&b.id()))
+                .expect("a built-in the lighting does not shade");
+            let other_name = CString::new(other.name()).unwrap();
+            let other_params: Vec<HistencilBrdfParam> = (other.params().into_iter())
+                .map(|(name, value)| HistencilBrdfParam {
+                    name: Box::leak(CString::new(name).unwrap().into_boxed_c_str()).as_ptr(),
+                    value,
+                })
+                .collect();
+            let unshaded = [
+                materials[0],
+                HistencilMaterial {
+                    brdf_name: other_name.as_ptr(),
+                    param_count: other_params.len() as u32,
+                    params: other_params.as_ptr(),
+                },
+            ];
+            let r = histencil_lighting_check_materials(lighting, unshaded.as_ptr(), 2);
+            assert_eq!(r, R::BadSetup, "{}", last_error());
+            let message = last_error();
+            let words = format!("material 1 is `{}`", other.name());
+            assert!(
+                message.contains(&words) && message.contains("does not shade"),
+                "{message}"
+            );
+
             let mut tables = null_mut();
             let r = histencil_lut_tables_create(
                 c_ctx,

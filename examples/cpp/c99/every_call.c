@@ -143,6 +143,25 @@ int main(void) {
             fprintf(stderr, "lambert encodes as id %u, %f\n", model, (double)packed[0]);
             failures += 1;
         }
+        {
+            /* Rows a decode hook reads by material index: written, and refused where they cannot be. */
+            HistencilMaterial material;
+            unsigned char rows[2 * HISTENCIL_MATERIAL_ROW_BYTES];
+            uint32_t id = 99;
+            material.brdf_name = "lambert";
+            material.param_count = 1;
+            material.params = &rho;
+            expect(histencil_material_rows_write(NULL, &material, 1, NULL, sizeof rows), HISTENCIL_RESULT_INVALID_ARGUMENT, "rows is null", "material_rows_write(NULL rows)");
+            expect(histencil_material_rows_write(NULL, &material, 1, rows, 8), HISTENCIL_RESULT_INVALID_ARGUMENT, "rows_size", "material_rows_write(short)");
+            expect(histencil_material_rows_write(NULL, &material, 0, rows, sizeof rows), HISTENCIL_RESULT_INVALID_ARGUMENT, "material_count is 0", "material_rows_write(none)");
+            expect_ok(histencil_material_rows_write(NULL, &material, 1, rows, sizeof rows), "material_rows_write(lambert)");
+            memcpy(&id, rows + 16, sizeof id);
+            if (id != model) {
+                fprintf(stderr, "lambert's row holds id %u\n", id);
+                failures += 1;
+            }
+            expect(histencil_lighting_check_materials(NULL, &material, 1), HISTENCIL_RESULT_INVALID_ARGUMENT, "lighting is null", "lighting_check_materials(NULL)");
+        }
         memset(&features, 0, sizeof features);
         memset(&features13, 0, sizeof features13);
         expect(histencil_device_features(NULL, &features13), HISTENCIL_RESULT_INVALID_ARGUMENT, "null", "device_features(NULL)");
