@@ -360,6 +360,30 @@ fn a_brdf_of_the_colour_squared_is_held_to_forward_and_refused_by_the_lut() {
         text.contains("engine BRDF `dim` returns -") && text.contains("for a surface of colour"),
         "{text}"
     );
+    // Negative only near one colour, which the set's probe does not try (an outside trial's):
+    // a renderer whose scene has a surface of that colour probes it at its own, and refuses.
+    let (set, modules) = one_brdf(
+        "near",
+        "vec3 near(vec4 p, vec3 tint, vec3 N, vec3 T, vec3 V, vec3 L) {\n    float s = length(tint - vec3(0.37, 0.6, 0.2)) < 0.05 ? -1.0 : 1.0;\n    return vec3(max(dot(N, L), 0.0)) * s;\n}\n",
+        true,
+    );
+    let mut scene = histencil_scene::embedded("default").unwrap();
+    histencil_scene::retarget_brdfs(&mut scene, &set);
+    with_validated_context(|ctx| {
+        histencil_vk::probe_brdfs(ctx, modules).expect("the set's colours miss it");
+        let desc = RendererDesc {
+            brdfs: modules,
+            ..RendererDesc::new(SIZE, SIZE)
+        };
+        Renderer::with_desc(ctx, scene.clone(), &desc).expect("no surface of that colour");
+        scene.objects[0].material.tint = glam::Vec3::new(0.37, 0.6, 0.2);
+        let err = Renderer::with_desc(ctx, scene, &desc).err().unwrap();
+        let text = err.to_string();
+        assert!(
+            text.contains("engine BRDF `near` returns -") && text.contains("0.37"),
+            "{text}"
+        );
+    });
 }
 
 /// A wrapped diffuse lights where `N.L <= 0`, where a table's axes end: the LUT would drop that

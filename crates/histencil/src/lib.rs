@@ -109,7 +109,7 @@ pub mod prelude {
     pub use histencil_scene::{
         Falloff, Light, LightKind, Material, Mesh, ParticleLayout, ParticleSystem,
     };
-    pub use histencil_vk::{compile_brdf_set, probe_brdfs, BrdfModules};
+    pub use histencil_vk::{compile_brdf_set, probe_brdfs, probe_materials, BrdfModules};
 
     // Planning (no Vulkan).
     pub use histencil_model::{

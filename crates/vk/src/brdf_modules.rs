@@ -429,23 +429,76 @@ fn probe(ctx: &Context, modules: &'static BrdfModules) -> Result<Vec<BrdfId>> {
         if n_dot_l <= 0.0 && channels.iter().any(|x| *x > 0.0) && !below.contains(&brdf.id()) {
             below.push(brdf.id());
         }
-        // Negative light (a BRDF reading another's parameters, say) is refused as a NaN is:
-        // every technique and the forward reference would subtract it alike.
-        let bad = channels.into_iter().find(|x| !x.is_finite() || *x < 0.0);
-        if let Some(x) = bad {
-            let colour = tint.map_or(String::new(), |t| format!(" for a surface of colour {t:?}"));
-            return Err(Error::BrdfSet(format!(
-                "engine BRDF `{}` returns {x} with parameters {:?}{colour} at N {n:?}, V {v:?}, \
-                 L {l:?}: it must be finite and not negative wherever it is evaluated (the \
-                 forward reference would hold the same value, so no comparison could see it)",
-                brdf.name(),
-                &brdf.packed_params()[..3],
-            )));
-        }
+        refuse_bad(brdf, tint, [n, v, l], &channels)?;
     }
     let mut known = probed.lock().unwrap_or_else(|p| p.into_inner());
     known.push((key, below.clone()));
     Ok(below)
+}
+
+/// Refuses a value that is NaN, infinite or negative. Negative light (a BRDF reading another's
+/// parameters, say) is refused as a NaN is: every technique and the forward reference would
+/// subtract it alike.
+fn refuse_bad(
+    brdf: &Brdf,
+    tint: Option<&[f32; 3]>,
+    [n, v, l]: [&V3<f32>; 3],
+    channels: &[f32],
+) -> Result<()> {
+    let Some(x) = channels.iter().find(|x| !x.is_finite() || **x < 0.0) else {
+        return Ok(());
+    };
+    let colour = tint.map_or(String::new(), |t| format!(" for a surface of colour {t:?}"));
+    Err(Error::BrdfSet(format!(
+        "engine BRDF `{}` returns {x} with parameters {:?}{colour} at N {n:?}, V {v:?}, L {l:?}: \
+         it must be finite and not negative wherever it is evaluated (the forward reference \
+         would hold the same value, so no comparison could see it)",
+        brdf.name(),
+        &brdf.packed_params()[..3],
+    )))
+}
+
+/// [`probe_finite`]'s test at a scene's own materials: each material of a BRDF whose function
+/// takes the tint, as a surface of its own colour, at the probe's directions. The set's probe
+/// tries 27 colours; a function that goes negative only near another colour is found here,
+/// for the materials a frame will shade. Histencil's `Renderer` runs it for its scene; an
+/// engine runs it for its materials (each a BRDF and its colour) beside [`probe_finite`].
+///
+/// # Errors
+/// [`Error::BrdfSet`] naming the BRDF, its parameters, the colour and the directions; Vulkan
+/// errors.
+pub fn probe_materials(
+    ctx: &Context,
+    modules: &'static BrdfModules,
+    materials: &[(Brdf, [f32; 3])],
+) -> Result<()> {
+    let takes_tint = |b: &Brdf| match b {
+        Brdf::Engine { id, .. } => modules
+            .set
+            .spec(BrdfId::Engine(*id))
+            .is_some_and(|s| s.tint),
+        _ => false,
+    };
+    let mut distinct: Vec<(Brdf, [f32; 3])> = Vec::new();
+    for m in materials.iter().filter(|(b, _)| takes_tint(b)) {
+        if !distinct.contains(m) {
+            distinct.push(*m);
+        }
+    }
+    if distinct.is_empty() {
+        return Ok(());
+    }
+    let directions = probe_directions();
+    let cases: Vec<crate::tools::brdf_eval::TintedCase> = (distinct.iter())
+        .flat_map(|(brdf, tint)| directions.iter().map(move |d| (*brdf, *tint, *d)))
+        .collect();
+    let mut evaluator = crate::BrdfEvaluator::with_module(ctx, modules.brdf_eval)?;
+    let values = evaluator.evaluate_tinted(ctx, &cases);
+    evaluator.destroy(ctx);
+    for ((brdf, tint, [n, _, v, l]), value) in cases.iter().zip(values?) {
+        refuse_bad(brdf, Some(tint), [n, v, l], &value)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -42,7 +42,7 @@ pub use alpha::{
 };
 pub use brdf_modules::{
     compile as compile_brdf_set, compile_with_hooks as compile_brdf_set_with_hooks, lut_refusal,
-    probe_finite as probe_brdfs, BrdfModules,
+    probe_finite as probe_brdfs, probe_materials, BrdfModules,
 };
 pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};
 pub use gpu::debug::{ValidationLog, ValidationMessage};

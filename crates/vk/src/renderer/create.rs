@@ -104,6 +104,11 @@ impl<'c> Renderer<'c> {
         scene.validate()?;
         check_brdfs(&scene, &desc.brdfs.set)?;
         crate::brdf_modules::probe_finite(ctx, desc.brdfs)?;
+        let materials: Vec<_> = (scene.objects.iter().map(|o| &o.material))
+            .chain(scene.alpha_objects.iter().map(|o| &o.material))
+            .map(|m| (m.brdf, m.tint.to_array()))
+            .collect();
+        crate::brdf_modules::probe_materials(ctx, desc.brdfs, &materials)?;
         crate::renderer::materials::check_images(ctx, &scene)?;
         scene.normalise_lights();
         let brdfs: Vec<BrdfId> = scene.brdfs_in_use();
