@@ -571,14 +571,21 @@ impl BrdfSet {
     /// the manifest is called there, and the signature its function must have, for each BRDF
     /// whose function the message names. `None` when the message is not about such a call.
     pub fn generated_call_hint(&self, message: &str) -> Option<String> {
-        if !message.contains("brdf_set/") {
+        if !message.contains("brdf_set/") && !message.contains("brdf_set\\") {
             return None;
         }
         let args = "vec3 N, vec3 T, vec3 V, vec3 L";
         let mut lines = Vec::new();
         for (_, spec) in self.engine() {
-            let named =
-                |f: &str| message.contains(&format!("'{f}'")) || message.contains(&format!("{f}("));
+            // As a whole word: `base(` inside `sheen_base(` is not `base`'s call.
+            let named = |f: &str| {
+                let call = format!("{f}(");
+                message.contains(&format!("'{f}'"))
+                    || message.match_indices(&call).any(|(at, _)| {
+                        let before = message[..at].chars().next_back();
+                        !before.is_some_and(|c| c.is_alphanumeric() || c == '_')
+                    })
+            };
             let (function, glsl) = (&spec.function, &spec.glsl);
             if named(function) {
                 let signature = if spec.tint {
@@ -689,7 +696,7 @@ impl BrdfSet {
     fn unknown(&self, name: String) -> BrdfError {
         let names: Vec<&str> = self.ids().iter().map(|b| b.name()).collect();
         let nearest = (names.iter())
-            .map(|n| (edits(n, &name), *n))
+            .map(|n| (edits(n, &name.to_lowercase()), *n))
             .filter(|(d, _)| *d <= 2)
             .min()
             .map_or(String::new(), |(_, n)| format!("; did you mean `{n}`?"));
@@ -842,6 +849,9 @@ mod tests {
             set.generated_call_hint("toon.glsl:3: error: 'x' : undeclared"),
             None
         );
+        // A call of another function whose name ends in this one's is not its call.
+        let other = "brdf_set/tinted.glsl:3: error: in call to my_metal_rough(p, tint";
+        assert_eq!(set.generated_call_hint(other), None);
     }
 
     /// A misspelt name in a scene read with an engine's set names the set's BRDFs, its own
@@ -858,6 +868,11 @@ mod tests {
             text.contains("holds: lambert, toon, ue4_standard")
                 && text.ends_with("did you mean `ue4_standard`?"),
             "{text}"
+        );
+        let shouted = set.parse("UE4_STANDARD", &none).unwrap_err().to_string();
+        assert!(
+            shouted.ends_with("did you mean `ue4_standard`?"),
+            "{shouted}"
         );
         let far = set.parse("velvet", &none).unwrap_err().to_string();
         assert!(!far.contains("did you mean"), "{far}");

@@ -944,8 +944,9 @@ enum HistencilResult histencil_lightmaps_destroy(struct HistencilLightmaps *ligh
 //
 // Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer, too many materials;
 // `BAD_SETUP` for a BRDF the shaders' set lacks, parameters out of range, a resolution
-// histencil-brdf refuses or a BRDF no table can hold (the message says why: a function that
-// takes the tint, the tangent read); `DEVICE_LIMIT` when the values pass the device's storage-buffer range.
+// histencil-brdf refuses, a BRDF no table can hold (the message says why: a function that
+// takes the tint, the tangent read, light where N.L <= 0), or a BRDF of the shaders' set that
+// returns NaN, an infinity or negative light where the probe evaluates it; `DEVICE_LIMIT` when the values pass the device's storage-buffer range.
 //
 // Thread safety: not at the same time as another call on `context`.
 //
@@ -987,11 +988,11 @@ enum HistencilResult histencil_lut_tables_destroy(struct HistencilLutTables *tab
 // each, in order: what a decode hook reading rows by material index binds (the book's
 // two-target hook: a uniform block of 256 rows). Nothing is written on an error.
 //
-// Errors: `INVALID_ARGUMENT` for a null pointer, no material, too many materials, or `rows_size`
+// Errors: `INVALID_ARGUMENT` for a null pointer, no material, more than 65536, or `rows_size`
 // under `material_count * HISTENCIL_MATERIAL_ROW_BYTES`; `BAD_SETUP` for a BRDF the set lacks
 // or parameters out of range, naming the material.
 //
-// Thread safety: any thread.
+// Thread safety: any thread, not at the same time as `histencil_shaders_destroy(shaders)`.
 //
 // # Safety
 // `shaders` is null (histencil's own BRDFs) or a live handle; `materials` is null or points at
@@ -1008,8 +1009,8 @@ enum HistencilResult histencil_material_rows_write(const struct HistencilShaders
 // under the stencil technique and no tile class under tiled, its pixels unlit with no error.
 // Call it whenever the rows change.
 //
-// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, no material or too
-// many; `BAD_SETUP` for a BRDF the lighting's set lacks, parameters out of range, or a
+// Errors: `INVALID_ARGUMENT` for a null or freed handle, a null pointer, no material or more
+// than 65536; `BAD_SETUP` for a BRDF the lighting's set lacks, parameters out of range, or a
 // material whose BRDF the lighting does not shade, naming the material.
 //
 // Thread safety: not at the same time as another call naming `lighting`.

@@ -39,8 +39,9 @@ const MAX_MATERIALS: u32 = 1 << 12;
 ///
 /// Errors: `INVALID_ARGUMENT` for a null or freed handle or pointer, too many materials;
 /// `BAD_SETUP` for a BRDF the shaders' set lacks, parameters out of range, a resolution
-/// histencil-brdf refuses or a BRDF no table can hold (the message says why: a function that
-/// takes the tint, the tangent read); `DEVICE_LIMIT` when the values pass the device's storage-buffer range.
+/// histencil-brdf refuses, a BRDF no table can hold (the message says why: a function that
+/// takes the tint, the tangent read, light where N.L <= 0), or a BRDF of the shaders' set that
+/// returns NaN, an infinity or negative light where the probe evaluates it; `DEVICE_LIMIT` when the values pass the device's storage-buffer range.
 ///
 /// Thread safety: not at the same time as another call on `context`.
 ///

@@ -301,7 +301,7 @@ fn probe_directions() -> Vec<[V3<f32>; 4]> {
 
 /// Refuses an engine BRDF that returns NaN, an infinity or a negative value anywhere it is
 /// probed (its parameters at their defaults, each at its ends, all at their ends, at
-/// `probe_directions`; one that takes the tint at each of `PROBE_TINTS`), naming the BRDF and
+/// `probe_directions`; one that takes the tint at each of `probe_tints`), naming the BRDF and
 /// the point: such a value is written into every technique's frame and the forward
 /// reference's alike, where no comparison between them can see it. Histencil's own BRDFs are
 /// held to their f64 reference instead, and pass at once.
@@ -309,16 +309,19 @@ fn probe_directions() -> Vec<[V3<f32>; 4]> {
 /// # Errors
 /// [`Error::BrdfSet`] naming the BRDF, its parameters and the directions; Vulkan errors.
 pub fn probe_finite(ctx: &Context, modules: &'static BrdfModules) -> Result<()> {
-    probe(ctx, modules).map(|_| ())
+    probe(ctx, modules)
 }
 
 /// Whether the LUT technique can hold `brdf` of `modules`' set in a table: the set's own answer
-/// ([`BrdfSet::tabulable`]), and for an engine BRDF the probe's: one that returns light where
-/// `N.L <= 0` (a wrap or translucent lobe) is refused, since a table's axes end at the horizon
-/// and it would drop that light in silence. `Ok(None)` where a table can hold it.
+/// ([`BrdfSet::tabulable`]), and for an engine BRDF the device's, at the material's own
+/// parameters: one that returns light where `N.L <= 0` (a wrap or translucent lobe) is refused,
+/// since a table's axes end at the horizon and it would drop that light in silence. A value
+/// there under a thousandth of the material's largest above the horizon (a division guarded
+/// by `max(dot(N, L), 1e-4)`, say) is not counted: the table's own error is far larger. The
+/// set is probed first ([`probe_finite`]). `Ok(None)` where a table can hold it.
 ///
 /// # Errors
-/// The probe's ([`probe_finite`]).
+/// The probe's ([`probe_finite`]); Vulkan errors.
 pub fn lut_refusal(
     ctx: &Context,
     modules: &'static BrdfModules,
@@ -330,14 +333,55 @@ pub fn lut_refusal(
     let Brdf::Engine { id, .. } = brdf else {
         return Ok(None);
     };
-    let below = probe(ctx, modules)?;
-    Ok(below
-        .contains(&BrdfId::Engine(*id))
-        .then_some(LutError::EngineUntabulable {
+    probe(ctx, modules)?;
+    Ok(
+        lights_below_horizon(ctx, modules, brdf)?.then_some(LutError::EngineUntabulable {
             brdf: id.name(),
             reason: "it returns light where N.L <= 0 (a wrap or translucent lobe), and a \
-                     table's axes end at the horizon: it would drop that light",
-        }))
+                 table's axes end at the horizon: it would drop that light",
+        }),
+    )
+}
+
+/// Whether `brdf`, an engine BRDF with its parameters, returns light where `N.L <= 0` past a
+/// thousandth of its largest value above the horizon, at `probe_directions` (both parts).
+/// Once per material, modules and device.
+fn lights_below_horizon(ctx: &Context, modules: &'static BrdfModules, brdf: &Brdf) -> Result<bool> {
+    type Known = Vec<((usize, String, u32, [u64; 4]), bool)>;
+    static KNOWN: OnceLock<Mutex<Known>> = OnceLock::new();
+    let key = (
+        modules as *const BrdfModules as usize,
+        ctx.device_name().to_owned(),
+        brdf.id().index(),
+        brdf.packed_params().map(f64::to_bits),
+    );
+    let known = KNOWN.get_or_init(Default::default);
+    if let Some((_, below)) =
+        (known.lock().unwrap_or_else(|p| p.into_inner()).iter()).find(|(k, _)| *k == key)
+    {
+        return Ok(*below);
+    }
+    let cases: Vec<(Brdf, [V3<f32>; 4])> =
+        probe_directions().into_iter().map(|d| (*brdf, d)).collect();
+    let mut evaluator = crate::BrdfEvaluator::with_module(ctx, modules.brdf_eval)?;
+    let values = evaluator.evaluate(ctx, &cases);
+    evaluator.destroy(ctx);
+    let (mut above, mut below) = (0f32, 0f32);
+    for ((_, [n, _, _, l]), parts) in cases.iter().zip(values?) {
+        let n_dot_l: f32 = n.iter().zip(l).map(|(a, b)| a * b).sum();
+        let largest = parts.channels().into_iter().fold(0f32, f32::max);
+        if n_dot_l <= 0.0 {
+            below = below.max(largest);
+        } else {
+            above = above.max(largest);
+        }
+    }
+    let lights = below > 0.0 && below > 1e-3 * above;
+    known
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .push((key, lights));
+    Ok(lights)
 }
 
 /// The surface colours a BRDF that takes the tint is probed at: each channel at 0, a half and 1
@@ -355,25 +399,26 @@ fn probe_tints() -> Vec<[f32; 3]> {
     out
 }
 
-/// [`probe_finite`], once per set and device, returning the engine BRDFs that light where
-/// `N.L <= 0` ([`lut_refusal`]).
-fn probe(ctx: &Context, modules: &'static BrdfModules) -> Result<Vec<BrdfId>> {
+/// [`probe_finite`], once per set and device.
+fn probe(ctx: &Context, modules: &'static BrdfModules) -> Result<()> {
     if modules.set.is_builtin_only() {
-        return Ok(Vec::new());
+        return Ok(());
     }
     // Once per modules and device: a check builds several renderers of one set.
-    type Probed = Vec<((usize, String), Vec<BrdfId>)>;
+    type Probed = Vec<(usize, String)>;
     static PROBED: OnceLock<Mutex<Probed>> = OnceLock::new();
     let key = (
         modules as *const BrdfModules as usize,
         ctx.device_name().to_owned(),
     );
     let probed = PROBED.get_or_init(Default::default);
-    let known = probed.lock().unwrap_or_else(|p| p.into_inner());
-    if let Some((_, below)) = known.iter().find(|(k, _)| *k == key) {
-        return Ok(below.clone());
+    if probed
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .contains(&key)
+    {
+        return Ok(());
     }
-    drop(known);
     let directions = probe_directions();
     // A BRDF whose function takes the tint has no parts: it is probed as a surface of each of
     // the probe's colours, as every technique calls it.
@@ -423,17 +468,11 @@ fn probe(ctx: &Context, modules: &'static BrdfModules) -> Result<Vec<BrdfId>> {
                 .map(|(brdf, tint, dirs)| (brdf, Some(tint), dirs))
                 .zip(with_tint.iter().map(|v| v.to_vec())),
         );
-    let mut below: Vec<BrdfId> = Vec::new();
     for ((brdf, tint, [n, _, v, l]), channels) in values {
-        let n_dot_l: f32 = n.iter().zip(l).map(|(a, b)| a * b).sum();
-        if n_dot_l <= 0.0 && channels.iter().any(|x| *x > 0.0) && !below.contains(&brdf.id()) {
-            below.push(brdf.id());
-        }
         refuse_bad(brdf, tint, [n, v, l], &channels)?;
     }
-    let mut known = probed.lock().unwrap_or_else(|p| p.into_inner());
-    known.push((key, below.clone()));
-    Ok(below)
+    probed.lock().unwrap_or_else(|p| p.into_inner()).push(key);
+    Ok(())
 }
 
 /// Refuses a value that is NaN, infinite or negative. Negative light (a BRDF reading another's
