@@ -19,6 +19,12 @@ use std::path::{Path, PathBuf};
 
 const SIZE: u32 = 96;
 
+/// The LUT technique, without hi-stencil.
+const LUT: Technique = Technique::Lut {
+    backend: Backend::Native,
+    flush: FlushPolicy::Auto,
+};
+
 fn techniques() -> Vec<(&'static str, Shading)> {
     let flush = FlushPolicy::Auto;
     vec![
@@ -337,11 +343,7 @@ fn a_brdf_of_the_colour_squared_is_held_to_forward_and_refused_by_the_lut() {
             ..RendererDesc::new(SIZE, SIZE)
         };
         let mut renderer = Renderer::with_desc(ctx, scene.clone(), &desc).unwrap();
-        let lut = Technique::Lut {
-            backend: Backend::Native,
-            flush: FlushPolicy::Auto,
-        };
-        let err = renderer.render(lut, Readback::ALL).err().unwrap();
+        let err = renderer.render(LUT, Readback::ALL).err().unwrap();
         let text = err.to_string();
         assert!(
             text.contains("`metal_rough_rgb`: its function takes the tint"),
@@ -418,11 +420,7 @@ fn a_brdf_that_lights_below_the_horizon_has_no_table() {
             ..RendererDesc::new(SIZE, SIZE)
         };
         let mut renderer = Renderer::with_desc(ctx, scene, &desc).unwrap();
-        let lut = Technique::Lut {
-            backend: Backend::Native,
-            flush: FlushPolicy::Auto,
-        };
-        let err = renderer.render(lut, Readback::ALL).err().unwrap();
+        let err = renderer.render(LUT, Readback::ALL).err().unwrap();
         assert!(
             matches!(err, histencil_vk::Error::LutUntabulable { .. }),
             "{err}"
@@ -700,11 +698,7 @@ fn an_engine_brdfs_lut_table_is_filled_by_its_glsl() {
     };
     let given = [("alpha", alpha), ("f0", f0), ("f90", f90)];
     let mine = set.engine_brdf("my_ggx", &given).unwrap();
-    let lut: Shading = Technique::Lut {
-        backend: Backend::Native,
-        flush: FlushPolicy::Auto,
-    }
-    .into();
+    let lut: Shading = LUT.into();
     with_validated_context(|ctx| {
         let cpu = histencil_vk::LutTables::new(ctx, &[ggx], 9).unwrap();
         let gpu = histencil_vk::LutTables::with_modules(ctx, modules, &[mine], 9).unwrap();

@@ -759,6 +759,16 @@ mod tests {
         }
     }
 
+    /// A BRDF whose function `metal_rough` takes the tint, in `toon.glsl`.
+    fn metal() -> EngineBrdfSpec {
+        EngineBrdfSpec {
+            name: "metal".into(),
+            function: "metal_rough".into(),
+            tint: true,
+            ..toon()
+        }
+    }
+
     #[test]
     fn a_table_holds_an_engine_brdf_unless_it_takes_the_tint_or_reads_the_tangent() {
         let mut sheen = toon();
@@ -767,10 +777,7 @@ mod tests {
         let mut hair = toon();
         hair.name = "hair".into();
         hair.tangent = true;
-        let mut metal = toon();
-        metal.name = "metal".into();
-        metal.tint = true;
-        let set = BrdfSet::new(&[BrdfId::Ggx], vec![toon(), sheen, hair, metal]).unwrap();
+        let set = BrdfSet::new(&[BrdfId::Ggx], vec![toon(), sheen, hair, metal()]).unwrap();
         let of = |name: &str| set.engine_brdf(name, &[]).unwrap();
         assert_eq!(set.tabulable(&of("toon")), Ok(()));
         // Two factors per entry: the white part is held beside the tinted one.
@@ -805,10 +812,7 @@ mod tests {
     /// a white part beside it is refused.
     #[test]
     fn a_brdf_that_takes_the_tint_is_called_with_it() {
-        let mut metal = toon();
-        metal.name = "metal".into();
-        metal.function = "metal_rough".into();
-        metal.tint = true;
+        let mut metal = metal();
         let set = BrdfSet::new(&[], vec![metal.clone()]).unwrap();
         let files = set.glsl_files("engine");
         let text = |name: &str| &files.iter().find(|(n, _)| *n == name).unwrap().1;
@@ -828,10 +832,7 @@ mod tests {
     /// the hint names the BRDF, its file and the signature the call wants.
     #[test]
     fn a_mismatched_signature_is_explained_from_the_manifest() {
-        let mut metal = toon();
-        metal.name = "metal".into();
-        metal.function = "metal_rough".into();
-        metal.tint = true;
+        let metal = metal();
         let set = BrdfSet::new(&[], vec![toon(), metal]).unwrap();
         let message = "/out/set/brdf_set/tinted.glsl:3: error: 'metal_rough' : no matching \
                        overloaded function found";
