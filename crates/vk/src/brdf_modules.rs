@@ -16,8 +16,8 @@ use std::sync::{Mutex, OnceLock};
 use histencil_brdf::lut::LutError;
 use histencil_brdf::{Brdf, BrdfId, BrdfSet, V3};
 
-use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Error, Result};
 use crate::lighting::hooks::LightModules;
 use crate::shaders;
 

@@ -28,7 +28,9 @@ pub mod shader_layouts;
 mod tools;
 
 // The device layer's public modules, at the crate's root where engines and tests find them.
-pub use gpu::{access, descriptors, gpu_types, state};
+pub use gpu::access;
+pub use gpu::device::descriptors;
+pub use gpu::frame::{gpu_types, state};
 
 /// The compiled SPIR-V of every shader module (built by build.rs, never checked in).
 pub mod shaders {
@@ -44,22 +46,26 @@ pub use brdf_modules::{
     compile as compile_brdf_set, compile_with_hooks as compile_brdf_set_with_hooks, lut_refusal,
     probe_finite as probe_brdfs, probe_materials, BrdfModules,
 };
-pub use gpu::context::{BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver};
-pub use gpu::debug::{ValidationLog, ValidationMessage};
-pub use gpu::driver::{Canary, DriverInfo, CANARY_CALLS, CANARY_ID};
-pub use gpu::error::{Cause, Error, Result};
+pub use gpu::device::canary::{Canary, CANARY_CALLS};
+pub use gpu::device::context::{
+    BorrowedDevice, Context, ContextDesc, DepthStencilFormat, StepObserver,
+};
+pub use gpu::device::debug::CANARY_ID;
+pub use gpu::device::debug::{ValidationLog, ValidationMessage};
+pub use gpu::device::driver::DriverInfo;
+pub use gpu::device::error::{Cause, Error, Result};
 #[doc(hidden)]
-pub use gpu::hazards::{omit_hand_over, HandOver, Omitted};
-pub use gpu::limits::{describe as describe_limits, DeviceLimits, Limit, Need, NEEDS};
-pub use gpu::quirks::{Quirk, QuirkRule, Quirks, QUIRKS};
-pub use gpu::readback::{FrameImages, Readback};
-pub use gpu::requirements::{DeviceRequirements, REQUIREMENTS};
-pub use gpu::spirv_bindings::{reflect_bindings, ModuleBindings, Resource, ResourceKind};
-pub use gpu::targets::{check_extent, GBUFFER_FORMATS};
-pub use gpu::teardown::StillInFlight;
+pub use gpu::device::hazards::{omit_hand_over, HandOver, Omitted};
+pub use gpu::device::limits::{describe as describe_limits, DeviceLimits, Limit, Need, NEEDS};
+pub use gpu::device::quirks::{Quirk, QuirkRule, Quirks, QUIRKS};
+pub use gpu::device::requirements::{DeviceRequirements, REQUIREMENTS};
+pub use gpu::device::spirv_bindings::{reflect_bindings, ModuleBindings, Resource, ResourceKind};
+pub use gpu::device::teardown::StillInFlight;
 #[cfg(feature = "tools")]
-pub use gpu::timing::median_of_sorted;
-pub use gpu::timing::{FrameTimings, LightingBreakdown, LightmapTimings};
+pub use gpu::encoder::timing::median_of_sorted;
+pub use gpu::encoder::timing::{FrameTimings, LightingBreakdown, LightmapTimings};
+pub use gpu::frame::readback::{FrameImages, Readback};
+pub use gpu::frame::targets::{check_extent, GBUFFER_FORMATS};
 pub use gpu_types::ProjectionError;
 pub use histencil_model::{
     CostModel, DepthIdCosts, FlushPolicy, FrameChoice, SlotWeights, TileStats, TiledCosts,

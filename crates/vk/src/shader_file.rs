@@ -22,7 +22,7 @@ use std::sync::{Mutex, OnceLock};
 use histencil_brdf::BrdfSet;
 
 use crate::brdf_modules::{compile_with_hooks, modules_of, BrdfModules, Scratch};
-use crate::gpu::spirv_bindings::reflect_bindings;
+use crate::gpu::device::spirv_bindings::reflect_bindings;
 use crate::lighting::hooks::spirv_words;
 
 const HEAD: &str = "histencil shaders\nformat 1\n";

@@ -1,12 +1,12 @@
 //! Every shader module and the pipeline layout it is used with, gathered from the passes that
 //! own the sets (each pass keeps its own set's table beside the code that writes it; the sets
-//! every pass shares, the frame's and the G-buffer's, are `gpu::descriptors`'). The reflection
+//! every pass shares, the frame's and the G-buffer's, are `gpu::device::descriptors`'). The reflection
 //! test (`tests/reflection.rs`) holds every module's SPIR-V to its layout here. A layout is its
 //! sets in order: set N is element N.
 
 use crate::alpha::lightmaps::ALPHA_SET;
 use crate::alpha::ALPHA_LIGHTMAP_SET;
-use crate::gpu::descriptors::{BindingDesc, FRAME_SET, GBUFFER_SET};
+use crate::gpu::device::descriptors::{BindingDesc, FRAME_SET, GBUFFER_SET};
 use crate::hi_stencil::{HI_STENCIL_SET, HI_STENCIL_UPDATE_SET};
 use crate::lighting::lut::{LUT_EVAL_SET, LUT_SET};
 use crate::passes::geometry::MATERIAL_SET;

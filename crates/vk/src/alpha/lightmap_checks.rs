@@ -3,7 +3,7 @@
 
 use super::lightmaps::{AlphaLightmapsDesc, LightmapFrame};
 use crate::gpu::access::ImageRef;
-use crate::gpu::error::{Error, Result};
+use crate::gpu::device::error::{Error, Result};
 use ash::vk;
 
 /// A direction map fits when these lightmaps make one, in their format, at the atlas's extent.

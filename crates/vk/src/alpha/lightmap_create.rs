@@ -49,7 +49,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         }
 
         let slots = self.desc.frames_in_flight;
-        let sizes = crate::gpu::descriptors::pool_sizes(&[(FRAME_SET, slots), (ALPHA_SET, slots)]);
+        let sizes =
+            crate::gpu::device::descriptors::pool_sizes(&[(FRAME_SET, slots), (ALPHA_SET, slots)]);
         let info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(2 * slots)
             .pool_sizes(&sizes);

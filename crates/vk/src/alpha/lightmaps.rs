@@ -17,20 +17,20 @@ mod create;
 use super::gpu::{frame_records, AlphaDrawPush, FrameRecords};
 use super::lightmap_checks::{bad, check_direction, check_frame};
 use crate::gpu::access::ImageRef;
-use crate::gpu::attachments::{begin_all_cleared, CLEAR_BLACK};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{
     binding, create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers,
     BindingDesc, BindingKind, FRAME_SET, GRAPHICS_STAGES,
 };
-use crate::gpu::error::{Error, Result, VkCall};
-use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
-use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
-use crate::gpu::state::FULLSCREEN;
-use crate::gpu::teardown::{free_or_retire, DestroyResult, PendingSlots};
-use crate::gpu::timing::{LightmapTimings, SlotTimer};
+use crate::gpu::device::error::{Error, Result, VkCall};
+use crate::gpu::device::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::{free_or_retire, DestroyResult, PendingSlots};
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::encoder::timing::{LightmapTimings, SlotTimer};
+use crate::gpu::frame::attachments::{begin_all_cleared, CLEAR_BLACK};
+use crate::gpu::frame::gpu_types::{FrameUniforms, GpuLight};
+use crate::gpu::frame::state::FULLSCREEN;
 use crate::shaders;
 use ash::vk;
 use gpu_allocator::MemoryLocation;

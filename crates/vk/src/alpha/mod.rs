@@ -21,20 +21,20 @@ pub use lightmap_checks::max_lightmap_side;
 pub use lightmaps::{AlphaLightmaps, AlphaLightmapsDesc, LightmapFrame};
 
 use crate::gpu::access::{Contents, ImageAccess};
-use crate::gpu::attachments::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{
     binding, create_pipeline_layout, create_set_layout, write_sampled_images, BindingDesc,
     BindingKind, GRAPHICS_STAGES,
 };
-use crate::gpu::error::{Result, VkCall};
-use crate::gpu::meshes::Meshes;
-use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::{Buffer, Image};
-use crate::gpu::state::{oriented, FULLSCREEN};
-use crate::gpu::targets::{Targets, HDR_FORMAT};
-use crate::gpu::timing::LightmapTimings;
+use crate::gpu::device::error::{Result, VkCall};
+use crate::gpu::device::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::device::resources::{Buffer, Image};
+use crate::gpu::encoder::meshes::Meshes;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::encoder::timing::LightmapTimings;
+use crate::gpu::frame::attachments::{begin_cleared, begin_hdr_rendering, Load, CLEAR_BLACK};
+use crate::gpu::frame::state::{oriented, FULLSCREEN};
+use crate::gpu::frame::targets::{Targets, HDR_FORMAT};
 use crate::shader_consts::ALPHA_MODES;
 use crate::shaders;
 use ash::vk;
@@ -592,7 +592,7 @@ fn create_lightmap_set(
     parts: &mut Parts,
     layout: vk::DescriptorSetLayout,
 ) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
-    let sizes = crate::gpu::descriptors::pool_sizes(&[(ALPHA_LIGHTMAP_SET, 1)]);
+    let sizes = crate::gpu::device::descriptors::pool_sizes(&[(ALPHA_LIGHTMAP_SET, 1)]);
     let info = vk::DescriptorPoolCreateInfo::default()
         .max_sets(1)
         .pool_sizes(&sizes);
@@ -630,5 +630,5 @@ fn write_lightmap_set(
         .image_info(&filter);
     // SAFETY: `set` was just allocated (`create_lightmap_set`) and no command buffer uses it;
     // binding 2 is the layout's sampler (`ALPHA_LIGHTMAP_SET`) and `sampler` is live.
-    unsafe { crate::gpu::descriptors::update_sets(ctx, &[write]) };
+    unsafe { crate::gpu::device::descriptors::update_sets(ctx, &[write]) };
 }

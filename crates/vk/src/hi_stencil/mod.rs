@@ -24,15 +24,17 @@
 //! count the fragments they shade.
 
 use crate::gpu::access::{access_info, BufferAccess, Contents, ImageAccess, ImageRef, Use};
-use crate::gpu::attachments::{depth_stencil_attachment, Load};
-use crate::gpu::compute::ComputePipeline;
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, sets_of, write_storage_buffers, BindingDesc, BindingKind};
-use crate::gpu::error::{Result, VkCall};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::{Buffer, Image};
-use crate::gpu::state::compare_op;
-use crate::gpu::teardown::{build, Destroy};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{
+    binding, sets_of, write_storage_buffers, BindingDesc, BindingKind,
+};
+use crate::gpu::device::error::{Result, VkCall};
+use crate::gpu::device::resources::{Buffer, Image};
+use crate::gpu::device::teardown::{build, Destroy};
+use crate::gpu::encoder::compute::ComputePipeline;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::frame::attachments::{depth_stencil_attachment, Load};
+use crate::gpu::frame::state::compare_op;
 use crate::shader_consts::{
     HI_STENCIL_MODE_AND_OR, HI_STENCIL_MODE_CONSOLE, HI_STENCIL_MODE_PRETESTS,
     HI_STENCIL_UPDATE_GROUP,
@@ -107,7 +109,7 @@ fn write_read_only_view(ctx: &Context, set: vk::DescriptorSet, binding: u32, vie
     // SAFETY: `set` and `view` were made from this context's device; the set is not bound by a
     // pending command buffer (the surface's sets are written at creation, at a resize once no
     // slot is in flight, and per slot once that slot's frame is declared finished).
-    unsafe { crate::gpu::descriptors::update_sets(ctx, &[write]) };
+    unsafe { crate::gpu::device::descriptors::update_sets(ctx, &[write]) };
 }
 
 /// Words of the statistics buffer (`HiStencilStats` in include/hi_stencil.glsl).

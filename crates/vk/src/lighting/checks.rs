@@ -3,8 +3,8 @@
 
 use super::{LightingDesc, LightingFrame};
 use crate::gpu::access::{ImageRef, LightingTargets};
-use crate::gpu::error::{Error, Result};
-use crate::gpu::targets::GBUFFER_FORMATS;
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::frame::targets::GBUFFER_FORMATS;
 use crate::lighting::hooks::{HookSets, LightHooks};
 use ash::vk;
 use histencil_model::{FramePlan, PassKind, Shader, Step};

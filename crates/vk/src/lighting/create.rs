@@ -2,15 +2,15 @@
 //! hi-stencil surface and the light volumes; a failure half way leaves the rest to `Drop`.
 
 use super::{DeferredLighting, Slot};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{
     create_pipeline_layout, create_set_layout, write_frame_set, write_storage_buffers, FRAME_SET,
     GBUFFER_SET, GRAPHICS_STAGES,
 };
-use crate::gpu::error::{Result, VkCall};
-use crate::gpu::gpu_types::{FrameUniforms, GpuLight, PUSH_CONSTANT_BYTES};
-use crate::gpu::resources::Buffer;
-use crate::gpu::timing::SlotTimer;
+use crate::gpu::device::error::{Result, VkCall};
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::encoder::timing::SlotTimer;
+use crate::gpu::frame::gpu_types::{FrameUniforms, GpuLight, PUSH_CONSTANT_BYTES};
 use crate::hi_stencil::HiStencilSurface;
 use crate::hi_stencil::HI_STENCIL_SET;
 use crate::lighting::hooks::LightHooks;
@@ -78,7 +78,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         // Per slot its frame set, and with the built-in decode its G-buffer set; the hi-stencil
         // and LUT sets once.
         let decode_sets = if builtin { slots } else { 0 };
-        let sizes = crate::gpu::descriptors::pool_sizes(&[
+        let sizes = crate::gpu::device::descriptors::pool_sizes(&[
             (FRAME_SET, slots),
             (GBUFFER_SET, decode_sets),
             (HI_STENCIL_SET, 1),

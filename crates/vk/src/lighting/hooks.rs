@@ -9,10 +9,10 @@
 //! its visibility's in set 4, each in a descriptor set layout of its own, and the sets bound per
 //! frame from [`HookSets`]. Why build time: see `histencil_build`.
 
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{layout_bindings, GBUFFER_SET, GRAPHICS_STAGES};
-use crate::gpu::error::{Error, Result};
-use crate::gpu::spirv_bindings::{reflect_bindings, Resource};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{layout_bindings, GBUFFER_SET, GRAPHICS_STAGES};
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::spirv_bindings::{reflect_bindings, Resource};
 pub use crate::passes::light_modules::LightModules;
 use ash::vk;
 use histencil_brdf::BrdfId;
@@ -84,8 +84,12 @@ pub enum BrdfParams {
 }
 
 /// What each of an engine's layouts holds ([`EngineHooks::register_layouts`]).
-pub(crate) type LayoutCounts =
-    std::sync::Arc<Vec<(vk::DescriptorSetLayout, Vec<crate::gpu::limits::SetCounts>)>>;
+pub(crate) type LayoutCounts = std::sync::Arc<
+    Vec<(
+        vk::DescriptorSetLayout,
+        Vec<crate::gpu::device::limits::SetCounts>,
+    )>,
+>;
 
 impl EngineHooks {
     /// Tells `ctx` what the engine's layouts hold, so the pipeline layouts made with them are
@@ -134,12 +138,12 @@ impl EngineHooks {
         let tiled_refusal = check_modules(&modules, &layouts)?;
         let mut layout_counts = vec![(
             decode.layout,
-            crate::gpu::limits::SetCounts::of_bindings(decode.bindings),
+            crate::gpu::device::limits::SetCounts::of_bindings(decode.bindings),
         )];
         layout_counts.extend(visibility.map(|v| {
             (
                 v.layout,
-                crate::gpu::limits::SetCounts::of_bindings(v.bindings),
+                crate::gpu::device::limits::SetCounts::of_bindings(v.bindings),
             )
         }));
         Ok(Self {
@@ -386,7 +390,7 @@ impl LightHooks {
         // How many sets a pipeline layout may hold (an engine's visibility hook needs 5).
         let bindable = ctx
             .device_limits()
-            .get(crate::gpu::limits::Limit::BoundDescriptorSets);
+            .get(crate::gpu::device::limits::Limit::BoundDescriptorSets);
         if sets > bindable {
             return Err(Error::DeviceLimit(format!(
                 "a visibility hook binds set 4, and this device binds at most {} sets (the \

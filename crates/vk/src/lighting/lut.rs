@@ -3,12 +3,12 @@
 //! evaluator that runs the GLSL lookup on chosen directions so it can be held to
 //! [`Lut::lookup`].
 
-use crate::gpu::compute::{pad, CaseKernel};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
-use crate::gpu::error::{Error, Result};
-use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::{free_or_retire, InFlight};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{binding, BindingDesc, BindingKind};
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::{free_or_retire, InFlight};
+use crate::gpu::encoder::compute::{pad, CaseKernel};
 use crate::shaders;
 use crate::{BrdfEvaluator, BrdfModules};
 use ash::vk;

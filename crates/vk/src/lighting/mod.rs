@@ -21,32 +21,32 @@ mod create;
 mod frames;
 pub mod hooks;
 pub(crate) mod lut;
+mod record_tiled;
 mod stencil_check;
-mod tiled;
 
 use checks::{
     bad, bad_setup, check_desc, check_frame, check_usage, needs_hi_stencil, writes_hi_stencil,
     UsageNeeds,
 };
 pub use frames::{gbuffer_stencil_reference, LightingDesc, LightingFrame, TiledFrame};
+pub use record_tiled::TILED_HDR_FORMATS;
 pub use stencil_check::{StencilCheck, StencilReport};
-pub use tiled::TILED_HDR_FORMATS;
 
 use crate::gpu::access::LightingTargets;
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{write_sampled_images, write_storage_buffers};
-use crate::gpu::error::{Error, Result};
-use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::{free_or_retire, Destroy, DestroyResult, PendingSlots};
-use crate::gpu::timing::{LightingBreakdown, SlotTimer};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{write_sampled_images, write_storage_buffers};
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::{free_or_retire, Destroy, DestroyResult, PendingSlots};
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::encoder::timing::{LightingBreakdown, SlotTimer};
+use crate::gpu::frame::gpu_types::{FrameUniforms, GpuLight};
 use crate::hi_stencil::{GpuHierarchy, HiStencilSurface};
 use crate::lighting::hooks::HookSets;
 use crate::passes::depth_id::DepthIdPass;
+use crate::passes::light_passes::{Emulation, LightingPass};
 use crate::passes::light_pipelines::{prepare_pipelines, BrdfSource, LightPipelines};
 use crate::passes::light_volumes::LightVolumes;
-use crate::passes::lighting::{Emulation, LightingPass};
 use crate::passes::tiled::TileSide;
 use crate::passes::tiled::TiledLighting;
 use ash::vk;

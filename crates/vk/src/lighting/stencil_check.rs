@@ -9,11 +9,11 @@
 //! histencil may zero). It is a debug aid: a copy of the stencil per frame that asks for it.
 
 use crate::gpu::access::ImageRef;
-use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::free_or_retire;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::free_or_retire;
+use crate::gpu::encoder::recording::Recording;
 use ash::vk;
 use histencil_model::StencilLayout;
 use std::fmt;

@@ -18,13 +18,13 @@
 //! (`histencil_model::depth_id_stats`), not timed here.
 
 use crate::gpu::access::{uses_of, BufferAccess, Contents, ImageAccess, LightingTargets};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::create_pipeline_layout;
-use crate::gpu::error::Result;
-use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::{Buffer, Image};
-use crate::gpu::teardown::{build, Destroy};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::create_pipeline_layout;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::device::resources::{Buffer, Image};
+use crate::gpu::device::teardown::{build, Destroy};
+use crate::gpu::encoder::recording::Recording;
 use crate::passes::light_modules::LightModules;
 use crate::passes::{depth_stencil_attachment, Load};
 use crate::shaders;

@@ -7,15 +7,15 @@ use super::{
     CLEAR_BLACK,
 };
 use crate::gpu::access::{uses_of, Contents, ImageAccess, LightingTargets};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, pass_layouts, BindingDesc, BindingKind};
-use crate::gpu::error::Result;
-use crate::gpu::gpu_types::PUSH_CONSTANT_BYTES;
-use crate::gpu::meshes::Meshes;
-use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::recording::Recording;
-use crate::gpu::state::{oriented, with_stencil, OPAQUE};
-use crate::gpu::teardown::build;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{binding, pass_layouts, BindingDesc, BindingKind};
+use crate::gpu::device::error::Result;
+use crate::gpu::device::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::device::teardown::build;
+use crate::gpu::encoder::meshes::Meshes;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::frame::gpu_types::PUSH_CONSTANT_BYTES;
+use crate::gpu::frame::state::{oriented, with_stencil, OPAQUE};
 use crate::shaders;
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -315,7 +315,7 @@ impl MeshPasses {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(MeshPasses);
+crate::gpu::device::teardown::destroy_by_method!(MeshPasses);
 
 /// One mesh pass being recorded: a pipeline and the frame's inputs.
 struct Draw<'a> {

@@ -1,9 +1,9 @@
 //! The pipelines of the lighting pass, created the first time a plan needs them: a scene pays
 //! only for the BRDFs it uses, and a technique only for its own shaders.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::Result;
-use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
 use crate::hi_stencil::{plan_touches, TouchedTiles, TOUCH_FORMAT};
 use crate::passes::light_modules::LightModules;
 use crate::shaders;

@@ -1,11 +1,11 @@
 //! The light volumes the lighting draws: a sphere circumscribing a point light's range, a cone
 //! a spot light's, each a [`GpuMesh`] in host-visible memory.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::Result;
-use crate::gpu::meshes::GpuMesh;
-use crate::gpu::recording::Recording;
-use crate::gpu::teardown::Owned;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::teardown::Owned;
+use crate::gpu::encoder::meshes::GpuMesh;
+use crate::gpu::encoder::recording::Recording;
 use histencil_scene::{light_cone, light_sphere, LightKind};
 
 /// Light-volume tessellation: enough that the circumscribed mesh stays close to the sphere / cone.

@@ -7,20 +7,20 @@
 //! pass's rendering and opens its label, `Recording::step`); no pass takes a bare command
 //! buffer, and the entry points an engine calls with its own wrap it in one at once.
 //! The lighting's
-//! per-frame recording (`lighting.rs`) and the light pipelines it creates per plan
+//! per-frame recording (`light_passes.rs`) and the light pipelines it creates per plan
 //! (`light_pipelines.rs`) live here and belong to `DeferredLighting`.
 
 pub(crate) mod depth_id;
 pub mod geometry;
 pub mod light_modules;
+pub mod light_passes;
 pub mod light_pipelines;
 pub(crate) mod light_volumes;
-pub mod lighting;
 pub mod names;
 pub(crate) mod tiled;
 pub mod tonemap;
 
-pub(crate) use crate::gpu::attachments::{
+pub(crate) use crate::gpu::frame::attachments::{
     begin_hdr_rendering, begin_hdr_rendering_as, clear_depth_stencil, color_attachment,
     depth_stencil_attachment, Load, CLEAR_BLACK,
 };

@@ -12,19 +12,19 @@
 
 use crate::gpu::access::LeaveOut::{self, Barrier, Declaration};
 use crate::gpu::access::{uses_of, BufferAccess, Contents, ImageAccess, ImageRef, LightingTargets};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{
     binding, create_pipeline_layout, create_set_layout, sets_of, write_storage_buffers,
     BindingDesc, BindingKind,
 };
-use crate::gpu::error::{Error, Result};
-use crate::gpu::hazards::HandOver;
-use crate::gpu::limits::Limit;
-use crate::gpu::pipelines::create_compute_pipeline;
-use crate::gpu::quirks::Quirk;
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::{build, Destroy};
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::hazards::HandOver;
+use crate::gpu::device::limits::Limit;
+use crate::gpu::device::pipelines::create_compute_pipeline;
+use crate::gpu::device::quirks::Quirk;
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::{build, Destroy};
+use crate::gpu::encoder::recording::Recording;
 use crate::passes::light_modules::LightModules;
 use crate::shader_consts::TILED_MODELS;
 use crate::shaders;
@@ -467,7 +467,7 @@ impl TiledLighting {
         // Binding 4 is `TILED_SET`'s storage image, and `hdr` is the caller's live view with
         // `STORAGE` usage (`record_tiled`'s # Safety, `check_usage`), in `GENERAL` when the
         // kernels run.
-        unsafe { crate::gpu::descriptors::update_sets(ctx, &[write]) };
+        unsafe { crate::gpu::device::descriptors::update_sets(ctx, &[write]) };
     }
 
     /// Records the classification with `sets` bound: the G-buffer (or the decode hook's
@@ -626,5 +626,5 @@ impl TiledLighting {
 
 /// What a hazard test leaves out of a declaration where it omits `hand_over` (nothing else).
 fn omitted(hand_over: HandOver, part: LeaveOut) -> Option<LeaveOut> {
-    (!crate::gpu::hazards::records(hand_over)).then_some(part)
+    (!crate::gpu::device::hazards::records(hand_over)).then_some(part)
 }

@@ -3,16 +3,16 @@
 
 use super::{color_attachment, Load, CLEAR_BLACK};
 use crate::gpu::access::{Contents, ImageAccess};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{
     binding, one_set, pass_layouts, write_sampled_images, BindingDesc, BindingKind,
 };
-use crate::gpu::error::Result;
-use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::recording::Recording;
-use crate::gpu::state::FULLSCREEN;
-use crate::gpu::targets::Targets;
-use crate::gpu::teardown::build;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::device::teardown::build;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::frame::state::FULLSCREEN;
+use crate::gpu::frame::targets::Targets;
 use crate::shaders;
 use ash::vk;
 
@@ -124,4 +124,4 @@ impl Tonemap {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(Tonemap);
+crate::gpu::device::teardown::destroy_by_method!(Tonemap);

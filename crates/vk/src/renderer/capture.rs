@@ -4,14 +4,14 @@
 //! clamp). Running `histencil_model::Simulator` on them predicts the GPU frame exactly: its
 //! final stencil and its hi-stencil statistics (`tests/tests/hi_stencil.rs` holds it to that).
 
-use crate::gpu::attachments::begin_cleared;
-use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result};
-use crate::gpu::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::{Buffer, Image};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::pipelines::{create_pipeline, Blend, PipelineDesc, VertexInput};
+use crate::gpu::device::resources::{Buffer, Image};
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::frame::attachments::begin_cleared;
+use crate::passes::light_passes::LightDrawPush;
 use crate::passes::light_volumes::LightVolumes;
-use crate::passes::lighting::LightDrawPush;
 use crate::shaders;
 use ash::vk;
 use histencil_model::{

@@ -3,16 +3,16 @@
 //! order at drop.
 
 use super::{Renderer, RendererDesc};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::Descriptors;
-use crate::gpu::error::{Result, VkCall};
-use crate::gpu::gpu_types::{FrameUniforms, GpuLight};
-use crate::gpu::meshes::Meshes;
-use crate::gpu::readback::ReadbackBuffers;
-use crate::gpu::resources::Buffer;
-use crate::gpu::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
-use crate::gpu::teardown::{build, Destroy, Owned};
-use crate::gpu::timing::Timestamps;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::Descriptors;
+use crate::gpu::device::error::{Result, VkCall};
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::{build, Destroy, Owned};
+use crate::gpu::encoder::meshes::Meshes;
+use crate::gpu::encoder::timing::Timestamps;
+use crate::gpu::frame::gpu_types::{FrameUniforms, GpuLight};
+use crate::gpu::frame::readback::ReadbackBuffers;
+use crate::gpu::frame::targets::{check_extent, Targets, GBUFFER_FORMATS, HDR_FORMAT, LDR_FORMAT};
 use crate::lighting::hooks::LightHooks;
 use crate::lighting::{DeferredLighting, LightingDesc};
 use crate::passes::geometry::{MeshFormats, MeshPasses};

@@ -5,11 +5,11 @@
 use super::{Frame, Renderer};
 use crate::alpha::AlphaInputs;
 use crate::gpu::access::LightingTargets;
-use crate::gpu::error::{Error, Result, VkCall};
-use crate::gpu::readback::Readback;
-use crate::gpu::recording::Recording;
-use crate::gpu::targets::GBUFFER_FORMATS;
-use crate::gpu::timing::{progress_words, FrameTimings};
+use crate::gpu::device::error::{Error, Result, VkCall};
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::encoder::timing::{progress_words, FrameTimings};
+use crate::gpu::frame::readback::Readback;
+use crate::gpu::frame::targets::GBUFFER_FORMATS;
 use crate::hi_stencil::GpuHierarchy;
 use crate::lighting::hooks::HookSets;
 use crate::lighting::{LightingFrame, TiledFrame};
@@ -288,7 +288,8 @@ impl<'c> Renderer<'c> {
     fn wait_watching(&self, step: Option<&str>) -> std::result::Result<(), vk::Result> {
         let ctx = self.ctx;
         let start = std::time::Instant::now();
-        let timeout = std::time::Duration::from_nanos(crate::gpu::context::FENCE_TIMEOUT_NS);
+        let timeout =
+            std::time::Duration::from_nanos(crate::gpu::device::context::FENCE_TIMEOUT_NS);
         let mut slice = std::time::Duration::from_millis(50);
         let mut told = None;
         loop {

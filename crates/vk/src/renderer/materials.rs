@@ -4,11 +4,11 @@
 //! of the mesh pipelines (`crates/vk/shaders/include/material.glsl`). Objects without maps share a set
 //! whose maps are a white texel, which changes nothing.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result, VkCall};
-use crate::gpu::resources::{Buffer, Image};
-use crate::gpu::teardown::build;
-use crate::gpu::upload::{upload, BufferUpload, ImageUpload};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Error, Result, VkCall};
+use crate::gpu::device::resources::{Buffer, Image};
+use crate::gpu::device::teardown::build;
+use crate::gpu::encoder::upload::{upload, BufferUpload, ImageUpload};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -407,7 +407,7 @@ impl GpuMaterials {
     ) -> Result<()> {
         let count = plan.sets.len() as u32;
         let table = crate::passes::geometry::MATERIAL_SET;
-        let sizes = crate::gpu::descriptors::pool_sizes(&[(table, count)]);
+        let sizes = crate::gpu::device::descriptors::pool_sizes(&[(table, count)]);
         let pool_info = vk::DescriptorPoolCreateInfo::default()
             .max_sets(count)
             .pool_sizes(&sizes);
@@ -466,7 +466,7 @@ impl GpuMaterials {
             // matches a binding of `MATERIAL_SET` (material.glsl); the record's offset is a
             // multiple of 256 (every device's largest uniform alignment); the textures and
             // samplers were made above, the textures uploaded and left shader-read-only.
-            unsafe { crate::gpu::descriptors::update_sets(ctx, &writes) };
+            unsafe { crate::gpu::device::descriptors::update_sets(ctx, &writes) };
         }
         self.object_sets = plan.object_sets.iter().map(|&s| sets[s as usize]).collect();
         Ok(())
@@ -494,7 +494,7 @@ impl GpuMaterials {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(GpuMaterials);
+crate::gpu::device::teardown::destroy_by_method!(GpuMaterials);
 
 #[cfg(test)]
 mod tests {

@@ -2,8 +2,8 @@
 //! the planner's inputs from the scene, and the uniforms of the mesh and alpha passes.
 
 use super::Renderer;
-use crate::gpu::error::Result;
-use crate::gpu::gpu_types::FrameUniforms;
+use crate::gpu::device::error::Result;
+use crate::gpu::frame::gpu_types::FrameUniforms;
 use crate::renderer::technique::{Backend, FrameDesc, MixedTiles, Technique, TileSide};
 use histencil_model::{
     plan_frame, DepthConvention, FarPlane, FrameChoice, FramePlan, LightShape, Perspective,

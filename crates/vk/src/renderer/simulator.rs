@@ -1,8 +1,8 @@
 //! The CPU simulator's inputs, captured from the GPU's own frame.
 
 use super::Renderer;
-use crate::gpu::error::Result;
-use crate::gpu::resources::Buffer;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::resources::Buffer;
 use crate::hi_stencil::GpuHierarchy;
 use crate::renderer::capture::{FootprintCapture, SimulatorInputs};
 use crate::renderer::technique::{Backend, FrameDesc, Technique, TileSide};

@@ -3,7 +3,7 @@
 //! frame description that carries them.
 
 use crate::alpha::AlphaMode;
-use crate::gpu::readback::Readback;
+use crate::gpu::frame::readback::Readback;
 use crate::passes::light_pipelines::BrdfSource;
 use crate::passes::names;
 pub use crate::passes::tiled::{MixedTiles, TileClassify, TileSide};

@@ -1,10 +1,10 @@
 //! Evaluates BRDF cases on the GPU with the GLSL spelling (`crates/vk/shaders/brdf_eval.comp`), so the
 //! shipping shader code can be held to the f64 reference. One dispatch per call.
 
-use crate::gpu::compute::{pad, CaseKernel};
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{binding, BindingDesc, BindingKind};
-use crate::gpu::error::Result;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{binding, BindingDesc, BindingKind};
+use crate::gpu::device::error::Result;
+use crate::gpu::encoder::compute::{pad, CaseKernel};
 use crate::shaders;
 use histencil_brdf::{Brdf, Parts, V3};
 

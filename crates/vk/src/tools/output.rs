@@ -3,7 +3,7 @@
 //! so a failed or interrupted run leaves no empty or truncated output behind. The checks run
 //! before long work create nothing, so a failed run leaves no empty folders either.
 
-use crate::gpu::error::{Error, Result};
+use crate::gpu::device::error::{Error, Result};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 

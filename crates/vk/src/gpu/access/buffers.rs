@@ -1,9 +1,8 @@
 //! Declared buffer accesses and the hand-overs derived from them: a step says how it uses a
-//! buffer next ([`Recording::declare_buffers`]), and the barrier follows from the buffer's
+//! buffer next (the encoder's `Recording::declare_buffers`), and the barrier follows from the buffer's
 //! last declared uses, in recording order across command buffers ([`BufferUse`],
 //! [`hand_over`], pure and unit-tested).
 
-use crate::gpu::recording::Recording;
 use ash::vk;
 
 /// How a buffer is used, as [`ImageAccess`](super::ImageAccess) says it of an image: the stages and accesses a
@@ -49,7 +48,7 @@ pub fn buffer_access_info(access: BufferAccess) -> (vk::PipelineStageFlags2, vk:
     }
 }
 
-/// What a hazard test leaves out of a declaration ([`Recording::declare_buffers_leaving_out`]).
+/// What a hazard test leaves out of a declaration (`Recording::declare_buffers_leaving_out`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum LeaveOut {
     Barrier,
@@ -112,74 +111,6 @@ pub(crate) fn hand_over(last: BufferUse, next: BufferAccess) -> (Option<Scopes>,
             (Some((write, (stage, access))), after)
         }
         _ => (None, after),
-    }
-}
-
-impl Recording<'_> {
-    /// Declares how the step being recorded uses `uses`' buffers next, and records the one
-    /// barrier command that hands each over from its last declared uses (in recording order,
-    /// across command buffers: [`BufferUse`]); nothing where none is needed (a read after a
-    /// read, or a read the last write was already made visible to). Outside rendering.
-    ///
-    /// The hazard check holds the declarations to the shaders: until the innermost open label
-    /// closes, its draws and dispatches may write the buffers declared with a write access,
-    /// and any other buffer a shader writes is an error (`HISTENCIL-UNDECLARED-WRITE`, naming
-    /// the pass, set and binding), for no barrier could be derived for it.
-    pub(crate) fn declare_buffers(&self, uses: &[(vk::Buffer, BufferAccess)]) {
-        self.declare_buffers_leaving_out(uses, None);
-    }
-
-    /// [`Self::declare_buffers`] less one of its parts, for a hazard test to prove the check
-    /// finds it missing (`crate::gpu::hazards::HandOver`): the barrier (the uses still
-    /// recorded as the buffers' last), or the declaration the check holds shaders to (the
-    /// barrier still recorded). `None` leaves out nothing.
-    pub(crate) fn declare_buffers_leaving_out(
-        &self,
-        uses: &[(vk::Buffer, BufferAccess)],
-        leave_out: Option<LeaveOut>,
-    ) {
-        if let (Some(h), false) = (self.hazards(), leave_out == Some(LeaveOut::Declaration)) {
-            let writes: Vec<vk::Buffer> = uses
-                .iter()
-                .filter(|(_, a)| a.writes())
-                .map(|(b, _)| *b)
-                .collect();
-            h.declare_writes(self.any(), &writes);
-        }
-        let barriers: Vec<vk::BufferMemoryBarrier2> = {
-            let mut last = self
-                .ctx()
-                .buffer_uses
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
-            uses.iter()
-                .filter_map(|&(buffer, access)| {
-                    let state = last.entry(buffer).or_default();
-                    let (barrier, next) = hand_over(*state, access);
-                    *state = next;
-                    barrier.map(|(src, dst)| {
-                        vk::BufferMemoryBarrier2::default()
-                            .src_stage_mask(src.0)
-                            .src_access_mask(src.1)
-                            .dst_stage_mask(dst.0)
-                            .dst_access_mask(dst.1)
-                            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .buffer(buffer)
-                            .offset(0)
-                            .size(vk::WHOLE_SIZE)
-                    })
-                })
-                .collect()
-        };
-        if barriers.is_empty() || leave_out == Some(LeaveOut::Barrier) {
-            return;
-        }
-        let dependency = vk::DependencyInfo::default().buffer_memory_barriers(&barriers);
-        // SAFETY: outside rendering (`barrier` checks it in debug builds); the buffers are live
-        // (the callers' own), and each barrier names only stages and accesses of the buffer
-        // access table, which the recording's queue family supports.
-        unsafe { self.barrier(&dependency) };
     }
 }
 

@@ -5,8 +5,45 @@
 //! sees them ([`crate::Context`] records the largest need met), so a device below a need gets an
 //! error that names the limit, never a driver's undefined behaviour.
 
-use crate::gpu::descriptors::BindingKind;
 use ash::vk;
+
+/// What a binding holds: the subset of Vulkan's descriptor types histencil's shaders use
+/// (separate images and samplers, no combined image samplers), and the kinds the device's
+/// per-kind descriptor limits count (`SetCounts`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    /// A `uniform` block (`UNIFORM_BUFFER`).
+    UniformBuffer,
+    /// A `buffer` block (`STORAGE_BUFFER`).
+    StorageBuffer,
+    /// A `texture2D` (`SAMPLED_IMAGE`).
+    SampledImage,
+    /// A `sampler` (`SAMPLER`).
+    Sampler,
+    /// An `image2D` written by a compute pass (`STORAGE_IMAGE`).
+    StorageImage,
+}
+
+impl BindingKind {
+    /// Every kind, in the order of `SetCounts`' counts.
+    pub const ALL: [BindingKind; 5] = [
+        BindingKind::UniformBuffer,
+        BindingKind::StorageBuffer,
+        BindingKind::SampledImage,
+        BindingKind::Sampler,
+        BindingKind::StorageImage,
+    ];
+
+    pub(crate) fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
+            BindingKind::Sampler => vk::DescriptorType::SAMPLER,
+            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+        }
+    }
+}
 
 /// A `VkPhysicalDeviceLimits` member histencil's work depends on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

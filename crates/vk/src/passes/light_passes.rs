@@ -1,6 +1,6 @@
 //! The deferred lighting pass, driven by histencil-model's frame plan: every light's passes
 //! (setup, per-BRDF mask and shade, cleanup, as `plan_light` derives them for the platform
-//! backend), with the state of each draw translated by `Recording::apply` (`gpu/state.rs`).
+//! backend), with the state of each draw translated by `Recording::apply` (`gpu/frame/state.rs`).
 //!
 //! This module only decides how each light is classified and which BRDFs it touches, and records
 //! the plan; the stencil logic lives in the model, where the CPU simulator checks it.
@@ -14,10 +14,10 @@ use super::light_pipelines::{
 };
 use super::{begin_hdr_rendering_as, Load, CLEAR_BLACK};
 use crate::gpu::access::{uses_of, BufferAccess, Contents, ImageAccess, LightingTargets};
-use crate::gpu::error::Result;
-use crate::gpu::recording::Recording;
-use crate::gpu::state::FULLSCREEN;
-use crate::gpu::timing::StepTimer;
+use crate::gpu::device::error::Result;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::encoder::timing::StepTimer;
+use crate::gpu::frame::state::FULLSCREEN;
 use crate::hi_stencil::{
     plan_touches, tile_rect, GpuHierarchy, HiStencilSurface, TouchedTiles, WriteTiles,
 };
@@ -158,7 +158,7 @@ impl Rendering {
     /// declarations (`Recording::declare_buffers` derives each barrier).
     /// Synchronisation validation does not see these buffers' hazards (with no barrier here
     /// at all every test passed on lavapipe, which runs draws in order, 2026-11-29); histencil's
-    /// hazard check does (`gpu/hazards`, `tests/tests/hazards.rs`). What it found: the light
+    /// hazard check does (`gpu/device/hazards`, `tests/tests/hazards.rs`). What it found: the light
     /// shaders reach these buffers by atomics alone, which need no memory dependency between
     /// draws, so what the split gives the statistics draws is their order (ending the
     /// rendering, and the attachments' barriers when it opens again); the declaration's
@@ -553,7 +553,7 @@ impl LightingPass<'_> {
     /// hazard test that leaves it out (`HandOver::LightSplit`) finds the counted draws of one
     /// rendering unordered.
     fn split_for_counting(&self, rendering: &mut Rendering) {
-        if crate::gpu::hazards::records(crate::gpu::hazards::HandOver::LightSplit) {
+        if crate::gpu::device::hazards::records(crate::gpu::device::hazards::HandOver::LightSplit) {
             rendering.split(self);
         }
     }

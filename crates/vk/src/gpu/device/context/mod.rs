@@ -4,12 +4,12 @@
 
 mod owned;
 
-use crate::gpu::quirks::{Quirks, QUIRKS};
+use crate::gpu::device::quirks::{Quirks, QUIRKS};
 use owned::pick_depth_stencil_format;
 
-use crate::gpu::debug::ValidationLog;
-use crate::gpu::error::{Error, Result};
-use crate::gpu::requirements::REQUIREMENTS;
+use crate::gpu::device::debug::ValidationLog;
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::requirements::REQUIREMENTS;
 use ash::vk;
 use gpu_allocator::vulkan::Allocator;
 use std::ffi::{CStr, CString};
@@ -161,7 +161,7 @@ pub struct Context {
     validation: Arc<ValidationLog>,
     device_name: String,
     device_type: vk::PhysicalDeviceType,
-    driver: crate::gpu::driver::DriverInfo,
+    driver: crate::gpu::device::driver::DriverInfo,
     /// Every pipeline's cache: the engine's (borrowed), or histencil's own on an owned device,
     /// so that a second renderer or lighting on one context reuses the first's compilations.
     pub(crate) pipeline_cache: vk::PipelineCache,
@@ -174,14 +174,17 @@ pub struct Context {
     pub(crate) max_image_dimension: u32,
     pub(crate) max_storage_buffer_range: u32,
     /// The device's values of the limits histencil checks ([`crate::Limit`]).
-    pub(crate) limits: crate::gpu::limits::DeviceLimits,
+    pub(crate) limits: crate::gpu::device::limits::DeviceLimits,
     /// The largest need of each limit met on this context, for the reports and the test that
     /// holds [`crate::NEEDS`] to the code.
-    pub(crate) limits_used: crate::gpu::limits::LimitsUsed,
+    pub(crate) limits_used: crate::gpu::device::limits::LimitsUsed,
     /// What each set layout made on this context holds, by stage and kind: what a pipeline
     /// layout built from them is checked against.
     pub(crate) set_counts: Mutex<
-        std::collections::HashMap<vk::DescriptorSetLayout, Vec<crate::gpu::limits::SetCounts>>,
+        std::collections::HashMap<
+            vk::DescriptorSetLayout,
+            Vec<crate::gpu::device::limits::SetCounts>,
+        >,
     >,
     /// `depthBounds` is enabled on the device and histencil's pipelines take the depth bounds
     /// test as dynamic state: the renderer confines lights to their depth ranges
@@ -189,19 +192,19 @@ pub struct Context {
     /// enabled features histencil is not told.
     pub(crate) depth_bounds: bool,
     /// How histencil shapes its work on this driver ([`crate::QUIRKS`]).
-    pub(crate) quirks: crate::gpu::quirks::Quirks,
+    pub(crate) quirks: crate::gpu::device::quirks::Quirks,
     pub(crate) memory: MemoryAccount,
     /// The step observer and the labelled regions open ([`Context::observe_steps`]).
     steps: Mutex<Steps>,
     /// What engine-facing objects left behind when dropped while the GPU might still use it
     /// ([`Context::retire`]): freed at [`Context::free_retired`] or when the context drops.
     retired: Mutex<Vec<Retired>>,
-    /// The hazard check ([`crate::gpu::hazards`]): on for a context histencil creates with
+    /// The hazard check ([`crate::gpu::device::hazards`]): on for a context histencil creates with
     /// validation, in debug builds, and where an engine turns it on
     /// ([`Context::check_hazards`]).
-    pub(crate) hazards: std::sync::OnceLock<crate::gpu::hazards::Hazards>,
+    pub(crate) hazards: std::sync::OnceLock<crate::gpu::device::hazards::Hazards>,
     /// Each buffer's last declared uses, in recording order: what the barrier a step's
-    /// declaration needs is derived from ([`Recording::declare_buffers`](crate::gpu::recording::Recording)).
+    /// declaration needs is derived from ([`Recording::declare_buffers`](crate::gpu::encoder::recording::Recording)).
     pub(crate) buffer_uses:
         Mutex<std::collections::HashMap<vk::Buffer, crate::gpu::access::BufferUse>>,
 }
@@ -442,7 +445,7 @@ impl Context {
         // SAFETY: `driver_info`'s # Safety: `physical_device` belongs to `instance`, created for
         // Vulkan 1.3 (this fn's # Safety), and supports 1.3 (`missing` above found nothing).
         let mut driver =
-            unsafe { crate::gpu::driver::driver_info(&instance, physical_device, None) };
+            unsafe { crate::gpu::device::driver::driver_info(&instance, physical_device, None) };
         let quirks = Quirks::of(QUIRKS, driver.id, driver.version);
         driver.quirks = quirks.describe();
         Ok(Self {
@@ -467,7 +470,7 @@ impl Context {
             timestamp_period_ns: f64::from(props.limits.timestamp_period),
             max_image_dimension: props.limits.max_image_dimension2_d,
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
-            limits: crate::gpu::limits::DeviceLimits::new(&props.limits),
+            limits: crate::gpu::device::limits::DeviceLimits::new(&props.limits),
             limits_used: Default::default(),
             set_counts: Default::default(),
             queue_lock: Mutex::new(()),
@@ -499,7 +502,7 @@ impl Context {
 
     /// The driver as Vulkan names it (name, build, conformance) and the validation layer's
     /// version: what tells two builds of one driver apart where [`Context::device_name`] cannot.
-    pub fn driver(&self) -> &crate::gpu::driver::DriverInfo {
+    pub fn driver(&self) -> &crate::gpu::device::driver::DriverInfo {
         &self.driver
     }
 
@@ -513,17 +516,17 @@ impl Context {
 
     /// The quirks in force on this device: the table's rows for its driver, or none with
     /// [`ContextDesc::general_path`].
-    pub fn quirks(&self) -> &crate::gpu::quirks::Quirks {
+    pub fn quirks(&self) -> &crate::gpu::device::quirks::Quirks {
         &self.quirks
     }
 
     /// The device's values of the limits histencil checks.
-    pub fn device_limits(&self) -> &crate::gpu::limits::DeviceLimits {
+    pub fn device_limits(&self) -> &crate::gpu::device::limits::DeviceLimits {
         &self.limits
     }
 
     /// The largest need of `limit` that work made on this context has had (0 before any).
-    pub fn limit_used(&self, limit: crate::gpu::limits::Limit) -> u32 {
+    pub fn limit_used(&self, limit: crate::gpu::device::limits::Limit) -> u32 {
         self.limits_used.get(limit)
     }
 
@@ -531,7 +534,7 @@ impl Context {
     /// and `what` needs it where the device offers less.
     pub(crate) fn need(
         &self,
-        limit: crate::gpu::limits::Limit,
+        limit: crate::gpu::device::limits::Limit,
         need: u32,
         what: &str,
     ) -> Result<()> {
@@ -584,7 +587,7 @@ impl Context {
     /// on before creating lightings. Returns false (and changes nothing) where it was on.
     pub fn check_hazards(&self, log: Arc<ValidationLog>) -> bool {
         self.hazards
-            .set(crate::gpu::hazards::Hazards::new(log))
+            .set(crate::gpu::device::hazards::Hazards::new(log))
             .is_ok()
     }
 

@@ -3,9 +3,9 @@
 //! its depth-stencil format and the allocator; each step undone if a later one fails.
 
 use super::{Context, ContextDesc, DepthStencilFormat, MemoryAccount, VALIDATION_LAYER};
-use crate::gpu::debug::ValidationLog;
-use crate::gpu::error::{Error, Result, VkCall};
-use crate::gpu::requirements::REQUIREMENTS;
+use crate::gpu::device::debug::ValidationLog;
+use crate::gpu::device::error::{Error, Result, VkCall};
+use crate::gpu::device::requirements::REQUIREMENTS;
 use ash::vk;
 use std::ffi::CStr;
 use std::mem::ManuallyDrop;
@@ -115,7 +115,7 @@ impl Context {
                         .into(),
                 ));
             };
-            layer_text = Some(crate::gpu::driver::layer_version(layer));
+            layer_text = Some(crate::gpu::device::driver::layer_version(layer));
             // SAFETY: a global command; `VALIDATION_LAYER` is a NUL-terminated `'static` name
             // of a layer found installed just above.
             let layer_exts =
@@ -315,20 +315,26 @@ impl Context {
         let limits = props.limits;
         // SAFETY: `driver_info`'s # Safety: `physical_device` is `instance`'s, the instance was
         // created for Vulkan 1.3, and the device supports 1.3 (it passed `REQUIREMENTS.missing`).
-        let mut driver =
-            unsafe { crate::gpu::driver::driver_info(&instance, physical_device, layer_text) };
-        let quirks = if desc.general_path {
-            crate::gpu::quirks::Quirks::none()
-        } else {
-            crate::gpu::quirks::Quirks::of(crate::gpu::quirks::QUIRKS, driver.id, driver.version)
+        let mut driver = unsafe {
+            crate::gpu::device::driver::driver_info(&instance, physical_device, layer_text)
         };
-        let device_limits = crate::gpu::limits::DeviceLimits::new(&limits);
+        let quirks = if desc.general_path {
+            crate::gpu::device::quirks::Quirks::none()
+        } else {
+            crate::gpu::device::quirks::Quirks::of(
+                crate::gpu::device::quirks::QUIRKS,
+                driver.id,
+                driver.version,
+            )
+        };
+        let device_limits = crate::gpu::device::limits::DeviceLimits::new(&limits);
         let device_limits = if desc.spec_minimum_limits {
             device_limits.at_spec_minimum()
         } else {
             device_limits
         };
-        driver.limits = crate::gpu::limits::describe(crate::gpu::limits::NEEDS, &device_limits);
+        driver.limits =
+            crate::gpu::device::limits::describe(crate::gpu::device::limits::NEEDS, &device_limits);
         if desc.spec_minimum_limits {
             driver
                 .limits
@@ -347,7 +353,9 @@ impl Context {
                 .unwrap_or_default();
         let hazards = std::sync::OnceLock::new();
         if cfg!(debug_assertions) && desc.validation {
-            let _ = hazards.set(crate::gpu::hazards::Hazards::new(validation.clone()));
+            let _ = hazards.set(crate::gpu::device::hazards::Hazards::new(
+                validation.clone(),
+            ));
         }
         let ctx = Self {
             _entry: Some(entry),

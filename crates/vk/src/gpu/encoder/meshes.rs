@@ -1,12 +1,12 @@
 //! Meshes on the GPU ([`GpuMesh`]): the scene's object shapes ([`Meshes`]); the lighting's
 //! light volumes are `passes::light_volumes`'.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::Result;
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
-use crate::gpu::teardown::build;
-use crate::gpu::upload::{upload, BufferUpload};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::build;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::encoder::upload::{upload, BufferUpload};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use histencil_scene::{unit_box, uv_sphere, Mesh, Shape, SPHERE_DETAIL};
@@ -174,6 +174,6 @@ impl Meshes {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(Meshes);
+crate::gpu::device::teardown::destroy_by_method!(Meshes);
 
-crate::gpu::teardown::destroy_by_method!(GpuMesh);
+crate::gpu::device::teardown::destroy_by_method!(GpuMesh);

@@ -5,7 +5,7 @@
 //! Hi-stencil state is not Vulkan state: the GPU tile surface that emulates it is recorded by
 //! the lighting pass, not here.
 
-use crate::gpu::recording::Recording;
+use crate::gpu::encoder::recording::Recording;
 use ash::vk;
 use histencil_model::{
     CompareOp, CullMode, DepthConvention, DepthRange, DepthState, FaceStencil, PassState, StencilOp,

@@ -33,7 +33,7 @@
 //! synchronisation of a command buffer asks; a
 //! step's body records through the same shared reference it was handed, without reborrowing.
 
-use crate::gpu::context::Context;
+use crate::gpu::device::context::Context;
 use ash::vk;
 use std::cell::{Cell, RefCell};
 
@@ -227,7 +227,7 @@ impl<'a> Recording<'a> {
 
     /// The context's hazard check, when it has one: what the commands journal their buffer
     /// accesses and barriers to.
-    pub(crate) fn hazards(&self) -> Option<&'a crate::gpu::hazards::Hazards> {
+    pub(crate) fn hazards(&self) -> Option<&'a crate::gpu::device::hazards::Hazards> {
         self.ctx.hazards.get()
     }
 

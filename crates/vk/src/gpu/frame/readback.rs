@@ -2,12 +2,12 @@
 
 use crate::gpu::access::ImageRef;
 use crate::gpu::access::{Contents, ImageAccess};
-use crate::gpu::context::Context;
-use crate::gpu::error::Result;
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
-use crate::gpu::targets::Targets;
-use crate::gpu::teardown::build;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::device::teardown::build;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::frame::targets::Targets;
 use ash::vk;
 use histencil_brdf::BrdfId;
 use image::{GrayImage, Rgba32FImage, RgbaImage};
@@ -189,4 +189,4 @@ impl ReadbackBuffers {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(ReadbackBuffers);
+crate::gpu::device::teardown::destroy_by_method!(ReadbackBuffers);

@@ -21,8 +21,8 @@
 
 pub(crate) mod check;
 
-use crate::gpu::debug::{ValidationLog, ValidationMessage};
-use crate::gpu::spirv_bindings::{binding_reach, reflect_bindings, Reach, ResourceKind};
+use crate::gpu::device::debug::{ValidationLog, ValidationMessage};
+use crate::gpu::device::spirv_bindings::{binding_reach, reflect_bindings, Reach, ResourceKind};
 use ash::vk;
 use ash::vk::Handle;
 use ash::vk::{AccessFlags2 as A, PipelineStageFlags2 as S};

@@ -1,10 +1,10 @@
 //! Graphics pipelines. Everything that changes between the talk's light passes (cull mode, depth
 //! and stencil state) is dynamic state set per draw from the model's pass state
-//! ([`Recording::apply`](crate::gpu::recording::Recording::apply)); pipelines differ only in shaders, attachments, blending and
+//! ([`Recording::apply`](crate::gpu::encoder::recording::Recording::apply)); pipelines differ only in shaders, attachments, blending and
 //! colour writes.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::{Result, VkCall};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Result, VkCall};
 use ash::vk;
 use std::io::Cursor;
 
@@ -206,7 +206,7 @@ fn vertex_attributes(input: VertexInput) -> (u32, Vec<vk::VertexInputAttributeDe
 
 pub fn create_pipeline(ctx: &Context, desc: &PipelineDesc) -> Result<vk::Pipeline> {
     ctx.need(
-        crate::gpu::limits::Limit::ColorAttachments,
+        crate::gpu::device::limits::Limit::ColorAttachments,
         desc.color_formats.len() as u32,
         &format!("pipeline `{}`", desc.name),
     )?;

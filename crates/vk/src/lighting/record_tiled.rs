@@ -5,10 +5,10 @@
 use super::checks::{bad, check_slot_and_lights, check_targets, check_usage, UsageNeeds};
 use super::{DeferredLighting, TiledFrame};
 use crate::gpu::access::LightingTargets;
-use crate::gpu::context::Context;
-use crate::gpu::error::Result;
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::encoder::recording::Recording;
 use crate::lighting::hooks::LightHooks;
 use crate::passes::depth_id::{DepthIdDesc, DepthIdPass};
 use crate::passes::tiled::{MixedTiles, TileSide};

@@ -7,6 +7,9 @@ use std::ffi::CStr;
 use std::fmt;
 use std::sync::Mutex;
 
+/// The message id the canary's call must draw: a buffer of size zero.
+pub const CANARY_ID: &str = "VUID-VkBufferCreateInfo-size-00912";
+
 /// One WARNING or ERROR message.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ValidationMessage {
@@ -158,7 +161,7 @@ pub(crate) unsafe extern "system" fn messenger_callback(
         // The canary's deliberate call is the one call the layer is asked to stop (a callback's
         // TRUE makes it return VK_ERROR_VALIDATION_FAILED_EXT instead of passing the call on):
         // no driver ever sees a buffer of size zero from a layer that reports it.
-        let abort = id == crate::gpu::driver::CANARY_ID;
+        let abort = id == CANARY_ID;
         log.lock().push(ValidationMessage {
             severity,
             id,

@@ -1,8 +1,8 @@
 //! GPU timestamps around the passes of a frame.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::{Result, VkCall};
-use crate::gpu::recording::{PassClock, Recording};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Result, VkCall};
+use crate::gpu::encoder::recording::{PassClock, Recording};
 use ash::vk;
 use std::cell::RefCell;
 
@@ -522,7 +522,7 @@ impl SlotTimer {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(Timestamps);
+crate::gpu::device::teardown::destroy_by_method!(Timestamps);
 
 #[cfg(test)]
 mod tests {

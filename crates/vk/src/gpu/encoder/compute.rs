@@ -4,15 +4,15 @@
 //! case by case).
 
 use crate::gpu::access::BufferAccess;
-use crate::gpu::context::Context;
-use crate::gpu::descriptors::{
+use crate::gpu::device::context::Context;
+use crate::gpu::device::descriptors::{
     create_pipeline_layout, create_set_layout, create_storage_buffer_set, BindingDesc,
 };
-use crate::gpu::error::Result;
-use crate::gpu::pipelines::create_compute_pipeline;
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
-use crate::gpu::upload::submit_once;
+use crate::gpu::device::error::Result;
+use crate::gpu::device::pipelines::create_compute_pipeline;
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::encoder::recording::Recording;
+use crate::gpu::encoder::upload::submit_once;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 

@@ -11,8 +11,8 @@
 //! - [`Owned`] holds one finished part of a larger whole (a renderer's targets, its meshes) until
 //!   the whole is made; dropped before [`Owned::keep`], it destroys its part.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Error, Result};
 use ash::vk;
 
 /// A value made of Vulkan objects and allocations that frees them all. It must accept being
@@ -85,8 +85,8 @@ impl<T: Destroy> Drop for Owned<'_, T> {
 /// Implements [`Destroy`] by the types' own `destroy(&mut self, &Context)`.
 macro_rules! destroy_by_method {
     ($($t:ty),* $(,)?) => {
-        $(impl $crate::gpu::teardown::Destroy for $t {
-            fn destroy(&mut self, ctx: &$crate::gpu::context::Context) {
+        $(impl $crate::gpu::device::teardown::Destroy for $t {
+            fn destroy(&mut self, ctx: &$crate::gpu::device::context::Context) {
                 <$t>::destroy(self, ctx)
             }
         })*

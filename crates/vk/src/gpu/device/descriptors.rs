@@ -2,50 +2,21 @@
 //! The sets every pass shares (the frame's, the G-buffer's) are here; each pass keeps its own
 //! set's table, and `crate::shader_layouts` gathers them for the reflection test.
 
-use crate::gpu::context::Context;
-use crate::gpu::error::{Result, VkCall};
-use crate::gpu::gpu_types::PUSH_CONSTANT_BYTES;
-use crate::gpu::limits::{layout_needs, SetCounts};
-use crate::gpu::teardown::build;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Result, VkCall};
+use crate::gpu::device::limits::{layout_needs, SetCounts};
+use crate::gpu::device::teardown::build;
 use ash::vk;
 
-/// What a binding holds: the subset of Vulkan's descriptor types histencil's shaders use
-/// (separate images and samplers, no combined image samplers), and the kinds the device's
-/// per-kind descriptor limits count (`limits::SetCounts`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BindingKind {
-    /// A `uniform` block (`UNIFORM_BUFFER`).
-    UniformBuffer,
-    /// A `buffer` block (`STORAGE_BUFFER`).
-    StorageBuffer,
-    /// A `texture2D` (`SAMPLED_IMAGE`).
-    SampledImage,
-    /// A `sampler` (`SAMPLER`).
-    Sampler,
-    /// An `image2D` written by a compute pass (`STORAGE_IMAGE`).
-    StorageImage,
-}
+pub use crate::gpu::device::limits::BindingKind;
 
-impl BindingKind {
-    /// Every kind, in the order of `SetCounts`' counts.
-    pub const ALL: [BindingKind; 5] = [
-        BindingKind::UniformBuffer,
-        BindingKind::StorageBuffer,
-        BindingKind::SampledImage,
-        BindingKind::Sampler,
-        BindingKind::StorageImage,
-    ];
+/// Bytes of push-constant space every pipeline layout declares: the largest block, the mesh
+/// passes' `Draw` (`passes::geometry::DrawPush`, which asserts it is this size; every other
+/// pass's block is smaller, and a layout's range must cover it).
+pub const PUSH_CONSTANT_BYTES: u32 = 96;
 
-    fn descriptor_type(self) -> vk::DescriptorType {
-        match self {
-            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
-            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
-            BindingKind::SampledImage => vk::DescriptorType::SAMPLED_IMAGE,
-            BindingKind::Sampler => vk::DescriptorType::SAMPLER,
-            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
-        }
-    }
-}
+// 128 bytes is the push-constant space every Vulkan device guarantees.
+const _: () = assert!(PUSH_CONSTANT_BYTES <= 128);
 
 /// One binding of a set: its number, what it holds, and the GLSL name that declares it.
 #[derive(Clone, Copy, Debug)]
@@ -460,7 +431,7 @@ impl Descriptors {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(Descriptors);
+crate::gpu::device::teardown::destroy_by_method!(Descriptors);
 
 #[cfg(test)]
 mod pool_tests {

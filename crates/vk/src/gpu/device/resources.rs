@@ -3,8 +3,8 @@
 //! empty values (`Default`) hold null handles, which `destroy` accepts.
 
 use crate::gpu::access::{subresource_range, ImageRef, ImageState};
-use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result, VkCall};
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Error, Result, VkCall};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
@@ -364,12 +364,12 @@ impl Default for Image {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(Buffer, Image);
+crate::gpu::device::teardown::destroy_by_method!(Buffer, Image);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::context::ContextDesc;
+    use crate::gpu::device::context::ContextDesc;
 
     /// The leak check the end-to-end tests rely on can fail: a buffer left alive at teardown is
     /// reported by the validation layer's object tracker.

@@ -4,10 +4,10 @@
 //! before the function returns.
 
 use crate::gpu::access::Upload;
-use crate::gpu::context::Context;
-use crate::gpu::error::{Result, VkCall};
-use crate::gpu::recording::Recording;
-use crate::gpu::resources::Buffer;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Result, VkCall};
+use crate::gpu::device::resources::Buffer;
+use crate::gpu::encoder::recording::Recording;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
@@ -65,8 +65,12 @@ pub(crate) fn submit_once(
             // Creation waits for its own one-off work, as buffer creation does; frames never
             // come through here.
             ctx.step("waiting on the GPU");
-            d.wait_for_fences(&[fence], true, crate::gpu::context::FENCE_TIMEOUT_NS)
-                .call("vkWaitForFences")?;
+            d.wait_for_fences(
+                &[fence],
+                true,
+                crate::gpu::device::context::FENCE_TIMEOUT_NS,
+            )
+            .call("vkWaitForFences")?;
             if let Some(hazards) = ctx.hazards.get() {
                 hazards.waited(fence);
             }

@@ -4,7 +4,7 @@
 //! emulation's touch draw and the alpha passes use them as the passes do.
 
 use crate::gpu::access::{Contents, ImageAccess, ImageRef, Use};
-use crate::gpu::recording::Recording;
+use crate::gpu::encoder::recording::Recording;
 use ash::vk;
 use histencil_model::DepthConvention;
 

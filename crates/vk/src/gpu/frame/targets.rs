@@ -2,10 +2,10 @@
 //! and captures).
 
 use crate::gpu::access::LightingTargets;
-use crate::gpu::context::Context;
-use crate::gpu::error::{Error, Result};
-use crate::gpu::resources::Image;
-use crate::gpu::teardown::build;
+use crate::gpu::device::context::Context;
+use crate::gpu::device::error::{Error, Result};
+use crate::gpu::device::resources::Image;
+use crate::gpu::device::teardown::build;
 use ash::vk;
 
 /// The G-buffer's formats, in binding order: albedo, normal-depth, material
@@ -110,4 +110,4 @@ impl Targets {
     }
 }
 
-crate::gpu::teardown::destroy_by_method!(Targets);
+crate::gpu::device::teardown::destroy_by_method!(Targets);

@@ -167,13 +167,7 @@ impl GpuLight {
     }
 }
 
-/// Bytes of push-constant space every pipeline layout declares: the largest block, the mesh
-/// passes' `Draw` (`passes::geometry::DrawPush`, which asserts it is this size; every other
-/// pass's block is smaller, and a layout's range must cover it).
-pub const PUSH_CONSTANT_BYTES: u32 = 96;
-
-// 128 bytes is the push-constant space every Vulkan device guarantees.
-const _: () = assert!(PUSH_CONSTANT_BYTES <= 128);
+pub use crate::gpu::device::descriptors::PUSH_CONSTANT_BYTES;
 
 #[cfg(test)]
 mod tests {

@@ -9,7 +9,7 @@
 //! its device, and that what a draw or dispatch reads (the bound pipeline, sets, pushes, dynamic
 //! state, buffers) was bound and set. Each caller's `SAFETY` says how it knows.
 
-use crate::gpu::recording::Recording;
+use crate::gpu::encoder::recording::Recording;
 use ash::vk;
 
 impl Recording<'_> {
