@@ -26,10 +26,14 @@ use crate::steady::{ClockSettings, Stability, SteadyClock};
 use crate::variants::with_brdf_count;
 use crate::{write_file, AlphaReference, LabError, Result};
 use histencil_scene::{ParticleLayout, ParticleSystem, Scene, MAX_SLICES};
+use histencil_vk::passes::names;
 use histencil_vk::{Backend, Context, FlushPolicy, Renderer, RendererDesc, Shading, Technique};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+/// What the alpha sweeps time: the lightmaps and the alpha pass that reads them.
+const ALPHA_PASSES: &[&str] = &[names::ALPHA_LIGHTMAPS, names::ALPHA];
 
 /// The setting a sweep varies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -237,8 +241,7 @@ pub fn run_sweep(
                     ..RendererDesc::new(width, height)
                 };
                 let mut renderer = Renderer::with_desc(ctx, original.clone(), &desc)?;
-                let passes = ["alpha-lightmaps", "alpha"];
-                let mut timed = || time_passes(&mut renderer, technique, &passes, frames);
+                let mut timed = || time_passes(&mut renderer, technique, ALPHA_PASSES, frames);
                 let speed = steady.round(&round(i), progress, &mut timed)?;
                 let lit = frame(&mut renderer, technique)?;
                 let masked = reference.error(&lit);
@@ -260,8 +263,7 @@ pub fn run_sweep(
                     };
                 }
                 let mut renderer = Renderer::new(ctx, scene, width, height)?;
-                let passes = ["alpha-lightmaps", "alpha"];
-                let mut timed = || time_passes(&mut renderer, technique, &passes, frames);
+                let mut timed = || time_passes(&mut renderer, technique, ALPHA_PASSES, frames);
                 let speed = steady.round(&round(i), progress, &mut timed)?;
                 let lit = frame(&mut renderer, technique)?;
                 let masked = reference.error(&lit);

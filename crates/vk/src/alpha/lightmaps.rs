@@ -315,7 +315,7 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         self.write_frame(cmd, frame, atlas)?;
         // SAFETY: this fn's # Safety: `cmd` is recording on the lightmaps' device, on a graphics
         // queue family, outside any render pass; this call alone records into it now.
-        unsafe { self.record_pass(cmd, frame.slot, frame.layout, atlas, None) };
+        unsafe { self.record_pass(cmd, (frame.slot, frame.layout), atlas, None, None) };
         Ok(())
     }
 
@@ -345,7 +345,15 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         check_direction(&self.desc, atlas, direction)?;
         self.write_frame(cmd, frame, atlas)?;
         // SAFETY: as in `record`, whose # Safety this fn's is.
-        unsafe { self.record_pass(cmd, frame.slot, frame.layout, atlas, Some(direction)) };
+        unsafe {
+            self.record_pass(
+                cmd,
+                (frame.slot, frame.layout),
+                atlas,
+                Some(direction),
+                None,
+            )
+        };
         Ok(())
     }
 
@@ -424,7 +432,10 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
 
     /// Records the lightmap pass of the frame last written into `slot`: clears `atlas` (and
     /// `direction`, which makes it the directional pass), then one additive draw per (entity,
-    /// light that reaches it) over the entity's region.
+    /// light that reaches it) over the entity's region. Through `outer` when given (the
+    /// renderer's frame's recording of `cmd`, whose clock then times the pass
+    /// [`names::ALPHA_LIGHTMAPS`](crate::passes::names::ALPHA_LIGHTMAPS)), else through a
+    /// recording of its own of the engine's `cmd`, untimed.
     ///
     /// # Safety
     /// As [`Recording::new`]: `cmd` is recording on this context's device, on a graphics queue
@@ -432,15 +443,20 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     pub(crate) unsafe fn record_pass(
         &mut self,
         cmd: vk::CommandBuffer,
-        slot: u32,
-        layout: &LightmapLayout,
+        (slot, layout): (u32, &LightmapLayout),
         atlas: &mut ImageRef,
         direction: Option<&mut ImageRef>,
+        outer: Option<&Recording>,
     ) {
         let ctx: &Context = &self.ctx;
-        // SAFETY: this fn's # Safety is `Recording::new`'s.
-        let recording = unsafe { Recording::new(ctx, cmd) };
-        let rec = &recording;
+        debug_assert!(
+            outer.is_none_or(|r| r.any() == cmd),
+            "another buffer's recording"
+        );
+        // SAFETY: this fn's # Safety is `Recording::new`'s. Made only for an engine's call: the
+        // renderer's records through its own.
+        let owned = outer.is_none().then(|| unsafe { Recording::new(ctx, cmd) });
+        let rec = outer.or(owned.as_ref()).expect("one of the two");
         self.pending.recorded(slot, rec.outside());
         let slot = &mut self.slots[slot as usize];
         // Queries are reset outside rendering, as Vulkan requires.
@@ -449,8 +465,9 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             t.reset(rec);
             t.start(rec);
         }
-        // One name with or without a direction map: the frame times this pass by it.
-        rec.step(crate::passes::names::ALPHA_LIGHTMAPS, |rec| {
+        // One pass, with or without a direction map: its label, and its time where `rec` has a
+        // clock (the renderer's frame).
+        rec.pass(crate::passes::names::ALPHA_LIGHTMAPS, |rec| {
             let pipeline = match direction {
                 Some(direction) => {
                     begin_all_cleared(rec, &mut [atlas, direction], CLEAR_BLACK);
@@ -504,7 +521,9 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
             }
             rec.end_rendering();
         });
-        recording.finish();
+        if let Some(own) = owned {
+            own.finish();
+        }
     }
 
     /// Sets 0 and 1 of the alpha pipelines (frame, alpha), for histencil's own alpha pass.

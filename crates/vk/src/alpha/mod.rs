@@ -380,11 +380,11 @@ impl<'c> AlphaLighting<'c> {
         };
         // SAFETY: the renderer's command buffer is recording on this device, outside rendering
         // between its passes (`Renderer::record_deferred` and the alpha pass after it), and
-        // only this call records into it now (`rec` waits for it, `Recording::new`).
+        // the lightmaps record through `rec`, its one recording.
         unsafe {
-            let cmd = rec.outside();
-            self.lightmaps
-                .record_pass(cmd, 0, &self.layout, &mut self.lightmap, direction)
+            let (cmd, layout) = (rec.outside(), (0, &self.layout));
+            let lightmaps = &mut self.lightmaps;
+            lightmaps.record_pass(cmd, layout, &mut self.lightmap, direction, Some(rec))
         };
         Ok(())
     }

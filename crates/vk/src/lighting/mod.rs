@@ -418,11 +418,14 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     ) -> Result<()> {
         // SAFETY: the caller upholds this fn's # Safety, which is `record_emulating`'s; with
         // no hierarchy it needs nothing more.
-        unsafe { self.record_emulating(cmd, frame, targets, None) }
+        unsafe { self.record_emulating(cmd, frame, targets, None, None) }
     }
 
     /// [`DeferredLighting::record`], emulating `hierarchy`, the hierarchical stencil of an AMD
-    /// GPU (`crate::hi_stencil::amd`), which needs [`LightingDesc::hi_stencil`].
+    /// GPU (`crate::hi_stencil::amd`), which needs [`LightingDesc::hi_stencil`]; through `outer`
+    /// when given (the renderer's frame's recording of `cmd`, whose clock then times the pass
+    /// [`names::LIGHTING`](crate::passes::names::LIGHTING)), else through a recording of its own
+    /// of the engine's `cmd`, untimed.
     ///
     /// # Safety
     /// As [`DeferredLighting::record`].
@@ -432,6 +435,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         frame: &LightingFrame,
         targets: &mut LightingTargets,
         hierarchy: Option<GpuHierarchy>,
+        outer: Option<&Recording>,
     ) -> Result<()> {
         let (count_stats, source) = (frame.tile_stats, frame.brdf_source);
         check_frame(&self.desc, frame, targets)?;
@@ -477,12 +481,17 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         if source == BrdfSource::Table {
             sets.push(self.lut_set);
         }
+        debug_assert!(
+            outer.is_none_or(|r| r.any() == cmd),
+            "another buffer's recording"
+        );
         // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
         // family with graphics and compute, outside any render pass; this call alone records
-        // into it now.
-        let rec = unsafe { Recording::new(ctx, cmd) };
+        // into it now. Made only for an engine's call: the renderer's records through its own.
+        let owned = outer.is_none().then(|| unsafe { Recording::new(ctx, cmd) });
+        let rec = outer.or(owned.as_ref()).expect("one of the two");
         let pass = LightingPass {
-            rec: &rec,
+            rec,
             plan: frame.plan,
             lights: frame.lights,
             brdfs: &self.desc.brdfs,
@@ -508,7 +517,9 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let emulation = slot.emulation.active();
         self.pending.recorded(frame.slot, cmd);
         let recorded = pass.record(targets, hi_stencil, timer, emulation);
-        rec.finish();
+        if let Some(own) = owned {
+            own.finish();
+        }
         recorded
     }
 

@@ -170,7 +170,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         // Each a pass of its own, timed where `rec` has a clock (the renderer's).
         tiled.record_classify(rec, &sets, targets, depth_sampled, clear, mixed, shape);
         tiled.record_light_lists(rec, frame.lights.len() as u32);
-        match shade {
+        // The lighting itself: one pass, whichever way its BRDFs' pixels are found.
+        rec.pass(crate::passes::names::LIGHTING, |rec| match shade {
             TiledShade::Kernels => tiled.record_shade(rec, mixed, &mut targets.hdr),
             TiledShade::DepthId => {
                 let side = frame.side;
@@ -195,7 +196,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                     buffers,
                 );
             }
-        }
+        });
         if let Some(own) = owned {
             own.finish();
         }

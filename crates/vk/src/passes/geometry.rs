@@ -214,7 +214,9 @@ impl MeshPasses {
         }
     }
 
-    /// Writes the G-buffer and each draw's BRDF slot into the stencil BRDF bits.
+    /// Writes the G-buffer and each draw's BRDF slot into the stencil BRDF bits. Part of the
+    /// pass [`names::GBUFFER`](super::names::GBUFFER), which its caller records
+    /// (`Renderer::record_gbuffer_into`, with the emissive draws where a frame has them).
     pub(crate) fn record_gbuffer(
         &self,
         rec: &Recording,
@@ -222,42 +224,40 @@ impl MeshPasses {
         stencil: &GbufferStencil,
         targets: &mut LightingTargets,
     ) {
-        rec.step(super::names::GBUFFER, |rec| {
-            let (color, discard) = (ImageAccess::ColorAttachment, Contents::Discard);
-            let mut uses = uses_of(&mut targets.gbuffer, color, discard);
-            let ds = ImageAccess::DepthStencilAttachment;
-            uses.push((&mut targets.depth_stencil, ds, discard));
-            rec.declare(&mut uses);
-            // The material target's w (BRDF id) is cleared to -1: "no geometry here".
-            let no_brdf = vk::ClearValue {
-                color: vk::ClearColorValue {
-                    float32: [0.0, 0.0, 0.0, -1.0],
-                },
-            };
-            let clears = [CLEAR_BLACK, CLEAR_BLACK, no_brdf];
-            let colors: Vec<_> = targets
-                .gbuffer
-                .iter()
-                .zip(clears)
-                .map(|(i, clear)| color_attachment(i, Load::Clear(clear)))
-                .collect();
-            let depth = inputs.depth;
-            let clear = Load::Clear(clear_depth_stencil(depth));
-            let ds = depth_stencil_attachment(&targets.depth_stencil, clear);
-            rec.begin_rendering_over(inputs.extent, &colors, Some(&ds));
-            let GbufferStencil {
-                layout,
-                slots,
-                preserved_pattern,
-            } = *stencil;
-            self.draw(rec, self.gbuffer, inputs).objects(|i| {
-                Some(match gbuffer_stencil(layout, slots[i], preserved_pattern) {
-                    Some(s) => with_stencil(oriented(OPAQUE, depth), s),
-                    None => oriented(OPAQUE, depth),
-                })
-            });
-            rec.end_rendering();
+        let (color, discard) = (ImageAccess::ColorAttachment, Contents::Discard);
+        let mut uses = uses_of(&mut targets.gbuffer, color, discard);
+        let ds = ImageAccess::DepthStencilAttachment;
+        uses.push((&mut targets.depth_stencil, ds, discard));
+        rec.declare(&mut uses);
+        // The material target's w (BRDF id) is cleared to -1: "no geometry here".
+        let no_brdf = vk::ClearValue {
+            color: vk::ClearColorValue {
+                float32: [0.0, 0.0, 0.0, -1.0],
+            },
+        };
+        let clears = [CLEAR_BLACK, CLEAR_BLACK, no_brdf];
+        let colors: Vec<_> = targets
+            .gbuffer
+            .iter()
+            .zip(clears)
+            .map(|(i, clear)| color_attachment(i, Load::Clear(clear)))
+            .collect();
+        let depth = inputs.depth;
+        let clear = Load::Clear(clear_depth_stencil(depth));
+        let ds = depth_stencil_attachment(&targets.depth_stencil, clear);
+        rec.begin_rendering_over(inputs.extent, &colors, Some(&ds));
+        let GbufferStencil {
+            layout,
+            slots,
+            preserved_pattern,
+        } = *stencil;
+        self.draw(rec, self.gbuffer, inputs).objects(|i| {
+            Some(match gbuffer_stencil(layout, slots[i], preserved_pattern) {
+                Some(s) => with_stencil(oriented(OPAQUE, depth), s),
+                None => oriented(OPAQUE, depth),
+            })
         });
+        rec.end_rendering();
     }
 
     /// The forward reference: lit HDR colour straight from the meshes.
@@ -269,12 +269,10 @@ impl MeshPasses {
     ) {
         let depth = Load::Clear(clear_depth_stencil(inputs.depth));
         let opaque = oriented(OPAQUE, inputs.depth);
-        self.draw(rec, self.forward, inputs).hdr_pass(
-            targets,
-            super::names::FORWARD,
-            depth,
-            |_| Some(opaque),
-        );
+        rec.pass(super::names::FORWARD, |rec| {
+            let draw = self.draw(rec, self.forward, inputs);
+            draw.hdr_pass(targets, depth, |_| Some(opaque));
+        });
     }
 
     /// After the G-buffer pass (whose depth it reads): clears the HDR target and writes the
@@ -290,10 +288,12 @@ impl MeshPasses {
     ) {
         let visible = oriented(VISIBLE_AGAIN, inputs.depth);
         let objects = &inputs.scene.objects;
-        self.draw(rec, self.emissive, inputs)
-            .hdr_pass(targets, "emissive", Load::Keep, |i| {
+        rec.step("emissive", |rec| {
+            let draw = self.draw(rec, self.emissive, inputs);
+            draw.hdr_pass(targets, Load::Keep, |i| {
                 objects[i].material.emits().then_some(visible)
             });
+        });
     }
 
     /// Frees the pipelines and layouts; a second call does nothing.
@@ -369,22 +369,20 @@ impl Draw<'_> {
         }
     }
 
-    /// A pass labelled `label` into the cleared HDR target and the depth-stencil (`depth`:
-    /// cleared or kept), drawing the objects `state_of` gives a state.
+    /// Draws into the cleared HDR target and the depth-stencil (`depth`: cleared or kept) the
+    /// objects `state_of` gives a state; unlabelled, inside its caller's pass or step.
     fn hdr_pass(
         &self,
         targets: &mut LightingTargets,
-        label: &str,
         depth: Load,
         state_of: impl Fn(usize) -> Option<PassState>,
     ) {
-        self.rec.step(label, |rec| {
-            let attachments = (&mut targets.hdr, &mut targets.depth_stencil);
-            let (extent, hdr) = (self.inputs.extent, Load::Clear(CLEAR_BLACK));
-            begin_hdr_rendering(rec, attachments, extent, hdr, depth);
-            self.objects(state_of);
-            rec.end_rendering();
-        });
+        let rec = self.rec;
+        let attachments = (&mut targets.hdr, &mut targets.depth_stencil);
+        let (extent, hdr) = (self.inputs.extent, Load::Clear(CLEAR_BLACK));
+        begin_hdr_rendering(rec, attachments, extent, hdr, depth);
+        self.objects(state_of);
+        rec.end_rendering();
     }
 }
 

@@ -273,121 +273,124 @@ impl LightingPass<'_> {
             steps: timer,
             emulation,
         };
-        rec.begin_label(super::names::LIGHTING);
-        let (sampled, keep) = (ImageAccess::FragmentSampled, Contents::Keep);
-        let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
-        rec.declare(&mut uses);
-        // Query resets are outside rendering.
-        if let Some(t) = timers.steps.as_deref_mut() {
-            t.reset(rec);
-        }
-        if let Some(t) = timers.emulation.as_deref_mut() {
-            t.reset(rec);
-            t.start(rec);
-        }
-        hi_stencil.record_reset(self.rec);
-        // The light shaders count into the hi-stencil's touched marks and statistics.
-        let counted = hi_stencil.fragment_written();
-        rec.declare_buffers(&counted.map(|b| (b, BufferAccess::FragmentReadWrite)));
-        timers.mark(self, Emulation::BOOKKEEPING);
-        self.bind_sets();
-        let mut rendering = Rendering {
-            cleared: !self.clear_hdr,
-            counted,
-            tested: hi_stencil.fragment_read(),
-        };
-        rendering.open(self, targets);
-        if let Some(t) = timers.steps.as_deref_mut() {
-            t.start(rec);
-        }
-        // Each planned light's passes sit inside one label of its own.
-        let mut current_light = None;
-        let mut light_label = |light: Option<usize>| {
-            if current_light == light {
-                return;
+        // One pass: its label, and its time where `rec` has a clock (the renderer's frame).
+        rec.pass(super::names::LIGHTING, |rec| {
+            let (sampled, keep) = (ImageAccess::FragmentSampled, Contents::Keep);
+            let mut uses = uses_of(&mut targets.gbuffer, sampled, keep);
+            rec.declare(&mut uses);
+            // Query resets are outside rendering.
+            if let Some(t) = timers.steps.as_deref_mut() {
+                t.reset(rec);
             }
-            if current_light.is_some() {
-                rec.end_label();
+            if let Some(t) = timers.emulation.as_deref_mut() {
+                t.reset(rec);
+                t.start(rec);
             }
-            current_light = light;
-            if let Some(light) = light {
-                let input = self.plan.lights[light].input;
-                rec.begin_label(&format!("light-{input}"));
+            hi_stencil.record_reset(self.rec);
+            // The light shaders count into the hi-stencil's touched marks and statistics.
+            let counted = hi_stencil.fragment_written();
+            rec.declare_buffers(&counted.map(|b| (b, BufferAccess::FragmentReadWrite)));
+            timers.mark(self, Emulation::BOOKKEEPING);
+            self.bind_sets();
+            let mut rendering = Rendering {
+                cleared: !self.clear_hdr,
+                counted,
+                tested: hi_stencil.fragment_read(),
+            };
+            rendering.open(self, targets);
+            if let Some(t) = timers.steps.as_deref_mut() {
+                t.start(rec);
             }
-        };
-        let touches = plan_touches(self.plan);
-        for (index, step) in self.plan.steps.iter().enumerate() {
-            match step {
-                Step::Pass { light, pass } => {
-                    light_label(Some(*light));
-                    let scene_light = self.plan.lights[*light].input as u32;
-                    let group = || {
-                        let group = pass_group(pass.kind, self.brdfs, self.brdf_source);
-                        (group, Some(scene_light))
-                    };
-                    timers.step(self, &pass.label(), group, |timers| {
-                        let test = self.hierarchy.as_ref().and_then(|h| h.test_for(pass));
-                        if let Some(test) = test {
+            // Each planned light's passes sit inside one label of its own.
+            let mut current_light = None;
+            let mut light_label = |light: Option<usize>| {
+                if current_light == light {
+                    return;
+                }
+                if current_light.is_some() {
+                    rec.end_label();
+                }
+                current_light = light;
+                if let Some(light) = light {
+                    let input = self.plan.lights[light].input;
+                    rec.begin_label(&format!("light-{input}"));
+                }
+            };
+            let touches = plan_touches(self.plan);
+            for (index, step) in self.plan.steps.iter().enumerate() {
+                match step {
+                    Step::Pass { light, pass } => {
+                        light_label(Some(*light));
+                        let scene_light = self.plan.lights[*light].input as u32;
+                        let group = || {
+                            let group = pass_group(pass.kind, self.brdfs, self.brdf_source);
+                            (group, Some(scene_light))
+                        };
+                        timers.step(self, &pass.label(), group, |timers| {
+                            let test = self.hierarchy.as_ref().and_then(|h| h.test_for(pass));
+                            if let Some(test) = test {
+                                timers.bookkeeping(self, || {
+                                    rendering.close(self);
+                                    let rect =
+                                        tile_rect(self.extent, self.screen_rect(*light, pass));
+                                    let ds = &mut targets.depth_stencil;
+                                    hi_stencil.record_evaluate(self.rec, self.slot, ds, test, rect);
+                                });
+                            }
+                            let bounded = (pass, self.plan.lights[*light].depth_range);
+                            let tested = test.is_some();
+                            self.record_pass(
+                                targets,
+                                &mut rendering,
+                                index,
+                                bounded,
+                                scene_light,
+                                tested,
+                            );
+                            if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
+                                timers.bookkeeping(self, || {
+                                    rendering.split(self);
+                                    let touched =
+                                        touches[index].expect("every write has its touch");
+                                    let write = (*light, pass, &hi, touched);
+                                    self.record_write_tiles(targets, hi_stencil, write);
+                                });
+                            }
+                        });
+                    }
+                    Step::FlushHiStencil => {
+                        let group = || ("flush".to_owned(), None);
+                        timers.step(self, "flush-hi-stencil", group, |timers| {
                             timers.bookkeeping(self, || {
                                 rendering.close(self);
-                                let rect = tile_rect(self.extent, self.screen_rect(*light, pass));
-                                let ds = &mut targets.depth_stencil;
-                                hi_stencil.record_evaluate(self.rec, self.slot, ds, test, rect);
-                            });
-                        }
-                        let bounded = (pass, self.plan.lights[*light].depth_range);
-                        let tested = test.is_some();
-                        self.record_pass(
-                            targets,
-                            &mut rendering,
-                            index,
-                            bounded,
-                            scene_light,
-                            tested,
-                        );
-                        if let Some(hi) = pass.state.hi_stencil.filter(|h| h.write) {
-                            timers.bookkeeping(self, || {
-                                rendering.split(self);
-                                let touched = touches[index].expect("every write has its touch");
-                                let write = (*light, pass, &hi, touched);
-                                self.record_write_tiles(targets, hi_stencil, write);
-                            });
-                        }
-                    });
-                }
-                Step::FlushHiStencil => {
-                    let group = || ("flush".to_owned(), None);
-                    timers.step(self, "flush-hi-stencil", group, |timers| {
-                        timers.bookkeeping(self, || {
+                                hi_stencil.record_flush(self.rec);
+                            })
+                        });
+                    }
+                    Step::SavePreserved { .. } => {
+                        let group = || ("save-preserved".to_owned(), None);
+                        timers.step(self, "save-preserved", group, |_| {
                             rendering.close(self);
-                            hi_stencil.record_flush(self.rec);
-                        })
-                    });
-                }
-                Step::SavePreserved { .. } => {
-                    let group = || ("save-preserved".to_owned(), None);
-                    timers.step(self, "save-preserved", group, |_| {
-                        rendering.close(self);
-                        hi_stencil.record_save(self.rec, &mut targets.depth_stencil);
-                    });
-                }
-                Step::RestorePreserved { mask } => {
-                    light_label(None);
-                    let group = || ("restore-preserved".to_owned(), None);
-                    timers.step(self, "restore-preserved", group, |_| {
-                        rendering.open(self, targets);
-                        self.record_restore(*mask);
-                    });
+                            hi_stencil.record_save(self.rec, &mut targets.depth_stencil);
+                        });
+                    }
+                    Step::RestorePreserved { mask } => {
+                        light_label(None);
+                        let group = || ("restore-preserved".to_owned(), None);
+                        timers.step(self, "restore-preserved", group, |_| {
+                            rendering.open(self, targets);
+                            self.record_restore(*mask);
+                        });
+                    }
                 }
             }
-        }
-        light_label(None);
-        rendering.close(self);
-        timers.mark(self, Emulation::TECHNIQUE);
-        if self.count_stats {
-            hi_stencil.record_stats_readable(self.rec);
-        }
-        rec.end_label();
+            light_label(None);
+            rendering.close(self);
+            timers.mark(self, Emulation::TECHNIQUE);
+            if self.count_stats {
+                hi_stencil.record_stats_readable(self.rec);
+            }
+        });
         Ok(())
     }
 

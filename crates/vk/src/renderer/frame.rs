@@ -61,9 +61,9 @@ impl<'c> Renderer<'c> {
         if let Some(alpha) = self.alpha.as_mut() {
             let frame_set = self.descriptors.frame_set;
             let (scene, meshes) = (&self.scene, &self.meshes);
-            rec.timed(names::ALPHA_LIGHTMAPS, |rec| {
-                alpha.record_lightmaps(rec, scene, &view, desc.alpha, desc.pass_timing)
-            })?;
+            // A timed pass of its own where the alpha mode has lightmaps
+            // (`names::ALPHA_LIGHTMAPS`).
+            alpha.record_lightmaps(rec, scene, &view, desc.alpha, desc.pass_timing)?;
             let inputs = AlphaInputs {
                 scene,
                 meshes,
@@ -119,12 +119,10 @@ impl<'c> Renderer<'c> {
 
     /// The forward frame's one pass: every object lit by every light into the HDR target.
     fn record_forward_pass(&mut self, rec: &Recording, desc: &FrameDesc) {
-        rec.timed(Shading::Forward.lighting_pass(), |rec| {
-            let mut targets = self.targets.lighting();
-            let inputs = self.mesh_inputs(desc.depth);
-            self.mesh_passes.record_forward(rec, &inputs, &mut targets);
-            self.targets.lit(&targets);
-        });
+        let mut targets = self.targets.lighting();
+        let inputs = self.mesh_inputs(desc.depth);
+        self.mesh_passes.record_forward(rec, &inputs, &mut targets);
+        self.targets.lit(&targets);
     }
 
     /// The deferred frame's passes: the G-buffer, emission into the HDR target, and the
@@ -141,16 +139,7 @@ impl<'c> Renderer<'c> {
         let ctx = self.ctx;
         // Emitted light goes into the HDR target once; the lighting adds onto it.
         let emits = self.scene.objects.iter().any(|o| o.material.emits());
-        rec.timed(names::GBUFFER, |rec| {
-            self.record_gbuffer_pass(rec, desc);
-            if emits {
-                let mut targets = self.targets.lighting();
-                let inputs = self.mesh_inputs(desc.depth);
-                self.mesh_passes.record_emissive(rec, &inputs, &mut targets);
-                self.targets.lit(&targets);
-            }
-        });
-        let lighting_pass = desc.shading.lighting_pass();
+        self.record_gbuffer_pass(rec, desc, emits);
         let tiled = match technique {
             Technique::Tiled { mixed, side } => Some((mixed, side, TiledShade::Kernels)),
             Technique::DepthId { side } => Some((MixedTiles::PerBrdf, side, TiledShade::DepthId)),
@@ -170,12 +159,12 @@ impl<'c> Renderer<'c> {
             let mut targets = self.targets.lighting();
             // SAFETY: as for `record_emulating` below; and the HDR target has `STORAGE` usage
             // (`Targets::new`), and the built-in hooks bind no engine resources. The lighting
-            // records through `rec`, so the classification and light lists are timed passes of
-            // this frame's clock.
-            rec.timed(lighting_pass, |rec| unsafe {
+            // records through `rec`, so the classification, the light lists and the lighting are
+            // timed passes of this frame's clock.
+            unsafe {
                 let (cmd, lighting) = (rec.outside(), &mut self.lighting);
-                lighting.record_tiled_with(cmd, &frame, &mut targets, shade, Some(rec))
-            })?;
+                lighting.record_tiled_with(cmd, &frame, &mut targets, shade, Some(rec))?;
+            }
             self.targets.lit(&targets);
             return Ok(());
         }
@@ -192,14 +181,14 @@ impl<'c> Renderer<'c> {
         };
         let mut targets = self.targets.lighting();
         // SAFETY: `rec` was begun by `begin_commands` on this context's device, the one the
-        // lighting was made with, and every pass before this one ended its rendering (`rec`
-        // records nothing until the lighting's own recording returns); the
-        // targets are the renderer's own, with the states it tracks (`Targets::lit` after each
+        // lighting was made with, and every pass before this one ended its rendering (the
+        // lighting records through `rec`, `cmd`'s one recording); the targets are the renderer's own, with the states it tracks (`Targets::lit` after each
         // pass); `begin_commands` declared slot 0 finished after the last frame's wait.
-        rec.timed(lighting_pass, |rec| unsafe {
-            self.lighting
-                .record_emulating(rec.outside(), &frame, &mut targets, hierarchy)
-        })?;
+        unsafe {
+            let cmd = rec.outside();
+            let lighting = &mut self.lighting;
+            lighting.record_emulating(cmd, &frame, &mut targets, hierarchy, Some(rec))?;
+        }
         self.targets.lit(&targets);
         Ok(())
     }
@@ -318,11 +307,17 @@ impl<'c> Renderer<'c> {
         }
     }
 
-    /// Records the G-buffer pass into the renderer's targets.
-    pub(super) fn record_gbuffer_pass(&mut self, rec: &Recording, desc: &FrameDesc) {
+    /// Records the G-buffer pass into the renderer's targets, with the emitted light written
+    /// into the HDR target where `emissive` (the deferred frame's, when the scene emits).
+    pub(super) fn record_gbuffer_pass(
+        &mut self,
+        rec: &Recording,
+        desc: &FrameDesc,
+        emissive: bool,
+    ) {
         let mut targets = self.targets.lighting();
         let (depth, pattern) = (desc.depth, desc.preserved_pattern);
-        self.record_gbuffer_into(rec, &mut targets, depth, pattern);
+        self.record_gbuffer_into(rec, &mut targets, (depth, pattern), emissive);
         self.targets.lit(&targets);
     }
 
@@ -339,12 +334,15 @@ impl<'c> Renderer<'c> {
         }
     }
 
+    /// The pass [`names::GBUFFER`]: the G-buffer of `targets` written with the depth convention
+    /// and preserved-bits pattern given, and where `emissive` the emitted light into its HDR
+    /// image, which the lighting then adds onto (one label and one time for both).
     fn record_gbuffer_into(
         &self,
         rec: &Recording,
         targets: &mut LightingTargets,
-        depth: DepthConvention,
-        preserved_pattern: u8,
+        (depth, preserved_pattern): (DepthConvention, u8),
+        emissive: bool,
     ) {
         let stencil = GbufferStencil {
             layout: &self.stencil_layout,
@@ -352,8 +350,13 @@ impl<'c> Renderer<'c> {
             preserved_pattern,
         };
         let inputs = self.mesh_inputs(depth);
-        self.mesh_passes
-            .record_gbuffer(rec, &inputs, &stencil, targets);
+        rec.pass(names::GBUFFER, |rec| {
+            let passes = &self.mesh_passes;
+            passes.record_gbuffer(rec, &inputs, &stencil, targets);
+            if emissive {
+                passes.record_emissive(rec, &inputs, targets);
+            }
+        });
     }
 
     /// Records histencil's G-buffer pass of the scene (its camera, its objects) into another
@@ -391,7 +394,7 @@ impl<'c> Renderer<'c> {
         // SAFETY: this fn's # Safety is `Recording::new`'s, and the renderer's device is its
         // context's.
         let rec = unsafe { Recording::new(self.ctx, cmd) };
-        self.record_gbuffer_into(&rec, targets, DepthConvention::Standard, 0);
+        self.record_gbuffer_into(&rec, targets, (DepthConvention::Standard, 0), false);
         rec.finish();
         Ok(())
     }

@@ -46,7 +46,7 @@ impl Renderer<'_> {
         let mut stencil = Buffer::readback(ctx, "simulator-stencil-readback", pixels)?;
         let result = (|| {
             let rec = self.begin_commands()?;
-            self.record_gbuffer_pass(&rec, desc);
+            self.record_gbuffer_pass(&rec, desc, false);
             let image = &mut self.targets.depth_stencil;
             rec.copy_image_to_buffer(image, vk::ImageAspectFlags::DEPTH, &depth);
             rec.copy_image_to_buffer(image, vk::ImageAspectFlags::STENCIL, &stencil);
@@ -152,7 +152,7 @@ impl Renderer<'_> {
         let mut stencil = Buffer::readback(ctx, "pretest-stencil-readback", pixels)?;
         let result = (|| {
             let rec = self.begin_commands()?;
-            self.record_gbuffer_pass(&rec, desc);
+            self.record_gbuffer_pass(&rec, desc, false);
             let image = &mut self.targets.depth_stencil;
             rec.copy_image_to_buffer(image, vk::ImageAspectFlags::STENCIL, &stencil);
             rec.host_readable(vk::PipelineStageFlags2::COPY);

@@ -20,13 +20,13 @@
 //! wraps each pass in its label: [`Recording::step`] does the label. A recording may also carry
 //! a clock (`start_clock`, in `timing.rs`; the renderer's frame has one): then
 //! `rec.pass(name, body)` is the label and a timestamp after the pass's commands in one call
-//! (the tone map, the alpha pass, the tiled classification and light lists), which is both the
-//! frame's per-pass GPU time and the GPU-written marker a stalled wait reports
-//! (`timing::progress_words`: the marks the GPU has written name the passes it finished).
-//! `rec.timed(name, body)` is the timestamp alone, for the passes whose label is recorded
-//! inside another recording of the command buffer or spans less than the time (the G-buffer
-//! with the emissive pass, the lighting, the lightmaps). A recording without a clock (an
-//! engine's command buffer) records the same commands, untimed.
+//! (every pass of [`crate::passes::names`]: the G-buffer with its emissive draws, the forward
+//! reference, the tiled classification and light lists, the lighting, the lightmaps, the alpha
+//! pass, the tone map), which is both the frame's per-pass GPU time and the GPU-written marker
+//! a stalled wait reports (`timing::progress_words`: the marks the GPU has written name the
+//! passes it finished). The engine entry points record through the renderer's recording when
+//! the renderer calls them, and through one of their own of the engine's command buffer
+//! otherwise: a recording without a clock records the same commands, untimed.
 //!
 //! Methods take `&self`: the state is in `Cell`s, which makes a `Recording` `!Sync` (and the
 //! clock's `Rc` `!Send`), so one thread records through it, as Vulkan's external
@@ -37,11 +37,11 @@ use crate::gpu::device::context::Context;
 use ash::vk;
 use std::cell::{Cell, RefCell};
 
-/// Where a recording's timed passes write their end timestamps (`Recording::timed`): a
-/// timestamp pool, how many marks it holds, and the names of the marks written so far (`start`
-/// first). One recording's own: an entry point the renderer shares with engines records through
-/// the renderer's recording (`DeferredLighting::record_tiled_with`), so its passes are timed by
-/// this clock without one being lent.
+/// Where a recording's passes write their end timestamps (`Recording::pass`): a timestamp
+/// pool, how many marks it holds, and the names of the marks written so far (`start` first).
+/// One recording's own: an entry point the renderer shares with engines records through the
+/// renderer's recording (`record_tiled_with`, `record_emulating`, the lightmaps' `record_pass`),
+/// so its passes are timed by this clock without one being lent.
 pub(crate) struct PassClock {
     pub(super) pool: vk::QueryPool,
     pub(super) capacity: u32,

@@ -351,7 +351,7 @@ pub(crate) fn progress_words(names: &[&str], written: usize) -> String {
 }
 
 impl Recording<'_> {
-    /// Times this recording's passes ([`Self::timed`]) with the first `capacity` marks of
+    /// Times this recording's passes ([`Self::pass`]) with the first `capacity` marks of
     /// `pool`: resets them and writes the `start` mark. Outside rendering. Private: `capacity`
     /// is the pool's own count (`Timestamps::time`'s), which the queries' validity relies on.
     fn start_clock(&mut self, pool: vk::QueryPool, capacity: u32) {
@@ -364,19 +364,11 @@ impl Recording<'_> {
         self.mark("start");
     }
 
-    /// Records `body`, then, where this recording has a clock, a timestamp that ends the pass
-    /// `name`: written by the GPU once every command before it has finished, so the pass's GPU
-    /// time is the distance from the mark before, and a stalled wait names the passes whose
-    /// marks were written. Without a clock, `body` alone.
-    pub fn timed<R>(&self, name: &'static str, body: impl FnOnce(&Self) -> R) -> R {
-        let out = body(self);
-        self.mark(name);
-        out
-    }
-
     /// Records a pass: `body` inside its debug label `name` and, where this recording has a
-    /// clock, a timestamp that ends the pass under the same name ([`Self::timed`]). The one call
-    /// a pass makes, so that its label and its time cannot be spelled apart or cover different
+    /// clock, a timestamp that ends the pass under the same name: written by the GPU once every
+    /// command before it has finished, so the pass's GPU time is the distance from the mark
+    /// before, and a stalled wait names the passes whose marks were written. The one call a
+    /// pass makes, so that its label and its time cannot be spelled apart or cover different
     /// commands; without a clock (an engine's command buffer) the label alone.
     pub fn pass<R>(&self, name: &'static str, body: impl FnOnce(&Self) -> R) -> R {
         let out = self.step(name, body);
