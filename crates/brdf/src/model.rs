@@ -139,8 +139,10 @@ pub const MODEL_NAMES: [&str; 8] = {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum BrdfError {
     /// The name is none of [`MODEL_NAMES`].
-    #[error("unknown BRDF `{0}` (known: {names}; an engine's own BRDFs are known only with its \
-             BRDF set: `--brdfs DIR` on the command line)", names = MODEL_NAMES.join(", "))]
+    #[error("unknown BRDF `{0}` (known: {names}; an engine's own BRDFs are known only with the \
+             BRDF set that declares them, its brdfs.toml: `--brdfs DIR` on the command line, the \
+             BRDF folder of histencil_shaders_compile in C, BrdfSet::load in Rust)",
+             names = MODEL_NAMES.join(", "))]
     UnknownModel(String),
     /// A name that a set with BRDFs of an engine's own does not hold
     /// ([`crate::BrdfSet::parse`]): its names are listed, with the nearest when one is close.

@@ -603,22 +603,38 @@ pub fn failures_csv(report: &RunReport) -> String {
 /// known-wrong cases' tally, skip reasons grouped, and the first failures with their reasons.
 pub fn summary(report: &RunReport) -> String {
     let mut out = String::new();
-    let tally: Vec<String> = Status::ALL
-        .iter()
-        .filter(|s| report.count(**s) > 0)
-        .map(|s| format!("{} {s}", report.count(*s)))
-        .collect();
-    let _ = writeln!(
-        out,
-        "histencil check: {} cases on {} in {:.1} s: {}",
-        report.records.len(),
-        report.device,
-        report.seconds,
-        if tally.is_empty() {
+    // The device's own rows (each worker's canary and teardown) are records too, but not cases
+    // of the matrix: they are tallied apart, so the case count matches what `--list` and the
+    // progress lines counted.
+    let is_device = |r: &&Record| r.scene == "device";
+    let tally = |device: bool| -> String {
+        let counts: Vec<String> = Status::ALL
+            .iter()
+            .map(|s| {
+                let of = |r: &&Record| is_device(r) == device && r.status == *s;
+                (s, report.records.iter().filter(of).count())
+            })
+            .filter(|(_, n)| *n > 0)
+            .map(|(s, n)| format!("{n} {s}"))
+            .collect();
+        if counts.is_empty() {
             "none".to_owned()
         } else {
-            tally.join(", ")
+            counts.join(", ")
         }
+    };
+    let device_rows = report.records.iter().filter(is_device).count();
+    let checks = match device_rows {
+        0 => String::new(),
+        _ => format!("; device checks (canaries, teardowns): {}", tally(true)),
+    };
+    let _ = writeln!(
+        out,
+        "histencil check: {} cases on {} in {:.1} s: {}{checks}",
+        report.records.len() - device_rows,
+        report.device,
+        report.seconds,
+        tally(false),
     );
     let _ = writeln!(out, "driver: {}", report.driver);
     if let Some(why) = &report.incomplete {
@@ -806,6 +822,23 @@ mod tests {
         let back = from_json(&v).unwrap();
         assert_eq!(back.records, r.records);
         assert_eq!(junit(&back), junit(&r));
+    }
+
+    #[test]
+    fn the_summary_counts_cases_as_listed_and_the_device_checks_apart() {
+        let mut r = report();
+        let mut canary = r.records[0].clone();
+        (canary.scene, canary.name) = ("device".into(), "canary-d32_sfloat_s8_uint".into());
+        r.records.push(canary);
+        let first = summary(&r).lines().next().unwrap().to_owned();
+        assert!(
+            first.starts_with("histencil check: 3 cases on llvmpipe in 1.5 s: 1 Pass, 1 Fail"),
+            "{first}"
+        );
+        assert!(
+            first.ends_with("; device checks (canaries, teardowns): 1 Pass"),
+            "{first}"
+        );
     }
 
     #[test]
