@@ -53,7 +53,12 @@ fn a_clean_slice_passes_and_its_known_wrong_cases_fail_as_expected() {
     assert_eq!(code, Some(0), "{stdout}\n{stderr}");
     // Not a terminal: no progress bar in the log.
     assert!(!stderr.contains('\u{1b}'), "{stderr}");
-    assert!(stdout.contains(": 71 Pass\n"), "{stdout}");
+    // The slice's 69 cases, and the worker's canary and teardown apart.
+    assert!(
+        stdout.contains(" 69 cases on llvmpipe ")
+            && stdout.contains(": 69 Pass; device checks (canaries, teardowns): 2 Pass\n"),
+        "{stdout}"
+    );
     assert!(stdout.contains("driver: llvmpipe (Mesa "), "{stdout}");
     assert!(
         stdout.contains("known-wrong cases: 4 failed as expected"),

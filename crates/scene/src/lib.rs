@@ -16,6 +16,7 @@ mod import;
 mod light_rig;
 mod mesh;
 mod shading;
+mod split_mix;
 mod tangents;
 mod texture;
 mod town;

@@ -3,7 +3,7 @@
 //! maps, three of them emissive) in four BRDFs, and 256 point and spot lights. Everything is made here, from fixed
 //! seeds, so the scene is the same on every machine and needs no asset download.
 
-use crate::embedded::SplitMix;
+use crate::split_mix::SplitMix;
 use crate::tangents::{self, Space};
 use crate::{
     uv_transform, Camera, Light, LightKind, Material, MaterialMaps, Mesh, Object, Scene, Shape,

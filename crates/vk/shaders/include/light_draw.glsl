@@ -1,4 +1,4 @@
-// Per-draw push constants of the light passes. Rust mirror: crates/vk/src/passes/lighting.rs
+// Per-draw push constants of the light passes. Rust mirror: crates/vk/src/passes/light_passes.rs
 // (LightDrawPush); flag bits: LIGHT_DRAW_* in generated.glsl.
 #ifndef LIGHT_DRAW_GLSL
 #define LIGHT_DRAW_GLSL

@@ -439,7 +439,8 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
     ///
     /// # Safety
     /// As [`Recording::new`]: `cmd` is recording on this context's device, on a graphics queue
-    /// family, outside any render pass, and only this call records into it meanwhile.
+    /// family, outside any render pass, and only this call records into it meanwhile; with
+    /// `outer`, that is `cmd`'s one recording, outside rendering.
     pub(crate) unsafe fn record_pass(
         &mut self,
         cmd: vk::CommandBuffer,

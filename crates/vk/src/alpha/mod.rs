@@ -346,8 +346,9 @@ impl<'c> AlphaLighting<'c> {
     }
 
     /// Writes the frame's entity records (every mode reads them) and, in the lightmap modes,
-    /// records the lightmap pass through `rec`'s command buffer, as an engine would (through
-    /// the lightmaps' own entry points), with timestamps if asked ([`Self::lightmap_timings`]).
+    /// records the lightmap pass through `rec` (the body the lightmaps' entry points share, so
+    /// what an engine records is what this records; `rec`'s clock times it), with per-entity
+    /// timestamps if asked ([`Self::lightmap_timings`]).
     pub fn record_lightmaps(
         &mut self,
         rec: &Recording,

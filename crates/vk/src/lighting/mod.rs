@@ -428,7 +428,8 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// of the engine's `cmd`, untimed.
     ///
     /// # Safety
-    /// As [`DeferredLighting::record`].
+    /// As [`DeferredLighting::record`]; with `outer`, that is `cmd`'s one recording, outside
+    /// rendering.
     pub(crate) unsafe fn record_emulating(
         &mut self,
         cmd: vk::CommandBuffer,

@@ -81,12 +81,13 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     }
 
     /// [`DeferredLighting::record_tiled`], through `outer` when given (the renderer's frame's
-    /// recording of `cmd`, whose clock then times the classification, `tile-classify`, and the
-    /// light lists, `tile-lights`, as passes of their own), else through a recording of its own
-    /// of the engine's `cmd`, untimed.
+    /// recording of `cmd`, whose clock then times the classification, `tile-classify`, the
+    /// light lists, `tile-lights`, and the shading, `lighting`, as passes of their own), else
+    /// through a recording of its own of the engine's `cmd`, untimed.
     ///
     /// # Safety
-    /// As [`DeferredLighting::record_tiled`].
+    /// As [`DeferredLighting::record_tiled`]; with `outer`, that is `cmd`'s one recording,
+    /// outside rendering.
     pub(crate) unsafe fn record_tiled_with(
         &mut self,
         cmd: vk::CommandBuffer,

@@ -4,8 +4,9 @@
 //! `destroy` (a creation that fails half way frees what it made); each frame it records from
 //! one inputs struct (`MeshInputs`, `TonemapInputs`, `LightingFrame`, `LightmapFrame`,
 //! `AlphaInputs`) through the caller's `Recording` (the encoder: it begins and ends the
-//! pass's rendering and opens its label, `Recording::step`); no pass takes a bare command
-//! buffer, and the entry points an engine calls with its own wrap it in one at once.
+//! pass's rendering, and `Recording::pass` gives the pass its label and, on a clock, its
+//! time); no pass takes a bare command buffer, and the entry points an engine calls with its
+//! own wrap it in one at once.
 //! The lighting's
 //! per-frame recording (`light_passes.rs`) and the light pipelines it creates per plan
 //! (`light_pipelines.rs`) live here and belong to `DeferredLighting`.

@@ -182,8 +182,9 @@ impl<'c> Renderer<'c> {
         let mut targets = self.targets.lighting();
         // SAFETY: `rec` was begun by `begin_commands` on this context's device, the one the
         // lighting was made with, and every pass before this one ended its rendering (the
-        // lighting records through `rec`, `cmd`'s one recording); the targets are the renderer's own, with the states it tracks (`Targets::lit` after each
-        // pass); `begin_commands` declared slot 0 finished after the last frame's wait.
+        // lighting records through `rec`, `cmd`'s one recording); the targets are the
+        // renderer's own, with the states it tracks (`Targets::lit` after each pass);
+        // `begin_commands` declared slot 0 finished after the last frame's wait.
         unsafe {
             let cmd = rec.outside();
             let lighting = &mut self.lighting;

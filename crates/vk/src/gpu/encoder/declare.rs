@@ -202,7 +202,7 @@ fn recorded_stages() -> vk::PipelineStageFlags2 {
 impl Recording<'_> {
     /// Declares how the step being recorded uses `uses`' buffers next, and records the one
     /// barrier command that hands each over from its last declared uses (in recording order,
-    /// across command buffers: [`BufferUse`]); nothing where none is needed (a read after a
+    /// across command buffers: `access::BufferUse`); nothing where none is needed (a read after a
     /// read, or a read the last write was already made visible to). Outside rendering.
     ///
     /// The hazard check holds the declarations to the shaders: until the innermost open label

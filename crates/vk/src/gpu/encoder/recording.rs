@@ -3,18 +3,20 @@
 //! that beginning and ending rendering, opening and closing a label, and asking for the command
 //! buffer inside or outside rendering all go through it and a debug build checks each against
 //! that state. No pass takes a bare `vk::CommandBuffer`: only the entry points do (an engine's
-//! `unsafe fn record*` and the crate-private bodies they share with the renderer, which hands
-//! them its recording's buffer), each wrapping it in a `Recording` at once. The commands
+//! `unsafe fn record*` and the crate-private bodies they share with the renderer), each
+//! recording through the renderer's `Recording` when the renderer hands it over, else wrapping
+//! the engine's buffer in a `Recording` of its own at once. The commands
 //! themselves (binds, pushes, draws, dispatches, fills, copies) are its methods in
 //! `commands.rs`, each checked against the rendering state.
 //!
 //! Barriers, copies and dynamic state are its methods too, written beside what they serve.
-//! Every barrier is derived in `access.rs` from what a step declares: `declare` and
+//! Every barrier is derived by `crate::gpu::access` from what a step declares and recorded by
+//! `declare.rs`: `declare` and
 //! `transition` for images (`rec.declare(&mut [(image, access, contents), ..])`, one barrier
 //! command taking them all there), `declare_buffers` for buffers, `declare_upload` for an
 //! upload's levelled images, `host_readable` for what the host reads after the fence, and
 //! `memory_barrier` where an engine's hooks bind what histencil cannot see. `apply` is in
-//! `state.rs`, `copy_image_to_buffer` in `readback.rs`. Modelled on wgpu-hal's
+//! `frame/state.rs`, `copy_image_to_buffer` in `frame/readback.rs`. Modelled on wgpu-hal's
 //! `CommandEncoder` and Granite's `CommandBuffer`, which own `begin_render_pass` /
 //! `end_render_pass` so pass state cannot be forgotten, and on kajiya's `record_pass_cb`, which
 //! wraps each pass in its label: [`Recording::step`] does the label. A recording may also carry
@@ -67,9 +69,7 @@ impl<'a> Recording<'a> {
     /// `cmd` is in the recording state, was allocated from `ctx`'s device on a queue family
     /// that supports what its users record (graphics for rendering and draws, compute for
     /// dispatches), and is outside any render pass or dynamic rendering; until this value is
-    /// dropped only this value's users record into it. (A recording of `cmd` made earlier, and
-    /// outside rendering, may hand `cmd` to an entry point that makes its own recording, as
-    /// an engine's call does: it records nothing until that returns.)
+    /// dropped only this value's users record into it.
     pub unsafe fn new(ctx: &'a Context, cmd: vk::CommandBuffer) -> Self {
         Self {
             ctx,
