@@ -4,6 +4,7 @@
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use gpu_allocator::MemoryLocation;
 use histencil_vk::{BorrowedDevice, ImageState, ValidationLog, REQUIREMENTS};
 use std::sync::{Arc, Mutex};
 
@@ -321,10 +322,29 @@ impl Engine {
     }
 
     pub fn readback_buffer(&self, size: u64) -> EngineBuffer {
+        let (usage, location) = (vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu);
+        self.host_buffer(size, usage, location, "engine-readback")
+    }
+
+    /// A buffer the GPU reads holding `bytes` (an upload's source, a uniform block), with
+    /// `usage`.
+    pub fn upload_buffer(&self, bytes: &[u8], usage: vk::BufferUsageFlags) -> EngineBuffer {
+        let size = bytes.len() as u64;
+        let mut b = self.host_buffer(size, usage, MemoryLocation::CpuToGpu, "engine-upload");
+        let mapped = b.allocation.mapped_slice_mut().expect("host visible");
+        mapped[..bytes.len()].copy_from_slice(bytes);
+        b
+    }
+
+    fn host_buffer(
+        &self,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+        name: &str,
+    ) -> EngineBuffer {
         use gpu_allocator::vulkan::{AllocationCreateDesc, AllocationScheme};
-        let info = vk::BufferCreateInfo::default()
-            .size(size)
-            .usage(vk::BufferUsageFlags::TRANSFER_DST);
+        let info = vk::BufferCreateInfo::default().size(size).usage(usage);
         let buffer = unsafe { self.device.create_buffer(&info, None) }.expect("buffer");
         let requirements = unsafe { self.device.get_buffer_memory_requirements(buffer) };
         let allocation = self
@@ -332,9 +352,9 @@ impl Engine {
             .lock()
             .unwrap()
             .allocate(&AllocationCreateDesc {
-                name: "engine-readback",
+                name,
                 requirements,
-                location: gpu_allocator::MemoryLocation::GpuToCpu,
+                location,
                 linear: true,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
@@ -453,7 +473,14 @@ impl Engine {
         let gbuffer = names
             .iter()
             .zip(histencil_vk::GBUFFER_FORMATS)
-            .map(|(n, f)| self.image(n, f, extent, U::COLOR_ATTACHMENT | U::SAMPLED))
+            .map(|(n, f)| {
+                self.image(
+                    n,
+                    f,
+                    extent,
+                    U::COLOR_ATTACHMENT | U::SAMPLED | U::TRANSFER_SRC,
+                )
+            })
             .collect();
         let depth_usage = U::DEPTH_STENCIL_ATTACHMENT | U::TRANSFER_SRC | U::SAMPLED;
         let hdr_usage = U::COLOR_ATTACHMENT | U::TRANSFER_DST | U::TRANSFER_SRC | U::STORAGE;
