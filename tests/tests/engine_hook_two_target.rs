@@ -139,8 +139,9 @@ fn the_two_target_hooks_make_light_pipelines_the_validation_layer_accepts() {
 /// materials of each of its three BRDFs, differing in their parameters) is re-encoded as the
 /// hooks' header says (an octahedral RG16 normal, an RGBA8 tint with the material index in
 /// alpha, depth read back from the depth attachment, one row per material), and the stencil
-/// technique lit through the hooks matches the same frame lit through histencil's own decode,
-/// every channel within what the encodings change:
+/// and tiled techniques lit through the hooks (the tiled kernels call them from compute
+/// shaders) match the same frames lit through histencil's own decode, every channel within
+/// what the encodings change:
 /// - the tint, rounded to 8 bits: at most half a step, `0.5 / 255`, on a channel of tint `t`,
 ///   and the light is linear in the tint with a white part that only adds, so it moves a
 ///   channel lit `v` by at most `v * (0.5 / 255) / t` (plus the reference's own f16 tint,
@@ -157,7 +158,9 @@ fn the_two_target_hooks_make_light_pipelines_the_validation_layer_accepts() {
 fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
     use histencil_brdf::{Brdf, BrdfId, BrdfSet, MaterialRows};
     use histencil_tests::engine::{copy_to_buffer, hdr_floats, plain_frame};
-    use histencil_vk::{BrdfParams, HookSets, ImageState};
+    use histencil_vk::{
+        BrdfParams, HookSets, ImageState, MixedTiles, TileClassify, TileSide, TiledFrame,
+    };
     let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
     scene.normalise_lights();
     let engine = Engine::start();
@@ -352,62 +355,69 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
             decode: Some(hook_set),
             visibility: None,
         };
-        // One frame through the hooks into `two.hdr`, read back as floats: the G-buffer pass
-        // again (the same depth and stencil), then the hooks' images uploaded and lit.
-        let mut light = |first: bool, two: &mut histencil_vk::LightingTargets| -> Vec<f32> {
+        // One frame lit and read back as floats: the G-buffer pass again (the same depth and
+        // stencil), then lit through histencil's own decode (`hooks` false) or through the
+        // hooks (their images uploaded on the first such frame), by the stencil technique or
+        // the tiled one.
+        let mut uploaded = false;
+        let mut light = |hooks: bool, tiled: bool| -> Vec<f32> {
             let readback = engine.readback_buffer(8 * pixels as u64);
-            // SAFETY: as above; every image's state is tracked, and the slot was finished.
+            // SAFETY: as above; every image's state is tracked, and the slots were finished.
             unsafe {
                 let (pool, cmd) = engine.command_buffer();
                 d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default())
                     .unwrap();
                 renderer.record_gbuffer(cmd, &mut refs).unwrap();
-                two.depth_stencil = refs.depth_stencil;
-                if first {
-                    upload(d, cmd, &mut two.gbuffer, staging.buffer, extent, sampled);
-                    clear_shadow_map(d, cmd, &mut shadow, sampled);
+                let (lighting, targets, hook_sets) = match hooks {
+                    false => (&mut builtin, &mut refs, HookSets::default()),
+                    true => {
+                        two.depth_stencil = refs.depth_stencil;
+                        if !uploaded {
+                            upload(d, cmd, &mut two.gbuffer, staging.buffer, extent, sampled);
+                            clear_shadow_map(d, cmd, &mut shadow, sampled);
+                            uploaded = true;
+                        }
+                        (&mut lighting, &mut two, hook_sets)
+                    }
+                };
+                if tiled {
+                    let frame = TiledFrame {
+                        slot: 0,
+                        view: &view,
+                        lights: &scene.lights,
+                        clear_hdr: true,
+                        side: TileSide::Sixteen,
+                        mixed: MixedTiles::PerBrdf,
+                        classify: TileClassify::for_context(&ctx),
+                        hook_sets,
+                    };
+                    lighting.record_tiled(cmd, &frame, targets).unwrap();
+                } else {
+                    let frame = plain_frame(&view, &scene.lights, &plan, hook_sets);
+                    lighting.record(cmd, &frame, targets).unwrap();
                 }
-                let frame = plain_frame(&view, &scene.lights, &plan, hook_sets);
-                lighting.record(cmd, &frame, two).unwrap();
-                copy_to_buffer(d, cmd, &mut two.hdr, readback.buffer);
+                copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
+                let depth_stencil = targets.depth_stencil;
                 engine.submit_and_wait(pool, cmd);
                 lighting.slot_finished(0).unwrap();
+                refs.depth_stencil = depth_stencil;
             }
             let out = hdr_floats(readback.bytes());
             engine.free_buffer(readback);
             out
         };
-        let through_hooks = light(true, &mut two);
-
+        let through_hooks = light(true, false);
         let drawn = rows_of.iter().filter(|r| r.is_some()).count();
         assert!(drawn > pixels / 2, "the scene covers the frame");
-        let mut worst = 0.0f32;
-        for (px, row) in rows_of.iter().enumerate() {
-            for c in 0..4 {
-                let (want, got) = (reference[4 * px + c], through_hooks[4 * px + c]);
-                if row.is_none() || c == 3 {
-                    assert_eq!(want.to_bits(), got.to_bits(), "pixel {px} channel {c}");
-                    continue;
-                }
-                let t = albedo[4 * px + c];
-                let tinted = if t > 0.0 {
-                    (0.5 / 255.0) / t + 2f32.powi(-11)
-                } else {
-                    0.0
-                };
-                let bound = want.abs() * (tinted + 0.01 + 2f32.powi(-10)) + 1e-4;
-                let error = (got - want).abs();
-                worst = worst.max(error / bound);
-                assert!(
-                    error <= bound,
-                    "pixel {px} channel {c}: {got} through the hooks, {want} through \
-                     histencil's decode (tint {t}, bound {bound})"
-                );
-            }
-        }
         let lit = reference.iter().filter(|v| **v > 0.0).count();
         assert!(lit > pixels, "the reference is mostly dark");
-        eprintln!("worst channel at {worst:.3} of its bound, {drawn} of {pixels} pixels drawn");
+        let worst = assert_within_encodings(&reference, &through_hooks, &rows_of, &albedo);
+        eprintln!("stencil: worst channel at {worst:.3} of its bound, {drawn} of {pixels} drawn");
+        // The tiled kernels call the same hooks from compute shaders.
+        let tiled_reference = light(false, true);
+        let tiled_hooks = light(true, true);
+        let worst = assert_within_encodings(&tiled_reference, &tiled_hooks, &rows_of, &albedo);
+        eprintln!("tiled: worst channel at {worst:.3} of its bound");
 
         // Two rows of one BRDF swap their parameters: only their pixels change.
         let (a, b) = same_brdf_pair(&materials);
@@ -420,7 +430,7 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         let rewrite = [write(3, T::UNIFORM_BUFFER).buffer_info(&rows_write)];
         // SAFETY: the set is not in use: its last frame finished.
         unsafe { d.update_descriptor_sets(&rewrite, &[]) };
-        let after_swap = light(false, &mut two);
+        let after_swap = light(true, false);
         let (mut moved, mut kept) = (0, 0);
         for (px, row) in rows_of.iter().enumerate() {
             let same = (0..4)
@@ -458,6 +468,42 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
     engine.destroy().assert_clean();
+}
+
+/// Asserts every channel of `got` is within what the two targets' encodings change of
+/// `reference` (the bound the test above derives; undrawn pixels and alpha bit for bit), and
+/// returns the worst channel's error as a fraction of its bound.
+fn assert_within_encodings(
+    reference: &[f32],
+    got: &[f32],
+    rows_of: &[Option<u8>],
+    albedo: &[f32],
+) -> f32 {
+    let mut worst = 0.0f32;
+    for (px, row) in rows_of.iter().enumerate() {
+        for c in 0..4 {
+            let (want, got) = (reference[4 * px + c], got[4 * px + c]);
+            if row.is_none() || c == 3 {
+                assert_eq!(want.to_bits(), got.to_bits(), "pixel {px} channel {c}");
+                continue;
+            }
+            let t = albedo[4 * px + c];
+            let tinted = if t > 0.0 {
+                (0.5 / 255.0) / t + 2f32.powi(-11)
+            } else {
+                0.0
+            };
+            let bound = want.abs() * (tinted + 0.01 + 2f32.powi(-10)) + 1e-4;
+            let error = (got - want).abs();
+            worst = worst.max(error / bound);
+            assert!(
+                error <= bound,
+                "pixel {px} channel {c}: {got} through the hooks, {want} through histencil's \
+                 decode (tint {t}, bound {bound})"
+            );
+        }
+    }
+    worst
 }
 
 /// The octahedral coordinates in [-1, 1]^2 of unit vector `n`, the inverse of
