@@ -265,9 +265,13 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         );
         let staging = engine.upload_buffer(&encoded, vk::BufferUsageFlags::TRANSFER_SRC);
         let ubo = vk::BufferUsageFlags::UNIFORM_BUFFER;
-        let mut row_bytes = rows.bytes();
-        row_bytes.resize(256 * 32, 0);
-        let row_buffer = engine.upload_buffer(&row_bytes, ubo);
+        // The hook's block: TWO_TARGET_MATERIALS (256) rows, those past the materials zeros.
+        let row_block = |rows: &MaterialRows| {
+            let mut bytes = rows.bytes();
+            bytes.resize(256 * histencil_brdf::MATERIAL_ROW_BYTES, 0);
+            engine.upload_buffer(&bytes, ubo)
+        };
+        let row_buffer = row_block(&rows);
         // std140: the matrix, the shadowed light (none: ~0u), the biases.
         let identity = glam::Mat4::IDENTITY.to_cols_array();
         let mut shadow_block: Vec<u8> = identity.iter().flat_map(|f| f.to_le_bytes()).collect();
@@ -423,9 +427,7 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         let (a, b) = same_brdf_pair(&materials);
         let mut swapped = materials.clone();
         swapped.swap(a, b);
-        let mut swapped_bytes = MaterialRows::new(&set, &swapped).unwrap().bytes();
-        swapped_bytes.resize(256 * 32, 0);
-        let row_buffer_swapped = engine.upload_buffer(&swapped_bytes, ubo);
+        let row_buffer_swapped = row_block(&MaterialRows::new(&set, &swapped).unwrap());
         let rows_write = buffer(&row_buffer_swapped);
         let rewrite = [write(3, T::UNIFORM_BUFFER).buffer_info(&rows_write)];
         // SAFETY: the set is not in use: its last frame finished.

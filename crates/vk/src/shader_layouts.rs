@@ -1,6 +1,6 @@
-//! Every shader module and the pipeline layout it is used with, gathered from the passes that
-//! own the sets (each pass keeps its own set's table beside the code that writes it; the sets
-//! every pass shares, the frame's and the G-buffer's, are `gpu::device::descriptors`'). The reflection
+//! Every shader module and the pipeline layout it is used with, gathered from the passes that own
+//! the sets (each pass keeps its own set's table beside the code that writes it; the sets every
+//! pass shares, the frame's and the G-buffer's, are `gpu::device::descriptors`'). The reflection
 //! test (`tests/reflection.rs`) holds every module's SPIR-V to its layout here. A layout is its
 //! sets in order: set N is element N.
 

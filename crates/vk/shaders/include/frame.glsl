@@ -1,5 +1,6 @@
-// Set 0, shared by every pass: per-frame uniforms and the scene's lights.
-// Rust mirror: crates/vk/src/gpu/frame/gpu_types.rs (FrameUniforms, GpuLight); layout: gpu/device/descriptors.rs.
+// Set 0, shared by every pass: per-frame uniforms and the scene's lights. Rust mirror:
+// crates/vk/src/gpu/frame/gpu_types.rs (FrameUniforms, GpuLight); layout:
+// gpu/device/descriptors.rs.
 #ifndef FRAME_GLSL
 #define FRAME_GLSL
 

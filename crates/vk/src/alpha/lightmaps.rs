@@ -450,81 +450,78 @@ impl<C: Deref<Target = Context>> AlphaLightmaps<C> {
         outer: Option<&Recording>,
     ) {
         let ctx: &Context = &self.ctx;
-        debug_assert!(
-            outer.is_none_or(|r| r.any() == cmd),
-            "another buffer's recording"
-        );
-        // SAFETY: this fn's # Safety is `Recording::new`'s. Made only for an engine's call: the
-        // renderer's records through its own.
-        let owned = outer.is_none().then(|| unsafe { Recording::new(ctx, cmd) });
-        let rec = outer.or(owned.as_ref()).expect("one of the two");
-        self.pending.recorded(slot, rec.outside());
+        self.pending.recorded(slot, cmd);
         let slot = &mut self.slots[slot as usize];
-        // Queries are reset outside rendering, as Vulkan requires.
-        let mut timer = slot.timer.active();
-        if let Some(t) = timer.as_deref_mut() {
-            t.reset(rec);
-            t.start(rec);
-        }
-        // One pass, with or without a direction map: its label, and its time where `rec` has a
-        // clock (the renderer's frame).
-        rec.pass(crate::passes::names::ALPHA_LIGHTMAPS, |rec| {
-            let pipeline = match direction {
-                Some(direction) => {
-                    begin_all_cleared(rec, &mut [atlas, direction], CLEAR_BLACK);
-                    self.directional_pipeline
-                }
-                None => {
-                    begin_all_cleared(rec, &mut [atlas], CLEAR_BLACK);
-                    self.pipeline
-                }
-            };
-            // SAFETY: the recording is on this context's device (the # Safety of `record` and
-            // `record_directional`, and `AlphaLighting` records into the renderer's own), inside
-            // the rendering begun above. The pipeline is non-null: the directional one only with a
-            // direction map, which `check_direction` (or `AlphaLighting`'s desc) ties to a direction
-            // format; it and the layout were made by `create` and live as long as `self`. The
-            // slot's sets were written by `write_frame` and match the layout's sets 0 and 1.
-            unsafe {
-                let sets = [slot.frame_set, slot.alpha_set];
-                rec.bind_graphics(pipeline, self.pipeline_layout, &sets);
-            }
-            rec.apply(&FULLSCREEN);
+        let record = |rec: &Recording| {
+            // Queries are reset outside rendering, as Vulkan requires.
+            let mut timer = slot.timer.active();
             if let Some(t) = timer.as_deref_mut() {
-                t.mark(rec, "clear".to_owned(), None);
+                t.reset(rec);
+                t.start(rec);
             }
-            for (index, (r, lights)) in layout.regions.iter().zip(&slot.entity_lights).enumerate() {
-                if lights.is_empty() {
-                    continue;
+            // One pass, with or without a direction map: its label, and its time where `rec` has a
+            // clock (the renderer's frame).
+            rec.pass(crate::passes::names::ALPHA_LIGHTMAPS, |rec| {
+                let pipeline = match direction {
+                    Some(direction) => {
+                        begin_all_cleared(rec, &mut [atlas, direction], CLEAR_BLACK);
+                        self.directional_pipeline
+                    }
+                    None => {
+                        begin_all_cleared(rec, &mut [atlas], CLEAR_BLACK);
+                        self.pipeline
+                    }
+                };
+                // SAFETY: the recording is on this context's device (the # Safety of `record` and
+                // `record_directional`, and `AlphaLighting` records into the renderer's own),
+                // inside the rendering begun above. The pipeline is non-null: the directional one
+                // only with a direction map, which `check_direction` (or `AlphaLighting`'s desc)
+                // ties to a direction format; it and the layout were made by `create` and live as
+                // long as `self`. The slot's sets were written by `write_frame` and match the
+                // layout's sets 0 and 1.
+                unsafe {
+                    let sets = [slot.frame_set, slot.alpha_set];
+                    rec.bind_graphics(pipeline, self.pipeline_layout, &sets);
                 }
-                let mut region = r.region;
-                (region.width, region.height) = r.shape.size();
-                set_region(rec, region);
-                for &light in lights {
-                    let push = AlphaDrawPush {
-                        entity: index as u32,
-                        light,
-                        ..Default::default()
-                    };
-                    // SAFETY: inside the rendering begun above, with the pipeline and sets bound,
-                    // the dynamic state set (`apply`, `set_region`); the push is `AlphaDrawPush` at
-                    // offset 0, the layout's graphics-stage range; the full-screen triangle reads
-                    // no vertex buffer.
-                    unsafe {
-                        let bytes = bytemuck::bytes_of(&push);
-                        rec.push(self.pipeline_layout, GRAPHICS_STAGES, 0, bytes);
-                        rec.draw(3, 0);
+                rec.apply(&FULLSCREEN);
+                if let Some(t) = timer.as_deref_mut() {
+                    t.mark(rec, "clear".to_owned(), None);
+                }
+                for (index, (r, lights)) in
+                    layout.regions.iter().zip(&slot.entity_lights).enumerate()
+                {
+                    if lights.is_empty() {
+                        continue;
+                    }
+                    let mut region = r.region;
+                    (region.width, region.height) = r.shape.size();
+                    set_region(rec, region);
+                    for &light in lights {
+                        let push = AlphaDrawPush {
+                            entity: index as u32,
+                            light,
+                            ..Default::default()
+                        };
+                        // SAFETY: inside the rendering begun above, with the pipeline and sets
+                        // bound, the dynamic state set (`apply`, `set_region`); the push is
+                        // `AlphaDrawPush` at offset 0, the layout's graphics-stage range; the
+                        // full-screen triangle reads no vertex buffer.
+                        unsafe {
+                            let bytes = bytemuck::bytes_of(&push);
+                            rec.push(self.pipeline_layout, GRAPHICS_STAGES, 0, bytes);
+                            rec.draw(3, 0);
+                        }
+                    }
+                    if let Some(t) = timer.as_deref_mut() {
+                        t.mark(rec, "entity".to_owned(), Some(index as u32));
                     }
                 }
-                if let Some(t) = timer.as_deref_mut() {
-                    t.mark(rec, "entity".to_owned(), Some(index as u32));
-                }
-            }
-            rec.end_rendering();
-        });
-        if let Some(own) = owned {
-            own.finish();
-        }
+                rec.end_rendering();
+            });
+        };
+        // SAFETY: this fn's # Safety is `Recording::new`'s, or `outer` is `cmd`'s recording (the
+        // renderer's).
+        unsafe { Recording::through(ctx, cmd, outer, record) };
     }
 
     /// Sets 0 and 1 of the alpha pipelines (frame, alpha), for histencil's own alpha pass.

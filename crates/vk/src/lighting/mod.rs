@@ -482,34 +482,6 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         if source == BrdfSource::Table {
             sets.push(self.lut_set);
         }
-        debug_assert!(
-            outer.is_none_or(|r| r.any() == cmd),
-            "another buffer's recording"
-        );
-        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
-        // family with graphics and compute, outside any render pass; this call alone records
-        // into it now. Made only for an engine's call: the renderer's records through its own.
-        let owned = outer.is_none().then(|| unsafe { Recording::new(ctx, cmd) });
-        let rec = outer.or(owned.as_ref()).expect("one of the two");
-        let pass = LightingPass {
-            rec,
-            plan: frame.plan,
-            lights: frame.lights,
-            brdfs: &self.desc.brdfs,
-            volumes: self.volumes.as_ref().expect("made with the lighting"),
-            pipelines: &self.pipelines,
-            pipeline_layout: self.pipeline_layout,
-            sets: &sets,
-            visibility_set: frame.hook_sets.visibility,
-            brdf_source: source,
-            extent: self.desc.extent,
-            count_stats,
-            clear_hdr: frame.clear_hdr,
-            depth_sampled: self.desc.hooks.samples_depth(),
-            slot: frame.slot,
-            engine_hooks: !self.desc.hooks.is_builtin_decode(),
-            hierarchy,
-        };
         let hi_stencil = self.hi_stencil.as_mut().expect("made with the lighting");
         if writes_hi_stencil(frame.plan) || hierarchy.is_some() {
             hi_stencil.prepare_slot(ctx, frame.slot, &targets.depth_stencil)?;
@@ -517,11 +489,32 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
         let timer = slot.timer.active();
         let emulation = slot.emulation.active();
         self.pending.recorded(frame.slot, cmd);
-        let recorded = pass.record(targets, hi_stencil, timer, emulation);
-        if let Some(own) = owned {
-            own.finish();
-        }
-        recorded
+        let record = |rec: &Recording| {
+            let pass = LightingPass {
+                rec,
+                plan: frame.plan,
+                lights: frame.lights,
+                brdfs: &self.desc.brdfs,
+                volumes: self.volumes.as_ref().expect("made with the lighting"),
+                pipelines: &self.pipelines,
+                pipeline_layout: self.pipeline_layout,
+                sets: &sets,
+                visibility_set: frame.hook_sets.visibility,
+                brdf_source: source,
+                extent: self.desc.extent,
+                count_stats,
+                clear_hdr: frame.clear_hdr,
+                depth_sampled: self.desc.hooks.samples_depth(),
+                slot: frame.slot,
+                engine_hooks: !self.desc.hooks.is_builtin_decode(),
+                hierarchy,
+            };
+            pass.record(targets, hi_stencil, timer, emulation)
+        };
+        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
+        // family with graphics and compute, outside any render pass; this call alone records
+        // into it now, or `outer` is its recording (the renderer's).
+        unsafe { Recording::through(ctx, cmd, outer, record) }
     }
 
     /// Of the last frame recorded into `slot`, once the GPU has finished it: the time the

@@ -156,51 +156,45 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
             visibility: frame.hook_sets.visibility,
         };
         self.pending.recorded(frame.slot, cmd);
-        debug_assert!(
-            outer.is_none_or(|r| r.any() == cmd),
-            "another buffer's recording"
-        );
-        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
-        // family with graphics and compute, outside any render pass; this call alone records
-        // into it now. Made only for an engine's call: the renderer's records through its own.
-        let owned = outer.is_none().then(|| unsafe { Recording::new(ctx, cmd) });
-        let rec = outer.or(owned.as_ref()).expect("one of the two");
         let depth_sampled = self.desc.hooks.samples_depth();
         let (clear, mixed) = (frame.clear_hdr, frame.mixed);
         let shape = frame.classify;
-        // Each a pass of its own, timed where `rec` has a clock (the renderer's).
-        tiled.record_classify(rec, &sets, targets, depth_sampled, clear, mixed, shape);
-        tiled.record_light_lists(rec, frame.lights.len() as u32);
-        // The lighting itself: one pass, whichever way its BRDFs' pixels are found.
-        rec.pass(crate::passes::names::LIGHTING, |rec| match shade {
-            TiledShade::Kernels => tiled.record_shade(rec, mixed, &mut targets.hdr),
-            TiledShade::DepthId => {
-                let side = frame.side;
-                let (_, pass) = self
-                    .depth_id
-                    .iter_mut()
-                    .find(|(s, _)| *s == side)
-                    .expect("made");
-                let bound = (
-                    [frame_set, decode_set, tiled.set(frame.slot)],
-                    sets.visibility,
-                );
-                let push = tiled.push_bytes(clear, mixed);
-                let buffers = tiled.buffers();
-                pass.record(
-                    rec,
-                    frame.slot,
-                    bound,
-                    &push,
-                    targets,
-                    depth_sampled,
-                    buffers,
-                );
-            }
-        });
-        if let Some(own) = owned {
-            own.finish();
-        }
+        let record = |rec: &Recording| {
+            // Each a pass of its own, timed where `rec` has a clock (the renderer's).
+            tiled.record_classify(rec, &sets, targets, depth_sampled, clear, mixed, shape);
+            tiled.record_light_lists(rec, frame.lights.len() as u32);
+            // The lighting itself: one pass, whichever way its BRDFs' pixels are found.
+            rec.pass(crate::passes::names::LIGHTING, |rec| match shade {
+                TiledShade::Kernels => tiled.record_shade(rec, mixed, &mut targets.hdr),
+                TiledShade::DepthId => {
+                    let side = frame.side;
+                    let (_, pass) = self
+                        .depth_id
+                        .iter_mut()
+                        .find(|(s, _)| *s == side)
+                        .expect("made");
+                    let bound = (
+                        [frame_set, decode_set, tiled.set(frame.slot)],
+                        sets.visibility,
+                    );
+                    let push = tiled.push_bytes(clear, mixed);
+                    let buffers = tiled.buffers();
+                    pass.record(
+                        rec,
+                        frame.slot,
+                        bound,
+                        &push,
+                        targets,
+                        depth_sampled,
+                        buffers,
+                    );
+                }
+            });
+        };
+        // SAFETY: the caller's # Safety: `cmd` is recording on this context's device, on a queue
+        // family with graphics and compute, outside any render pass; this call alone records
+        // into it now, or `outer` is its recording (the renderer's).
+        unsafe { Recording::through(ctx, cmd, outer, record) };
         Ok(())
     }
 

@@ -1,7 +1,7 @@
-//! Declared buffer accesses and the hand-overs derived from them: a step says how it uses a
-//! buffer next (the encoder's `Recording::declare_buffers`), and the barrier follows from the buffer's
-//! last declared uses, in recording order across command buffers ([`BufferUse`],
-//! [`hand_over`], pure and unit-tested).
+//! Declared buffer accesses and the hand-overs derived from them: a step says how it uses a buffer
+//! next (the encoder's `Recording::declare_buffers`), and the barrier follows from the buffer's
+//! last declared uses, in recording order across command buffers ([`BufferUse`], [`hand_over`],
+//! pure and unit-tested).
 
 use ash::vk;
 

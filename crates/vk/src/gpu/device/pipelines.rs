@@ -1,7 +1,7 @@
 //! Graphics pipelines. Everything that changes between the talk's light passes (cull mode, depth
 //! and stencil state) is dynamic state set per draw from the model's pass state
-//! ([`Recording::apply`](crate::gpu::encoder::recording::Recording::apply)); pipelines differ only in shaders, attachments, blending and
-//! colour writes.
+//! ([`Recording::apply`](crate::gpu::encoder::recording::Recording::apply)); pipelines differ only
+//! in shaders, attachments, blending and colour writes.
 
 use crate::gpu::device::context::Context;
 use crate::gpu::device::error::{Result, VkCall};

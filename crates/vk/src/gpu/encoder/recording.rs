@@ -240,6 +240,34 @@ impl<'a> Recording<'a> {
         }
     }
 
+    /// Records `body` through `outer` when given (the caller's recording of `cmd`, the
+    /// renderer's, whose clock then times the body's passes), else through a recording of its
+    /// own of `cmd` (an engine's buffer: untimed), finished after `body`. The one way the entry
+    /// points an engine shares with the renderer record, so no clock is ever lent.
+    ///
+    /// # Safety
+    /// Without `outer`, as [`Recording::new`] for `cmd` on `ctx`'s device; with it, `outer` is
+    /// `cmd`'s one recording, outside rendering.
+    pub(crate) unsafe fn through<R>(
+        ctx: &'a Context,
+        cmd: vk::CommandBuffer,
+        outer: Option<&Recording<'_>>,
+        body: impl FnOnce(&Recording<'_>) -> R,
+    ) -> R {
+        debug_assert!(
+            outer.is_none_or(|r| r.any() == cmd),
+            "another buffer's recording"
+        );
+        if let Some(rec) = outer {
+            return body(rec);
+        }
+        // SAFETY: this fn's # Safety, without `outer`.
+        let own = unsafe { Recording::new(ctx, cmd) };
+        let out = body(&own);
+        own.finish();
+        out
+    }
+
     /// Ends the recording, checking (in debug builds) that rendering and every label it opened
     /// were closed, as every caller of histencil's recording functions is promised. Returns
     /// the names of the marks its clock holds (`start`, then each timed pass), none without one.

@@ -203,8 +203,9 @@ pub struct Context {
     /// validation, in debug builds, and where an engine turns it on
     /// ([`Context::check_hazards`]).
     pub(crate) hazards: std::sync::OnceLock<crate::gpu::device::hazards::Hazards>,
-    /// Each buffer's last declared uses, in recording order: what the barrier a step's
-    /// declaration needs is derived from ([`Recording::declare_buffers`](crate::gpu::encoder::recording::Recording)).
+    /// Each buffer's last declared uses, in recording order: what the barrier a step's declaration
+    /// needs is derived from
+    /// ([`Recording::declare_buffers`](crate::gpu::encoder::recording::Recording)).
     pub(crate) buffer_uses:
         Mutex<std::collections::HashMap<vk::Buffer, crate::gpu::access::BufferUse>>,
 }
