@@ -121,6 +121,55 @@ enum CompareCommand {
     /// a decided verdict reverses between two runs of one device, driver and conditions (a
     /// repeat); a reversal between a quiet and a loaded run is listed as a finding.
     Merge(CompareMergeArgs),
+    /// Whether a change moved the lighting time: two builds (or two settings) of one workload,
+    /// their runs alternated on one device (before, after, before, after ...); per cell the
+    /// after run's median over the before run's, pair by pair, and the lab's verdict on their
+    /// median at --margin (none from fewer than 10 pairs). Writes paired.md and paired.json.
+    Pair(ComparePairArgs),
+}
+
+#[derive(clap::Args)]
+struct ComparePairArgs {
+    /// The before runs' output folders, in the order they ran.
+    #[arg(long, required = true, num_args = 1..)]
+    before: Vec<PathBuf>,
+    /// The after runs' output folders, in the order they ran: the i-th ran right after the
+    /// i-th before run.
+    #[arg(long, required = true, num_args = 1..)]
+    after: Vec<PathBuf>,
+    /// A tie within ± this many percent.
+    #[arg(long, default_value_t = 2.0)]
+    margin: f64,
+    /// What the before runs ran (a commit, say), for the table.
+    #[arg(long, default_value = "before")]
+    before_name: String,
+    /// What the after runs ran, for the table.
+    #[arg(long, default_value = "after")]
+    after_name: String,
+    /// Where paired.md and paired.json go.
+    #[arg(long, default_value = "out/compare-paired")]
+    out: PathBuf,
+}
+
+fn compare_pair(args: &ComparePairArgs) -> Result<()> {
+    use histencil_lab::compare::{merge::DeviceReport, pair::Paired};
+    let read = |dirs: &[PathBuf]| {
+        dirs.iter()
+            .map(|dir| DeviceReport::read(dir))
+            .collect::<std::result::Result<Vec<_>, _>>()
+    };
+    let paired = Paired::new(
+        read(&args.before)?,
+        read(&args.after)?,
+        (args.before_name.clone(), args.after_name.clone()),
+        args.margin / 100.0,
+    )?;
+    histencil_vk::check_output_dir(&args.out)?;
+    for path in paired.write(&args.out)? {
+        println!("wrote {}", path.display());
+    }
+    print!("{}", paired.markdown());
+    Ok(())
 }
 
 #[derive(clap::Args)]
@@ -427,8 +476,10 @@ fn steady_llvmpipe() {
 }
 
 pub fn compare(args: &CompareArgs, lights: DefaultLights) -> Result<()> {
-    if let Some(CompareCommand::Merge(merge)) = &args.command {
-        return compare_merge(merge);
+    match &args.command {
+        Some(CompareCommand::Merge(merge)) => return compare_merge(merge),
+        Some(CompareCommand::Pair(pair)) => return compare_pair(pair),
+        None => {}
     }
     steady_llvmpipe();
     histencil_vk::check_output_dir(&args.out)?;

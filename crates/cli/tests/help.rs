@@ -15,6 +15,7 @@ const HELP: &[(&str, &[&str])] = &[
     ("scenes", &["scenes", "--help"]),
     ("compare", &["compare", "--help"]),
     ("compare-merge", &["compare", "merge", "--help"]),
+    ("compare-pair", &["compare", "pair", "--help"]),
     ("todays-gpus", &["todays-gpus", "--help"]),
     ("scale", &["scale", "--help"]),
     ("sweep", &["sweep", "--help"]),

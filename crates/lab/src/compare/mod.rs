@@ -3,6 +3,7 @@
 
 mod measure;
 pub mod merge;
+pub mod pair;
 mod report;
 
 pub use measure::MAX_ROUNDS;
