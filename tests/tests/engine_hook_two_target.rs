@@ -138,10 +138,11 @@ fn the_two_target_hooks_make_light_pipelines_the_validation_layer_accepts() {
 /// The book's two-target hooks light a frame: histencil's own G-buffer of `brdfs-3` (two
 /// materials of each of its three BRDFs, differing in their parameters) is re-encoded as the
 /// hooks' header says (an octahedral RG16 normal, an RGBA8 tint with the material index in
-/// alpha, depth read back from the depth attachment, one row per material), and the stencil
-/// and tiled techniques lit through the hooks (the tiled kernels call them from compute
-/// shaders) match the same frames lit through histencil's own decode, every channel within
-/// what the encodings change:
+/// alpha, depth read back from the depth attachment, one row per material), and the stencil,
+/// LUT, tiled and depth-id techniques lit through the hooks (the LUT technique picks each
+/// pixel's table through `decode_lut_material`; the tiled and depth-id kernels call the hooks
+/// from compute shaders) match the same frames lit through histencil's own decode, every
+/// channel within what the encodings change:
 /// - the tint, rounded to 8 bits: at most half a step, `0.5 / 255`, on a channel of tint `t`,
 ///   and the light is linear in the tint with a white part that only adds, so it moves a
 ///   channel lit `v` by at most `v * (0.5 / 255) / t` (plus the reference's own f16 tint,
@@ -159,7 +160,8 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
     use histencil_brdf::{Brdf, BrdfId, BrdfSet, MaterialRows};
     use histencil_tests::engine::{copy_to_buffer, hdr_floats, plain_frame};
     use histencil_vk::{
-        BrdfParams, HookSets, ImageState, MixedTiles, TileClassify, TileSide, TiledFrame,
+        BrdfParams, BrdfSource, HookSets, ImageState, MixedTiles, TileClassify, TileSide,
+        TiledFrame,
     };
     let mut scene = histencil_scene::embedded("brdfs-3").unwrap();
     scene.normalise_lights();
@@ -172,7 +174,7 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         // SAFETY: the engine's handles outlive the context; nothing else uses its queue.
         let ctx = unsafe { Context::from_raw(engine.lend(engine.queue_family)) }.expect("context");
         let ds_format = ctx.depth_stencil_format().vk();
-        let renderer = Renderer::new(&ctx, scene.clone(), width, height).unwrap();
+        let mut renderer = Renderer::new(&ctx, scene.clone(), width, height).unwrap();
         let layout = *renderer.stencil_layout();
         let brdfs = renderer.brdfs().to_vec();
         let view = scene.camera.view_desc(width as f32 / height as f32);
@@ -361,10 +363,17 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         };
         // One frame lit and read back as floats: the G-buffer pass again (the same depth and
         // stencil), then lit through histencil's own decode (`hooks` false) or through the
-        // hooks (their images uploaded on the first such frame), by the stencil technique or
-        // the tiled one.
+        // hooks (their images uploaded on the first such frame), by `how`.
+        // The LUT technique's tables, one per material in the G-buffer's index order, which
+        // is the order the book's tint alpha carries too.
+        let tables = renderer.lut_tables().unwrap();
+        // SAFETY: the tables outlive every frame below, each waited for.
+        unsafe {
+            builtin.set_lut_tables(tables);
+            lighting.set_lut_tables(tables);
+        }
         let mut uploaded = false;
-        let mut light = |hooks: bool, tiled: bool| -> Vec<f32> {
+        let mut light = |hooks: bool, how: How| -> Vec<f32> {
             let readback = engine.readback_buffer(8 * pixels as u64);
             // SAFETY: as above; every image's state is tracked, and the slots were finished.
             unsafe {
@@ -384,7 +393,7 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
                         (&mut lighting, &mut two, hook_sets)
                     }
                 };
-                if tiled {
+                if matches!(how, How::Tiled | How::DepthId) {
                     let frame = TiledFrame {
                         slot: 0,
                         view: &view,
@@ -395,9 +404,16 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
                         classify: TileClassify::for_context(&ctx),
                         hook_sets,
                     };
-                    lighting.record_tiled(cmd, &frame, targets).unwrap();
+                    if how == How::Tiled {
+                        lighting.record_tiled(cmd, &frame, targets).unwrap();
+                    } else {
+                        lighting.record_depth_id(cmd, &frame, targets).unwrap();
+                    }
                 } else {
-                    let frame = plain_frame(&view, &scene.lights, &plan, hook_sets);
+                    let mut frame = plain_frame(&view, &scene.lights, &plan, hook_sets);
+                    if how == How::Lut {
+                        frame.brdf_source = BrdfSource::Table;
+                    }
                     lighting.record(cmd, &frame, targets).unwrap();
                 }
                 copy_to_buffer(d, cmd, &mut targets.hdr, readback.buffer);
@@ -410,18 +426,23 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
             engine.free_buffer(readback);
             out
         };
-        let through_hooks = light(true, false);
+        let through_hooks = light(true, How::Stencil);
         let drawn = rows_of.iter().filter(|r| r.is_some()).count();
         assert!(drawn > pixels / 2, "the scene covers the frame");
         let lit = reference.iter().filter(|v| **v > 0.0).count();
         assert!(lit > pixels, "the reference is mostly dark");
         let worst = assert_within_encodings(&reference, &through_hooks, &rows_of, &albedo);
         eprintln!("stencil: worst channel at {worst:.3} of its bound, {drawn} of {pixels} drawn");
-        // The tiled kernels call the same hooks from compute shaders.
-        let tiled_reference = light(false, true);
-        let tiled_hooks = light(true, true);
-        let worst = assert_within_encodings(&tiled_reference, &tiled_hooks, &rows_of, &albedo);
-        eprintln!("tiled: worst channel at {worst:.3} of its bound");
+        // The LUT technique reads each pixel's table through decode_lut_material; the tiled
+        // and depth-id kernels call the same hooks from compute shaders. Each is held to the
+        // same technique through histencil's own decode (the LUT's own error against the
+        // formulas is the same on both sides).
+        for how in [How::Lut, How::Tiled, How::DepthId] {
+            let builtin_frame = light(false, how);
+            let hooks_frame = light(true, how);
+            let worst = assert_within_encodings(&builtin_frame, &hooks_frame, &rows_of, &albedo);
+            eprintln!("{how:?}: worst channel at {worst:.3} of its bound");
+        }
 
         // Two rows of one BRDF swap their parameters: only their pixels change.
         let (a, b) = same_brdf_pair(&materials);
@@ -432,7 +453,7 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         let rewrite = [write(3, T::UNIFORM_BUFFER).buffer_info(&rows_write)];
         // SAFETY: the set is not in use: its last frame finished.
         unsafe { d.update_descriptor_sets(&rewrite, &[]) };
-        let after_swap = light(true, false);
+        let after_swap = light(true, How::Stencil);
         let (mut moved, mut kept) = (0, 0);
         for (px, row) in rows_of.iter().enumerate() {
             let same = (0..4)
@@ -470,6 +491,15 @@ fn the_two_target_hooks_light_a_frame_as_histencils_own_decode_does() {
         assert!(ctx.validation_log().is_empty(), "messages go to the engine");
     }
     engine.destroy().assert_clean();
+}
+
+/// The techniques the test lights a frame with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum How {
+    Stencil,
+    Lut,
+    Tiled,
+    DepthId,
 }
 
 /// Asserts every channel of `got` is within what the two targets' encodings change of
