@@ -473,12 +473,12 @@ fn compare_verdicts_do_not_reverse_between_repeats_and_a_load_is_a_finding() {
     use histencil_lab::compare::pair::Paired;
     let read = |d: &std::path::PathBuf| vec![DeviceReport::read(d).unwrap()];
     let names = || ("quiet".to_string(), "again".to_string());
-    let paired = Paired::new(read(&dirs[0]), read(&dirs[1]), names(), 0.02).unwrap();
+    let paired = Paired::new(read(&dirs[0]), read(&dirs[1]), names(), 0.02, &[]).unwrap();
     assert_eq!(paired.cells.len(), 36, "{}", paired.markdown());
     assert!(paired.left_out.is_empty());
     assert_eq!(paired.tally(), [0, 0, 0, 36]);
     assert!(paired.cells.iter().all(|c| c.ratio.median > 0.0));
-    let refused = Paired::new(read(&dirs[0]), read(&dirs[2]), names(), 0.02).unwrap_err();
+    let refused = Paired::new(read(&dirs[0]), read(&dirs[2]), names(), 0.02, &[]).unwrap_err();
     assert!(refused.to_string().contains("busy threads"), "{refused}");
 }
 

@@ -122,7 +122,7 @@ enum CompareCommand {
     /// repeat); a reversal between a quiet and a loaded run is listed as a finding.
     Merge(CompareMergeArgs),
     /// Whether a change moved the lighting time: two builds (or two settings) of one workload,
-    /// their runs alternated on one device (before, after, before, after ...); per cell the
+    /// their runs alternated on one device (before, after, then after, before ...); per cell the
     /// after run's median over the before run's, pair by pair, and the lab's verdict on their
     /// median at --margin (none from fewer than 10 pairs). Writes paired.md and paired.json.
     Pair(ComparePairArgs),
@@ -130,11 +130,12 @@ enum CompareCommand {
 
 #[derive(clap::Args)]
 struct ComparePairArgs {
-    /// The before runs' output folders, in the order they ran.
+    /// The before runs' output folders, in the order the pairs ran.
     #[arg(long, required = true, num_args = 1..)]
     before: Vec<PathBuf>,
-    /// The after runs' output folders, in the order they ran: the i-th ran right after the
-    /// i-th before run.
+    /// The after runs' output folders, in the same order: the i-th ran next to the i-th before
+    /// run, which of the two went first alternating from pair to pair (so that a drift of the
+    /// machine does not always favour one).
     #[arg(long, required = true, num_args = 1..)]
     after: Vec<PathBuf>,
     /// A tie within ± this many percent.
@@ -146,6 +147,11 @@ struct ComparePairArgs {
     /// What the after runs ran, for the table.
     #[arg(long, default_value = "after")]
     after_name: String,
+    /// A setting of the reports (a key of report.json's `settings`) that may differ between
+    /// the runs: the one under test (`depth_bounds`, say). Every other setting both reports
+    /// hold must agree.
+    #[arg(long, value_name = "KEY")]
+    differs: Vec<String>,
     /// Where paired.md and paired.json go.
     #[arg(long, default_value = "out/compare-paired")]
     out: PathBuf,
@@ -163,6 +169,7 @@ fn compare_pair(args: &ComparePairArgs) -> Result<()> {
         read(&args.after)?,
         (args.before_name.clone(), args.after_name.clone()),
         args.margin / 100.0,
+        &args.differs,
     )?;
     histencil_vk::check_output_dir(&args.out)?;
     for path in paired.write(&args.out)? {

@@ -59,6 +59,9 @@ pub struct DeviceReport {
     /// `(technique, cells by BRDF count)`.
     pub rows: Vec<(String, Vec<MergedCell>)>,
     pub sizes: Vec<MergedSize>,
+    /// The report's `settings` object as written: what `compare pair` holds two builds' runs
+    /// to, key by key.
+    pub settings: Value,
 }
 
 /// Where in `report.json` a value was missing or of the wrong type.
@@ -174,11 +177,12 @@ impl DeviceReport {
             depth_bounds: v["settings"]["depth_bounds"].as_bool().unwrap_or(false),
             rows,
             sizes,
+            settings: v["settings"].clone(),
         })
     }
 
     /// The conditions of the run: "quiet", or the load beside it.
-    fn conditions(&self) -> String {
+    pub(crate) fn conditions(&self) -> String {
         let mut load = match self.beside_load {
             0 => "quiet".into(),
             n => format!("beside {n} busy threads"),
@@ -596,6 +600,7 @@ mod tests {
                 stencil_over_branching: i(0.9),
                 faster: "undecided".into(),
             }],
+            settings: Value::Null,
         }
     }
 
