@@ -544,6 +544,21 @@ fn lightmap_frames_that_do_not_fit_are_refused_before_recording() {
         };
         let atlas = || atlas_image.as_ref(ImageState::UNDEFINED);
         refuse("slot", &LightmapFrame { slot: 2, ..frame }, &mut atlas());
+        // A NaN view or light, as the lighting's record paths refuse them.
+        let mut nan_view = *frame.view;
+        nan_view.view_to_clip[0][0] = f32::NAN;
+        refuse(
+            "view",
+            &LightmapFrame {
+                view: &nan_view,
+                ..frame
+            },
+            &mut atlas(),
+        );
+        let mut nan_lights = frame.lights.to_vec();
+        nan_lights[0].radius = f32::NAN;
+        let lights = &nan_lights;
+        refuse("light", &LightmapFrame { lights, ..frame }, &mut atlas());
         // An atlas said to lack COLOR_ATTACHMENT: refused, naming the usage, not drawn into.
         let no_attachment = ImageRef {
             usage: U::SAMPLED,

@@ -210,6 +210,22 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                 Err(Error::BadFrame(m)) => assert!(m.contains("light 0: "), "{m}"),
                 other => panic!("a NaN light was accepted by depth-id: {other:?}"),
             }
+            // A view made NaN likewise: an outside trial found both lit it black and said
+            // nothing, where the planned techniques refuse it.
+            let mut bad_view = *frame.view;
+            bad_view.world_to_view[3][0] = f32::NAN;
+            let nan_view = TiledFrame {
+                view: &bad_view,
+                ..frame
+            };
+            match lighting.record_tiled(cmd, &nan_view, &mut images.refs()) {
+                Err(Error::BadFrame(m)) => assert!(m.contains("the view: "), "{m}"),
+                other => panic!("a NaN view was accepted by tiled: {other:?}"),
+            }
+            match lighting.record_depth_id(cmd, &nan_view, &mut images.refs()) {
+                Err(Error::BadFrame(m)) => assert!(m.contains("the view: "), "{m}"),
+                other => panic!("a NaN view was accepted by depth-id: {other:?}"),
+            }
             d.end_command_buffer(cmd).unwrap();
         }
         drop(other);

@@ -45,8 +45,8 @@ pub(super) fn check_direction(
     Ok(())
 }
 
-/// Checks one frame against the lightmaps and the atlas: the slot, each entity and its region,
-/// the atlas's format and size.
+/// Checks one frame against the lightmaps and the atlas: the slot, the view and the lights,
+/// each entity and its region, the atlas's format and size.
 pub(super) fn check_frame(
     desc: &AlphaLightmapsDesc,
     frame: &LightmapFrame,
@@ -65,6 +65,16 @@ pub(super) fn check_frame(
             "slot {} of {} frames in flight",
             frame.slot, desc.frames_in_flight
         )));
+    }
+    // The lighting's record paths refuse these too: a NaN light or view lights an atlas with
+    // NaN or nothing, in silence.
+    if let Err(e) = histencil_model::View::new(frame.view) {
+        return Err(bad(format!("the view: {e}")));
+    }
+    if let Some((i, problem)) =
+        (frame.lights.iter().enumerate()).find_map(|(i, l)| l.problem().map(|p| (i, p)))
+    {
+        return Err(bad(format!("light {i}: {problem}")));
     }
     if atlas.format != desc.atlas_format {
         return Err(bad(format!(

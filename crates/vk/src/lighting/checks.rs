@@ -138,7 +138,7 @@ pub(super) fn check_frame(
     frame: &LightingFrame,
     targets: &LightingTargets,
 ) -> Result<()> {
-    check_slot_and_lights(desc, frame.slot, frame.lights)?;
+    check_slot_view_and_lights(desc, frame.slot, frame.view, frame.lights)?;
     check_plan_indices(desc, frame.plan, frame.lights.len())?;
     if !desc.hi_stencil && needs_hi_stencil(frame.plan) {
         return Err(bad(
@@ -172,14 +172,19 @@ pub(super) fn check_frame(
     check_targets(desc, &frame.hook_sets, targets)
 }
 
-/// Checks a frame's slot and lights against the lighting's description: the count, and every
-/// light as a scene's validation holds it (a light made NaN after its frame was planned, or on
-/// a technique that plans nothing, is refused here, not shaded as nothing).
-pub(super) fn check_slot_and_lights(
+/// Checks a frame's slot, view and lights against the lighting's description: the count, the
+/// view as the planner holds it, and every light as a scene's validation holds it. A view or a
+/// light made NaN after its frame was planned, or given to a technique that plans nothing (the
+/// tiled and depth-id ones), is refused here, not shaded as nothing.
+pub(super) fn check_slot_view_and_lights(
     desc: &LightingDesc,
     slot: u32,
+    view: &histencil_model::ViewDesc,
     lights: &[histencil_scene::Light],
 ) -> Result<()> {
+    if let Err(e) = histencil_model::View::new(view) {
+        return Err(bad(format!("the view: {e}")));
+    }
     if let Some((index, problem)) = lights
         .iter()
         .enumerate()

@@ -2,7 +2,7 @@
 //! classification, the light lists, then the tiled kernels or the depth-id passes
 //! (`crate::passes::tiled`, `crate::passes::depth_id`).
 
-use super::checks::{bad, check_slot_and_lights, check_targets, check_usage, UsageNeeds};
+use super::checks::{bad, check_slot_view_and_lights, check_targets, check_usage, UsageNeeds};
 use super::{DeferredLighting, TiledFrame};
 use crate::gpu::access::LightingTargets;
 use crate::gpu::device::context::Context;
@@ -103,7 +103,7 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                     .to_owned(),
             ));
         }
-        check_slot_and_lights(&self.desc, frame.slot, frame.lights)?;
+        check_slot_view_and_lights(&self.desc, frame.slot, frame.view, frame.lights)?;
         check_targets(&self.desc, &frame.hook_sets, targets)?;
         let needs = UsageNeeds::tiled(&self.desc);
         check_usage(targets, &needs)?;
