@@ -70,8 +70,14 @@
 #define HISTENCIL_PLATFORM_PS3 1
 
 // `HistencilFrame.platform`: 360-like hi-stencil (no read mask, preserved bits zeroed as lights
-// draw), emulated; needs a lighting made with `hi_stencil`.
+// draw, the engine's stencil bits among them: as the 360 did), emulated; needs a lighting made
+// with `hi_stencil`. `HISTENCIL_PLATFORM_X360_SAVE_RESTORE` keeps the engine's bits.
 #define HISTENCIL_PLATFORM_X360 2
+
+// `HistencilFrame.platform`: 360-like hi-stencil as `HISTENCIL_PLATFORM_X360`, with the talk's
+// fix: the engine's stencil bits are copied out before lighting and drawn back after it (the
+// depth-stencil target needs `TRANSFER_SRC`); needs a lighting made with `hi_stencil`.
+#define HISTENCIL_PLATFORM_X360_SAVE_RESTORE 3
 
 // The Vulkan version an engine's instance must be created for: `VK_API_VERSION_1_3`, spelt
 // out for the header (`api_version_is_vulkans` holds the two equal).
@@ -271,7 +277,11 @@ typedef struct HistencilLightingDesc {
   // histencil's shaders compiled for the engine's BRDFs and hooks (`histencil_shaders_compile`
   // or `histencil_shaders_load`), or null for histencil's own BRDFs, G-buffer and no shadows.
   const struct HistencilShaders *shaders;
-  // Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
+  // How many stencil bits the engine keeps for itself at least (0 to 6): every bit above
+  // histencil's culling bit and BRDF field is the engine's, the bits outside the write mask
+  // `histencil_lighting_stencil_reference` gives. Lighting preserves them on every platform
+  // but `HISTENCIL_PLATFORM_X360`, which zeroes them as the 360 did
+  // (`HISTENCIL_PLATFORM_X360_SAVE_RESTORE` brings them back).
   uint32_t engine_stencil_bits;
   // The targets' width.
   uint32_t width;
@@ -377,7 +387,8 @@ typedef struct HistencilImage {
 //   with each surface's BRDF slot (`histencil_lighting_stencil_reference`), the BRDF bits
 //   cleared to 0 everywhere else first.
 // - `depth_stencil`: `DEPTH_STENCIL_ATTACHMENT`, and `SAMPLED` for the PS3-like and 360-like
-//   platforms (the hi-stencil emulation reads it), `TRANSFER_SRC` for a 360-like save.
+//   platforms (the hi-stencil emulation reads it), `TRANSFER_SRC` for
+//   `HISTENCIL_PLATFORM_X360_SAVE_RESTORE` (it copies the engine's stencil bits out).
 // - `hdr`: `COLOR_ATTACHMENT`, and `STORAGE` for the tiled and depth-id techniques (which take
 //   `VK_FORMAT_R16G16B16A16_SFLOAT` only).
 //

@@ -45,8 +45,13 @@ pub const HISTENCIL_PLATFORM_NATIVE: u32 = 0;
 /// lighting made with `hi_stencil`.
 pub const HISTENCIL_PLATFORM_PS3: u32 = 1;
 /// `HistencilFrame.platform`: 360-like hi-stencil (no read mask, preserved bits zeroed as lights
-/// draw), emulated; needs a lighting made with `hi_stencil`.
+/// draw, the engine's stencil bits among them: as the 360 did), emulated; needs a lighting made
+/// with `hi_stencil`. `HISTENCIL_PLATFORM_X360_SAVE_RESTORE` keeps the engine's bits.
 pub const HISTENCIL_PLATFORM_X360: u32 = 2;
+/// `HistencilFrame.platform`: 360-like hi-stencil as `HISTENCIL_PLATFORM_X360`, with the talk's
+/// fix: the engine's stencil bits are copied out before lighting and drawn back after it (the
+/// depth-stencil target needs `TRANSFER_SRC`); needs a lighting made with `hi_stencil`.
+pub const HISTENCIL_PLATFORM_X360_SAVE_RESTORE: u32 = 3;
 
 /// One light, in world space.
 #[repr(C)]
@@ -229,7 +234,8 @@ impl HistencilImage {
 ///   with each surface's BRDF slot (`histencil_lighting_stencil_reference`), the BRDF bits
 ///   cleared to 0 everywhere else first.
 /// - `depth_stencil`: `DEPTH_STENCIL_ATTACHMENT`, and `SAMPLED` for the PS3-like and 360-like
-///   platforms (the hi-stencil emulation reads it), `TRANSFER_SRC` for a 360-like save.
+///   platforms (the hi-stencil emulation reads it), `TRANSFER_SRC` for
+///   `HISTENCIL_PLATFORM_X360_SAVE_RESTORE` (it copies the engine's stencil bits out).
 /// - `hdr`: `COLOR_ATTACHMENT`, and `STORAGE` for the tiled and depth-id techniques (which take
 ///   `VK_FORMAT_R16G16B16A16_SFLOAT` only).
 ///

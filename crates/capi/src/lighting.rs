@@ -3,9 +3,9 @@
 
 use crate::frame::{
     HistencilFrame, HistencilStepTime, HistencilTargets, HISTENCIL_PLATFORM_NATIVE,
-    HISTENCIL_PLATFORM_PS3, HISTENCIL_PLATFORM_X360, HISTENCIL_TECHNIQUE_BRANCHING,
-    HISTENCIL_TECHNIQUE_DEPTH_ID, HISTENCIL_TECHNIQUE_LUT, HISTENCIL_TECHNIQUE_STENCIL,
-    HISTENCIL_TECHNIQUE_TILED,
+    HISTENCIL_PLATFORM_PS3, HISTENCIL_PLATFORM_X360, HISTENCIL_PLATFORM_X360_SAVE_RESTORE,
+    HISTENCIL_TECHNIQUE_BRANCHING, HISTENCIL_TECHNIQUE_DEPTH_ID, HISTENCIL_TECHNIQUE_LUT,
+    HISTENCIL_TECHNIQUE_STENCIL, HISTENCIL_TECHNIQUE_TILED,
 };
 use crate::handles::{self, Kind};
 use crate::shaders::{brdf_named, shaders_of, HistencilShaders};
@@ -34,7 +34,11 @@ pub struct HistencilLightingDesc {
     /// histencil's shaders compiled for the engine's BRDFs and hooks (`histencil_shaders_compile`
     /// or `histencil_shaders_load`), or null for histencil's own BRDFs, G-buffer and no shadows.
     pub shaders: *const HistencilShaders,
-    /// Stencil bits the engine keeps for itself, which lighting preserves (0 to 6).
+    /// How many stencil bits the engine keeps for itself at least (0 to 6): every bit above
+    /// histencil's culling bit and BRDF field is the engine's, the bits outside the write mask
+    /// `histencil_lighting_stencil_reference` gives. Lighting preserves them on every platform
+    /// but `HISTENCIL_PLATFORM_X360`, which zeroes them as the 360 did
+    /// (`HISTENCIL_PLATFORM_X360_SAVE_RESTORE` brings them back).
     pub engine_stencil_bits: u32,
     /// The targets' width.
     pub width: u32,
@@ -430,6 +434,10 @@ pub unsafe extern "C" fn histencil_lighting_record(
                     HISTENCIL_PLATFORM_X360 => Backend::X360 {
                         zero_preserved: true,
                         save_restore: false,
+                    },
+                    HISTENCIL_PLATFORM_X360_SAVE_RESTORE => Backend::X360 {
+                        zero_preserved: true,
+                        save_restore: true,
                     },
                     p => {
                         return Err(Failure::invalid(format!(

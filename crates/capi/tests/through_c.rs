@@ -48,6 +48,14 @@ fn frames_lit_through_c_are_the_rust_apis_bit_for_bit() {
                 HISTENCIL_PLATFORM_NATIVE,
                 Some(Backend::Native),
             ),
+            (
+                HISTENCIL_TECHNIQUE_STENCIL,
+                HISTENCIL_PLATFORM_X360_SAVE_RESTORE,
+                Some(Backend::X360 {
+                    zero_preserved: true,
+                    save_restore: true,
+                }),
+            ),
             (HISTENCIL_TECHNIQUE_TILED, HISTENCIL_PLATFORM_NATIVE, None),
         ];
         for (technique, platform, backend) in cases {
