@@ -479,7 +479,10 @@ fn compare_verdicts_do_not_reverse_between_repeats_and_a_load_is_a_finding() {
     assert_eq!(paired.tally(), [0, 0, 0, 36]);
     assert!(paired.cells.iter().all(|c| c.ratio.median > 0.0));
     let refused = Paired::new(read(&dirs[0]), read(&dirs[2]), names(), 0.02, &[]).unwrap_err();
-    assert!(refused.to_string().contains("beside_load_threads"), "{refused}");
+    assert!(
+        refused.to_string().contains("beside_load_threads"),
+        "{refused}"
+    );
 }
 
 /// The demo's contact sheet shows the talk's failures: each failure frame visibly differs from

@@ -221,11 +221,13 @@ typedef struct HistencilLight {
   float radius;
   // Its colour times its intensity, linear.
   float color[3];
-  // Spot lights: the angle from the axis where the light starts to fade, in radians.
+  // Spot lights: the angle from the axis where the light starts to fade, in radians (0 to
+  // `outer_angle`).
   float inner_angle;
   // Spot and directional lights: the way the light travels (need not be unit length).
   float direction[3];
-  // Spot lights: the angle from the axis where the light ends, in radians.
+  // Spot lights: the angle from the axis where the light ends, in radians, above
+  // `inner_angle` and at most 80 degrees.
   float outer_angle;
 } HistencilLight;
 
@@ -643,7 +645,9 @@ enum HistencilResult histencil_device_features(VkPhysicalDeviceFeatures *feature
 // histencil's `light.glsl` (a forward reference shading as histencil shades, say) read in set 0.
 //
 // Errors: `INVALID_ARGUMENT` for a null pointer, an unknown light kind or falloff;
-// `BAD_FRAME` for a view whose projection cannot be inverted per pixel.
+// `BAD_FRAME` for a zero width or height, and for a view or a light
+// `histencil_lighting_record` would refuse (not finite, a projection that cannot be inverted
+// per pixel, a light's radius or angles out of range).
 //
 // Thread safety: any thread.
 //
@@ -775,8 +779,9 @@ enum HistencilResult histencil_lighting_stencil_reference(struct HistencilLighti
 // unknown technique, platform, light kind or falloff, or counts that do not match;
 // `BAD_FRAME` for a slot past `frames_in_flight`, more lights than `max_lights`, a light or
 // view histencil cannot light with, targets of another extent or format or without the usages
-// the technique needs; `IN_FLIGHT` for a slot recorded and not declared finished;
-// `UNSUPPORTED` for a hi-stencil platform on a lighting made without `hi_stencil`.
+// the technique needs, a hi-stencil platform on a lighting made without `hi_stencil`, the LUT
+// technique before `histencil_lighting_set_lut_tables`; `IN_FLIGHT` for a slot recorded and
+// not declared finished.
 //
 // Cannot be checked (the engine's to keep): that `command_buffer` is recording, outside a
 // render pass, on a graphics and compute queue family of the context's device; that the images

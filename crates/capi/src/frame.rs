@@ -67,11 +67,13 @@ pub struct HistencilLight {
     pub radius: f32,
     /// Its colour times its intensity, linear.
     pub color: [f32; 3],
-    /// Spot lights: the angle from the axis where the light starts to fade, in radians.
+    /// Spot lights: the angle from the axis where the light starts to fade, in radians (0 to
+    /// `outer_angle`).
     pub inner_angle: f32,
     /// Spot and directional lights: the way the light travels (need not be unit length).
     pub direction: [f32; 3],
-    /// Spot lights: the angle from the axis where the light ends, in radians.
+    /// Spot lights: the angle from the axis where the light ends, in radians, above
+    /// `inner_angle` and at most 80 degrees.
     pub outer_angle: f32,
 }
 

@@ -184,7 +184,9 @@ pub const HISTENCIL_GPU_LIGHT_BYTES: u32 = 64;
 /// histencil's `light.glsl` (a forward reference shading as histencil shades, say) read in set 0.
 ///
 /// Errors: `INVALID_ARGUMENT` for a null pointer, an unknown light kind or falloff;
-/// `BAD_FRAME` for a view whose projection cannot be inverted per pixel.
+/// `BAD_FRAME` for a zero width or height, and for a view or a light
+/// `histencil_lighting_record` would refuse (not finite, a projection that cannot be inverted
+/// per pixel, a light's radius or angles out of range).
 ///
 /// Thread safety: any thread.
 ///
@@ -211,14 +213,32 @@ pub unsafe extern "C" fn histencil_shading_inputs(
         if frame_block.is_null() || (light_count > 0 && gpu_lights.is_null()) {
             return Err(Failure::invalid("frame_block or gpu_lights is null"));
         }
+        // What `histencil_lighting_record` refuses is refused here too: a forward reference
+        // fed NaN shades NaN, and the engine compares it with a frame histencil never lit.
+        let bad_frame = |message: String| Failure {
+            result: HistencilResult::BadFrame,
+            message,
+        };
+        if width == 0 || height == 0 {
+            return Err(bad_frame(format!("a {width}x{height} viewport")));
+        }
+        if let Err(e) = histencil::View::new(&view) {
+            return Err(bad_frame(format!("the view: {e}")));
+        }
+        let converted = (lights.iter().enumerate())
+            .map(|(i, l)| l.to_light(i))
+            .collect::<crate::Outcome<Vec<_>>>()?;
+        if let Some((i, problem)) =
+            (converted.iter().enumerate()).find_map(|(i, l)| l.problem().map(|p| (i, p)))
+        {
+            return Err(bad_frame(format!("light {i}: {problem}")));
+        }
         let uniforms =
             FrameUniforms::from_view(&view, width, height, light_count).map_err(|e| Failure {
                 result: HistencilResult::BadFrame,
                 message: format!("the view: {e}"),
             })?;
-        let gpu: Vec<GpuLight> = (lights.iter().enumerate())
-            .map(|(i, l)| l.to_light(i).map(|l| GpuLight::new(&l)))
-            .collect::<crate::Outcome<_>>()?;
+        let gpu: Vec<GpuLight> = converted.iter().map(GpuLight::new).collect();
         let block = bytemuck::bytes_of(&uniforms);
         let light_bytes: &[u8] = bytemuck::cast_slice(&gpu);
         // SAFETY: this fn's # Safety: room for the block and every light; the sources are
@@ -246,6 +266,65 @@ mod tests {
             super::HISTENCIL_GPU_LIGHT_BYTES as usize,
             size_of::<GpuLight>()
         );
+    }
+
+    /// What `histencil_lighting_record` refuses, the shading inputs refuse too: a zero
+    /// viewport, a view that is not finite, a light out of range (an outside trial's forward
+    /// reference was fed NaN where the lighting refused the frame).
+    #[test]
+    fn shading_inputs_refuse_what_recording_refuses() {
+        use crate::{HistencilLight, HistencilResult as R, HistencilView};
+        // An embedded scene's camera, its matrices flattened column by column.
+        let camera = histencil::scene::embedded("default").unwrap().camera;
+        let desc = camera.view_desc(1.0);
+        let flat = |m: [[f32; 4]; 4]| -> [f32; 16] { bytemuck::cast(m) };
+        let view = HistencilView {
+            world_to_view: flat(desc.world_to_view),
+            view_to_clip: flat(desc.view_to_clip),
+            reversed_depth: 0,
+        };
+        let light = HistencilLight {
+            kind: crate::HISTENCIL_LIGHT_POINT,
+            falloff: crate::HISTENCIL_FALLOFF_SQUARED_WINDOW,
+            position: [0.0, 1.0, 0.0],
+            radius: 2.0,
+            color: [1.0; 3],
+            inner_angle: 0.0,
+            direction: [0.0; 3],
+            outer_angle: 0.0,
+        };
+        let mut block = [0u8; super::HISTENCIL_FRAME_UNIFORMS_BYTES as usize];
+        let mut gpu = [0u8; super::HISTENCIL_GPU_LIGHT_BYTES as usize];
+        let mut inputs = |view: &HistencilView, size: u32, light: &HistencilLight| {
+            // SAFETY: live structs and buffers of the sizes the header asks for.
+            let r = unsafe {
+                super::histencil_shading_inputs(
+                    view,
+                    size,
+                    size,
+                    light,
+                    1,
+                    block.as_mut_ptr(),
+                    gpu.as_mut_ptr(),
+                )
+            };
+            // SAFETY: the header's: never null, valid until the next call on this thread.
+            let said = unsafe { std::ffi::CStr::from_ptr(crate::histencil_last_error()) };
+            (r, said.to_string_lossy().into_owned())
+        };
+        assert_eq!(inputs(&view, 64, &light).0, R::Success);
+        let (r, said) = inputs(&view, 0, &light);
+        assert_eq!((r, said.as_str()), (R::BadFrame, "a 0x0 viewport"));
+        let mut nan_view = view;
+        nan_view.world_to_view[12] = f32::NAN;
+        let (r, said) = inputs(&nan_view, 64, &light);
+        assert!(r == R::BadFrame && said.starts_with("the view: "), "{said}");
+        let nan_radius = HistencilLight {
+            radius: f32::NAN,
+            ..light
+        };
+        let (r, said) = inputs(&view, 64, &nan_radius);
+        assert!(r == R::BadFrame && said.starts_with("light 0: "), "{said}");
     }
 
     #[test]

@@ -367,8 +367,9 @@ pub unsafe extern "C" fn histencil_lighting_stencil_reference(
 /// unknown technique, platform, light kind or falloff, or counts that do not match;
 /// `BAD_FRAME` for a slot past `frames_in_flight`, more lights than `max_lights`, a light or
 /// view histencil cannot light with, targets of another extent or format or without the usages
-/// the technique needs; `IN_FLIGHT` for a slot recorded and not declared finished;
-/// `UNSUPPORTED` for a hi-stencil platform on a lighting made without `hi_stencil`.
+/// the technique needs, a hi-stencil platform on a lighting made without `hi_stencil`, the LUT
+/// technique before `histencil_lighting_set_lut_tables`; `IN_FLIGHT` for a slot recorded and
+/// not declared finished.
 ///
 /// Cannot be checked (the engine's to keep): that `command_buffer` is recording, outside a
 /// render pass, on a graphics and compute queue family of the context's device; that the images

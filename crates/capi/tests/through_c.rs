@@ -226,6 +226,24 @@ fn misuse_through_c_returns_its_error_and_names_the_problem() {
                     R::BadSetup,
                     "bits",
                 ),
+                // An HDR format no light pass can blend into: refused at creation (an outside
+                // trial's was accepted, then failed the validation layer at the first frame).
+                (
+                    HistencilLightingDesc {
+                        hdr_format: vk::Format::UNDEFINED,
+                        ..good
+                    },
+                    R::BadSetup,
+                    "HDR format UNDEFINED",
+                ),
+                (
+                    HistencilLightingDesc {
+                        hdr_format: vk::Format::D32_SFLOAT,
+                        ..good
+                    },
+                    R::BadSetup,
+                    "cannot blend into it",
+                ),
             ];
             for (desc, code, words) in bad_descs {
                 expect(

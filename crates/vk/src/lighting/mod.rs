@@ -164,11 +164,22 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
     /// ([`DeferredLighting::prepare`]). A failure half way frees what was made.
     ///
     /// # Errors
-    /// [`Error::BadSetup`] for a zero extent, a depth format without stencil, no frames in
-    /// flight, too many BRDFs for the layout, or a depth-stencil format other than the one the
-    /// context was lent with; Vulkan and allocation errors.
+    /// [`Error::BadSetup`] for a zero extent, a depth format without stencil, an HDR format the
+    /// device cannot blend into, no frames in flight, too many BRDFs for the layout, or a
+    /// depth-stencil format other than the one the context was lent with; Vulkan and allocation
+    /// errors.
     pub fn new(ctx: C, desc: &LightingDesc) -> Result<Self> {
         check_desc(desc)?;
+        // The light passes add light into the HDR target with blending: a format the device
+        // cannot blend into would fail at the first pipeline (a validation error, not a refusal).
+        let blend = vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND;
+        if !ctx.format_features(desc.hdr_format).contains(blend) {
+            return Err(bad_setup(format!(
+                "HDR format {:?}: the device cannot blend into it as a colour attachment, which \
+                 the light passes do (Vulkan requires it of R16G16B16A16_SFLOAT)",
+                desc.hdr_format
+            )));
+        }
         desc.hooks.check(&ctx)?;
         desc.hooks.check_ids(&desc.brdfs)?;
         if ctx.depth_stencil_named && desc.depth_stencil_format != ctx.depth_stencil_format {
@@ -461,9 +472,12 @@ impl<C: Deref<Target = Context>> DeferredLighting<C> {
                 "hi-stencil statistics from a lighting made without hi-stencil",
             ));
         }
+        // A call out of order, not a missing feature: the message says what to call first.
         if source == BrdfSource::Table && !self.lut_written {
-            return Err(Error::Unsupported(
-                "the LUT technique before its tables exist",
+            return Err(bad(
+                "the LUT technique before its tables are set: call DeferredLighting::set_lut_tables \
+                 (through C, histencil_lighting_set_lut_tables) first"
+                    .into(),
             ));
         }
         self.prepare_for(frame.plan, count_stats, source, hierarchy.is_some())?;

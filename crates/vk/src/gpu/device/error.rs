@@ -136,8 +136,8 @@ pub enum Error {
     /// as such, not as a frame's fault.
     #[error("bad lighting setup: {0}")]
     BadSetup(String),
-    /// A combination histencil does not implement (statistics without hi-stencil, the LUT
-    /// technique before its tables, ...): the message names it.
+    /// A combination histencil does not implement (statistics without hi-stencil, ...): the
+    /// message names it.
     #[error("not supported yet: {0}")]
     Unsupported(&'static str),
     /// A BRDF set that cannot be compiled (the engine's GLSL, with its file and line), or a

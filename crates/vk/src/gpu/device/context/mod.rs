@@ -147,6 +147,8 @@ pub struct Context {
     /// Whether the instance, device, messenger and allocator are histencil's to destroy.
     owned: bool,
     pub(crate) instance: ash::Instance,
+    /// The device's physical device, whose format features a description is checked against.
+    physical_device: vk::PhysicalDevice,
     pub(crate) device: ash::Device,
     pub(crate) queue: vk::Queue,
     pub(crate) queue_family: u32,
@@ -453,6 +455,7 @@ impl Context {
             _entry: None,
             owned: false,
             instance,
+            physical_device,
             device,
             queue,
             queue_family,
@@ -483,6 +486,16 @@ impl Context {
             hazards: Default::default(),
             buffer_uses: Mutex::default(),
         })
+    }
+
+    /// What the device can do with `format` in optimally tiled images.
+    pub(crate) fn format_features(&self, format: vk::Format) -> vk::FormatFeatureFlags {
+        // SAFETY: `physical_device` is the live instance's: enumerated by `Context::new`, or
+        // promised by `from_raw`'s caller.
+        unsafe {
+            (self.instance).get_physical_device_format_properties(self.physical_device, format)
+        }
+        .optimal_tiling_features
     }
 
     /// Whether histencil created (and will destroy) the device.

@@ -361,6 +361,7 @@ impl Context {
             _entry: Some(entry),
             owned: true,
             instance,
+            physical_device,
             device,
             queue,
             queue_family,
