@@ -161,7 +161,7 @@ pub fn plan_frame(
     // after the driver freed the last frame's commands (lavapipe allocates each command), and
     // glibc sorted all that was freed in them (plan + record of 256 lights through C, which
     // plans right after the reset, took 4 % longer than through Rust on lavapipe; sized, the
-    // two are within 1 %).
+    // two are within about 2 %).
     let mut lights = Vec::with_capacity(inputs.lights.len());
     for (index, shape) in inputs.lights.iter().enumerate() {
         if let Some(problem) = shape.problem() {
