@@ -222,16 +222,11 @@ pub unsafe extern "C" fn histencil_shading_inputs(
         if width == 0 || height == 0 {
             return Err(bad_frame(format!("a {width}x{height} viewport")));
         }
-        if let Err(e) = histencil::View::new(&view) {
-            return Err(bad_frame(format!("the view: {e}")));
-        }
         let converted = (lights.iter().enumerate())
             .map(|(i, l)| l.to_light(i))
             .collect::<crate::Outcome<Vec<_>>>()?;
-        if let Some((i, problem)) =
-            (converted.iter().enumerate()).find_map(|(i, l)| l.problem().map(|p| (i, p)))
-        {
-            return Err(bad_frame(format!("light {i}: {problem}")));
+        if let Some(problem) = histencil::vk::frame_inputs_problem(&view, &converted) {
+            return Err(bad_frame(problem));
         }
         let uniforms =
             FrameUniforms::from_view(&view, width, height, light_count).map_err(|e| Failure {

@@ -76,8 +76,8 @@ pub use lighting::hooks::{
 };
 pub use lighting::lut::{LutEvaluator, LutTables};
 pub use lighting::{
-    gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame, StencilCheck,
-    StencilReport, TiledFrame, TILED_HDR_FORMATS,
+    frame_inputs_problem, gbuffer_stencil_reference, DeferredLighting, LightingDesc, LightingFrame,
+    StencilCheck, StencilReport, TiledFrame, TILED_HDR_FORMATS,
 };
 pub use passes::light_pipelines::BrdfSource;
 pub use renderer::capture::SimulatorInputs;

@@ -66,15 +66,10 @@ pub(super) fn check_frame(
             frame.slot, desc.frames_in_flight
         )));
     }
-    // The lighting's record paths refuse these too: a NaN light or view lights an atlas with
-    // NaN or nothing, in silence.
-    if let Err(e) = histencil_model::View::new(frame.view) {
-        return Err(bad(format!("the view: {e}")));
-    }
-    if let Some((i, problem)) =
-        (frame.lights.iter().enumerate()).find_map(|(i, l)| l.problem().map(|p| (i, p)))
-    {
-        return Err(bad(format!("light {i}: {problem}")));
+    // As the lighting's record paths: a NaN light or view lights an atlas with NaN or nothing,
+    // in silence.
+    if let Some(problem) = crate::frame_inputs_problem(frame.view, frame.lights) {
+        return Err(bad(problem));
     }
     if atlas.format != desc.atlas_format {
         return Err(bad(format!(

@@ -172,6 +172,22 @@ pub(super) fn check_frame(
     check_targets(desc, &frame.hook_sets, targets)
 }
 
+/// What every recording of histencil refuses of a frame's view and lights, said as its refusal
+/// does (`the view: ...`, `light 3: ...`): a view the planner cannot use (not finite, singular,
+/// no near plane) or a light a scene's validation refuses. The lighting's and the lightmaps'
+/// record paths ask it, and an engine can ask it of the inputs its own forward reference shades
+/// with (the C API's `histencil_shading_inputs` does), so that a frame histencil refuses is never
+/// compared with one shaded from NaN.
+pub fn frame_inputs_problem(
+    view: &histencil_model::ViewDesc,
+    lights: &[histencil_scene::Light],
+) -> Option<String> {
+    if let Err(e) = histencil_model::View::new(view) {
+        return Some(format!("the view: {e}"));
+    }
+    (lights.iter().enumerate()).find_map(|(i, l)| l.problem().map(|p| format!("light {i}: {p}")))
+}
+
 /// Checks a frame's slot, view and lights against the lighting's description: the count, the
 /// view as the planner holds it, and every light as a scene's validation holds it. A view or a
 /// light made NaN after its frame was planned, or given to a technique that plans nothing (the
@@ -182,15 +198,8 @@ pub(super) fn check_slot_view_and_lights(
     view: &histencil_model::ViewDesc,
     lights: &[histencil_scene::Light],
 ) -> Result<()> {
-    if let Err(e) = histencil_model::View::new(view) {
-        return Err(bad(format!("the view: {e}")));
-    }
-    if let Some((index, problem)) = lights
-        .iter()
-        .enumerate()
-        .find_map(|(i, l)| l.problem().map(|p| (i, p)))
-    {
-        return Err(bad(format!("light {index}: {problem}")));
+    if let Some(problem) = frame_inputs_problem(view, lights) {
+        return Err(bad(problem));
     }
     let lights = lights.len();
     if slot >= desc.frames_in_flight {

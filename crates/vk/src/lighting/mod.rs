@@ -24,6 +24,7 @@ pub(crate) mod lut;
 mod record_tiled;
 mod stencil_check;
 
+pub use checks::frame_inputs_problem;
 use checks::{
     bad, bad_setup, check_desc, check_frame, check_usage, needs_hi_stencil, writes_hi_stencil,
     UsageNeeds,
