@@ -194,37 +194,40 @@ fn an_engine_records_the_tiled_technique_into_its_frames() {
                 Err(Error::BadFrame(m)) => assert!(m.contains("a pass of its own"), "{m}"),
                 other => panic!("depth-id with branching mixed tiles was accepted: {other:?}"),
             }
-            // A light made NaN (after its frame was built, say): refused by both techniques,
-            // which plan nothing, as plan_frame refuses it, not shaded as nothing.
+            // A light or a view made NaN (after its frame was built, say): refused by both
+            // techniques, which plan nothing, as plan_frame refuses them, not shaded as nothing
+            // (an outside trial found a NaN view lit black, and SUCCESS said).
             let mut broken = lights.clone();
             broken[0].position.x = f32::NAN;
-            let nan = TiledFrame {
+            let mut bad_view = *frame.view;
+            bad_view.world_to_view[3][0] = f32::NAN;
+            let nan_light = TiledFrame {
                 lights: &broken,
                 ..frame
             };
-            match lighting.record_tiled(cmd, &nan, &mut images.refs()) {
-                Err(Error::BadFrame(m)) => assert!(m.contains("light 0: "), "{m}"),
-                other => panic!("a NaN light was accepted by tiled: {other:?}"),
-            }
-            match lighting.record_depth_id(cmd, &nan, &mut images.refs()) {
-                Err(Error::BadFrame(m)) => assert!(m.contains("light 0: "), "{m}"),
-                other => panic!("a NaN light was accepted by depth-id: {other:?}"),
-            }
-            // A view made NaN likewise: an outside trial found both lit it black and said
-            // nothing, where the planned techniques refuse it.
-            let mut bad_view = *frame.view;
-            bad_view.world_to_view[3][0] = f32::NAN;
             let nan_view = TiledFrame {
                 view: &bad_view,
                 ..frame
             };
-            match lighting.record_tiled(cmd, &nan_view, &mut images.refs()) {
-                Err(Error::BadFrame(m)) => assert!(m.contains("the view: "), "{m}"),
-                other => panic!("a NaN view was accepted by tiled: {other:?}"),
-            }
-            match lighting.record_depth_id(cmd, &nan_view, &mut images.refs()) {
-                Err(Error::BadFrame(m)) => assert!(m.contains("the view: "), "{m}"),
-                other => panic!("a NaN view was accepted by depth-id: {other:?}"),
+            for (what, nan, said) in [
+                ("light", nan_light, "light 0: "),
+                ("view", nan_view, "the view: "),
+            ] {
+                for (technique, refused) in [
+                    (
+                        "tiled",
+                        lighting.record_tiled(cmd, &nan, &mut images.refs()),
+                    ),
+                    (
+                        "depth-id",
+                        lighting.record_depth_id(cmd, &nan, &mut images.refs()),
+                    ),
+                ] {
+                    match refused {
+                        Err(Error::BadFrame(m)) => assert!(m.contains(said), "{m}"),
+                        other => panic!("a NaN {what} was accepted by {technique}: {other:?}"),
+                    }
+                }
             }
             d.end_command_buffer(cmd).unwrap();
         }
