@@ -159,14 +159,9 @@ struct ComparePairArgs {
 
 fn compare_pair(args: &ComparePairArgs) -> Result<()> {
     use histencil_lab::compare::{merge::DeviceReport, pair::Paired};
-    let read = |dirs: &[PathBuf]| {
-        dirs.iter()
-            .map(|dir| DeviceReport::read(dir))
-            .collect::<std::result::Result<Vec<_>, _>>()
-    };
     let paired = Paired::new(
-        read(&args.before)?,
-        read(&args.after)?,
+        DeviceReport::read_all(&args.before)?,
+        DeviceReport::read_all(&args.after)?,
         (args.before_name.clone(), args.after_name.clone()),
         args.margin / 100.0,
         &args.differs,
@@ -191,11 +186,7 @@ struct CompareMergeArgs {
 
 fn compare_merge(args: &CompareMergeArgs) -> Result<()> {
     histencil_vk::check_output_dir(&args.out)?;
-    let reports = args
-        .runs
-        .iter()
-        .map(|dir| histencil_lab::compare::merge::DeviceReport::read(dir))
-        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let reports = histencil_lab::compare::merge::DeviceReport::read_all(&args.runs)?;
     let merged = histencil_lab::compare::merge::Merged::new(reports)?;
     for path in merged.write(&args.out)? {
         println!("wrote {}", path.display());

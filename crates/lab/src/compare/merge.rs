@@ -181,6 +181,14 @@ impl DeviceReport {
         })
     }
 
+    /// Reads each of `dirs` ([`DeviceReport::read`]), in order.
+    ///
+    /// # Errors
+    /// The first folder's whose report is missing or malformed.
+    pub fn read_all(dirs: &[PathBuf]) -> Result<Vec<Self>> {
+        dirs.iter().map(|dir| Self::read(dir)).collect()
+    }
+
     /// The conditions of the run: "quiet", or the load beside it.
     pub(crate) fn conditions(&self) -> String {
         let mut load = match self.beside_load {
